@@ -1,0 +1,27 @@
+# The README's commands. `make test` is what CI runs (via .ci/run).
+CARGO ?= cargo
+export CARGO
+
+.PHONY: setup demo test bench snapshots fmt
+
+setup:
+	@echo "==> setup: system packages"
+	@bash scripts/setup.sh
+
+demo: setup
+	@echo "==> demo: $(CARGO) run --release --example gallery"
+	$(CARGO) run --release --example gallery
+
+test: setup
+	@bash scripts/test.sh
+
+bench:
+	@echo "==> bench"
+	$(CARGO) bench
+
+snapshots:
+	@echo "==> snapshots: regenerating codegen snapshots"
+	UPDATE_SNAPSHOTS=1 $(CARGO) test --test snapshots
+
+fmt:
+	$(CARGO) fmt --all

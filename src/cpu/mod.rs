@@ -1,0 +1,402 @@
+//! The CPU reference: evaluates a scene's distance, colour and normal, and
+//! sphere-traces rays, in `f64` or `f32`.
+//!
+//! It runs the same formulas as the OpenCL kernels and is the oracle every
+//! test compares against. It is written for clarity and exactness, not
+//! speed.
+
+mod real;
+pub mod sdf;
+
+use glam::DVec3;
+
+pub use real::{Real, V3, v3};
+use sdf::Estimate;
+
+use crate::error::Result;
+use crate::ir::{Ir, NodeId, ParamValues, Scalar};
+use crate::scene::{CsgOp, Kind, Node};
+
+/// The colour given to surfaces that no `color` node paints.
+pub const DEFAULT_COLOR: [f64; 3] = [0.8, 0.8, 0.8];
+
+/// What the scene is like at one point.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Sample<T> {
+    /// Signed distance (or a bound) to the nearest surface.
+    pub distance: T,
+    /// Linear RGB colour of the nearest surface.
+    pub color: V3<T>,
+    /// Orbit trap in `[0, 1]` (1 for non-fractal surfaces).
+    pub trap: T,
+}
+
+/// Evaluates one scene's geometry on the CPU.
+///
+/// ```
+/// use fractal_sdf::prelude::*;
+/// let eval = cpu::Evaluator::new(&sphere(1.0))?;
+/// assert!((eval.distance(dvec3(3.0, 0.0, 0.0)) - 2.0).abs() < 1e-12);
+/// # Ok::<(), fractal_sdf::Error>(())
+/// ```
+#[derive(Debug, Clone)]
+pub struct Evaluator {
+    ir: Ir,
+    values: ParamValues,
+}
+
+impl Evaluator {
+    /// Validates and lowers `geometry`; dynamic parameters start at their
+    /// defaults.
+    ///
+    /// # Errors
+    /// Any validation error of the geometry.
+    pub fn new(geometry: &Node) -> Result<Self> {
+        Ok(Self::from_ir(Ir::lower(geometry)?))
+    }
+
+    /// An evaluator for an already lowered scene.
+    #[must_use]
+    pub fn from_ir(ir: Ir) -> Self {
+        let values = ir.default_values();
+        Evaluator { ir, values }
+    }
+
+    /// The lowered scene.
+    #[must_use]
+    pub fn ir(&self) -> &Ir {
+        &self.ir
+    }
+
+    /// The current dynamic parameter values.
+    #[must_use]
+    pub fn values(&self) -> &ParamValues {
+        &self.values
+    }
+
+    /// Sets a dynamic parameter.
+    ///
+    /// # Errors
+    /// See [`ParamValues::set`].
+    pub fn set_param(&mut self, name: &str, value: f64) -> Result<()> {
+        self.values.set(name, value)
+    }
+
+    /// Distance at `p` in `f64`.
+    #[must_use]
+    pub fn distance(&self, p: DVec3) -> f64 {
+        self.sample::<f64>(p.into()).distance
+    }
+
+    /// Distance at `p` in `f32`, rounding parameters to `f32` as the F32
+    /// kernels do.
+    #[must_use]
+    pub fn distance_f32(&self, p: glam::Vec3) -> f32 {
+        self.sample::<f32>(p.into()).distance
+    }
+
+    /// Distance, colour and orbit trap at `p`.
+    #[must_use]
+    pub fn sample<T: Real>(&self, p: V3<T>) -> Sample<T> {
+        self.eval(self.ir.root(), p)
+    }
+
+    /// The unit surface normal at `p` by central differences with step `h`.
+    #[must_use]
+    pub fn normal(&self, p: DVec3, h: f64) -> DVec3 {
+        let d = |q: DVec3| self.distance(q);
+        let g = DVec3::new(
+            d(p + DVec3::X * h) - d(p - DVec3::X * h),
+            d(p + DVec3::Y * h) - d(p - DVec3::Y * h),
+            d(p + DVec3::Z * h) - d(p - DVec3::Z * h),
+        );
+        g.try_normalize().unwrap_or(DVec3::Y)
+    }
+
+    fn scalar<T: Real>(&self, s: Scalar) -> T {
+        T::of(match s {
+            Scalar::Baked(v) => v,
+            Scalar::Dynamic(slot) => self.values.as_slice()[slot as usize],
+        })
+    }
+
+    fn vector<T: Real>(&self, v: [Scalar; 3]) -> V3<T> {
+        v3(self.scalar(v[0]), self.scalar(v[1]), self.scalar(v[2]))
+    }
+
+    fn leaf<T: Real>(distance: T) -> Sample<T> {
+        Sample {
+            distance,
+            color: V3::splat(T::of(DEFAULT_COLOR[0])),
+            trap: T::one(),
+        }
+    }
+
+    fn fractal<T: Real>(e: Estimate<T>) -> Sample<T> {
+        Sample {
+            trap: e.trap,
+            ..Self::leaf(e.distance)
+        }
+    }
+
+    #[allow(clippy::too_many_lines)]
+    fn eval<T: Real>(&self, id: NodeId, p: V3<T>) -> Sample<T> {
+        let s = |x: Scalar| self.scalar::<T>(x);
+        let v = |x: [Scalar; 3]| self.vector::<T>(x);
+        match self.ir.node(id) {
+            Kind::Sphere { radius } => Self::leaf(sdf::sphere(p, s(*radius))),
+            Kind::Cuboid { half_extents } => Self::leaf(sdf::cuboid(p, v(*half_extents))),
+            Kind::RoundBox {
+                half_extents,
+                radius,
+            } => Self::leaf(sdf::round_box(p, v(*half_extents), s(*radius))),
+            Kind::Torus {
+                major_radius,
+                minor_radius,
+            } => Self::leaf(sdf::torus(p, s(*major_radius), s(*minor_radius))),
+            Kind::Cylinder {
+                radius,
+                half_height,
+            } => Self::leaf(sdf::cylinder(p, s(*radius), s(*half_height))),
+            Kind::Capsule { a, b, radius } => Self::leaf(sdf::capsule(p, v(*a), v(*b), s(*radius))),
+            Kind::Plane { normal, offset } => Self::leaf(sdf::plane(p, v(*normal), s(*offset))),
+            Kind::Octahedron { size } => Self::leaf(sdf::octahedron(p, s(*size))),
+            Kind::CappedCone {
+                half_height,
+                bottom_radius,
+                top_radius,
+            } => Self::leaf(sdf::capped_cone(
+                p,
+                s(*half_height),
+                s(*bottom_radius),
+                s(*top_radius),
+            )),
+            Kind::Ellipsoid { radii } => Self::leaf(sdf::ellipsoid(p, v(*radii))),
+            Kind::Mandelbulb(f) => Self::fractal(sdf::mandelbulb(
+                p,
+                s(f.power),
+                f.iterations,
+                s(f.bailout),
+                integer_power(f.power),
+            )),
+            Kind::Menger(f) => Self::fractal(sdf::menger(p, f.iterations, s(f.scale))),
+            Kind::Julia(f) => Self::fractal(sdf::julia(
+                p,
+                f.c.map(s),
+                s(f.slice_w),
+                f.iterations,
+                s(f.bailout),
+            )),
+            Kind::Sierpinski(f) => Self::fractal(sdf::sierpinski(p, f.iterations, s(f.scale))),
+            Kind::Translate { offset, child } => self.eval(*child, p - v(*offset)),
+            Kind::Rotate { axis, angle, child } => {
+                let k = V3::<f64>::from(*axis).cast::<T>();
+                self.eval(*child, rotate(p, k, -s(*angle)))
+            }
+            Kind::Scale { factor, child } => {
+                let f = s(*factor);
+                let mut out = self.eval(*child, p / f);
+                out.distance = out.distance * f;
+                out
+            }
+            Kind::Mirror { axis, child } => {
+                let i = axis.index();
+                self.eval(*child, p.with(i, p.get(i).abs()))
+            }
+            Kind::Round { radius, child } => {
+                let mut out = self.eval(*child, p);
+                out.distance = out.distance - s(*radius);
+                out
+            }
+            Kind::Onion { thickness, child } => {
+                let mut out = self.eval(*child, p);
+                out.distance = out.distance.abs() - s(*thickness);
+                out
+            }
+            Kind::Elongate { extents, child } => {
+                let h = v(*extents);
+                self.eval(*child, p - p.zip(h, |c, e| c.max(-e).min(e)))
+            }
+            Kind::Repeat { period, child } => {
+                let c = v(*period);
+                self.eval(*child, repeat(p, c, None))
+            }
+            Kind::RepeatLimited {
+                period,
+                limit,
+                child,
+            } => {
+                let c = v(*period);
+                self.eval(*child, repeat(p, c, Some(*limit)))
+            }
+            Kind::Twist { rate, child } => {
+                let k = s(*rate);
+                let (sn, cs) = (k * p.y).sin_cos();
+                let q = v3(cs * p.x - sn * p.z, p.y, sn * p.x + cs * p.z);
+                let mut out = self.eval(*child, q);
+                let t = k.abs() * (p.x.hypot(p.z) + out.distance.abs());
+                let half = T::of(0.5) * t;
+                out.distance = out.distance / (half + (T::one() + half * half).sqrt());
+                out
+            }
+            Kind::Bend { rate, child } => {
+                let k = s(*rate);
+                let (sn, cs) = (k * p.x).sin_cos();
+                let q = v3(cs * p.x - sn * p.y, sn * p.x + cs * p.y, p.z);
+                let mut out = self.eval(*child, q);
+                let t = k.abs() * (p.x.hypot(p.y) + out.distance.abs());
+                out.distance = out.distance / (T::one() + t);
+                out
+            }
+            Kind::Csg {
+                op,
+                smoothing,
+                a,
+                b,
+            } => {
+                let k = smoothing.map_or(T::zero(), s);
+                combine(*op, k, self.eval(*a, p), self.eval(*b, p))
+            }
+            Kind::Color { color, child } => Sample {
+                color: v(*color),
+                ..self.eval(*child, p)
+            },
+        }
+    }
+}
+
+/// The trig-free integer form applies when the power is a baked integer.
+/// Code generation makes the same choice.
+#[must_use]
+pub fn integer_power(power: Scalar) -> Option<u32> {
+    match power {
+        #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss)]
+        Scalar::Baked(v) if v.fract() == 0.0 && (2.0..=64.0).contains(&v) => Some(v as u32),
+        _ => None,
+    }
+}
+
+/// Rotates `p` by `angle` around the unit axis `k` (Rodrigues' formula).
+fn rotate<T: Real>(p: V3<T>, k: V3<T>, angle: T) -> V3<T> {
+    let (sn, cs) = angle.sin_cos();
+    p * cs + k.cross(p) * sn + k * (k.dot(p) * (T::one() - cs))
+}
+
+/// Folds `p` into the cell of size `c` around the origin (no folding on
+/// axes with `c = 0`), clamping the cell index to `±limit` if given.
+fn repeat<T: Real>(p: V3<T>, c: V3<T>, limit: Option<[u32; 3]>) -> V3<T> {
+    let mut q = p;
+    for i in 0..3 {
+        let ci = c.get(i);
+        if ci > T::zero() {
+            let mut cell = (p.get(i) / ci).round();
+            if let Some(l) = limit {
+                let l = T::of(f64::from(l[i]));
+                cell = cell.max(-l).min(l);
+            }
+            q = q.with(i, p.get(i) - ci * cell);
+        }
+    }
+    q
+}
+
+/// Hard or smooth CSG of two samples. Every operation is a (smooth) minimum
+/// of signed operands: union `min(a, b)`, subtraction `-min(-a, b)`,
+/// intersection `-min(-a, -b)`.
+fn combine<T: Real>(op: CsgOp, k: T, a: Sample<T>, b: Sample<T>) -> Sample<T> {
+    let (sa, sb) = match op {
+        CsgOp::Union => (T::one(), T::one()),
+        CsgOp::Subtract => (-T::one(), T::one()),
+        CsgOp::Intersect => (-T::one(), -T::one()),
+    };
+    let (x, y) = (sa * a.distance, sb * b.distance);
+    let (m, blend) = sdf::smooth_min(x, y, k);
+    let (near, far) = if x < y { (a, b) } else { (b, a) };
+    let mix = |u: T, w: T| u + (w - u) * blend;
+    Sample {
+        distance: if op == CsgOp::Union { m } else { -m },
+        color: near.color.zip(far.color, mix),
+        trap: mix(near.trap, far.trap),
+    }
+}
+
+/// A ray: origin and unit direction.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Ray {
+    /// Where the ray starts.
+    pub origin: DVec3,
+    /// Its unit direction.
+    pub direction: DVec3,
+}
+
+/// Sphere-tracing limits.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct MarchSettings {
+    /// Give up after this many steps.
+    pub max_steps: u32,
+    /// Give up beyond this distance along the ray.
+    pub max_distance: f64,
+    /// A hit is a distance below `epsilon + t * epsilon_per_unit` (the
+    /// second term scales the threshold with the pixel footprint).
+    pub epsilon: f64,
+    /// Growth of the hit threshold per unit of ray length.
+    pub epsilon_per_unit: f64,
+}
+
+impl Default for MarchSettings {
+    fn default() -> Self {
+        MarchSettings {
+            max_steps: 256,
+            max_distance: 100.0,
+            epsilon: 1e-4,
+            epsilon_per_unit: 0.0,
+        }
+    }
+}
+
+/// The result of tracing one ray.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Hit {
+    /// Whether a surface was reached.
+    pub hit: bool,
+    /// Distance along the ray where the march stopped.
+    pub depth: f64,
+    /// Steps (distance evaluations) taken.
+    pub steps: u32,
+    /// The smallest distance seen along the ray (drives glow).
+    pub min_distance: f64,
+}
+
+/// Sphere-traces `ray` through the scene.
+#[must_use]
+pub fn march(eval: &Evaluator, ray: Ray, settings: &MarchSettings) -> Hit {
+    let mut t = 0.0;
+    let mut min_distance = f64::INFINITY;
+    for step in 0..settings.max_steps {
+        let d = eval.distance(ray.origin + ray.direction * t);
+        min_distance = min_distance.min(d);
+        if d < settings.epsilon + t * settings.epsilon_per_unit {
+            return Hit {
+                hit: true,
+                depth: t,
+                steps: step + 1,
+                min_distance,
+            };
+        }
+        t += d;
+        if t > settings.max_distance {
+            return Hit {
+                hit: false,
+                depth: t,
+                steps: step + 1,
+                min_distance,
+            };
+        }
+    }
+    Hit {
+        hit: false,
+        depth: t,
+        steps: settings.max_steps,
+        min_distance,
+    }
+}

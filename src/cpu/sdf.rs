@@ -1,0 +1,307 @@
+//! Distance formulas for every primitive and fractal, generic over the
+//! precision. Each has a twin in `kernels/*.cl` that performs the same
+//! operations in the same order; the conformance tests hold them together.
+//!
+//! Sources: the primitives and smooth minimum follow Inigo Quilez's
+//! "distance functions" article; the fractal estimators follow Quilez
+//! (quaternion Julia), White/Nylander and Hart (Mandelbulb) and Knighty's
+//! kaleidoscopic IFS (Menger, Sierpinski).
+
+use super::real::{Real, V3, v3};
+
+/// Exact distance to a sphere of radius `r` at the origin.
+#[must_use]
+pub fn sphere<T: Real>(p: V3<T>, r: T) -> T {
+    p.length() - r
+}
+
+/// Exact distance to an axis-aligned box with half extents `b`.
+#[must_use]
+pub fn cuboid<T: Real>(p: V3<T>, b: V3<T>) -> T {
+    let q = p.abs() - b;
+    q.max_s(T::zero()).length() + q.max_element().min(T::zero())
+}
+
+/// Exact distance to a box of half extents `b` with edges rounded by `r`.
+#[must_use]
+pub fn round_box<T: Real>(p: V3<T>, b: V3<T>, r: T) -> T {
+    let q = p.abs() - b + V3::splat(r);
+    q.max_s(T::zero()).length() + q.max_element().min(T::zero()) - r
+}
+
+/// Exact distance to a torus around the y axis.
+#[must_use]
+pub fn torus<T: Real>(p: V3<T>, major: T, minor: T) -> T {
+    let qx = p.x.hypot(p.z) - major;
+    qx.hypot(p.y) - minor
+}
+
+/// Exact distance to a capped cylinder along y.
+#[must_use]
+pub fn cylinder<T: Real>(p: V3<T>, r: T, h: T) -> T {
+    let dx = p.x.hypot(p.z) - r;
+    let dy = p.y.abs() - h;
+    dx.max(dy).min(T::zero()) + dx.max(T::zero()).hypot(dy.max(T::zero()))
+}
+
+/// Exact distance to a capsule around the segment `a`-`b`.
+#[must_use]
+pub fn capsule<T: Real>(p: V3<T>, a: V3<T>, b: V3<T>, r: T) -> T {
+    let pa = p - a;
+    let ba = b - a;
+    let h = (pa.dot(ba) / ba.dot(ba).max(T::tiny()))
+        .max(T::zero())
+        .min(T::one());
+    (pa - ba * h).length() - r
+}
+
+/// Exact distance to the half-space `dot(p, n) + offset <= 0` (`n` is
+/// normalised here; a zero `n` gives the constant `offset`).
+#[must_use]
+pub fn plane<T: Real>(p: V3<T>, n: V3<T>, offset: T) -> T {
+    let n = n / n.length().max(T::tiny());
+    p.dot(n) + offset
+}
+
+/// Exact distance to the octahedron `|x| + |y| + |z| <= s`.
+#[must_use]
+pub fn octahedron<T: Real>(p: V3<T>, s: T) -> T {
+    let p = p.abs();
+    let m = p.x + p.y + p.z - s;
+    let three = T::of(3.0);
+    let q = if three * p.x < m {
+        p
+    } else if three * p.y < m {
+        v3(p.y, p.z, p.x)
+    } else if three * p.z < m {
+        v3(p.z, p.x, p.y)
+    } else {
+        return m * T::of(0.577_350_269_189_625_8);
+    };
+    let k = (T::of(0.5) * (q.z - q.y + s)).max(T::zero()).min(s);
+    v3(q.x, q.y - s + k, q.z - k).length()
+}
+
+/// Exact distance to a capped cone along y: radius `r1` at `-h`, `r2` at
+/// `+h`.
+#[must_use]
+pub fn capped_cone<T: Real>(p: V3<T>, h: T, r1: T, r2: T) -> T {
+    let (qx, qy) = (p.x.hypot(p.z), p.y);
+    let (k1x, k1y) = (r2, h);
+    let (k2x, k2y) = (r2 - r1, T::of(2.0) * h);
+    let cap_r = if qy < T::zero() { r1 } else { r2 };
+    let (cax, cay) = (qx - qx.min(cap_r), qy.abs() - h);
+    let k2_len2 = (k2x * k2x + k2y * k2y).max(T::tiny());
+    let t = (((k1x - qx) * k2x + (k1y - qy) * k2y) / k2_len2)
+        .max(T::zero())
+        .min(T::one());
+    let (cbx, cby) = (qx - k1x + k2x * t, qy - k1y + k2y * t);
+    let s = if cbx < T::zero() && cay < T::zero() {
+        -T::one()
+    } else {
+        T::one()
+    };
+    s * (cax * cax + cay * cay).min(cbx * cbx + cby * cby).sqrt()
+}
+
+/// A distance bound for an axis-aligned ellipsoid with semi-axes `r`.
+#[must_use]
+pub fn ellipsoid<T: Real>(p: V3<T>, r: V3<T>) -> T {
+    let k0 = (p / r).length();
+    let k1 = (p / (r * r)).length();
+    k0 * (k0 - T::one()) / k1.max(T::tiny())
+}
+
+/// A distance estimate with its orbit trap in `[0, 1]`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Estimate<T> {
+    /// The distance estimate (a bound).
+    pub distance: T,
+    /// The orbit trap, for colouring.
+    pub trap: T,
+}
+
+/// `(cos, sin)` of `n` times the angle whose cosine and sine are `(c, s)`,
+/// by binary exponentiation of `c + i s`: the trig-free integer power.
+fn angle_power<T: Real>(c: T, s: T, n: u32) -> (T, T) {
+    let (mut rc, mut rs) = (T::one(), T::zero());
+    let (mut bc, mut bs) = (c, s);
+    let mut e = n;
+    while e > 0 {
+        if e & 1 == 1 {
+            (rc, rs) = (rc * bc - rs * bs, rc * bs + rs * bc);
+        }
+        (bc, bs) = (bc * bc - bs * bs, T::of(2.0) * bc * bs);
+        e >>= 1;
+    }
+    (rc, rs)
+}
+
+/// The Mandelbulb distance estimate `0.5 ln(r) r / dr`.
+///
+/// `integer_power` selects the trig-free form (`Some(n)` must equal
+/// `power`); otherwise the map uses `acos`/`atan2`/`sin`/`cos`. The orbit
+/// trap is the smallest `|z|` reached, clamped to `[0, 1]`.
+#[must_use]
+pub fn mandelbulb<T: Real>(
+    p: V3<T>,
+    power: T,
+    iterations: u32,
+    bailout: T,
+    integer_power: Option<u32>,
+) -> Estimate<T> {
+    let mut z = p;
+    let mut dr = T::one();
+    let mut trap = T::one();
+    for _ in 0..iterations {
+        let r = z.length();
+        if r > bailout {
+            break;
+        }
+        trap = trap.min(r);
+        dr = (power * r.powf(power - T::one()) * dr + T::one()).min(T::derivative_cap());
+        let zr = r.powf(power);
+        let rho = z.x.hypot(z.y);
+        let (st, ct, sp, cp) = match integer_power {
+            Some(n) => {
+                let inv_r = T::one() / r.max(T::tiny());
+                let (ct, st) = angle_power(z.z * inv_r, rho * inv_r, n);
+                let (cp, sp) = if rho > T::tiny() {
+                    angle_power(z.x / rho, z.y / rho, n)
+                } else {
+                    (T::one(), T::zero())
+                };
+                (st, ct, sp, cp)
+            }
+            None => {
+                let theta = (z.z / r.max(T::tiny())).max(-T::one()).min(T::one()).acos() * power;
+                let phi = z.y.atan2(z.x) * power;
+                (theta.sin(), theta.cos(), phi.sin(), phi.cos())
+            }
+        };
+        z = v3(st * cp, st * sp, ct) * zr + p;
+    }
+    let r = z.length();
+    Estimate {
+        distance: T::of(0.5) * r.max(T::tiny()).ln() * r / dr,
+        trap,
+    }
+}
+
+/// The Menger sponge (KIFS form) distance bound: fold into the fundamental
+/// region, scale about the kept cube, and finish with the exact box
+/// distance divided by `scale^iterations`.
+#[must_use]
+pub fn menger<T: Real>(p: V3<T>, iterations: u32, scale: T) -> Estimate<T> {
+    let mut z = p;
+    let mut s = T::one();
+    let mut trap = T::one();
+    let shift = scale - T::one();
+    for _ in 0..iterations {
+        z = z.abs();
+        if z.x < z.y {
+            z = v3(z.y, z.x, z.z);
+        }
+        if z.x < z.z {
+            z = v3(z.z, z.y, z.x);
+        }
+        if z.y < z.z {
+            z = v3(z.x, z.z, z.y);
+        }
+        trap = trap.min(z.length() * T::of(0.577_350_269_189_625_8));
+        z = v3(z.x * scale - shift, z.y * scale - shift, z.z * scale);
+        if z.z > T::of(0.5) * shift {
+            z.z = z.z - shift;
+        }
+        s = s * scale;
+    }
+    Estimate {
+        distance: cuboid(z, V3::splat(T::one())) / s,
+        trap,
+    }
+}
+
+/// Distance bound to the tetrahedron with vertices `(1,1,1)`, `(-1,-1,1)`,
+/// `(1,-1,-1)`, `(-1,1,-1)`: the largest signed face-plane distance.
+#[must_use]
+pub fn tetrahedron<T: Real>(z: V3<T>) -> T {
+    let a = (-z.x - z.y - z.z).max(z.x + z.y - z.z);
+    let b = (-z.x + z.y + z.z).max(z.x - z.y + z.z);
+    (a.max(b) - T::one()) * T::of(0.577_350_269_189_625_8)
+}
+
+/// The Sierpinski tetrahedron (KIFS form) distance bound: reflect towards
+/// the vertex `(1,1,1)`, scale about it, finish with the tetrahedron bound
+/// divided by `scale^iterations`.
+#[must_use]
+pub fn sierpinski<T: Real>(p: V3<T>, iterations: u32, scale: T) -> Estimate<T> {
+    let mut z = p;
+    let mut s = T::one();
+    let mut trap = T::one();
+    let shift = scale - T::one();
+    for _ in 0..iterations {
+        if z.x + z.y < T::zero() {
+            z = v3(-z.y, -z.x, z.z);
+        }
+        if z.x + z.z < T::zero() {
+            z = v3(-z.z, z.y, -z.x);
+        }
+        if z.y + z.z < T::zero() {
+            z = v3(z.x, -z.z, -z.y);
+        }
+        trap = trap.min(z.length() * T::of(0.577_350_269_189_625_8));
+        z = z * scale - V3::splat(shift);
+        s = s * scale;
+    }
+    Estimate {
+        distance: tetrahedron(z) / s,
+        trap,
+    }
+}
+
+/// The quaternion Julia distance estimate `0.25 ln(|z|^2) sqrt(|z|^2 /
+/// |dz|^2)` for `z -> z^2 + c`, the point being `(p, w)` with the real part
+/// first.
+#[must_use]
+pub fn julia<T: Real>(p: V3<T>, c: [T; 4], w: T, iterations: u32, bailout: T) -> Estimate<T> {
+    let mut z = [p.x, p.y, p.z, w];
+    let dot = |q: &[T; 4]| q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3];
+    let mut mz2 = dot(&z);
+    let mut md2 = T::one();
+    let mut trap = mz2;
+    let bailout2 = bailout * bailout;
+    for _ in 0..iterations {
+        md2 = (md2 * T::of(4.0) * mz2).min(T::derivative_cap());
+        let two_x = T::of(2.0) * z[0];
+        z = [
+            z[0] * z[0] - z[1] * z[1] - z[2] * z[2] - z[3] * z[3] + c[0],
+            two_x * z[1] + c[1],
+            two_x * z[2] + c[2],
+            two_x * z[3] + c[3],
+        ];
+        mz2 = dot(&z);
+        trap = trap.min(mz2);
+        if mz2 > bailout2 {
+            break;
+        }
+    }
+    Estimate {
+        distance: T::of(0.25) * mz2.max(T::tiny()).ln() * (mz2 / md2.max(T::tiny())).sqrt(),
+        trap: trap.sqrt().min(T::one()),
+    }
+}
+
+/// The polynomial smooth minimum of radius `k` and its blend factor: the
+/// result is `min(a, b) - h^2 k / 4` with `h = max(k - |a - b|, 0) / k`, so
+/// it is at most `k / 4` below `min(a, b)`, and exactly `min(a, b)` when
+/// `k = 0`. The second value is the weight of the larger operand's colour,
+/// in `[0, 0.5]`.
+#[must_use]
+pub fn smooth_min<T: Real>(a: T, b: T, k: T) -> (T, T) {
+    if k <= T::zero() {
+        return (a.min(b), T::zero());
+    }
+    let h = (k - (a - b).abs()).max(T::zero()) / k;
+    let m = h * h * T::of(0.5);
+    (a.min(b) - m * k * T::of(0.5), m)
+}

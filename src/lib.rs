@@ -1,0 +1,76 @@
+//! # fractal-sdf
+//!
+//! Write 3D scenes — primitives, transforms, smooth CSG and the fractals
+//! Mandelbulb, Menger sponge, quaternion Julia and Sierpinski tetrahedron —
+//! as typed Rust values; evaluate them exactly on the CPU, or compile them to
+//! OpenCL C and ray-march them on any OpenCL device.
+//!
+//! ## The pipeline
+//!
+//! Each stage is a module and a function of the previous stage's output:
+//!
+//! 1. [`scene`]: the typed scene ([`Node`], [`Scene`]) and its builder API.
+//! 2. [`ir`]: validation and lowering to a flat arena whose parameters are
+//!    baked constants or dynamic slots.
+//! 3. [`cpu`]: the reference evaluator (distance, colour, normal, sphere
+//!    tracing) in `f64` and `f32`; the oracle for every test.
+//!
+//! ## A tour
+//!
+//! Build a scene from a fractal and a smoothly blended pair of primitives,
+//! then ask the CPU reference for distances:
+//!
+//! ```
+//! use fractal_sdf::prelude::*;
+//!
+//! // A Mandelbulb of power 8, moved to the left.
+//! let bulb = mandelbulb(8.0).translate(dvec3(-1.5, 0.0, 0.0));
+//! // A sphere melting into a box, painted orange, on the right.
+//! let blob = sphere(0.6)
+//!     .smooth_union(cuboid(dvec3(0.4, 0.4, 0.4)).translate(dvec3(0.5, 0.0, 0.0)), 0.2)
+//!     .color(dvec3(1.0, 0.5, 0.1))
+//!     .translate(dvec3(1.5, 0.0, 0.0));
+//! let scene = Scene::new(bulb.union(blob));
+//! scene.validate()?;
+//!
+//! let eval = cpu::Evaluator::new(scene.geometry.as_ref().unwrap())?;
+//! // Far from everything, the distance is positive and finite...
+//! let far = eval.distance(dvec3(0.0, 5.0, 0.0));
+//! assert!(far > 3.0 && far.is_finite());
+//! // ...and the centre of the sphere is inside.
+//! assert!(eval.distance(dvec3(1.5, 0.0, 0.0)) < 0.0);
+//! # Ok::<(), fractal_sdf::Error>(())
+//! ```
+//!
+//! Bad input is a typed error that names the node and the parameter, never a
+//! panic:
+//!
+//! ```
+//! use fractal_sdf::prelude::*;
+//! let err = Scene::new(sphere(1.0).union(torus(1.0, -0.2))).validate().unwrap_err();
+//! assert_eq!(
+//!     err.to_string(),
+//!     "union/b:torus: parameter `minor_radius` must be >= 0, got -0.2"
+//! );
+//! ```
+#![warn(missing_docs)]
+
+pub mod cpu;
+pub mod error;
+pub mod ir;
+pub mod scene;
+
+pub use error::{Error, Result};
+pub use scene::{Node, Scene};
+
+/// Everything needed to write scenes: `use fractal_sdf::prelude::*;`.
+pub mod prelude {
+    pub use crate::cpu;
+    pub use crate::error::{Error, Result};
+    pub use crate::scene::{
+        Axis, Camera, Light, Mandelbulb, Menger, Node, Param, Param3, Projection, QuaternionJulia,
+        Scene, Sierpinski, capped_cone, capsule, cuboid, cylinder, ellipsoid, julia, mandelbulb,
+        menger, octahedron, param, param3, plane, round_box, sierpinski, sphere, torus,
+    };
+    pub use glam::{DQuat, DVec3, EulerRot, Vec3, dvec3, vec3};
+}

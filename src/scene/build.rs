@@ -1,0 +1,421 @@
+//! The fluent builder API: free functions that make shapes, and methods on
+//! [`Node`] that transform and combine them.
+//!
+//! Nothing here validates: building never fails, and [`Scene::validate`]
+//! (or anything that compiles a scene) reports every bad value with the node
+//! and parameter it belongs to.
+//!
+//! [`Scene::validate`]: super::Scene::validate
+
+use glam::{DQuat, DVec3, EulerRot};
+
+use super::node::{Axis, CsgOp, Kind, Mandelbulb, Menger, Node, QuaternionJulia, Sierpinski};
+use super::param::{Param, Param3};
+
+/// A sphere of `radius` at the origin.
+#[must_use]
+pub fn sphere(radius: impl Into<Param>) -> Node {
+    Kind::Sphere {
+        radius: radius.into(),
+    }
+    .into()
+}
+
+/// An axis-aligned box at the origin with the given half extents.
+#[must_use]
+pub fn cuboid(half_extents: impl Into<Param3>) -> Node {
+    Kind::Cuboid {
+        half_extents: half_extents.into(),
+    }
+    .into()
+}
+
+/// A box of the given half extents whose edges are rounded by `radius`.
+#[must_use]
+pub fn round_box(half_extents: impl Into<Param3>, radius: impl Into<Param>) -> Node {
+    Kind::RoundBox {
+        half_extents: half_extents.into(),
+        radius: radius.into(),
+    }
+    .into()
+}
+
+/// A torus around the y axis.
+#[must_use]
+pub fn torus(major_radius: impl Into<Param>, minor_radius: impl Into<Param>) -> Node {
+    Kind::Torus {
+        major_radius: major_radius.into(),
+        minor_radius: minor_radius.into(),
+    }
+    .into()
+}
+
+/// A capped cylinder along the y axis.
+#[must_use]
+pub fn cylinder(radius: impl Into<Param>, half_height: impl Into<Param>) -> Node {
+    Kind::Cylinder {
+        radius: radius.into(),
+        half_height: half_height.into(),
+    }
+    .into()
+}
+
+/// A capsule around the segment from `a` to `b`.
+#[must_use]
+pub fn capsule(a: impl Into<Param3>, b: impl Into<Param3>, radius: impl Into<Param>) -> Node {
+    Kind::Capsule {
+        a: a.into(),
+        b: b.into(),
+        radius: radius.into(),
+    }
+    .into()
+}
+
+/// The half-space below the plane `dot(p, normal) + offset = 0`.
+#[must_use]
+pub fn plane(normal: impl Into<Param3>, offset: impl Into<Param>) -> Node {
+    Kind::Plane {
+        normal: normal.into(),
+        offset: offset.into(),
+    }
+    .into()
+}
+
+/// A regular octahedron with vertices at distance `size` on each axis.
+#[must_use]
+pub fn octahedron(size: impl Into<Param>) -> Node {
+    Kind::Octahedron { size: size.into() }.into()
+}
+
+/// A capped cone along y from radius `bottom_radius` at `-half_height` to
+/// `top_radius` at `+half_height`.
+#[must_use]
+pub fn capped_cone(
+    half_height: impl Into<Param>,
+    bottom_radius: impl Into<Param>,
+    top_radius: impl Into<Param>,
+) -> Node {
+    Kind::CappedCone {
+        half_height: half_height.into(),
+        bottom_radius: bottom_radius.into(),
+        top_radius: top_radius.into(),
+    }
+    .into()
+}
+
+/// An axis-aligned ellipsoid with the given semi-axes (a distance bound).
+#[must_use]
+pub fn ellipsoid(radii: impl Into<Param3>) -> Node {
+    Kind::Ellipsoid {
+        radii: radii.into(),
+    }
+    .into()
+}
+
+/// A Mandelbulb of `power` with 12 iterations and bailout 2. Build a
+/// [`Mandelbulb`] for other settings.
+#[must_use]
+pub fn mandelbulb(power: impl Into<Param>) -> Node {
+    Mandelbulb::new(power).into()
+}
+
+/// The classic Menger sponge (scale 3) with `iterations` levels.
+#[must_use]
+pub fn menger(iterations: u32) -> Node {
+    Menger::new(iterations).into()
+}
+
+/// A quaternion Julia set for the constant `c` = (x, y, z, w), with 12
+/// iterations, bailout 4 and the slice w = 0.
+#[must_use]
+pub fn julia(c: [f64; 4]) -> Node {
+    QuaternionJulia::new(c.map(Param::from)).into()
+}
+
+/// The classic Sierpinski tetrahedron (scale 2) with `iterations` levels.
+#[must_use]
+pub fn sierpinski(iterations: u32) -> Node {
+    Sierpinski::new(iterations).into()
+}
+
+impl Mandelbulb {
+    /// A Mandelbulb of `power` with 12 iterations and bailout 2.
+    #[must_use]
+    pub fn new(power: impl Into<Param>) -> Self {
+        Mandelbulb {
+            power: power.into(),
+            iterations: 12,
+            bailout: 2.0.into(),
+        }
+    }
+
+    /// Sets the iteration count.
+    #[must_use]
+    pub fn iterations(mut self, iterations: u32) -> Self {
+        self.iterations = iterations;
+        self
+    }
+
+    /// Sets the escape radius.
+    #[must_use]
+    pub fn bailout(mut self, bailout: impl Into<Param>) -> Self {
+        self.bailout = bailout.into();
+        self
+    }
+}
+
+impl Menger {
+    /// A classic (scale 3) sponge with `iterations` levels.
+    #[must_use]
+    pub fn new(iterations: u32) -> Self {
+        Menger {
+            iterations,
+            scale: 3.0.into(),
+        }
+    }
+
+    /// Sets the scale factor of each level.
+    #[must_use]
+    pub fn scale(mut self, scale: impl Into<Param>) -> Self {
+        self.scale = scale.into();
+        self
+    }
+}
+
+impl QuaternionJulia {
+    /// A Julia set for `c` with 12 iterations, bailout 4, slice w = 0.
+    #[must_use]
+    pub fn new(c: [Param; 4]) -> Self {
+        QuaternionJulia {
+            c,
+            iterations: 12,
+            bailout: 4.0.into(),
+            slice_w: 0.0.into(),
+        }
+    }
+
+    /// Sets the iteration count.
+    #[must_use]
+    pub fn iterations(mut self, iterations: u32) -> Self {
+        self.iterations = iterations;
+        self
+    }
+
+    /// Sets the escape radius.
+    #[must_use]
+    pub fn bailout(mut self, bailout: impl Into<Param>) -> Self {
+        self.bailout = bailout.into();
+        self
+    }
+
+    /// Sets the w coordinate of the rendered 3D slice.
+    #[must_use]
+    pub fn slice_w(mut self, w: impl Into<Param>) -> Self {
+        self.slice_w = w.into();
+        self
+    }
+}
+
+impl Sierpinski {
+    /// A classic (scale 2) tetrahedron with `iterations` levels.
+    #[must_use]
+    pub fn new(iterations: u32) -> Self {
+        Sierpinski {
+            iterations,
+            scale: 2.0.into(),
+        }
+    }
+
+    /// Sets the scale factor of each level.
+    #[must_use]
+    pub fn scale(mut self, scale: impl Into<Param>) -> Self {
+        self.scale = scale.into();
+        self
+    }
+}
+
+/// Transforms, domain operations, booleans and colour.
+impl Node {
+    /// Moves the node by `offset`.
+    #[must_use]
+    pub fn translate(self, offset: impl Into<Param3>) -> Node {
+        Kind::Translate {
+            offset: offset.into(),
+            child: self,
+        }
+        .into()
+    }
+
+    /// Rotates the node by `angle` radians around `axis` (normalised here; a
+    /// zero axis is reported by validation).
+    #[must_use]
+    pub fn rotate(self, axis: impl Into<DVec3>, angle: impl Into<Param>) -> Node {
+        let axis = axis.into();
+        Kind::Rotate {
+            axis: axis.try_normalize().unwrap_or(axis),
+            angle: angle.into(),
+            child: self,
+        }
+        .into()
+    }
+
+    /// Rotates the node by a quaternion (normalised here).
+    #[must_use]
+    pub fn rotate_quat(self, rotation: DQuat) -> Node {
+        let (axis, angle) = rotation.normalize().to_axis_angle();
+        if angle == 0.0 || !axis.is_finite() {
+            return self.rotate(DVec3::Y, 0.0);
+        }
+        self.rotate(axis, angle)
+    }
+
+    /// Rotates the node by Euler angles in radians, applied in `order`.
+    #[must_use]
+    pub fn rotate_euler(self, order: EulerRot, a: f64, b: f64, c: f64) -> Node {
+        self.rotate_quat(DQuat::from_euler(order, a, b, c))
+    }
+
+    /// Scales the node uniformly by `factor` (distances are rescaled, so an
+    /// exact shape stays exact).
+    #[must_use]
+    pub fn scale(self, factor: impl Into<Param>) -> Node {
+        Kind::Scale {
+            factor: factor.into(),
+            child: self,
+        }
+        .into()
+    }
+
+    /// Mirrors the node's positive half across the plane normal to `axis`.
+    #[must_use]
+    pub fn mirror(self, axis: Axis) -> Node {
+        Kind::Mirror { axis, child: self }.into()
+    }
+
+    /// Grows the node by `radius`, rounding its edges.
+    #[must_use]
+    pub fn round(self, radius: impl Into<Param>) -> Node {
+        Kind::Round {
+            radius: radius.into(),
+            child: self,
+        }
+        .into()
+    }
+
+    /// Keeps only a shell of `thickness` around the node's surface.
+    #[must_use]
+    pub fn onion(self, thickness: impl Into<Param>) -> Node {
+        Kind::Onion {
+            thickness: thickness.into(),
+            child: self,
+        }
+        .into()
+    }
+
+    /// Stretches the node by `extents` along each axis.
+    #[must_use]
+    pub fn elongate(self, extents: impl Into<Param3>) -> Node {
+        Kind::Elongate {
+            extents: extents.into(),
+            child: self,
+        }
+        .into()
+    }
+
+    /// Repeats the node forever with cell size `period` (0: not on that axis).
+    #[must_use]
+    pub fn repeat(self, period: impl Into<Param3>) -> Node {
+        Kind::Repeat {
+            period: period.into(),
+            child: self,
+        }
+        .into()
+    }
+
+    /// Repeats the node in cells `-limit..=limit` per axis.
+    #[must_use]
+    pub fn repeat_limited(self, period: impl Into<Param3>, limit: [u32; 3]) -> Node {
+        Kind::RepeatLimited {
+            period: period.into(),
+            limit,
+            child: self,
+        }
+        .into()
+    }
+
+    /// Twists the node around y by `rate` radians per unit.
+    #[must_use]
+    pub fn twist(self, rate: impl Into<Param>) -> Node {
+        Kind::Twist {
+            rate: rate.into(),
+            child: self,
+        }
+        .into()
+    }
+
+    /// Bends the node in the xy plane by `rate` radians per unit of x.
+    #[must_use]
+    pub fn bend(self, rate: impl Into<Param>) -> Node {
+        Kind::Bend {
+            rate: rate.into(),
+            child: self,
+        }
+        .into()
+    }
+
+    /// Paints the node with a linear RGB colour.
+    #[must_use]
+    pub fn color(self, rgb: impl Into<Param3>) -> Node {
+        Kind::Color {
+            color: rgb.into(),
+            child: self,
+        }
+        .into()
+    }
+
+    fn csg(self, op: CsgOp, smoothing: Option<Param>, other: impl Into<Node>) -> Node {
+        Kind::Csg {
+            op,
+            smoothing,
+            a: self,
+            b: other.into(),
+        }
+        .into()
+    }
+
+    /// Everything in `self` or `other`.
+    #[must_use]
+    pub fn union(self, other: impl Into<Node>) -> Node {
+        self.csg(CsgOp::Union, None, other)
+    }
+
+    /// `self` with `other` carved out.
+    #[must_use]
+    pub fn subtract(self, other: impl Into<Node>) -> Node {
+        self.csg(CsgOp::Subtract, None, other)
+    }
+
+    /// Only what is in both `self` and `other`.
+    #[must_use]
+    pub fn intersect(self, other: impl Into<Node>) -> Node {
+        self.csg(CsgOp::Intersect, None, other)
+    }
+
+    /// Union with a smooth blend of radius `k` (`k = 0` is the hard union).
+    #[must_use]
+    pub fn smooth_union(self, other: impl Into<Node>, k: impl Into<Param>) -> Node {
+        self.csg(CsgOp::Union, Some(k.into()), other)
+    }
+
+    /// Subtraction with a smooth seam of radius `k`.
+    #[must_use]
+    pub fn smooth_subtract(self, other: impl Into<Node>, k: impl Into<Param>) -> Node {
+        self.csg(CsgOp::Subtract, Some(k.into()), other)
+    }
+
+    /// Intersection with a smooth seam of radius `k`.
+    #[must_use]
+    pub fn smooth_intersect(self, other: impl Into<Node>, k: impl Into<Param>) -> Node {
+        self.csg(CsgOp::Intersect, Some(k.into()), other)
+    }
+}

@@ -1,0 +1,351 @@
+//! Scenes as typed Rust values: geometry ([`Node`]), lights and a camera.
+//!
+//! Building never fails; [`Scene::validate`] (which every renderer and
+//! code generator calls first) reports the first bad value as a typed
+//! [`Error`](crate::Error) naming the node's path and the parameter.
+
+pub mod build;
+mod node;
+mod param;
+
+use glam::DVec3;
+
+pub use build::{
+    capped_cone, capsule, cuboid, cylinder, ellipsoid, julia, mandelbulb, menger, octahedron,
+    plane, round_box, sierpinski, sphere, torus,
+};
+pub(crate) use node::Mapper;
+pub use node::{
+    Axis, CsgOp, Kind, MAX_ESCAPE_ITERATIONS, MAX_FOLD_ITERATIONS, Mandelbulb, Menger, Node,
+    NodeKind, ParamSpec, QuaternionJulia, Rule, Sierpinski,
+};
+pub use param::{Param, Param3, param, param3};
+
+use crate::error::{Error, Result};
+
+/// How the camera projects the scene.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Projection {
+    /// Perspective with a vertical field of view in degrees, in (0, 180).
+    Perspective {
+        /// Vertical field of view in degrees.
+        fov_y_degrees: f64,
+    },
+    /// Orthographic: parallel rays, `height` scene units visible vertically.
+    Orthographic {
+        /// Visible height in scene units, greater than 0.
+        height: f64,
+    },
+}
+
+/// A look-at camera.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Camera {
+    /// Where the camera is.
+    pub position: DVec3,
+    /// The point it looks at.
+    pub target: DVec3,
+    /// The approximate up direction (made orthogonal to the view).
+    pub up: DVec3,
+    /// Perspective or orthographic.
+    pub projection: Projection,
+}
+
+impl Camera {
+    /// A perspective camera at `position` looking at `target`, y up, with a
+    /// 45° vertical field of view.
+    #[must_use]
+    pub fn look_at(position: impl Into<DVec3>, target: impl Into<DVec3>) -> Self {
+        Camera {
+            position: position.into(),
+            target: target.into(),
+            up: DVec3::Y,
+            projection: Projection::Perspective {
+                fov_y_degrees: 45.0,
+            },
+        }
+    }
+
+    /// Sets the vertical field of view in degrees (perspective).
+    #[must_use]
+    pub fn fov(mut self, fov_y_degrees: f64) -> Self {
+        self.projection = Projection::Perspective { fov_y_degrees };
+        self
+    }
+
+    /// Switches to an orthographic projection showing `height` units.
+    #[must_use]
+    pub fn orthographic(mut self, height: f64) -> Self {
+        self.projection = Projection::Orthographic { height };
+        self
+    }
+
+    /// Sets the up direction.
+    #[must_use]
+    pub fn up(mut self, up: impl Into<DVec3>) -> Self {
+        self.up = up.into();
+        self
+    }
+
+    /// The orthonormal camera basis `(right, up, forward)`.
+    ///
+    /// # Errors
+    /// [`Error::Camera`] if the camera is degenerate (see [`Camera::validate`]).
+    pub fn basis(&self) -> Result<(DVec3, DVec3, DVec3)> {
+        self.validate()?;
+        let forward = (self.target - self.position).normalize();
+        let right = forward.cross(self.up).normalize();
+        let up = right.cross(forward);
+        Ok((right, up, forward))
+    }
+
+    /// Checks that the camera can form an image: finite vectors, target
+    /// different from position, up not parallel to the view, field of view
+    /// in (0°, 180°), orthographic height > 0.
+    ///
+    /// # Errors
+    /// [`Error::Camera`] saying what is wrong.
+    pub fn validate(&self) -> Result<()> {
+        let bad = |reason: &str| {
+            Err(Error::Camera {
+                reason: reason.into(),
+            })
+        };
+        if !(self.position.is_finite() && self.target.is_finite() && self.up.is_finite()) {
+            return bad("position, target and up must be finite");
+        }
+        let view = self.target - self.position;
+        if view.length() <= f64::EPSILON * self.position.length().max(1.0) {
+            return bad("target equals position");
+        }
+        if view.normalize().cross(self.up).length() < 1e-9 {
+            return bad("up is zero or parallel to the view direction");
+        }
+        match self.projection {
+            Projection::Perspective { fov_y_degrees } => {
+                if !(fov_y_degrees > 0.0 && fov_y_degrees < 180.0) {
+                    return Err(Error::Camera {
+                        reason: format!(
+                            "vertical field of view must be in (0, 180) degrees, got {fov_y_degrees}"
+                        ),
+                    });
+                }
+            }
+            Projection::Orthographic { height } => {
+                if !(height > 0.0 && height.is_finite()) {
+                    return Err(Error::Camera {
+                        reason: format!("orthographic height must be > 0, got {height}"),
+                    });
+                }
+            }
+        }
+        Ok(())
+    }
+}
+
+impl Default for Camera {
+    /// Looking at the origin from (0, 0.5, 3.5).
+    fn default() -> Self {
+        Camera::look_at(DVec3::new(0.0, 0.5, 3.5), DVec3::ZERO)
+    }
+}
+
+/// Where light comes from.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum LightSource {
+    /// Parallel light, like the sun; `direction` points from the scene
+    /// towards the light.
+    Directional {
+        /// Direction towards the light (normalised when rendering).
+        direction: DVec3,
+    },
+    /// Light from a point, falling off with the square of the distance.
+    Point {
+        /// The light's position.
+        position: DVec3,
+    },
+}
+
+/// A light with colour, intensity and shadow softness.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Light {
+    /// Directional or point.
+    pub source: LightSource,
+    /// Linear RGB colour, each component at least 0.
+    pub color: DVec3,
+    /// Brightness multiplier, at least 0.
+    pub intensity: f64,
+    /// Soft-shadow penumbra width: 0 gives hard shadows, larger values give
+    /// wider penumbrae (0.05 is a good start).
+    pub softness: f64,
+}
+
+impl Light {
+    /// A white directional light shining from `direction`.
+    #[must_use]
+    pub fn directional(direction: impl Into<DVec3>) -> Self {
+        Light {
+            source: LightSource::Directional {
+                direction: direction.into(),
+            },
+            color: DVec3::ONE,
+            intensity: 1.0,
+            softness: 0.05,
+        }
+    }
+
+    /// A white point light at `position`.
+    #[must_use]
+    pub fn point(position: impl Into<DVec3>) -> Self {
+        Light {
+            source: LightSource::Point {
+                position: position.into(),
+            },
+            color: DVec3::ONE,
+            intensity: 1.0,
+            softness: 0.05,
+        }
+    }
+
+    /// Sets the colour.
+    #[must_use]
+    pub fn color(mut self, rgb: impl Into<DVec3>) -> Self {
+        self.color = rgb.into();
+        self
+    }
+
+    /// Sets the intensity.
+    #[must_use]
+    pub fn intensity(mut self, intensity: f64) -> Self {
+        self.intensity = intensity;
+        self
+    }
+
+    /// Sets the penumbra width (0: hard shadows).
+    #[must_use]
+    pub fn softness(mut self, softness: f64) -> Self {
+        self.softness = softness;
+        self
+    }
+
+    fn validate(&self, index: usize) -> Result<()> {
+        let node = format!("light[{index}]");
+        let vector = |name: &str, v: DVec3, nonzero: bool| -> Result<()> {
+            if let Some(bad) = v.to_array().into_iter().find(|c| !c.is_finite()) {
+                return Err(Error::NonFinite {
+                    node: node.clone(),
+                    param: name.into(),
+                    value: bad,
+                });
+            }
+            if nonzero && v.length() == 0.0 {
+                return Err(Error::ZeroVector {
+                    node: node.clone(),
+                    param: name.into(),
+                });
+            }
+            Ok(())
+        };
+        match self.source {
+            LightSource::Directional { direction } => vector("direction", direction, true)?,
+            LightSource::Point { position } => vector("position", position, false)?,
+        }
+        vector("color", self.color, false)?;
+        let scalars = [
+            ("color", self.color.min_element()),
+            ("intensity", self.intensity),
+            ("softness", self.softness),
+        ];
+        for (name, value) in scalars {
+            if !(value >= 0.0 && value.is_finite()) {
+                return Err(Error::OutOfRange {
+                    node: node.clone(),
+                    param: name.into(),
+                    value,
+                    expected: ">= 0".into(),
+                });
+            }
+        }
+        Ok(())
+    }
+}
+
+/// Geometry, lights and a camera: everything needed to render a picture.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Scene {
+    /// The geometry, or `None` for an empty scene (which does not validate).
+    pub geometry: Option<Node>,
+    /// The lights; an empty list renders with ambient light only.
+    pub lights: Vec<Light>,
+    /// The camera.
+    pub camera: Camera,
+}
+
+impl Scene {
+    /// A scene with `geometry`, the default camera and a key light from the
+    /// upper right with a dimmer fill light.
+    #[must_use]
+    pub fn new(geometry: impl Into<Node>) -> Self {
+        Scene {
+            geometry: Some(geometry.into()),
+            ..Scene::empty()
+        }
+    }
+
+    /// A scene with no geometry (add some with [`Scene::add`]), the default
+    /// camera and the default lights.
+    #[must_use]
+    pub fn empty() -> Self {
+        Scene {
+            geometry: None,
+            lights: vec![
+                Light::directional(DVec3::new(0.6, 0.8, 0.4)).intensity(1.0),
+                Light::directional(DVec3::new(-0.7, 0.3, -0.5))
+                    .intensity(0.25)
+                    .color(DVec3::new(0.7, 0.8, 1.0)),
+            ],
+            camera: Camera::default(),
+        }
+    }
+
+    /// Adds geometry (a union with what is already there).
+    #[must_use]
+    pub fn add(mut self, node: impl Into<Node>) -> Self {
+        let node = node.into();
+        self.geometry = Some(match self.geometry.take() {
+            Some(g) => g.union(node),
+            None => node,
+        });
+        self
+    }
+
+    /// Replaces the camera.
+    #[must_use]
+    pub fn with_camera(mut self, camera: Camera) -> Self {
+        self.camera = camera;
+        self
+    }
+
+    /// Replaces the lights.
+    #[must_use]
+    pub fn with_lights(mut self, lights: impl IntoIterator<Item = Light>) -> Self {
+        self.lights = lights.into_iter().collect();
+        self
+    }
+
+    /// Checks every value in the scene: geometry parameters, camera and
+    /// lights.
+    ///
+    /// # Errors
+    /// The first problem found, as a typed [`Error`] naming the node path and
+    /// the parameter.
+    pub fn validate(&self) -> Result<()> {
+        let geometry = self.geometry.as_ref().ok_or(Error::EmptyScene)?;
+        crate::ir::Ir::lower(geometry)?;
+        self.camera.validate()?;
+        for (i, light) in self.lights.iter().enumerate() {
+            light.validate(i)?;
+        }
+        Ok(())
+    }
+}

@@ -1,0 +1,682 @@
+//! The node vocabulary: one enum, [`Kind`], shared by the user-facing scene
+//! tree ([`Node`]) and the lowered IR, so every node type, its parameters
+//! and their validity rules are written down exactly once.
+
+use glam::DVec3;
+
+use super::param::{Param, Param3};
+
+/// The largest iteration count accepted by the escape-time fractals
+/// (Mandelbulb, quaternion Julia).
+pub const MAX_ESCAPE_ITERATIONS: u32 = 256;
+
+/// The largest iteration count accepted by the folding fractals (Menger
+/// sponge, Sierpinski tetrahedron). Each level shrinks detail by the fractal's
+/// scale, so 20 levels of a scale-3 sponge are already below `f64` precision.
+pub const MAX_FOLD_ITERATIONS: u32 = 20;
+
+/// A coordinate axis.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum Axis {
+    /// The x axis.
+    X,
+    /// The y axis.
+    Y,
+    /// The z axis.
+    Z,
+}
+
+impl Axis {
+    /// The axis index: 0, 1 or 2.
+    #[must_use]
+    pub fn index(self) -> usize {
+        self as usize
+    }
+}
+
+/// The boolean operation of a [`Kind::Csg`] node.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum CsgOp {
+    /// Everything in `a` or `b`: `min(a, b)`.
+    Union,
+    /// `a` with `b` carved out of it: `max(a, -b)`.
+    Subtract,
+    /// Only what is in both: `max(a, b)`.
+    Intersect,
+}
+
+/// The Mandelbulb: the escape-time fractal of the "triplex" power map
+/// `z -> z^power + p` in spherical coordinates (White and Nylander).
+///
+/// Distance estimate: `0.5 * ln(r) * r / dr` with the running derivative
+/// `dr`, a bound (it does not overestimate within the sampled tests). The
+/// orbit trap is the smallest `|z|` the orbit reaches, mapped to `[0, 1]`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Mandelbulb<S = Param> {
+    /// The power of the map; at least 2. An integer 8 is the classic bulb.
+    pub power: S,
+    /// Escape-time iterations, 1 to [`MAX_ESCAPE_ITERATIONS`].
+    pub iterations: u32,
+    /// The escape radius; at least 1 (2 is usual).
+    pub bailout: S,
+}
+
+/// The Menger sponge as a folding (KIFS) fractal in the cube `[-1, 1]^3`.
+///
+/// Scale 3 is the classic sponge; other scales in `[2, 4]` give related
+/// sponges. Distance: the exact box distance of the folded point divided by
+/// `scale^iterations`, a bound. Iterations 0 is the solid cube.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Menger<S = Param> {
+    /// Folding levels, 0 to [`MAX_FOLD_ITERATIONS`].
+    pub iterations: u32,
+    /// The scale factor of each level, in `[2, 4]`; 3 is the classic sponge.
+    pub scale: S,
+}
+
+/// A quaternion Julia set `z -> z^2 + c`, sliced at `w = slice_w`.
+///
+/// Distance estimate: `0.5 * |z| * ln|z| / |dz|`, a bound.
+#[derive(Debug, Clone, PartialEq)]
+pub struct QuaternionJulia<S = Param> {
+    /// The constant `c` as (x, y, z, w).
+    pub c: [S; 4],
+    /// Escape-time iterations, 1 to [`MAX_ESCAPE_ITERATIONS`].
+    pub iterations: u32,
+    /// The escape radius; at least 1 (4 is usual).
+    pub bailout: S,
+    /// The w coordinate of the 3D slice through the 4D set.
+    pub slice_w: S,
+}
+
+/// The Sierpinski tetrahedron as a folding (KIFS) fractal, with vertices at
+/// `(1,1,1)`, `(-1,-1,1)`, `(1,-1,-1)` and `(-1,1,-1)`.
+///
+/// Scale 2 is the classic gasket; other scales in `[1.5, 4]` give related
+/// sets. Distance: a tetrahedron bound of the folded point divided by
+/// `scale^iterations`, a bound. Iterations 0 is the solid tetrahedron.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Sierpinski<S = Param> {
+    /// Folding levels, 0 to [`MAX_FOLD_ITERATIONS`].
+    pub iterations: u32,
+    /// The scale factor of each level, in `[1.5, 4]`; 2 is the classic.
+    pub scale: S,
+}
+
+/// Every node type, generic over how a scalar (`S`), a vector (`V`) and a
+/// child (`C`) are stored.
+///
+/// The scene tree uses [`NodeKind`] (`Param`, `Param3`, `Node`); the IR uses
+/// slots and arena handles. All sizes are in scene units, all angles in
+/// radians. "Exact" means the value is the Euclidean distance; "bound" means
+/// it never exceeds it (so rays never skip a surface).
+#[derive(Debug, Clone, PartialEq)]
+pub enum Kind<S, V, C> {
+    /// A sphere at the origin. Exact.
+    Sphere {
+        /// Radius, at least 0.
+        radius: S,
+    },
+    /// An axis-aligned box at the origin. Exact.
+    Cuboid {
+        /// Half the size along each axis, each at least 0.
+        half_extents: V,
+    },
+    /// A box with rounded edges; its outer size is `half_extents`. Exact.
+    RoundBox {
+        /// Half the outer size along each axis, each at least 0.
+        half_extents: V,
+        /// Edge radius, from 0 to the smallest half extent.
+        radius: S,
+    },
+    /// A torus around the y axis. Exact.
+    Torus {
+        /// Distance from the centre to the middle of the tube.
+        major_radius: S,
+        /// Radius of the tube.
+        minor_radius: S,
+    },
+    /// A capped cylinder along the y axis. Exact.
+    Cylinder {
+        /// Radius, at least 0.
+        radius: S,
+        /// Half the height, at least 0.
+        half_height: S,
+    },
+    /// A capsule: all points within `radius` of the segment `a`-`b`. Exact.
+    Capsule {
+        /// One end of the segment.
+        a: V,
+        /// The other end of the segment.
+        b: V,
+        /// Radius, at least 0.
+        radius: S,
+    },
+    /// The half-space `dot(p, normal) + offset <= 0`, normal normalised.
+    /// Exact.
+    Plane {
+        /// The outward normal; must not be zero (it is normalised).
+        normal: V,
+        /// Signed offset along the normal.
+        offset: S,
+    },
+    /// A regular octahedron `|x| + |y| + |z| <= size`. Exact.
+    Octahedron {
+        /// Distance from the centre to each vertex, at least 0.
+        size: S,
+    },
+    /// A cone along y, cut at `±half_height`, with radius `bottom_radius` at
+    /// `-half_height` and `top_radius` at `+half_height`. Exact.
+    CappedCone {
+        /// Half the height, at least 0.
+        half_height: S,
+        /// Radius at the bottom cap, at least 0.
+        bottom_radius: S,
+        /// Radius at the top cap, at least 0.
+        top_radius: S,
+    },
+    /// An axis-aligned ellipsoid. A bound, not exact: the distance is
+    /// underestimated away from the axes (Quilez's `k0 (k0 - 1) / k1`).
+    Ellipsoid {
+        /// Semi-axes, each greater than 0.
+        radii: V,
+    },
+    /// See [`Mandelbulb`].
+    Mandelbulb(Mandelbulb<S>),
+    /// See [`Menger`].
+    Menger(Menger<S>),
+    /// See [`QuaternionJulia`].
+    Julia(QuaternionJulia<S>),
+    /// See [`Sierpinski`].
+    Sierpinski(Sierpinski<S>),
+    /// Moves the child by `offset`. Preserves exactness.
+    Translate {
+        /// The translation.
+        offset: V,
+        /// The moved node.
+        child: C,
+    },
+    /// Rotates the child by `angle` radians around the unit vector `axis`
+    /// (right-handed). Preserves exactness.
+    Rotate {
+        /// The rotation axis, normalised; must not be zero.
+        axis: DVec3,
+        /// The angle in radians.
+        angle: S,
+        /// The rotated node.
+        child: C,
+    },
+    /// Uniform scale; the distance is rescaled, so exactness is preserved.
+    Scale {
+        /// The scale factor, greater than 0.
+        factor: S,
+        /// The scaled node.
+        child: C,
+    },
+    /// Mirror symmetry across the plane through the origin normal to `axis`:
+    /// the child's positive half appears on both sides. Exact when the child
+    /// is symmetric or lies entirely on the positive side; a bound otherwise.
+    Mirror {
+        /// The axis normal to the mirror plane.
+        axis: Axis,
+        /// The mirrored node.
+        child: C,
+    },
+    /// Rounds the child: grows it by `radius` (`d - radius`).
+    Round {
+        /// The rounding radius, at least 0.
+        radius: S,
+        /// The rounded node.
+        child: C,
+    },
+    /// A shell of the child's surface: `|d| - thickness`.
+    Onion {
+        /// Half the shell thickness, at least 0.
+        thickness: S,
+        /// The shelled node.
+        child: C,
+    },
+    /// Stretches the child by inserting `extents` of straight material at
+    /// the origin along each axis (`p - clamp(p, -h, h)`). Exact outside,
+    /// a bound inside.
+    Elongate {
+        /// How far to stretch along each axis (each half), at least 0.
+        extents: V,
+        /// The elongated node.
+        child: C,
+    },
+    /// Infinite repetition with cell size `period` (0 on an axis: no
+    /// repetition there). Exact when the child fits in half a cell.
+    Repeat {
+        /// Cell size along each axis, at least 0.
+        period: V,
+        /// The repeated node.
+        child: C,
+    },
+    /// Repetition limited to cells `-limit..=limit` on each axis.
+    RepeatLimited {
+        /// Cell size along each axis, at least 0.
+        period: V,
+        /// How many copies each side of the original, per axis.
+        limit: [u32; 3],
+        /// The repeated node.
+        child: C,
+    },
+    /// Twists the child around the y axis by `rate` radians per unit of y.
+    /// The twist stretches space by a local Lipschitz factor
+    /// `L = t/2 + sqrt(1 + t^2/4)`, `t = |rate| (rho + |d|)` (rho: distance
+    /// from the y axis); the distance is divided by it, so it stays a bound.
+    Twist {
+        /// Radians of twist per unit along y.
+        rate: S,
+        /// The twisted node.
+        child: C,
+    },
+    /// Bends the child in the xy plane by `rate` radians per unit of x.
+    /// Local Lipschitz factor `1 + |rate| (rho + |d|)` (rho: length of
+    /// `p.xy`); the distance is divided by it, so it stays a bound.
+    Bend {
+        /// Radians of bend per unit along x.
+        rate: S,
+        /// The bent node.
+        child: C,
+    },
+    /// A boolean of two nodes, hard (`smoothing: None`) or smooth with the
+    /// polynomial smooth minimum of radius `k`, which deviates from the hard
+    /// operation by at most `k / 4` and equals it at `k = 0`. Colours blend
+    /// across the smooth seam.
+    Csg {
+        /// Union, subtraction or intersection.
+        op: CsgOp,
+        /// The smoothing radius `k >= 0`, or `None` for the hard operation.
+        smoothing: Option<S>,
+        /// The first operand.
+        a: C,
+        /// The second operand.
+        b: C,
+    },
+    /// Paints the child (every surface below this node) with a linear RGB
+    /// colour.
+    Color {
+        /// Linear RGB, each at least 0.
+        color: V,
+        /// The painted node.
+        child: C,
+    },
+}
+
+/// What a parameter must satisfy. Every rule also requires a finite value.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Rule {
+    /// Any finite value.
+    Finite,
+    /// At least 0.
+    NonNegative,
+    /// Greater than 0.
+    Positive,
+    /// Within `[min, max]`.
+    Range(f64, f64),
+}
+
+impl Rule {
+    /// Whether `v` satisfies the rule.
+    #[must_use]
+    pub fn accepts(self, v: f64) -> bool {
+        v.is_finite()
+            && match self {
+                Rule::Finite => true,
+                Rule::NonNegative => v >= 0.0,
+                Rule::Positive => v > 0.0,
+                Rule::Range(lo, hi) => (lo..=hi).contains(&v),
+            }
+    }
+
+    /// A short human description, such as `">= 0"`.
+    #[must_use]
+    pub fn describe(self) -> String {
+        match self {
+            Rule::Finite => "finite".into(),
+            Rule::NonNegative => ">= 0".into(),
+            Rule::Positive => "> 0".into(),
+            Rule::Range(lo, hi) => format!("in [{lo}, {hi}]"),
+        }
+    }
+}
+
+/// A parameter's name within its node and the rule it must satisfy.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ParamSpec {
+    /// The field name, such as `"radius"`.
+    pub name: &'static str,
+    /// What the value must satisfy.
+    pub rule: Rule,
+}
+
+const fn spec(name: &'static str, rule: Rule) -> ParamSpec {
+    ParamSpec { name, rule }
+}
+
+/// Converts the scalars, vectors and children of a [`Kind`] into another
+/// representation, failing with `E`. Used by lowering and validation.
+pub(crate) trait Mapper<S, V, C> {
+    type S2;
+    type V2;
+    type C2;
+    type E;
+    fn scalar(&mut self, s: &S, spec: ParamSpec) -> Result<Self::S2, Self::E>;
+    fn vector(&mut self, v: &V, spec: ParamSpec) -> Result<Self::V2, Self::E>;
+    fn child(&mut self, c: &C) -> Result<Self::C2, Self::E>;
+}
+
+impl<S, V, C> Kind<S, V, C> {
+    /// The node type's name, as used in error messages.
+    #[must_use]
+    pub fn name(&self) -> &'static str {
+        match self {
+            Kind::Sphere { .. } => "sphere",
+            Kind::Cuboid { .. } => "cuboid",
+            Kind::RoundBox { .. } => "round_box",
+            Kind::Torus { .. } => "torus",
+            Kind::Cylinder { .. } => "cylinder",
+            Kind::Capsule { .. } => "capsule",
+            Kind::Plane { .. } => "plane",
+            Kind::Octahedron { .. } => "octahedron",
+            Kind::CappedCone { .. } => "capped_cone",
+            Kind::Ellipsoid { .. } => "ellipsoid",
+            Kind::Mandelbulb(_) => "mandelbulb",
+            Kind::Menger(_) => "menger",
+            Kind::Julia(_) => "julia",
+            Kind::Sierpinski(_) => "sierpinski",
+            Kind::Translate { .. } => "translate",
+            Kind::Rotate { .. } => "rotate",
+            Kind::Scale { .. } => "scale",
+            Kind::Mirror { .. } => "mirror",
+            Kind::Round { .. } => "round",
+            Kind::Onion { .. } => "onion",
+            Kind::Elongate { .. } => "elongate",
+            Kind::Repeat { .. } => "repeat",
+            Kind::RepeatLimited { .. } => "repeat_limited",
+            Kind::Twist { .. } => "twist",
+            Kind::Bend { .. } => "bend",
+            Kind::Csg { op, smoothing, .. } => match (op, smoothing.is_some()) {
+                (CsgOp::Union, false) => "union",
+                (CsgOp::Subtract, false) => "subtract",
+                (CsgOp::Intersect, false) => "intersect",
+                (CsgOp::Union, true) => "smooth_union",
+                (CsgOp::Subtract, true) => "smooth_subtract",
+                (CsgOp::Intersect, true) => "smooth_intersect",
+            },
+            Kind::Color { .. } => "color",
+        }
+    }
+
+    /// The node's children, in order (`a` before `b`).
+    #[must_use]
+    pub fn children(&self) -> Vec<&C> {
+        match self {
+            Kind::Sphere { .. }
+            | Kind::Cuboid { .. }
+            | Kind::RoundBox { .. }
+            | Kind::Torus { .. }
+            | Kind::Cylinder { .. }
+            | Kind::Capsule { .. }
+            | Kind::Plane { .. }
+            | Kind::Octahedron { .. }
+            | Kind::CappedCone { .. }
+            | Kind::Ellipsoid { .. }
+            | Kind::Mandelbulb(_)
+            | Kind::Menger(_)
+            | Kind::Julia(_)
+            | Kind::Sierpinski(_) => vec![],
+            Kind::Translate { child, .. }
+            | Kind::Rotate { child, .. }
+            | Kind::Scale { child, .. }
+            | Kind::Mirror { child, .. }
+            | Kind::Round { child, .. }
+            | Kind::Onion { child, .. }
+            | Kind::Elongate { child, .. }
+            | Kind::Repeat { child, .. }
+            | Kind::RepeatLimited { child, .. }
+            | Kind::Twist { child, .. }
+            | Kind::Bend { child, .. }
+            | Kind::Color { child, .. } => vec![child],
+            Kind::Csg { a, b, .. } => vec![a, b],
+        }
+    }
+
+    /// Whether this is one of the four fractals.
+    #[must_use]
+    pub fn is_fractal(&self) -> bool {
+        matches!(
+            self,
+            Kind::Mandelbulb(_) | Kind::Menger(_) | Kind::Julia(_) | Kind::Sierpinski(_)
+        )
+    }
+
+    /// The node's iteration count, for the fractals.
+    #[must_use]
+    pub fn iterations(&self) -> Option<u32> {
+        match self {
+            Kind::Mandelbulb(m) => Some(m.iterations),
+            Kind::Menger(m) => Some(m.iterations),
+            Kind::Julia(j) => Some(j.iterations),
+            Kind::Sierpinski(s) => Some(s.iterations),
+            _ => None,
+        }
+    }
+
+    /// The allowed iteration range, for the fractals.
+    #[must_use]
+    pub fn iteration_range(&self) -> Option<(u32, u32)> {
+        match self {
+            Kind::Mandelbulb(_) | Kind::Julia(_) => Some((1, MAX_ESCAPE_ITERATIONS)),
+            Kind::Menger(_) | Kind::Sierpinski(_) => Some((0, MAX_FOLD_ITERATIONS)),
+            _ => None,
+        }
+    }
+
+    /// Rebuilds the node with every scalar, vector and child converted by
+    /// `m`, which sees each parameter's name and rule. This match is the one
+    /// place that lists which parameters each node has.
+    pub(crate) fn try_map<M>(&self, m: &mut M) -> Result<Kind<M::S2, M::V2, M::C2>, M::E>
+    where
+        M: Mapper<S, V, C>,
+    {
+        use Rule::{Finite, NonNegative, Positive, Range};
+        Ok(match self {
+            Kind::Sphere { radius } => Kind::Sphere {
+                radius: m.scalar(radius, spec("radius", NonNegative))?,
+            },
+            Kind::Cuboid { half_extents } => Kind::Cuboid {
+                half_extents: m.vector(half_extents, spec("half_extents", NonNegative))?,
+            },
+            Kind::RoundBox {
+                half_extents,
+                radius,
+            } => Kind::RoundBox {
+                half_extents: m.vector(half_extents, spec("half_extents", NonNegative))?,
+                radius: m.scalar(radius, spec("radius", NonNegative))?,
+            },
+            Kind::Torus {
+                major_radius,
+                minor_radius,
+            } => Kind::Torus {
+                major_radius: m.scalar(major_radius, spec("major_radius", NonNegative))?,
+                minor_radius: m.scalar(minor_radius, spec("minor_radius", NonNegative))?,
+            },
+            Kind::Cylinder {
+                radius,
+                half_height,
+            } => Kind::Cylinder {
+                radius: m.scalar(radius, spec("radius", NonNegative))?,
+                half_height: m.scalar(half_height, spec("half_height", NonNegative))?,
+            },
+            Kind::Capsule { a, b, radius } => Kind::Capsule {
+                a: m.vector(a, spec("a", Finite))?,
+                b: m.vector(b, spec("b", Finite))?,
+                radius: m.scalar(radius, spec("radius", NonNegative))?,
+            },
+            Kind::Plane { normal, offset } => Kind::Plane {
+                normal: m.vector(normal, spec("normal", Finite))?,
+                offset: m.scalar(offset, spec("offset", Finite))?,
+            },
+            Kind::Octahedron { size } => Kind::Octahedron {
+                size: m.scalar(size, spec("size", NonNegative))?,
+            },
+            Kind::CappedCone {
+                half_height,
+                bottom_radius,
+                top_radius,
+            } => Kind::CappedCone {
+                half_height: m.scalar(half_height, spec("half_height", NonNegative))?,
+                bottom_radius: m.scalar(bottom_radius, spec("bottom_radius", NonNegative))?,
+                top_radius: m.scalar(top_radius, spec("top_radius", NonNegative))?,
+            },
+            Kind::Ellipsoid { radii } => Kind::Ellipsoid {
+                radii: m.vector(radii, spec("radii", Positive))?,
+            },
+            Kind::Mandelbulb(f) => Kind::Mandelbulb(Mandelbulb {
+                power: m.scalar(&f.power, spec("power", Range(2.0, 64.0)))?,
+                iterations: f.iterations,
+                bailout: m.scalar(&f.bailout, spec("bailout", Range(1.0, 1e6)))?,
+            }),
+            Kind::Menger(f) => Kind::Menger(Menger {
+                iterations: f.iterations,
+                scale: m.scalar(&f.scale, spec("scale", Range(2.0, 4.0)))?,
+            }),
+            Kind::Julia(f) => Kind::Julia(QuaternionJulia {
+                c: [
+                    m.scalar(&f.c[0], spec("c.x", Range(-4.0, 4.0)))?,
+                    m.scalar(&f.c[1], spec("c.y", Range(-4.0, 4.0)))?,
+                    m.scalar(&f.c[2], spec("c.z", Range(-4.0, 4.0)))?,
+                    m.scalar(&f.c[3], spec("c.w", Range(-4.0, 4.0)))?,
+                ],
+                iterations: f.iterations,
+                bailout: m.scalar(&f.bailout, spec("bailout", Range(1.0, 1e6)))?,
+                slice_w: m.scalar(&f.slice_w, spec("slice_w", Finite))?,
+            }),
+            Kind::Sierpinski(f) => Kind::Sierpinski(Sierpinski {
+                iterations: f.iterations,
+                scale: m.scalar(&f.scale, spec("scale", Range(1.5, 4.0)))?,
+            }),
+            Kind::Translate { offset, child } => Kind::Translate {
+                offset: m.vector(offset, spec("offset", Finite))?,
+                child: m.child(child)?,
+            },
+            Kind::Rotate { axis, angle, child } => Kind::Rotate {
+                axis: *axis,
+                angle: m.scalar(angle, spec("angle", Finite))?,
+                child: m.child(child)?,
+            },
+            Kind::Scale { factor, child } => Kind::Scale {
+                factor: m.scalar(factor, spec("factor", Positive))?,
+                child: m.child(child)?,
+            },
+            Kind::Mirror { axis, child } => Kind::Mirror {
+                axis: *axis,
+                child: m.child(child)?,
+            },
+            Kind::Round { radius, child } => Kind::Round {
+                radius: m.scalar(radius, spec("radius", NonNegative))?,
+                child: m.child(child)?,
+            },
+            Kind::Onion { thickness, child } => Kind::Onion {
+                thickness: m.scalar(thickness, spec("thickness", NonNegative))?,
+                child: m.child(child)?,
+            },
+            Kind::Elongate { extents, child } => Kind::Elongate {
+                extents: m.vector(extents, spec("extents", NonNegative))?,
+                child: m.child(child)?,
+            },
+            Kind::Repeat { period, child } => Kind::Repeat {
+                period: m.vector(period, spec("period", NonNegative))?,
+                child: m.child(child)?,
+            },
+            Kind::RepeatLimited {
+                period,
+                limit,
+                child,
+            } => Kind::RepeatLimited {
+                period: m.vector(period, spec("period", NonNegative))?,
+                limit: *limit,
+                child: m.child(child)?,
+            },
+            Kind::Twist { rate, child } => Kind::Twist {
+                rate: m.scalar(rate, spec("rate", Finite))?,
+                child: m.child(child)?,
+            },
+            Kind::Bend { rate, child } => Kind::Bend {
+                rate: m.scalar(rate, spec("rate", Finite))?,
+                child: m.child(child)?,
+            },
+            Kind::Csg {
+                op,
+                smoothing,
+                a,
+                b,
+            } => Kind::Csg {
+                op: *op,
+                smoothing: match smoothing {
+                    Some(k) => Some(m.scalar(k, spec("k", NonNegative))?),
+                    None => None,
+                },
+                a: m.child(a)?,
+                b: m.child(b)?,
+            },
+            Kind::Color { color, child } => Kind::Color {
+                color: m.vector(color, spec("color", NonNegative))?,
+                child: m.child(child)?,
+            },
+        })
+    }
+}
+
+/// The node kind of the user-facing scene tree.
+pub type NodeKind = Kind<Param, Param3, Node>;
+
+/// A node of a scene: a shape, a fractal, or an operation on other nodes.
+///
+/// Build nodes with the free functions ([`sphere`](super::sphere),
+/// [`mandelbulb`](super::mandelbulb), ...) and combine them with the methods
+/// in [`build`](super::build). A `Node` is a plain value: clone it, compare
+/// it, keep it in a `Vec`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Node(Box<NodeKind>);
+
+impl Node {
+    /// The node's kind and parameters.
+    #[must_use]
+    pub fn kind(&self) -> &NodeKind {
+        &self.0
+    }
+}
+
+impl From<NodeKind> for Node {
+    fn from(kind: NodeKind) -> Self {
+        Node(Box::new(kind))
+    }
+}
+
+impl From<Mandelbulb> for Node {
+    fn from(f: Mandelbulb) -> Self {
+        Kind::Mandelbulb(f).into()
+    }
+}
+
+impl From<Menger> for Node {
+    fn from(f: Menger) -> Self {
+        Kind::Menger(f).into()
+    }
+}
+
+impl From<QuaternionJulia> for Node {
+    fn from(f: QuaternionJulia) -> Self {
+        Kind::Julia(f).into()
+    }
+}
+
+impl From<Sierpinski> for Node {
+    fn from(f: Sierpinski) -> Self {
+        Kind::Sierpinski(f).into()
+    }
+}
