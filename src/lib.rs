@@ -58,6 +58,7 @@
 pub mod cpu;
 pub mod error;
 pub mod ir;
+pub mod quality;
 pub mod scene;
 
 pub use error::{Error, Result};
@@ -67,6 +68,7 @@ pub use scene::{Node, Scene};
 pub mod prelude {
     pub use crate::cpu;
     pub use crate::error::{Error, Result};
+    pub use crate::quality::{Effects, Glow, Precision, Quality};
     pub use crate::scene::{
         Axis, Camera, Light, Mandelbulb, Menger, Node, Param, Param3, Projection, QuaternionJulia,
         Scene, Sierpinski, capped_cone, capsule, cuboid, cylinder, ellipsoid, julia, mandelbulb,

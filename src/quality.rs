@@ -1,0 +1,285 @@
+//! Render settings: how accurately to march ([`Quality`]) and which
+//! lighting effects to compile in ([`Effects`]).
+//!
+//! Both are plain data read by code generation: an effect that is off, or a
+//! sample count of zero, produces no code at all.
+
+use glam::DVec3;
+
+use crate::error::{Error, Result};
+
+/// Floating-point precision of the generated kernel.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
+pub enum Precision {
+    /// 32-bit floats: fastest, every device supports them.
+    #[default]
+    F32,
+    /// 64-bit floats via `cl_khr_fp64`: for deep zooms and huge or tiny
+    /// scales. Slower, and not every device has it.
+    F64,
+}
+
+/// Every speed-versus-accuracy knob. Start from a preset and adjust.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Quality {
+    /// Give up on a ray after this many steps.
+    pub max_steps: u32,
+    /// Hit threshold as a multiple of the pixel footprint at the hit distance
+    /// (1.0: the surface is resolved to about one pixel).
+    pub hit_epsilon: f64,
+    /// Rays stop beyond this distance from the camera.
+    pub max_distance: f64,
+    /// Normal finite-difference step as a multiple of the pixel footprint.
+    pub normal_epsilon: f64,
+    /// Ambient-occlusion samples along the normal (0: no occlusion term).
+    pub ao_samples: u32,
+    /// Spacing of ambient-occlusion samples in scene units.
+    pub ao_step: f64,
+    /// Maximum steps of each shadow ray (0: no shadows).
+    pub shadow_steps: u32,
+    /// If set, every fractal uses this many iterations instead of its own.
+    pub fractal_iterations: Option<u32>,
+    /// Kernel precision.
+    pub precision: Precision,
+    /// Over-relaxation factor for sphere tracing, in `[1, 2)`; 1 is plain
+    /// sphere tracing. Larger values take longer steps and fall back when
+    /// they overshoot.
+    pub over_relaxation: f64,
+    /// Samples per pixel along each axis (N×N jittered samples; 1: one
+    /// sample at the pixel centre).
+    pub supersampling: u32,
+}
+
+impl Quality {
+    /// Fast previews while moving: few steps, coarse threshold, no AO.
+    #[must_use]
+    pub fn draft() -> Self {
+        Quality {
+            max_steps: 64,
+            hit_epsilon: 4.0,
+            max_distance: 50.0,
+            normal_epsilon: 2.0,
+            ao_samples: 0,
+            ao_step: 0.05,
+            shadow_steps: 0,
+            fractal_iterations: None,
+            precision: Precision::F32,
+            over_relaxation: 1.0,
+            supersampling: 1,
+        }
+    }
+
+    /// Interactive quality.
+    #[must_use]
+    pub fn preview() -> Self {
+        Quality {
+            max_steps: 128,
+            hit_epsilon: 1.5,
+            ao_samples: 3,
+            shadow_steps: 32,
+            ..Self::draft()
+        }
+    }
+
+    /// Final images.
+    #[must_use]
+    pub fn production() -> Self {
+        Quality {
+            max_steps: 256,
+            hit_epsilon: 0.75,
+            max_distance: 100.0,
+            normal_epsilon: 1.0,
+            ao_samples: 5,
+            shadow_steps: 96,
+            ..Self::preview()
+        }
+    }
+
+    /// The accuracy reference: F64, many steps, a tiny threshold.
+    #[must_use]
+    pub fn reference() -> Self {
+        Quality {
+            max_steps: 2048,
+            hit_epsilon: 0.1,
+            normal_epsilon: 0.5,
+            shadow_steps: 256,
+            precision: Precision::F64,
+            ..Self::production()
+        }
+    }
+
+    /// Checks every knob.
+    ///
+    /// # Errors
+    /// [`Error::Quality`] naming the first bad setting.
+    pub fn validate(&self) -> Result<()> {
+        let check = |setting: &'static str, value: f64, ok: bool, expected: &str| {
+            if ok && value.is_finite() {
+                Ok(())
+            } else {
+                Err(Error::Quality {
+                    setting,
+                    value,
+                    expected: expected.into(),
+                })
+            }
+        };
+        let steps = f64::from(self.max_steps);
+        check(
+            "max_steps",
+            steps,
+            (1..=100_000).contains(&self.max_steps),
+            "in 1..=100000",
+        )?;
+        check(
+            "hit_epsilon",
+            self.hit_epsilon,
+            self.hit_epsilon > 0.0,
+            "> 0",
+        )?;
+        check(
+            "max_distance",
+            self.max_distance,
+            self.max_distance > 0.0,
+            "> 0",
+        )?;
+        check(
+            "normal_epsilon",
+            self.normal_epsilon,
+            self.normal_epsilon > 0.0,
+            "> 0",
+        )?;
+        check(
+            "ao_samples",
+            f64::from(self.ao_samples),
+            self.ao_samples <= 32,
+            "<= 32",
+        )?;
+        check("ao_step", self.ao_step, self.ao_step > 0.0, "> 0")?;
+        check(
+            "shadow_steps",
+            f64::from(self.shadow_steps),
+            self.shadow_steps <= 10_000,
+            "<= 10000",
+        )?;
+        if let Some(n) = self.fractal_iterations {
+            check(
+                "fractal_iterations",
+                f64::from(n),
+                (1..=256).contains(&n),
+                "in 1..=256",
+            )?;
+        }
+        check(
+            "over_relaxation",
+            self.over_relaxation,
+            (1.0..2.0).contains(&self.over_relaxation),
+            "in [1, 2)",
+        )?;
+        check(
+            "supersampling",
+            f64::from(self.supersampling),
+            (1..=8).contains(&self.supersampling),
+            "in 1..=8",
+        )
+    }
+}
+
+impl Default for Quality {
+    /// [`Quality::production`].
+    fn default() -> Self {
+        Self::production()
+    }
+}
+
+/// Glow around surfaces, from how closely a ray passed them.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Glow {
+    /// Linear RGB colour of the glow.
+    pub color: DVec3,
+    /// Strength; 0.5 is subtle, 2 is strong.
+    pub strength: f64,
+}
+
+/// Lighting effects. Each one that is off is left out of the kernel.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Effects {
+    /// Ambient occlusion (needs [`Quality::ao_samples`] > 0).
+    pub ambient_occlusion: bool,
+    /// Shadows from every light (needs [`Quality::shadow_steps`] > 0);
+    /// soft where the light's softness is above 0.
+    pub shadows: bool,
+    /// Glow on rays that pass close to a surface.
+    pub glow: Option<Glow>,
+    /// Distance fog: the fraction of light lost per unit, 0 for none.
+    pub fog_density: f64,
+    /// Colour of the background at the top of the image (linear RGB).
+    pub sky_top: DVec3,
+    /// Colour of the background at the bottom of the image (linear RGB).
+    pub sky_bottom: DVec3,
+    /// Output gamma (2.2 for sRGB-like output; 1 for linear).
+    pub gamma: f64,
+}
+
+impl Default for Effects {
+    /// Ambient occlusion and shadows on, no glow, no fog, a blue-grey
+    /// gradient background.
+    fn default() -> Self {
+        Effects {
+            ambient_occlusion: true,
+            shadows: true,
+            glow: None,
+            fog_density: 0.0,
+            sky_top: DVec3::new(0.32, 0.42, 0.58),
+            sky_bottom: DVec3::new(0.06, 0.07, 0.09),
+            gamma: 2.2,
+        }
+    }
+}
+
+impl Effects {
+    /// Everything off: plain diffuse shading on the background.
+    #[must_use]
+    pub fn none() -> Self {
+        Effects {
+            ambient_occlusion: false,
+            shadows: false,
+            glow: None,
+            fog_density: 0.0,
+            ..Self::default()
+        }
+    }
+
+    /// Checks every value.
+    ///
+    /// # Errors
+    /// [`Error::Quality`] naming the first bad setting.
+    pub fn validate(&self) -> Result<()> {
+        let bad = |setting: &'static str, value: f64, expected: &str| Error::Quality {
+            setting,
+            value,
+            expected: expected.into(),
+        };
+        if let Some(g) = self.glow {
+            let lowest = g.color.min_element();
+            if !(g.color.is_finite() && lowest >= 0.0) {
+                return Err(bad("glow.color", lowest, "finite and >= 0"));
+            }
+            if !(g.strength.is_finite() && g.strength >= 0.0) {
+                return Err(bad("glow.strength", g.strength, "finite and >= 0"));
+            }
+        }
+        if !(self.fog_density.is_finite() && self.fog_density >= 0.0) {
+            return Err(bad("fog_density", self.fog_density, "finite and >= 0"));
+        }
+        for (name, c) in [("sky_top", self.sky_top), ("sky_bottom", self.sky_bottom)] {
+            if !(c.is_finite() && c.min_element() >= 0.0) {
+                return Err(bad(name, c.min_element(), "finite and >= 0"));
+            }
+        }
+        if !(self.gamma.is_finite() && self.gamma > 0.0) {
+            return Err(bad("gamma", self.gamma, "> 0"));
+        }
+        Ok(())
+    }
+}
