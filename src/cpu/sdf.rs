@@ -159,8 +159,13 @@ pub fn mandelbulb<T: Real>(
             break;
         }
         trap = trap.min(r);
-        dr = (power * r.powf(power - T::one()) * dr + T::one()).min(T::derivative_cap());
-        let zr = r.powf(power);
+        // r^(power - 1), by repeated multiplication in the integer form.
+        let r_pow = match integer_power {
+            Some(n) => r.powi(n as i32 - 1),
+            None => r.powf(power - T::one()),
+        };
+        dr = (power * r_pow * dr + T::one()).min(T::derivative_cap());
+        let zr = r_pow * r;
         let rho = z.x.hypot(z.y);
         let (st, ct, sp, cp) = match integer_power {
             Some(n) => {

@@ -1,0 +1,1 @@
+/* The marcher lands with the executor. */

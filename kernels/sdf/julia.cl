@@ -1,0 +1,18 @@
+/* Quaternion Julia z -> z^2 + c at the point (p, w), real part first. */
+real julia(real3 p, real4 c, real w, int iterations, real bailout, real* trap) {
+    real4 z = (real4)(p, w);
+    real mz2 = dot(z, z);
+    real md2 = R(1.0);
+    real t = mz2;
+    real bailout2 = bailout * bailout;
+    for (int i = 0; i < iterations; i++) {
+        md2 = fmin(md2 * R(4.0) * mz2, DERIVATIVE_CAP);
+        real two_x = R(2.0) * z.x;
+        z = (real4)(z.x * z.x - z.y * z.y - z.z * z.z - z.w * z.w, two_x * z.y, two_x * z.z, two_x * z.w) + c;
+        mz2 = dot(z, z);
+        t = fmin(t, mz2);
+        if (mz2 > bailout2) break;
+    }
+    *trap = fmin(sqrt(t), R(1.0));
+    return R(0.25) * log(fmax(mz2, REAL_TINY)) * sqrt(mz2 / fmax(md2, REAL_TINY));
+}

@@ -1,0 +1,3 @@
+real sd_sphere(real3 p, real r) {
+    return length(p) - r;
+}

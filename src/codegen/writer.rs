@@ -1,0 +1,147 @@
+//! A small source writer: indentation, a fixed statement style and the one
+//! place float literals are formatted.
+
+use std::fmt::Write as _;
+
+use crate::ir::Scalar;
+use crate::quality::Precision;
+
+/// Accumulates OpenCL C source with an indentation level.
+pub(crate) struct Writer {
+    out: String,
+    indent: usize,
+    precision: Precision,
+}
+
+impl Writer {
+    pub(crate) fn new(precision: Precision) -> Self {
+        Writer {
+            out: String::new(),
+            indent: 0,
+            precision,
+        }
+    }
+
+    /// Writes one line at the current indentation.
+    pub(crate) fn line(&mut self, text: impl AsRef<str>) {
+        let text = text.as_ref();
+        if !text.is_empty() {
+            self.out.extend(std::iter::repeat_n("    ", self.indent));
+            self.out.push_str(text);
+        }
+        self.out.push('\n');
+    }
+
+    /// Writes a block of text verbatim (used for the embedded kernels).
+    pub(crate) fn raw(&mut self, text: &str) {
+        self.out.push_str(text);
+        if !text.ends_with('\n') {
+            self.out.push('\n');
+        }
+    }
+
+    /// Opens a `{` block.
+    pub(crate) fn open(&mut self, head: impl AsRef<str>) {
+        self.line(format!("{} {{", head.as_ref()));
+        self.indent += 1;
+    }
+
+    /// Closes a block.
+    pub(crate) fn close(&mut self) {
+        self.indent -= 1;
+        self.line("}");
+    }
+
+    /// A float literal of the kernel's precision that reads back as exactly
+    /// `v` rounded to that precision: `1.0f`, `(-0.5f)`, `1e-30f`. F64 has no
+    /// suffix. Non-finite values never reach code generation (validation
+    /// rejects them); if one did, this panics rather than emit `inf`.
+    pub(crate) fn float(&self, v: f64) -> String {
+        literal(v, self.precision)
+    }
+
+    /// A scalar parameter: a literal, or a read of the parameter buffer.
+    pub(crate) fn scalar(&self, s: Scalar) -> String {
+        match s {
+            Scalar::Baked(v) => self.float(v),
+            Scalar::Dynamic(slot) => format!("params[{slot}]"),
+        }
+    }
+
+    /// A vector parameter as a `real3` expression.
+    pub(crate) fn vector(&self, v: [Scalar; 3]) -> String {
+        let [x, y, z] = v.map(|s| self.scalar(s));
+        if x == y && y == z {
+            format!("(real3)({x})")
+        } else {
+            format!("(real3)({x}, {y}, {z})")
+        }
+    }
+
+    pub(crate) fn finish(self) -> String {
+        self.out
+    }
+}
+
+/// Formats `v` as an OpenCL C literal of `precision` (see [`Writer::float`]).
+///
+/// # Panics
+/// If `v` is NaN or infinite.
+#[must_use]
+pub fn literal(v: f64, precision: Precision) -> String {
+    assert!(
+        v.is_finite(),
+        "non-finite literal {v} reached code generation"
+    );
+    let mut s = String::new();
+    match precision {
+        // Debug formatting is the shortest text that parses back to the same
+        // value, with a `.` or an exponent, so it is a valid C float constant.
+        #[allow(clippy::cast_possible_truncation)]
+        Precision::F32 => write!(s, "{:?}f", v as f32),
+        Precision::F64 => write!(s, "{v:?}"),
+    }
+    .expect("writing to a String cannot fail");
+    if s.starts_with('-') {
+        format!("({s})")
+    } else {
+        s
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn literals_round_trip_exactly() {
+        for v in [
+            0.0,
+            1.0,
+            -0.5,
+            0.1,
+            1e-30,
+            1e30,
+            3.141_592_653_589_793,
+            1.0 / 3.0,
+        ] {
+            let f = literal(v, Precision::F32);
+            #[allow(clippy::cast_possible_truncation)]
+            let expect = v as f32;
+            let text = f.trim_matches(['(', ')']).trim_end_matches('f');
+            assert_eq!(text.parse::<f32>().unwrap(), expect, "{f}");
+            assert!(
+                f.contains('.') || f.contains('e'),
+                "{f} is not a float constant"
+            );
+            let d = literal(v, Precision::F64);
+            assert_eq!(d.trim_matches(['(', ')']).parse::<f64>().unwrap(), v, "{d}");
+        }
+    }
+
+    #[test]
+    #[should_panic(expected = "non-finite")]
+    fn non_finite_literals_are_refused() {
+        let _ = literal(f64::NAN, Precision::F32);
+    }
+}
