@@ -122,7 +122,7 @@ mod tests {
             0.1,
             1e-30,
             1e30,
-            3.141_592_653_589_793,
+            std::f64::consts::PI,
             1.0 / 3.0,
         ] {
             let f = literal(v, Precision::F32);

@@ -368,6 +368,13 @@ pub(crate) trait Mapper<S, V, C> {
     fn child(&mut self, c: &C) -> Result<Self::C2, Self::E>;
 }
 
+/// The result of mapping a `Kind<S, V, C>` with `M`.
+pub(crate) type Mapped<S, V, C, M> = Kind<
+    <M as Mapper<S, V, C>>::S2,
+    <M as Mapper<S, V, C>>::V2,
+    <M as Mapper<S, V, C>>::C2,
+>;
+
 impl<S, V, C> Kind<S, V, C> {
     /// The node type's name, as used in error messages.
     #[must_use]
@@ -478,7 +485,7 @@ impl<S, V, C> Kind<S, V, C> {
     /// Rebuilds the node with every scalar, vector and child converted by
     /// `m`, which sees each parameter's name and rule. This match is the one
     /// place that lists which parameters each node has.
-    pub(crate) fn try_map<M>(&self, m: &mut M) -> Result<Kind<M::S2, M::V2, M::C2>, M::E>
+    pub(crate) fn try_map<M>(&self, m: &mut M) -> Result<Mapped<S, V, C, M>, M::E>
     where
         M: Mapper<S, V, C>,
     {
