@@ -9,6 +9,8 @@
 
 use std::collections::HashMap;
 
+use glam::{DQuat, DVec3};
+
 use crate::error::{Error, Result};
 use crate::scene::{Kind, Mapper, Node, Param, Param3, ParamSpec, Rule};
 
@@ -158,6 +160,14 @@ impl ParamValues {
     }
 }
 
+/// The vector's value if every component is baked.
+fn baked3(v: Vector) -> Option<DVec3> {
+    match v {
+        [Scalar::Baked(x), Scalar::Baked(y), Scalar::Baked(z)] => Some(DVec3::new(x, y, z)),
+        _ => None,
+    }
+}
+
 fn check_rule(node: &str, param: &str, value: f64, rule: Rule) -> Result<()> {
     if !value.is_finite() {
         return Err(Error::NonFinite {
@@ -199,9 +209,117 @@ impl Lowering {
         let lowered = kind.try_map(self)?;
         self.operand = saved_operand;
         self.path = saved;
+        let folded = self.fold(lowered);
         let id = NodeId(u32::try_from(self.nodes.len()).expect("fewer than 2^32 nodes"));
-        self.nodes.push(lowered);
+        self.nodes.push(folded);
         Ok(id)
+    }
+
+    /// Folds what can be folded at compile time: chains of baked
+    /// translations, rotations and scales become one node, identity
+    /// transforms and a `k = 0` smoothing disappear, and an outer colour
+    /// over an inner one (which wins) is dropped. A single-child node's child
+    /// is always the last node pushed, so merging pops it.
+    fn fold(&mut self, node: IrNode) -> IrNode {
+        use Scalar::Baked;
+        let child_of = |n: &IrNode| match n {
+            Kind::Translate { child, .. }
+            | Kind::Rotate { child, .. }
+            | Kind::Scale { child, .. }
+            | Kind::Color { child, .. } => Some(*child),
+            _ => None,
+        };
+        let Some(child) = child_of(&node) else {
+            return match node {
+                Kind::Csg {
+                    op,
+                    smoothing: Some(Baked(k)),
+                    a,
+                    b,
+                } if k == 0.0 => Kind::Csg {
+                    op,
+                    smoothing: None,
+                    a,
+                    b,
+                },
+                other => other,
+            };
+        };
+        debug_assert_eq!(child.index() + 1, self.nodes.len());
+        let inner = &self.nodes[child.index()];
+        let merged = match (&node, inner) {
+            (Kind::Translate { offset, .. }, _) if *offset == [Baked(0.0); 3] => {
+                Some(inner.clone())
+            }
+            (
+                Kind::Rotate {
+                    angle: Baked(a), ..
+                },
+                _,
+            ) if *a == 0.0 => Some(inner.clone()),
+            (
+                Kind::Scale {
+                    factor: Baked(f), ..
+                },
+                _,
+            ) if *f == 1.0 => Some(inner.clone()),
+            (Kind::Color { .. }, Kind::Color { .. }) => Some(inner.clone()),
+            (
+                Kind::Translate { offset: outer, .. },
+                Kind::Translate {
+                    offset: inner_offset,
+                    child: grandchild,
+                },
+            ) => match (baked3(*outer), baked3(*inner_offset)) {
+                (Some(o), Some(i)) => Some(Kind::Translate {
+                    offset: (o + i).to_array().map(Baked),
+                    child: *grandchild,
+                }),
+                _ => None,
+            },
+            (
+                Kind::Scale {
+                    factor: Baked(outer),
+                    ..
+                },
+                Kind::Scale {
+                    factor: Baked(inner_factor),
+                    child: grandchild,
+                },
+            ) => Some(Kind::Scale {
+                factor: Baked(outer * inner_factor),
+                child: *grandchild,
+            }),
+            (
+                Kind::Rotate {
+                    axis: a1,
+                    angle: Baked(t1),
+                    ..
+                },
+                Kind::Rotate {
+                    axis: a2,
+                    angle: Baked(t2),
+                    child: grandchild,
+                },
+            ) => {
+                let q = DQuat::from_axis_angle(*a1, *t1) * DQuat::from_axis_angle(*a2, *t2);
+                let (axis, angle) = q.to_axis_angle();
+                Some(Kind::Rotate {
+                    axis: if axis.is_finite() { axis } else { DVec3::Y },
+                    angle: Baked(if axis.is_finite() { angle } else { 0.0 }),
+                    child: *grandchild,
+                })
+            }
+            _ => None,
+        };
+        match merged {
+            Some(m) => {
+                self.nodes.pop();
+                // The merged node may fold again with what is below it.
+                self.fold(m)
+            }
+            None => node,
+        }
     }
 
     fn lower_param(&mut self, p: &Param, param: &str, rule: Rule) -> Result<Scalar> {

@@ -369,11 +369,8 @@ pub(crate) trait Mapper<S, V, C> {
 }
 
 /// The result of mapping a `Kind<S, V, C>` with `M`.
-pub(crate) type Mapped<S, V, C, M> = Kind<
-    <M as Mapper<S, V, C>>::S2,
-    <M as Mapper<S, V, C>>::V2,
-    <M as Mapper<S, V, C>>::C2,
->;
+pub(crate) type Mapped<S, V, C, M> =
+    Kind<<M as Mapper<S, V, C>>::S2, <M as Mapper<S, V, C>>::V2, <M as Mapper<S, V, C>>::C2>;
 
 impl<S, V, C> Kind<S, V, C> {
     /// The node type's name, as used in error messages.
@@ -571,7 +568,7 @@ impl<S, V, C> Kind<S, V, C> {
                 child: m.child(child)?,
             },
             Kind::Rotate { axis, angle, child } => Kind::Rotate {
-                axis: *axis,
+                axis: axis.normalize_or_zero(),
                 angle: m.scalar(angle, spec("angle", Finite))?,
                 child: m.child(child)?,
             },

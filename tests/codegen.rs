@@ -1,0 +1,171 @@
+//! Code generation: only what the scene needs, dynamic versus baked
+//! parameters, folding, and safe identifiers.
+
+use fractal_sdf::codegen::{self, Options};
+use fractal_sdf::ir::Ir;
+use fractal_sdf::prelude::*;
+
+fn source(geometry: Node, options: &Options) -> String {
+    codegen::emit(&Scene::new(geometry), options)
+        .unwrap()
+        .source
+}
+
+#[test]
+fn sphere_scene_contains_no_fractal_helper_and_no_disabled_effect() {
+    let options = Options {
+        effects: Effects::none(),
+        ..Options::default()
+    };
+    let src = source(sphere(1.0), &options);
+    for absent in [
+        "mandelbulb",
+        "menger",
+        "julia",
+        "sierpinski",
+        "angle_power",
+        "sd_box",
+        "smooth_min",
+        "ENABLE_AO",
+        "ENABLE_SHADOWS",
+        "ENABLE_GLOW",
+        "ENABLE_FOG",
+    ] {
+        assert!(
+            !src.contains(absent),
+            "sphere scene source contains `{absent}`"
+        );
+    }
+    assert!(src.contains("real sd_sphere("));
+}
+
+#[test]
+fn effects_that_are_on_are_defined() {
+    let options = Options {
+        effects: Effects {
+            glow: Some(Glow {
+                color: dvec3(1.0, 0.5, 0.2),
+                strength: 1.0,
+            }),
+            fog_density: 0.1,
+            ..Effects::default()
+        },
+        ..Options::default()
+    };
+    let src = source(sphere(1.0), &options);
+    for present in ["ENABLE_AO", "ENABLE_SHADOWS", "ENABLE_GLOW", "ENABLE_FOG"] {
+        assert!(
+            src.contains(&format!("#define {present}")),
+            "missing {present}"
+        );
+    }
+}
+
+#[test]
+fn fractal_helpers_pull_in_their_dependencies_once() {
+    let src = source(menger(3).union(sierpinski(3)), &Options::default());
+    assert_eq!(src.matches("real sd_box(").count(), 1);
+    assert_eq!(src.matches("real sd_tetrahedron(").count(), 1);
+    assert!(!src.contains("mandelbulb"));
+}
+
+#[test]
+fn integer_power_eight_uses_the_trig_free_form() {
+    let src = source(mandelbulb(8.0), &Options::default());
+    assert!(src.contains("mandelbulb_int(p0, 8, 12, 2.0f, &t0)"));
+    assert!(!src.contains("acos"), "power 8 must not use trigonometry");
+
+    let src = source(mandelbulb(7.5), &Options::default());
+    assert!(src.contains("acos"));
+    assert!(!src.contains("angle_power"));
+
+    // A dynamic power cannot be specialised.
+    let src = source(mandelbulb(param("power", 8.0)), &Options::default());
+    assert!(src.contains("mandelbulb(p0, params[0], 12, 2.0f, &t0)"));
+}
+
+#[test]
+fn dynamic_values_keep_the_source_but_change_the_distance() {
+    let scene = |r: f64| Scene::new(sphere(param("radius", r)).translate(dvec3(0.5, 0.0, 0.0)));
+    let a = codegen::emit(&scene(1.0), &Options::default()).unwrap();
+    let b = codegen::emit(&scene(2.0), &Options::default()).unwrap();
+    assert_eq!(a.source, b.source);
+    assert_eq!(a.hash, b.hash);
+    assert_eq!(a.params[0].default, 1.0);
+    assert_eq!(b.params[0].default, 2.0);
+
+    let mut eval = cpu::Evaluator::new(scene(1.0).geometry.as_ref().unwrap()).unwrap();
+    let p = dvec3(3.0, 0.0, 0.0);
+    let before = eval.distance(p);
+    eval.set_param("radius", 2.0).unwrap();
+    assert_eq!(before - 1.0, eval.distance(p));
+}
+
+#[test]
+fn baked_values_change_the_source_and_hash() {
+    let a = codegen::emit(&Scene::new(sphere(1.0)), &Options::default()).unwrap();
+    let b = codegen::emit(&Scene::new(sphere(1.5)), &Options::default()).unwrap();
+    assert_ne!(a.source, b.source);
+    assert_ne!(a.hash, b.hash);
+}
+
+#[test]
+fn baked_iteration_counts_are_constant_loop_bounds_and_can_be_overridden() {
+    let mut options = Options::default();
+    let src = source(menger(4), &options);
+    assert!(src.contains("menger(p0, 4, 3.0f, &t0)"));
+    options.quality.fractal_iterations = Some(2);
+    let src = source(menger(4), &options);
+    assert!(src.contains("menger(p0, 2, 3.0f, &t0)"));
+}
+
+#[test]
+fn f64_source_declares_double_precision() {
+    let options = Options {
+        quality: Quality {
+            precision: Precision::F64,
+            ..Quality::default()
+        },
+        ..Options::default()
+    };
+    let src = source(sphere(0.1), &options);
+    assert!(src.contains("#pragma OPENCL EXTENSION cl_khr_fp64 : enable"));
+    assert!(src.contains("typedef double real;"));
+    assert!(src.contains("sd_sphere(p0, 0.1)"));
+}
+
+#[test]
+fn chains_of_baked_transforms_fold_into_one_node() {
+    let chain = sphere(1.0)
+        .translate(dvec3(1.0, 0.0, 0.0))
+        .translate(dvec3(0.0, 2.0, 0.0))
+        .scale(2.0)
+        .scale(0.25)
+        .rotate(DVec3::Z, 0.3)
+        .rotate(DVec3::Z, 0.2)
+        .smooth_union(torus(1.0, 0.2), 0.0);
+    let ir = Ir::lower(&chain).unwrap();
+    // sphere, translate, scale, rotate, torus, union.
+    assert_eq!(ir.nodes().len(), 6, "{:#?}", ir.nodes());
+    let unfolded = cpu::Evaluator::new(&chain).unwrap();
+    let p = dvec3(0.3, -0.7, 1.1);
+    let by_hand = {
+        let q = DQuat::from_axis_angle(DVec3::Z, -0.5) * p;
+        let s = (q / 0.5 - dvec3(1.0, 2.0, 0.0)).length() - 1.0;
+        (s * 0.5).min(fractal_sdf::cpu::sdf::torus(p.into(), 1.0, 0.2))
+    };
+    approx::assert_relative_eq!(unfolded.distance(p), by_hand, epsilon = 1e-12);
+    let src = source(chain, &Options::default());
+    assert!(
+        !src.contains("smooth_min"),
+        "k = 0 must fold to the hard union"
+    );
+}
+
+#[test]
+fn dynamic_parameter_names_never_reach_the_source() {
+    let name = "r\"); } __kernel void evil() { /*";
+    let src = source(sphere(param(name, 1.0)), &Options::default());
+    assert!(!src.contains("evil"));
+    assert!(src.contains("params[0]"));
+}
