@@ -58,6 +58,7 @@
 pub mod codegen;
 pub mod cpu;
 pub mod error;
+pub mod gallery;
 pub mod ir;
 pub mod quality;
 pub mod scene;

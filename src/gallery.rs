@@ -1,0 +1,239 @@
+//! Ready-made example scenes, each framed by its camera and lit.
+//!
+//! The examples, the viewer, the benchmarks and the tests all draw from
+//! here, so a scene that looks right in the gallery is the scene the tests
+//! check.
+//!
+//! ```
+//! for (name, scene) in fractal_sdf::gallery::all() {
+//!     scene.validate().unwrap_or_else(|e| panic!("{name}: {e}"));
+//! }
+//! ```
+
+use std::f64::consts::FRAC_PI_2;
+
+use glam::{DVec3, dvec3};
+
+use crate::scene::{
+    Axis, Camera, Light, Mandelbulb, Node, QuaternionJulia, Scene, capped_cone, capsule, cuboid,
+    cylinder, ellipsoid, julia, menger, octahedron, param, plane, round_box, sierpinski, sphere,
+    torus,
+};
+
+/// Every gallery scene by name.
+#[must_use]
+pub fn all() -> Vec<(&'static str, Scene)> {
+    vec![
+        ("mandelbulb", mandelbulb()),
+        ("menger", menger_sponge()),
+        ("julia", quaternion_julia()),
+        ("sierpinski", sierpinski_tetrahedron()),
+        ("csg", csg()),
+        ("primitives", primitives()),
+        ("domain_ops", domain_ops()),
+        ("fractal_mix", fractal_mix()),
+    ]
+}
+
+/// The gallery scene called `name`, if there is one.
+#[must_use]
+pub fn by_name(name: &str) -> Option<Scene> {
+    all().into_iter().find(|(n, _)| *n == name).map(|(_, s)| s)
+}
+
+/// The names of the gallery scenes.
+#[must_use]
+pub fn names() -> Vec<&'static str> {
+    all().into_iter().map(|(n, _)| n).collect()
+}
+
+fn floor(height: f64) -> Node {
+    plane(DVec3::Y, height).color(dvec3(0.55, 0.55, 0.6))
+}
+
+fn key_and_fill() -> Vec<Light> {
+    vec![
+        Light::directional(dvec3(0.5, 0.8, 0.35))
+            .color(dvec3(1.0, 0.95, 0.85))
+            .softness(0.06),
+        Light::directional(dvec3(-0.6, 0.35, -0.4))
+            .color(dvec3(0.6, 0.7, 1.0))
+            .intensity(0.3),
+    ]
+}
+
+/// A power-8 Mandelbulb standing on its axis.
+#[must_use]
+pub fn mandelbulb() -> Scene {
+    let bulb = Node::from(Mandelbulb::new(8.0).iterations(10))
+        .rotate(DVec3::X, -FRAC_PI_2)
+        .color(dvec3(0.9, 0.6, 0.35));
+    Scene::new(bulb)
+        .with_camera(Camera::look_at(dvec3(1.6, 1.1, 2.2), dvec3(0.0, -0.05, 0.0)).fov(40.0))
+        .with_lights(key_and_fill())
+}
+
+/// A level-4 Menger sponge on a floor.
+#[must_use]
+pub fn menger_sponge() -> Scene {
+    let sponge = menger(4)
+        .rotate(DVec3::Y, 0.5)
+        .color(dvec3(0.85, 0.85, 0.8));
+    Scene::new(sponge.union(floor(1.0)))
+        .with_camera(Camera::look_at(dvec3(2.6, 1.9, 3.2), dvec3(0.0, -0.1, 0.0)).fov(42.0))
+        .with_lights(key_and_fill())
+}
+
+/// A quaternion Julia set.
+#[must_use]
+pub fn quaternion_julia() -> Scene {
+    let set = Node::from(
+        QuaternionJulia::new([(-0.2).into(), 0.6.into(), 0.2.into(), 0.2.into()]).iterations(11),
+    )
+    .color(dvec3(0.45, 0.7, 0.95));
+    Scene::new(set)
+        .with_camera(Camera::look_at(dvec3(0.0, 1.2, 2.6), DVec3::ZERO).fov(45.0))
+        .with_lights(key_and_fill())
+}
+
+/// A level-7 Sierpinski tetrahedron on a floor.
+#[must_use]
+pub fn sierpinski_tetrahedron() -> Scene {
+    let tet = sierpinski(7).color(dvec3(0.95, 0.75, 0.45));
+    Scene::new(tet.union(floor(1.0)))
+        .with_camera(Camera::look_at(dvec3(2.4, 1.4, 3.0), dvec3(0.0, -0.1, 0.0)).fov(45.0))
+        .with_lights(key_and_fill())
+}
+
+/// Smooth union, subtraction and intersection of transformed primitives.
+#[must_use]
+pub fn csg() -> Scene {
+    let blend = sphere(0.55)
+        .smooth_union(
+            cuboid(dvec3(0.35, 0.35, 0.35)).translate(dvec3(0.45, 0.0, 0.0)),
+            0.25,
+        )
+        .color(dvec3(0.95, 0.45, 0.2))
+        .translate(dvec3(-1.3, 0.0, 0.0));
+    let carved = round_box(dvec3(0.5, 0.5, 0.5), 0.08)
+        .smooth_subtract(sphere(0.62), 0.08)
+        .color(dvec3(0.3, 0.65, 0.95))
+        .rotate(DVec3::Y, 0.6);
+    let lens = sphere(0.6)
+        .translate(dvec3(0.0, 0.0, 0.3))
+        .smooth_intersect(sphere(0.6).translate(dvec3(0.0, 0.0, -0.3)), 0.1)
+        .color(dvec3(0.4, 0.85, 0.45))
+        .rotate(DVec3::X, 0.9)
+        .translate(dvec3(1.3, 0.0, 0.0));
+    Scene::new(blend.union(carved).union(lens).union(floor(0.6)))
+        .with_camera(Camera::look_at(dvec3(0.0, 1.5, 3.6), dvec3(0.0, -0.1, 0.0)).fov(45.0))
+        .with_lights(key_and_fill())
+}
+
+/// One of every primitive in a row.
+#[must_use]
+pub fn primitives() -> Scene {
+    let items = [
+        sphere(0.35),
+        cuboid(dvec3(0.3, 0.3, 0.3)),
+        round_box(dvec3(0.3, 0.3, 0.3), 0.08),
+        torus(0.28, 0.1),
+        cylinder(0.25, 0.35),
+        capsule(dvec3(0.0, -0.3, 0.0), dvec3(0.0, 0.3, 0.0), 0.18),
+        octahedron(0.4),
+        capped_cone(0.35, 0.3, 0.1),
+        ellipsoid(dvec3(0.35, 0.2, 0.25)),
+    ];
+    let count = items.len();
+    let row = items
+        .into_iter()
+        .enumerate()
+        .map(|(i, node)| {
+            #[allow(clippy::cast_precision_loss)]
+            let t = i as f64 / (count - 1) as f64;
+            let hue = dvec3(
+                0.9 - 0.6 * t,
+                0.45 + 0.35 * (1.0 - (2.0 * t - 1.0).abs()),
+                0.3 + 0.6 * t,
+            );
+            #[allow(clippy::cast_precision_loss)]
+            let x = (i as f64 - 4.0) * 0.85;
+            node.color(hue).translate(dvec3(x, 0.0, 0.0))
+        })
+        .reduce(Node::union)
+        .expect("nine primitives");
+    Scene::new(row.union(floor(0.4)))
+        .with_camera(Camera::look_at(dvec3(0.0, 2.2, 5.5), dvec3(0.0, -0.2, 0.0)).fov(50.0))
+        .with_lights(key_and_fill())
+}
+
+/// Twist, bend, repetition, shells, elongation and mirroring.
+#[must_use]
+pub fn domain_ops() -> Scene {
+    let twisted = cuboid(dvec3(0.25, 0.6, 0.25))
+        .twist(2.0)
+        .color(dvec3(0.9, 0.4, 0.4))
+        .translate(dvec3(-1.5, 0.0, 0.0));
+    let bent = cuboid(dvec3(0.6, 0.1, 0.2))
+        .bend(0.8)
+        .color(dvec3(0.4, 0.9, 0.5))
+        .translate(dvec3(-0.4, 0.0, 0.0));
+    let shell = sphere(0.45)
+        .onion(0.04)
+        .subtract(cuboid(dvec3(1.0, 1.0, 1.0)).translate(dvec3(0.0, 1.2, 0.0)))
+        .color(dvec3(0.4, 0.6, 0.95))
+        .translate(dvec3(0.65, 0.0, 0.0));
+    let pills = sphere(0.12)
+        .elongate(dvec3(0.0, 0.15, 0.0))
+        .repeat_limited(dvec3(0.35, 0.0, 0.35), [1, 0, 1])
+        .color(dvec3(0.95, 0.8, 0.3))
+        .translate(dvec3(1.6, -0.25, 0.0));
+    let mirrored = torus(0.2, 0.06)
+        .rotate(DVec3::X, FRAC_PI_2)
+        .translate(dvec3(0.5, 0.0, 0.0))
+        .mirror(Axis::X)
+        .round(0.01)
+        .color(dvec3(0.8, 0.5, 0.9))
+        .translate(dvec3(0.0, 0.85, -0.8));
+    Scene::new(
+        twisted
+            .union(bent)
+            .union(shell)
+            .union(pills)
+            .union(mirrored)
+            .union(floor(0.6)),
+    )
+    .with_camera(Camera::look_at(dvec3(0.0, 1.6, 3.8), dvec3(0.0, 0.0, 0.0)).fov(45.0))
+    .with_lights(key_and_fill())
+}
+
+/// All four fractals blended with smooth CSG, transforms and a dynamic
+/// parameter (`power`).
+#[must_use]
+pub fn fractal_mix() -> Scene {
+    let bulb = Node::from(Mandelbulb::new(param("power", 8.0)).iterations(8))
+        .rotate(DVec3::X, -FRAC_PI_2)
+        .scale(0.5)
+        .color(dvec3(0.9, 0.55, 0.3))
+        .translate(dvec3(-1.1, 0.0, 0.0));
+    let sponge = menger(3)
+        .scale(0.45)
+        .smooth_subtract(sphere(0.55), 0.05)
+        .color(dvec3(0.8, 0.8, 0.75))
+        .translate(dvec3(0.0, 0.0, -0.6));
+    let set = julia([-0.2, 0.6, 0.2, 0.2])
+        .scale(0.5)
+        .color(dvec3(0.4, 0.7, 0.95))
+        .translate(dvec3(1.1, 0.0, 0.0));
+    let tet = sierpinski(5)
+        .scale(0.35)
+        .color(dvec3(0.95, 0.8, 0.4))
+        .translate(dvec3(0.0, 0.0, 0.7));
+    let fractals = bulb
+        .smooth_union(sponge, 0.1)
+        .smooth_union(set, 0.1)
+        .smooth_union(tet, 0.1);
+    Scene::new(fractals.union(floor(0.55)))
+        .with_camera(Camera::look_at(dvec3(0.0, 1.6, 3.2), dvec3(0.0, -0.1, 0.0)).fov(45.0))
+        .with_lights(key_and_fill())
+}
