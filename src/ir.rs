@@ -233,10 +233,10 @@ impl Lowering {
             return match node {
                 Kind::Csg {
                     op,
-                    smoothing: Some(Baked(k)),
+                    smoothing: Some(Baked(0.0)),
                     a,
                     b,
-                } if k == 0.0 => Kind::Csg {
+                } => Kind::Csg {
                     op,
                     smoothing: None,
                     a,

@@ -26,10 +26,7 @@ fn check(name: &str, source: &str) -> Result<(), String> {
         .lines()
         .zip(source.lines())
         .position(|(a, b)| a != b)
-        .map_or_else(
-            || committed.lines().count().min(source.lines().count()),
-            |i| i,
-        );
+        .unwrap_or_else(|| committed.lines().count().min(source.lines().count()));
     Err(format!(
         "{name}: generated source differs from {} at line {}:\n  committed: {:?}\n  generated: {:?}\n\
          If the change is intended, run `make snapshots` and review the diff.",
