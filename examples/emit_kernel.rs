@@ -1,8 +1,10 @@
-//! Prints the OpenCL C generated for an example scene.
+//! Prints the OpenCL C generated for a gallery scene.
 //!
-//! `cargo run --example emit_kernel -- [sphere|mandelbulb|menger|julia|sierpinski|csg] [f32|f64]`
+//! `cargo run --example emit_kernel -- [SCENE] [f32|f64]`, where SCENE is one
+//! of the gallery's names (default `csg`).
 
 use fractal_sdf::codegen::{self, Options};
+use fractal_sdf::gallery;
 use fractal_sdf::prelude::*;
 
 fn main() -> Result<()> {
@@ -12,26 +14,9 @@ fn main() -> Result<()> {
         Some("f64") => Precision::F64,
         _ => Precision::F32,
     };
-    let geometry = match name.as_str() {
-        "sphere" => sphere(1.0),
-        "mandelbulb" => mandelbulb(8.0),
-        "menger" => menger(4),
-        "julia" => julia([-0.2, 0.6, 0.2, 0.2]),
-        "sierpinski" => sierpinski(6),
-        "csg" => sphere(param("radius", 0.8))
-            .smooth_union(
-                cuboid(dvec3(0.5, 0.5, 0.5)).translate(dvec3(0.7, 0.0, 0.0)),
-                0.2,
-            )
-            .subtract(cylinder(0.25, 2.0))
-            .color(dvec3(1.0, 0.4, 0.1))
-            .union(plane(dvec3(0.0, 1.0, 0.0), 1.0)),
-        other => {
-            eprintln!(
-                "unknown scene `{other}`; try sphere, mandelbulb, menger, julia, sierpinski or csg"
-            );
-            std::process::exit(2);
-        }
+    let Some(scene) = gallery::by_name(&name) else {
+        eprintln!("unknown scene `{name}`; choose one of: {}", gallery::names().join(", "));
+        std::process::exit(2);
     };
     let options = Options {
         quality: Quality {
@@ -40,11 +25,12 @@ fn main() -> Result<()> {
         },
         ..Options::default()
     };
-    let kernel = codegen::emit(&Scene::new(geometry), &options)?;
+    let kernel = codegen::emit(&scene, &options)?;
     print!("{}", kernel.source);
     eprintln!(
-        "{} lines, hash {:016x}",
+        "{name}: {} lines, {} dynamic parameters, hash {:016x}",
         kernel.source.lines().count(),
+        kernel.params.len(),
         kernel.hash
     );
     Ok(())
