@@ -15,7 +15,10 @@ fn main() -> Result<()> {
         _ => Precision::F32,
     };
     let Some(scene) = gallery::by_name(&name) else {
-        eprintln!("unknown scene `{name}`; choose one of: {}", gallery::names().join(", "));
+        eprintln!(
+            "unknown scene `{name}`; choose one of: {}",
+            gallery::names().join(", ")
+        );
         std::process::exit(2);
     };
     let options = Options {

@@ -49,6 +49,14 @@ pub enum Error {
         /// The parameter's name.
         param: String,
     },
+    /// A custom shape's definition or use is invalid.
+    #[error("custom shape `{name}`: {reason}")]
+    CustomShape {
+        /// The shape's name.
+        name: String,
+        /// What is wrong.
+        reason: String,
+    },
     /// The scene has no geometry.
     #[error("the scene is empty: add geometry with `Scene::new(node)` or `Scene::add`")]
     EmptyScene,

@@ -12,7 +12,7 @@ use std::collections::HashMap;
 use glam::{DQuat, DVec3};
 
 use crate::error::{Error, Result};
-use crate::scene::{Kind, Mapper, Node, Param, Param3, ParamSpec, Rule};
+use crate::scene::{CustomShape, Kind, Mapper, Node, Param, Param3, ParamSpec, Rule};
 
 /// A handle to a node in an [`Ir`] arena.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
@@ -76,6 +76,7 @@ impl Ir {
             slot_by_name: HashMap::new(),
             path: String::new(),
             operand: None,
+            customs: HashMap::new(),
         };
         let root = lowering.lower(geometry, geometry.kind().name().to_string())?;
         Ok(Ir {
@@ -195,6 +196,8 @@ struct Lowering {
     path: String,
     /// For a boolean being lowered: how many operands were lowered so far.
     operand: Option<usize>,
+    /// The custom shapes met so far, by name.
+    customs: HashMap<String, CustomShape>,
 }
 
 impl Lowering {
@@ -202,6 +205,9 @@ impl Lowering {
         let saved = std::mem::replace(&mut self.path, path);
         let kind = node.kind();
         check_structure(kind, &self.path)?;
+        if let Kind::Custom { shape, .. } = kind {
+            self.check_custom(shape)?;
+        }
         let saved_operand = std::mem::replace(
             &mut self.operand,
             matches!(kind, Kind::Csg { .. }).then_some(0),
@@ -322,6 +328,21 @@ impl Lowering {
         }
     }
 
+    /// One definition per custom shape name in a scene.
+    fn check_custom(&mut self, shape: &CustomShape) -> Result<()> {
+        match self.customs.get(shape.name()) {
+            Some(known) if known != shape => Err(Error::CustomShape {
+                name: shape.name().into(),
+                reason: "two different shapes with this name are used in one scene".into(),
+            }),
+            Some(_) => Ok(()),
+            None => {
+                self.customs.insert(shape.name().into(), shape.clone());
+                Ok(())
+            }
+        }
+    }
+
     fn lower_param(&mut self, p: &Param, param: &str, rule: Rule) -> Result<Scalar> {
         check_rule(&self.path, param, p.default_value(), rule)?;
         match p {
@@ -354,11 +375,11 @@ impl Mapper<Param, Param3, Node> for Lowering {
     type C2 = NodeId;
     type E = Error;
 
-    fn scalar(&mut self, s: &Param, spec: ParamSpec) -> Result<Scalar> {
+    fn scalar(&mut self, s: &Param, spec: ParamSpec<'_>) -> Result<Scalar> {
         self.lower_param(s, spec.name, spec.rule)
     }
 
-    fn vector(&mut self, v: &Param3, spec: ParamSpec) -> Result<Vector> {
+    fn vector(&mut self, v: &Param3, spec: ParamSpec<'_>) -> Result<Vector> {
         let [x, y, z] = v.components();
         Ok([
             self.lower_param(x, &format!("{}.x", spec.name), spec.rule)?,
@@ -420,6 +441,16 @@ fn check_structure(kind: &crate::scene::NodeKind, path: &str) -> Result<()> {
             if n.is_finite() && n.length() == 0.0 {
                 return Err(zero("normal"));
             }
+        }
+        Kind::Custom { shape, args } if args.len() != shape.arity() => {
+            return Err(Error::CustomShape {
+                name: shape.name().into(),
+                reason: format!(
+                    "{path}: expects {} parameter values, got {}",
+                    shape.arity(),
+                    args.len()
+                ),
+            });
         }
         Kind::RoundBox {
             half_extents,

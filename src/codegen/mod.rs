@@ -103,12 +103,18 @@ pub fn emit_ir(ir: &Ir, lights: usize, options: &Options) -> Result<KernelSource
     let mut emitter = scene::SceneEmitter::new(ir, &mut body, options.quality.fractal_iterations);
     emitter.emit();
     let used: Vec<&'static str> = emitter.used.iter().copied().collect();
+    let customs: Vec<_> = emitter.customs.values().cloned().collect();
 
     let mut w = writer::Writer::new(precision);
     header(&mut w, options, lights);
     for helper in helpers::closure(&used) {
         w.line(format!("/* ---- {} ---- */", helper.name));
         w.raw(helper.source);
+        w.line("");
+    }
+    for shape in &customs {
+        w.line(format!("/* ---- custom shape {} ---- */", shape.name()));
+        w.raw(&shape.opencl_definition());
         w.line("");
     }
     w.line("/* ---- scene ---- */");

@@ -2,12 +2,12 @@
 //! block per node, children before parents. The same walk writes `DE`
 //! (distance only) and `DE_shade` (distance, colour and orbit trap).
 
-use std::collections::BTreeSet;
+use std::collections::{BTreeMap, BTreeSet};
 
 use super::writer::Writer;
 use crate::cpu::integer_power;
 use crate::ir::{Ir, NodeId, Scalar};
-use crate::scene::{CsgOp, Kind};
+use crate::scene::{CsgOp, CustomShape, Kind};
 
 /// The variables holding one node's result.
 struct Vars {
@@ -24,6 +24,8 @@ pub(crate) struct SceneEmitter<'a> {
     iteration_override: Option<u32>,
     /// Names of the helper functions the emitted code calls.
     pub(crate) used: BTreeSet<&'static str>,
+    /// The custom shapes the emitted code calls, by name.
+    pub(crate) customs: BTreeMap<String, CustomShape>,
 }
 
 impl<'a> SceneEmitter<'a> {
@@ -35,6 +37,7 @@ impl<'a> SceneEmitter<'a> {
             points: 0,
             iteration_override,
             used: BTreeSet::new(),
+            customs: BTreeMap::new(),
         }
     }
 
@@ -76,7 +79,9 @@ impl<'a> SceneEmitter<'a> {
 
     /// A leaf: its distance expression, default colour, trap 1.
     fn leaf(&mut self, id: NodeId, helper: &'static str, expr: String) -> Vars {
-        self.used.insert(helper);
+        if !helper.is_empty() {
+            self.used.insert(helper);
+        }
         let v = vars(id);
         self.w.line(format!("real {} = {expr};", v.d));
         if self.shade {
@@ -314,6 +319,16 @@ impl<'a> SceneEmitter<'a> {
             } => {
                 let (a, b) = (self.node(*a, p), self.node(*b, p));
                 self.csg(id, *op, *smoothing, &a, &b)
+            }
+            Kind::Custom { shape, args } => {
+                let mut call = format!("{}({p}", shape.function_name());
+                for a in args {
+                    call.push_str(", ");
+                    call.push_str(&w(self, *a));
+                }
+                call.push(')');
+                self.customs.insert(shape.name().to_string(), shape.clone());
+                self.leaf(id, "", call)
             }
             Kind::Color { color, child } => {
                 let c = self.node(*child, p);

@@ -257,6 +257,11 @@ impl Evaluator {
                 let k = smoothing.map_or(T::zero(), s);
                 combine(*op, k, self.eval(*a, p), self.eval(*b, p))
             }
+            Kind::Custom { shape, args } => {
+                let args: Vec<f64> = args.iter().map(|a| self.scalar::<f64>(*a)).collect();
+                let q = p.cast::<f64>().into();
+                Self::leaf(T::of(shape.distance(q, &args)))
+            }
             Kind::Color { color, child } => Sample {
                 color: v(*color),
                 ..self.eval(*child, p)

@@ -5,6 +5,7 @@
 //! [`Error`](crate::Error) naming the node's path and the parameter.
 
 pub mod build;
+mod custom;
 mod node;
 mod param;
 
@@ -14,6 +15,7 @@ pub use build::{
     capped_cone, capsule, cuboid, cylinder, ellipsoid, julia, mandelbulb, menger, octahedron,
     plane, round_box, sierpinski, sphere, torus,
 };
+pub use custom::{CpuDistance, CustomShape};
 pub(crate) use node::Mapper;
 pub use node::{
     Axis, CsgOp, Kind, MAX_ESCAPE_ITERATIONS, MAX_FOLD_ITERATIONS, Mandelbulb, Menger, Node,

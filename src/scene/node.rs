@@ -4,6 +4,7 @@
 
 use glam::DVec3;
 
+use super::custom::CustomShape;
 use super::param::{Param, Param3};
 
 /// The largest iteration count accepted by the escape-time fractals
@@ -295,6 +296,13 @@ pub enum Kind<S, V, C> {
         /// The second operand.
         b: C,
     },
+    /// A user-defined shape (see [`CustomShape`]) with its parameter values.
+    Custom {
+        /// The shape's definition.
+        shape: CustomShape,
+        /// One value per declared parameter, in order.
+        args: Vec<S>,
+    },
     /// Paints the child (every surface below this node) with a linear RGB
     /// colour.
     Color {
@@ -345,14 +353,14 @@ impl Rule {
 
 /// A parameter's name within its node and the rule it must satisfy.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct ParamSpec {
+pub struct ParamSpec<'a> {
     /// The field name, such as `"radius"`.
-    pub name: &'static str,
+    pub name: &'a str,
     /// What the value must satisfy.
     pub rule: Rule,
 }
 
-const fn spec(name: &'static str, rule: Rule) -> ParamSpec {
+const fn spec(name: &str, rule: Rule) -> ParamSpec<'_> {
     ParamSpec { name, rule }
 }
 
@@ -363,8 +371,8 @@ pub(crate) trait Mapper<S, V, C> {
     type V2;
     type C2;
     type E;
-    fn scalar(&mut self, s: &S, spec: ParamSpec) -> Result<Self::S2, Self::E>;
-    fn vector(&mut self, v: &V, spec: ParamSpec) -> Result<Self::V2, Self::E>;
+    fn scalar(&mut self, s: &S, spec: ParamSpec<'_>) -> Result<Self::S2, Self::E>;
+    fn vector(&mut self, v: &V, spec: ParamSpec<'_>) -> Result<Self::V2, Self::E>;
     fn child(&mut self, c: &C) -> Result<Self::C2, Self::E>;
 }
 
@@ -410,6 +418,7 @@ impl<S, V, C> Kind<S, V, C> {
                 (CsgOp::Subtract, true) => "smooth_subtract",
                 (CsgOp::Intersect, true) => "smooth_intersect",
             },
+            Kind::Custom { .. } => "custom",
             Kind::Color { .. } => "color",
         }
     }
@@ -431,7 +440,8 @@ impl<S, V, C> Kind<S, V, C> {
             | Kind::Mandelbulb(_)
             | Kind::Menger(_)
             | Kind::Julia(_)
-            | Kind::Sierpinski(_) => vec![],
+            | Kind::Sierpinski(_)
+            | Kind::Custom { .. } => vec![],
             Kind::Translate { child, .. }
             | Kind::Rotate { child, .. }
             | Kind::Scale { child, .. }
@@ -626,6 +636,14 @@ impl<S, V, C> Kind<S, V, C> {
                 },
                 a: m.child(a)?,
                 b: m.child(b)?,
+            },
+            Kind::Custom { shape, args } => Kind::Custom {
+                shape: shape.clone(),
+                args: args
+                    .iter()
+                    .zip(shape.params())
+                    .map(|(a, (name, rule))| m.scalar(a, spec(name, rule)))
+                    .collect::<Result<_, _>>()?,
             },
             Kind::Color { color, child } => Kind::Color {
                 color: m.vector(color, spec("color", NonNegative))?,

@@ -1,0 +1,197 @@
+//! User-defined shapes: a Rust distance function (the CPU reference) and
+//! its OpenCL C twin, usable in scenes like any built-in node.
+//!
+//! ```
+//! use fractal_sdf::prelude::*;
+//! use fractal_sdf::scene::{CustomShape, Rule};
+//!
+//! // A gyroid shell, |sin x cos y + sin y cos z + sin z cos x| / 1.5 - t, a
+//! // bound because the gradient of the trigonometric sum is at most 1.5.
+//! let gyroid = CustomShape::new(
+//!     "gyroid",
+//!     &[("thickness", Rule::NonNegative)],
+//!     |p, a| {
+//!         let g = p.x.sin() * p.y.cos() + p.y.sin() * p.z.cos() + p.z.sin() * p.x.cos();
+//!         g.abs() / 1.5 - a[0]
+//!     },
+//!     "real g = sin(p.x) * cos(p.y) + sin(p.y) * cos(p.z) + sin(p.z) * cos(p.x);
+//!      return fabs(g) / R(1.5) - thickness;",
+//! )?;
+//! let node = gyroid.node([0.1]).intersect(sphere(2.0));
+//! let eval = cpu::Evaluator::new(&node)?;
+//! assert!(eval.distance(dvec3(0.0, 0.0, 0.0)) < 0.0);
+//! # Ok::<(), fractal_sdf::Error>(())
+//! ```
+
+use std::fmt;
+use std::sync::Arc;
+
+use glam::DVec3;
+
+use super::node::{Kind, Node, Rule};
+use super::param::Param;
+use crate::error::{Error, Result};
+
+/// The Rust distance function of a custom shape: the point and the
+/// parameter values in declaration order.
+pub type CpuDistance = dyn Fn(DVec3, &[f64]) -> f64 + Send + Sync;
+
+/// A user-defined shape. Cheap to clone (shared).
+///
+/// The OpenCL body is the body of a function
+/// `real custom_NAME(real3 p, real PARAM1, real PARAM2, ...)` that returns
+/// the distance; it may use `real`, `real2`, `real3`, `R(x)` for literals and
+/// every OpenCL built-in. It is compiled in only when a scene uses the
+/// shape. The CPU function runs in `f64` (also when the CPU reference
+/// evaluates in `f32`).
+///
+/// The name and parameter names become OpenCL identifiers, so they must be
+/// ASCII identifiers (`[A-Za-z_][A-Za-z0-9_]*`, at most 48 characters); the
+/// generated function is namespaced as `custom_NAME`. The body is code you
+/// write and is emitted as given.
+#[derive(Clone)]
+pub struct CustomShape(Arc<Inner>);
+
+struct Inner {
+    name: String,
+    params: Vec<(String, Rule)>,
+    cpu: Box<CpuDistance>,
+    opencl: String,
+}
+
+impl CustomShape {
+    /// Defines a shape called `name` with parameters `(name, rule)`, a CPU
+    /// distance function and its OpenCL C body.
+    ///
+    /// # Errors
+    /// [`Error::CustomShape`] if a name is not a valid identifier, a
+    /// parameter name repeats or shadows `p`, or the body is empty.
+    pub fn new(
+        name: &str,
+        params: &[(&str, Rule)],
+        cpu: impl Fn(DVec3, &[f64]) -> f64 + Send + Sync + 'static,
+        opencl_body: &str,
+    ) -> Result<Self> {
+        let bad = |reason: String| Error::CustomShape {
+            name: name.chars().take(48).collect(),
+            reason,
+        };
+        check_identifier(name).map_err(|r| bad(format!("name {r}")))?;
+        let mut seen: Vec<&str> = vec!["p"];
+        for (param, _) in params {
+            check_identifier(param).map_err(|r| bad(format!("parameter `{param}` {r}")))?;
+            if seen.contains(param) {
+                return Err(bad(format!(
+                    "parameter name `{param}` is used twice or shadows `p`"
+                )));
+            }
+            seen.push(param);
+        }
+        if opencl_body.trim().is_empty() {
+            return Err(bad("the OpenCL body is empty".into()));
+        }
+        Ok(CustomShape(Arc::new(Inner {
+            name: name.into(),
+            params: params.iter().map(|(n, r)| ((*n).to_string(), *r)).collect(),
+            cpu: Box::new(cpu),
+            opencl: opencl_body.into(),
+        })))
+    }
+
+    /// The shape's name.
+    #[must_use]
+    pub fn name(&self) -> &str {
+        &self.0.name
+    }
+
+    /// The parameters' names and rules, in order.
+    pub fn params(&self) -> impl Iterator<Item = (&str, Rule)> {
+        self.0.params.iter().map(|(n, r)| (n.as_str(), *r))
+    }
+
+    /// Number of parameters.
+    #[must_use]
+    pub fn arity(&self) -> usize {
+        self.0.params.len()
+    }
+
+    /// Evaluates the CPU distance function.
+    #[must_use]
+    pub fn distance(&self, p: DVec3, args: &[f64]) -> f64 {
+        (self.0.cpu)(p, args)
+    }
+
+    /// The OpenCL function name, `custom_NAME`.
+    #[must_use]
+    pub fn function_name(&self) -> String {
+        format!("custom_{}", self.0.name)
+    }
+
+    /// The full OpenCL C function definition.
+    #[must_use]
+    pub fn opencl_definition(&self) -> String {
+        let params: String = self
+            .0
+            .params
+            .iter()
+            .map(|(n, _)| format!(", real {n}"))
+            .collect();
+        format!(
+            "real {}(real3 p{params}) {{\n{}\n}}\n",
+            self.function_name(),
+            self.0.opencl.trim_end()
+        )
+    }
+
+    /// A node of this shape with the given parameter values (plain numbers
+    /// or [`param`](super::param) for dynamic ones). A wrong number of
+    /// values is reported by validation.
+    #[must_use]
+    pub fn node<P: Into<Param>>(&self, args: impl IntoIterator<Item = P>) -> Node {
+        Kind::Custom {
+            shape: self.clone(),
+            args: args.into_iter().map(Into::into).collect(),
+        }
+        .into()
+    }
+
+    /// Whether two handles define the same shape: the same name, parameters
+    /// and OpenCL body.
+    fn same_definition(&self, other: &Self) -> bool {
+        Arc::ptr_eq(&self.0, &other.0)
+            || (self.0.name == other.0.name
+                && self.0.params == other.0.params
+                && self.0.opencl == other.0.opencl)
+    }
+}
+
+impl PartialEq for CustomShape {
+    fn eq(&self, other: &Self) -> bool {
+        self.same_definition(other)
+    }
+}
+
+impl fmt::Debug for CustomShape {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.debug_struct("CustomShape")
+            .field("name", &self.0.name)
+            .field("params", &self.0.params)
+            .finish_non_exhaustive()
+    }
+}
+
+fn check_identifier(s: &str) -> std::result::Result<(), String> {
+    let mut chars = s.chars();
+    let first_ok = chars
+        .next()
+        .is_some_and(|c| c.is_ascii_alphabetic() || c == '_');
+    if !first_ok || !chars.all(|c| c.is_ascii_alphanumeric() || c == '_') {
+        return Err(format!(
+            "`{s}` is not an identifier ([A-Za-z_][A-Za-z0-9_]*)"
+        ));
+    }
+    if s.len() > 48 {
+        return Err(format!("`{s}` is longer than 48 characters"));
+    }
+    Ok(())
+}
