@@ -57,6 +57,12 @@ pub enum Error {
         /// What is wrong.
         reason: String,
     },
+    /// A camera path is invalid.
+    #[error("camera path: {reason}")]
+    Animation {
+        /// What is wrong.
+        reason: String,
+    },
     /// The scene has no geometry.
     #[error("the scene is empty: add geometry with `Scene::new(node)` or `Scene::add`")]
     EmptyScene,

@@ -55,6 +55,7 @@
 //! ```
 #![warn(missing_docs)]
 
+pub mod animation;
 pub mod codegen;
 pub mod cpu;
 pub mod error;
