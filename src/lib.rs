@@ -61,6 +61,7 @@ pub mod cpu;
 pub mod error;
 pub mod gallery;
 pub mod ir;
+pub mod metrics;
 pub mod quality;
 pub mod scene;
 
