@@ -14,6 +14,7 @@
 //!    baked constants or dynamic slots.
 //! 3. [`cpu`]: the reference evaluator (distance, colour, normal, sphere
 //!    tracing) in `f64` and `f32`; the oracle for every test.
+//! 4. [`output`]: saving images (atomic PNG writes).
 //!
 //! ## A tour
 //!
@@ -58,6 +59,7 @@
 pub mod cpu;
 pub mod error;
 pub mod ir;
+pub mod output;
 pub mod quality;
 pub mod scene;
 
