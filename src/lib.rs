@@ -14,7 +14,10 @@
 //!    baked constants or dynamic slots.
 //! 3. [`cpu`]: the reference evaluator (distance, colour, normal, sphere
 //!    tracing) in `f64` and `f32`; the oracle for every test.
-//! 4. [`output`]: saving images (atomic PNG writes).
+//! 4. `render` (feature `opencl`, on by default): the OpenCL executor —
+//!    device choice, program build and cache, tiled ray marching into an
+//!    image with depth, hit, normal and step outputs.
+//! 5. [`output`]: saving images (atomic PNG writes).
 //!
 //! ## A tour
 //!
@@ -61,6 +64,8 @@ pub mod error;
 pub mod ir;
 pub mod output;
 pub mod quality;
+#[cfg(feature = "opencl")]
+pub mod render;
 pub mod scene;
 
 pub use error::{Error, Result};
