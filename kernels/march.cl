@@ -168,17 +168,17 @@ real march_ambient_occlusion(real3 p, real3 n, __global const real* params) {
 #endif
 
 #ifdef ENABLE_SHADOWS
-// Visibility of a light from ro along rd up to distance max_t: 0 in full
-// shadow, 1 fully lit. softness 0 gives a hard shadow; above 0, Quilez's
-// improved soft shadow (2018) with a penumbra that grows with softness.
-// The ray is blocked where it comes within eps of a surface; callers pass
-// a fraction of the surface hit threshold so shadows are not fattened by
-// a pixel where objects nearly touch.
-real march_shadow(real3 ro, real3 rd, real max_t, real eps, real softness,
+// Visibility of a light from ro along rd, from distance start to max_t: 0
+// in full shadow, 1 fully lit. softness 0 gives a hard shadow; above 0,
+// Quilez's improved soft shadow (2018) with a penumbra that grows with
+// softness. The ray is blocked where it comes within eps of a surface;
+// callers pass a fraction of the surface hit threshold so shadows are not
+// fattened by a pixel where objects nearly touch.
+real march_shadow(real3 ro, real3 rd, real max_t, real eps, real start, real softness,
                   __global const real* params) {
     real visible = R(1.0);
     real prev_h = R(1e20);
-    real t = eps;
+    real t = start;
     for (int i = 0; i < SHADOW_STEPS && t < max_t; ++i) {
         real h = DE(ro + rd * t, params);
         if (h < eps) {
@@ -186,8 +186,11 @@ real march_shadow(real3 ro, real3 rd, real max_t, real eps, real softness,
         }
         if (softness > R(0.0)) {
             // The closest point to the surface between this sample and the
-            // previous one, estimated from the two distance spheres.
-            real y = h * h / (R(2.0) * prev_h);
+            // previous one, estimated from the two distance spheres. They
+            // cross only if h < 2 prev_h, always true of an exact distance
+            // but not of every estimator (or after a minimum-length step);
+            // otherwise use this sample's own distance.
+            real y = h < R(2.0) * prev_h ? h * h / (R(2.0) * prev_h) : R(0.0);
             real side = sqrt(fmax(h * h - y * y, R(0.0)));
             visible = fmin(visible, side / (softness * fmax(t - y, REAL_TINY)));
             prev_h = h;
@@ -230,8 +233,8 @@ real3 march_shade(real3 p, real3 n, real3 rd, real eps, __global const real* par
     real3 color = albedo * sky * (MARCH_AMBIENT * occlusion);
 
 #ifdef ENABLE_SHADOWS
-    // Shadow rays start one hit threshold off the surface, four times their
-    // own threshold, so a surface never shadows itself.
+    // Shadow rays start one hit threshold off the surface and are blocked
+    // within a quarter of it, so a surface does not shadow itself.
     real3 lifted = p + n * eps;
 #endif
     for (int i = 0; i < light_count; ++i) {
@@ -252,7 +255,8 @@ real3 march_shade(real3 p, real3 n, real3 rd, real eps, __global const real* par
             continue;
         }
 #ifdef ENABLE_SHADOWS
-        real visible = march_shadow(lifted, to_light, light_distance, R(0.25) * eps, l[7], params);
+        real visible =
+            march_shadow(lifted, to_light, light_distance, R(0.25) * eps, eps, l[7], params);
         if (visible <= R(0.0)) {
             continue;
         }

@@ -220,6 +220,37 @@ fn a_soft_shadow_has_a_penumbra_and_a_hard_one_has_none() {
     );
 }
 
+/// Regression: the improved soft-shadow estimate assumed each distance is
+/// less than twice the previous one. Under a light straight overhead a
+/// flat floor's distance doubles exactly at every shadow step, and the
+/// whole open floor went black.
+#[test]
+fn soft_shadows_from_straight_above_light_an_open_floor() {
+    let Some(_) = gpu::device() else { return };
+    let overhead = Light::directional(dvec3(0.0, 1.0, 0.0)).softness(0.05);
+    let scene = gpu::sphere_box_floor().with_lights([overhead]);
+    let effects = Effects {
+        ambient_occlusion: false,
+        ..Effects::default()
+    };
+    let shadowed = render(&scene, gpu::quick(), effects);
+    let unshadowed = render(&scene, gpu::quick(), Effects::none());
+    let view = Renderer::with_options(&scene, &gpu::options(gpu::quick(), effects))
+        .unwrap()
+        .viewport(W, H)
+        .unwrap();
+    let (x, y) = gpu::project(&view, dvec3(0.0, 0.0, 1.2));
+    let (a, b) = (
+        gpu::luminance(&shadowed.image, x, y, 1),
+        gpu::luminance(&unshadowed.image, x, y, 1),
+    );
+    eprintln!("open floor: {a:.1} with shadows, {b:.1} without");
+    assert!(
+        (a - b).abs() < 2.0,
+        "open floor under an overhead light: {a} vs {b}"
+    );
+}
+
 #[test]
 fn glow_brightens_missed_rays_near_the_surface_only() {
     let Some(_) = gpu::device() else { return };
