@@ -120,3 +120,65 @@ fn orthographic_and_f64_match_the_cpu_reference() {
         "the floor fills the orthographic view"
     );
 }
+
+#[test]
+fn over_relaxation_agrees_and_takes_fewer_steps() {
+    let Some(_) = gpu::device() else { return };
+    let scene = gpu::sphere_box_floor();
+    let frame = |over_relaxation: f64| {
+        let quality = Quality {
+            over_relaxation,
+            ..Quality::production()
+        };
+        let mut r =
+            Renderer::with_options(&scene, &gpu::options(quality, Effects::none())).unwrap();
+        let f = r.render_with_aovs(96, 64).unwrap();
+        (r, f)
+    };
+    let (renderer, plain) = frame(1.0);
+    let (_, relaxed) = frame(1.6);
+    // The same pixels hit; each over-relaxed march stops inside the hit band
+    // of the surface the plain march found (not past it, not behind it).
+    let view = renderer.viewport(96, 64).unwrap();
+    let eps = renderer.options().quality.hit_epsilon;
+    let eval = Evaluator::new(scene.geometry.as_ref().unwrap()).unwrap();
+    let (mut same_hit, mut both, mut in_band) = (0, 0, 0);
+    for y in 0..64 {
+        for x in 0..96 {
+            let i = plain.index(x, y);
+            same_hit += usize::from(plain.hit[i] == relaxed.hit[i]);
+            if plain.hit[i] && relaxed.hit[i] {
+                both += 1;
+                let ray = view.ray(f64::from(x) + 0.5, f64::from(y) + 0.5);
+                let t = f64::from(relaxed.depth[i]);
+                let d = eval.distance(ray.origin + ray.direction * t);
+                let band = eps * view.footprint(t);
+                // Along grazing rays the band is long; a jump through a
+                // surface would land much farther.
+                let near = (t - f64::from(plain.depth[i])).abs() < 0.05 * t;
+                in_band += usize::from(d < band && d > -0.5 * band && near);
+            }
+        }
+    }
+    eprintln!("over-relaxed: {same_hit} same hits of 6144, {in_band} of {both} in the hit band");
+    assert!(
+        same_hit * 100 >= 6144 * 99,
+        "{same_hit} of 6144 hit masks agree"
+    );
+    assert!(
+        in_band * 100 >= both * 99,
+        "{in_band} of {both} stop in the hit band"
+    );
+    let mean =
+        |f: &Frame| f.steps.iter().map(|&s| f64::from(s)).sum::<f64>() / f.steps.len() as f64;
+    let (m1, m2) = (mean(&plain), mean(&relaxed));
+    eprintln!("mean steps: {m1:.1} plain, {m2:.1} over-relaxed");
+    assert!(m2 < m1, "over-relaxation saves steps: {m2} vs {m1}");
+}
+
+/// A renderer can move to another thread (a render loop, a worker).
+#[test]
+fn renderers_are_send() {
+    fn send<T: Send>() {}
+    send::<Renderer>();
+}
