@@ -14,6 +14,10 @@
 //!    baked constants or dynamic slots.
 //! 3. [`cpu`]: the reference evaluator (distance, colour, normal, sphere
 //!    tracing) in `f64` and `f32`; the oracle for every test.
+//! 4. `render` (feature `opencl`, on by default): the OpenCL executor —
+//!    device choice, program build and cache, tiled ray marching into an
+//!    image with depth, hit, normal and step outputs.
+//! 5. [`output`]: saving images (atomic PNG writes).
 //!
 //! ## A tour
 //!
@@ -62,7 +66,10 @@ pub mod error;
 pub mod gallery;
 pub mod ir;
 pub mod metrics;
+pub mod output;
 pub mod quality;
+#[cfg(feature = "opencl")]
+pub mod render;
 pub mod scene;
 
 pub use error::{Error, Result};

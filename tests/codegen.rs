@@ -26,10 +26,11 @@ fn sphere_scene_contains_no_fractal_helper_and_no_disabled_effect() {
         "angle_power",
         "sd_box",
         "smooth_min",
-        "ENABLE_AO",
-        "ENABLE_SHADOWS",
-        "ENABLE_GLOW",
-        "ENABLE_FOG",
+        "#ifdef",
+        "AO_SAMPLES",
+        "SHADOW_STEPS",
+        "GLOW_",
+        "FOG_",
     ] {
         assert!(
             !src.contains(absent),
@@ -53,12 +54,21 @@ fn effects_that_are_on_are_defined() {
         ..Options::default()
     };
     let src = source(sphere(1.0), &options);
-    for present in ["ENABLE_AO", "ENABLE_SHADOWS", "ENABLE_GLOW", "ENABLE_FOG"] {
+    for present in ["AO_SAMPLES", "SHADOW_STEPS", "GLOW_STRENGTH", "FOG_DENSITY"] {
         assert!(
             src.contains(&format!("#define {present}")),
             "missing {present}"
         );
+        // The effect's code is compiled in and uses the constant.
+        assert!(
+            src.matches(present).count() >= 2,
+            "{present} is defined but unused"
+        );
     }
+    assert!(
+        !src.contains("#ifdef"),
+        "feature blocks are resolved by code generation"
+    );
 }
 
 #[test]

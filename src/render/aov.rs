@@ -1,0 +1,63 @@
+//! A rendered frame with its arbitrary output values (AOVs).
+
+use image::RgbaImage;
+
+/// An image plus, per pixel, what the ray through the pixel centre found.
+///
+/// Every vector is row-major with `width × height` entries, index
+/// `y * width + x` (see [`Frame::index`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Frame {
+    /// The shaded image.
+    pub image: RgbaImage,
+    /// Distance along the pixel-centre ray to the surface, in scene units;
+    /// `f32::INFINITY` where the ray missed.
+    pub depth: Vec<f32>,
+    /// Whether the pixel-centre ray reached a surface.
+    pub hit: Vec<bool>,
+    /// World-space unit normal at the hit; `[0, 0, 0]` where the ray missed.
+    pub normal: Vec<[f32; 3]>,
+    /// Distance evaluations of the primary march, summed over the pixel's
+    /// colour samples (a per-pixel cost map).
+    pub steps: Vec<u32>,
+}
+
+impl Frame {
+    /// The image width in pixels.
+    #[must_use]
+    pub fn width(&self) -> u32 {
+        self.image.width()
+    }
+
+    /// The image height in pixels.
+    #[must_use]
+    pub fn height(&self) -> u32 {
+        self.image.height()
+    }
+
+    /// The index of pixel `(x, y)` in the AOV vectors.
+    ///
+    /// # Panics
+    /// If the pixel is outside the image.
+    #[must_use]
+    pub fn index(&self, x: u32, y: u32) -> usize {
+        assert!(
+            x < self.width() && y < self.height(),
+            "pixel ({x}, {y}) is outside the {}x{} frame",
+            self.width(),
+            self.height()
+        );
+        y as usize * self.width() as usize + x as usize
+    }
+
+    /// The fraction of pixels whose centre ray hit a surface.
+    #[must_use]
+    pub fn coverage(&self) -> f64 {
+        if self.hit.is_empty() {
+            return 0.0;
+        }
+        #[allow(clippy::cast_precision_loss)]
+        let covered = self.hit.iter().filter(|&&h| h).count() as f64 / self.hit.len() as f64;
+        covered
+    }
+}

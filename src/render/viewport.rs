@@ -1,0 +1,259 @@
+//! The camera as the kernel sees it: the ray through each pixel and the
+//! size of a pixel at each distance, plus the packed light list.
+//!
+//! Nothing here touches OpenCL; the layouts match the comment at the top of
+//! `kernels/march.cl`.
+
+use glam::DVec3;
+
+use crate::cpu::{MarchSettings, Ray};
+use crate::error::{Error, Result};
+use crate::quality::{Precision, Quality};
+use crate::scene::{Camera, Light, LightSource, Projection};
+
+/// Reals in the packed camera buffer.
+pub(crate) const CAMERA_LEN: usize = 20;
+/// Reals per light in the packed light buffer.
+pub(crate) const LIGHT_LEN: usize = 8;
+
+/// A camera fixed to an image size: the rays the kernel traces and the
+/// pixel footprint that scales its hit threshold.
+///
+/// The kernel traces exactly these rays (pixel centres when
+/// [`Quality::supersampling`] is 1), so a test can march them on the CPU
+/// with [`cpu::march`](crate::cpu::march) and [`Viewport::march_settings`]
+/// and compare.
+///
+/// ```
+/// use fractal_sdf::prelude::*;
+/// use fractal_sdf::render::Viewport;
+/// let view = Viewport::new(&Camera::look_at(dvec3(0.0, 0.0, 5.0), DVec3::ZERO), 64, 64, Precision::F32)?;
+/// // The centre of the image looks straight ahead.
+/// let ray = view.ray(32.0, 32.0);
+/// assert!((ray.direction - dvec3(0.0, 0.0, -1.0)).length() < 1e-12);
+/// # Ok::<(), fractal_sdf::Error>(())
+/// ```
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Viewport {
+    origin: DVec3,
+    right: DVec3,
+    up: DVec3,
+    forward: DVec3,
+    half_w: f64,
+    half_h: f64,
+    orthographic: bool,
+    footprint_base: f64,
+    footprint_per_unit: f64,
+    width: u32,
+    height: u32,
+}
+
+impl Viewport {
+    /// The viewport of `camera` for a `width` × `height` image.
+    ///
+    /// The pixel footprint at distance `t` along a ray is
+    /// `base + per_unit · t`. A perspective camera's `per_unit` is the
+    /// height of a pixel at unit distance, `2·tan(fov/2) / height`; its
+    /// `base` is a floor that keeps the hit threshold above zero at `t = 0`:
+    /// the scene scale (camera distance from the origin plus distance to
+    /// its target) times 1e-6 in `F32` and 1e-12 in `F64`, about eight ulps
+    /// of a coordinate of that size. An orthographic camera's footprint is
+    /// the constant `height / pixels`.
+    ///
+    /// # Errors
+    /// [`Error::Camera`] for a degenerate camera, [`Error::Resolution`] if a
+    /// side is 0.
+    pub fn new(camera: &Camera, width: u32, height: u32, precision: Precision) -> Result<Self> {
+        if width == 0 || height == 0 {
+            return Err(Error::Resolution {
+                width,
+                height,
+                reason: "width and height must be at least 1".into(),
+            });
+        }
+        let (right, up, forward) = camera.basis()?;
+        let aspect = f64::from(width) / f64::from(height);
+        let scale = camera.position.length() + (camera.target - camera.position).length();
+        let relative_floor = match precision {
+            Precision::F32 => 1e-6,
+            Precision::F64 => 1e-12,
+        };
+        let (half_h, orthographic, footprint_base, footprint_per_unit) = match camera.projection {
+            Projection::Perspective { fov_y_degrees } => {
+                let half_h = (fov_y_degrees.to_radians() * 0.5).tan();
+                let per_unit = 2.0 * half_h / f64::from(height);
+                (half_h, false, scale * relative_floor, per_unit)
+            }
+            Projection::Orthographic { height: visible } => {
+                (visible * 0.5, true, visible / f64::from(height), 0.0)
+            }
+        };
+        Ok(Viewport {
+            origin: camera.position,
+            right,
+            up,
+            forward,
+            half_w: half_h * aspect,
+            half_h,
+            orthographic,
+            footprint_base,
+            footprint_per_unit,
+            width,
+            height,
+        })
+    }
+
+    /// The ray through image position `(x, y)` in pixels, `(0, 0)` being the
+    /// top-left corner: the centre of pixel `(i, j)` is `(i + 0.5, j + 0.5)`.
+    #[must_use]
+    pub fn ray(&self, x: f64, y: f64) -> Ray {
+        let u = (2.0 * x / f64::from(self.width) - 1.0) * self.half_w;
+        let v = (1.0 - 2.0 * y / f64::from(self.height)) * self.half_h;
+        if self.orthographic {
+            Ray {
+                origin: self.origin + self.right * u + self.up * v,
+                direction: self.forward,
+            }
+        } else {
+            Ray {
+                origin: self.origin,
+                direction: (self.forward + self.right * u + self.up * v).normalize(),
+            }
+        }
+    }
+
+    /// Scene units covered by one pixel at distance `t` along a ray.
+    #[must_use]
+    pub fn footprint(&self, t: f64) -> f64 {
+        self.footprint_base + self.footprint_per_unit * t
+    }
+
+    /// The CPU reference's settings for the same march as the kernel: the
+    /// hit threshold is `quality.hit_epsilon` pixel footprints.
+    #[must_use]
+    pub fn march_settings(&self, quality: &Quality) -> MarchSettings {
+        MarchSettings {
+            max_steps: quality.max_steps,
+            max_distance: quality.max_distance,
+            epsilon: quality.hit_epsilon * self.footprint_base,
+            epsilon_per_unit: quality.hit_epsilon * self.footprint_per_unit,
+        }
+    }
+
+    /// The image size.
+    #[must_use]
+    pub fn size(&self) -> (u32, u32) {
+        (self.width, self.height)
+    }
+
+    /// The kernel's camera buffer (layout in `kernels/march.cl`).
+    pub(crate) fn pack(&self) -> [f64; CAMERA_LEN] {
+        let mut c = [0.0; CAMERA_LEN];
+        let put = |c: &mut [f64; CAMERA_LEN], at: usize, v: DVec3, w: f64| {
+            c[at..at + 4].copy_from_slice(&[v.x, v.y, v.z, w]);
+        };
+        put(
+            &mut c,
+            0,
+            self.origin,
+            f64::from(u8::from(self.orthographic)),
+        );
+        put(&mut c, 4, self.right, self.half_w);
+        put(&mut c, 8, self.up, self.half_h);
+        put(&mut c, 12, self.forward, 0.0);
+        c[16] = self.footprint_base;
+        c[17] = self.footprint_per_unit;
+        c
+    }
+}
+
+/// The kernel's light buffer (layout in `kernels/march.cl`); at least one
+/// (unused) entry so the buffer is never empty.
+pub(crate) fn pack_lights(lights: &[Light]) -> Vec<f64> {
+    let mut out = Vec::with_capacity(LIGHT_LEN * lights.len().max(1));
+    for light in lights {
+        let (v, kind) = match light.source {
+            LightSource::Directional { direction } => (direction.normalize(), 0.0),
+            LightSource::Point { position } => (position, 1.0),
+        };
+        let radiance = light.color * light.intensity;
+        out.extend_from_slice(&[v.x, v.y, v.z, kind]);
+        out.extend_from_slice(&[radiance.x, radiance.y, radiance.z, light.softness]);
+    }
+    if out.is_empty() {
+        out.resize(LIGHT_LEN, 0.0);
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use glam::dvec3;
+
+    fn camera() -> Camera {
+        Camera::look_at(dvec3(1.0, 2.0, 6.0), dvec3(0.0, 0.5, 0.0)).fov(60.0)
+    }
+
+    #[test]
+    fn corner_rays_span_the_field_of_view() {
+        let (w, h) = (80, 40);
+        let view = Viewport::new(&camera(), w, h, Precision::F32).unwrap();
+        let (right, up, forward) = camera().basis().unwrap();
+        let top = view.ray(f64::from(w) / 2.0, 0.0).direction;
+        // The top edge is half the vertical field of view above forward.
+        let angle = top.dot(forward).acos().to_degrees();
+        assert!((angle - 30.0).abs() < 1e-9, "{angle}");
+        assert!(top.dot(up) > 0.0);
+        // The right edge: tan(half horizontal fov) = aspect * tan(30°).
+        let side = view.ray(f64::from(w), f64::from(h) / 2.0).direction;
+        let tan = side.dot(right) / side.dot(forward);
+        assert!((tan - 2.0 * 30f64.to_radians().tan()).abs() < 1e-9, "{tan}");
+    }
+
+    #[test]
+    fn perspective_footprint_is_one_pixel_at_unit_distance() {
+        let view = Viewport::new(&camera(), 100, 50, Precision::F32).unwrap();
+        let a = view.ray(50.0, 25.0).direction;
+        let b = view.ray(50.0, 26.0).direction;
+        // One pixel apart at distance 1 at the image centre: the footprint
+        // (off-axis it overestimates, which only makes thresholds safer).
+        let gap = (a - b).length();
+        let fp = view.footprint(1.0) - view.footprint(0.0);
+        assert!((gap / fp - 1.0).abs() < 0.05, "{gap} vs {fp}");
+        assert!(view.footprint(0.0) > 0.0);
+        let settings = view.march_settings(&Quality::production());
+        assert!((settings.epsilon_per_unit - 0.75 * fp).abs() < 1e-15);
+    }
+
+    #[test]
+    fn orthographic_rays_are_parallel_and_offset() {
+        let cam = camera().orthographic(4.0);
+        let view = Viewport::new(&cam, 40, 40, Precision::F64).unwrap();
+        let a = view.ray(0.0, 0.0);
+        let b = view.ray(40.0, 40.0);
+        assert_eq!(a.direction, b.direction);
+        assert!(((a.origin - b.origin).length() - 4.0 * 2f64.sqrt()).abs() < 1e-9);
+        assert!((view.footprint(123.0) - 0.1).abs() < 1e-15);
+        assert_eq!(view.pack()[3], 1.0);
+    }
+
+    #[test]
+    fn zero_size_is_a_resolution_error() {
+        let err = Viewport::new(&camera(), 0, 10, Precision::F32).unwrap_err();
+        assert!(matches!(err, Error::Resolution { width: 0, .. }), "{err}");
+    }
+
+    #[test]
+    fn lights_pack_normalised_directions_and_radiance() {
+        let lights = [
+            Light::directional(dvec3(0.0, 2.0, 0.0)).intensity(2.0),
+            Light::point(dvec3(1.0, 2.0, 3.0)).softness(0.0),
+        ];
+        let packed = pack_lights(&lights);
+        assert_eq!(packed.len(), 2 * LIGHT_LEN);
+        assert_eq!(&packed[..8], &[0.0, 1.0, 0.0, 0.0, 2.0, 2.0, 2.0, 0.05]);
+        assert_eq!(&packed[8..], &[1.0, 2.0, 3.0, 1.0, 1.0, 1.0, 1.0, 0.0]);
+        assert_eq!(pack_lights(&[]).len(), LIGHT_LEN);
+    }
+}

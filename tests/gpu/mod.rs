@@ -1,0 +1,118 @@
+//! Shared helpers for the OpenCL render tests: the device check, fixture
+//! scenes and pixel measurements.
+#![allow(dead_code)] // each test binary uses a different subset
+
+use fractal_sdf::prelude::*;
+use fractal_sdf::render::{DeviceInfo, RenderOptions, devices};
+use fractal_sdf::scene::LightSource;
+use image::RgbaImage;
+
+/// The device the tests will render on, or `None` where no OpenCL platform
+/// is installed: the test then returns early with a note. Under `CI=true`
+/// a missing platform fails the test instead.
+pub fn device() -> Option<DeviceInfo> {
+    let in_ci = std::env::var("CI").is_ok_and(|v| v == "true" || v == "1");
+    match devices() {
+        Ok(list) if !list.is_empty() => Some(list[0].clone()),
+        Ok(_) | Err(Error::NoPlatform { .. }) => {
+            let why = devices().err().map_or_else(
+                || "an OpenCL platform without devices".to_string(),
+                |e| e.to_string(),
+            );
+            assert!(!in_ci, "CI=true requires OpenCL: {why}");
+            eprintln!("note: skipping OpenCL render test: {why}");
+            None
+        }
+        Err(other) => panic!("listing OpenCL devices failed: {other}"),
+    }
+}
+
+/// Saves an image for inspection when `FRACTAL_SDF_TEST_OUT` names a
+/// directory.
+pub fn save(name: &str, image: &RgbaImage) {
+    if let Ok(dir) = std::env::var("FRACTAL_SDF_TEST_OUT") {
+        let path = std::path::Path::new(&dir).join(format!("{name}.png"));
+        fractal_sdf::output::save_png(image, path).expect("save test image");
+    }
+}
+
+/// The floor: the plane y = 0.
+pub fn floor() -> Node {
+    plane(dvec3(0.0, 1.0, 0.0), 0.0)
+}
+
+/// A sphere of dynamic radius `radius` (default 0.5) resting on the floor
+/// at x = -0.6, and an orange box at x = 0.6.
+pub fn sphere_box_floor() -> Scene {
+    let ball = sphere(param("radius", 0.5)).translate(dvec3(-0.6, 0.5, 0.0));
+    let block = cuboid(dvec3(0.35, 0.35, 0.35))
+        .color(dvec3(0.9, 0.45, 0.1))
+        .translate(dvec3(0.6, 0.35, 0.1));
+    Scene::new(floor().union(ball).union(block))
+        .with_camera(Camera::look_at(dvec3(0.0, 1.4, 3.2), dvec3(0.0, 0.35, 0.0)).fov(40.0))
+}
+
+/// A directional light with the given softness from above, right and
+/// behind the scene, so shadows fall towards the camera.
+pub fn sun(softness: f64) -> Light {
+    Light::directional(dvec3(0.5, 1.0, -0.6)).softness(softness)
+}
+
+/// Options on the first device with the given quality and effects.
+pub fn options(quality: Quality, effects: Effects) -> RenderOptions {
+    RenderOptions {
+        quality,
+        effects,
+        ..RenderOptions::default()
+    }
+}
+
+/// A quick quality: production thresholds, fewer shading samples.
+pub fn quick() -> Quality {
+    Quality {
+        max_steps: 192,
+        ao_samples: 5,
+        shadow_steps: 96,
+        ..Quality::production()
+    }
+}
+
+/// Mean luminance (0–255) of the pixels in a square of half side `r`
+/// around `(x, y)`.
+pub fn luminance(image: &RgbaImage, x: u32, y: u32, r: u32) -> f64 {
+    let mut sum = 0.0;
+    let mut n = 0.0;
+    for j in y.saturating_sub(r)..=(y + r).min(image.height() - 1) {
+        for i in x.saturating_sub(r)..=(x + r).min(image.width() - 1) {
+            let p = image.get_pixel(i, j).0;
+            sum += 0.2126 * f64::from(p[0]) + 0.7152 * f64::from(p[1]) + 0.0722 * f64::from(p[2]);
+            n += 1.0;
+        }
+    }
+    sum / n
+}
+
+/// The pixel whose centre ray passes closest to the world point `p`.
+pub fn project(view: &fractal_sdf::render::Viewport, p: DVec3) -> (u32, u32) {
+    let (w, h) = view.size();
+    let mut best = (0, 0, f64::INFINITY);
+    for y in 0..h {
+        for x in 0..w {
+            let ray = view.ray(f64::from(x) + 0.5, f64::from(y) + 0.5);
+            let to = p - ray.origin;
+            let miss = (to - ray.direction * to.dot(ray.direction)).length();
+            if miss < best.2 {
+                best = (x, y, miss);
+            }
+        }
+    }
+    (best.0, best.1)
+}
+
+/// Whether a directional light is the only light and points as given.
+pub fn direction_of(light: &Light) -> Option<DVec3> {
+    match light.source {
+        LightSource::Directional { direction } => Some(direction.normalize()),
+        LightSource::Point { .. } => None,
+    }
+}

@@ -1,0 +1,184 @@
+//! The OpenCL marcher agrees with the CPU reference, ray for ray.
+
+mod gpu;
+
+use fractal_sdf::cpu::{self, Evaluator};
+use fractal_sdf::prelude::*;
+use fractal_sdf::render::{Frame, Renderer};
+
+/// Compares a frame's hit mask and depth with `cpu::march` on the same rays
+/// and thresholds; returns (hit agreement, depth agreement among pixels
+/// both hit).
+fn compare(renderer: &Renderer, frame: &Frame, scene: &Scene) -> (f64, f64) {
+    let (w, h) = (frame.width(), frame.height());
+    let view = renderer.viewport(w, h).unwrap();
+    let settings = view.march_settings(&renderer.options().quality);
+    let eval = Evaluator::new(scene.geometry.as_ref().unwrap()).unwrap();
+    let (mut same_hit, mut both, mut same_depth) = (0, 0, 0);
+    let mut worst = 0.0f64;
+    for y in 0..h {
+        for x in 0..w {
+            let i = frame.index(x, y);
+            let reference = cpu::march(
+                &eval,
+                view.ray(f64::from(x) + 0.5, f64::from(y) + 0.5),
+                &settings,
+            );
+            if reference.hit == frame.hit[i] {
+                same_hit += 1;
+            }
+            if reference.hit && frame.hit[i] {
+                both += 1;
+                let t = reference.depth;
+                // The march stops somewhere within the hit threshold of the
+                // surface; float rounding may move it by a step.
+                let tolerance = 1e-4 * t + view.footprint(t) * settings_eps(renderer);
+                let error = (f64::from(frame.depth[i]) - t).abs();
+                worst = worst.max(error / tolerance);
+                if error <= tolerance {
+                    same_depth += 1;
+                }
+            }
+        }
+    }
+    let pixels = f64::from(w * h);
+    eprintln!("largest depth error: {worst:.3} of the tolerance");
+    (
+        f64::from(same_hit) / pixels,
+        f64::from(same_depth) / f64::from(both.max(1)),
+    )
+}
+
+fn settings_eps(renderer: &Renderer) -> f64 {
+    renderer.options().quality.hit_epsilon
+}
+
+#[test]
+fn hit_mask_and_depth_match_the_cpu_reference() {
+    let Some(_) = gpu::device() else { return };
+    let scene = gpu::sphere_box_floor();
+    let quality = Quality::production();
+    let mut renderer =
+        Renderer::with_options(&scene, &gpu::options(quality, Effects::none())).unwrap();
+    let frame = renderer.render_with_aovs(96, 64).unwrap();
+    gpu::save("agreement_perspective", &frame.image);
+    let (hits, depths) = compare(&renderer, &frame, &scene);
+    eprintln!("agreement: {hits:.4} of hit masks, {depths:.4} of depths");
+    assert!(
+        hits >= 0.99,
+        "hit masks agree on {:.2}% of pixels",
+        100.0 * hits
+    );
+    assert!(
+        depths >= 0.99,
+        "depths agree on {:.2}% of hit pixels",
+        100.0 * depths
+    );
+    // Misses have infinite depth and no normal; hits a unit normal.
+    for i in 0..frame.hit.len() {
+        let n = frame.normal[i];
+        let len = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
+        if frame.hit[i] {
+            assert!(
+                frame.depth[i].is_finite() && (len - 1.0).abs() < 1e-3,
+                "pixel {i}"
+            );
+        } else {
+            assert!(frame.depth[i] == f32::INFINITY && len == 0.0, "pixel {i}");
+        }
+    }
+}
+
+#[test]
+fn orthographic_and_f64_match_the_cpu_reference() {
+    let Some(device) = gpu::device() else { return };
+    let scene = gpu::sphere_box_floor();
+    let camera = Camera::look_at(dvec3(2.0, 2.5, 3.0), dvec3(0.0, 0.3, 0.0)).orthographic(3.0);
+    let scene = scene.with_camera(camera);
+    let mut quality = Quality::production();
+    if device.fp64 {
+        quality.precision = Precision::F64;
+    }
+    let mut renderer =
+        Renderer::with_options(&scene, &gpu::options(quality, Effects::none())).unwrap();
+    let frame = renderer.render_with_aovs(80, 60).unwrap();
+    gpu::save("agreement_orthographic", &frame.image);
+    let (hits, depths) = compare(&renderer, &frame, &scene);
+    eprintln!("agreement: {hits:.4} of hit masks, {depths:.4} of depths");
+    assert!(
+        hits >= 0.99,
+        "hit masks agree on {:.2}% of pixels",
+        100.0 * hits
+    );
+    assert!(
+        depths >= 0.99,
+        "depths agree on {:.2}% of hit pixels",
+        100.0 * depths
+    );
+    assert!(
+        frame.coverage() > 0.99,
+        "the floor fills the orthographic view"
+    );
+}
+
+#[test]
+fn over_relaxation_agrees_and_takes_fewer_steps() {
+    let Some(_) = gpu::device() else { return };
+    let scene = gpu::sphere_box_floor();
+    let frame = |over_relaxation: f64| {
+        let quality = Quality {
+            over_relaxation,
+            ..Quality::production()
+        };
+        let mut r =
+            Renderer::with_options(&scene, &gpu::options(quality, Effects::none())).unwrap();
+        let f = r.render_with_aovs(96, 64).unwrap();
+        (r, f)
+    };
+    let (renderer, plain) = frame(1.0);
+    let (_, relaxed) = frame(1.6);
+    // The same pixels hit; each over-relaxed march stops inside the hit band
+    // of the surface the plain march found (not past it, not behind it).
+    let view = renderer.viewport(96, 64).unwrap();
+    let eps = renderer.options().quality.hit_epsilon;
+    let eval = Evaluator::new(scene.geometry.as_ref().unwrap()).unwrap();
+    let (mut same_hit, mut both, mut in_band) = (0, 0, 0);
+    for y in 0..64 {
+        for x in 0..96 {
+            let i = plain.index(x, y);
+            same_hit += usize::from(plain.hit[i] == relaxed.hit[i]);
+            if plain.hit[i] && relaxed.hit[i] {
+                both += 1;
+                let ray = view.ray(f64::from(x) + 0.5, f64::from(y) + 0.5);
+                let t = f64::from(relaxed.depth[i]);
+                let d = eval.distance(ray.origin + ray.direction * t);
+                let band = eps * view.footprint(t);
+                // Along grazing rays the band is long; a jump through a
+                // surface would land much farther.
+                let near = (t - f64::from(plain.depth[i])).abs() < 0.05 * t;
+                in_band += usize::from(d < band && d > -0.5 * band && near);
+            }
+        }
+    }
+    eprintln!("over-relaxed: {same_hit} same hits of 6144, {in_band} of {both} in the hit band");
+    assert!(
+        same_hit * 100 >= 6144 * 99,
+        "{same_hit} of 6144 hit masks agree"
+    );
+    assert!(
+        in_band * 100 >= both * 99,
+        "{in_band} of {both} stop in the hit band"
+    );
+    let mean =
+        |f: &Frame| f.steps.iter().map(|&s| f64::from(s)).sum::<f64>() / f.steps.len() as f64;
+    let (m1, m2) = (mean(&plain), mean(&relaxed));
+    eprintln!("mean steps: {m1:.1} plain, {m2:.1} over-relaxed");
+    assert!(m2 < m1, "over-relaxation saves steps: {m2} vs {m1}");
+}
+
+/// A renderer can move to another thread (a render loop, a worker).
+#[test]
+fn renderers_are_send() {
+    fn send<T: Send>() {}
+    send::<Renderer>();
+}

@@ -1,0 +1,320 @@
+//! Each lighting effect does what it is for, where it should.
+
+mod gpu;
+
+use fractal_sdf::cpu::{self, Evaluator, MarchSettings, Ray};
+use fractal_sdf::prelude::*;
+use fractal_sdf::quality::Glow;
+use fractal_sdf::render::{Frame, Renderer};
+
+const W: u32 = 96;
+const H: u32 = 64;
+
+fn render(scene: &Scene, quality: Quality, effects: Effects) -> Frame {
+    let mut r = Renderer::with_options(scene, &gpu::options(quality, effects)).unwrap();
+    r.render_with_aovs(W, H).unwrap()
+}
+
+fn luma(frame: &Frame, i: usize) -> f64 {
+    let (x, y) = (i as u32 % W, i as u32 / W);
+    gpu::luminance(&frame.image, x, y, 0)
+}
+
+/// Pixels showing the open floor (normal straight up).
+fn floor_pixels(frame: &Frame) -> Vec<usize> {
+    (0..frame.hit.len())
+        .filter(|&i| frame.hit[i] && frame.normal[i][1] > 0.999)
+        .collect()
+}
+
+#[test]
+fn ambient_occlusion_darkens_the_crease_where_a_box_meets_the_floor() {
+    let Some(_) = gpu::device() else { return };
+    // Ambient light only, so occlusion is the only thing that varies.
+    let scene = gpu::sphere_box_floor().with_lights([]);
+    let with = Effects {
+        shadows: false,
+        ..Effects::default()
+    };
+    let without = Effects::none();
+    // Samples up to 0.5 from the surface: the crease spans a few pixels.
+    let quality = Quality {
+        ao_step: 0.1,
+        ..gpu::quick()
+    };
+    let on = render(&scene, quality, with);
+    let off = render(&scene, quality, without);
+    gpu::save("effects_ao_on", &on.image);
+    let view = Renderer::with_options(&scene, &gpu::options(gpu::quick(), without))
+        .unwrap()
+        .viewport(W, H)
+        .unwrap();
+    // On the floor 0.03 in front of the box's front face, and out in the open.
+    let (cx, cy) = gpu::project(&view, dvec3(0.6, 0.0, 0.48));
+    let (ox, oy) = gpu::project(&view, dvec3(0.0, 0.0, 1.0));
+    for (x, y) in [(cx, cy), (ox, oy)] {
+        let i = on.index(x, y);
+        assert!(
+            on.hit[i] && on.normal[i][1] > 0.99,
+            "({x}, {y}) is not open floor"
+        );
+    }
+    let crease = |f: &Frame| gpu::luminance(&f.image, cx, cy, 0);
+    let open = |f: &Frame| gpu::luminance(&f.image, ox, oy, 0);
+    let ratio_on = crease(&on) / open(&on);
+    let ratio_off = crease(&off) / open(&off);
+    eprintln!("crease/open luminance: {ratio_on:.3} with AO, {ratio_off:.3} without");
+    assert!(
+        (ratio_off - 1.0).abs() < 0.02,
+        "without AO the floor is even: {ratio_off}"
+    );
+    assert!(ratio_on < 0.8, "AO darkens the crease: {ratio_on}");
+    // The open floor is unoccluded.
+    assert!((open(&on) - open(&off)).abs() < 2.0);
+}
+
+/// Which floor pixels the CPU reference sees in shadow from `light_dir`:
+/// (clearly shadowed, clearly lit). A pixel is clear-cut when the shadow
+/// rays from its floor point, its four neighbours' floor points and a point
+/// 0.1 above it all agree: the kernel's shading point and the start of its
+/// shadow ray lie up to about a pixel from the exact floor point.
+fn classify_shadows(scene: &Scene, frame: &Frame, light_dir: DVec3) -> (Vec<usize>, Vec<usize>) {
+    let eval = Evaluator::new(scene.geometry.as_ref().unwrap()).unwrap();
+    let view = Renderer::with_options(scene, &gpu::options(gpu::quick(), Effects::none()))
+        .unwrap()
+        .viewport(W, H)
+        .unwrap();
+    let settings = MarchSettings {
+        max_steps: 512,
+        max_distance: 50.0,
+        epsilon: 1e-4,
+        epsilon_per_unit: 0.0,
+    };
+    // Where the ray through image position (x, y) meets the floor y = 0.
+    let floor_point = |x: f64, y: f64| {
+        let ray = view.ray(x, y);
+        ray.origin - ray.direction * (ray.origin.y / ray.direction.y)
+    };
+    let blocked = |p: DVec3| {
+        let ray = Ray {
+            origin: p + dvec3(0.0, 1e-3, 0.0),
+            direction: light_dir,
+        };
+        cpu::march(&eval, ray, &settings).hit
+    };
+    let (mut dark, mut lit) = (Vec::new(), Vec::new());
+    for i in floor_pixels(frame) {
+        let (x, y) = (f64::from(i as u32 % W) + 0.5, f64::from(i as u32 / W) + 0.5);
+        let around = [(0.0, 0.0), (1.0, 0.0), (-1.0, 0.0), (0.0, 1.0), (0.0, -1.0)];
+        let raised = floor_point(x, y) + dvec3(0.0, 0.1, 0.0);
+        let count = around
+            .iter()
+            .map(|(dx, dy)| floor_point(x + dx, y + dy))
+            .chain([raised])
+            .filter(|&p| blocked(p))
+            .count();
+        match count {
+            0 => lit.push(i),
+            6 => dark.push(i),
+            _ => {}
+        }
+    }
+    (dark, lit)
+}
+
+fn mean(v: impl Iterator<Item = f64>) -> f64 {
+    let (s, n) = v.fold((0.0, 0.0), |(s, n), x| (s + x, n + 1.0));
+    s / n
+}
+
+#[test]
+fn a_shadowed_floor_point_is_darker_than_a_lit_one() {
+    let Some(_) = gpu::device() else { return };
+    let sun = gpu::sun(0.0);
+    let scene = gpu::sphere_box_floor().with_lights([sun]);
+    let effects = Effects {
+        ambient_occlusion: false,
+        ..Effects::default()
+    };
+    let frame = render(&scene, gpu::quick(), effects);
+    gpu::save("effects_hard_shadow", &frame.image);
+    let (dark, lit) = classify_shadows(&scene, &frame, gpu::direction_of(&sun).unwrap());
+    assert!(
+        dark.len() > 30 && lit.len() > 300,
+        "{} dark, {} lit",
+        dark.len(),
+        lit.len()
+    );
+    let brightest_dark = dark.iter().map(|&i| luma(&frame, i)).fold(0.0, f64::max);
+    let darkest_lit = lit.iter().map(|&i| luma(&frame, i)).fold(255.0, f64::min);
+    eprintln!(
+        "{} shadowed pixels up to {brightest_dark:.1}, {} lit from {darkest_lit:.1}",
+        dark.len(),
+        lit.len()
+    );
+    assert!(
+        brightest_dark + 20.0 < darkest_lit,
+        "shadowed up to {brightest_dark}, lit from {darkest_lit}"
+    );
+    // Without shadows the same pixels are lit.
+    let unshadowed = render(&scene, gpu::quick(), Effects::none());
+    let d = mean(dark.iter().map(|&i| luma(&unshadowed, i)));
+    let l = mean(lit.iter().map(|&i| luma(&unshadowed, i)));
+    assert!((d - l).abs() < 3.0, "no shadows: {d} vs {l}");
+}
+
+/// Linear green channel of pixel `i`.
+fn linear(frame: &Frame, i: usize) -> f64 {
+    let (x, y) = (i as u32 % W, i as u32 / W);
+    (f64::from(frame.image.get_pixel(x, y).0[1]) / 255.0).powf(2.2)
+}
+
+/// Per floor pixel, the fraction of the light that reaches it: the shadowed
+/// render's light above ambient over the unshadowed render's.
+fn visibility(scene: &Scene, quality: Quality) -> (Vec<f64>, Frame) {
+    let effects = Effects {
+        ambient_occlusion: false,
+        ..Effects::default()
+    };
+    let shadowed = render(scene, quality, effects);
+    let unshadowed = render(scene, quality, Effects::none());
+    let ambient = render(&scene.clone().with_lights([]), quality, Effects::none());
+    let v = floor_pixels(&unshadowed)
+        .into_iter()
+        .filter(|&i| shadowed.hit[i] && shadowed.normal[i][1] > 0.999)
+        .map(|i| {
+            let base = linear(&ambient, i);
+            (linear(&shadowed, i) - base) / (linear(&unshadowed, i) - base)
+        })
+        .collect();
+    (v, shadowed)
+}
+
+#[test]
+fn a_soft_shadow_has_a_penumbra_and_a_hard_one_has_none() {
+    let Some(_) = gpu::device() else { return };
+    let base = gpu::sphere_box_floor();
+    let (hard, _) = visibility(&base.clone().with_lights([gpu::sun(0.0)]), gpu::quick());
+    let (soft, image) = visibility(&base.with_lights([gpu::sun(0.3)]), gpu::quick());
+    gpu::save("effects_soft_shadow", &image.image);
+    let partial = |v: &[f64]| v.iter().filter(|&&x| x > 0.15 && x < 0.85).count();
+    let umbra = |v: &[f64]| v.iter().filter(|&&x| x < 0.05).count();
+    assert!(umbra(&hard) > 30, "the hard render has a shadow");
+    assert!(umbra(&soft) > 10, "the soft render has an umbra");
+    let (in_hard, in_soft) = (partial(&hard), partial(&soft));
+    eprintln!(
+        "partly lit floor pixels: {in_hard} hard, {in_soft} soft; umbra {} hard, {} soft",
+        umbra(&hard),
+        umbra(&soft)
+    );
+    assert!(
+        in_hard <= hard.len() / 200,
+        "hard shadow edge: {in_hard} of {}",
+        hard.len()
+    );
+    let shadowed = umbra(&hard);
+    assert!(
+        in_soft >= shadowed / 4 && in_soft > 10 * in_hard.max(1),
+        "soft penumbra: {in_soft} (hard: {in_hard}, hard shadow: {shadowed} of {})",
+        soft.len()
+    );
+}
+
+/// Regression: the improved soft-shadow estimate assumed each distance is
+/// less than twice the previous one. Under a light straight overhead a
+/// flat floor's distance doubles exactly at every shadow step, and the
+/// whole open floor went black.
+#[test]
+fn soft_shadows_from_straight_above_light_an_open_floor() {
+    let Some(_) = gpu::device() else { return };
+    let overhead = Light::directional(dvec3(0.0, 1.0, 0.0)).softness(0.05);
+    let scene = gpu::sphere_box_floor().with_lights([overhead]);
+    let effects = Effects {
+        ambient_occlusion: false,
+        ..Effects::default()
+    };
+    let shadowed = render(&scene, gpu::quick(), effects);
+    let unshadowed = render(&scene, gpu::quick(), Effects::none());
+    let view = Renderer::with_options(&scene, &gpu::options(gpu::quick(), effects))
+        .unwrap()
+        .viewport(W, H)
+        .unwrap();
+    let (x, y) = gpu::project(&view, dvec3(0.0, 0.0, 1.2));
+    let (a, b) = (
+        gpu::luminance(&shadowed.image, x, y, 1),
+        gpu::luminance(&unshadowed.image, x, y, 1),
+    );
+    eprintln!("open floor: {a:.1} with shadows, {b:.1} without");
+    assert!(
+        (a - b).abs() < 2.0,
+        "open floor under an overhead light: {a} vs {b}"
+    );
+}
+
+#[test]
+fn glow_brightens_missed_rays_near_the_surface_only() {
+    let Some(_) = gpu::device() else { return };
+    let scene = Scene::new(sphere(0.5))
+        .with_camera(Camera::look_at(dvec3(0.0, 0.0, 4.0), DVec3::ZERO).fov(40.0));
+    let glow = Effects {
+        glow: Some(Glow {
+            color: dvec3(1.0, 0.6, 0.2),
+            strength: 1.0,
+        }),
+        ..Effects::none()
+    };
+    let on = render(&scene, gpu::quick(), glow);
+    let off = render(&scene, gpu::quick(), Effects::none());
+    gpu::save("effects_glow", &on.image);
+    // Surfaces are unchanged; a missed pixel beside the silhouette glows; a
+    // far corner does not.
+    let mut near_gain = Vec::new();
+    for y in 0..H {
+        for x in 1..W - 1 {
+            let i = on.index(x, y);
+            if on.hit[i] {
+                assert_eq!(on.image.get_pixel(x, y), off.image.get_pixel(x, y));
+            } else if on.hit[i - 1] || on.hit[i + 1] {
+                near_gain.push(luma(&on, i) - luma(&off, i));
+            }
+        }
+    }
+    assert!(!near_gain.is_empty());
+    let weakest = near_gain.iter().copied().fold(255.0, f64::min);
+    eprintln!("weakest glow beside the silhouette: {weakest:.1}");
+    assert!(weakest > 40.0, "glow beside the silhouette: {weakest}");
+    for (x, y) in [(0, 0), (W - 1, 0), (0, H - 1), (W - 1, H - 1)] {
+        let gain = gpu::luminance(&on.image, x, y, 0) - gpu::luminance(&off.image, x, y, 0);
+        eprintln!("corner ({x}, {y}) glow: {gain:.1}");
+        assert!(gain < 8.0, "corner ({x}, {y}) glows by {gain}");
+    }
+}
+
+#[test]
+fn fog_fades_distant_surfaces_into_the_background() {
+    let Some(_) = gpu::device() else { return };
+    let scene = gpu::sphere_box_floor().with_lights([gpu::sun(0.0)]);
+    let fog = Effects {
+        fog_density: 0.3,
+        ..Effects::none()
+    };
+    let on = render(&scene, gpu::quick(), fog);
+    let off = render(&scene, gpu::quick(), Effects::none());
+    // The farthest floor pixel is closer to the background colour with fog.
+    let far = floor_pixels(&off)
+        .into_iter()
+        .max_by(|&a, &b| off.depth[a].total_cmp(&off.depth[b]))
+        .unwrap();
+    let (x, y) = (far as u32 % W, far as u32 / W);
+    // The background gradient's value at this row.
+    let sky = Effects::default().sky_top.lerp(
+        Effects::default().sky_bottom,
+        (f64::from(y) + 0.5) / f64::from(H),
+    );
+    let g = |c: f64| 255.0 * c.powf(1.0 / 2.2);
+    let target = 0.2126 * g(sky.x) + 0.7152 * g(sky.y) + 0.0722 * g(sky.z);
+    let d_on = (luma(&on, far) - target).abs();
+    let d_off = (luma(&off, far) - target).abs();
+    eprintln!("distance from the background: {d_on:.1} with fog, {d_off:.1} without");
+    assert!(d_on < 0.5 * d_off, "fog at ({x}, {y}): {d_on} vs {d_off}");
+}

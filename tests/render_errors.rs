@@ -1,0 +1,133 @@
+//! Bad settings and bad programs are typed errors with what is needed to
+//! fix them.
+
+mod gpu;
+
+use fractal_sdf::prelude::*;
+use fractal_sdf::render::{DeviceSelector, ProgramSource, RenderOptions, Renderer, devices};
+
+#[test]
+fn a_build_failure_carries_the_log_and_the_source() {
+    let Some(_) = gpu::device() else { return };
+    let source = ProgramSource {
+        source: "__kernel void render_tile(__global float* x) { x[0] = undefined_name; }\n".into(),
+        precision: Precision::F32,
+    };
+    let err = Renderer::with_source(
+        &gpu::sphere_box_floor(),
+        &RenderOptions::default(),
+        source.clone(),
+    )
+    .unwrap_err();
+    match &err {
+        Error::Build {
+            device,
+            log,
+            kernel_source,
+        } => {
+            assert!(!device.is_empty());
+            assert!(log.contains("undefined_name"), "log: {log}");
+            assert_eq!(kernel_source, &source.source);
+        }
+        other => panic!("expected Error::Build, got {other:?}"),
+    }
+    assert!(err.to_string().contains("undefined_name"));
+}
+
+#[test]
+fn invalid_settings_are_refused_before_anything_runs() {
+    let scene = gpu::sphere_box_floor();
+    let bad_quality = RenderOptions {
+        quality: Quality {
+            max_steps: 0,
+            ..Quality::draft()
+        },
+        ..RenderOptions::default()
+    };
+    let err = Renderer::with_options(&scene, &bad_quality).unwrap_err();
+    assert!(
+        matches!(
+            err,
+            Error::Quality {
+                setting: "max_steps",
+                ..
+            }
+        ),
+        "{err}"
+    );
+
+    let bad_effects = RenderOptions {
+        effects: Effects {
+            gamma: 0.0,
+            ..Effects::default()
+        },
+        ..RenderOptions::default()
+    };
+    let err = Renderer::with_options(&scene, &bad_effects).unwrap_err();
+    assert!(
+        matches!(
+            err,
+            Error::Quality {
+                setting: "gamma",
+                ..
+            }
+        ),
+        "{err}"
+    );
+
+    let no_tiles = RenderOptions {
+        tile_size: 0,
+        ..RenderOptions::default()
+    };
+    let err = Renderer::with_options(&scene, &no_tiles).unwrap_err();
+    assert!(
+        matches!(
+            err,
+            Error::Quality {
+                setting: "tile_size",
+                ..
+            }
+        ),
+        "{err}"
+    );
+
+    let err = Renderer::new(&Scene::empty(), Quality::draft()).unwrap_err();
+    assert!(matches!(err, Error::EmptyScene), "{err}");
+}
+
+#[test]
+fn an_unmatched_device_selector_lists_the_devices() {
+    let Some(device) = gpu::device() else { return };
+    let options = RenderOptions {
+        device: DeviceSelector::device("no such device anywhere"),
+        ..RenderOptions::default()
+    };
+    let err = Renderer::with_options(&gpu::sphere_box_floor(), &options).unwrap_err();
+    assert!(matches!(err, Error::NoDevice { .. }), "{err}");
+    assert!(err.to_string().contains(&device.name), "{err}");
+    // Selecting the device by its own names works.
+    let options = RenderOptions {
+        device: DeviceSelector {
+            platform: Some(device.platform.to_uppercase()),
+            device: Some(device.name.clone()),
+        },
+        ..RenderOptions::default()
+    };
+    let r = Renderer::with_options(&gpu::sphere_box_floor(), &options).unwrap();
+    assert_eq!(r.device(), &device);
+}
+
+#[test]
+fn devices_describe_themselves() {
+    let Some(_) = gpu::device() else { return };
+    for d in devices().unwrap() {
+        assert!(!d.name.is_empty() && !d.platform.is_empty());
+        assert!(
+            d.opencl_version.starts_with("OpenCL"),
+            "{}",
+            d.opencl_version
+        );
+        assert!(d.compute_units >= 1 && d.max_work_group_size >= 1);
+        assert!(d.label().contains(" / "));
+    }
+}
