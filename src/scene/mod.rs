@@ -310,6 +310,7 @@ impl Scene {
 
     /// Adds geometry (a union with what is already there).
     #[must_use]
+    #[allow(clippy::should_implement_trait)] // A builder step, not arithmetic.
     pub fn add(mut self, node: impl Into<Node>) -> Self {
         let node = node.into();
         self.geometry = Some(match self.geometry.take() {

@@ -478,6 +478,7 @@ impl<S, V, C> Kind<S, V, C> {
     /// Rebuilds the node with every scalar, vector and child converted by
     /// `m`, which sees each parameter's name and rule. This match is the one
     /// place that lists which parameters each node has.
+    #[allow(clippy::type_complexity)] // The mapped kind is the point.
     pub(crate) fn try_map<M>(&self, m: &mut M) -> Result<Kind<M::S2, M::V2, M::C2>, M::E>
     where
         M: Mapper<S, V, C>,
