@@ -15,6 +15,10 @@
 //! 3. [`cpu`]: the reference evaluator (distance, colour, normal, sphere
 //!    tracing) in `f64` and `f32`; the oracle for every test.
 //!
+//! With the `proptest` feature, [`testing`] offers strategies for valid
+//! scenes and checkers for the distance invariants (Lipschitz bound, never
+//! overestimating, exactness), to property-test your own nodes.
+//!
 //! ## A tour
 //!
 //! Build a scene from a fractal and a smoothly blended pair of primitives,
@@ -60,6 +64,8 @@ pub mod error;
 pub mod ir;
 pub mod quality;
 pub mod scene;
+#[cfg(feature = "proptest")]
+pub mod testing;
 
 pub use error::{Error, Result};
 pub use scene::{Node, Scene};
