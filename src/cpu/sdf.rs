@@ -105,9 +105,18 @@ pub fn capped_cone<T: Real>(p: V3<T>, h: T, r1: T, r2: T) -> T {
 }
 
 /// A distance bound for an axis-aligned ellipsoid with semi-axes `r`.
+///
+/// Outside, Quilez's `k0 (k0 - 1) / k1`. Inside, that formula overestimates
+/// (by up to the ratio of the longest to the shortest semi-axis, and it is
+/// 0 at the centre), so the interior uses `(k0 - 1) min(r)`: scaling by
+/// `1 / r` stretches no length by more than `1 / min(r)`, so this never
+/// exceeds the true depth.
 #[must_use]
 pub fn ellipsoid<T: Real>(p: V3<T>, r: V3<T>) -> T {
     let k0 = (p / r).length();
+    if k0 < T::one() {
+        return (k0 - T::one()) * r.min_element();
+    }
     let k1 = (p / (r * r)).length();
     k0 * (k0 - T::one()) / k1.max(T::tiny())
 }
