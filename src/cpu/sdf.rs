@@ -150,7 +150,9 @@ fn angle_power<T: Real>(c: T, s: T, n: u32) -> (T, T) {
 ///
 /// `integer_power` selects the trig-free form (`Some(n)` must equal
 /// `power`); otherwise the map uses `acos`/`atan2`/`sin`/`cos`. The orbit
-/// trap is the smallest `|z|` reached, clamped to `[0, 1]`.
+/// trap is the smallest `|z|` reached, clamped to `[0, 1]`. The orbit
+/// escapes beyond `bailout`, or sooner if `r^power` would pass
+/// [`Real::magnitude_cap`] (only for large powers and bailouts).
 #[must_use]
 pub fn mandelbulb<T: Real>(
     p: V3<T>,
@@ -162,9 +164,13 @@ pub fn mandelbulb<T: Real>(
     let mut z = p;
     let mut dr = T::one();
     let mut trap = T::one();
+    // Escape before r^power passes the magnitude cap: beyond it r^power
+    // overflows to infinity (and NaN), and once `dr` is capped a huge r
+    // inflates the estimate.
+    let escape = bailout.min(T::magnitude_cap().powf(T::one() / power));
     for _ in 0..iterations {
         let r = z.length();
-        if r > bailout {
+        if r > escape {
             break;
         }
         trap = trap.min(r);
