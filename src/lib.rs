@@ -15,7 +15,7 @@
 //! 3. [`cpu`]: the reference evaluator (distance, colour, normal, sphere
 //!    tracing) in `f64` and `f32`; the oracle for every test.
 //!
-//! With the `proptest` feature, [`testing`] offers strategies for valid
+//! With the `proptest` feature, the `testing` module offers strategies for valid
 //! scenes and checkers for the distance invariants (Lipschitz bound, never
 //! overestimating, exactness), to property-test your own nodes.
 //!

@@ -2,7 +2,7 @@
 //!
 //! Building never fails; [`Scene::validate`] (which every renderer and
 //! code generator calls first) reports the first bad value as a typed
-//! [`Error`](crate::Error) naming the node's path and the parameter.
+//! [`Error`] naming the node's path and the parameter.
 
 pub mod build;
 mod node;
