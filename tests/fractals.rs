@@ -342,6 +342,72 @@ fn fixtures_agree_with_membership_on_the_sign() {
     }
 }
 
+/// Points spread evenly through `[-1, 1]^3` (the R3 low-discrepancy
+/// sequence).
+fn cube_points(n: u32) -> impl Iterator<Item = DVec3> {
+    let g = 1.220_744_084_605_759_5_f64; // x^4 = x + 1
+    let a = dvec3(1.0 / g, 1.0 / (g * g), 1.0 / (g * g * g));
+    (0..n).map(move |i| {
+        let v = DVec3::splat(0.5) + a * f64::from(i);
+        (v - v.floor()) * 2.0 - DVec3::ONE
+    })
+}
+
+/// The oracles themselves: the sponge keeps 20 of 27 subcubes per level
+/// and the gasket 4 half-size tetrahedra (half the volume), so their
+/// volume fractions of `[-1, 1]^3` are `(20/27)^n` and `(1/3) (1/2)^n`.
+#[test]
+fn membership_oracles_have_the_right_volumes() {
+    const N: u32 = 200_000;
+    for level in 0..=3 {
+        let count = |inside: &dyn Fn(DVec3) -> bool| {
+            f64::from(u32::try_from(cube_points(N).filter(|&p| inside(p)).count()).unwrap())
+                / f64::from(N)
+        };
+        let sponge = count(&|p| menger_inside(p, level));
+        let expected = (20.0f64 / 27.0).powi(i32::try_from(level).unwrap());
+        assert!(
+            relative_eq!(sponge, expected, max_relative = 0.01),
+            "level {level}: {sponge}"
+        );
+        let gasket = count(&|p| sierpinski_inside(p, level));
+        let expected = 0.5f64.powi(i32::try_from(level).unwrap()) / 3.0;
+        assert!(
+            relative_eq!(gasket, expected, max_relative = 0.01),
+            "level {level}: {gasket}"
+        );
+    }
+}
+
+/// On the z axis the power-2 triplex map is the real map `t -> t^2 + c`,
+/// whose bounded orbits are `c` in `[-2, 1/4]`; on the real axis a Julia
+/// set of real `c` follows the same map.
+#[test]
+fn escape_oracles_reduce_to_the_real_quadratic_map() {
+    for (c, inside) in [
+        (-2.1, false),
+        (-1.9, true),
+        (0.0, true),
+        (0.2, true),
+        (0.3, false),
+    ] {
+        assert_eq!(
+            mandelbulb_inside(dvec3(0.0, 0.0, c), 2.0, 256, 2.0),
+            inside,
+            "{c}"
+        );
+    }
+    // For c = -1 the real Julia set spans [-phi, phi] (phi the golden ratio).
+    let c = [-1.0, 0.0, 0.0, 0.0];
+    for (x, inside) in [(0.0, true), (1.6, true), (1.63, false), (-1.63, false)] {
+        assert_eq!(
+            julia_inside(dvec3(x, 0.0, 0.0), c, 0.0, 256, 4.0),
+            inside,
+            "{x}"
+        );
+    }
+}
+
 /// Evenly spread unit vectors (an additive recurrence).
 fn directions(n: u32) -> impl Iterator<Item = DVec3> {
     (0..n).filter_map(|i| {
