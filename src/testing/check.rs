@@ -22,7 +22,8 @@ pub const ROUNDING_ALLOWANCE: f64 = 16.0 * f64::EPSILON;
 /// `1 - SHELL_FACTOR` or less go unnoticed.
 pub const SHELL_FACTOR: f64 = 1.0 - 1e-6;
 
-/// Which invariant a [`Failure`] breaks.
+/// Which invariant a [`Failure`] breaks. Non-exhaustive: more checks
+/// (such as agreement between a device and the CPU reference) can join.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 #[non_exhaustive]
 pub enum Check {
