@@ -223,8 +223,8 @@ impl Lowering {
 
     /// Folds what can be folded at compile time: chains of baked
     /// translations, rotations and scales become one node, identity
-    /// transforms and a `k = 0` smoothing disappear, and an outer colour
-    /// over an inner one (which wins) is dropped. A single-child node's child
+    /// transforms and a `k = 0` smoothing disappear, and an inner colour
+    /// under an outer one (which paints over it) is dropped. A single-child node's child
     /// is always the last node pushed, so merging pops it.
     fn fold(&mut self, node: IrNode) -> IrNode {
         use Scalar::Baked;
@@ -269,7 +269,16 @@ impl Lowering {
                 },
                 _,
             ) if *f == 1.0 => Some(inner.clone()),
-            (Kind::Color { .. }, Kind::Color { .. }) => Some(inner.clone()),
+            // The outer colour paints over the inner one.
+            (
+                Kind::Color { color, .. },
+                Kind::Color {
+                    child: grandchild, ..
+                },
+            ) => Some(Kind::Color {
+                color: *color,
+                child: *grandchild,
+            }),
             (
                 Kind::Translate { offset: outer, .. },
                 Kind::Translate {

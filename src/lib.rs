@@ -19,6 +19,10 @@
 //!    image with depth, hit, normal and step outputs.
 //! 5. [`output`]: saving images (atomic PNG writes).
 //!
+//! With the `proptest` feature, the `testing` module offers strategies for valid
+//! scenes and checkers for the distance invariants (Lipschitz bound, never
+//! overestimating, exactness), to property-test your own nodes.
+//!
 //! ## A tour
 //!
 //! Build a scene from a fractal and a smoothly blended pair of primitives,
@@ -71,6 +75,8 @@ pub mod quality;
 #[cfg(feature = "opencl")]
 pub mod render;
 pub mod scene;
+#[cfg(feature = "proptest")]
+pub mod testing;
 
 pub use error::{Error, Result};
 pub use scene::{Node, Scene};

@@ -3,9 +3,11 @@ real mandelbulb(real3 p, real power, int iterations, real bailout, real* trap) {
     real3 z = p;
     real dr = R(1.0);
     real t = R(1.0);
+    /* Escape before r^power passes MAGNITUDE_CAP (large powers and bailouts). */
+    real escape = fmin(bailout, pow(MAGNITUDE_CAP, R(1.0) / power));
     for (int i = 0; i < iterations; i++) {
         real r = length(z);
-        if (r > bailout) {
+        if (r > escape) {
             break;
         }
         t = fmin(t, r);

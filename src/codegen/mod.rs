@@ -158,6 +158,7 @@ fn header(w: &mut writer::Writer, options: &Options) {
     let mut defines = vec![
         ("REAL_TINY", f(1e-30)),
         ("DERIVATIVE_CAP", f(1e30)),
+        ("MAGNITUDE_CAP", f(1e18)),
         ("DEFAULT_COLOR", rgb(crate::cpu::DEFAULT_COLOR.into())),
         ("MAX_STEPS", q.max_steps.to_string()),
         ("MAX_DISTANCE", f(q.max_distance)),

@@ -83,7 +83,9 @@ impl Writer {
     }
 }
 
-/// Formats `v` as an OpenCL C literal of `precision` (see [`Writer::float`]).
+/// Formats `v` as an OpenCL C literal of `precision` that reads back as
+/// exactly `v` rounded to that precision: `1.0f`, `(-0.5f)`, `1e-30f` (F64
+/// has no suffix). Negative values are parenthesised.
 ///
 /// # Panics
 /// If `v` is NaN or infinite.

@@ -20,6 +20,12 @@ pub trait Real: Float + FloatConst + std::fmt::Debug + Send + Sync + 'static {
     fn derivative_cap() -> Self {
         Self::of(1e30)
     }
+    /// The largest magnitude an escape-time iteration may produce (`1e18`
+    /// in both precisions): the squared length of a vector this long stays
+    /// below `f32::MAX`, and dividing it by a capped derivative stays tiny.
+    fn magnitude_cap() -> Self {
+        Self::of(1e18)
+    }
 }
 
 impl Real for f32 {

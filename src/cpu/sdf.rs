@@ -105,9 +105,18 @@ pub fn capped_cone<T: Real>(p: V3<T>, h: T, r1: T, r2: T) -> T {
 }
 
 /// A distance bound for an axis-aligned ellipsoid with semi-axes `r`.
+///
+/// Outside, Quilez's `k0 (k0 - 1) / k1`. Inside, that formula overestimates
+/// (by up to the ratio of the longest to the shortest semi-axis, and it is
+/// 0 at the centre), so the interior uses `(k0 - 1) min(r)`: scaling by
+/// `1 / r` stretches no length by more than `1 / min(r)`, so this never
+/// exceeds the true depth.
 #[must_use]
 pub fn ellipsoid<T: Real>(p: V3<T>, r: V3<T>) -> T {
     let k0 = (p / r).length();
+    if k0 < T::one() {
+        return (k0 - T::one()) * r.min_element();
+    }
     let k1 = (p / (r * r)).length();
     k0 * (k0 - T::one()) / k1.max(T::tiny())
 }
@@ -141,7 +150,9 @@ fn angle_power<T: Real>(c: T, s: T, n: u32) -> (T, T) {
 ///
 /// `integer_power` selects the trig-free form (`Some(n)` must equal
 /// `power`); otherwise the map uses `acos`/`atan2`/`sin`/`cos`. The orbit
-/// trap is the smallest `|z|` reached, clamped to `[0, 1]`.
+/// trap is the smallest `|z|` reached, clamped to `[0, 1]`. The orbit
+/// escapes beyond `bailout`, or sooner if `r^power` would pass
+/// [`Real::magnitude_cap`] (only for large powers and bailouts).
 #[must_use]
 pub fn mandelbulb<T: Real>(
     p: V3<T>,
@@ -153,9 +164,13 @@ pub fn mandelbulb<T: Real>(
     let mut z = p;
     let mut dr = T::one();
     let mut trap = T::one();
+    // Escape before r^power passes the magnitude cap: beyond it r^power
+    // overflows to infinity (and NaN), and once `dr` is capped a huge r
+    // inflates the estimate.
+    let escape = bailout.min(T::magnitude_cap().powf(T::one() / power));
     for _ in 0..iterations {
         let r = z.length();
-        if r > bailout {
+        if r > escape {
             break;
         }
         trap = trap.min(r);

@@ -2,7 +2,7 @@
 //!
 //! Building never fails; [`Scene::validate`] (which every renderer and
 //! code generator calls first) reports the first bad value as a typed
-//! [`Error`](crate::Error) naming the node's path and the parameter.
+//! [`Error`] naming the node's path and the parameter.
 
 pub mod build;
 mod custom;
@@ -312,7 +312,7 @@ impl Scene {
 
     /// Adds geometry (a union with what is already there).
     #[must_use]
-    #[allow(clippy::should_implement_trait)]
+    #[allow(clippy::should_implement_trait)] // A builder step, not arithmetic.
     pub fn add(mut self, node: impl Into<Node>) -> Self {
         let node = node.into();
         self.geometry = Some(match self.geometry.take() {

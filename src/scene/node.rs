@@ -176,8 +176,10 @@ pub enum Kind<S, V, C> {
         /// Radius at the top cap, at least 0.
         top_radius: S,
     },
-    /// An axis-aligned ellipsoid. A bound, not exact: the distance is
-    /// underestimated away from the axes (Quilez's `k0 (k0 - 1) / k1`).
+    /// An axis-aligned ellipsoid. A bound, not exact: outside, the distance
+    /// is underestimated away from the axes (Quilez's `k0 (k0 - 1) / k1`,
+    /// which is not 1-Lipschitz near thin ellipsoids); inside, the depth is
+    /// `(k0 - 1)` times the shortest semi-axis.
     Ellipsoid {
         /// Semi-axes, each greater than 0.
         radii: V,

@@ -7,6 +7,7 @@ typedef float4 real4;
 #define R(x) x##f
 #define REAL_TINY 1e-30f
 #define DERIVATIVE_CAP 1e30f
+#define MAGNITUDE_CAP 1e18f
 #define DEFAULT_COLOR (real3)(0.8f, 0.8f, 0.8f)
 #define MAX_STEPS 256
 #define MAX_DISTANCE 100.0f

@@ -7,6 +7,7 @@ typedef float4 real4;
 #define R(x) x##f
 #define REAL_TINY 1e-30f
 #define DERIVATIVE_CAP 1e30f
+#define MAGNITUDE_CAP 1e18f
 #define DEFAULT_COLOR (real3)(0.8f, 0.8f, 0.8f)
 #define MAX_STEPS 256
 #define MAX_DISTANCE 100.0f
@@ -44,9 +45,11 @@ real mandelbulb(real3 p, real power, int iterations, real bailout, real* trap) {
     real3 z = p;
     real dr = R(1.0);
     real t = R(1.0);
+    /* Escape before r^power passes MAGNITUDE_CAP (large powers and bailouts). */
+    real escape = fmin(bailout, pow(MAGNITUDE_CAP, R(1.0) / power));
     for (int i = 0; i < iterations; i++) {
         real r = length(z);
-        if (r > bailout) {
+        if (r > escape) {
             break;
         }
         t = fmin(t, r);

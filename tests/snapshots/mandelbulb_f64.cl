@@ -8,6 +8,7 @@ typedef double4 real4;
 #define R(x) x
 #define REAL_TINY 1e-30
 #define DERIVATIVE_CAP 1e30
+#define MAGNITUDE_CAP 1e18
 #define DEFAULT_COLOR (real3)(0.8, 0.8, 0.8)
 #define MAX_STEPS 2048
 #define MAX_DISTANCE 100.0
@@ -47,9 +48,11 @@ real mandelbulb_int(real3 p, int n, int iterations, real bailout, real* trap) {
     real3 z = p;
     real dr = R(1.0);
     real t = R(1.0);
+    /* Escape before r^power passes MAGNITUDE_CAP (large powers and bailouts). */
+    real escape = fmin(bailout, pow(MAGNITUDE_CAP, R(1.0) / (real)n));
     for (int i = 0; i < iterations; i++) {
         real r = length(z);
-        if (r > bailout) {
+        if (r > escape) {
             break;
         }
         t = fmin(t, r);

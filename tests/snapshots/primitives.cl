@@ -7,6 +7,7 @@ typedef float4 real4;
 #define R(x) x##f
 #define REAL_TINY 1e-30f
 #define DERIVATIVE_CAP 1e30f
+#define MAGNITUDE_CAP 1e18f
 #define DEFAULT_COLOR (real3)(0.8f, 0.8f, 0.8f)
 #define MAX_STEPS 256
 #define MAX_DISTANCE 100.0f
@@ -103,6 +104,9 @@ real sd_capped_cone(real3 p, real h, real r1, real r2) {
 /* ---- ellipsoid ---- */
 real sd_ellipsoid(real3 p, real3 r) {
     real k0 = length(p / r);
+    if (k0 < R(1.0)) {
+        return (k0 - R(1.0)) * fmin(fmin(r.x, r.y), r.z);
+    }
     real k1 = length(p / (r * r));
     return k0 * (k0 - R(1.0)) / fmax(k1, REAL_TINY);
 }

@@ -1,0 +1,151 @@
+//! Whether a point belongs to a fractal, decided from the fractal's
+//! definition (escape time, ternary digits, sub-tetrahedra) and sharing no
+//! code with the distance estimators in [`cpu::sdf`](crate::cpu::sdf):
+//! these are the oracle the estimators are checked against.
+
+use glam::{DMat3, DQuat, DVec3};
+
+/// Whether `p` is in the Mandelbulb of `power` at `iterations` iterations:
+/// the orbit `z0 = p`, `z(k+1) = z(k)^power + p` (the triplex power in
+/// spherical coordinates: the radius raised to `power`, the polar angle
+/// from +z and the azimuth around z multiplied by `power`) stays within
+/// `bailout` for `k = 0..=iterations`.
+///
+/// ```
+/// use fractal_sdf::prelude::*;
+/// use fractal_sdf::testing::mandelbulb_inside;
+/// assert!(mandelbulb_inside(DVec3::ZERO, 8.0, 12, 2.0));
+/// assert!(!mandelbulb_inside(dvec3(1.5, 0.0, 0.0), 8.0, 12, 2.0));
+/// ```
+#[must_use]
+pub fn mandelbulb_inside(p: DVec3, power: f64, iterations: u32, bailout: f64) -> bool {
+    let mut z = p;
+    for _ in 0..iterations {
+        let r = z.length();
+        if r > bailout {
+            return false;
+        }
+        z = if r == 0.0 {
+            p
+        } else {
+            let polar = (z.z / r).clamp(-1.0, 1.0).acos() * power;
+            let azimuth = z.y.atan2(z.x) * power;
+            let direction = DVec3::new(
+                polar.sin() * azimuth.cos(),
+                polar.sin() * azimuth.sin(),
+                polar.cos(),
+            );
+            direction * r.powf(power) + p
+        };
+    }
+    z.length() <= bailout
+}
+
+/// Whether `p` is in the 3D slice at `w = slice_w` of the quaternion Julia
+/// set of `c` (real part first, as in the scene's `c`): the orbit of the
+/// quaternion `z0 = p.x + p.y i + p.z j + slice_w k` under
+/// `z -> z * z + c` stays within `bailout` for `k = 0..=iterations`.
+///
+/// ```
+/// use fractal_sdf::prelude::*;
+/// use fractal_sdf::testing::julia_inside;
+/// let c = [-0.2, 0.6, 0.2, 0.2];
+/// assert!(!julia_inside(dvec3(2.0, 0.0, 0.0), c, 0.0, 12, 4.0));
+/// ```
+#[must_use]
+pub fn julia_inside(p: DVec3, c: [f64; 4], slice_w: f64, iterations: u32, bailout: f64) -> bool {
+    // glam's quaternions keep the real part in `w`.
+    let c = DQuat::from_xyzw(c[1], c[2], c[3], c[0]);
+    let mut z = DQuat::from_xyzw(p.y, p.z, slice_w, p.x);
+    for _ in 0..iterations {
+        if z.length() > bailout {
+            return false;
+        }
+        z = z * z + c;
+    }
+    z.length() <= bailout
+}
+
+/// Whether `p` is in the classic (scale 3) Menger sponge on `[-1, 1]^3`
+/// with `iterations` levels, by ternary digits: at each level the current
+/// cell is split into 27, and the point is removed if at least two of its
+/// three coordinates lie in the open middle third. Level 0 is the solid
+/// cube. Points exactly on a cell boundary may go either way.
+///
+/// ```
+/// use fractal_sdf::prelude::*;
+/// use fractal_sdf::testing::menger_inside;
+/// assert!(menger_inside(dvec3(0.99, 0.99, 0.99), 3));
+/// // The corner cube of level 3 is removed around (0.9, 0.9, 0.9).
+/// assert!(!menger_inside(dvec3(0.9, 0.9, 0.9), 3));
+/// assert!(!menger_inside(DVec3::ZERO, 1));
+/// assert!(menger_inside(DVec3::ZERO, 0));
+/// ```
+#[must_use]
+pub fn menger_inside(p: DVec3, iterations: u32) -> bool {
+    let mut u = (p + DVec3::ONE) * 0.5;
+    if u.min_element() < 0.0 || u.max_element() > 1.0 {
+        return false;
+    }
+    for _ in 0..iterations {
+        let s = u * 3.0;
+        let middle = s.to_array().iter().filter(|&&c| c > 1.0 && c < 2.0).count();
+        if middle >= 2 {
+            return false;
+        }
+        let digit = s.floor().clamp(DVec3::ZERO, DVec3::splat(2.0));
+        u = s - digit;
+    }
+    true
+}
+
+/// The vertices of the Sierpinski tetrahedron.
+const VERTICES: [DVec3; 4] = [
+    DVec3::new(1.0, 1.0, 1.0),
+    DVec3::new(-1.0, -1.0, 1.0),
+    DVec3::new(1.0, -1.0, -1.0),
+    DVec3::new(-1.0, 1.0, -1.0),
+];
+
+/// Whether `p` is in the solid tetrahedron [`VERTICES`], from its
+/// barycentric coordinates.
+fn in_tetrahedron(p: DVec3) -> bool {
+    let [v0, v1, v2, v3] = VERTICES;
+    let edges = DMat3::from_cols(v1 - v0, v2 - v0, v3 - v0);
+    let l = edges.inverse() * (p - v0);
+    l.min_element() >= 0.0 && l.x + l.y + l.z <= 1.0
+}
+
+/// Whether `p` is in the classic (scale 2) Sierpinski tetrahedron with
+/// vertices `(1,1,1)`, `(-1,-1,1)`, `(1,-1,-1)`, `(-1,1,-1)` and
+/// `iterations` levels, by recursive containment: the point must lie in the
+/// tetrahedron `T`, and at each level in one of the four half-size
+/// sub-tetrahedra `v_i + (T - v_i) / 2`, which then becomes `T`. Level 0 is
+/// the solid tetrahedron.
+///
+/// ```
+/// use fractal_sdf::prelude::*;
+/// use fractal_sdf::testing::sierpinski_inside;
+/// assert!(sierpinski_inside(dvec3(0.99, 0.99, 0.99), 5));
+/// assert!(sierpinski_inside(DVec3::ZERO, 0));
+/// assert!(!sierpinski_inside(dvec3(0.0, 0.0, -0.2), 1));
+/// ```
+#[must_use]
+pub fn sierpinski_inside(p: DVec3, iterations: u32) -> bool {
+    if !in_tetrahedron(p) {
+        return false;
+    }
+    let mut z = p;
+    for _ in 0..iterations {
+        // z is in v + (T - v) / 2 exactly when 2 z - v is in T.
+        match VERTICES
+            .iter()
+            .map(|&v| 2.0 * z - v)
+            .find(|&q| in_tetrahedron(q))
+        {
+            Some(q) => z = q,
+            None => return false,
+        }
+    }
+    true
+}

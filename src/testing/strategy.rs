@@ -1,0 +1,462 @@
+//! Strategies that build only valid values.
+//!
+//! (They return `impl Strategy`, which is already `#[must_use]`.)
+
+use std::f64::consts::PI;
+
+use glam::{DQuat, DVec3};
+use proptest::prelude::*;
+
+use crate::cpu::Ray;
+use crate::scene::{
+    Axis, MAX_ESCAPE_ITERATIONS, MAX_FOLD_ITERATIONS, Mandelbulb, Menger, Node, Param, Param3,
+    QuaternionJulia, Sierpinski, capped_cone, capsule, cuboid, cylinder, ellipsoid, octahedron,
+    param, plane, round_box, sphere, torus,
+};
+
+/// The largest size (radius, half extent, height) the primitive strategies
+/// draw.
+const MAX_SIZE: f64 = 1.5;
+
+/// A size in `[0, max]`: mostly in `[0.05, max]`, sometimes exactly 0.
+fn size(max: f64) -> impl Strategy<Value = f64> + Clone {
+    prop_oneof![1 => Just(0.0), 15 => 0.05..=max]
+}
+
+/// A scalar parameter: usually baked, sometimes dynamic. A dynamic
+/// parameter is named after its tag (which fixes its rule) and its value,
+/// so equal names always carry equal defaults and rules.
+fn scalar(
+    tag: &'static str,
+    value: impl Strategy<Value = f64> + Clone,
+) -> impl Strategy<Value = Param> + Clone {
+    (value, prop::bool::weighted(0.2)).prop_map(move |(v, dynamic)| {
+        if dynamic {
+            param(format!("{tag}#{:016x}", v.to_bits()), v)
+        } else {
+            Param::Value(v)
+        }
+    })
+}
+
+/// Three components from one strategy.
+fn vector(component: impl Strategy<Value = f64> + Clone) -> impl Strategy<Value = DVec3> + Clone {
+    (component.clone(), component.clone(), component).prop_map(|(x, y, z)| DVec3::new(x, y, z))
+}
+
+/// A vector parameter (baked).
+fn vector_param(
+    component: impl Strategy<Value = f64> + Clone,
+) -> impl Strategy<Value = Param3> + Clone {
+    vector(component).prop_map(Param3::from)
+}
+
+/// A point in the cube `[-extent, extent]^3`.
+///
+/// # Panics
+/// If `extent` is negative or not finite.
+///
+/// ```
+/// use fractal_sdf::testing::point;
+/// use proptest::prelude::*;
+/// proptest!(|(p in point(2.0))| prop_assert!(p.abs().max_element() <= 2.0));
+/// ```
+pub fn point(extent: f64) -> impl Strategy<Value = DVec3> + Clone {
+    assert!(
+        extent >= 0.0 && extent.is_finite(),
+        "extent must be finite and >= 0"
+    );
+    vector(-extent..=extent)
+}
+
+/// A unit vector, uniformly distributed on the sphere.
+///
+/// ```
+/// use fractal_sdf::testing::unit_vector;
+/// use proptest::prelude::*;
+/// proptest!(|(u in unit_vector())| prop_assert!((u.length() - 1.0).abs() < 1e-12));
+/// ```
+pub fn unit_vector() -> impl Strategy<Value = DVec3> + Clone {
+    // Archimedes: z uniform in [-1, 1] and a uniform angle give a uniform
+    // point on the sphere.
+    (-1.0..=1.0f64, 0.0..(2.0 * PI)).prop_map(|(z, phi): (f64, f64)| {
+        let rho = (1.0 - z * z).max(0.0).sqrt();
+        DVec3::new(rho * phi.cos(), rho * phi.sin(), z).normalize()
+    })
+}
+
+/// A rotation: a unit axis and an angle in `[-pi, pi]`.
+pub fn rotation() -> impl Strategy<Value = DQuat> + Clone {
+    (unit_vector(), -PI..=PI).prop_map(|(axis, angle)| DQuat::from_axis_angle(axis, angle))
+}
+
+/// A ray from a point in `[-extent, extent]^3` in a uniform direction.
+///
+/// # Panics
+/// If `extent` is negative or not finite.
+pub fn ray(extent: f64) -> impl Strategy<Value = Ray> + Clone {
+    (point(extent), unit_vector()).prop_map(|(origin, direction)| Ray { origin, direction })
+}
+
+/// Two points for a Lipschitz check: `p` in `[-extent, extent]^3` and `q`
+/// at a distance from `p` spread log-uniformly over
+/// `[1e-6 * max_separation, max_separation]`, in a uniform direction.
+///
+/// # Panics
+/// If `extent` is negative or not finite, or `max_separation` is not
+/// positive and finite.
+pub fn point_pair(extent: f64, max_separation: f64) -> impl Strategy<Value = (DVec3, DVec3)> {
+    assert!(
+        max_separation > 0.0 && max_separation.is_finite(),
+        "max_separation must be finite and > 0"
+    );
+    (point(extent), unit_vector(), 0.0..=6.0f64)
+        .prop_map(move |(p, u, decades)| (p, p + u * (max_separation * 10f64.powf(-decades))))
+}
+
+/// A sphere of radius in `[0, 1.5]`.
+pub fn sphere_node() -> impl Strategy<Value = Node> + Clone {
+    scalar("sphere.radius", size(MAX_SIZE)).prop_map(sphere)
+}
+
+/// A box with half extents in `[0, 1.5]`.
+pub fn cuboid_node() -> impl Strategy<Value = Node> + Clone {
+    vector_param(size(MAX_SIZE)).prop_map(cuboid)
+}
+
+/// A rounded box: half extents in `[0, 1.5]`, rounding radius at most the
+/// smallest half extent.
+pub fn round_box_node() -> impl Strategy<Value = Node> + Clone {
+    (vector(size(MAX_SIZE)), 0.0..=1.0f64).prop_map(|(b, f)| round_box(b, f * b.min_element()))
+}
+
+/// A torus: major radius in `[0, 1.5]`, minor radius in `[0, 0.6]`.
+pub fn torus_node() -> impl Strategy<Value = Node> + Clone {
+    (
+        scalar("torus.major_radius", size(MAX_SIZE)),
+        scalar("torus.minor_radius", size(0.6)),
+    )
+        .prop_map(|(major, minor)| torus(major, minor))
+}
+
+/// A capped cylinder: radius and half height in `[0, 1.5]`.
+pub fn cylinder_node() -> impl Strategy<Value = Node> + Clone {
+    (
+        scalar("cylinder.radius", size(MAX_SIZE)),
+        scalar("cylinder.half_height", size(MAX_SIZE)),
+    )
+        .prop_map(|(r, h)| cylinder(r, h))
+}
+
+/// A capsule between two points of `[-1.5, 1.5]^3`, radius in `[0, 0.8]`.
+pub fn capsule_node() -> impl Strategy<Value = Node> + Clone {
+    (
+        point(MAX_SIZE),
+        point(MAX_SIZE),
+        scalar("capsule.radius", size(0.8)),
+    )
+        .prop_map(|(a, b, r)| capsule(a, b, r))
+}
+
+/// A half-space: a normal of length in `[0.1, 10]` (validation normalises
+/// it) and an offset in `[-2, 2]`.
+pub fn plane_node() -> impl Strategy<Value = Node> + Clone {
+    (
+        unit_vector(),
+        0.1..=10.0f64,
+        scalar("plane.offset", -2.0..=2.0f64),
+    )
+        .prop_map(|(n, len, offset)| plane(n * len, offset))
+}
+
+/// A regular octahedron of size in `[0, 1.5]`.
+pub fn octahedron_node() -> impl Strategy<Value = Node> + Clone {
+    scalar("octahedron.size", size(MAX_SIZE)).prop_map(octahedron)
+}
+
+/// A capped cone: half height and both cap radii in `[0, 1.5]`.
+pub fn capped_cone_node() -> impl Strategy<Value = Node> + Clone {
+    (
+        scalar("capped_cone.half_height", size(MAX_SIZE)),
+        scalar("capped_cone.bottom_radius", size(MAX_SIZE)),
+        scalar("capped_cone.top_radius", size(MAX_SIZE)),
+    )
+        .prop_map(|(h, r1, r2)| capped_cone(h, r1, r2))
+}
+
+/// An ellipsoid (a distance bound, not exact) with semi-axes in
+/// `[0.05, 1.5]`.
+pub fn ellipsoid_node() -> impl Strategy<Value = Node> + Clone {
+    vector(0.05..=MAX_SIZE).prop_map(ellipsoid)
+}
+
+/// Any exact primitive (not the ellipsoid), untransformed.
+pub fn exact_primitive() -> impl Strategy<Value = Node> + Clone {
+    prop_oneof![
+        sphere_node(),
+        cuboid_node(),
+        round_box_node(),
+        torus_node(),
+        cylinder_node(),
+        capsule_node(),
+        plane_node(),
+        octahedron_node(),
+        capped_cone_node(),
+    ]
+}
+
+/// A distance-preserving transform.
+#[derive(Debug, Clone)]
+enum Rigid {
+    Translate(DVec3),
+    Rotate(DQuat),
+    Scale(f64),
+}
+
+impl Rigid {
+    fn apply(self, node: Node) -> Node {
+        match self {
+            Rigid::Translate(v) => node.translate(v),
+            Rigid::Rotate(q) => node.rotate_quat(q),
+            Rigid::Scale(s) => node.scale(s),
+        }
+    }
+}
+
+fn rigid() -> impl Strategy<Value = Rigid> + Clone {
+    prop_oneof![
+        point(2.0).prop_map(Rigid::Translate),
+        rotation().prop_map(Rigid::Rotate),
+        (0.25..=4.0f64).prop_map(Rigid::Scale),
+    ]
+}
+
+fn transformed(node: impl Strategy<Value = Node>, max: usize) -> impl Strategy<Value = Node> {
+    (node, prop::collection::vec(rigid(), 0..=max))
+        .prop_map(|(n, ts)| ts.into_iter().fold(n, |n, t| t.apply(n)))
+}
+
+/// Any exact primitive under up to three translations, rotations and
+/// uniform scales, all of which keep the distance exact.
+pub fn exact_node() -> impl Strategy<Value = Node> + Clone {
+    transformed(exact_primitive(), 3).boxed()
+}
+
+/// A shape symmetric under each axis' sign flip, with the half extents of
+/// its bounding box.
+fn symmetric_shape() -> impl Strategy<Value = (Node, DVec3)> {
+    prop_oneof![
+        size(MAX_SIZE).prop_map(|r| (sphere(r), DVec3::splat(r))),
+        vector(size(MAX_SIZE)).prop_map(|b| (cuboid(b), b)),
+        (vector(size(MAX_SIZE)), 0.0..=1.0f64)
+            .prop_map(|(b, f)| (round_box(b, f * b.min_element()), b)),
+        (size(MAX_SIZE), size(0.6)).prop_map(|(big, small)| (
+            torus(big, small),
+            DVec3::new(big + small, small, big + small)
+        )),
+        (size(MAX_SIZE), size(MAX_SIZE)).prop_map(|(r, h)| (cylinder(r, h), DVec3::new(r, h, r))),
+        size(MAX_SIZE).prop_map(|s| (octahedron(s), DVec3::splat(s))),
+    ]
+}
+
+/// Repetition that stays a distance bound: a shape symmetric under each
+/// axis' sign flip, repeated (infinitely or within limits) with a period
+/// per axis of 0 (no repetition) or at least twice the shape's extent, so
+/// every copy lies inside its own cell.
+pub fn repeated_node() -> impl Strategy<Value = Node> + Clone {
+    let period = prop_oneof![1 => Just(None), 3 => (0.0..=1.0f64).prop_map(Some)];
+    (
+        symmetric_shape(),
+        period.clone(),
+        period.clone(),
+        period,
+        prop::option::of([0u32..=3, 0..=3, 0..=3]),
+    )
+        .prop_map(|((shape, extent), px, py, pz, limit)| {
+            let cell = |gap: Option<f64>, e: f64| gap.map_or(0.0, |g| 2.0 * e + g + 0.01);
+            let period = DVec3::new(cell(px, extent.x), cell(py, extent.y), cell(pz, extent.z));
+            match limit {
+                Some(limit) => shape.repeat_limited(period, limit),
+                None => shape.repeat(period),
+            }
+        })
+        .boxed()
+}
+
+fn axis() -> impl Strategy<Value = Axis> + Clone {
+    prop_oneof![Just(Axis::X), Just(Axis::Y), Just(Axis::Z)]
+}
+
+fn color() -> impl Strategy<Value = DVec3> + Clone {
+    vector(0.0..=1.0f64)
+}
+
+/// A boolean of two nodes: one of the three operations, hard or smooth
+/// with `k` in `[0, 1]` (sometimes exactly 0).
+fn csg(a: Node, b: Node, op: u8, smoothing: Option<f64>) -> Node {
+    match (op % 3, smoothing) {
+        (0, None) => a.union(b),
+        (1, None) => a.subtract(b),
+        (_, None) => a.intersect(b),
+        (0, Some(k)) => a.smooth_union(b, k),
+        (1, Some(k)) => a.smooth_subtract(b, k),
+        (_, Some(k)) => a.smooth_intersect(b, k),
+    }
+}
+
+fn smoothing() -> impl Strategy<Value = Option<f64>> + Clone {
+    prop_oneof![
+        2 => Just(None),
+        1 => Just(Some(0.0)),
+        3 => (0.0..=1.0f64).prop_map(Some),
+    ]
+}
+
+/// Operations that keep a 1-Lipschitz distance bound 1-Lipschitz.
+fn lipschitz_ops(inner: BoxedStrategy<Node>) -> impl Strategy<Value = Node> {
+    prop_oneof![
+        (inner.clone(), rigid()).prop_map(|(n, t)| t.apply(n)),
+        (inner.clone(), -3.0..=3.0f64).prop_map(|(n, k)| n.twist(k)),
+        (inner.clone(), -3.0..=3.0f64).prop_map(|(n, k)| n.bend(k)),
+        (inner.clone(), axis()).prop_map(|(n, a)| n.mirror(a)),
+        (inner.clone(), 0.0..=0.3f64).prop_map(|(n, r)| n.round(r)),
+        (inner.clone(), 0.0..=0.2f64).prop_map(|(n, t)| n.onion(t)),
+        (inner.clone(), vector(0.0..=0.5f64)).prop_map(|(n, e)| n.elongate(e)),
+        (inner.clone(), color()).prop_map(|(n, c)| n.color(c)),
+        (inner.clone(), inner, 0u8..3, smoothing()).prop_map(|(a, b, op, k)| csg(a, b, op, k)),
+    ]
+}
+
+/// Nodes whose distance is a 1-Lipschitz bound, so it never overestimates:
+/// exact primitives and bounded repetitions ([`repeated_node`]) as leaves,
+/// combined to depth 3 by transforms, twist and bend (rates in `[-3, 3]`),
+/// mirror, round, onion, elongate, colour and hard and smooth booleans.
+///
+/// The ellipsoid is not here: outside it is a bound, but not a 1-Lipschitz
+/// one near thin ellipsoids.
+pub fn bounded_node() -> impl Strategy<Value = Node> + Clone {
+    let leaf = prop_oneof![
+        6 => exact_node(),
+        1 => repeated_node(),
+    ];
+    leaf.prop_recursive(3, 12, 2, lipschitz_ops).boxed()
+}
+
+/// An iteration count in `min..=max`, often small, sometimes an end of the
+/// range.
+fn iterations(min: u32, max: u32, usual: u32) -> impl Strategy<Value = u32> {
+    prop_oneof![
+        4 => min..=usual,
+        1 => Just(min),
+        1 => Just(max),
+        1 => min..=max,
+    ]
+}
+
+/// An escape radius in `[1, 1e6]`: usually near 2 to 4, sometimes an end
+/// of the range.
+fn bailout() -> impl Strategy<Value = f64> {
+    prop_oneof![
+        4 => 1.5..=8.0f64,
+        1 => Just(1.0),
+        1 => Just(1e6),
+        1 => 1.0..=1e6f64,
+    ]
+}
+
+/// A Mandelbulb with any valid settings: power in `[2, 64]` (integer or
+/// not, baked or dynamic, so both the trig-free and the trigonometric
+/// form are drawn), iterations in `1..=256`, bailout in `[1, 1e6]`.
+pub fn mandelbulb_node() -> impl Strategy<Value = Node> + Clone {
+    let power = prop_oneof![
+        3 => (2u32..=16).prop_map(f64::from),
+        2 => 2.0..=16.0f64,
+        1 => (17u32..=64).prop_map(f64::from),
+        1 => 16.0..=64.0f64,
+    ];
+    (
+        scalar("mandelbulb.power", power),
+        iterations(1, MAX_ESCAPE_ITERATIONS, 16),
+        bailout(),
+    )
+        .prop_map(|(power, n, b)| Mandelbulb::new(power).iterations(n).bailout(b).into())
+        .boxed()
+}
+
+/// A Menger sponge with 0 to 20 levels and a scale in `[2, 4]` (often the
+/// classic 3).
+pub fn menger_node() -> impl Strategy<Value = Node> + Clone {
+    let scale = prop_oneof![Just(3.0), 2.0..=4.0f64];
+    (iterations(0, MAX_FOLD_ITERATIONS, 6), scale)
+        .prop_map(|(n, s)| Menger::new(n).scale(s).into())
+        .boxed()
+}
+
+/// A quaternion Julia set: `c` in `[-1.5, 1.5]^4` (sometimes up to the
+/// valid `[-4, 4]^4`), iterations in `1..=256`, bailout in `[1, 1e6]`,
+/// slice `w` in `[-2, 2]`.
+pub fn julia_node() -> impl Strategy<Value = Node> + Clone {
+    let component = prop_oneof![4 => -1.5..=1.5f64, 1 => -4.0..=4.0f64];
+    (
+        [
+            scalar("julia.c", component.clone()),
+            scalar("julia.c", component.clone()),
+            scalar("julia.c", component.clone()),
+            scalar("julia.c", component),
+        ],
+        iterations(1, MAX_ESCAPE_ITERATIONS, 16),
+        bailout(),
+        -2.0..=2.0f64,
+    )
+        .prop_map(|(c, n, b, w)| {
+            QuaternionJulia::new(c)
+                .iterations(n)
+                .bailout(b)
+                .slice_w(w)
+                .into()
+        })
+        .boxed()
+}
+
+/// A Sierpinski tetrahedron with 0 to 20 levels and a scale in `[1.5, 4]`
+/// (often the classic 2).
+pub fn sierpinski_node() -> impl Strategy<Value = Node> + Clone {
+    let scale = prop_oneof![Just(2.0), 1.5..=4.0f64];
+    (iterations(0, MAX_FOLD_ITERATIONS, 8), scale)
+        .prop_map(|(n, s)| Sierpinski::new(n).scale(s).into())
+        .boxed()
+}
+
+/// Any of the four fractals with valid parameters.
+pub fn fractal_node() -> impl Strategy<Value = Node> + Clone {
+    prop_oneof![
+        mandelbulb_node(),
+        menger_node(),
+        julia_node(),
+        sierpinski_node(),
+    ]
+}
+
+/// Whole scenes: random trees of depth at most `depth` (and a size that
+/// grows with it) mixing every node type: exact primitives, ellipsoids,
+/// fractals, every transform and domain operation (twist and bend with
+/// rates in `[-3, 3]`, repetition with any period and any child) and hard
+/// and smooth booleans. They always validate; their distances need not be
+/// bounds.
+pub fn scene_node(depth: u32) -> impl Strategy<Value = Node> + Clone {
+    let leaf = prop_oneof![
+        6 => exact_node(),
+        1 => ellipsoid_node(),
+        2 => fractal_node(),
+    ];
+    leaf.prop_recursive(depth, 4 * depth + 4, 2, |inner| {
+        let period = vector(prop_oneof![Just(0.0), 0.5..=4.0f64]);
+        prop_oneof![
+            4 => lipschitz_ops(inner.clone()),
+            1 => (inner.clone(), period.clone()).prop_map(|(n, c)| n.repeat(c)),
+            1 => (inner, period, [0u32..=3, 0..=3, 0..=3])
+                .prop_map(|(n, c, l)| n.repeat_limited(c, l)),
+        ]
+    })
+    .boxed()
+}

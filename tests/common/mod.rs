@@ -1,0 +1,6 @@
+//! Shared by the integration tests (and, later, golden renders and
+//! benchmarks): fixture scenes and independently derived distances.
+#![allow(dead_code)]
+
+pub mod analytic;
+pub mod fixtures;

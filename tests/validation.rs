@@ -1,0 +1,595 @@
+//! Bad input is a typed error naming the node path and the parameter,
+//! never a panic: sizes, non-finite numbers, iteration counts, powers,
+//! smoothing, zero directions, empty scenes, degenerate cameras, lights
+//! and dynamic parameters.
+
+use fractal_sdf::prelude::*;
+use fractal_sdf::testing::scene_node;
+use proptest::prelude::*;
+
+fn error_of(node: Node) -> Error {
+    let err = Scene::new(node.clone()).validate().unwrap_err();
+    // Lowering for the CPU reports the same error.
+    assert_eq!(
+        cpu::Evaluator::new(&node).unwrap_err().to_string(),
+        err.to_string()
+    );
+    err
+}
+
+#[track_caller]
+fn assert_out_of_range(node: Node, path: &str, name: &str, bad: f64, rule: &str) {
+    match error_of(node) {
+        Error::OutOfRange {
+            node,
+            param,
+            value,
+            expected,
+        } => {
+            assert_eq!((node.as_str(), param.as_str()), (path, name));
+            assert_eq!(value.to_bits(), bad.to_bits());
+            assert_eq!(expected, rule);
+        }
+        other => panic!("expected OutOfRange for {path}/{name}, got {other:?}"),
+    }
+}
+
+#[track_caller]
+fn assert_non_finite(node: Node, path: &str, name: &str) {
+    match error_of(node) {
+        Error::NonFinite { node, param, value } => {
+            assert_eq!((node.as_str(), param.as_str()), (path, name));
+            assert!(!value.is_finite());
+        }
+        other => panic!("expected NonFinite for {path}/{name}, got {other:?}"),
+    }
+}
+
+#[track_caller]
+fn assert_iterations(node: Node, path: &str, bad: u32, range: (u32, u32)) {
+    match error_of(node) {
+        Error::Iterations {
+            node,
+            value,
+            min,
+            max,
+        } => {
+            assert_eq!(node, path);
+            assert_eq!((value, min, max), (bad, range.0, range.1));
+        }
+        other => panic!("expected Iterations for {path}, got {other:?}"),
+    }
+}
+
+#[track_caller]
+fn assert_zero_vector(node: Node, path: &str, name: &str) {
+    match error_of(node) {
+        Error::ZeroVector { node, param } => {
+            assert_eq!((node.as_str(), param.as_str()), (path, name))
+        }
+        other => panic!("expected ZeroVector for {path}/{name}, got {other:?}"),
+    }
+}
+
+#[test]
+fn negative_sizes_are_out_of_range() {
+    let v = |x, y, z| dvec3(x, y, z);
+    assert_out_of_range(sphere(-1.0), "sphere", "radius", -1.0, ">= 0");
+    assert_out_of_range(
+        cuboid(v(1.0, -0.5, 1.0)),
+        "cuboid",
+        "half_extents.y",
+        -0.5,
+        ">= 0",
+    );
+    assert_out_of_range(
+        round_box(v(1.0, 1.0, 1.0), -0.1),
+        "round_box",
+        "radius",
+        -0.1,
+        ">= 0",
+    );
+    assert_out_of_range(torus(-1.0, 0.2), "torus", "major_radius", -1.0, ">= 0");
+    assert_out_of_range(torus(1.0, -0.2), "torus", "minor_radius", -0.2, ">= 0");
+    assert_out_of_range(cylinder(-1.0, 1.0), "cylinder", "radius", -1.0, ">= 0");
+    assert_out_of_range(cylinder(1.0, -1.0), "cylinder", "half_height", -1.0, ">= 0");
+    assert_out_of_range(
+        capsule(DVec3::ZERO, DVec3::ONE, -0.5),
+        "capsule",
+        "radius",
+        -0.5,
+        ">= 0",
+    );
+    assert_out_of_range(octahedron(-2.0), "octahedron", "size", -2.0, ">= 0");
+    assert_out_of_range(
+        capped_cone(1.0, -1.0, 0.5),
+        "capped_cone",
+        "bottom_radius",
+        -1.0,
+        ">= 0",
+    );
+    assert_out_of_range(
+        capped_cone(-1.0, 1.0, 0.5),
+        "capped_cone",
+        "half_height",
+        -1.0,
+        ">= 0",
+    );
+    assert_out_of_range(
+        capped_cone(1.0, 1.0, -0.5),
+        "capped_cone",
+        "top_radius",
+        -0.5,
+        ">= 0",
+    );
+    assert_out_of_range(
+        ellipsoid(v(1.0, 0.0, 1.0)),
+        "ellipsoid",
+        "radii.y",
+        0.0,
+        "> 0",
+    );
+    assert_out_of_range(sphere(1.0).scale(0.0), "scale", "factor", 0.0, "> 0");
+    assert_out_of_range(sphere(1.0).round(-0.1), "round", "radius", -0.1, ">= 0");
+    assert_out_of_range(sphere(1.0).onion(-0.1), "onion", "thickness", -0.1, ">= 0");
+    assert_out_of_range(
+        sphere(1.0).elongate(v(0.0, 0.0, -1.0)),
+        "elongate",
+        "extents.z",
+        -1.0,
+        ">= 0",
+    );
+    assert_out_of_range(
+        sphere(1.0).repeat(v(-2.0, 0.0, 0.0)),
+        "repeat",
+        "period.x",
+        -2.0,
+        ">= 0",
+    );
+    assert_out_of_range(
+        sphere(1.0).repeat_limited(v(1.0, -2.0, 0.0), [1, 1, 1]),
+        "repeat_limited",
+        "period.y",
+        -2.0,
+        ">= 0",
+    );
+    assert_out_of_range(
+        sphere(1.0).color(v(1.0, -0.1, 0.0)),
+        "color",
+        "color.y",
+        -0.1,
+        ">= 0",
+    );
+}
+
+#[test]
+fn a_rounding_radius_larger_than_the_box_is_out_of_range() {
+    match error_of(round_box(dvec3(1.0, 0.2, 1.0), 0.5)) {
+        Error::OutOfRange {
+            node,
+            param,
+            value,
+            expected,
+        } => {
+            assert_eq!(
+                (node.as_str(), param.as_str(), value),
+                ("round_box", "radius", 0.5)
+            );
+            assert_eq!(expected, "<= the smallest half extent (0.2)");
+        }
+        other => panic!("{other:?}"),
+    }
+}
+
+#[test]
+fn nan_and_infinite_values_are_non_finite() {
+    for bad in [f64::NAN, f64::INFINITY, f64::NEG_INFINITY] {
+        assert_non_finite(sphere(bad), "sphere", "radius");
+        assert_non_finite(cuboid(dvec3(1.0, 1.0, bad)), "cuboid", "half_extents.z");
+        assert_non_finite(
+            sphere(1.0).translate(dvec3(bad, 0.0, 0.0)),
+            "translate",
+            "offset.x",
+        );
+        assert_non_finite(sphere(1.0).rotate(DVec3::Y, bad), "rotate", "angle");
+        assert_non_finite(
+            sphere(1.0).rotate(dvec3(0.0, bad, 1.0), 1.0),
+            "rotate",
+            "axis",
+        );
+        assert_non_finite(plane(dvec3(0.0, bad, 0.0), 0.0), "plane", "normal.y");
+        assert_non_finite(plane(DVec3::Y, bad), "plane", "offset");
+        assert_non_finite(
+            capsule(dvec3(bad, 0.0, 0.0), DVec3::ONE, 0.1),
+            "capsule",
+            "a.x",
+        );
+        assert_non_finite(sphere(1.0).twist(bad), "twist", "rate");
+        assert_non_finite(sphere(1.0).bend(bad), "bend", "rate");
+        assert_non_finite(
+            sphere(1.0).smooth_union(sphere(1.0), bad),
+            "smooth_union",
+            "k",
+        );
+        assert_non_finite(mandelbulb(bad), "mandelbulb", "power");
+        assert_non_finite(
+            Mandelbulb::new(8.0).bailout(bad).into(),
+            "mandelbulb",
+            "bailout",
+        );
+        assert_non_finite(julia([0.0, bad, 0.0, 0.0]), "julia", "c.y");
+        assert_non_finite(
+            QuaternionJulia::new([0.0.into(), 0.0.into(), 0.0.into(), 0.0.into()])
+                .slice_w(bad)
+                .into(),
+            "julia",
+            "slice_w",
+        );
+        assert_non_finite(Menger::new(2).scale(bad).into(), "menger", "scale");
+        assert_non_finite(Sierpinski::new(2).scale(bad).into(), "sierpinski", "scale");
+    }
+}
+
+#[test]
+fn iteration_counts_outside_their_range_are_rejected() {
+    let escape = (1, MAX_ESCAPE_ITERATIONS);
+    let fold = (0, MAX_FOLD_ITERATIONS);
+    assert_iterations(
+        Mandelbulb::new(8.0).iterations(0).into(),
+        "mandelbulb",
+        0,
+        escape,
+    );
+    assert_iterations(
+        Mandelbulb::new(8.0).iterations(257).into(),
+        "mandelbulb",
+        257,
+        escape,
+    );
+    let j = || QuaternionJulia::new([(-0.2).into(), 0.6.into(), 0.2.into(), 0.2.into()]);
+    assert_iterations(j().iterations(0).into(), "julia", 0, escape);
+    assert_iterations(j().iterations(u32::MAX).into(), "julia", u32::MAX, escape);
+    assert_iterations(menger(21), "menger", 21, fold);
+    assert_iterations(sierpinski(21), "sierpinski", 21, fold);
+    // The ends of the ranges are valid.
+    for node in [
+        Mandelbulb::new(8.0).iterations(1).into(),
+        Mandelbulb::new(8.0).iterations(256).into(),
+        j().iterations(256).into(),
+        menger(0),
+        menger(20),
+        sierpinski(0),
+        sierpinski(20),
+    ] {
+        Scene::new(node).validate().unwrap();
+    }
+}
+
+use fractal_sdf::scene::{MAX_ESCAPE_ITERATIONS, MAX_FOLD_ITERATIONS};
+
+#[test]
+fn fractal_settings_outside_their_ranges_are_rejected() {
+    assert_out_of_range(mandelbulb(1.5), "mandelbulb", "power", 1.5, "in [2, 64]");
+    assert_out_of_range(mandelbulb(64.5), "mandelbulb", "power", 64.5, "in [2, 64]");
+    assert_out_of_range(
+        Mandelbulb::new(8.0).bailout(0.5).into(),
+        "mandelbulb",
+        "bailout",
+        0.5,
+        "in [1, 1000000]",
+    );
+    assert_out_of_range(
+        julia([5.0, 0.0, 0.0, 0.0]),
+        "julia",
+        "c.x",
+        5.0,
+        "in [-4, 4]",
+    );
+    assert_out_of_range(
+        Menger::new(2).scale(1.5).into(),
+        "menger",
+        "scale",
+        1.5,
+        "in [2, 4]",
+    );
+    assert_out_of_range(
+        Sierpinski::new(2).scale(5.0).into(),
+        "sierpinski",
+        "scale",
+        5.0,
+        "in [1.5, 4]",
+    );
+}
+
+#[test]
+fn negative_smoothing_is_rejected_for_every_smooth_boolean() {
+    let (a, b) = (sphere(1.0), cuboid(DVec3::ONE));
+    assert_out_of_range(
+        a.clone().smooth_union(b.clone(), -0.1),
+        "smooth_union",
+        "k",
+        -0.1,
+        ">= 0",
+    );
+    assert_out_of_range(
+        a.clone().smooth_subtract(b.clone(), -0.1),
+        "smooth_subtract",
+        "k",
+        -0.1,
+        ">= 0",
+    );
+    assert_out_of_range(
+        a.smooth_intersect(b, -0.1),
+        "smooth_intersect",
+        "k",
+        -0.1,
+        ">= 0",
+    );
+}
+
+#[test]
+fn zero_directions_are_rejected() {
+    assert_zero_vector(sphere(1.0).rotate(DVec3::ZERO, 1.0), "rotate", "axis");
+    assert_zero_vector(plane(DVec3::ZERO, 1.0), "plane", "normal");
+}
+
+#[test]
+fn errors_name_the_path_to_the_node() {
+    assert_out_of_range(
+        sphere(1.0).union(torus(1.0, -0.2)),
+        "union/b:torus",
+        "minor_radius",
+        -0.2,
+        ">= 0",
+    );
+    let deep = sphere(-1.0)
+        .translate(DVec3::X)
+        .smooth_union(cuboid(DVec3::ONE), 0.1)
+        .color(DVec3::ONE);
+    assert_out_of_range(
+        deep,
+        "color/smooth_union/a:translate/sphere",
+        "radius",
+        -1.0,
+        ">= 0",
+    );
+    let err = error_of(sphere(1.0).union(torus(1.0, -0.2)));
+    assert_eq!(
+        err.to_string(),
+        "union/b:torus: parameter `minor_radius` must be >= 0, got -0.2"
+    );
+}
+
+#[test]
+fn an_empty_scene_is_rejected() {
+    assert!(matches!(Scene::empty().validate(), Err(Error::EmptyScene)));
+    // Adding geometry makes it valid.
+    Scene::empty().add(sphere(1.0)).validate().unwrap();
+}
+
+#[track_caller]
+fn assert_camera_error(camera: Camera, reason: &str) {
+    let err = Scene::new(sphere(1.0))
+        .with_camera(camera)
+        .validate()
+        .unwrap_err();
+    match err {
+        Error::Camera { reason: r } => assert!(r.contains(reason), "{r:?} lacks {reason:?}"),
+        other => panic!("expected a camera error, got {other:?}"),
+    }
+}
+
+#[test]
+fn degenerate_cameras_are_rejected() {
+    let p = dvec3(1.0, 2.0, 3.0);
+    assert_camera_error(Camera::look_at(p, p), "target equals position");
+    for fov in [0.0, 180.0, -10.0, 270.0, f64::NAN, f64::INFINITY] {
+        assert_camera_error(Camera::look_at(p, DVec3::ZERO).fov(fov), "field of view");
+    }
+    assert_camera_error(
+        Camera::look_at(p, DVec3::ZERO).orthographic(0.0),
+        "orthographic height",
+    );
+    assert_camera_error(
+        Camera::look_at(p, DVec3::ZERO).orthographic(f64::NAN),
+        "orthographic height",
+    );
+    assert_camera_error(
+        Camera::look_at(dvec3(f64::NAN, 0.0, 0.0), DVec3::ZERO),
+        "finite",
+    );
+    assert_camera_error(Camera::look_at(DVec3::Y, DVec3::ZERO), "parallel");
+    assert_camera_error(
+        Camera::look_at(p, DVec3::ZERO).up(DVec3::ZERO),
+        "up is zero",
+    );
+    // Just inside the limits is fine.
+    for fov in [1e-3, 179.9] {
+        Camera::look_at(p, DVec3::ZERO).fov(fov).validate().unwrap();
+    }
+}
+
+#[test]
+fn bad_lights_name_the_light() {
+    let with = |light: Light| Scene::new(sphere(1.0)).with_lights([Light::point(DVec3::Y), light]);
+    let err = with(Light::directional(DVec3::ZERO))
+        .validate()
+        .unwrap_err();
+    assert!(
+        matches!(&err, Error::ZeroVector { node, param } if node == "light[1]" && param == "direction"),
+        "{err:?}"
+    );
+    let err = with(Light::point(dvec3(0.0, f64::NAN, 0.0)))
+        .validate()
+        .unwrap_err();
+    assert!(
+        matches!(&err, Error::NonFinite { node, param, .. } if node == "light[1]" && param == "position"),
+        "{err:?}"
+    );
+    let err = with(Light::point(DVec3::Y).intensity(-1.0))
+        .validate()
+        .unwrap_err();
+    assert!(
+        matches!(&err, Error::OutOfRange { param, .. } if param == "intensity"),
+        "{err:?}"
+    );
+    let err = with(Light::point(DVec3::Y).softness(f64::INFINITY))
+        .validate()
+        .unwrap_err();
+    assert!(
+        matches!(&err, Error::OutOfRange { param, .. } if param == "softness"),
+        "{err:?}"
+    );
+    let err = with(Light::point(DVec3::Y).color(dvec3(1.0, -1.0, 0.0)))
+        .validate()
+        .unwrap_err();
+    assert!(
+        matches!(&err, Error::OutOfRange { param, .. } if param == "color"),
+        "{err:?}"
+    );
+}
+
+#[test]
+fn dynamic_parameters_are_checked_when_set() {
+    let mut eval = cpu::Evaluator::new(&sphere(param("r", 1.0))).unwrap();
+    let err = eval.set_param("r", -1.0).unwrap_err();
+    assert!(
+        matches!(&err, Error::OutOfRange { node, param, value, expected }
+            if node == "dynamic parameter" && param == "r" && *value == -1.0 && expected == ">= 0"),
+        "{err:?}"
+    );
+    let err = eval.set_param("r", f64::NAN).unwrap_err();
+    assert!(
+        matches!(&err, Error::NonFinite { param, .. } if param == "r"),
+        "{err:?}"
+    );
+    let err = eval.set_param("radius", 2.0).unwrap_err();
+    assert!(
+        matches!(&err, Error::UnknownParam { name } if name == "radius"),
+        "{err:?}"
+    );
+    // Failed sets leave the value alone.
+    assert_eq!(eval.values().get("r"), Some(1.0));
+    eval.set_param("r", 2.0).unwrap();
+    assert_eq!(eval.values().get("r"), Some(2.0));
+    // Range rules hold for dynamic fractal settings too.
+    let mut bulb = cpu::Evaluator::new(&mandelbulb(param("power", 8.0))).unwrap();
+    assert!(matches!(
+        bulb.set_param("power", 1.0),
+        Err(Error::OutOfRange { .. })
+    ));
+    assert!(matches!(
+        bulb.set_param("power", 65.0),
+        Err(Error::OutOfRange { .. })
+    ));
+    bulb.set_param("power", 2.0).unwrap();
+}
+
+#[test]
+fn invalid_dynamic_defaults_are_rejected_where_they_are_used() {
+    assert_out_of_range(sphere(param("r", -1.0)), "sphere", "radius", -1.0, ">= 0");
+    assert_non_finite(
+        sphere(1.0).translate(param3("at", dvec3(0.0, f64::NAN, 0.0))),
+        "translate",
+        "offset.y",
+    );
+}
+
+#[test]
+fn conflicting_declarations_of_one_name_are_rejected() {
+    let conflict = |node: Node| match error_of(node) {
+        Error::ConflictingParam { name } => name,
+        other => panic!("expected ConflictingParam, got {other:?}"),
+    };
+    // Different defaults.
+    assert_eq!(
+        conflict(sphere(param("r", 1.0)).union(sphere(param("r", 2.0)))),
+        "r"
+    );
+    // Same default, different rules (radius >= 0, offset finite).
+    let offset = [param("x", 1.0), 0.0.into(), 0.0.into()];
+    assert_eq!(conflict(sphere(param("x", 1.0)).translate(offset)), "x");
+    // The same declaration twice shares one slot.
+    let shared = sphere(param("r", 1.0)).union(torus(2.0, param("r", 1.0)));
+    let ir = fractal_sdf::ir::Ir::lower(&shared).unwrap();
+    assert_eq!(ir.params().len(), 1);
+}
+
+/// A value that breaks a rule: non-finite, or negative.
+fn bad_size() -> impl Strategy<Value = f64> {
+    prop_oneof![
+        Just(f64::NAN),
+        Just(f64::INFINITY),
+        Just(f64::NEG_INFINITY),
+        -1e300..-1e-300f64,
+    ]
+}
+
+/// A value outside `[lo, hi]`, or non-finite.
+fn outside(lo: f64, hi: f64) -> impl Strategy<Value = f64> {
+    prop_oneof![
+        Just(f64::NAN),
+        Just(f64::INFINITY),
+        Just(f64::NEG_INFINITY),
+        (-1e300..lo).prop_filter("below", move |&v| v < lo),
+        (hi..1e300).prop_filter("above", move |&v| v > hi),
+    ]
+}
+
+/// A node with exactly one invalid setting, and its node name.
+fn broken_node() -> impl Strategy<Value = (Node, &'static str)> {
+    prop_oneof![
+        bad_size().prop_map(|v| (sphere(v), "sphere")),
+        bad_size().prop_map(|v| (cuboid(dvec3(1.0, v, 1.0)), "cuboid")),
+        bad_size().prop_map(|v| (torus(1.0, v), "torus")),
+        bad_size().prop_map(|v| (capped_cone(v, 1.0, 0.5), "capped_cone")),
+        bad_size().prop_map(|v| (sphere(1.0).onion(v), "onion")),
+        bad_size().prop_map(|v| (sphere(1.0).smooth_union(sphere(0.5), v), "smooth_union")),
+        bad_size().prop_map(|v| (ellipsoid(dvec3(v, 1.0, 1.0)), "ellipsoid")),
+        bad_size().prop_map(|v| (sphere(1.0).scale(v), "scale")),
+        outside(2.0, 64.0).prop_map(|v| (mandelbulb(v), "mandelbulb")),
+        outside(1.0, 1e6).prop_map(|v| (Mandelbulb::new(8.0).bailout(v).into(), "mandelbulb")),
+        outside(-4.0, 4.0).prop_map(|v| (julia([0.0, 0.0, v, 0.0]), "julia")),
+        outside(2.0, 4.0).prop_map(|v| (Menger::new(2).scale(v).into(), "menger")),
+        outside(1.5, 4.0).prop_map(|v| (Sierpinski::new(2).scale(v).into(), "sierpinski")),
+        prop_oneof![Just(0u32), 257..=u32::MAX]
+            .prop_map(|n| (Mandelbulb::new(8.0).iterations(n).into(), "mandelbulb")),
+        (21..=u32::MAX).prop_map(|n| (menger(n), "menger")),
+        Just((sphere(1.0).rotate(DVec3::ZERO, 1.0), "rotate")),
+        Just((plane(DVec3::ZERO, 0.0), "plane")),
+    ]
+}
+
+proptest! {
+    /// One bad value anywhere in a valid scene: an error naming the bad
+    /// node, never a panic.
+    #[test]
+    fn invalid_values_anywhere_give_an_error_not_a_panic(
+        valid in scene_node(3),
+        (broken, name) in broken_node(),
+        place in 0u8..4,
+    ) {
+        let node = match place {
+            0 => broken,
+            1 => valid.union(broken),
+            2 => broken.smooth_subtract(valid, 0.1),
+            _ => broken.translate(DVec3::X).color(DVec3::ONE).intersect(valid),
+        };
+        let err = Scene::new(node.clone()).validate().unwrap_err();
+        let message = err.to_string();
+        prop_assert!(message.contains(name), "{} does not name {}", message, name);
+        prop_assert!(cpu::Evaluator::new(&node).is_err());
+    }
+
+    /// Setting a dynamic parameter to a bad value: an error, the old value
+    /// kept, never a panic.
+    #[test]
+    fn invalid_dynamic_values_give_an_error_not_a_panic(bad in bad_size()) {
+        let mut eval = cpu::Evaluator::new(&sphere(param("r", 1.0)).twist(param("k", 0.5)))?;
+        prop_assert!(eval.set_param("r", bad).is_err());
+        prop_assert_eq!(eval.values().get("r"), Some(1.0));
+        if !bad.is_finite() {
+            prop_assert!(eval.set_param("k", bad).is_err());
+        }
+    }
+}
