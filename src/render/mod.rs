@@ -47,8 +47,10 @@
 //! count are kernel arguments, so none of them is in the source.
 
 mod aov;
+mod buffer;
 mod device;
 mod dispatch;
+mod points;
 mod program;
 mod renderer;
 mod viewport;
@@ -56,6 +58,7 @@ mod viewport;
 pub use aov::Frame;
 pub use device::{DEVICE_ENV, DeviceInfo, DeviceKind, DeviceSelector, devices};
 pub use dispatch::{DEFAULT_TILE_SIZE, MAX_IMAGE_SIDE};
+pub use points::{PointEvaluator, PointSample};
 pub use program::{BuildInfo, ProgramSource, program_builds};
 pub use renderer::{RenderOptions, Renderer};
 pub use viewport::Viewport;

@@ -5,6 +5,7 @@ use image::RgbaImage;
 use ocl::{Buffer, Context, Kernel, MemFlags, Program, Queue};
 
 use super::aov::Frame;
+use super::buffer::RealBuffer;
 use super::device::{self, DeviceInfo, DeviceSelector, Selected, opencl};
 use super::dispatch::{self, DEFAULT_TILE_SIZE, MAX_IMAGE_SIDE};
 use super::program::{self, BuildInfo, ProgramSource};
@@ -550,76 +551,6 @@ fn local_size(kernel: &Kernel, selected: &Selected) -> Result<(usize, usize)> {
         max = max.min(n);
     }
     Ok(dispatch::local_size(max))
-}
-
-/// A buffer of `real`s in the program's precision.
-#[derive(Debug)]
-enum RealBuffer {
-    F32(Buffer<f32>),
-    F64(Buffer<f64>),
-}
-
-impl RealBuffer {
-    fn new(queue: &Queue, precision: Precision, values: &[f64]) -> Result<Self> {
-        let len = values.len().max(1);
-        let flags = MemFlags::new().read_only();
-        let buffer = match precision {
-            Precision::F32 => RealBuffer::F32(
-                Buffer::builder()
-                    .queue(queue.clone())
-                    .flags(flags)
-                    .len(len)
-                    .build()
-                    .map_err(opencl)?,
-            ),
-            Precision::F64 => RealBuffer::F64(
-                Buffer::builder()
-                    .queue(queue.clone())
-                    .flags(flags)
-                    .len(len)
-                    .build()
-                    .map_err(opencl)?,
-            ),
-        };
-        buffer.write(values)?;
-        Ok(buffer)
-    }
-
-    fn len(&self) -> usize {
-        match self {
-            RealBuffer::F32(b) => b.len(),
-            RealBuffer::F64(b) => b.len(),
-        }
-    }
-
-    fn write(&self, values: &[f64]) -> Result<()> {
-        if values.is_empty() {
-            return Ok(());
-        }
-        match self {
-            RealBuffer::F32(b) => {
-                #[allow(clippy::cast_possible_truncation)]
-                let v: Vec<f32> = values.iter().map(|&x| x as f32).collect();
-                b.write(&v).len(v.len()).enq().map_err(opencl)
-            }
-            RealBuffer::F64(b) => b.write(values).len(values.len()).enq().map_err(opencl),
-        }
-    }
-
-    fn push_arg<'b>(&'b self, builder: &mut ocl::builders::KernelBuilder<'b>) {
-        match self {
-            RealBuffer::F32(b) => builder.arg(b),
-            RealBuffer::F64(b) => builder.arg(b),
-        };
-    }
-
-    fn set_arg(&self, kernel: &Kernel, index: u32) -> Result<()> {
-        match self {
-            RealBuffer::F32(b) => kernel.set_arg(index, b),
-            RealBuffer::F64(b) => kernel.set_arg(index, b),
-        }
-        .map_err(opencl)
-    }
 }
 
 /// The per-frame inputs: dynamic parameters, camera and lights.

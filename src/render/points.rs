@@ -1,0 +1,143 @@
+//! Evaluating a scene's generated `DE` and `DE_shade` at arbitrary points
+//! on an OpenCL device: how the OpenCL twins of the formulas are checked
+//! against the CPU reference.
+
+use glam::DVec3;
+use ocl::{Kernel, Queue};
+
+use super::buffer::RealBuffer;
+use super::device::{self, DeviceInfo, DeviceSelector, Selected, opencl};
+use super::program::{self, ProgramSource};
+use crate::codegen::{self, Options, Target};
+use crate::error::Result;
+use crate::ir::{Ir, ParamValues};
+use crate::quality::{Precision, Quality};
+use crate::scene::Node;
+
+/// What the device computed at one point.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PointSample {
+    /// `DE(p)`.
+    pub distance: f64,
+    /// The distance `DE_shade(p)` returned (must equal `distance`).
+    pub shade_distance: f64,
+    /// The colour `DE_shade` returned.
+    pub color: DVec3,
+    /// The orbit trap `DE_shade` returned.
+    pub trap: f64,
+}
+
+/// Runs a scene's generated distance functions on an OpenCL device.
+///
+/// ```no_run
+/// use fractal_sdf::prelude::*;
+/// use fractal_sdf::render::{DeviceSelector, PointEvaluator};
+///
+/// let node = mandelbulb(8.0);
+/// let mut device = PointEvaluator::new(&node, Precision::F32, &DeviceSelector::auto())?;
+/// let cpu = cpu::Evaluator::new(&node)?;
+/// let p = dvec3(0.3, 1.2, -0.4);
+/// let on_device = device.eval(&[p])?[0].distance;
+/// assert!((on_device - f64::from(cpu.distance_f32(p.as_vec3()))).abs() < 1e-4);
+/// # Ok::<(), fractal_sdf::Error>(())
+/// ```
+#[derive(Debug)]
+pub struct PointEvaluator {
+    selected: Selected,
+    queue: Queue,
+    program: ocl::Program,
+    precision: Precision,
+    values: ParamValues,
+}
+
+impl PointEvaluator {
+    /// Generates and builds the evaluation program for `geometry` in
+    /// `precision` on the selected device.
+    ///
+    /// # Errors
+    /// Validation errors, [`Error::NoPlatform`](crate::Error::NoPlatform),
+    /// [`Error::Fp64Unsupported`](crate::Error::Fp64Unsupported),
+    /// [`Error::Build`](crate::Error::Build).
+    pub fn new(geometry: &Node, precision: Precision, selector: &DeviceSelector) -> Result<Self> {
+        let ir = Ir::lower(geometry)?;
+        let options = Options {
+            quality: Quality {
+                precision,
+                ..Quality::default()
+            },
+            target: Target::Evaluate,
+            ..Options::default()
+        };
+        let kernel = codegen::emit_ir(&ir, &options)?;
+        let selected = device::select(selector)?;
+        let context = program::context(&selected)?;
+        let queue = Queue::new(&context, selected.device, None).map_err(opencl)?;
+        let source = ProgramSource {
+            source: kernel.source,
+            precision,
+        };
+        let (program, _, _) = program::build(&selected, &context, &source)?;
+        Ok(PointEvaluator {
+            selected,
+            queue,
+            program,
+            precision,
+            values: ir.default_values(),
+        })
+    }
+
+    /// The device it runs on.
+    #[must_use]
+    pub fn device(&self) -> &DeviceInfo {
+        &self.selected.info
+    }
+
+    /// Sets a dynamic parameter for later evaluations.
+    ///
+    /// # Errors
+    /// See [`ParamValues::set`].
+    pub fn set_param(&mut self, name: &str, value: f64) -> Result<()> {
+        self.values.set(name, value)
+    }
+
+    /// Evaluates every point (rounded to the program's precision).
+    ///
+    /// # Errors
+    /// [`Error::OpenCl`](crate::Error::OpenCl) if a buffer or the launch
+    /// fails.
+    pub fn eval(&self, points: &[DVec3]) -> Result<Vec<PointSample>> {
+        if points.is_empty() {
+            return Ok(Vec::new());
+        }
+        let packed: Vec<f64> = points.iter().flat_map(|p| [p.x, p.y, p.z, 0.0]).collect();
+        let q = &self.queue;
+        let input = RealBuffer::new(q, self.precision, &packed)?;
+        let params = RealBuffer::new(q, self.precision, self.values.as_slice())?;
+        let output = RealBuffer::output(q, self.precision, points.len() * 8)?;
+        let count = u32::try_from(points.len()).map_err(opencl)?;
+        let mut builder = Kernel::builder();
+        builder
+            .program(&self.program)
+            .name("eval_points")
+            .queue(q.clone())
+            .global_work_size(points.len());
+        input.push_arg(&mut builder);
+        params.push_arg(&mut builder);
+        output.push_arg(&mut builder);
+        builder.arg(count);
+        let kernel = builder.build().map_err(opencl)?;
+        // SAFETY: the kernel reads `count` points and writes 8 reals per
+        // point, exactly the sizes of the buffers bound above.
+        unsafe { kernel.enq().map_err(opencl)? };
+        let out = output.read()?;
+        Ok(out
+            .chunks_exact(8)
+            .map(|c| PointSample {
+                distance: c[0],
+                shade_distance: c[1],
+                trap: c[2],
+                color: DVec3::new(c[4], c[5], c[6]),
+            })
+            .collect())
+    }
+}

@@ -1,0 +1,242 @@
+//! Conformance: every node type's OpenCL twin, and composite scenes, agree
+//! with the CPU reference on 10,000 random points plus "spicy" ones (the
+//! origin, the axes, fractal bailout spheres, ±1e6), in both precisions,
+//! and are finite everywhere.
+//!
+//! Tolerances: the device result `g` and the CPU reference `c` (evaluated in
+//! the same precision) must satisfy `|g - c| <= tol * max(1, |c|)` with
+//! `tol = 1e-4` for F32 and `1e-10` for F64, at every point. Colours must
+//! agree to the same tolerance. Run with `--nocapture` to see the worst
+//! error of each node.
+
+mod gpu;
+
+use fractal_sdf::cpu::Evaluator;
+use fractal_sdf::prelude::*;
+use fractal_sdf::render::{DeviceSelector, PointEvaluator};
+use fractal_sdf::scene::{CustomShape, Rule};
+
+/// Deterministic pseudo-random points in the cube `[-extent, extent]^3`.
+fn random_points(n: usize, extent: f64, seed: u64) -> Vec<DVec3> {
+    let mut s = seed.max(1);
+    let mut next = move || {
+        s ^= s << 13;
+        s ^= s >> 7;
+        s ^= s << 17;
+        #[allow(clippy::cast_precision_loss)]
+        let unit = (s >> 11) as f64 / (1u64 << 53) as f64;
+        (2.0 * unit - 1.0) * extent
+    };
+    (0..n).map(|_| dvec3(next(), next(), next())).collect()
+}
+
+/// The origin, points on and near the axes, on the bailout spheres of the
+/// fractals (radius 2 and 4), near the surfaces, and far away.
+fn spicy_points() -> Vec<DVec3> {
+    let mut pts = vec![DVec3::ZERO];
+    let dirs = [
+        DVec3::X,
+        DVec3::Y,
+        DVec3::Z,
+        -DVec3::X,
+        -DVec3::Y,
+        -DVec3::Z,
+        dvec3(1.0, 1.0, 1.0).normalize(),
+        dvec3(-1.0, 1.0, -1.0).normalize(),
+    ];
+    for d in dirs {
+        for r in [1e-7, 1e-3, 0.5, 1.0, 2.0, 4.0, 1e3, 1e6] {
+            pts.push(d * r);
+        }
+    }
+    pts
+}
+
+fn gyroid() -> CustomShape {
+    CustomShape::new(
+        "gyroid",
+        &[("thickness", Rule::NonNegative)],
+        |p, a| {
+            let g = p.x.sin() * p.y.cos() + p.y.sin() * p.z.cos() + p.z.sin() * p.x.cos();
+            g.abs() / 1.5 - a[0]
+        },
+        "real g = sin(p.x) * cos(p.y) + sin(p.y) * cos(p.z) + sin(p.z) * cos(p.x);\n\
+         return fabs(g) / R(1.5) - thickness;",
+    )
+    .expect("a valid custom shape")
+}
+
+/// One node of every kind, and composites.
+fn nodes() -> Vec<(&'static str, Node)> {
+    let s = || sphere(0.6);
+    let b = || cuboid(dvec3(0.5, 0.3, 0.4));
+    let mut v = vec![
+        ("sphere", sphere(0.8)),
+        ("cuboid", b()),
+        ("round_box", round_box(dvec3(0.5, 0.4, 0.3), 0.1)),
+        ("torus", torus(0.7, 0.2)),
+        ("cylinder", cylinder(0.4, 0.6)),
+        (
+            "capsule",
+            capsule(dvec3(-0.3, -0.5, 0.1), dvec3(0.4, 0.6, -0.2), 0.25),
+        ),
+        ("plane", plane(dvec3(0.2, 1.0, -0.3), 0.4)),
+        ("octahedron", octahedron(0.9)),
+        ("capped_cone", capped_cone(0.6, 0.5, 0.2)),
+        ("ellipsoid", ellipsoid(dvec3(0.7, 0.4, 0.5))),
+        ("mandelbulb_int", mandelbulb(8.0)),
+        ("mandelbulb_trig", mandelbulb(7.3)),
+        ("mandelbulb_dynamic", mandelbulb(param("power", 5.0))),
+        ("menger", menger(4)),
+        ("julia", julia([-0.2, 0.6, 0.2, 0.2])),
+        ("sierpinski", sierpinski(6)),
+        ("translate", b().translate(dvec3(0.3, -0.2, 0.1))),
+        ("rotate", b().rotate(dvec3(1.0, 2.0, 0.5), 0.7)),
+        ("rotate_dynamic", b().rotate(DVec3::Y, param("angle", 0.4))),
+        ("scale", b().scale(1.7)),
+        (
+            "mirror",
+            b().translate(dvec3(0.4, 0.0, 0.0)).mirror(Axis::X),
+        ),
+        ("round", b().round(0.1)),
+        ("onion", s().onion(0.05)),
+        ("elongate", s().elongate(dvec3(0.3, 0.0, 0.2))),
+        ("repeat", sphere(0.2).repeat(dvec3(0.7, 0.0, 0.9))),
+        (
+            "repeat_limited",
+            sphere(0.2).repeat_limited(dvec3(0.6, 0.6, 0.0), [2, 1, 0]),
+        ),
+        ("twist", b().twist(1.5)),
+        ("bend", b().bend(0.9)),
+        ("union", s().union(b().translate(dvec3(0.5, 0.0, 0.0)))),
+        ("subtract", b().subtract(s())),
+        ("intersect", b().intersect(s())),
+        (
+            "smooth_union",
+            s().smooth_union(b().translate(dvec3(0.5, 0.0, 0.0)), 0.3),
+        ),
+        ("smooth_subtract", b().smooth_subtract(s(), 0.2)),
+        (
+            "smooth_intersect",
+            b().smooth_intersect(s(), param("k", 0.2)),
+        ),
+        ("color", s().color(dvec3(0.2, 0.4, 0.9))),
+        ("custom", gyroid().node([0.1]).intersect(sphere(1.5))),
+    ];
+    for (name, scene) in fractal_sdf::gallery::all() {
+        let name: &'static str = Box::leak(format!("gallery_{name}").into_boxed_str());
+        v.push((name, scene.geometry.expect("gallery scenes have geometry")));
+    }
+    v
+}
+
+struct Stats {
+    worst: f64,
+    worst_at: DVec3,
+    over: usize,
+    color_over: usize,
+    total: usize,
+}
+
+fn compare(name: &str, node: &Node, precision: Precision, points: &[DVec3]) -> Stats {
+    let device = PointEvaluator::new(node, precision, &DeviceSelector::auto())
+        .unwrap_or_else(|e| panic!("{name}: {e}"));
+    let cpu = Evaluator::new(node).unwrap();
+    let got = device.eval(points).unwrap();
+    let tol = match precision {
+        Precision::F32 => 1e-4,
+        Precision::F64 => 1e-10,
+    };
+    let mut stats = Stats {
+        worst: 0.0,
+        worst_at: DVec3::ZERO,
+        over: 0,
+        color_over: 0,
+        total: points.len(),
+    };
+    for (p, g) in points.iter().zip(&got) {
+        let (reference, color) = match precision {
+            Precision::F32 => {
+                let s = cpu.sample::<f32>(p.as_vec3().into());
+                (f64::from(s.distance), glam::Vec3::from(s.color).as_dvec3())
+            }
+            Precision::F64 => {
+                let s = cpu.sample::<f64>((*p).into());
+                (s.distance, DVec3::from(s.color))
+            }
+        };
+        assert!(
+            g.distance.is_finite() && g.trap.is_finite() && g.color.is_finite(),
+            "{name} {precision:?}: non-finite result {g:?} at {p}"
+        );
+        assert!(
+            reference.is_finite(),
+            "{name}: CPU reference not finite at {p}"
+        );
+        assert_eq!(
+            g.distance.to_bits(),
+            g.shade_distance.to_bits(),
+            "{name} {precision:?}: DE and DE_shade differ at {p}"
+        );
+        let err = (g.distance - reference).abs() / reference.abs().max(1.0);
+        if err > tol {
+            stats.over += 1;
+        }
+        if err > stats.worst {
+            stats.worst = err;
+            stats.worst_at = *p;
+        }
+        if (g.color - color).abs().max_element() > tol {
+            stats.color_over += 1;
+        }
+    }
+    stats
+}
+
+fn check_all(precision: Precision) {
+    if gpu::device().is_none() {
+        return;
+    }
+    let mut points = random_points(10_000, 2.5, 0x5eed);
+    points.extend(spicy_points());
+    let mut failures = Vec::new();
+    for (name, node) in nodes() {
+        let s = compare(name, &node, precision, &points);
+        eprintln!(
+            "{name:>24} {precision:?}: worst relative error {:.2e} at {:.4}; over tolerance: {} distances, {} colours of {} points",
+            s.worst, s.worst_at, s.over, s.color_over, s.total
+        );
+        if s.over > 0 || s.color_over > 0 {
+            failures.push(format!(
+                "{name}: {} distances and {} colours of {} points over tolerance (worst {:.3e} at {})",
+                s.over, s.color_over, s.total, s.worst, s.worst_at
+            ));
+        }
+    }
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
+}
+
+#[test]
+fn opencl_f32_matches_the_cpu_reference() {
+    check_all(Precision::F32);
+}
+
+#[test]
+fn opencl_f64_matches_the_cpu_reference() {
+    check_all(Precision::F64);
+}
+
+#[test]
+fn dynamic_values_reach_the_device() {
+    if gpu::device().is_none() {
+        return;
+    }
+    let node = sphere(param("radius", 1.0)).translate(dvec3(0.5, 0.0, 0.0));
+    let mut device = PointEvaluator::new(&node, Precision::F64, &DeviceSelector::auto()).unwrap();
+    let p = dvec3(3.0, 0.0, 0.0);
+    let before = device.eval(&[p]).unwrap()[0].distance;
+    device.set_param("radius", 2.0).unwrap();
+    let after = device.eval(&[p]).unwrap()[0].distance;
+    assert_eq!(before, 1.5);
+    assert_eq!(after, 0.5);
+}
