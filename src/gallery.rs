@@ -69,7 +69,7 @@ pub fn mandelbulb() -> Scene {
         .rotate(DVec3::X, -FRAC_PI_2)
         .color(dvec3(0.9, 0.6, 0.35));
     Scene::new(bulb)
-        .with_camera(Camera::look_at(dvec3(1.6, 1.1, 2.2), dvec3(0.0, -0.05, 0.0)).fov(40.0))
+        .with_camera(Camera::look_at(dvec3(2.05, 1.45, 2.8), dvec3(0.0, -0.12, 0.0)).fov(40.0))
         .with_lights(key_and_fill())
 }
 
@@ -130,7 +130,7 @@ pub fn csg() -> Scene {
         .with_lights(key_and_fill())
 }
 
-/// One of every primitive in a row.
+/// One of every primitive, in two rows.
 #[must_use]
 pub fn primitives() -> Scene {
     let items = [
@@ -139,7 +139,7 @@ pub fn primitives() -> Scene {
         round_box(dvec3(0.3, 0.3, 0.3), 0.08),
         torus(0.28, 0.1),
         cylinder(0.25, 0.35),
-        capsule(dvec3(0.0, -0.3, 0.0), dvec3(0.0, 0.3, 0.0), 0.18),
+        capsule(dvec3(0.0, -0.2, 0.0), dvec3(0.0, 0.2, 0.0), 0.18),
         octahedron(0.4),
         capped_cone(0.35, 0.3, 0.1),
         ellipsoid(dvec3(0.35, 0.2, 0.25)),
@@ -156,14 +156,18 @@ pub fn primitives() -> Scene {
                 0.45 + 0.35 * (1.0 - (2.0 * t - 1.0).abs()),
                 0.3 + 0.6 * t,
             );
-            #[allow(clippy::cast_precision_loss)]
-            let x = (i as f64 - 4.0) * 0.85;
-            node.color(hue).translate(dvec3(x, 0.0, 0.0))
+            // Five in the back row, four in front, 0.95 apart.
+            let (column, z) = if i < 5 {
+                (i as f64 - 2.0, -0.6)
+            } else {
+                (i as f64 - 6.5, 0.6)
+            };
+            node.color(hue).translate(dvec3(column * 0.95, 0.0, z))
         })
         .reduce(Node::union)
         .expect("nine primitives");
     Scene::new(row.union(floor(0.4)))
-        .with_camera(Camera::look_at(dvec3(0.0, 2.2, 5.5), dvec3(0.0, -0.2, 0.0)).fov(50.0))
+        .with_camera(Camera::look_at(dvec3(0.0, 2.0, 4.2), dvec3(0.0, -0.15, 0.0)).fov(45.0))
         .with_lights(key_and_fill())
 }
 

@@ -39,6 +39,7 @@ pub(crate) const HELPERS: &[Helper] = &[
     helper!("julia"),
     helper!("smooth_min"),
     helper!("rotate"),
+    helper!("warp"),
 ];
 
 /// The helpers needed for `used` (adding dependencies), in library order.

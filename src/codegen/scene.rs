@@ -289,15 +289,9 @@ impl<'a> SceneEmitter<'a> {
                     "(real3)(k{i} * {p}.x - s{i} * {p}.z, {p}.y, s{i} * {p}.x + k{i} * {p}.z)"
                 ));
                 let c = self.node(*child, &q);
-                self.w.line(format!(
-                    "real h{i} = R(0.5) * fabs({k}) * (hypot({p}.x, {p}.z) + fabs({}));",
-                    c.d
-                ));
-                self.post(
-                    id,
-                    c,
-                    &format!("{{d}} / (h{i} + sqrt(R(1.0) + h{i} * h{i}))"),
-                )
+                self.used.insert("warp");
+                let rho = format!("hypot({p}.x, {p}.z)");
+                self.post(id, c, &format!("twist_bound({{d}}, {k}, {rho})"))
             }
             Kind::Bend { rate, child } => {
                 let k = w(self, *rate);
@@ -308,8 +302,9 @@ impl<'a> SceneEmitter<'a> {
                     "(real3)(k{i} * {p}.x - s{i} * {p}.y, s{i} * {p}.x + k{i} * {p}.y, {p}.z)"
                 ));
                 let c = self.node(*child, &q);
-                let t = format!("fabs({k}) * (hypot({p}.x, {p}.y) + fabs({{d}}))");
-                self.post(id, c, &format!("{{d}} / (R(1.0) + {t})"))
+                self.used.insert("warp");
+                let rho = format!("hypot({p}.x, {p}.y)");
+                self.post(id, c, &format!("bend_bound({{d}}, {k}, {rho})"))
             }
             Kind::Csg {
                 op,

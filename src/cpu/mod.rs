@@ -234,9 +234,7 @@ impl Evaluator {
                 let (sn, cs) = (k * p.y).sin_cos();
                 let q = v3(cs * p.x - sn * p.z, p.y, sn * p.x + cs * p.z);
                 let mut out = self.eval(*child, q);
-                let t = k.abs() * (p.x.hypot(p.z) + out.distance.abs());
-                let half = T::of(0.5) * t;
-                out.distance = out.distance / (half + (T::one() + half * half).sqrt());
+                out.distance = sdf::twist_bound(out.distance, k, p.x.hypot(p.z));
                 out
             }
             Kind::Bend { rate, child } => {
@@ -244,8 +242,7 @@ impl Evaluator {
                 let (sn, cs) = (k * p.x).sin_cos();
                 let q = v3(cs * p.x - sn * p.y, sn * p.x + cs * p.y, p.z);
                 let mut out = self.eval(*child, q);
-                let t = k.abs() * (p.x.hypot(p.y) + out.distance.abs());
-                out.distance = out.distance / (T::one() + t);
+                out.distance = sdf::bend_bound(out.distance, k, p.x.hypot(p.y));
                 out
             }
             Kind::Csg {

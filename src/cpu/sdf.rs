@@ -325,3 +325,39 @@ pub fn smooth_min<T: Real>(a: T, b: T, k: T) -> (T, T) {
     let m = h * h * T::of(0.5);
     (a.min(b) - m * k * T::of(0.5), m)
 }
+
+/// The twist's local Lipschitz factor `t/2 + sqrt(1 + t^2/4)` at
+/// `t = |k| rho`: the largest stretch of the map `p -> rotate_y(k p.y) p` at
+/// distance `rho` from the y axis.
+fn twist_stretch<T: Real>(k: T, rho: T) -> T {
+    let half = T::of(0.5) * k.abs() * rho;
+    half + (T::one() + half * half).sqrt()
+}
+
+/// The bend's local Lipschitz factor `1 + |k| rho` at distance `rho` from
+/// the z axis.
+fn bend_stretch<T: Real>(k: T, rho: T) -> T {
+    T::one() + k.abs() * rho
+}
+
+/// Turns the child's distance `d` at the warped point into a bound in the
+/// unwarped space, for a warp whose stretch grows with `rho`: with
+/// `L0 = stretch(rho)` and `L1 = stretch(rho + |d| / L0)`, every point of
+/// the ball of radius `|d| / L1` maps within `|d|` of the warped point, so
+/// `d / L1` never overestimates.
+fn warp_bound<T: Real>(d: T, rho: T, stretch: impl Fn(T) -> T) -> T {
+    let reach = d.abs() / stretch(rho);
+    d / stretch(rho + reach)
+}
+
+/// The distance bound of a twisted child (see [`warp_bound`]).
+#[must_use]
+pub fn twist_bound<T: Real>(d: T, k: T, rho: T) -> T {
+    warp_bound(d, rho, |r| twist_stretch(k, r))
+}
+
+/// The distance bound of a bent child (see [`warp_bound`]).
+#[must_use]
+pub fn bend_bound<T: Real>(d: T, k: T, rho: T) -> T {
+    warp_bound(d, rho, |r| bend_stretch(k, r))
+}

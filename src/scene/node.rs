@@ -266,9 +266,10 @@ pub enum Kind<S, V, C> {
         child: C,
     },
     /// Twists the child around the y axis by `rate` radians per unit of y.
-    /// The twist stretches space by a local Lipschitz factor
-    /// `L = t/2 + sqrt(1 + t^2/4)`, `t = |rate| (rho + |d|)` (rho: distance
-    /// from the y axis); the distance is divided by it, so it stays a bound.
+    /// The twist stretches space by up to `L(rho) = t/2 + sqrt(1 + t^2/4)`,
+    /// `t = |rate| rho`, at distance `rho` from the y axis; the child's
+    /// distance `d` is divided by `L(rho + |d| / L(rho))`, the largest
+    /// stretch within reach, so the result stays a bound.
     Twist {
         /// Radians of twist per unit along y.
         rate: S,
@@ -276,8 +277,8 @@ pub enum Kind<S, V, C> {
         child: C,
     },
     /// Bends the child in the xy plane by `rate` radians per unit of x.
-    /// Local Lipschitz factor `1 + |rate| (rho + |d|)` (rho: length of
-    /// `p.xy`); the distance is divided by it, so it stays a bound.
+    /// Local stretch `L(rho) = 1 + |rate| rho` (rho: length of `p.xy`); the
+    /// distance is divided by `L(rho + |d| / L(rho))`, so it stays a bound.
     Bend {
         /// Radians of bend per unit along x.
         rate: S,

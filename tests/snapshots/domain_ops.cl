@@ -53,6 +53,28 @@ real3 rotate_axis(real3 p, real3 k, real angle) {
     return p * c + cross(k, p) * s + k * (dot(k, p) * (R(1.0) - c));
 }
 
+/* ---- warp ---- */
+/* Distance bounds for warped children (twist, bend): with the warp's local
+   stretch L(rho), d / L(rho + |d| / L(rho)) never overestimates. */
+real twist_stretch(real k, real rho) {
+    real a = R(0.5) * fabs(k) * rho;
+    return a + sqrt(R(1.0) + a * a);
+}
+
+real bend_stretch(real k, real rho) {
+    return R(1.0) + fabs(k) * rho;
+}
+
+real twist_bound(real d, real k, real rho) {
+    real reach = fabs(d) / twist_stretch(k, rho);
+    return d / twist_stretch(k, rho + reach);
+}
+
+real bend_bound(real d, real k, real rho) {
+    real reach = fabs(d) / bend_stretch(k, rho);
+    return d / bend_stretch(k, rho + reach);
+}
+
 /* ---- scene ---- */
 real DE(real3 p0, __global const real* params) {
     real3 p1 = p0 - (real3)((-1.5f), 0.0f, 0.0f);
@@ -60,14 +82,13 @@ real DE(real3 p0, __global const real* params) {
     real k1 = cos(2.0f * p1.y);
     real3 p2 = (real3)(k1 * p1.x - s1 * p1.z, p1.y, s1 * p1.x + k1 * p1.z);
     real d0 = sd_box(p2, (real3)(0.25f, 0.6f, 0.25f));
-    real h1 = R(0.5) * fabs(2.0f) * (hypot(p1.x, p1.z) + fabs(d0));
-    real d1 = d0 / (h1 + sqrt(R(1.0) + h1 * h1));
+    real d1 = twist_bound(d0, 2.0f, hypot(p1.x, p1.z));
     real3 p3 = p0 - (real3)((-0.4f), 0.0f, 0.0f);
     real s5 = sin(0.8f * p3.x);
     real k5 = cos(0.8f * p3.x);
     real3 p4 = (real3)(k5 * p3.x - s5 * p3.y, s5 * p3.x + k5 * p3.y, p3.z);
     real d4 = sd_box(p4, (real3)(0.6f, 0.1f, 0.2f));
-    real d5 = d4 / (R(1.0) + fabs(0.8f) * (hypot(p3.x, p3.y) + fabs(d4)));
+    real d5 = bend_bound(d4, 0.8f, hypot(p3.x, p3.y));
     real x8 = d1;
     real y8 = d5;
     real d8 = fmin(x8, y8);
@@ -116,8 +137,7 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     real d0 = sd_box(p2, (real3)(0.25f, 0.6f, 0.25f));
     real3 c0 = DEFAULT_COLOR;
     real t0 = R(1.0);
-    real h1 = R(0.5) * fabs(2.0f) * (hypot(p1.x, p1.z) + fabs(d0));
-    real d1 = d0 / (h1 + sqrt(R(1.0) + h1 * h1));
+    real d1 = twist_bound(d0, 2.0f, hypot(p1.x, p1.z));
     real3 c2 = (real3)(0.9f, 0.4f, 0.4f);
     real3 p3 = p0 - (real3)((-0.4f), 0.0f, 0.0f);
     real s5 = sin(0.8f * p3.x);
@@ -126,7 +146,7 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     real d4 = sd_box(p4, (real3)(0.6f, 0.1f, 0.2f));
     real3 c4 = DEFAULT_COLOR;
     real t4 = R(1.0);
-    real d5 = d4 / (R(1.0) + fabs(0.8f) * (hypot(p3.x, p3.y) + fabs(d4)));
+    real d5 = bend_bound(d4, 0.8f, hypot(p3.x, p3.y));
     real3 c6 = (real3)(0.4f, 0.9f, 0.5f);
     real x8 = d1;
     real y8 = d5;

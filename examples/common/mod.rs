@@ -1,0 +1,79 @@
+//! Shared by the examples: render one gallery scene to `out/NAME.png` and
+//! print what it cost.
+#![allow(dead_code)] // each example uses a different subset
+
+use std::time::Instant;
+
+use fractal_sdf::prelude::*;
+use fractal_sdf::render::{RenderOptions, Renderer};
+
+/// Runs an example's body, printing an error (with its message, not its
+/// debug form) and exiting with status 1 if it fails.
+pub fn run(body: impl FnOnce() -> Result<()>) -> std::process::ExitCode {
+    match body() {
+        Ok(()) => std::process::ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("error: {e}");
+            std::process::ExitCode::FAILURE
+        }
+    }
+}
+
+/// Image size from `--size WxH` on the command line, or `default`.
+pub fn size_arg(default: (u32, u32)) -> (u32, u32) {
+    let args: Vec<String> = std::env::args().collect();
+    args.iter()
+        .position(|a| a == "--size")
+        .and_then(|i| args.get(i + 1))
+        .and_then(|s| s.split_once('x'))
+        .and_then(|(w, h)| Some((w.parse().ok()?, h.parse().ok()?)))
+        .unwrap_or(default)
+}
+
+/// Renders `scene` at `size` with `options` to `out/NAME.png`, printing the
+/// device, build and render times.
+pub fn render_to_png(
+    name: &str,
+    scene: &Scene,
+    options: &RenderOptions,
+    size: (u32, u32),
+) -> Result<()> {
+    let start = Instant::now();
+    let mut renderer = Renderer::with_options(scene, options)?;
+    let build = renderer.build_info().clone();
+    let t = Instant::now();
+    let image = renderer.render(size.0, size.1)?;
+    let render_time = t.elapsed();
+    let path = format!("out/{name}.png");
+    fractal_sdf::output::save_png(&image, &path)?;
+    println!(
+        "{name:<12} {}x{} on {}: build {:.0} ms{}, render {:.0} ms, total {:.0} ms -> {path}",
+        size.0,
+        size.1,
+        renderer.device().name,
+        build.build_time.as_secs_f64() * 1e3,
+        if build.cached { " (cached)" } else { "" },
+        render_time.as_secs_f64() * 1e3,
+        start.elapsed().as_secs_f64() * 1e3,
+    );
+    Ok(())
+}
+
+/// The options the gallery renders with: production quality with 2×2
+/// supersampling and a soft glow.
+pub fn gallery_options() -> RenderOptions {
+    RenderOptions {
+        quality: Quality {
+            supersampling: 2,
+            ..Quality::production()
+        },
+        effects: Effects {
+            glow: Some(Glow {
+                color: dvec3(0.6, 0.75, 1.0),
+                strength: 0.6,
+            }),
+            ..Effects::default()
+        },
+        ..RenderOptions::default()
+    }
+}
