@@ -77,6 +77,7 @@ pub mod render;
 pub mod scene;
 #[cfg(feature = "proptest")]
 pub mod testing;
+pub mod timing;
 
 pub use error::{Error, Result};
 pub use scene::{Node, Scene};

@@ -62,3 +62,5 @@ pub use points::{PointEvaluator, PointSample};
 pub use program::{BuildInfo, ProgramSource, program_builds};
 pub use renderer::{RenderOptions, Renderer};
 pub use viewport::Viewport;
+
+pub use crate::timing::FrameTiming;

@@ -1,8 +1,11 @@
 //! The renderer: one scene's program on one device, and the buffers that
 //! carry the per-frame inputs (parameters, camera, lights) and outputs.
 
+use std::time::{Duration, Instant};
+
 use image::RgbaImage;
-use ocl::{Buffer, Context, Kernel, MemFlags, Program, Queue};
+use ocl::enums::ProfilingInfo;
+use ocl::{Buffer, Context, Event, Kernel, MemFlags, Program, Queue};
 
 use super::aov::Frame;
 use super::buffer::RealBuffer;
@@ -15,6 +18,7 @@ use crate::error::{Error, Result};
 use crate::ir::{Ir, ParamValues};
 use crate::quality::{Effects, Precision, Quality};
 use crate::scene::{Camera, Light, Scene};
+use crate::timing::FrameTiming;
 
 /// Everything that decides how a scene is rendered, apart from the scene.
 #[derive(Debug, Clone, PartialEq)]
@@ -99,6 +103,7 @@ pub struct Renderer {
     local: (usize, usize),
     inputs: Inputs,
     targets: Targets,
+    timing: Option<FrameTiming>,
 }
 
 /// Generates the program for a scene. This is the one place that turns a
@@ -159,7 +164,7 @@ impl Renderer {
         let values = Ir::lower(geometry)?.default_values();
         let selected = device::select(&options.device)?;
         let context = program::context(&selected)?;
-        let queue = Queue::new(&context, selected.device, None).map_err(opencl)?;
+        let queue = profiling_queue(&context, &selected)?;
         let inputs = Inputs::new(&queue, source.precision, &values, &scene.lights)?;
         let targets = Targets::new(&queue, 1, 1, true)?;
         let (program, build, compiled) = program::build(&selected, &context, &source)?;
@@ -179,6 +184,7 @@ impl Renderer {
             local,
             inputs,
             targets,
+            timing: None,
         })
     }
 
@@ -189,9 +195,12 @@ impl Renderer {
     /// whose buffers cannot be allocated; [`Error::OpenCl`] if the device
     /// fails.
     pub fn render(&mut self, width: u32, height: u32) -> Result<RgbaImage> {
-        self.run(width, height, false)?;
+        let start = Instant::now();
+        let kernel = self.run(width, height, false)?;
+        let read = Instant::now();
         let mut rgba = host_vec::<u8>(width, height, 4)?;
         self.targets.rgba.read(&mut rgba).enq().map_err(opencl)?;
+        self.record_timing(start, read, kernel);
         Ok(RgbaImage::from_raw(width, height, rgba).expect("buffer has width * height * 4 bytes"))
     }
 
@@ -201,7 +210,9 @@ impl Renderer {
     /// # Errors
     /// As [`Renderer::render`].
     pub fn render_with_aovs(&mut self, width: u32, height: u32) -> Result<Frame> {
-        self.run(width, height, true)?;
+        let start = Instant::now();
+        let kernel = self.run(width, height, true)?;
+        let read = Instant::now();
         let t = &self.targets;
         let mut rgba = host_vec::<u8>(width, height, 4)?;
         let mut depth = host_vec::<f32>(width, height, 1)?;
@@ -213,6 +224,7 @@ impl Renderer {
         t.hit.read(&mut hit).enq().map_err(opencl)?;
         t.normals.read(&mut normals).enq().map_err(opencl)?;
         t.steps.read(&mut steps).enq().map_err(opencl)?;
+        self.record_timing(start, read, kernel);
         Ok(Frame {
             image: RgbaImage::from_raw(width, height, rgba)
                 .expect("buffer has width * height * 4 bytes"),
@@ -224,6 +236,25 @@ impl Renderer {
                 .collect(),
             steps,
         })
+    }
+
+    /// What the last frame cost: kernel time (from OpenCL profiling
+    /// events), readback and the whole call. `None` before the first frame
+    /// and after a failed one.
+    ///
+    /// ```no_run
+    /// use fractal_sdf::prelude::*;
+    /// use fractal_sdf::render::Renderer;
+    ///
+    /// let mut renderer = Renderer::new(&Scene::new(sphere(1.0)), Quality::preview())?;
+    /// renderer.render(320, 240)?;
+    /// let t = renderer.last_timing().expect("a frame was rendered");
+    /// println!("kernel {:?}, readback {:?}, total {:?}", t.kernel, t.readback, t.total);
+    /// # Ok::<(), fractal_sdf::Error>(())
+    /// ```
+    #[must_use]
+    pub fn last_timing(&self) -> Option<FrameTiming> {
+        self.timing
     }
 
     /// Sets a dynamic parameter for the next frames (no recompilation).
@@ -375,8 +406,20 @@ impl Renderer {
         Ok(())
     }
 
-    /// Uploads the frame's inputs and launches every tile.
-    fn run(&mut self, width: u32, height: u32, aovs: bool) -> Result<()> {
+    fn record_timing(&mut self, start: Instant, read: Instant, kernel: (Duration, bool)) {
+        let end = Instant::now();
+        self.timing = Some(FrameTiming {
+            kernel: kernel.0,
+            readback: end - read,
+            total: end - start,
+            profiled: kernel.1,
+        });
+    }
+
+    /// Uploads the frame's inputs, launches every tile and waits for them.
+    /// Returns the kernel time and whether it comes from profiling events.
+    fn run(&mut self, width: u32, height: u32, aovs: bool) -> Result<(Duration, bool)> {
+        self.timing = None;
         check_size(width, height)?;
         let view = self.viewport(width, height)?;
         if !self.targets.fits(width, height, aovs) {
@@ -407,6 +450,8 @@ impl Renderer {
         k.set_arg(arg::HIT, &t.hit).map_err(opencl)?;
         k.set_arg(arg::NORMALS, &t.normals).map_err(opencl)?;
         k.set_arg(arg::STEPS, &t.steps).map_err(opencl)?;
+        let launched = Instant::now();
+        let mut events = Vec::new();
         for tile in dispatch::tiles(width, height, self.options.tile_size) {
             #[allow(clippy::cast_possible_wrap)]
             {
@@ -418,16 +463,47 @@ impl Renderer {
             let global = dispatch::global_size(tile, self.local);
             // SAFETY: every buffer argument is alive in `self`, and the
             // kernel bounds-checks every work item against the tile.
+            let mut event = Event::empty();
             unsafe {
                 k.cmd()
                     .global_work_size(global)
                     .local_work_size(self.local)
+                    .enew(&mut event)
                     .enq()
                     .map_err(opencl)?;
             }
+            events.push(event);
         }
-        self.queue.finish().map_err(opencl)
+        self.queue.finish().map_err(opencl)?;
+        Ok(match profiled_time(&events) {
+            Some(kernel) => (kernel, true),
+            None => (launched.elapsed(), false),
+        })
     }
+}
+
+/// An in-order queue with profiling enabled, or a plain one on a device
+/// that refuses profiling.
+fn profiling_queue(context: &Context, selected: &Selected) -> Result<Queue> {
+    Queue::new(
+        context,
+        selected.device,
+        Some(ocl::flags::QUEUE_PROFILING_ENABLE),
+    )
+    .or_else(|_| Queue::new(context, selected.device, None))
+    .map_err(opencl)
+}
+
+/// The summed run time of finished kernel launches, from their profiling
+/// events; `None` if any event has no profiling information.
+fn profiled_time(events: &[Event]) -> Option<Duration> {
+    let mut total = 0u64;
+    for event in events {
+        let at = |what| event.profiling_info(what).ok()?.time().ok();
+        let (start, end) = (at(ProfilingInfo::Start)?, at(ProfilingInfo::End)?);
+        total += end.checked_sub(start)?;
+    }
+    Some(Duration::from_nanos(total))
 }
 
 /// A clear error, before anything is allocated, for an image whose output
