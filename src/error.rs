@@ -63,6 +63,15 @@ pub enum Error {
         /// What is wrong.
         reason: String,
     },
+    /// Text given to a parser (a key script, a frame range, a size) does
+    /// not say what it should.
+    #[error("invalid {what}: {reason}")]
+    Invalid {
+        /// What was being read, such as `"key script"`.
+        what: &'static str,
+        /// What is wrong with it.
+        reason: String,
+    },
     /// The scene has no geometry.
     #[error("the scene is empty: add geometry with `Scene::new(node)` or `Scene::add`")]
     EmptyScene,

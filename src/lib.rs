@@ -65,6 +65,7 @@
 
 pub mod animation;
 pub mod codegen;
+pub mod control;
 pub mod cpu;
 pub mod error;
 pub mod gallery;
@@ -86,7 +87,7 @@ pub use scene::{Node, Scene};
 pub mod prelude {
     pub use crate::cpu;
     pub use crate::error::{Error, Result};
-    pub use crate::quality::{Effects, Glow, Precision, Quality};
+    pub use crate::quality::{Effects, Glow, Precision, Preset, Quality};
     pub use crate::scene::{
         Axis, Camera, Light, Mandelbulb, Menger, Node, Param, Param3, Projection, QuaternionJulia,
         Scene, Sierpinski, capped_cone, capsule, cuboid, cylinder, ellipsoid, julia, mandelbulb,

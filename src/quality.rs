@@ -283,3 +283,64 @@ impl Effects {
         Ok(())
     }
 }
+
+/// The named quality presets, in increasing cost.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
+pub enum Preset {
+    /// [`Quality::draft`].
+    Draft,
+    /// [`Quality::preview`].
+    #[default]
+    Preview,
+    /// [`Quality::production`].
+    Production,
+    /// [`Quality::reference`].
+    Reference,
+}
+
+impl Preset {
+    /// Every preset, cheapest first.
+    pub const ALL: [Preset; 4] = [
+        Preset::Draft,
+        Preset::Preview,
+        Preset::Production,
+        Preset::Reference,
+    ];
+
+    /// The preset's settings.
+    #[must_use]
+    pub fn quality(self) -> Quality {
+        match self {
+            Preset::Draft => Quality::draft(),
+            Preset::Preview => Quality::preview(),
+            Preset::Production => Quality::production(),
+            Preset::Reference => Quality::reference(),
+        }
+    }
+
+    /// The lower-case name: `draft`, `preview`, `production`, `reference`.
+    #[must_use]
+    pub fn name(self) -> &'static str {
+        match self {
+            Preset::Draft => "draft",
+            Preset::Preview => "preview",
+            Preset::Production => "production",
+            Preset::Reference => "reference",
+        }
+    }
+
+    /// The preset called `name` (case-insensitive).
+    ///
+    /// ```
+    /// use fractal_sdf::quality::{Preset, Quality};
+    /// assert_eq!(Preset::from_name("Draft"), Some(Preset::Draft));
+    /// assert_eq!(Preset::from_name("draft").unwrap().quality(), Quality::draft());
+    /// assert_eq!(Preset::from_name("ultra"), None);
+    /// ```
+    #[must_use]
+    pub fn from_name(name: &str) -> Option<Preset> {
+        Self::ALL
+            .into_iter()
+            .find(|p| p.name().eq_ignore_ascii_case(name.trim()))
+    }
+}

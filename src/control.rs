@@ -1,0 +1,585 @@
+//! Interactive control, without a window: a fly-through camera
+//! ([`FlyCamera`]), the keys that move it ([`Movement`]), the keys that
+//! change what is drawn ([`Action`], [`ViewSettings`]) and scripted key
+//! presses for unattended runs ([`KeyScript`]).
+//!
+//! A window toolkit only has to translate its events into key names (`"w"`,
+//! `"g"`, `"3"`, `"f12"`, ...) and mouse deltas; everything else is here and
+//! tested.
+//!
+//! ```
+//! use fractal_sdf::control::{Action, FlyCamera, Movement};
+//! use fractal_sdf::prelude::*;
+//!
+//! let start = Camera::look_at(dvec3(0.0, 0.0, 5.0), DVec3::ZERO);
+//! let mut fly = FlyCamera::from_camera(&start);
+//! let mut keys = Movement::default();
+//! assert!(keys.set("w", true));
+//! fly.speed = 2.0;
+//! fly.advance(keys, 0.5); // one unit towards the target
+//! let camera = fly.camera(&start);
+//! assert!((camera.position.z - 4.0).abs() < 1e-9);
+//! assert_eq!(Action::for_key("g"), Some(Action::ToggleGlow));
+//! ```
+
+use std::f64::consts::{FRAC_PI_2, TAU};
+
+use glam::{DVec3, dvec3};
+
+use crate::error::{Error, Result};
+use crate::quality::{Effects, Glow, Preset, Quality};
+use crate::scene::Camera;
+
+/// A first-person camera: a position, a heading (`yaw`) and an elevation
+/// (`pitch`), moved by keys at `speed` units per second and turned by mouse
+/// motion at `sensitivity` radians per pixel.
+///
+/// Yaw 0 looks down −z; positive yaw turns right. Pitch is kept inside
+/// ±[`FlyCamera::MAX_PITCH`] so the view never flips over the pole.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct FlyCamera {
+    /// Where the camera is.
+    pub position: DVec3,
+    /// Heading in radians, in `[0, 2π)`.
+    pub yaw: f64,
+    /// Elevation in radians; positive looks up.
+    pub pitch: f64,
+    /// Movement speed in scene units per second.
+    pub speed: f64,
+    /// Radians turned per pixel of mouse motion.
+    pub sensitivity: f64,
+}
+
+impl FlyCamera {
+    /// The steepest pitch, just short of straight up or down (89°).
+    pub const MAX_PITCH: f64 = FRAC_PI_2 * (89.0 / 90.0);
+    /// The slowest speed [`FlyCamera::change_speed`] allows.
+    pub const MIN_SPEED: f64 = 1e-4;
+    /// The fastest speed [`FlyCamera::change_speed`] allows.
+    pub const MAX_SPEED: f64 = 1e4;
+    /// The default mouse sensitivity: 0.004 radians per pixel.
+    pub const DEFAULT_SENSITIVITY: f64 = 0.004;
+
+    /// A camera at `position` looking along `direction` (any non-zero
+    /// vector), moving at 1 unit per second.
+    #[must_use]
+    pub fn new(position: DVec3, direction: DVec3) -> Self {
+        let d = direction.try_normalize().unwrap_or(DVec3::NEG_Z);
+        let pitch = d.y.clamp(-1.0, 1.0).asin();
+        let yaw = d.x.atan2(-d.z).rem_euclid(TAU);
+        FlyCamera {
+            position,
+            yaw,
+            pitch: pitch.clamp(-Self::MAX_PITCH, Self::MAX_PITCH),
+            speed: 1.0,
+            sensitivity: Self::DEFAULT_SENSITIVITY,
+        }
+    }
+
+    /// Takes over a scene camera's position and view direction; the speed
+    /// crosses the distance to its target in about three seconds.
+    #[must_use]
+    pub fn from_camera(camera: &Camera) -> Self {
+        let to_target = camera.target - camera.position;
+        FlyCamera {
+            speed: (to_target.length() / 3.0).clamp(Self::MIN_SPEED, Self::MAX_SPEED),
+            ..Self::new(camera.position, to_target)
+        }
+    }
+
+    /// The unit view direction.
+    #[must_use]
+    pub fn forward(&self) -> DVec3 {
+        let (sy, cy) = self.yaw.sin_cos();
+        let (sp, cp) = self.pitch.sin_cos();
+        dvec3(cp * sy, sp, -cp * cy)
+    }
+
+    /// The unit direction to the right of the view, level with the ground.
+    #[must_use]
+    pub fn right(&self) -> DVec3 {
+        let (sy, cy) = self.yaw.sin_cos();
+        dvec3(cy, 0.0, sy)
+    }
+
+    /// Turns by a mouse motion of `dx`, `dy` pixels (right and down are
+    /// positive, as window systems report them).
+    pub fn look(&mut self, dx: f64, dy: f64) {
+        if !(dx.is_finite() && dy.is_finite()) {
+            return;
+        }
+        self.yaw = (self.yaw + dx * self.sensitivity).rem_euclid(TAU);
+        self.pitch = (self.pitch - dy * self.sensitivity).clamp(-Self::MAX_PITCH, Self::MAX_PITCH);
+    }
+
+    /// Multiplies the speed by 1.25 per step (negative steps slow down),
+    /// within [`FlyCamera::MIN_SPEED`]..=[`FlyCamera::MAX_SPEED`].
+    pub fn change_speed(&mut self, steps: f64) {
+        if steps.is_finite() {
+            self.speed = (self.speed * 1.25f64.powf(steps)).clamp(Self::MIN_SPEED, Self::MAX_SPEED);
+        }
+    }
+
+    /// Moves for `dt` seconds with the keys held in `keys`; returns whether
+    /// the camera moved. Diagonal movement is as fast as straight movement.
+    pub fn advance(&mut self, keys: Movement, dt: f64) -> bool {
+        let [right, up, forward] = keys.axes();
+        let step = self.right() * right + DVec3::Y * up + self.forward() * forward;
+        let Some(direction) = step.try_normalize() else {
+            return false;
+        };
+        if !(dt.is_finite() && dt > 0.0) {
+            return false;
+        }
+        self.position += direction * self.speed * dt;
+        true
+    }
+
+    /// `base` (for its projection) moved to this camera's position and
+    /// view, with y up.
+    #[must_use]
+    pub fn camera(&self, base: &Camera) -> Camera {
+        Camera {
+            position: self.position,
+            target: self.position + self.forward(),
+            up: DVec3::Y,
+            ..*base
+        }
+    }
+}
+
+/// Which movement keys are held: W/S (or the up and down arrows) forward
+/// and back, A/D (or the left and right arrows) left and right, E/Q up and
+/// down.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct Movement {
+    /// W or the up arrow.
+    pub forward: bool,
+    /// S or the down arrow.
+    pub back: bool,
+    /// A or the left arrow.
+    pub left: bool,
+    /// D or the right arrow.
+    pub right: bool,
+    /// E.
+    pub up: bool,
+    /// Q.
+    pub down: bool,
+}
+
+impl Movement {
+    /// Records a press (`pressed`) or release of the key `name`; returns
+    /// whether it is a movement key.
+    pub fn set(&mut self, name: &str, pressed: bool) -> bool {
+        let held = match name {
+            "w" | "arrowup" => &mut self.forward,
+            "s" | "arrowdown" => &mut self.back,
+            "a" | "arrowleft" => &mut self.left,
+            "d" | "arrowright" => &mut self.right,
+            "e" => &mut self.up,
+            "q" => &mut self.down,
+            _ => return false,
+        };
+        *held = pressed;
+        true
+    }
+
+    /// `[right, up, forward]`, each −1, 0 or 1 (opposite keys cancel).
+    #[must_use]
+    pub fn axes(&self) -> [f64; 3] {
+        let axis = |plus: bool, minus: bool| f64::from(i8::from(plus) - i8::from(minus));
+        [
+            axis(self.right, self.left),
+            axis(self.up, self.down),
+            axis(self.forward, self.back),
+        ]
+    }
+
+    /// Whether the held keys move the camera.
+    #[must_use]
+    pub fn is_moving(&self) -> bool {
+        self.axes() != [0.0; 3]
+    }
+}
+
+/// What a key press asks for, other than movement.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Action {
+    /// `o`: ambient occlusion on or off.
+    ToggleAmbientOcclusion,
+    /// `h`: shadows on or off.
+    ToggleShadows,
+    /// `g`: glow on or off.
+    ToggleGlow,
+    /// `1`–`4`: draft, preview, production, reference quality.
+    Quality(Preset),
+    /// `space`: pause or resume the animated parameters.
+    ToggleAnimation,
+    /// `r`: back to the scene's own camera.
+    ResetCamera,
+    /// `f12`: save a screenshot.
+    Screenshot,
+    /// `escape`: quit.
+    Quit,
+}
+
+impl Action {
+    /// Every action key and what it does, for help texts.
+    pub const KEYS: [(&'static str, &'static str); 8] = [
+        ("o", "toggle ambient occlusion"),
+        ("h", "toggle shadows"),
+        ("g", "toggle glow"),
+        ("1-4", "quality: draft, preview, production, reference"),
+        ("space", "pause or resume the animation"),
+        ("r", "reset the camera"),
+        ("f12", "save a screenshot"),
+        ("escape", "quit"),
+    ];
+
+    /// The action of the key `name` (lower case, as in [`Action::KEYS`]).
+    #[must_use]
+    pub fn for_key(name: &str) -> Option<Action> {
+        Some(match name {
+            "o" => Action::ToggleAmbientOcclusion,
+            "h" => Action::ToggleShadows,
+            "g" => Action::ToggleGlow,
+            "1" => Action::Quality(Preset::Draft),
+            "2" => Action::Quality(Preset::Preview),
+            "3" => Action::Quality(Preset::Production),
+            "4" => Action::Quality(Preset::Reference),
+            "space" => Action::ToggleAnimation,
+            "r" => Action::ResetCamera,
+            "f12" => Action::Screenshot,
+            "escape" => Action::Quit,
+            _ => return None,
+        })
+    }
+}
+
+/// The quality preset and effect switches of an interactive view.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ViewSettings {
+    /// The quality preset.
+    pub preset: Preset,
+    /// Ambient occlusion on (the draft preset has no AO samples, so it
+    /// shows none either way).
+    pub ambient_occlusion: bool,
+    /// Shadows on (none in the draft preset).
+    pub shadows: bool,
+    /// Glow on.
+    pub glow: bool,
+    /// The glow used when it is on.
+    pub glow_style: Glow,
+    /// Everything else about the effects (background, fog, gamma).
+    pub base: Effects,
+}
+
+impl Default for ViewSettings {
+    /// Preview quality, AO and shadows on, a soft blue glow off.
+    fn default() -> Self {
+        ViewSettings {
+            preset: Preset::Preview,
+            ambient_occlusion: true,
+            shadows: true,
+            glow: false,
+            glow_style: Glow {
+                color: dvec3(0.6, 0.75, 1.0),
+                strength: 0.8,
+            },
+            base: Effects::default(),
+        }
+    }
+}
+
+impl ViewSettings {
+    /// The quality to render with.
+    #[must_use]
+    pub fn quality(&self) -> Quality {
+        self.preset.quality()
+    }
+
+    /// The effects to render with.
+    #[must_use]
+    pub fn effects(&self) -> Effects {
+        Effects {
+            ambient_occlusion: self.ambient_occlusion,
+            shadows: self.shadows,
+            glow: self.glow.then_some(self.glow_style),
+            ..self.base
+        }
+    }
+
+    /// Applies an action; returns whether the quality or effects changed
+    /// (which means a new program).
+    pub fn apply(&mut self, action: Action) -> bool {
+        let before = *self;
+        match action {
+            Action::ToggleAmbientOcclusion => self.ambient_occlusion ^= true,
+            Action::ToggleShadows => self.shadows ^= true,
+            Action::ToggleGlow => self.glow ^= true,
+            Action::Quality(p) => self.preset = p,
+            _ => {}
+        }
+        *self != before
+    }
+
+    /// A short description, such as `preview, AO, shadows, glow`.
+    #[must_use]
+    pub fn summary(&self) -> String {
+        let mut parts = vec![self.preset.name()];
+        for (on, name) in [
+            (self.ambient_occlusion, "AO"),
+            (self.shadows, "shadows"),
+            (self.glow, "glow"),
+        ] {
+            if on {
+                parts.push(name);
+            }
+        }
+        parts.join(", ")
+    }
+}
+
+/// Key presses scheduled by frame number, for unattended runs: `"g,3"`
+/// presses `g` before frame 1 and `3` before frame 2; `"g@5,3@5"` presses
+/// both before frame 5. A key without `@FRAME` comes one frame after the
+/// previous key (the first at frame 1, so frame 0 shows the start).
+///
+/// ```
+/// use fractal_sdf::control::{Action, KeyScript};
+/// let script = KeyScript::parse("g, 3@4, o")?;
+/// assert_eq!(script.keys_at(1).collect::<Vec<_>>(), [Action::ToggleGlow]);
+/// assert_eq!(script.keys_at(4).count(), 1);
+/// assert_eq!(script.last_frame(), Some(5));
+/// assert!(KeyScript::parse("z").is_err());
+/// # Ok::<(), fractal_sdf::Error>(())
+/// ```
+#[derive(Debug, Clone, PartialEq, Eq, Default)]
+pub struct KeyScript {
+    presses: Vec<(u64, Action)>,
+}
+
+impl KeyScript {
+    /// Parses a comma-separated list of `KEY` or `KEY@FRAME` (keys as in
+    /// [`Action::KEYS`]; spaces around items are ignored).
+    ///
+    /// # Errors
+    /// [`Error::Invalid`] naming an unknown key or a bad frame number.
+    pub fn parse(text: &str) -> Result<Self> {
+        let bad = |reason: String| Error::Invalid {
+            what: "key script",
+            reason,
+        };
+        let mut presses = Vec::new();
+        let mut next = 1u64;
+        for item in text.split(',').map(str::trim).filter(|s| !s.is_empty()) {
+            let (key, frame) = match item.split_once('@') {
+                Some((key, frame)) => {
+                    let frame = frame
+                        .trim()
+                        .parse::<u64>()
+                        .map_err(|_| bad(format!("`{item}`: the frame must be a whole number")))?;
+                    (key.trim(), frame)
+                }
+                None => (item, next),
+            };
+            let key = key.to_ascii_lowercase();
+            let action = Action::for_key(&key).ok_or_else(|| {
+                let known: Vec<&str> = Action::KEYS.iter().map(|(k, _)| *k).collect();
+                bad(format!("unknown key `{key}` (keys: {})", known.join(", ")))
+            })?;
+            presses.push((frame, action));
+            next = frame + 1;
+        }
+        presses.sort_by_key(|&(frame, _)| frame);
+        Ok(KeyScript { presses })
+    }
+
+    /// The actions pressed before frame `frame`, in script order.
+    pub fn keys_at(&self, frame: u64) -> impl Iterator<Item = Action> + '_ {
+        self.presses
+            .iter()
+            .filter(move |(f, _)| *f == frame)
+            .map(|&(_, a)| a)
+    }
+
+    /// The frame of the last press, if any.
+    #[must_use]
+    pub fn last_frame(&self) -> Option<u64> {
+        self.presses.last().map(|&(f, _)| f)
+    }
+
+    /// Whether the script presses nothing.
+    #[must_use]
+    pub fn is_empty(&self) -> bool {
+        self.presses.is_empty()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use approx::assert_relative_eq;
+
+    fn close(a: DVec3, b: DVec3) {
+        assert!(a.abs_diff_eq(b, 1e-12), "{a} != {b}");
+    }
+
+    fn held(keys: &[&str]) -> Movement {
+        let mut m = Movement::default();
+        for k in keys {
+            assert!(m.set(k, true), "{k} is a movement key");
+        }
+        m
+    }
+
+    #[test]
+    fn direction_round_trips_through_yaw_and_pitch() {
+        for d in [
+            dvec3(0.0, 0.0, -1.0),
+            dvec3(1.0, 0.0, 0.0),
+            dvec3(-2.0, 1.0, 3.0),
+            dvec3(0.3, -0.8, -0.1),
+        ] {
+            let fly = FlyCamera::new(DVec3::ZERO, d);
+            close(fly.forward(), d.normalize());
+            assert!(fly.right().dot(fly.forward()).abs() < 1e-12);
+            assert_relative_eq!(fly.right().length(), 1.0, epsilon = 1e-12);
+        }
+        // Straight up is clamped just short of the pole.
+        let up = FlyCamera::new(DVec3::ZERO, DVec3::Y);
+        assert_relative_eq!(up.pitch, FlyCamera::MAX_PITCH);
+        // A zero direction falls back to -z.
+        close(
+            FlyCamera::new(DVec3::ZERO, DVec3::ZERO).forward(),
+            DVec3::NEG_Z,
+        );
+    }
+
+    #[test]
+    fn wasd_moves_relative_to_the_view_at_speed() {
+        // Looking down +x: forward is +x, right is +z.
+        let mut fly = FlyCamera::new(DVec3::ZERO, DVec3::X);
+        fly.speed = 4.0;
+        assert!(fly.advance(held(&["w"]), 0.5));
+        close(fly.position, dvec3(2.0, 0.0, 0.0));
+        fly.advance(held(&["d"]), 0.25);
+        close(fly.position, dvec3(2.0, 0.0, 1.0));
+        fly.advance(held(&["e"]), 0.25);
+        assert_relative_eq!(fly.position.y, 1.0, epsilon = 1e-12);
+        fly.advance(held(&["q", "s"]), 0.25);
+        let diagonal = dvec3(-1.0, -1.0, 0.0).normalize();
+        close(fly.position, dvec3(2.0, 1.0, 1.0) + diagonal);
+        // Opposite keys cancel; nothing held or no time moves nothing.
+        let before = fly.position;
+        assert!(!fly.advance(held(&["a", "d"]), 1.0));
+        assert!(!fly.advance(Movement::default(), 1.0));
+        assert!(!fly.advance(held(&["w"]), 0.0));
+        assert!(!fly.advance(held(&["w"]), f64::NAN));
+        assert_eq!(fly.position, before);
+    }
+
+    #[test]
+    fn releasing_a_key_stops_it() {
+        let mut m = held(&["w", "arrowleft"]);
+        assert_eq!(m.axes(), [-1.0, 0.0, 1.0]);
+        m.set("w", false);
+        m.set("arrowleft", false);
+        assert!(!m.is_moving());
+        assert!(!m.set("g", true), "g is not a movement key");
+    }
+
+    #[test]
+    fn mouse_turns_and_pitch_is_clamped() {
+        let mut fly = FlyCamera::new(DVec3::ZERO, DVec3::NEG_Z);
+        fly.sensitivity = 0.01;
+        fly.look(50.0, 0.0); // right by 0.5 rad
+        assert_relative_eq!(fly.yaw, 0.5, epsilon = 1e-12);
+        assert!(fly.forward().x > 0.0, "turned right");
+        fly.look(0.0, -10.0); // mouse up: look up 0.1 rad
+        assert_relative_eq!(fly.pitch, 0.1, epsilon = 1e-12);
+        fly.look(0.0, -1e6);
+        assert_relative_eq!(fly.pitch, FlyCamera::MAX_PITCH);
+        fly.look(-1e3, 1e6);
+        assert_relative_eq!(fly.pitch, -FlyCamera::MAX_PITCH);
+        assert!((0.0..TAU).contains(&fly.yaw));
+        let before = fly;
+        fly.look(f64::NAN, 1.0);
+        assert_eq!(fly, before);
+    }
+
+    #[test]
+    fn scrolling_scales_speed_within_bounds() {
+        let mut fly = FlyCamera::new(DVec3::ZERO, DVec3::X);
+        fly.change_speed(2.0);
+        assert_relative_eq!(fly.speed, 1.5625, epsilon = 1e-12);
+        fly.change_speed(-2.0);
+        assert_relative_eq!(fly.speed, 1.0, epsilon = 1e-12);
+        fly.change_speed(1e6);
+        assert_relative_eq!(fly.speed, FlyCamera::MAX_SPEED);
+        fly.change_speed(-1e6);
+        assert_relative_eq!(fly.speed, FlyCamera::MIN_SPEED);
+    }
+
+    #[test]
+    fn from_camera_keeps_the_view_and_projection() {
+        let base = Camera::look_at(dvec3(0.0, 3.0, 4.0), dvec3(0.0, 0.0, 0.0)).orthographic(2.0);
+        let fly = FlyCamera::from_camera(&base);
+        assert_relative_eq!(fly.speed, 5.0 / 3.0, epsilon = 1e-12);
+        let cam = fly.camera(&base);
+        assert_eq!(cam.position, base.position);
+        assert_eq!(cam.projection, base.projection);
+        let dir = (cam.target - cam.position).normalize();
+        close(dir, dvec3(0.0, -0.6, -0.8));
+        cam.validate().unwrap();
+    }
+
+    #[test]
+    fn actions_change_settings_and_report_it() {
+        let mut s = ViewSettings::default();
+        assert_eq!(s.summary(), "preview, AO, shadows");
+        assert!(s.effects().glow.is_none());
+        assert!(s.apply(Action::ToggleGlow));
+        assert_eq!(s.effects().glow, Some(s.glow_style));
+        assert!(s.apply(Action::ToggleAmbientOcclusion));
+        assert!(s.apply(Action::ToggleShadows));
+        assert!(!s.effects().ambient_occlusion && !s.effects().shadows);
+        assert!(s.apply(Action::Quality(Preset::Production)));
+        assert_eq!(s.quality(), Quality::production());
+        assert!(!s.apply(Action::Quality(Preset::Production)), "no change");
+        assert!(!s.apply(Action::Screenshot));
+        assert_eq!(s.summary(), "production, glow");
+        // Every listed key has an action, and only those do.
+        for (key, _) in Action::KEYS {
+            if key != "1-4" {
+                assert!(Action::for_key(key).is_some(), "{key}");
+            }
+        }
+        for (key, preset) in ["1", "2", "3", "4"].into_iter().zip(Preset::ALL) {
+            assert_eq!(Action::for_key(key), Some(Action::Quality(preset)));
+        }
+        assert_eq!(Action::for_key("w"), None);
+    }
+
+    #[test]
+    fn key_scripts_schedule_presses_by_frame() {
+        let s = KeyScript::parse("g,3").unwrap();
+        assert_eq!(s.keys_at(0).count(), 0);
+        assert_eq!(s.keys_at(1).collect::<Vec<_>>(), [Action::ToggleGlow]);
+        assert_eq!(
+            s.keys_at(2).collect::<Vec<_>>(),
+            [Action::Quality(Preset::Production)]
+        );
+        let s = KeyScript::parse(" G@7 , o@2, h ").unwrap();
+        assert_eq!(s.last_frame(), Some(7));
+        assert_eq!(s.keys_at(3).collect::<Vec<_>>(), [Action::ToggleShadows]);
+        assert_eq!(s.keys_at(7).collect::<Vec<_>>(), [Action::ToggleGlow]);
+        let both = KeyScript::parse("g@5,1@5").unwrap();
+        assert_eq!(both.keys_at(5).count(), 2);
+        assert!(KeyScript::parse("").unwrap().is_empty());
+        let err = KeyScript::parse("g,x").unwrap_err().to_string();
+        assert!(err.contains("unknown key `x`"), "{err}");
+        let err = KeyScript::parse("g@soon").unwrap_err().to_string();
+        assert!(err.contains("`g@soon`"), "{err}");
+    }
+}
