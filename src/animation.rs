@@ -1,6 +1,7 @@
-//! Camera paths: keyframes (time, position, target) joined by a smooth
-//! Catmull-Rom spline that passes through every keyframe, saved and loaded
-//! as a small TOML file.
+//! Animation: camera paths — keyframes (time, position, target) joined by
+//! a smooth Catmull-Rom spline that passes through every keyframe, saved and
+//! loaded as a small TOML file — and [`Motion`]s, dynamic parameters that
+//! change with time.
 //!
 //! ```
 //! use fractal_sdf::animation::{CameraPath, Keyframe};
@@ -18,7 +19,9 @@
 //! # Ok::<(), fractal_sdf::Error>(())
 //! ```
 
-use glam::DVec3;
+use std::f64::consts::TAU;
+
+use glam::{DVec3, dvec3};
 use serde::{Deserialize, Serialize};
 
 use crate::error::{Error, Result};
@@ -80,6 +83,48 @@ impl CameraPath {
             }
         }
         Ok(CameraPath { keyframes })
+    }
+
+    /// One turn around `target` in `duration` seconds: `segments` + 1
+    /// keyframes (at least 4 segments) on a horizontal circle of `radius`,
+    /// `height` above the target, starting on the +z side and turning
+    /// counter-clockwise seen from above; every keyframe looks at `target`.
+    ///
+    /// ```
+    /// use fractal_sdf::animation::CameraPath;
+    /// use fractal_sdf::prelude::*;
+    /// let orbit = CameraPath::orbit(DVec3::ZERO, 3.0, 1.0, 12.0, 12)?;
+    /// let (p, t) = orbit.sample(3.0); // a quarter turn
+    /// assert!((p - dvec3(3.0, 1.0, 0.0)).length() < 1e-9);
+    /// assert_eq!(t, DVec3::ZERO);
+    /// # Ok::<(), fractal_sdf::Error>(())
+    /// ```
+    ///
+    /// # Errors
+    /// [`Error::Animation`] if a value is not finite or `duration` is not
+    /// positive.
+    pub fn orbit(
+        target: DVec3,
+        radius: f64,
+        height: f64,
+        duration: f64,
+        segments: u32,
+    ) -> Result<Self> {
+        let segments = segments.max(4);
+        if !(duration.is_finite() && duration > 0.0) {
+            return Err(Error::Animation {
+                reason: format!("an orbit's duration must be > 0, got {duration}"),
+            });
+        }
+        let keyframes = (0..=segments)
+            .map(|i| {
+                let f = f64::from(i) / f64::from(segments);
+                let (s, c) = (f * TAU).sin_cos();
+                let position = target + dvec3(radius * s, height, radius * c);
+                Keyframe::new(f * duration, position, target)
+            })
+            .collect();
+        CameraPath::new(keyframes)
     }
 
     /// The keyframes.
@@ -189,4 +234,83 @@ fn catmull_rom(
     let b1 = lerp(a1, a2, t0, t2);
     let b2 = lerp(a2, a3, t1, t3);
     lerp(b1, b2, t1, t2)
+}
+
+/// A dynamic parameter that moves with time, for animated scenes: its
+/// values at a time are set on the renderer before each frame.
+///
+/// ```
+/// use fractal_sdf::animation::Motion;
+/// let breathe = Motion::Oscillate {
+///     name: "power".into(),
+///     center: 8.0,
+///     amplitude: 2.0,
+///     period: 4.0,
+/// };
+/// assert_eq!(breathe.values(1.0), [("power".to_string(), 10.0)]);
+/// ```
+#[derive(Debug, Clone, PartialEq)]
+pub enum Motion {
+    /// `name` = `center` + `amplitude` · sin(2π t / `period`).
+    Oscillate {
+        /// The dynamic parameter.
+        name: String,
+        /// The middle value.
+        center: f64,
+        /// The largest change from `center`.
+        amplitude: f64,
+        /// Seconds per cycle.
+        period: f64,
+    },
+    /// The vector parameter `name` (made with
+    /// [`param3`](crate::scene::param3), slots `name.x`, `name.y`,
+    /// `name.z`) circles `center` horizontally at `radius`, once per
+    /// `period` seconds, starting on the +x side.
+    Orbit {
+        /// The vector parameter's name.
+        name: String,
+        /// The centre of the circle.
+        center: DVec3,
+        /// The circle's radius.
+        radius: f64,
+        /// Seconds per turn.
+        period: f64,
+    },
+}
+
+impl Motion {
+    /// The parameter values at `time` seconds, as `(slot name, value)`. A
+    /// period that is not positive stands still at the start.
+    #[must_use]
+    pub fn values(&self, time: f64) -> Vec<(String, f64)> {
+        let phase = |period: f64| {
+            if period > 0.0 && time.is_finite() {
+                TAU * (time / period).fract()
+            } else {
+                0.0
+            }
+        };
+        match self {
+            Motion::Oscillate {
+                name,
+                center,
+                amplitude,
+                period,
+            } => vec![(name.clone(), center + amplitude * phase(*period).sin())],
+            Motion::Orbit {
+                name,
+                center,
+                radius,
+                period,
+            } => {
+                let (s, c) = phase(*period).sin_cos();
+                let p = *center + dvec3(radius * c, 0.0, -radius * s);
+                ["x", "y", "z"]
+                    .into_iter()
+                    .zip(p.to_array())
+                    .map(|(axis, v)| (format!("{name}.{axis}"), v))
+                    .collect()
+            }
+        }
+    }
 }

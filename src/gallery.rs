@@ -14,10 +14,12 @@ use std::f64::consts::FRAC_PI_2;
 
 use glam::{DVec3, dvec3};
 
+use crate::animation::{CameraPath, Motion};
+use crate::error::Result;
 use crate::scene::{
     Axis, Camera, Light, Mandelbulb, Node, QuaternionJulia, Scene, capped_cone, capsule, cuboid,
-    cylinder, ellipsoid, julia, menger, octahedron, param, plane, round_box, sierpinski, sphere,
-    torus,
+    cylinder, ellipsoid, julia, menger, octahedron, param, param3, plane, round_box, sierpinski,
+    sphere, torus,
 };
 
 /// Every gallery scene by name.
@@ -32,7 +34,39 @@ pub fn all() -> Vec<(&'static str, Scene)> {
         ("primitives", primitives()),
         ("domain_ops", domain_ops()),
         ("fractal_mix", fractal_mix()),
+        ("benchmark", benchmark()),
     ]
+}
+
+/// The animated dynamic parameters of the gallery scene `name` (empty for
+/// a still scene): `fractal_mix`'s Mandelbulb breathes (its `power`), and
+/// `benchmark`'s sphere orbits the fractals (its `orbit`).
+///
+/// ```
+/// use fractal_sdf::gallery;
+/// assert!(gallery::motions("mandelbulb").is_empty());
+/// for (name, value) in gallery::motions("fractal_mix")[0].values(1.5) {
+///     assert_eq!(name, "power");
+///     assert!((6.0..=10.0).contains(&value));
+/// }
+/// ```
+#[must_use]
+pub fn motions(name: &str) -> Vec<Motion> {
+    match name {
+        "fractal_mix" => vec![Motion::Oscillate {
+            name: "power".into(),
+            center: 8.0,
+            amplitude: 2.0,
+            period: 6.0,
+        }],
+        "benchmark" => vec![Motion::Orbit {
+            name: "orbit".into(),
+            center: dvec3(0.0, -0.15, 0.0),
+            radius: 1.35,
+            period: 5.0,
+        }],
+        _ => Vec::new(),
+    }
 }
 
 /// The gallery scene called `name`, if there is one.
@@ -240,4 +274,55 @@ pub fn fractal_mix() -> Scene {
     Scene::new(fractals.union(floor(0.55)))
         .with_camera(Camera::look_at(dvec3(0.0, 1.6, 3.2), dvec3(0.0, -0.1, 0.0)).fov(45.0))
         .with_lights(key_and_fill())
+}
+
+/// The performance benchmark's scene: a Mandelbulb on a pedestal between a
+/// Menger sponge and a torus, a sphere orbiting them (the dynamic parameter
+/// `orbit`, see [`motions`]), a floor and two soft-shadowed lights. Seen
+/// along [`benchmark_path`].
+#[must_use]
+pub fn benchmark() -> Scene {
+    let bulb = Node::from(Mandelbulb::new(8.0).iterations(8))
+        .rotate(DVec3::X, -FRAC_PI_2)
+        .scale(0.6)
+        .color(dvec3(0.9, 0.6, 0.35))
+        .translate(dvec3(0.0, 0.05, 0.0));
+    let pedestal = cylinder(0.35, 0.2)
+        .smooth_union(
+            cuboid(dvec3(0.5, 0.05, 0.5)).translate(dvec3(0.0, -0.2, 0.0)),
+            0.05,
+        )
+        .color(dvec3(0.5, 0.5, 0.55))
+        .translate(dvec3(0.0, -0.75, 0.0));
+    let sponge = menger(3)
+        .scale(0.4)
+        .rotate(DVec3::Y, 0.4)
+        .color(dvec3(0.85, 0.85, 0.8))
+        .translate(dvec3(-1.5, -0.55, -0.3));
+    let ring = torus(0.35, 0.1)
+        .rotate(DVec3::X, 1.2)
+        .color(dvec3(0.4, 0.75, 0.95))
+        .translate(dvec3(1.5, -0.5, -0.2));
+    let moon = sphere(0.18)
+        .color(dvec3(0.95, 0.4, 0.3))
+        .translate(param3("orbit", dvec3(1.35, -0.15, 0.0)));
+    let geometry = bulb
+        .union(pedestal)
+        .union(sponge)
+        .union(ring)
+        .union(moon)
+        .union(floor(0.95));
+    Scene::new(geometry)
+        .with_camera(Camera::look_at(dvec3(0.0, 1.4, 3.6), dvec3(0.0, -0.3, 0.0)).fov(45.0))
+        .with_lights(key_and_fill())
+}
+
+/// The benchmark's fixed camera path: one 10-second turn around the scene,
+/// 3.6 units out and 1.7 up, looking just below the Mandelbulb.
+///
+/// # Errors
+/// None in practice: the path is constant (the `Result` is
+/// [`CameraPath::orbit`]'s).
+pub fn benchmark_path() -> Result<CameraPath> {
+    CameraPath::orbit(dvec3(0.0, -0.3, 0.0), 3.6, 1.7, 10.0, 16)
 }
