@@ -76,6 +76,7 @@ pub mod quality;
 #[cfg(feature = "opencl")]
 pub mod render;
 pub mod scene;
+pub mod sequence;
 #[cfg(feature = "proptest")]
 pub mod testing;
 pub mod timing;

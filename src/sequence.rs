@@ -1,0 +1,328 @@
+//! Frame sequences: a camera path rendered to numbered PNGs
+//! (`frame_00000.png`, `frame_00001.png`, ...) at a frame rate, resumable
+//! (frames already on disk are skipped) and renderable in sub-ranges.
+//!
+//! ```
+//! use fractal_sdf::sequence::{Sequence, parse_range};
+//!
+//! let seq = Sequence::for_duration("out/seq", 24.0, 2.0)?;
+//! assert_eq!(seq.frames(), 48);
+//! assert_eq!(seq.frame_path(7), std::path::Path::new("out/seq/frame_00007.png"));
+//! assert_eq!(seq.time(12), 0.5);
+//! assert_eq!(parse_range("10..20", seq.frames())?, 10..20);
+//! # Ok::<(), fractal_sdf::Error>(())
+//! ```
+
+use std::ops::Range;
+use std::path::{Path, PathBuf};
+
+use crate::error::{Error, Result};
+#[cfg(feature = "opencl")]
+use crate::{
+    animation::{CameraPath, Motion},
+    render::Renderer,
+    timing::FrameTiming,
+};
+
+/// The file name of frame `index`: `frame_00042.png`.
+#[must_use]
+pub fn frame_name(index: u32) -> String {
+    format!("frame_{index:05}.png")
+}
+
+/// The `printf`-style pattern matching [`frame_name`], for encoders such as
+/// `ffmpeg`.
+pub const FRAME_PATTERN: &str = "frame_%05d.png";
+
+/// A sequence of `frames` images at `fps` frames per second, stored in
+/// `dir`. Frame `i` shows time `i / fps` seconds from the start.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Sequence {
+    dir: PathBuf,
+    fps: f64,
+    frames: u32,
+}
+
+impl Sequence {
+    /// A sequence of `frames` frames at `fps`.
+    ///
+    /// # Errors
+    /// [`Error::Invalid`] if `fps` is not a positive finite number or
+    /// `frames` is 0.
+    pub fn new(dir: impl Into<PathBuf>, fps: f64, frames: u32) -> Result<Self> {
+        let bad = |reason: String| Error::Invalid {
+            what: "frame sequence",
+            reason,
+        };
+        if !(fps.is_finite() && fps > 0.0) {
+            return Err(bad(format!("the frame rate must be > 0, got {fps}")));
+        }
+        if frames == 0 {
+            return Err(bad("a sequence needs at least 1 frame".into()));
+        }
+        Ok(Sequence {
+            dir: dir.into(),
+            fps,
+            frames,
+        })
+    }
+
+    /// A sequence covering `seconds` at `fps`: `round(seconds × fps)`
+    /// frames, at least 1. The last frame is one frame before the end, so
+    /// a looping path (such as an orbit) repeats without a doubled frame.
+    ///
+    /// # Errors
+    /// As [`Sequence::new`], and [`Error::Invalid`] for a duration that is
+    /// not a positive finite number or needs more than `u32::MAX` frames.
+    pub fn for_duration(dir: impl Into<PathBuf>, fps: f64, seconds: f64) -> Result<Self> {
+        let count = (seconds * fps).round();
+        if !(seconds.is_finite() && seconds > 0.0 && count <= f64::from(u32::MAX)) {
+            return Err(Error::Invalid {
+                what: "frame sequence",
+                reason: format!("the duration must be > 0 and finite, got {seconds} s"),
+            });
+        }
+        #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss)]
+        let frames = (count as u32).max(1);
+        Self::new(dir, fps, frames)
+    }
+
+    /// The directory the frames are stored in.
+    #[must_use]
+    pub fn dir(&self) -> &Path {
+        &self.dir
+    }
+
+    /// Frames per second.
+    #[must_use]
+    pub fn fps(&self) -> f64 {
+        self.fps
+    }
+
+    /// The number of frames.
+    #[must_use]
+    pub fn frames(&self) -> u32 {
+        self.frames
+    }
+
+    /// Where frame `index` is stored.
+    #[must_use]
+    pub fn frame_path(&self, index: u32) -> PathBuf {
+        self.dir.join(frame_name(index))
+    }
+
+    /// The time frame `index` shows, in seconds from the start.
+    #[must_use]
+    pub fn time(&self, index: u32) -> f64 {
+        f64::from(index) / self.fps
+    }
+
+    /// The frames of `range` that are not on disk yet, in order.
+    #[must_use]
+    pub fn remaining(&self, range: Range<u32>) -> Vec<u32> {
+        range.filter(|&i| !self.frame_path(i).is_file()).collect()
+    }
+
+    /// The arguments of the `ffmpeg` command that encodes the frames into
+    /// an H.264 MP4 at `output`:
+    /// `-y -framerate R -i DIR/frame_%05d.png -pix_fmt yuv420p OUTPUT`.
+    #[must_use]
+    pub fn ffmpeg_args(&self, output: &Path) -> Vec<String> {
+        vec![
+            "-y".into(),
+            "-framerate".into(),
+            format!("{}", self.fps),
+            "-i".into(),
+            self.dir.join(FRAME_PATTERN).display().to_string(),
+            "-pix_fmt".into(),
+            "yuv420p".into(),
+            output.display().to_string(),
+        ]
+    }
+}
+
+/// A frame [`Sequence::render`] has just written.
+#[cfg(feature = "opencl")]
+#[derive(Debug, Clone, PartialEq)]
+pub struct RenderedFrame {
+    /// The frame's index in the sequence.
+    pub index: u32,
+    /// Where it was saved.
+    pub path: PathBuf,
+    /// What rendering it cost.
+    pub timing: Option<FrameTiming>,
+}
+
+#[cfg(feature = "opencl")]
+impl Sequence {
+    /// Renders the frames `indices` of this sequence at `width` × `height`
+    /// and saves each to [`Sequence::frame_path`] (atomically, so an
+    /// interrupted run leaves only whole frames). Frame `i` shows the
+    /// camera on `path` at `path.start() + time(i)` (with the renderer's
+    /// current camera's projection) and the `motions` at `time(i)`.
+    /// `on_frame` is called after each frame is saved.
+    ///
+    /// Pass [`Sequence::remaining`] as `indices` to resume a sequence.
+    ///
+    /// # Errors
+    /// The first render, parameter or file error; the frames saved before
+    /// it stay on disk.
+    pub fn render(
+        &self,
+        renderer: &mut Renderer,
+        path: &CameraPath,
+        motions: &[Motion],
+        indices: &[u32],
+        (width, height): (u32, u32),
+        mut on_frame: impl FnMut(&RenderedFrame),
+    ) -> Result<()> {
+        let base = *renderer.camera();
+        for &index in indices {
+            let t = self.time(index);
+            renderer.set_camera(path.camera_at(path.start() + t, &base))?;
+            for motion in motions {
+                for (name, value) in motion.values(t) {
+                    renderer.set_param(&name, value)?;
+                }
+            }
+            let image = renderer.render(width, height)?;
+            let file = self.frame_path(index);
+            crate::output::save_png(&image, &file)?;
+            on_frame(&RenderedFrame {
+                index,
+                path: file,
+                timing: renderer.last_timing(),
+            });
+        }
+        Ok(())
+    }
+}
+
+/// Parses a frame range of a sequence of `total` frames: `a..b` (frames a
+/// to b − 1), `a..=b`, `a..` (to the end), `..b`, `..` (all) or a single
+/// frame `n`.
+///
+/// ```
+/// use fractal_sdf::sequence::parse_range;
+/// assert_eq!(parse_range("5..=7", 24)?, 5..8);
+/// assert_eq!(parse_range("20..", 24)?, 20..24);
+/// assert_eq!(parse_range("3", 24)?, 3..4);
+/// assert!(parse_range("20..30", 24).is_err());
+/// # Ok::<(), fractal_sdf::Error>(())
+/// ```
+///
+/// # Errors
+/// [`Error::Invalid`] if the text is not a range, the range is empty or it
+/// reaches past the last frame.
+pub fn parse_range(text: &str, total: u32) -> Result<Range<u32>> {
+    let bad = |reason: String| Error::Invalid {
+        what: "frame range",
+        reason,
+    };
+    let number = |s: &str| -> Result<Option<u32>> {
+        let s = s.trim();
+        if s.is_empty() {
+            return Ok(None);
+        }
+        s.parse::<u32>()
+            .map(Some)
+            .map_err(|_| bad(format!("`{text}`: `{s}` is not a frame number")))
+    };
+    let text = text.trim();
+    let range = if let Some((a, b)) = text.split_once("..=") {
+        let end = number(b)?.ok_or_else(|| bad(format!("`{text}`: `..=` needs an end")))?;
+        number(a)?.unwrap_or(0)..end.saturating_add(1)
+    } else if let Some((a, b)) = text.split_once("..") {
+        number(a)?.unwrap_or(0)..number(b)?.unwrap_or(total)
+    } else {
+        let n = number(text)?.ok_or_else(|| bad("the range is empty".into()))?;
+        n..n.saturating_add(1)
+    };
+    if range.is_empty() {
+        return Err(bad(format!("`{text}` contains no frame")));
+    }
+    if range.end > total {
+        return Err(bad(format!(
+            "`{text}` reaches past the last frame ({} of frames 0..{total})",
+            range.end - 1
+        )));
+    }
+    Ok(range)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn frames_are_named_in_sortable_order() {
+        assert_eq!(frame_name(0), "frame_00000.png");
+        assert_eq!(frame_name(42), "frame_00042.png");
+        assert_eq!(frame_name(123_456), "frame_123456.png");
+        let mut names: Vec<String> = [10, 2, 100, 1].map(frame_name).to_vec();
+        names.sort();
+        assert_eq!(names, [1, 2, 10, 100].map(frame_name));
+    }
+
+    #[test]
+    fn frame_count_and_times_follow_the_rate() {
+        let s = Sequence::for_duration("d", 30.0, 10.0).unwrap();
+        assert_eq!(s.frames(), 300);
+        assert_eq!(s.time(0), 0.0);
+        assert_eq!(s.time(150), 5.0);
+        assert_eq!(Sequence::for_duration("d", 24.0, 0.01).unwrap().frames(), 1);
+        assert!(Sequence::for_duration("d", 24.0, 0.0).is_err());
+        assert!(Sequence::for_duration("d", 24.0, f64::INFINITY).is_err());
+        assert!(Sequence::for_duration("d", 1e9, 1e9).is_err());
+        assert!(Sequence::new("d", 0.0, 10).is_err());
+        assert!(Sequence::new("d", f64::NAN, 10).is_err());
+        let err = Sequence::new("d", 24.0, 0).unwrap_err().to_string();
+        assert!(err.contains("at least 1 frame"), "{err}");
+    }
+
+    #[test]
+    fn ranges_parse_like_rust_ranges() {
+        assert_eq!(parse_range("0..24", 24).unwrap(), 0..24);
+        assert_eq!(parse_range(" 2 .. 5 ", 24).unwrap(), 2..5);
+        assert_eq!(parse_range("2..=5", 24).unwrap(), 2..6);
+        assert_eq!(parse_range("..3", 24).unwrap(), 0..3);
+        assert_eq!(parse_range("..", 24).unwrap(), 0..24);
+        assert_eq!(parse_range("23", 24).unwrap(), 23..24);
+        assert_eq!(parse_range("..=23", 24).unwrap(), 0..24);
+        for bad in ["5..5", "7..3", "24", "0..25", "a..b", "", "1..=", "-1..3"] {
+            let err = parse_range(bad, 24).expect_err(bad);
+            assert!(matches!(err, Error::Invalid { .. }), "{bad}: {err}");
+        }
+        let err = parse_range("20..30", 24).unwrap_err().to_string();
+        assert!(err.contains("past the last frame (29"), "{err}");
+    }
+
+    #[test]
+    fn remaining_skips_frames_on_disk() {
+        let dir = std::env::temp_dir().join(format!("fractal-sdf-seq-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        std::fs::create_dir_all(&dir).unwrap();
+        let s = Sequence::new(&dir, 24.0, 6).unwrap();
+        assert_eq!(s.remaining(0..6), [0, 1, 2, 3, 4, 5]);
+        for i in [0, 2, 3] {
+            std::fs::write(s.frame_path(i), b"png").unwrap();
+        }
+        // A directory with a frame's name is not a frame.
+        std::fs::create_dir(s.frame_path(5)).unwrap();
+        assert_eq!(s.remaining(0..6), [1, 4, 5]);
+        assert_eq!(s.remaining(2..4), Vec::<u32>::new());
+        std::fs::remove_dir_all(dir).unwrap();
+    }
+
+    #[test]
+    fn ffmpeg_reads_the_numbered_frames() {
+        let s = Sequence::new("out/seq", 30.0, 10).unwrap();
+        let args = s.ffmpeg_args(Path::new("out/seq.mp4"));
+        assert_eq!(
+            args.join(" "),
+            "-y -framerate 30 -i out/seq/frame_%05d.png -pix_fmt yuv420p out/seq.mp4"
+        );
+        let pattern = FRAME_PATTERN.replace("%05d", "00007");
+        assert_eq!(pattern, frame_name(7));
+    }
+}
