@@ -11,6 +11,15 @@ REQUIRED_PACKAGES=(
     pocl-opencl-icd    # PoCL: a CPU OpenCL implementation, so no GPU is required
     clinfo             # lists OpenCL platforms/devices; used for the check below
     pkg-config
+    # The viewer example's window (feature `viewer`) and its smoke test:
+    xvfb               # a virtual X server, so the viewer runs without a display
+    xdotool            # sends real key presses to the viewer's window
+    libx11-6           # X11 client libraries winit and softbuffer load at run time
+    libx11-xcb1
+    libxcursor1
+    libxrandr2
+    libxi6
+    libxkbcommon-x11-0
 )
 
 say() { printf 'setup: %s\n' "$*"; }

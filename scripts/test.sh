@@ -1,6 +1,10 @@
 #!/usr/bin/env bash
 # The full check run by `make test` (and CI): format, lints, tests, docs.
 # Prints a header per step and the total wall time at the end.
+#
+# Every step uses the same features (`viewer` on), so the crate is compiled
+# once per mode; `cargo test --all-targets` also builds the viewer example
+# that tests/viewer_smoke.rs runs under Xvfb.
 set -euo pipefail
 
 CARGO=${CARGO:-cargo}
@@ -12,9 +16,9 @@ step() {
 }
 
 step "$CARGO" fmt --all -- --check
-step "$CARGO" clippy --all-targets -- -D warnings
-step "$CARGO" test --all-targets
-step "$CARGO" test --doc
-RUSTDOCFLAGS="-D warnings" step "$CARGO" doc --no-deps
+step "$CARGO" clippy --all-targets --all-features -- -D warnings
+step "$CARGO" test --all-targets --features viewer
+step "$CARGO" test --doc --features viewer
+RUSTDOCFLAGS="-D warnings" step "$CARGO" doc --no-deps --features viewer
 
 printf '\n==> make test: all steps passed in %ss\n' "$(($(date +%s) - start))"

@@ -77,3 +77,53 @@ pub fn gallery_options() -> RenderOptions {
         ..RenderOptions::default()
     }
 }
+
+/// A command-line error as the crate's error type.
+pub fn usage(e: impl std::fmt::Display) -> Error {
+    Error::Invalid {
+        what: "command line",
+        reason: format!("{e} (see --help)"),
+    }
+}
+
+/// Parses `WxH`, such as `640x480`.
+pub fn parse_size(text: &str) -> Result<(u32, u32)> {
+    text.split_once(['x', 'X'])
+        .and_then(|(w, h)| Some((w.trim().parse().ok()?, h.trim().parse().ok()?)))
+        .filter(|&(w, h)| w > 0 && h > 0)
+        .ok_or_else(|| usage(format!("`{text}` is not a size like 640x480")))
+}
+
+/// Parses a quality preset name.
+pub fn parse_preset(text: &str) -> Result<Preset> {
+    Preset::from_name(text).ok_or_else(|| {
+        let names: Vec<&str> = Preset::ALL.iter().map(|p| p.name()).collect();
+        usage(format!(
+            "unknown quality `{text}` (one of: {})",
+            names.join(", ")
+        ))
+    })
+}
+
+/// The gallery scene called `name`, or an error listing the names.
+pub fn gallery_scene(name: &str) -> Result<Scene> {
+    fractal_sdf::gallery::by_name(name).ok_or_else(|| {
+        usage(format!(
+            "unknown scene `{name}` (one of: {})",
+            fractal_sdf::gallery::names().join(", ")
+        ))
+    })
+}
+
+/// The CPU's model name from `/proc/cpuinfo` (Linux), or `unknown`.
+pub fn cpu_model() -> String {
+    std::fs::read_to_string("/proc/cpuinfo")
+        .ok()
+        .and_then(|text| {
+            text.lines()
+                .find(|l| l.starts_with("model name"))
+                .and_then(|l| l.split_once(':'))
+                .map(|(_, v)| v.trim().to_string())
+        })
+        .unwrap_or_else(|| "unknown".into())
+}
