@@ -52,14 +52,6 @@ real sd_plane(real3 p, real3 n, real offset) {
     return dot(p, n) + offset;
 }
 
-/* ---- rotate ---- */
-/* Rotates p by angle around the unit axis k (Rodrigues' formula). */
-real3 rotate_axis(real3 p, real3 k, real angle) {
-    real c = cos(angle);
-    real s = sin(angle);
-    return p * c + cross(k, p) * s + k * (dot(k, p) * (R(1.0) - c));
-}
-
 /* ---- warp ---- */
 /* Distance bounds for warped children (twist, bend): with the warp's local
    stretch L(rho), d / L(rho + |d| / L(rho)) never overestimates. */
@@ -131,7 +123,7 @@ real DE(real3 p0, __global const real* params) {
     real3 p11 = p10;
     p11.x = fabs(p11.x);
     real3 p12 = p11 - (real3)(0.5f, 0.0f, 0.0f);
-    real3 p13 = rotate_axis(p12, (real3)(1.0f, 0.0f, 0.0f), (-1.5707964f));
+    real3 p13 = (real3)(p12.x, p12.z, -p12.y);
     real d27 = sd_torus(p13, 0.2f, 0.06f);
     real d31 = d27 - 0.01f;
     real x34 = d26;
@@ -222,7 +214,7 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     real3 p11 = p10;
     p11.x = fabs(p11.x);
     real3 p12 = p11 - (real3)(0.5f, 0.0f, 0.0f);
-    real3 p13 = rotate_axis(p12, (real3)(1.0f, 0.0f, 0.0f), (-1.5707964f));
+    real3 p13 = (real3)(p12.x, p12.z, -p12.y);
     real d27 = sd_torus(p13, 0.2f, 0.06f);
     real3 c27 = DEFAULT_COLOR;
     real t27 = R(1.0);
