@@ -2,7 +2,7 @@
 CARGO ?= cargo
 export CARGO
 
-.PHONY: setup demo test bench snapshots fmt
+.PHONY: setup demo test bench snapshots golden fmt
 
 setup:
 	@echo "==> setup: system packages"
@@ -25,3 +25,7 @@ snapshots:
 
 fmt:
 	$(CARGO) fmt --all
+
+golden:
+	@echo "==> golden: regenerating golden render images"
+	UPDATE_GOLDEN=1 $(CARGO) test --test golden

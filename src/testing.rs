@@ -11,7 +11,9 @@
 //!   violation as a [`Failure`] that says where, what was measured and what
 //!   was allowed. They accept anything that is a [`DistanceField`]: a
 //!   [`Node`](crate::Node), a [`cpu::Evaluator`](crate::cpu::Evaluator) or a
-//!   closure `Fn(DVec3) -> f64`.
+//!   closure `Fn(DVec3) -> f64`. [`check_device_matches_cpu`] (feature
+//!   `opencl`) runs a node's generated OpenCL code on a device and compares
+//!   it with the CPU reference.
 //! - Membership tests ([`mandelbulb_inside`], [`julia_inside`],
 //!   [`menger_inside`], [`sierpinski_inside`]) decide whether a point is in
 //!   a fractal without using any distance-estimator code: they are the
@@ -43,6 +45,8 @@
 //! (named after their value, so two draws of one name always agree).
 
 mod check;
+#[cfg(feature = "opencl")]
+mod device;
 mod membership;
 mod strategy;
 
@@ -50,6 +54,8 @@ pub use check::{
     Check, DistanceField, Failure, LIPSCHITZ_TOLERANCE, ROUNDING_ALLOWANCE, SHELL_FACTOR,
     check_exact, check_lipschitz, check_never_overestimates,
 };
+#[cfg(feature = "opencl")]
+pub use device::{check_device_matches_cpu, random_points, spicy_points};
 pub use membership::{julia_inside, mandelbulb_inside, menger_inside, sierpinski_inside};
 pub use strategy::{
     bounded_node, capped_cone_node, capsule_node, cuboid_node, cylinder_node, ellipsoid_node,

@@ -6,51 +6,15 @@
 //! Tolerances: the device result `g` and the CPU reference `c` (evaluated in
 //! the same precision) must satisfy `|g - c| <= tol * max(1, |c|)` with
 //! `tol = 1e-4` for F32 and `1e-10` for F64, at every point. Colours must
-//! agree to the same tolerance. Run with `--nocapture` to see the worst
-//! error of each node.
+//! agree to the same tolerance. The check is the public
+//! `testing::check_device_matches_cpu`.
 
 mod gpu;
 
-use fractal_sdf::cpu::Evaluator;
 use fractal_sdf::prelude::*;
 use fractal_sdf::render::{DeviceSelector, PointEvaluator};
 use fractal_sdf::scene::{CustomShape, Rule};
-
-/// Deterministic pseudo-random points in the cube `[-extent, extent]^3`.
-fn random_points(n: usize, extent: f64, seed: u64) -> Vec<DVec3> {
-    let mut s = seed.max(1);
-    let mut next = move || {
-        s ^= s << 13;
-        s ^= s >> 7;
-        s ^= s << 17;
-        #[allow(clippy::cast_precision_loss)]
-        let unit = (s >> 11) as f64 / (1u64 << 53) as f64;
-        (2.0 * unit - 1.0) * extent
-    };
-    (0..n).map(|_| dvec3(next(), next(), next())).collect()
-}
-
-/// The origin, points on and near the axes, on the bailout spheres of the
-/// fractals (radius 2 and 4), near the surfaces, and far away.
-fn spicy_points() -> Vec<DVec3> {
-    let mut pts = vec![DVec3::ZERO];
-    let dirs = [
-        DVec3::X,
-        DVec3::Y,
-        DVec3::Z,
-        -DVec3::X,
-        -DVec3::Y,
-        -DVec3::Z,
-        dvec3(1.0, 1.0, 1.0).normalize(),
-        dvec3(-1.0, 1.0, -1.0).normalize(),
-    ];
-    for d in dirs {
-        for r in [1e-7, 1e-3, 0.5, 1.0, 2.0, 4.0, 1e3, 1e6] {
-            pts.push(d * r);
-        }
-    }
-    pts
-}
+use fractal_sdf::testing::{check_device_matches_cpu, random_points, spicy_points};
 
 fn gyroid() -> CustomShape {
     CustomShape::new(
@@ -130,89 +94,30 @@ fn nodes() -> Vec<(&'static str, Node)> {
     v
 }
 
-struct Stats {
-    worst: f64,
-    worst_at: DVec3,
-    over: usize,
-    color_over: usize,
-    total: usize,
-}
-
-fn compare(name: &str, node: &Node, precision: Precision, points: &[DVec3]) -> Stats {
-    let device = PointEvaluator::new(node, precision, &DeviceSelector::auto())
-        .unwrap_or_else(|e| panic!("{name}: {e}"));
-    let cpu = Evaluator::new(node).unwrap();
-    let got = device.eval(points).unwrap();
-    let tol = match precision {
-        Precision::F32 => 1e-4,
-        Precision::F64 => 1e-10,
-    };
-    let mut stats = Stats {
-        worst: 0.0,
-        worst_at: DVec3::ZERO,
-        over: 0,
-        color_over: 0,
-        total: points.len(),
-    };
-    for (p, g) in points.iter().zip(&got) {
-        let (reference, color) = match precision {
-            Precision::F32 => {
-                let s = cpu.sample::<f32>(p.as_vec3().into());
-                (f64::from(s.distance), glam::Vec3::from(s.color).as_dvec3())
-            }
-            Precision::F64 => {
-                let s = cpu.sample::<f64>((*p).into());
-                (s.distance, DVec3::from(s.color))
-            }
-        };
-        assert!(
-            g.distance.is_finite() && g.trap.is_finite() && g.color.is_finite(),
-            "{name} {precision:?}: non-finite result {g:?} at {p}"
-        );
-        assert!(
-            reference.is_finite(),
-            "{name}: CPU reference not finite at {p}"
-        );
-        assert_eq!(
-            g.distance.to_bits(),
-            g.shade_distance.to_bits(),
-            "{name} {precision:?}: DE and DE_shade differ at {p}"
-        );
-        let err = (g.distance - reference).abs() / reference.abs().max(1.0);
-        if err > tol {
-            stats.over += 1;
-        }
-        if err > stats.worst {
-            stats.worst = err;
-            stats.worst_at = *p;
-        }
-        if (g.color - color).abs().max_element() > tol {
-            stats.color_over += 1;
-        }
-    }
-    stats
-}
-
 fn check_all(precision: Precision) {
     if gpu::device().is_none() {
         return;
     }
     let mut points = random_points(10_000, 2.5, 0x5eed);
     points.extend(spicy_points());
-    let mut failures = Vec::new();
-    for (name, node) in nodes() {
-        let s = compare(name, &node, precision, &points);
-        eprintln!(
-            "{name:>24} {precision:?}: worst relative error {:.2e} at {:.4}; over tolerance: {} distances, {} colours of {} points",
-            s.worst, s.worst_at, s.over, s.color_over, s.total
-        );
-        if s.over > 0 || s.color_over > 0 {
-            failures.push(format!(
-                "{name}: {} distances and {} colours of {} points over tolerance (worst {:.3e} at {})",
-                s.over, s.color_over, s.total, s.worst, s.worst_at
-            ));
-        }
-    }
+    let tolerance = match precision {
+        Precision::F32 => 1e-4,
+        Precision::F64 => 1e-10,
+    };
+    let failures: Vec<String> = nodes()
+        .into_iter()
+        .filter_map(|(name, node)| {
+            check_device_matches_cpu(
+                &node,
+                &DeviceSelector::auto(),
+                precision,
+                &points,
+                tolerance,
+            )
+            .err()
+            .map(|f| format!("{name} ({precision:?}): {f}"))
+        })
+        .collect();
     assert!(failures.is_empty(), "{}", failures.join("\n"));
 }
 

@@ -1,10 +1,8 @@
 /* Mandelbulb of any real power, with acos/atan2/sin/cos. */
-real mandelbulb(real3 p, real power, int iterations, real bailout, real* trap) {
+real mandelbulb(real3 p, real power, int iterations, real escape, real* trap) {
     real3 z = p;
     real dr = R(1.0);
     real t = R(1.0);
-    /* Escape before r^power passes MAGNITUDE_CAP (large powers and bailouts). */
-    real escape = fmin(bailout, pow(MAGNITUDE_CAP, R(1.0) / power));
     for (int i = 0; i < iterations; i++) {
         real r = length(z);
         if (r > escape) {

@@ -21,6 +21,7 @@
 //! ```
 
 mod helpers;
+mod power;
 mod scene;
 mod writer;
 
@@ -102,12 +103,18 @@ pub fn emit_ir(ir: &Ir, options: &Options) -> Result<KernelSource> {
     emitter.emit();
     let used: Vec<&'static str> = emitter.used.iter().copied().collect();
     let customs: Vec<_> = emitter.customs.values().cloned().collect();
+    let powers: Vec<u32> = emitter.powers.iter().copied().collect();
 
     let mut w = writer::Writer::new(precision);
     header(&mut w, options);
     for helper in helpers::closure(&used) {
         w.line(format!("/* ---- {} ---- */", helper.name));
         w.raw(helper.source);
+        w.line("");
+    }
+    for n in powers {
+        w.line(format!("/* ---- {} ---- */", power::helper_name(n)));
+        w.raw(&power::mandelbulb_helper(n));
         w.line("");
     }
     for shape in &customs {
@@ -117,18 +124,41 @@ pub fn emit_ir(ir: &Ir, options: &Options) -> Result<KernelSource> {
     }
     w.line("/* ---- scene ---- */");
     w.raw(&body.finish());
+    Ok(finish(w, options, ir.params().to_vec()))
+}
+
+/// A complete program around hand-written scene functions: the header for
+/// `options`, then `scene_functions` (which must define `DE` and
+/// `DE_shade` with the signatures of the generated ones, using only the
+/// header's types and constants), then the target kernel. For experiments
+/// and for measuring generated code against hand-written code.
+///
+/// # Errors
+/// A validation error of the quality or effects.
+pub fn emit_handwritten(scene_functions: &str, options: &Options) -> Result<KernelSource> {
+    options.quality.validate()?;
+    options.effects.validate()?;
+    let mut w = writer::Writer::new(options.quality.precision);
+    header(&mut w, options);
+    w.line("/* ---- scene (hand-written) ---- */");
+    w.raw(scene_functions);
+    Ok(finish(w, options, Vec::new()))
+}
+
+/// Appends the target kernel and hashes the program.
+fn finish(mut w: writer::Writer, options: &Options, params: Vec<ParamSlot>) -> KernelSource {
     let kernel = match options.target {
         Target::Render => include_str!("../../kernels/march.cl"),
         Target::Evaluate => include_str!("../../kernels/eval.cl"),
     };
     w.raw(&select_features(kernel, &features(options)));
     let source = w.finish();
-    Ok(KernelSource {
+    KernelSource {
         hash: fnv1a(source.as_bytes()),
         source,
-        params: ir.params().to_vec(),
-        precision,
-    })
+        params,
+        precision: options.quality.precision,
+    }
 }
 
 fn header(w: &mut writer::Writer, options: &Options) {

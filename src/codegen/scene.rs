@@ -26,6 +26,8 @@ pub(crate) struct SceneEmitter<'a> {
     pub(crate) used: BTreeSet<&'static str>,
     /// The custom shapes the emitted code calls, by name.
     pub(crate) customs: BTreeMap<String, CustomShape>,
+    /// The integer Mandelbulb powers that need a specialised helper.
+    pub(crate) powers: BTreeSet<u32>,
 }
 
 impl<'a> SceneEmitter<'a> {
@@ -38,6 +40,7 @@ impl<'a> SceneEmitter<'a> {
             iteration_override,
             used: BTreeSet::new(),
             customs: BTreeMap::new(),
+            powers: BTreeSet::new(),
         }
     }
 
@@ -94,10 +97,15 @@ impl<'a> SceneEmitter<'a> {
     /// A fractal: the helper writes the trap through a pointer.
     fn fractal(&mut self, id: NodeId, helper: &'static str, args: String) -> Vars {
         self.used.insert(helper);
+        self.fractal_call(id, helper, &args)
+    }
+
+    /// A call of a fractal function (library or specialised).
+    fn fractal_call(&mut self, id: NodeId, function: &str, args: &str) -> Vars {
         let v = vars(id);
         self.w.line(format!("real {};", v.t));
         self.w
-            .line(format!("real {} = {helper}({args}, &{});", v.d, v.t));
+            .line(format!("real {} = {function}({args}, &{});", v.d, v.t));
         if self.shade {
             self.w.line(format!("real3 {} = DEFAULT_COLOR;", v.c));
         }
@@ -195,14 +203,26 @@ impl<'a> SceneEmitter<'a> {
             }
             Kind::Mandelbulb(f) => {
                 let n = self.iterations(f.iterations, (1, crate::scene::MAX_ESCAPE_ITERATIONS));
-                let bailout = w(self, f.bailout);
+                // The escape radius: a literal when power and bailout are
+                // baked, as the CPU computes it.
+                let escape = match (f.power, f.bailout) {
+                    (Scalar::Baked(p), Scalar::Baked(b)) => {
+                        self.w.float(crate::cpu::sdf::escape_radius(p, b))
+                    }
+                    _ => format!(
+                        "fmin({}, pow(MAGNITUDE_CAP, R(1.0) / {}))",
+                        w(self, f.bailout),
+                        w(self, f.power)
+                    ),
+                };
                 match integer_power(f.power) {
                     Some(power) => {
-                        let args = format!("{p}, {power}, {n}, {bailout}");
-                        self.fractal(id, "mandelbulb_int", args)
+                        self.powers.insert(power);
+                        let args = format!("{p}, {n}, {escape}");
+                        self.fractal_call(id, &super::power::helper_name(power), &args)
                     }
                     None => {
-                        let args = format!("{p}, {}, {n}, {bailout}", w(self, f.power));
+                        let args = format!("{p}, {}, {n}, {escape}", w(self, f.power));
                         self.fractal(id, "mandelbulb", args)
                     }
                 }
@@ -232,13 +252,19 @@ impl<'a> SceneEmitter<'a> {
                 self.node(*child, &q)
             }
             Kind::Rotate { axis, angle, child } => {
-                self.used.insert("rotate");
-                let axis = axis.to_array().map(Scalar::Baked);
-                let angle = match angle {
-                    Scalar::Baked(a) => self.w.float(-a),
-                    Scalar::Dynamic(_) => format!("-{}", w(self, *angle)),
+                let q = match angle {
+                    Scalar::Baked(a) => {
+                        let rows = crate::cpu::rotation_rows(*axis, -a);
+                        let [x, y, z] = rows.map(|r| self.dot_row([r.x, r.y, r.z], p));
+                        self.point(format!("(real3)({x}, {y}, {z})"))
+                    }
+                    Scalar::Dynamic(_) => {
+                        self.used.insert("rotate");
+                        let k = v3(self, axis.to_array().map(Scalar::Baked));
+                        let a = format!("-{}", w(self, *angle));
+                        self.point(format!("rotate_axis({p}, {k}, {a})"))
+                    }
                 };
-                let q = self.point(format!("rotate_axis({p}, {}, {angle})", v3(self, axis)));
                 self.node(*child, &q)
             }
             Kind::Scale { factor, child } => {
@@ -336,6 +362,30 @@ impl<'a> SceneEmitter<'a> {
                 Vars { c: v.c, ..c }
             }
         }
+    }
+
+    /// `row · p` as the CPU's `dot_row` computes it: non-zero terms, left to
+    /// right; `±1` entries need no multiplication.
+    fn dot_row(&self, row: [f64; 3], p: &str) -> String {
+        let mut sum = String::new();
+        for (a, axis) in row.into_iter().zip(["x", "y", "z"]) {
+            if a == 0.0 {
+                continue;
+            }
+            let term = match a {
+                1.0 => format!("{p}.{axis}"),
+                -1.0 => format!("-{p}.{axis}"),
+                _ => format!("{} * {p}.{axis}", self.w.float(a)),
+            };
+            if sum.is_empty() {
+                sum = term;
+            } else if let Some(negated) = term.strip_prefix('-') {
+                sum = format!("{sum} - {negated}");
+            } else {
+                sum = format!("{sum} + {term}");
+            }
+        }
+        if sum.is_empty() { "R(0.0)".into() } else { sum }
     }
 
     /// Folds `p` into a repetition cell, axis by axis, as `cpu::repeat` does.

@@ -189,10 +189,18 @@ impl Evaluator {
             )),
             Kind::Sierpinski(f) => Self::fractal(sdf::sierpinski(p, f.iterations, s(f.scale))),
             Kind::Translate { offset, child } => self.eval(*child, p - v(*offset)),
-            Kind::Rotate { axis, angle, child } => {
-                let k = V3::<f64>::from(*axis).cast::<T>();
-                self.eval(*child, rotate(p, k, -s(*angle)))
-            }
+            Kind::Rotate { axis, angle, child } => match angle {
+                // A baked rotation is a constant matrix (no trigonometry per
+                // evaluation); code generation emits the same rows.
+                Scalar::Baked(a) => {
+                    let [r0, r1, r2] = rotation_rows(*axis, -a).map(|r| r.cast::<T>());
+                    self.eval(*child, v3(dot_row(r0, p), dot_row(r1, p), dot_row(r2, p)))
+                }
+                Scalar::Dynamic(_) => {
+                    let k = V3::<f64>::from(*axis).cast::<T>();
+                    self.eval(*child, rotate(p, k, -s(*angle)))
+                }
+            },
             Kind::Scale { factor, child } => {
                 let f = s(*factor);
                 let mut out = self.eval(*child, p / f);
@@ -276,6 +284,35 @@ pub fn integer_power(power: Scalar) -> Option<u32> {
         Scalar::Baked(v) if v.fract() == 0.0 && (2.0..=64.0).contains(&v) => Some(v as u32),
         _ => None,
     }
+}
+
+/// The rows of the matrix rotating by `angle` around the unit `axis`,
+/// computed in `f64`.
+///
+/// Entries within `1e-15` of 0 or ±1 are snapped to them, so quarter turns
+/// are exact permutations (and code generation can drop the zero terms).
+#[must_use]
+pub fn rotation_rows(axis: DVec3, angle: f64) -> [V3<f64>; 3] {
+    let snap = |v: f64| {
+        let r = v.round();
+        if (v - r).abs() < 1e-15 { r } else { v }
+    };
+    let m = glam::DMat3::from_axis_angle(axis, angle).transpose();
+    [m.x_axis, m.y_axis, m.z_axis].map(|row| V3::from(row).map(snap))
+}
+
+/// `row · p` as `row.x p.x + row.y p.y + row.z p.z`, left to right, leaving
+/// out zero entries (adding an exact zero changes nothing).
+fn dot_row<T: Real>(row: V3<T>, p: V3<T>) -> T {
+    let mut sum: Option<T> = None;
+    for i in 0..3 {
+        let a = row.get(i);
+        if a != T::zero() {
+            let term = a * p.get(i);
+            sum = Some(sum.map_or(term, |s| s + term));
+        }
+    }
+    sum.unwrap_or_else(T::zero)
 }
 
 /// Rotates `p` by `angle` around the unit axis `k` (Rodrigues' formula).

@@ -130,6 +130,31 @@ pub struct Estimate<T> {
     pub trap: T,
 }
 
+/// The radius beyond which a Mandelbulb orbit escapes: `bailout`, or less
+/// where `r^power` would pass [`Real::magnitude_cap`] (`1e18`). Computed in
+/// `f64`; code generation emits the same value as a literal.
+#[must_use]
+pub fn escape_radius(power: f64, bailout: f64) -> f64 {
+    bailout.min(<f64 as Real>::magnitude_cap().powf(1.0 / power))
+}
+
+/// `x^n` by binary exponentiation (the same multiplications as the OpenCL
+/// twin `pow_int`).
+#[must_use]
+pub fn pow_int<T: Real>(x: T, n: u32) -> T {
+    let mut result = T::one();
+    let mut base = x;
+    let mut e = n;
+    while e > 0 {
+        if e & 1 == 1 {
+            result = result * base;
+        }
+        base = base * base;
+        e >>= 1;
+    }
+    result
+}
+
 /// `(cos, sin)` of `n` times the angle whose cosine and sine are `(c, s)`,
 /// by binary exponentiation of `c + i s`: the trig-free integer power.
 fn angle_power<T: Real>(c: T, s: T, n: u32) -> (T, T) {
@@ -167,7 +192,10 @@ pub fn mandelbulb<T: Real>(
     // Escape before r^power passes the magnitude cap: beyond it r^power
     // overflows to infinity (and NaN), and once `dr` is capped a huge r
     // inflates the estimate.
-    let escape = bailout.min(T::magnitude_cap().powf(T::one() / power));
+    let escape = T::of(escape_radius(
+        power.to_f64().unwrap_or(f64::NAN),
+        bailout.to_f64().unwrap_or(f64::NAN),
+    ));
     for _ in 0..iterations {
         let r = z.length();
         if r > escape {
@@ -176,7 +204,7 @@ pub fn mandelbulb<T: Real>(
         trap = trap.min(r);
         // r^(power - 1), by repeated multiplication in the integer form.
         let r_pow = match integer_power {
-            Some(n) => r.powi(n as i32 - 1),
+            Some(n) => pow_int(r, n - 1),
             None => r.powf(power - T::one()),
         };
         dr = (power * r_pow * dr + T::one()).min(T::derivative_cap());
@@ -350,13 +378,15 @@ fn warp_bound<T: Real>(d: T, rho: T, stretch: impl Fn(T) -> T) -> T {
     d / stretch(rho + reach)
 }
 
-/// The distance bound of a twisted child (see [`warp_bound`]).
+/// The distance bound of a twisted child: `d / L(rho + |d| / L(rho))` with
+/// the twist stretch `L`.
 #[must_use]
 pub fn twist_bound<T: Real>(d: T, k: T, rho: T) -> T {
     warp_bound(d, rho, |r| twist_stretch(k, r))
 }
 
-/// The distance bound of a bent child (see [`warp_bound`]).
+/// The distance bound of a bent child: `d / L(rho + |d| / L(rho))` with
+/// the bend stretch `L`.
 #[must_use]
 pub fn bend_bound<T: Real>(d: T, k: T, rho: T) -> T {
     warp_bound(d, rho, |r| bend_stretch(k, r))

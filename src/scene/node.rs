@@ -269,7 +269,10 @@ pub enum Kind<S, V, C> {
     /// The twist stretches space by up to `L(rho) = t/2 + sqrt(1 + t^2/4)`,
     /// `t = |rate| rho`, at distance `rho` from the y axis; the child's
     /// distance `d` is divided by `L(rho + |d| / L(rho))`, the largest
-    /// stretch within reach, so the result stays a bound.
+    /// stretch within reach, so the result stays a bound. Far from the axis
+    /// the bound tends to `1 / |rate|` whatever the true distance: intersect
+    /// the twisted node with a bounding cylinder (the twist keeps height and
+    /// distance from the axis) to keep rays fast there.
     Twist {
         /// Radians of twist per unit along y.
         rate: S,
@@ -279,6 +282,8 @@ pub enum Kind<S, V, C> {
     /// Bends the child in the xy plane by `rate` radians per unit of x.
     /// Local stretch `L(rho) = 1 + |rate| rho` (rho: length of `p.xy`); the
     /// distance is divided by `L(rho + |d| / L(rho))`, so it stays a bound.
+    /// Far away it tends to `1 / |rate|`: intersect the bent node with a
+    /// bounding sphere (the bend keeps the distance from the origin).
     Bend {
         /// Radians of bend per unit along x.
         rate: S,

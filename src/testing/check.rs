@@ -37,6 +37,8 @@ pub enum Check {
     NeverOverestimates,
     /// `d(p)` equals the analytic distance.
     Exact,
+    /// The OpenCL twin agrees with the CPU reference (distance and colour).
+    DeviceMatchesCpu,
 }
 
 /// A broken invariant: the worst violation a checker found, and how many
@@ -86,7 +88,7 @@ impl Failure {
         }
     }
 
-    fn new(
+    pub(crate) fn new(
         check: Check,
         points: Vec<DVec3>,
         values: Vec<f64>,
@@ -156,6 +158,18 @@ impl fmt::Display for Failure {
                 self.factor(),
                 tally("balls")
             ),
+            Check::DeviceMatchesCpu => write!(
+                f,
+                "the device disagrees with the CPU reference: {} = {} on the device but {} on \
+                 the CPU at p = {} (relative error {:e} > allowed {:e}); {}",
+                self.detail,
+                v[0],
+                v[1],
+                p[0],
+                self.measured,
+                self.allowed,
+                tally("points")
+            ),
             Check::Exact => write!(
                 f,
                 "not exact: d(p) = {} but the analytic distance is {} at p = {} \
@@ -210,14 +224,14 @@ impl<F: Fn(DVec3) -> f64> DistanceField for F {
 }
 
 /// Keeps the worst of a run of violations and counts them.
-struct Tally {
+pub(crate) struct Tally {
     checked: usize,
     worst: Option<Failure>,
     violations: usize,
 }
 
 impl Tally {
-    fn new() -> Self {
+    pub(crate) fn new() -> Self {
         Tally {
             checked: 0,
             worst: None,
@@ -225,11 +239,11 @@ impl Tally {
         }
     }
 
-    fn pass(&mut self) {
+    pub(crate) fn pass(&mut self) {
         self.checked += 1;
     }
 
-    fn fail(&mut self, failure: Failure) {
+    pub(crate) fn fail(&mut self, failure: Failure) {
         self.checked += 1;
         self.violations += 1;
         if self
@@ -241,7 +255,7 @@ impl Tally {
         }
     }
 
-    fn finish(self) -> Result<(), Failure> {
+    pub(crate) fn finish(self) -> Result<(), Failure> {
         match self.worst {
             None => Ok(()),
             Some(worst) => Err(Failure {

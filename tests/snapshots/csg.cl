@@ -57,14 +57,6 @@ real2 smooth_min(real a, real b, real k) {
     return (real2)(fmin(a, b) - m * k * R(0.5), m);
 }
 
-/* ---- rotate ---- */
-/* Rotates p by angle around the unit axis k (Rodrigues' formula). */
-real3 rotate_axis(real3 p, real3 k, real angle) {
-    real c = cos(angle);
-    real s = sin(angle);
-    return p * c + cross(k, p) * s + k * (dot(k, p) * (R(1.0) - c));
-}
-
 /* ---- scene ---- */
 real DE(real3 p0, __global const real* params) {
     real3 p1 = p0 - (real3)((-1.3f), 0.0f, 0.0f);
@@ -75,7 +67,7 @@ real DE(real3 p0, __global const real* params) {
     real y3 = d1;
     real2 m3 = smooth_min(x3, y3, 0.25f);
     real d3 = m3.x;
-    real3 p3 = rotate_axis(p0, (real3)(0.0f, 1.0f, 0.0f), (-0.6f));
+    real3 p3 = (real3)(0.8253356f * p0.x + (-0.5646425f) * p0.z, p0.y, 0.5646425f * p0.x + 0.8253356f * p0.z);
     real d6 = sd_round_box(p3, (real3)(0.5f), 0.08f);
     real d7 = sd_sphere(p3, 0.62f);
     real x8 = -d6;
@@ -86,7 +78,7 @@ real DE(real3 p0, __global const real* params) {
     real y11 = d8;
     real d11 = fmin(x11, y11);
     real3 p4 = p0 - (real3)(1.3f, 0.0f, 0.0f);
-    real3 p5 = rotate_axis(p4, (real3)(1.0f, 0.0f, 0.0f), (-0.9f));
+    real3 p5 = (real3)(p4.x, 0.62161f * p4.y + 0.7833269f * p4.z, (-0.7833269f) * p4.y + 0.62161f * p4.z);
     real3 p6 = p5 - (real3)(0.0f, 0.0f, 0.3f);
     real d12 = sd_sphere(p6, 0.6f);
     real3 p7 = p5 - (real3)(0.0f, 0.0f, (-0.3f));
@@ -121,7 +113,7 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     real3 c3 = x3 < y3 ? mix(c0, c1, m3.y) : mix(c1, c0, m3.y);
     real t3 = x3 < y3 ? mix(t0, t1, m3.y) : mix(t1, t0, m3.y);
     real3 c4 = (real3)(0.95f, 0.45f, 0.2f);
-    real3 p3 = rotate_axis(p0, (real3)(0.0f, 1.0f, 0.0f), (-0.6f));
+    real3 p3 = (real3)(0.8253356f * p0.x + (-0.5646425f) * p0.z, p0.y, 0.5646425f * p0.x + 0.8253356f * p0.z);
     real d6 = sd_round_box(p3, (real3)(0.5f), 0.08f);
     real3 c6 = DEFAULT_COLOR;
     real t6 = R(1.0);
@@ -141,7 +133,7 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     real3 c11 = x11 < y11 ? c4 : c9;
     real t11 = x11 < y11 ? t3 : t8;
     real3 p4 = p0 - (real3)(1.3f, 0.0f, 0.0f);
-    real3 p5 = rotate_axis(p4, (real3)(1.0f, 0.0f, 0.0f), (-0.9f));
+    real3 p5 = (real3)(p4.x, 0.62161f * p4.y + 0.7833269f * p4.z, (-0.7833269f) * p4.y + 0.62161f * p4.z);
     real3 p6 = p5 - (real3)(0.0f, 0.0f, 0.3f);
     real d12 = sd_sphere(p6, 0.6f);
     real3 c12 = DEFAULT_COLOR;

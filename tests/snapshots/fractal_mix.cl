@@ -41,12 +41,10 @@ real sd_plane(real3 p, real3 n, real offset) {
 
 /* ---- mandelbulb ---- */
 /* Mandelbulb of any real power, with acos/atan2/sin/cos. */
-real mandelbulb(real3 p, real power, int iterations, real bailout, real* trap) {
+real mandelbulb(real3 p, real power, int iterations, real escape, real* trap) {
     real3 z = p;
     real dr = R(1.0);
     real t = R(1.0);
-    /* Escape before r^power passes MAGNITUDE_CAP (large powers and bailouts). */
-    real escape = fmin(bailout, pow(MAGNITUDE_CAP, R(1.0) / power));
     for (int i = 0; i < iterations; i++) {
         real r = length(z);
         if (r > escape) {
@@ -145,21 +143,13 @@ real2 smooth_min(real a, real b, real k) {
     return (real2)(fmin(a, b) - m * k * R(0.5), m);
 }
 
-/* ---- rotate ---- */
-/* Rotates p by angle around the unit axis k (Rodrigues' formula). */
-real3 rotate_axis(real3 p, real3 k, real angle) {
-    real c = cos(angle);
-    real s = sin(angle);
-    return p * c + cross(k, p) * s + k * (dot(k, p) * (R(1.0) - c));
-}
-
 /* ---- scene ---- */
 real DE(real3 p0, __global const real* params) {
     real3 p1 = p0 - (real3)((-1.1f), 0.0f, 0.0f);
     real3 p2 = p1 / 0.5f;
-    real3 p3 = rotate_axis(p2, (real3)(1.0f, 0.0f, 0.0f), 1.5707964f);
+    real3 p3 = (real3)(p2.x, -p2.z, p2.y);
     real t0;
-    real d0 = mandelbulb(p3, params[0], 8, 2.0f, &t0);
+    real d0 = mandelbulb(p3, params[0], 8, fmin(2.0f, pow(MAGNITUDE_CAP, R(1.0) / params[0])), &t0);
     real d2 = d0 * 0.5f;
     real3 p4 = p0 - (real3)(0.0f, 0.0f, (-0.6f));
     real3 p5 = p4 / 0.45f;
@@ -203,9 +193,9 @@ real DE(real3 p0, __global const real* params) {
 real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     real3 p1 = p0 - (real3)((-1.1f), 0.0f, 0.0f);
     real3 p2 = p1 / 0.5f;
-    real3 p3 = rotate_axis(p2, (real3)(1.0f, 0.0f, 0.0f), 1.5707964f);
+    real3 p3 = (real3)(p2.x, -p2.z, p2.y);
     real t0;
-    real d0 = mandelbulb(p3, params[0], 8, 2.0f, &t0);
+    real d0 = mandelbulb(p3, params[0], 8, fmin(2.0f, pow(MAGNITUDE_CAP, R(1.0) / params[0])), &t0);
     real3 c0 = DEFAULT_COLOR;
     real d2 = d0 * 0.5f;
     real3 c3 = (real3)(0.9f, 0.55f, 0.3f);

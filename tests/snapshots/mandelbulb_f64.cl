@@ -23,73 +23,70 @@ typedef double4 real4;
 #define AO_STEP 0.05
 #define SHADOW_STEPS 256
 
-/* ---- angle_power ---- */
-/* (cos, sin) of n times the angle whose cosine and sine are (c, s):
-   binary exponentiation of c + i s, the trig-free integer power. */
-real2 angle_power(real c, real s, int n) {
-    real rc = R(1.0), rs = R(0.0);
-    real bc = c, bs = s;
-    for (int e = n; e > 0; e >>= 1) {
-        if (e & 1) {
-            real t = rc * bc - rs * bs;
-            rs = rc * bs + rs * bc;
-            rc = t;
-        }
-        real u = bc * bc - bs * bs;
-        bs = R(2.0) * bc * bs;
-        bc = u;
-    }
-    return (real2)(rc, rs);
-}
-
-/* ---- mandelbulb_int ---- */
-/* Mandelbulb of integer power n, trig-free (see angle_power). */
-real mandelbulb_int(real3 p, int n, int iterations, real bailout, real* trap) {
+/* ---- mandelbulb_p8 ---- */
+/* Mandelbulb of power 8, unrolled: no loop over the power, no trigonometry. */
+real mandelbulb_p8(real3 p, int iterations, real escape, real* trap) {
     real3 z = p;
     real dr = R(1.0);
     real t = R(1.0);
-    /* Escape before r^power passes MAGNITUDE_CAP (large powers and bailouts). */
-    real escape = fmin(bailout, pow(MAGNITUDE_CAP, R(1.0) / (real)n));
     for (int i = 0; i < iterations; i++) {
         real r = length(z);
         if (r > escape) {
             break;
         }
         t = fmin(t, r);
-        real r_pow = pown(r, n - 1);
-        dr = fmin((real)n * r_pow * dr + R(1.0), DERIVATIVE_CAP);
+        real qb0 = r * r;
+        real qr1 = r * qb0;
+        real qb1 = qb0 * qb0;
+        real qr2 = qr1 * qb1;
+        real r_pow = qr2;
+        dr = fmin(R(8.0) * r_pow * dr + R(1.0), DERIVATIVE_CAP);
         real zr = r_pow * r;
         real rho = hypot(z.x, z.y);
         real inv_r = R(1.0) / fmax(r, REAL_TINY);
-        real2 th = angle_power(z.z * inv_r, rho * inv_r, n);
-        real2 ph = rho > REAL_TINY ? angle_power(z.x / rho, z.y / rho, n) : (real2)(R(1.0), R(0.0));
-        z = (real3)(th.y * ph.x, th.y * ph.y, th.x) * zr + p;
+        real ct = z.z * inv_r;
+        real st = rho * inv_r;
+        real cp = R(1.0);
+        real sp = R(0.0);
+        if (rho > REAL_TINY) {
+            cp = z.x / rho;
+            sp = z.y / rho;
+        }
+        real thbc0 = ct * ct - st * st;
+        real thbs0 = R(2.0) * ct * st;
+        real thbc1 = thbc0 * thbc0 - thbs0 * thbs0;
+        real thbs1 = R(2.0) * thbc0 * thbs0;
+        real thbc2 = thbc1 * thbc1 - thbs1 * thbs1;
+        real thbs2 = R(2.0) * thbc1 * thbs1;
+        real thc = thbc2;
+        real ths = thbs2;
+        real phbc0 = cp * cp - sp * sp;
+        real phbs0 = R(2.0) * cp * sp;
+        real phbc1 = phbc0 * phbc0 - phbs0 * phbs0;
+        real phbs1 = R(2.0) * phbc0 * phbs0;
+        real phbc2 = phbc1 * phbc1 - phbs1 * phbs1;
+        real phbs2 = R(2.0) * phbc1 * phbs1;
+        real phc = phbc2;
+        real phs = phbs2;
+        z = (real3)(ths * phc, ths * phs, thc) * zr + p;
     }
     real r = length(z);
     *trap = t;
     return R(0.5) * log(fmax(r, REAL_TINY)) * r / dr;
 }
 
-/* ---- rotate ---- */
-/* Rotates p by angle around the unit axis k (Rodrigues' formula). */
-real3 rotate_axis(real3 p, real3 k, real angle) {
-    real c = cos(angle);
-    real s = sin(angle);
-    return p * c + cross(k, p) * s + k * (dot(k, p) * (R(1.0) - c));
-}
-
 /* ---- scene ---- */
 real DE(real3 p0, __global const real* params) {
-    real3 p1 = rotate_axis(p0, (real3)(1.0, 0.0, 0.0), 1.5707963267948966);
+    real3 p1 = (real3)(p0.x, -p0.z, p0.y);
     real t0;
-    real d0 = mandelbulb_int(p1, 8, 10, 2.0, &t0);
+    real d0 = mandelbulb_p8(p1, 10, 2.0, &t0);
     return d0;
 }
 
 real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
-    real3 p1 = rotate_axis(p0, (real3)(1.0, 0.0, 0.0), 1.5707963267948966);
+    real3 p1 = (real3)(p0.x, -p0.z, p0.y);
     real t0;
-    real d0 = mandelbulb_int(p1, 8, 10, 2.0, &t0);
+    real d0 = mandelbulb_p8(p1, 10, 2.0, &t0);
     real3 c0 = DEFAULT_COLOR;
     real3 c2 = (real3)(0.9, 0.6, 0.35);
     *color = c2;

@@ -55,17 +55,9 @@ real menger(real3 p, int iterations, real scale, real* trap) {
     return sd_box(z, (real3)(R(1.0))) / s;
 }
 
-/* ---- rotate ---- */
-/* Rotates p by angle around the unit axis k (Rodrigues' formula). */
-real3 rotate_axis(real3 p, real3 k, real angle) {
-    real c = cos(angle);
-    real s = sin(angle);
-    return p * c + cross(k, p) * s + k * (dot(k, p) * (R(1.0) - c));
-}
-
 /* ---- scene ---- */
 real DE(real3 p0, __global const real* params) {
-    real3 p1 = rotate_axis(p0, (real3)(0.0f, 1.0f, 0.0f), (-0.5f));
+    real3 p1 = (real3)(0.87758255f * p0.x + (-0.47942555f) * p0.z, p0.y, 0.47942555f * p0.x + 0.87758255f * p0.z);
     real t0;
     real d0 = menger(p1, 4, 3.0f, &t0);
     real d3 = sd_plane(p0, (real3)(0.0f, 1.0f, 0.0f), 1.0f);
@@ -76,7 +68,7 @@ real DE(real3 p0, __global const real* params) {
 }
 
 real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
-    real3 p1 = rotate_axis(p0, (real3)(0.0f, 1.0f, 0.0f), (-0.5f));
+    real3 p1 = (real3)(0.87758255f * p0.x + (-0.47942555f) * p0.z, p0.y, 0.47942555f * p0.x + 0.87758255f * p0.z);
     real t0;
     real d0 = menger(p1, 4, 3.0f, &t0);
     real3 c0 = DEFAULT_COLOR;
