@@ -44,6 +44,15 @@ real2 angle_power(real c, real s, int n) {
 /* ---- mandelbulb_int ---- */
 /* Mandelbulb of integer power n, trig-free (see angle_power). */
 real mandelbulb_int(real3 p, int n, int iterations, real bailout, real* trap) {
+    /* The ball of radius `ball` holds the set (proof: cpu::sdf::mandelbulb_radius);
+       beyond 1.5 times its radius (MANDELBULB_FAR_FIELD), its distance alone. */
+    real ball = pow(R(2.0), R(1.0) / (real)(n - 1));
+    real r0 = length(p);
+    real outer = r0 - ball;
+    if (r0 > R(1.5) * ball) {
+        *trap = R(1.0);
+        return outer;
+    }
     real3 z = p;
     real dr = R(1.0);
     real t = R(1.0);
@@ -66,7 +75,7 @@ real mandelbulb_int(real3 p, int n, int iterations, real bailout, real* trap) {
     }
     real r = length(z);
     *trap = t;
-    return R(0.5) * log(fmax(r, REAL_TINY)) * r / dr;
+    return fmax(R(0.5) * log(fmax(r, REAL_TINY)) * r / dr, outer);
 }
 
 /* ---- rotate ---- */
