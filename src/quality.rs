@@ -37,7 +37,9 @@ pub struct Quality {
     pub ao_step: f64,
     /// Maximum steps of each shadow ray (0: no shadows).
     pub shadow_steps: u32,
-    /// If set, every fractal uses this many iterations instead of its own.
+    /// If set, no fractal uses more than this many iterations (escape-time
+    /// iterations or folding levels): a cap, so a preset can trade detail
+    /// for speed without raising the cost of fractals that use fewer.
     pub fractal_iterations: Option<u32>,
     /// Kernel precision.
     pub precision: Precision,

@@ -129,6 +129,10 @@ fn baked_iteration_counts_are_constant_loop_bounds_and_can_be_overridden() {
     options.quality.fractal_iterations = Some(2);
     let src = source(menger(4), &options);
     assert!(src.contains("menger(p0, 2, 3.0f, &t0)"));
+    // A cap: fewer iterations than the cap stay as they are.
+    options.quality.fractal_iterations = Some(6);
+    let src = source(menger(4), &options);
+    assert!(src.contains("menger(p0, 4, 3.0f, &t0)"));
 }
 
 #[test]

@@ -16,11 +16,11 @@
 //! (`julia_interior_beyond_the_unit_ball_is_measured`). Outside
 //! that regime it is wider: power 2 with bailout 2 (whose set touches the
 //! bailout sphere) up to 1.17, and 4 iterations up to 0.82 (power 3) and
-//! 0.17 (Julia). Far from the Mandelbulb the estimate (`0.5 r ln r`
-//! beyond the bailout radius) grows faster than the distance: it first
-//! overestimates at r = 4.0 (power 3) to 4.8 (power 16), 4.7 for power 8
-//! (see `mandelbulb_far_field_is_measured`), so the band tests stay within
-//! r = 3.8.
+//! 0.17 (Julia). Far from the Mandelbulb the raw escape-time estimate
+//! (`0.5 r ln r` beyond the bailout radius) grows faster than the
+//! distance; beyond 1.5 times the radius of its proven bounding ball the
+//! estimator returns the distance to that ball instead
+//! (`mandelbulb_far_field_never_overestimates`).
 
 mod common;
 
@@ -127,8 +127,7 @@ proptest! {
     }
 
     /// Integer and non-integer powers, baked (integer powers take the
-    /// trig-free form) or dynamic (always trigonometric), within 3.8 of the
-    /// origin.
+    /// trig-free form) or dynamic (always trigonometric), near and far.
     #[test]
     fn mandelbulb_never_overestimates_outside_the_surface_band(
         power in prop_oneof![(3u32..=16).prop_map(f64::from), 3.0..16.0f64],
@@ -142,7 +141,7 @@ proptest! {
         let eval = cpu::Evaluator::new(&node)?;
         let points: Vec<_> = points
             .into_iter()
-            .filter(|&p| p.length() <= 3.8 && eval.distance(p) >= SURFACE_BAND)
+            .filter(|&p| eval.distance(p) >= SURFACE_BAND)
             .collect();
         let inside = |p| mandelbulb_inside(p, power, iterations, bailout);
         check_never_overestimates(&eval, inside, &points, 16)?;
@@ -421,38 +420,86 @@ fn directions(n: u32) -> impl Iterator<Item = DVec3> {
     })
 }
 
-/// Far from the Mandelbulb its estimate is `0.5 r ln r` (beyond the
-/// bailout radius), which grows faster than the distance. (0, 0, 0.66) is
-/// in the power-8 set, so the distance from (0, 0, r) is at most
-/// `r - 0.66`. Measured along +z (power 8, bailout 2):
-///
-/// | r | estimate | `r - 0.66` |
-/// |---|---|---|
-/// | 5 | 4.02 | 4.34 |
-/// | 7 | 6.81 | 6.34 (a ray from here towards the origin lands inside) |
-/// | 10 | 11.51 | 9.34 (a ray from here misses the bulb) |
-/// | 1e6 | 6.9e6 | 1e6 |
-///
-/// In every direction the first overestimate is at r = 4.7 for power 8
-/// (4.0 for power 3, 4.8 for power 16). This test holds the sound range
-/// and records the unsound one; rays must start within it (or be clipped
-/// to a bounding sphere).
+/// Far from the Mandelbulb the raw escape-time estimate is `0.5 r ln r`
+/// (beyond the bailout radius), which grows faster than the distance. It
+/// used to be returned as is: along +z (power 8, bailout 2), where
+/// (0, 0, 0.66) is in the set so the distance is at most `r - 0.66`, it
+/// gave 11.5 at r = 10 (a ray from there missed the bulb) and 6.9e6 at
+/// r = 1e6, and it first overestimated at r = 4.0 (power 3) to 4.8
+/// (power 16). Now, beyond 1.5 times the radius `2^(1/(n-1))` of the
+/// proven bounding ball, the estimator returns the distance to that ball.
 #[test]
-fn mandelbulb_far_field_is_measured() {
+fn mandelbulb_far_field_never_overestimates() {
     let inside = |p| mandelbulb_inside(p, 8.0, 12, 2.0);
     assert!(inside(dvec3(0.0, 0.0, 0.66)));
     let eval = cpu::Evaluator::new(&fixtures::mandelbulb_scene()).unwrap();
     let shell = |r: f64| -> Vec<DVec3> { directions(400).map(|u| u * r).collect() };
-    for r in [1.5, 2.0, 2.5, 3.0, 3.5, 4.0, 4.5] {
+    for r in [1.5, 2.0, 3.0, 4.5, 5.0, 7.0, 10.0, 100.0, 1e6] {
         if let Err(e) = check_never_overestimates(&eval, inside, &shell(r), 8) {
             panic!("at r = {r}: {e}");
         }
     }
-    let err = check_never_overestimates(&eval, inside, &shell(10.0), 8)
-        .expect_err("the far-field estimate changed: update the docs");
-    assert!(err.factor() > 1.1, "{err}");
-    let along_z = eval.distance(dvec3(0.0, 0.0, 10.0));
-    assert!(along_z > 10.0 - 0.66, "{along_z}");
+    for r in [5.0, 7.0, 10.0, 1e6] {
+        let along_z = eval.distance(dvec3(0.0, 0.0, r));
+        assert!(along_z <= r - 0.66, "at r = {r}: {along_z}");
+    }
+    // The bound is the ball's exact distance, so rays from far away lose
+    // nothing: one step from r = 1e6 lands on the ball.
+    let ball = sdf::mandelbulb_radius(8.0);
+    assert!((ball - 2f64.powf(1.0 / 7.0)).abs() < 1e-15);
+    let far = eval.distance(dvec3(0.0, 0.0, 1e6));
+    assert!((far - (1e6 - ball)).abs() < 1e-6, "{far}");
+    // A ray from r = 10 towards the origin reaches the surface where a ray
+    // from r = 3 does (it used to jump past the bulb).
+    let settings = cpu::MarchSettings {
+        epsilon: 1e-6,
+        ..cpu::MarchSettings::default()
+    };
+    let ray = |z: f64| cpu::Ray {
+        origin: dvec3(0.1, 0.05, z),
+        direction: dvec3(0.0, 0.0, -1.0),
+    };
+    let (from_far, from_near) = (
+        cpu::march(&eval, ray(10.0), &settings),
+        cpu::march(&eval, ray(3.0), &settings),
+    );
+    assert!(from_far.hit && from_near.hit);
+    assert!(
+        ((from_far.depth - 7.0) - from_near.depth).abs() < 1e-4,
+        "{from_far:?} vs {from_near:?}"
+    );
+}
+
+/// The bounding ball's lemma, checked: from just outside the ball every
+/// orbit grows at each step (so it never stays bounded and the estimate is
+/// positive there), for powers 2 to 64; the estimate is positive on the
+/// ball for bailouts 1 to 1e6 from one iteration up; far away the distance
+/// is the ball's.
+#[test]
+fn mandelbulb_bounding_ball_holds_the_set() {
+    for power in [2.0, 3.0, 7.5, 16.0, 64.0] {
+        let ball = sdf::mandelbulb_radius(power);
+        for u in directions(200) {
+            let p = u * (ball * (1.0 + 1e-9));
+            // Every |z_k| (k = 1..=8) exceeds |z_0| = |p|.
+            assert!(!mandelbulb_inside(p, power, 8, p.length()), "n={power} {p}");
+        }
+        for bailout in [1.0, 2.0, 1e6] {
+            for iterations in [1, 4, 12, 64] {
+                let node: Node = Mandelbulb::new(power)
+                    .iterations(iterations)
+                    .bailout(bailout)
+                    .into();
+                let eval = cpu::Evaluator::new(&node).unwrap();
+                for u in directions(50) {
+                    let near = eval.distance(u * (ball * (1.0 + 1e-9)));
+                    assert!(near > 0.0, "n={power} B={bailout} N={iterations}: {near}");
+                    let far = eval.distance(u * (ball * 3.0));
+                    assert!((far - 2.0 * ball).abs() <= 1e-12 * ball, "{far}");
+                }
+            }
+        }
+    }
 }
 
 /// For a constant outside the Mandelbrot set the Julia set is dust, and

@@ -2,6 +2,8 @@
 //! print what it cost.
 #![allow(dead_code)] // each example uses a different subset
 
+pub mod measure;
+
 use std::time::Instant;
 
 use fractal_sdf::prelude::*;

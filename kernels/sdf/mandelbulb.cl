@@ -1,5 +1,14 @@
 /* Mandelbulb of any real power, with acos/atan2/sin/cos. */
 real mandelbulb(real3 p, real power, int iterations, real escape, real* trap) {
+    /* The ball of radius `ball` holds the set (proof: cpu::sdf::mandelbulb_radius);
+       beyond 1.5 times its radius (MANDELBULB_FAR_FIELD), its distance alone. */
+    real ball = pow(R(2.0), R(1.0) / (power - R(1.0)));
+    real r0 = length(p);
+    real outer = r0 - ball;
+    if (r0 > R(1.5) * ball) {
+        *trap = R(1.0);
+        return outer;
+    }
     real3 z = p;
     real dr = R(1.0);
     real t = R(1.0);
@@ -19,5 +28,5 @@ real mandelbulb(real3 p, real power, int iterations, real escape, real* trap) {
     }
     real r = length(z);
     *trap = t;
-    return R(0.5) * log(fmax(r, REAL_TINY)) * r / dr;
+    return fmax(R(0.5) * log(fmax(r, REAL_TINY)) * r / dr, outer);
 }

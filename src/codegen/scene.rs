@@ -75,9 +75,13 @@ impl<'a> SceneEmitter<'a> {
         name
     }
 
+    /// A fractal's iteration count under [`Quality::fractal_iterations`]
+    /// (a cap), kept within the fractal's valid range.
+    ///
+    /// [`Quality::fractal_iterations`]: crate::quality::Quality::fractal_iterations
     fn iterations(&self, own: u32, (min, max): (u32, u32)) -> u32 {
         self.iteration_override
-            .map_or(own, |n| n.clamp(min.max(1), max))
+            .map_or(own, |cap| own.min(cap).clamp(min, max))
     }
 
     /// A leaf: its distance expression, default colour, trap 1.

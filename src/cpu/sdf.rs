@@ -171,13 +171,49 @@ fn angle_power<T: Real>(c: T, s: T, n: u32) -> (T, T) {
     (rc, rs)
 }
 
-/// The Mandelbulb distance estimate `0.5 ln(r) r / dr`.
+/// The radius `2^(1 / (power - 1))` of the ball that holds the Mandelbulb
+/// of `power`, and every point where its estimate is at most 0, for any
+/// number of iterations and any bailout.
+///
+/// Proof. The power map scales lengths exactly, `|z^n| = |z|^n` (it is a
+/// unit direction times `r^n`). Let `|p| > rho`, so `|p|^(n-1) > 2`. If
+/// `|z_k| >= |p|` (true for `z_0 = p`), then `|z_(k+1)| = |z_k^n + p| >=
+/// |z_k|^n - |p| >= |z_k| (|z_k|^(n-1) - 1) >= |z_k| (|p|^(n-1) - 1) >
+/// |z_k|`. So the orbit grows strictly (and without bound): it never stays
+/// bounded, and wherever the iteration stops (escaped or not) `|z| > |p| >
+/// 1`, so `ln |z| > 0` and the estimate is positive. Hence for `|p| > rho`
+/// the distance to the set is at least `|p| - rho`.
+#[must_use]
+pub fn mandelbulb_radius<T: Real>(power: T) -> T {
+    T::of(2.0).powf(T::one() / (power - T::one()))
+}
+
+/// Beyond `MANDELBULB_FAR_FIELD` times [`mandelbulb_radius`] the
+/// Mandelbulb's distance is the distance to its bounding ball alone.
+///
+/// The escape-time estimate grows like `0.5 r ln r` far from the set, faster
+/// than the distance: it overestimates from about 4 to 5 times the radius
+/// (measured over powers 2 to 64, bailouts 1 to 1e6, 4 to 32 iterations; 2
+/// times for power 2). At 1.5 times the ball bound is as large as the
+/// estimate for power 8, and the estimate is sound there for every power.
+pub const MANDELBULB_FAR_FIELD: f64 = 1.5;
+
+/// The Mandelbulb distance estimate `0.5 ln(r) r / dr`, bounded by the
+/// ball that holds the set.
 ///
 /// `integer_power` selects the trig-free form (`Some(n)` must equal
 /// `power`); otherwise the map uses `acos`/`atan2`/`sin`/`cos`. The orbit
 /// trap is the smallest `|z|` reached, clamped to `[0, 1]`. The orbit
 /// escapes beyond `bailout`, or sooner if `r^power` would pass
 /// [`Real::magnitude_cap`] (only for large powers and bailouts).
+///
+/// With `rho` = [`mandelbulb_radius`] and `outer = |p| - rho` (a proven
+/// lower bound of the distance outside the ball, and an upper bound of the
+/// depth inside it): beyond [`MANDELBULB_FAR_FIELD`]` * rho` the result is
+/// `outer` and the trap 1 (what the orbit gives there, as `|z| > 1`), with
+/// no iteration; nearer, it is `max(estimate, outer)`. The maximum of two
+/// lower bounds is one, so rays from far away land on the ball instead of
+/// overshooting the set.
 #[must_use]
 pub fn mandelbulb<T: Real>(
     p: V3<T>,
@@ -186,6 +222,15 @@ pub fn mandelbulb<T: Real>(
     bailout: T,
     integer_power: Option<u32>,
 ) -> Estimate<T> {
+    let ball = mandelbulb_radius(power);
+    let r0 = p.length();
+    let outer = r0 - ball;
+    if r0 > T::of(MANDELBULB_FAR_FIELD) * ball {
+        return Estimate {
+            distance: outer,
+            trap: T::one(),
+        };
+    }
     let mut z = p;
     let mut dr = T::one();
     let mut trap = T::one();
@@ -231,7 +276,7 @@ pub fn mandelbulb<T: Real>(
     }
     let r = z.length();
     Estimate {
-        distance: T::of(0.5) * r.max(T::tiny()).ln() * r / dr,
+        distance: (T::of(0.5) * r.max(T::tiny()).ln() * r / dr).max(outer),
         trap,
     }
 }

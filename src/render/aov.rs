@@ -20,6 +20,12 @@ pub struct Frame {
     /// Distance evaluations of the primary march, summed over the pixel's
     /// colour samples (a per-pixel cost map).
     pub steps: Vec<u32>,
+    /// Every distance evaluation the pixel's colour cost, summed over its
+    /// samples: the primary march, the normal (4), the step onto the
+    /// surface (1), the colour lookup (1), ambient occlusion and shadow
+    /// rays. With supersampling, the extra march through the pixel centre
+    /// that the other outputs need is not counted.
+    pub evaluations: Vec<u32>,
 }
 
 impl Frame {
@@ -50,6 +56,18 @@ impl Frame {
         y as usize * self.width() as usize + x as usize
     }
 
+    /// The mean of [`Frame::evaluations`]: distance evaluations per pixel.
+    #[must_use]
+    pub fn mean_evaluations(&self) -> f64 {
+        mean(&self.evaluations)
+    }
+
+    /// The mean of [`Frame::steps`]: primary-march steps per pixel.
+    #[must_use]
+    pub fn mean_steps(&self) -> f64 {
+        mean(&self.steps)
+    }
+
     /// The fraction of pixels whose centre ray hit a surface.
     #[must_use]
     pub fn coverage(&self) -> f64 {
@@ -60,4 +78,13 @@ impl Frame {
         let covered = self.hit.iter().filter(|&&h| h).count() as f64 / self.hit.len() as f64;
         covered
     }
+}
+
+fn mean(values: &[u32]) -> f64 {
+    if values.is_empty() {
+        return 0.0;
+    }
+    #[allow(clippy::cast_precision_loss)]
+    let mean = values.iter().map(|&v| f64::from(v)).sum::<f64>() / values.len() as f64;
+    mean
 }

@@ -64,6 +64,7 @@ mod arg {
     pub const HIT: u32 = 13;
     pub const NORMALS: u32 = 14;
     pub const STEPS: u32 = 15;
+    pub const EVALUATIONS: u32 = 16;
 }
 
 const KERNEL_NAME: &str = "render_tile";
@@ -205,7 +206,7 @@ impl Renderer {
     }
 
     /// Renders a `width` × `height` image with depth, hit mask, normal and
-    /// step-count outputs (see [`Frame`]).
+    /// cost outputs (see [`Frame`]).
     ///
     /// # Errors
     /// As [`Renderer::render`].
@@ -219,11 +220,13 @@ impl Renderer {
         let mut hit = host_vec::<u8>(width, height, 1)?;
         let mut normals = host_vec::<f32>(width, height, 3)?;
         let mut steps = host_vec::<u32>(width, height, 1)?;
+        let mut evaluations = host_vec::<u32>(width, height, 1)?;
         t.rgba.read(&mut rgba).enq().map_err(opencl)?;
         t.depth.read(&mut depth).enq().map_err(opencl)?;
         t.hit.read(&mut hit).enq().map_err(opencl)?;
         t.normals.read(&mut normals).enq().map_err(opencl)?;
         t.steps.read(&mut steps).enq().map_err(opencl)?;
+        t.evaluations.read(&mut evaluations).enq().map_err(opencl)?;
         self.record_timing(start, read, kernel);
         Ok(Frame {
             image: RgbaImage::from_raw(width, height, rgba)
@@ -235,6 +238,7 @@ impl Renderer {
                 .map(|n| [n[0], n[1], n[2]])
                 .collect(),
             steps,
+            evaluations,
         })
     }
 
@@ -450,6 +454,8 @@ impl Renderer {
         k.set_arg(arg::HIT, &t.hit).map_err(opencl)?;
         k.set_arg(arg::NORMALS, &t.normals).map_err(opencl)?;
         k.set_arg(arg::STEPS, &t.steps).map_err(opencl)?;
+        k.set_arg(arg::EVALUATIONS, &t.evaluations)
+            .map_err(opencl)?;
         let launched = Instant::now();
         let mut events = Vec::new();
         for tile in dispatch::tiles(width, height, self.options.tile_size) {
@@ -612,7 +618,8 @@ fn make_kernel(program: &Program, queue: &Queue, inputs: &Inputs, t: &Targets) -
         .arg(&t.depth)
         .arg(&t.hit)
         .arg(&t.normals)
-        .arg(&t.steps);
+        .arg(&t.steps)
+        .arg(&t.evaluations);
     b.build().map_err(opencl)
 }
 
@@ -692,6 +699,7 @@ struct Targets {
     hit: Buffer<u8>,
     normals: Buffer<f32>,
     steps: Buffer<u32>,
+    evaluations: Buffer<u32>,
 }
 
 impl Targets {
@@ -707,6 +715,7 @@ impl Targets {
             hit: output(queue, aov_pixels)?,
             normals: output(queue, aov_pixels * 3)?,
             steps: output(queue, aov_pixels)?,
+            evaluations: output(queue, aov_pixels)?,
         })
     }
 
@@ -714,7 +723,7 @@ impl Targets {
     fn bytes(width: u32, height: u32, aovs: bool) -> Vec<u64> {
         let pixels = u64::from(width) * u64::from(height);
         let aov = if aovs { pixels } else { 1 };
-        vec![pixels * 4, aov * 4, aov, aov * 12, aov * 4]
+        vec![pixels * 4, aov * 4, aov, aov * 12, aov * 4, aov * 4]
     }
 
     fn fits(&self, width: u32, height: u32, aovs: bool) -> bool {
@@ -762,7 +771,7 @@ mod tests {
         let err = check_device_memory(&device, 3840, 2160, true).unwrap_err();
         assert!(
             err.to_string()
-                .contains("198 MiB but `Small / gpu` has 128 MiB"),
+                .contains("230 MiB but `Small / gpu` has 128 MiB"),
             "{err}"
         );
     }

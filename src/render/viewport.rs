@@ -54,11 +54,14 @@ impl Viewport {
     /// The pixel footprint at distance `t` along a ray is
     /// `base + per_unit · t`. A perspective camera's `per_unit` is the
     /// height of a pixel at unit distance, `2·tan(fov/2) / height`; its
-    /// `base` is a floor that keeps the hit threshold above zero at `t = 0`:
-    /// the scene scale (camera distance from the origin plus distance to
-    /// its target) times 1e-6 in `F32` and 1e-12 in `F64`, about eight ulps
-    /// of a coordinate of that size. An orthographic camera's footprint is
-    /// the constant `height / pixels`.
+    /// `base` is a floor that keeps the hit threshold above zero at `t = 0`
+    /// and above the rounding of the positions the kernel evaluates: eight
+    /// units in the last place ([`Viewport::relative_floor`]) of the scene
+    /// scale, the camera's distance from the origin plus its distance to
+    /// its target. Both terms scale with the scene, so a scene scaled by
+    /// `s` and seen from `s` times as far has thresholds `s` times as
+    /// large. An orthographic camera's footprint is the constant
+    /// `height / pixels`.
     ///
     /// # Errors
     /// [`Error::Camera`] for a degenerate camera, [`Error::Resolution`] if a
@@ -74,10 +77,7 @@ impl Viewport {
         let (right, up, forward) = camera.basis()?;
         let aspect = f64::from(width) / f64::from(height);
         let scale = camera.position.length() + (camera.target - camera.position).length();
-        let relative_floor = match precision {
-            Precision::F32 => 1e-6,
-            Precision::F64 => 1e-12,
-        };
+        let relative_floor = Self::relative_floor(precision);
         let (half_h, orthographic, footprint_base, footprint_per_unit) = match camera.projection {
             Projection::Perspective { fov_y_degrees } => {
                 let half_h = (fov_y_degrees.to_radians() * 0.5).tan();
@@ -101,6 +101,26 @@ impl Viewport {
             width,
             height,
         })
+    }
+
+    /// Eight units in the last place of a number in `[1, 2)` in the
+    /// kernel's precision: `2^-20` (about 9.5e-7) in `F32`, `2^-49` (about
+    /// 1.8e-15) in `F64`. Times the scene scale it is the smallest footprint
+    /// a [`Viewport`] uses: positions are rounded to about a sixteenth of
+    /// it, so a deep zoom can resolve detail down to it and no further.
+    ///
+    /// ```
+    /// use fractal_sdf::prelude::*;
+    /// use fractal_sdf::render::Viewport;
+    /// assert_eq!(Viewport::relative_floor(Precision::F32), 8.0 * f64::from(f32::EPSILON));
+    /// assert_eq!(Viewport::relative_floor(Precision::F64), 8.0 * f64::EPSILON);
+    /// ```
+    #[must_use]
+    pub fn relative_floor(precision: Precision) -> f64 {
+        match precision {
+            Precision::F32 => 8.0 * f64::from(f32::EPSILON),
+            Precision::F64 => 8.0 * f64::EPSILON,
+        }
     }
 
     /// The ray through image position `(x, y)` in pixels, `(0, 0)` being the

@@ -52,53 +52,6 @@ real sd_plane(real3 p, real3 n, real offset) {
     return dot(p, n) + offset;
 }
 
-/* ---- angle_power ---- */
-/* (cos, sin) of n times the angle whose cosine and sine are (c, s):
-   binary exponentiation of c + i s, the trig-free integer power. */
-real2 angle_power(real c, real s, int n) {
-    real rc = R(1.0), rs = R(0.0);
-    real bc = c, bs = s;
-    for (int e = n; e > 0; e >>= 1) {
-        if (e & 1) {
-            real t = rc * bc - rs * bs;
-            rs = rc * bs + rs * bc;
-            rc = t;
-        }
-        real u = bc * bc - bs * bs;
-        bs = R(2.0) * bc * bs;
-        bc = u;
-    }
-    return (real2)(rc, rs);
-}
-
-/* ---- mandelbulb_int ---- */
-/* Mandelbulb of integer power n, trig-free (see angle_power). */
-real mandelbulb_int(real3 p, int n, int iterations, real bailout, real* trap) {
-    real3 z = p;
-    real dr = R(1.0);
-    real t = R(1.0);
-    /* Escape before r^power passes MAGNITUDE_CAP (large powers and bailouts). */
-    real escape = fmin(bailout, pow(MAGNITUDE_CAP, R(1.0) / (real)n));
-    for (int i = 0; i < iterations; i++) {
-        real r = length(z);
-        if (r > escape) {
-            break;
-        }
-        t = fmin(t, r);
-        real r_pow = pown(r, n - 1);
-        dr = fmin((real)n * r_pow * dr + R(1.0), DERIVATIVE_CAP);
-        real zr = r_pow * r;
-        real rho = hypot(z.x, z.y);
-        real inv_r = R(1.0) / fmax(r, REAL_TINY);
-        real2 th = angle_power(z.z * inv_r, rho * inv_r, n);
-        real2 ph = rho > REAL_TINY ? angle_power(z.x / rho, z.y / rho, n) : (real2)(R(1.0), R(0.0));
-        z = (real3)(th.y * ph.x, th.y * ph.y, th.x) * zr + p;
-    }
-    real r = length(z);
-    *trap = t;
-    return R(0.5) * log(fmax(r, REAL_TINY)) * r / dr;
-}
-
 /* ---- menger ---- */
 /* Menger sponge, KIFS form: fold, scale about the kept cube, box bound. */
 real menger(real3 p, int iterations, real scale, real* trap) {
@@ -132,21 +85,72 @@ real2 smooth_min(real a, real b, real k) {
     return (real2)(fmin(a, b) - m * k * R(0.5), m);
 }
 
-/* ---- rotate ---- */
-/* Rotates p by angle around the unit axis k (Rodrigues' formula). */
-real3 rotate_axis(real3 p, real3 k, real angle) {
-    real c = cos(angle);
-    real s = sin(angle);
-    return p * c + cross(k, p) * s + k * (dot(k, p) * (R(1.0) - c));
+/* ---- mandelbulb_p8 ---- */
+/* Mandelbulb of power 8, unrolled: no loop over the power, no trigonometry. */
+real mandelbulb_p8(real3 p, int iterations, real escape, real* trap) {
+    real ball = pow(R(2.0), R(1.0) / R(7.0));
+    real r0 = length(p);
+    real outer = r0 - ball;
+    if (r0 > R(1.5) * ball) {
+        *trap = R(1.0);
+        return outer;
+    }
+    real3 z = p;
+    real dr = R(1.0);
+    real t = R(1.0);
+    for (int i = 0; i < iterations; i++) {
+        real r = length(z);
+        if (r > escape) {
+            break;
+        }
+        t = fmin(t, r);
+        real qb0 = r * r;
+        real qr1 = r * qb0;
+        real qb1 = qb0 * qb0;
+        real qr2 = qr1 * qb1;
+        real r_pow = qr2;
+        dr = fmin(R(8.0) * r_pow * dr + R(1.0), DERIVATIVE_CAP);
+        real zr = r_pow * r;
+        real rho = hypot(z.x, z.y);
+        real inv_r = R(1.0) / fmax(r, REAL_TINY);
+        real ct = z.z * inv_r;
+        real st = rho * inv_r;
+        real cp = R(1.0);
+        real sp = R(0.0);
+        if (rho > REAL_TINY) {
+            cp = z.x / rho;
+            sp = z.y / rho;
+        }
+        real thbc0 = ct * ct - st * st;
+        real thbs0 = R(2.0) * ct * st;
+        real thbc1 = thbc0 * thbc0 - thbs0 * thbs0;
+        real thbs1 = R(2.0) * thbc0 * thbs0;
+        real thbc2 = thbc1 * thbc1 - thbs1 * thbs1;
+        real thbs2 = R(2.0) * thbc1 * thbs1;
+        real thc = thbc2;
+        real ths = thbs2;
+        real phbc0 = cp * cp - sp * sp;
+        real phbs0 = R(2.0) * cp * sp;
+        real phbc1 = phbc0 * phbc0 - phbs0 * phbs0;
+        real phbs1 = R(2.0) * phbc0 * phbs0;
+        real phbc2 = phbc1 * phbc1 - phbs1 * phbs1;
+        real phbs2 = R(2.0) * phbc1 * phbs1;
+        real phc = phbc2;
+        real phs = phbs2;
+        z = (real3)(ths * phc, ths * phs, thc) * zr + p;
+    }
+    real r = length(z);
+    *trap = t;
+    return fmax(R(0.5) * log(fmax(r, REAL_TINY)) * r / dr, outer);
 }
 
 /* ---- scene ---- */
 real DE(real3 p0, __global const real* params) {
     real3 p1 = p0 - (real3)(0.0f, 0.05f, 0.0f);
     real3 p2 = p1 / 0.6f;
-    real3 p3 = rotate_axis(p2, (real3)(1.0f, 0.0f, 0.0f), 1.5707964f);
+    real3 p3 = (real3)(p2.x, -p2.z, p2.y);
     real t0;
-    real d0 = mandelbulb_int(p3, 8, 8, 2.0f, &t0);
+    real d0 = mandelbulb_p8(p3, 8, 2.0f, &t0);
     real d2 = d0 * 0.6f;
     real3 p4 = p0 - (real3)(0.0f, (-0.75f), 0.0f);
     real d5 = sd_cylinder(p4, 0.35f, 0.2f);
@@ -160,7 +164,7 @@ real DE(real3 p0, __global const real* params) {
     real y11 = d8;
     real d11 = fmin(x11, y11);
     real3 p6 = p0 - (real3)((-1.5f), (-0.55f), (-0.3f));
-    real3 p7 = rotate_axis(p6, (real3)(0.0f, 1.0f, 0.0f), (-0.4f));
+    real3 p7 = (real3)(0.921061f * p6.x + (-0.38941833f) * p6.z, p6.y, 0.38941833f * p6.x + 0.921061f * p6.z);
     real3 p8 = p7 / 0.4f;
     real t12;
     real d12 = menger(p8, 3, 3.0f, &t12);
@@ -169,7 +173,7 @@ real DE(real3 p0, __global const real* params) {
     real y17 = d13;
     real d17 = fmin(x17, y17);
     real3 p9 = p0 - (real3)(1.5f, (-0.5f), (-0.2f));
-    real3 p10 = rotate_axis(p9, (real3)(1.0f, 0.0f, 0.0f), (-1.2f));
+    real3 p10 = (real3)(p9.x, 0.36235777f * p9.y + 0.9320391f * p9.z, (-0.9320391f) * p9.y + 0.36235777f * p9.z);
     real d18 = sd_torus(p10, 0.35f, 0.1f);
     real x22 = d17;
     real y22 = d18;
@@ -189,9 +193,9 @@ real DE(real3 p0, __global const real* params) {
 real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     real3 p1 = p0 - (real3)(0.0f, 0.05f, 0.0f);
     real3 p2 = p1 / 0.6f;
-    real3 p3 = rotate_axis(p2, (real3)(1.0f, 0.0f, 0.0f), 1.5707964f);
+    real3 p3 = (real3)(p2.x, -p2.z, p2.y);
     real t0;
-    real d0 = mandelbulb_int(p3, 8, 8, 2.0f, &t0);
+    real d0 = mandelbulb_p8(p3, 8, 2.0f, &t0);
     real3 c0 = DEFAULT_COLOR;
     real d2 = d0 * 0.6f;
     real3 c3 = (real3)(0.9f, 0.6f, 0.35f);
@@ -216,7 +220,7 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     real3 c11 = x11 < y11 ? c3 : c9;
     real t11 = x11 < y11 ? t0 : t8;
     real3 p6 = p0 - (real3)((-1.5f), (-0.55f), (-0.3f));
-    real3 p7 = rotate_axis(p6, (real3)(0.0f, 1.0f, 0.0f), (-0.4f));
+    real3 p7 = (real3)(0.921061f * p6.x + (-0.38941833f) * p6.z, p6.y, 0.38941833f * p6.x + 0.921061f * p6.z);
     real3 p8 = p7 / 0.4f;
     real t12;
     real d12 = menger(p8, 3, 3.0f, &t12);
@@ -229,7 +233,7 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     real3 c17 = x17 < y17 ? c11 : c15;
     real t17 = x17 < y17 ? t11 : t12;
     real3 p9 = p0 - (real3)(1.5f, (-0.5f), (-0.2f));
-    real3 p10 = rotate_axis(p9, (real3)(1.0f, 0.0f, 0.0f), (-1.2f));
+    real3 p10 = (real3)(p9.x, 0.36235777f * p9.y + 0.9320391f * p9.z, (-0.9320391f) * p9.y + 0.36235777f * p9.z);
     real d18 = sd_torus(p10, 0.35f, 0.1f);
     real3 c18 = DEFAULT_COLOR;
     real t18 = R(1.0);
@@ -306,6 +310,7 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
 #define MARCH_AMBIENT R(0.5)      // strength of the sky's hemisphere light
 #define MARCH_SPECULAR R(0.25)    // Blinn-Phong specular strength
 #define MARCH_SHININESS R(32.0)   // Blinn-Phong exponent
+#define MARCH_NORMAL_EVALUATIONS 4u // DE calls of march_normal
 
 typedef struct {
     real t;         // distance along the ray where the march stopped
@@ -401,7 +406,8 @@ MarchResult march_ray(real3 ro, real3 rd, const MarchCamera* cam,
     return r;
 }
 
-// Unit normal by tetrahedral differences (four evaluations) with step h.
+// Unit normal by tetrahedral differences (MARCH_NORMAL_EVALUATIONS
+// evaluations) with step h.
 real3 march_normal(real3 p, real h, real3 rd, __global const real* params) {
     const real2 k = (real2)(R(1.0), R(-1.0));
     real3 g = k.xyy * DE(p + k.xyy * h, params) + k.yyx * DE(p + k.yyx * h, params)
@@ -414,6 +420,7 @@ real3 march_normal(real3 p, real h, real3 rd, __global const real* params) {
 // Ambient occlusion: how much closer the surface is than expected at
 // AO_SAMPLES points along the normal, nearer samples weighing more.
 // 1 on an open face, towards 0 in a crease.
+// Evaluates DE AO_SAMPLES times.
 real march_ambient_occlusion(real3 p, real3 n, __global const real* params) {
     real missing = R(0.0);
     real expected = R(0.0);
@@ -433,14 +440,16 @@ real march_ambient_occlusion(real3 p, real3 n, __global const real* params) {
 // Quilez's improved soft shadow (2018) with a penumbra that grows with
 // softness. The ray is blocked where it comes within eps of a surface;
 // callers pass a fraction of the surface hit threshold so shadows are not
-// fattened by a pixel where objects nearly touch.
+// fattened by a pixel where objects nearly touch. Adds its DE evaluations
+// to *evals.
 real march_shadow(real3 ro, real3 rd, real max_t, real eps, real start, real softness,
-                  __global const real* params) {
+                  __global const real* params, uint* evals) {
     real visible = R(1.0);
     real prev_h = R(1e20);
     real t = start;
     for (int i = 0; i < SHADOW_STEPS && t < max_t; ++i) {
         real h = DE(ro + rd * t, params);
+        *evals += 1u;
         if (h < eps) {
             return R(0.0);
         }
@@ -476,16 +485,19 @@ real3 march_background(real py, int height) {
     return mix(SKY_BOTTOM, SKY_TOP, v);
 }
 
-// Lit colour of the surface point p with normal n, seen along rd.
+// Lit colour of the surface point p with normal n, seen along rd. Adds its
+// distance evaluations (DE_shade, occlusion, shadow rays) to *evals.
 real3 march_shade(real3 p, real3 n, real3 rd, real eps, __global const real* params,
-                  __global const real* lights, int light_count) {
+                  __global const real* lights, int light_count, uint* evals) {
     real3 albedo;
     real trap;
     DE_shade(p, params, &albedo, &trap);
+    *evals += 1u;
     albedo *= march_trap_tint(trap);
 
     real occlusion = R(1.0);
     occlusion = march_ambient_occlusion(p, n, params);
+    *evals += (uint)AO_SAMPLES;
     real3 sky = mix(SKY_BOTTOM, SKY_TOP, R(0.5) + R(0.5) * n.y);
     real3 color = albedo * sky * (MARCH_AMBIENT * occlusion);
 
@@ -510,7 +522,7 @@ real3 march_shade(real3 p, real3 n, real3 rd, real eps, __global const real* par
             continue;
         }
         real visible =
-            march_shadow(lifted, to_light, light_distance, R(0.25) * eps, eps, l[7], params);
+            march_shadow(lifted, to_light, light_distance, R(0.25) * eps, eps, l[7], params, evals);
         if (visible <= R(0.0)) {
             continue;
         }
@@ -542,7 +554,11 @@ real march_jitter(uint x, uint y, uint sample) {
 //
 // AOVs describe the ray through the pixel centre: depth (distance along
 // the ray, +INFINITY on a miss), hit (0/1), world-space normal (0 on a
-// miss) and the number of distance evaluations of all colour samples.
+// miss); and the cost of the pixel's colour: steps, the primary-march
+// distance evaluations of all its samples, and evaluations, every distance
+// evaluation of all its samples (primary march, normal, the step onto the
+// surface, DE_shade, occlusion and shadow rays). The extra march through
+// the pixel centre that AOVs need with supersampling is not counted.
 __kernel void render_tile(__global const real* params,
                           __global const real* camera,
                           __global const real* lights,
@@ -558,7 +574,8 @@ __kernel void render_tile(__global const real* params,
                           __global float* depth,
                           __global uchar* hit_mask,
                           __global float* normals,
-                          __global uint* steps) {
+                          __global uint* steps,
+                          __global uint* evaluations) {
     int lx = (int)get_global_id(0);
     int ly = (int)get_global_id(1);
     int x = x0 + lx;
@@ -570,6 +587,7 @@ __kernel void render_tile(__global const real* params,
 
     real3 sum = (real3)(R(0.0));
     uint total_steps = 0;
+    uint total_evals = 0;
     MarchResult centre = {R(0.0), R(1.0), 0, 0};
     real3 centre_normal = (real3)(R(0.0));
     for (int s = 0; s < SUPERSAMPLING * SUPERSAMPLING; ++s) {
@@ -589,6 +607,7 @@ __kernel void render_tile(__global const real* params,
         march_camera_ray(&cam, px, py, width, height, &ro, &rd);
         MarchResult m = march_ray(ro, rd, &cam, params);
         total_steps += (uint)m.steps;
+        total_evals += (uint)m.steps;
 
         real3 background = march_background(py, height);
         real3 color = background;
@@ -600,7 +619,9 @@ __kernel void render_tile(__global const real* params,
             // The march stopped up to a hit threshold short of the surface:
             // step onto it along the normal so secondary rays start there.
             p -= n * DE(p, params);
-            color = march_shade(p, n, rd, HIT_EPSILON * footprint, params, lights, light_count);
+            total_evals += MARCH_NORMAL_EVALUATIONS + 1u;
+            color = march_shade(p, n, rd, HIT_EPSILON * footprint, params, lights, light_count,
+                                &total_evals);
         }
         sum += color;
         if (s == 0) {
@@ -630,5 +651,6 @@ __kernel void render_tile(__global const real* params,
         hit_mask[idx] = (uchar)centre.hit;
         vstore3(convert_float3(centre_normal), idx, normals);
         steps[idx] = total_steps;
+        evaluations[idx] = total_evals;
     }
 }

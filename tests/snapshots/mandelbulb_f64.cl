@@ -26,6 +26,13 @@ typedef double4 real4;
 /* ---- mandelbulb_p8 ---- */
 /* Mandelbulb of power 8, unrolled: no loop over the power, no trigonometry. */
 real mandelbulb_p8(real3 p, int iterations, real escape, real* trap) {
+    real ball = pow(R(2.0), R(1.0) / R(7.0));
+    real r0 = length(p);
+    real outer = r0 - ball;
+    if (r0 > R(1.5) * ball) {
+        *trap = R(1.0);
+        return outer;
+    }
     real3 z = p;
     real dr = R(1.0);
     real t = R(1.0);
@@ -72,7 +79,7 @@ real mandelbulb_p8(real3 p, int iterations, real escape, real* trap) {
     }
     real r = length(z);
     *trap = t;
-    return R(0.5) * log(fmax(r, REAL_TINY)) * r / dr;
+    return fmax(R(0.5) * log(fmax(r, REAL_TINY)) * r / dr, outer);
 }
 
 /* ---- scene ---- */
@@ -137,6 +144,7 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
 #define MARCH_AMBIENT R(0.5)      // strength of the sky's hemisphere light
 #define MARCH_SPECULAR R(0.25)    // Blinn-Phong specular strength
 #define MARCH_SHININESS R(32.0)   // Blinn-Phong exponent
+#define MARCH_NORMAL_EVALUATIONS 4u // DE calls of march_normal
 
 typedef struct {
     real t;         // distance along the ray where the march stopped
@@ -232,7 +240,8 @@ MarchResult march_ray(real3 ro, real3 rd, const MarchCamera* cam,
     return r;
 }
 
-// Unit normal by tetrahedral differences (four evaluations) with step h.
+// Unit normal by tetrahedral differences (MARCH_NORMAL_EVALUATIONS
+// evaluations) with step h.
 real3 march_normal(real3 p, real h, real3 rd, __global const real* params) {
     const real2 k = (real2)(R(1.0), R(-1.0));
     real3 g = k.xyy * DE(p + k.xyy * h, params) + k.yyx * DE(p + k.yyx * h, params)
@@ -245,6 +254,7 @@ real3 march_normal(real3 p, real h, real3 rd, __global const real* params) {
 // Ambient occlusion: how much closer the surface is than expected at
 // AO_SAMPLES points along the normal, nearer samples weighing more.
 // 1 on an open face, towards 0 in a crease.
+// Evaluates DE AO_SAMPLES times.
 real march_ambient_occlusion(real3 p, real3 n, __global const real* params) {
     real missing = R(0.0);
     real expected = R(0.0);
@@ -264,14 +274,16 @@ real march_ambient_occlusion(real3 p, real3 n, __global const real* params) {
 // Quilez's improved soft shadow (2018) with a penumbra that grows with
 // softness. The ray is blocked where it comes within eps of a surface;
 // callers pass a fraction of the surface hit threshold so shadows are not
-// fattened by a pixel where objects nearly touch.
+// fattened by a pixel where objects nearly touch. Adds its DE evaluations
+// to *evals.
 real march_shadow(real3 ro, real3 rd, real max_t, real eps, real start, real softness,
-                  __global const real* params) {
+                  __global const real* params, uint* evals) {
     real visible = R(1.0);
     real prev_h = R(1e20);
     real t = start;
     for (int i = 0; i < SHADOW_STEPS && t < max_t; ++i) {
         real h = DE(ro + rd * t, params);
+        *evals += 1u;
         if (h < eps) {
             return R(0.0);
         }
@@ -307,16 +319,19 @@ real3 march_background(real py, int height) {
     return mix(SKY_BOTTOM, SKY_TOP, v);
 }
 
-// Lit colour of the surface point p with normal n, seen along rd.
+// Lit colour of the surface point p with normal n, seen along rd. Adds its
+// distance evaluations (DE_shade, occlusion, shadow rays) to *evals.
 real3 march_shade(real3 p, real3 n, real3 rd, real eps, __global const real* params,
-                  __global const real* lights, int light_count) {
+                  __global const real* lights, int light_count, uint* evals) {
     real3 albedo;
     real trap;
     DE_shade(p, params, &albedo, &trap);
+    *evals += 1u;
     albedo *= march_trap_tint(trap);
 
     real occlusion = R(1.0);
     occlusion = march_ambient_occlusion(p, n, params);
+    *evals += (uint)AO_SAMPLES;
     real3 sky = mix(SKY_BOTTOM, SKY_TOP, R(0.5) + R(0.5) * n.y);
     real3 color = albedo * sky * (MARCH_AMBIENT * occlusion);
 
@@ -341,7 +356,7 @@ real3 march_shade(real3 p, real3 n, real3 rd, real eps, __global const real* par
             continue;
         }
         real visible =
-            march_shadow(lifted, to_light, light_distance, R(0.25) * eps, eps, l[7], params);
+            march_shadow(lifted, to_light, light_distance, R(0.25) * eps, eps, l[7], params, evals);
         if (visible <= R(0.0)) {
             continue;
         }
@@ -373,7 +388,11 @@ real march_jitter(uint x, uint y, uint sample) {
 //
 // AOVs describe the ray through the pixel centre: depth (distance along
 // the ray, +INFINITY on a miss), hit (0/1), world-space normal (0 on a
-// miss) and the number of distance evaluations of all colour samples.
+// miss); and the cost of the pixel's colour: steps, the primary-march
+// distance evaluations of all its samples, and evaluations, every distance
+// evaluation of all its samples (primary march, normal, the step onto the
+// surface, DE_shade, occlusion and shadow rays). The extra march through
+// the pixel centre that AOVs need with supersampling is not counted.
 __kernel void render_tile(__global const real* params,
                           __global const real* camera,
                           __global const real* lights,
@@ -389,7 +408,8 @@ __kernel void render_tile(__global const real* params,
                           __global float* depth,
                           __global uchar* hit_mask,
                           __global float* normals,
-                          __global uint* steps) {
+                          __global uint* steps,
+                          __global uint* evaluations) {
     int lx = (int)get_global_id(0);
     int ly = (int)get_global_id(1);
     int x = x0 + lx;
@@ -401,6 +421,7 @@ __kernel void render_tile(__global const real* params,
 
     real3 sum = (real3)(R(0.0));
     uint total_steps = 0;
+    uint total_evals = 0;
     MarchResult centre = {R(0.0), R(1.0), 0, 0};
     real3 centre_normal = (real3)(R(0.0));
     for (int s = 0; s < SUPERSAMPLING * SUPERSAMPLING; ++s) {
@@ -420,6 +441,7 @@ __kernel void render_tile(__global const real* params,
         march_camera_ray(&cam, px, py, width, height, &ro, &rd);
         MarchResult m = march_ray(ro, rd, &cam, params);
         total_steps += (uint)m.steps;
+        total_evals += (uint)m.steps;
 
         real3 background = march_background(py, height);
         real3 color = background;
@@ -431,7 +453,9 @@ __kernel void render_tile(__global const real* params,
             // The march stopped up to a hit threshold short of the surface:
             // step onto it along the normal so secondary rays start there.
             p -= n * DE(p, params);
-            color = march_shade(p, n, rd, HIT_EPSILON * footprint, params, lights, light_count);
+            total_evals += MARCH_NORMAL_EVALUATIONS + 1u;
+            color = march_shade(p, n, rd, HIT_EPSILON * footprint, params, lights, light_count,
+                                &total_evals);
         }
         sum += color;
         if (s == 0) {
@@ -461,5 +485,6 @@ __kernel void render_tile(__global const real* params,
         hit_mask[idx] = (uchar)centre.hit;
         vstore3(convert_float3(centre_normal), idx, normals);
         steps[idx] = total_steps;
+        evaluations[idx] = total_evals;
     }
 }

@@ -1,0 +1,355 @@
+//! The speed-versus-accuracy trade-off, measured on every fractal of the
+//! gallery: each quality preset and sweeps of `max_steps` and
+//! `hit_epsilon`, timed (median of several renders after a warm-up) and
+//! compared with a `reference` render of the same pixels (F64, 2048 steps,
+//! a tenth-of-a-pixel threshold): PSNR, SSIM, hit-mask mismatch, mean
+//! depth error, and PSNR of both images box-filtered to half size. A row
+//! `reference/2` (the reference with both thresholds halved) shows how far
+//! the reference itself is from converged. Anti-aliasing is measured apart,
+//! at half the size, against a 4×4-sample render. Prints markdown tables,
+//! writes `out/tradeoff.csv` and plots time against error in
+//! `out/tradeoff.png`.
+//!
+//! ```text
+//! cargo run --release --example tradeoff [-- --quick | --size 640x480]
+//!     [--scenes mandelbulb,menger] [--no-aa]
+//! ```
+//!
+//! `--quick` renders 320×240 with fewer timed runs. Timings depend on the
+//! device and on whatever else the machine is doing.
+
+#[path = "../common/mod.rs"]
+mod common;
+mod plot;
+
+use std::fmt::Write as _;
+
+use common::measure::{self, Errors, Runs, Timing, compare};
+use fractal_sdf::prelude::*;
+use fractal_sdf::render::{Frame, RenderOptions, Renderer};
+
+/// The fractal scenes of the gallery.
+const SCENES: [&str; 4] = ["mandelbulb", "menger", "julia", "sierpinski"];
+
+/// One measured configuration of one scene.
+#[derive(Debug, Clone)]
+pub struct Row {
+    /// Gallery scene.
+    pub scene: String,
+    /// `preset`, `floor`, `max_steps`, `hit_epsilon` or `aa`.
+    pub group: &'static str,
+    /// What was varied, e.g. `preview` or `max_steps=64`.
+    pub label: String,
+    /// Median render time.
+    pub timing: Timing,
+    /// Reference time divided by this configuration's time.
+    pub speedup: f64,
+    /// Mean distance evaluations per pixel.
+    pub evaluations: f64,
+    /// Error against the group's reference.
+    pub errors: Errors,
+    /// Image size.
+    pub size: (u32, u32),
+}
+
+/// What is rendered and how often.
+#[derive(Clone, Copy)]
+struct Study {
+    size: (u32, u32),
+    runs: Runs,
+    effects: Effects,
+}
+
+impl Study {
+    /// Times `quality` on `scene` and renders one frame with AOVs.
+    fn measure(&self, scene: &Scene, quality: Quality) -> Result<(Timing, Frame)> {
+        let mut renderer = self.renderer(scene, quality)?;
+        let timing = measure::time_renders(&mut renderer, self.size, self.runs)?;
+        let frame = renderer.render_with_aovs(self.size.0, self.size.1)?;
+        Ok((timing, frame))
+    }
+
+    /// One frame with AOVs, untimed.
+    fn frame(&self, scene: &Scene, quality: Quality) -> Result<Frame> {
+        self.renderer(scene, quality)?
+            .render_with_aovs(self.size.0, self.size.1)
+    }
+
+    fn renderer(&self, scene: &Scene, quality: Quality) -> Result<Renderer> {
+        let options = RenderOptions {
+            quality,
+            effects: self.effects,
+            ..RenderOptions::default()
+        };
+        Renderer::with_options(scene, &options)
+    }
+
+    /// Measures every configuration of one group against `reference`.
+    fn group(
+        &self,
+        name: &str,
+        scene: &Scene,
+        group: &'static str,
+        configs: Vec<(String, Quality)>,
+        reference: (f64, &Frame),
+    ) -> Result<Vec<Row>> {
+        let mut rows = Vec::new();
+        for (label, quality) in configs {
+            let (timing, frame) = self.measure(scene, quality)?;
+            let row = Row {
+                scene: name.to_string(),
+                group,
+                label,
+                speedup: reference.0 / timing.median_ms,
+                evaluations: frame.mean_evaluations(),
+                errors: compare(&frame, reference.1),
+                timing,
+                size: self.size,
+            };
+            eprintln!(
+                "  {:<20} {:>9.1} ms  {:>6.1} evals/px  {:>6.2} dB",
+                row.label, row.timing.median_ms, row.evaluations, row.errors.psnr
+            );
+            rows.push(row);
+        }
+        Ok(rows)
+    }
+}
+
+/// The presets with one sample per pixel (march accuracy only).
+fn presets() -> Vec<(String, Quality)> {
+    [
+        ("draft", Quality::draft()),
+        ("preview", Quality::preview()),
+        ("production", Quality::production()),
+        ("reference", Quality::reference()),
+    ]
+    .into_iter()
+    .map(|(n, q)| {
+        (
+            n.to_string(),
+            Quality {
+                supersampling: 1,
+                ..q
+            },
+        )
+    })
+    .collect()
+}
+
+/// The reference with its hit and normal thresholds halved: its distance
+/// from the reference is the reference's own convergence error.
+fn floor() -> Vec<(String, Quality)> {
+    let r = Quality::reference();
+    let q = Quality {
+        hit_epsilon: r.hit_epsilon / 2.0,
+        normal_epsilon: r.normal_epsilon / 2.0,
+        ..r
+    };
+    vec![("reference/2".to_string(), q)]
+}
+
+/// Production quality with one knob swept.
+fn sweeps() -> Vec<(&'static str, Vec<(String, Quality)>)> {
+    let base = Quality::production();
+    let steps = [32, 64, 128, 512]
+        .into_iter()
+        .map(|max_steps| {
+            let q = Quality { max_steps, ..base };
+            (format!("max_steps={max_steps}"), q)
+        })
+        .collect();
+    let eps = [0.25, 0.5, 1.5, 3.0]
+        .into_iter()
+        .map(|hit_epsilon| {
+            let q = Quality {
+                hit_epsilon,
+                ..base
+            };
+            (format!("hit_epsilon={hit_epsilon}"), q)
+        })
+        .collect();
+    vec![("max_steps", steps), ("hit_epsilon", eps)]
+}
+
+/// Production quality with N×N samples per pixel, N = 1 to 3.
+fn anti_aliasing() -> Vec<(String, Quality)> {
+    (1..=3)
+        .map(|n| {
+            let q = Quality {
+                supersampling: n,
+                ..Quality::production()
+            };
+            (format!("production {n}x{n}"), q)
+        })
+        .collect()
+}
+
+fn table(rows: &[Row], groups: &[&str]) -> String {
+    let mut out = String::from(
+        "| scene | configuration | ms/frame | speed-up | DE evals/px | PSNR dB | PSNR ½ dB | SSIM | mask % | depth err |\n\
+         |---|---|---:|---:|---:|---:|---:|---:|---:|---:|\n",
+    );
+    for r in rows.iter().filter(|r| groups.contains(&r.group)) {
+        let e = &r.errors;
+        let db = |v: f64| {
+            if v.is_finite() {
+                format!("{v:.1}")
+            } else {
+                "∞".into()
+            }
+        };
+        let _ = writeln!(
+            out,
+            "| {} | {} | {:.0} | {:.1}× | {:.0} | {} | {} | {:.4} | {:.2} | {:.1e} |",
+            r.scene,
+            r.label,
+            r.timing.median_ms,
+            r.speedup,
+            r.evaluations,
+            db(e.psnr),
+            db(e.psnr_half),
+            e.ssim,
+            e.mask_pct,
+            e.depth
+        );
+    }
+    out
+}
+
+fn csv(rows: &[Row], device: &str) -> String {
+    let mut out = String::from(
+        "scene,group,configuration,width,height,device,median_ms,runs,speedup,evaluations_per_pixel,psnr_db,psnr_half_db,ssim,mask_mismatch_pct,mean_depth_error\n",
+    );
+    for r in rows {
+        let e = &r.errors;
+        let _ = writeln!(
+            out,
+            "{},{},{},{},{},\"{}\",{:.3},{},{:.3},{:.2},{:.3},{:.3},{:.5},{:.4},{:.3e}",
+            r.scene,
+            r.group,
+            r.label,
+            r.size.0,
+            r.size.1,
+            device,
+            r.timing.median_ms,
+            r.timing.runs,
+            r.speedup,
+            r.evaluations,
+            e.psnr,
+            e.psnr_half,
+            e.ssim,
+            e.mask_pct,
+            e.depth
+        );
+    }
+    out
+}
+
+fn main() -> std::process::ExitCode {
+    common::run(|| {
+        let quick = measure::flag("--quick");
+        let size = common::size_arg(if quick { (320, 240) } else { (640, 480) });
+        let runs = if quick {
+            Runs {
+                min: 3,
+                max: 5,
+                budget: std::time::Duration::from_secs(2),
+            }
+        } else {
+            Runs::default()
+        };
+        let scenes: Vec<String> = measure::value("--scenes").map_or_else(
+            || SCENES.iter().map(ToString::to_string).collect(),
+            |s| s.split(',').map(str::to_string).collect(),
+        );
+        let study = Study {
+            size,
+            runs,
+            effects: Effects::default(),
+        };
+        let device = fractal_sdf::render::devices()?
+            .first()
+            .map(|d| d.name.clone())
+            .unwrap_or_default();
+        eprintln!("{}x{} on {device}", size.0, size.1);
+        std::fs::create_dir_all("out").map_err(|e| Error::Io {
+            path: "out".into(),
+            source: e,
+        })?;
+        let mut rows = Vec::new();
+        for name in &scenes {
+            let Some(scene) = fractal_sdf::gallery::by_name(name) else {
+                eprintln!("error: no gallery scene `{name}`");
+                std::process::exit(2);
+            };
+            eprintln!("{name}: reference");
+            let reference_quality = Quality {
+                supersampling: 1,
+                ..Quality::reference()
+            };
+            let (timing, reference) = study.measure(&scene, reference_quality)?;
+            fractal_sdf::output::save_png(&reference.image, format!("out/tradeoff_{name}.png"))?;
+            let against = (timing.median_ms, &reference);
+            rows.extend(study.group(name, &scene, "preset", presets(), against)?);
+            let once = Study {
+                runs: Runs {
+                    min: 1,
+                    max: 1,
+                    ..runs
+                },
+                ..study
+            };
+            rows.extend(once.group(name, &scene, "floor", floor(), against)?);
+            for (group, configs) in sweeps() {
+                rows.extend(study.group(name, &scene, group, configs, against)?);
+            }
+            if !measure::flag("--no-aa") {
+                // Anti-aliasing, at half the size, against 4×4 samples of
+                // the same march.
+                let aa = Study {
+                    size: (size.0 / 2, size.1 / 2),
+                    ..once
+                };
+                let best = aa.frame(
+                    &scene,
+                    Quality {
+                        supersampling: 4,
+                        ..Quality::production()
+                    },
+                )?;
+                let mut aa_rows = aa.group(name, &scene, "aa", anti_aliasing(), (1.0, &best))?;
+                let one = aa_rows[0].timing.median_ms;
+                for r in &mut aa_rows {
+                    r.speedup = one / r.timing.median_ms;
+                }
+                rows.extend(aa_rows);
+            }
+        }
+        println!(
+            "Measured by `cargo run --release --example tradeoff` at {}x{} on {device}.\n",
+            size.0, size.1
+        );
+        println!("March accuracy (1 sample per pixel; error against `reference`):\n");
+        println!("{}", table(&rows, &["preset", "floor"]));
+        println!("Sweeps of production quality:\n");
+        println!("{}", table(&rows, &["max_steps", "hit_epsilon"]));
+        if rows.iter().any(|r| r.group == "aa") {
+            println!(
+                "Anti-aliasing at {}x{} (speed-up: against 1x1; error: against production with 4x4 samples):\n",
+                size.0 / 2,
+                size.1 / 2
+            );
+            println!("{}", table(&rows, &["aa"]));
+        }
+        let csv_path = "out/tradeoff.csv";
+        std::fs::write(csv_path, csv(&rows, &device)).map_err(|e| Error::Io {
+            path: csv_path.into(),
+            source: e,
+        })?;
+        let plot_path = "out/tradeoff.png";
+        fractal_sdf::output::save_png(&plot::draw(&rows, size, &device), plot_path)?;
+        eprintln!("wrote {csv_path} and {plot_path}");
+        Ok(())
+    })
+}
