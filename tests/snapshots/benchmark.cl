@@ -52,53 +52,6 @@ real sd_plane(real3 p, real3 n, real offset) {
     return dot(p, n) + offset;
 }
 
-/* ---- angle_power ---- */
-/* (cos, sin) of n times the angle whose cosine and sine are (c, s):
-   binary exponentiation of c + i s, the trig-free integer power. */
-real2 angle_power(real c, real s, int n) {
-    real rc = R(1.0), rs = R(0.0);
-    real bc = c, bs = s;
-    for (int e = n; e > 0; e >>= 1) {
-        if (e & 1) {
-            real t = rc * bc - rs * bs;
-            rs = rc * bs + rs * bc;
-            rc = t;
-        }
-        real u = bc * bc - bs * bs;
-        bs = R(2.0) * bc * bs;
-        bc = u;
-    }
-    return (real2)(rc, rs);
-}
-
-/* ---- mandelbulb_int ---- */
-/* Mandelbulb of integer power n, trig-free (see angle_power). */
-real mandelbulb_int(real3 p, int n, int iterations, real bailout, real* trap) {
-    real3 z = p;
-    real dr = R(1.0);
-    real t = R(1.0);
-    /* Escape before r^power passes MAGNITUDE_CAP (large powers and bailouts). */
-    real escape = fmin(bailout, pow(MAGNITUDE_CAP, R(1.0) / (real)n));
-    for (int i = 0; i < iterations; i++) {
-        real r = length(z);
-        if (r > escape) {
-            break;
-        }
-        t = fmin(t, r);
-        real r_pow = pown(r, n - 1);
-        dr = fmin((real)n * r_pow * dr + R(1.0), DERIVATIVE_CAP);
-        real zr = r_pow * r;
-        real rho = hypot(z.x, z.y);
-        real inv_r = R(1.0) / fmax(r, REAL_TINY);
-        real2 th = angle_power(z.z * inv_r, rho * inv_r, n);
-        real2 ph = rho > REAL_TINY ? angle_power(z.x / rho, z.y / rho, n) : (real2)(R(1.0), R(0.0));
-        z = (real3)(th.y * ph.x, th.y * ph.y, th.x) * zr + p;
-    }
-    real r = length(z);
-    *trap = t;
-    return R(0.5) * log(fmax(r, REAL_TINY)) * r / dr;
-}
-
 /* ---- menger ---- */
 /* Menger sponge, KIFS form: fold, scale about the kept cube, box bound. */
 real menger(real3 p, int iterations, real scale, real* trap) {
@@ -132,21 +85,65 @@ real2 smooth_min(real a, real b, real k) {
     return (real2)(fmin(a, b) - m * k * R(0.5), m);
 }
 
-/* ---- rotate ---- */
-/* Rotates p by angle around the unit axis k (Rodrigues' formula). */
-real3 rotate_axis(real3 p, real3 k, real angle) {
-    real c = cos(angle);
-    real s = sin(angle);
-    return p * c + cross(k, p) * s + k * (dot(k, p) * (R(1.0) - c));
+/* ---- mandelbulb_p8 ---- */
+/* Mandelbulb of power 8, unrolled: no loop over the power, no trigonometry. */
+real mandelbulb_p8(real3 p, int iterations, real escape, real* trap) {
+    real3 z = p;
+    real dr = R(1.0);
+    real t = R(1.0);
+    for (int i = 0; i < iterations; i++) {
+        real r = length(z);
+        if (r > escape) {
+            break;
+        }
+        t = fmin(t, r);
+        real qb0 = r * r;
+        real qr1 = r * qb0;
+        real qb1 = qb0 * qb0;
+        real qr2 = qr1 * qb1;
+        real r_pow = qr2;
+        dr = fmin(R(8.0) * r_pow * dr + R(1.0), DERIVATIVE_CAP);
+        real zr = r_pow * r;
+        real rho = hypot(z.x, z.y);
+        real inv_r = R(1.0) / fmax(r, REAL_TINY);
+        real ct = z.z * inv_r;
+        real st = rho * inv_r;
+        real cp = R(1.0);
+        real sp = R(0.0);
+        if (rho > REAL_TINY) {
+            cp = z.x / rho;
+            sp = z.y / rho;
+        }
+        real thbc0 = ct * ct - st * st;
+        real thbs0 = R(2.0) * ct * st;
+        real thbc1 = thbc0 * thbc0 - thbs0 * thbs0;
+        real thbs1 = R(2.0) * thbc0 * thbs0;
+        real thbc2 = thbc1 * thbc1 - thbs1 * thbs1;
+        real thbs2 = R(2.0) * thbc1 * thbs1;
+        real thc = thbc2;
+        real ths = thbs2;
+        real phbc0 = cp * cp - sp * sp;
+        real phbs0 = R(2.0) * cp * sp;
+        real phbc1 = phbc0 * phbc0 - phbs0 * phbs0;
+        real phbs1 = R(2.0) * phbc0 * phbs0;
+        real phbc2 = phbc1 * phbc1 - phbs1 * phbs1;
+        real phbs2 = R(2.0) * phbc1 * phbs1;
+        real phc = phbc2;
+        real phs = phbs2;
+        z = (real3)(ths * phc, ths * phs, thc) * zr + p;
+    }
+    real r = length(z);
+    *trap = t;
+    return R(0.5) * log(fmax(r, REAL_TINY)) * r / dr;
 }
 
 /* ---- scene ---- */
 real DE(real3 p0, __global const real* params) {
     real3 p1 = p0 - (real3)(0.0f, 0.05f, 0.0f);
     real3 p2 = p1 / 0.6f;
-    real3 p3 = rotate_axis(p2, (real3)(1.0f, 0.0f, 0.0f), 1.5707964f);
+    real3 p3 = (real3)(p2.x, -p2.z, p2.y);
     real t0;
-    real d0 = mandelbulb_int(p3, 8, 8, 2.0f, &t0);
+    real d0 = mandelbulb_p8(p3, 8, 2.0f, &t0);
     real d2 = d0 * 0.6f;
     real3 p4 = p0 - (real3)(0.0f, (-0.75f), 0.0f);
     real d5 = sd_cylinder(p4, 0.35f, 0.2f);
@@ -160,7 +157,7 @@ real DE(real3 p0, __global const real* params) {
     real y11 = d8;
     real d11 = fmin(x11, y11);
     real3 p6 = p0 - (real3)((-1.5f), (-0.55f), (-0.3f));
-    real3 p7 = rotate_axis(p6, (real3)(0.0f, 1.0f, 0.0f), (-0.4f));
+    real3 p7 = (real3)(0.921061f * p6.x + (-0.38941833f) * p6.z, p6.y, 0.38941833f * p6.x + 0.921061f * p6.z);
     real3 p8 = p7 / 0.4f;
     real t12;
     real d12 = menger(p8, 3, 3.0f, &t12);
@@ -169,7 +166,7 @@ real DE(real3 p0, __global const real* params) {
     real y17 = d13;
     real d17 = fmin(x17, y17);
     real3 p9 = p0 - (real3)(1.5f, (-0.5f), (-0.2f));
-    real3 p10 = rotate_axis(p9, (real3)(1.0f, 0.0f, 0.0f), (-1.2f));
+    real3 p10 = (real3)(p9.x, 0.36235777f * p9.y + 0.9320391f * p9.z, (-0.9320391f) * p9.y + 0.36235777f * p9.z);
     real d18 = sd_torus(p10, 0.35f, 0.1f);
     real x22 = d17;
     real y22 = d18;
@@ -189,9 +186,9 @@ real DE(real3 p0, __global const real* params) {
 real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     real3 p1 = p0 - (real3)(0.0f, 0.05f, 0.0f);
     real3 p2 = p1 / 0.6f;
-    real3 p3 = rotate_axis(p2, (real3)(1.0f, 0.0f, 0.0f), 1.5707964f);
+    real3 p3 = (real3)(p2.x, -p2.z, p2.y);
     real t0;
-    real d0 = mandelbulb_int(p3, 8, 8, 2.0f, &t0);
+    real d0 = mandelbulb_p8(p3, 8, 2.0f, &t0);
     real3 c0 = DEFAULT_COLOR;
     real d2 = d0 * 0.6f;
     real3 c3 = (real3)(0.9f, 0.6f, 0.35f);
@@ -216,7 +213,7 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     real3 c11 = x11 < y11 ? c3 : c9;
     real t11 = x11 < y11 ? t0 : t8;
     real3 p6 = p0 - (real3)((-1.5f), (-0.55f), (-0.3f));
-    real3 p7 = rotate_axis(p6, (real3)(0.0f, 1.0f, 0.0f), (-0.4f));
+    real3 p7 = (real3)(0.921061f * p6.x + (-0.38941833f) * p6.z, p6.y, 0.38941833f * p6.x + 0.921061f * p6.z);
     real3 p8 = p7 / 0.4f;
     real t12;
     real d12 = menger(p8, 3, 3.0f, &t12);
@@ -229,7 +226,7 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     real3 c17 = x17 < y17 ? c11 : c15;
     real t17 = x17 < y17 ? t11 : t12;
     real3 p9 = p0 - (real3)(1.5f, (-0.5f), (-0.2f));
-    real3 p10 = rotate_axis(p9, (real3)(1.0f, 0.0f, 0.0f), (-1.2f));
+    real3 p10 = (real3)(p9.x, 0.36235777f * p9.y + 0.9320391f * p9.z, (-0.9320391f) * p9.y + 0.36235777f * p9.z);
     real d18 = sd_torus(p10, 0.35f, 0.1f);
     real3 c18 = DEFAULT_COLOR;
     real t18 = R(1.0);
