@@ -1,8 +1,10 @@
 # The README's commands. `make test` is what CI runs (via .ci/run).
 CARGO ?= cargo
 export CARGO
+# The viewer's scene: `make viewer SCENE=menger`.
+SCENE ?= fractal_mix
 
-.PHONY: setup demo test bench snapshots golden fmt
+.PHONY: setup demo test bench viewer snapshots golden fmt
 
 setup:
 	@echo "==> setup: system packages"
@@ -14,6 +16,9 @@ demo: setup
 
 test: setup
 	@bash scripts/test.sh
+
+viewer: setup
+	$(CARGO) run --release --features viewer --example viewer -- $(SCENE)
 
 bench:
 	@echo "==> bench"

@@ -88,6 +88,19 @@ const COLUMNS: [&str; 10] = [
     "readback_ms",
 ];
 
+/// A value with about four significant digits (whole numbers as they are).
+fn number(x: f64) -> String {
+    if x.fract() == 0.0 && x.abs() < 1e15 {
+        format!("{x:.0}")
+    } else if x.abs() >= 100.0 {
+        format!("{x:.1}")
+    } else if x.abs() >= 1.0 {
+        format!("{x:.3}")
+    } else {
+        format!("{x:.5}")
+    }
+}
+
 /// Renders one run.
 fn run(renderer: &mut Renderer, size: (u32, u32), length: Length) -> Result<Run> {
     let path = gallery::benchmark_path()?;
@@ -223,13 +236,9 @@ fn main() -> std::process::ExitCode {
             .chain(COLUMNS.iter().map(|c| (*c).to_string()))
             .collect();
         let print_row = |label: &str, v: &[f64; 10]| {
-            let mut line = format!("{label:>5}");
-            for (i, x) in v.iter().enumerate() {
-                let _ = if i == 0 {
-                    write!(line, " {x:>7.0}")
-                } else {
-                    write!(line, " {x:>11.2}")
-                };
+            let mut line = format!("{label:>5} {:>7}", number(v[0]));
+            for x in &v[1..] {
+                let _ = write!(line, " {:>11}", number(*x));
             }
             println!("{line}");
         };
@@ -271,7 +280,7 @@ fn main() -> std::process::ExitCode {
             .map(|k| k.to_string())
             .chain(["mean".to_string()]);
         for (label, row) in labels.zip(rows.iter().chain([&mean])) {
-            let values: Vec<String> = row.iter().map(|x| format!("{x:.4}")).collect();
+            let values: Vec<String> = row.iter().map(|x| number(*x)).collect();
             let _ = writeln!(
                 text,
                 "{label},{},{},{},{},{},{},{},{}",

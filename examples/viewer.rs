@@ -42,7 +42,8 @@ OPTIONS:
   --no-shadows         start with shadows off
   --glow               start with glow on
   --sensitivity F      mouse sensitivity in radians per pixel (default 0.004)
-  --speed F            movement speed in units per second (default: the scene's size)
+  --speed F            movement speed in units per second (default: a third of
+                       the distance to the scene camera's target)
   --target-ms F        frame time aimed at while moving (default 50)
   --max-divisor N      most the resolution is divided by while moving (default 8)
   --shots DIR          where F12 saves screenshots (default out)
@@ -181,6 +182,8 @@ struct Viewer {
     dragging: bool,
     cursor: Option<(f64, f64)>,
     frame: u64,
+    /// The frame whose scripted keys were pressed last.
+    scripted: Option<u64>,
     smoothed_ms: f64,
     screenshot_wanted: bool,
     result: Result<()>,
@@ -231,6 +234,7 @@ impl Viewer {
             dragging: false,
             cursor: None,
             frame: 0,
+            scripted: None,
             smoothed_ms: 0.0,
             screenshot_wanted: false,
             result: Ok(()),
@@ -300,9 +304,14 @@ impl Viewer {
             (now - self.last_tick).as_secs_f64().min(0.25)
         };
         self.last_tick = now;
-        let script: Vec<Action> = self.args.keys.keys_at(self.frame).collect();
-        for action in script {
-            self.act(action, event_loop)?;
+        // Scripted keys for the coming frame, once even if a tick draws
+        // nothing.
+        if self.scripted != Some(self.frame) {
+            self.scripted = Some(self.frame);
+            let script: Vec<Action> = self.args.keys.keys_at(self.frame).collect();
+            for action in script {
+                self.act(action, event_loop)?;
+            }
         }
 
         // Update: camera and animated parameters.
@@ -555,8 +564,10 @@ fn next_free(dir: &std::path::Path) -> PathBuf {
 
 fn display_error(e: impl std::fmt::Display) -> Error {
     Error::Invalid {
-        what: "window",
-        reason: e.to_string(),
+        what: "display",
+        reason: format!(
+            "cannot open or draw the window: {e} (with no display, run under `xvfb-run -a`)"
+        ),
     }
 }
 
@@ -565,8 +576,8 @@ fn main() -> std::process::ExitCode {
         let Some(args) = parse_args()? else {
             return Ok(());
         };
-        let mut viewer = Viewer::new(args)?;
         let event_loop = EventLoop::new().map_err(display_error)?;
+        let mut viewer = Viewer::new(args)?;
         event_loop.set_control_flow(ControlFlow::Poll);
         event_loop.run_app(&mut viewer).map_err(display_error)?;
         viewer.result

@@ -3,8 +3,7 @@
 # Prints a header per step and the total wall time at the end.
 #
 # Every step uses the same features (`viewer` on), so the crate is compiled
-# once per mode; `cargo test --all-targets` also builds the viewer example
-# that tests/viewer_smoke.rs runs under Xvfb.
+# once per mode.
 set -euo pipefail
 
 CARGO=${CARGO:-cargo}
@@ -17,6 +16,9 @@ step() {
 
 step "$CARGO" fmt --all -- --check
 step "$CARGO" clippy --all-targets --all-features -- -D warnings
+# The binary tests/viewer_smoke.rs runs (`cargo test` builds examples only as
+# test harnesses); the test profile shares the library build with the tests.
+step "$CARGO" build --profile test --features viewer --example viewer
 step "$CARGO" test --all-targets --features viewer
 step "$CARGO" test --doc --features viewer
 RUSTDOCFLAGS="-D warnings" step "$CARGO" doc --no-deps --features viewer

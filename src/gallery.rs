@@ -61,7 +61,7 @@ pub fn motions(name: &str) -> Vec<Motion> {
         }],
         "benchmark" => vec![Motion::Orbit {
             name: "orbit".into(),
-            center: dvec3(0.0, -0.15, 0.0),
+            center: dvec3(0.0, 0.25, 0.0),
             radius: 1.35,
             period: 5.0,
         }],
@@ -311,7 +311,7 @@ pub fn benchmark() -> Scene {
         .translate(dvec3(1.5, -0.5, -0.2));
     let moon = sphere(0.18)
         .color(dvec3(0.95, 0.4, 0.3))
-        .translate(param3("orbit", dvec3(1.35, -0.15, 0.0)));
+        .translate(param3("orbit", dvec3(1.35, 0.25, 0.0)));
     let geometry = bulb
         .union(pedestal)
         .union(sponge)

@@ -19,6 +19,19 @@
 //!    image with depth, hit, normal and step outputs.
 //! 5. [`output`]: saving images (atomic PNG writes).
 //!
+//! Around the pipeline:
+//!
+//! - [`gallery`]: ready-made scenes, their animated parameters and the
+//!   benchmark scene and path.
+//! - [`animation`]: camera paths (Catmull-Rom through keyframes, orbits,
+//!   TOML) and [`Motion`](animation::Motion)s of dynamic parameters.
+//! - [`sequence`]: numbered frame files, frame ranges and resuming; with
+//!   `opencl`, rendering a path to them.
+//! - [`control`]: a fly-through camera, key bindings and view settings for
+//!   interactive viewers, independent of any window toolkit.
+//! - [`timing`]: per-frame timings, frame statistics and the resolution
+//!   choice of an interactive view.
+//!
 //! With the `proptest` feature, the `testing` module offers strategies for valid
 //! scenes and checkers for the distance invariants (Lipschitz bound, never
 //! overestimating, exactness), to property-test your own nodes.

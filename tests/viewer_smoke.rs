@@ -3,9 +3,9 @@
 //! key 1`: draft quality) each change what it shows, and its screenshots
 //! are not blank.
 //!
-//! Needs the example binary, which `cargo test --all-targets --features
-//! viewer` (as `make test` runs it) builds first, and `Xvfb` and `xdotool`
-//! (`make setup` installs them). Without them the tests print a note and
+//! Needs the example binary, built by `cargo build --profile test
+//! --features viewer --example viewer` (as `make test` does first), and
+//! `Xvfb` and `xdotool` (`make setup` installs them). Without them the tests print a note and
 //! pass, except under `CI=true`, where they fail.
 #![cfg(feature = "viewer")]
 
@@ -14,7 +14,7 @@ mod gpu;
 use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Stdio};
 use std::thread::sleep;
-use std::time::{Duration, Instant};
+use std::time::{Duration, Instant, SystemTime, UNIX_EPOCH};
 
 use image::RgbaImage;
 
@@ -25,7 +25,31 @@ fn in_ci() -> bool {
     std::env::var("CI").is_ok_and(|v| v == "true" || v == "1")
 }
 
-/// The viewer example next to this test binary (`target/PROFILE/examples`).
+const BUILD: &str = "cargo build --profile test --features viewer --example viewer";
+
+/// The newest modification time of the files under `dir`.
+fn newest(dir: &Path) -> SystemTime {
+    std::fs::read_dir(dir)
+        .into_iter()
+        .flatten()
+        .flatten()
+        .map(|entry| {
+            let path = entry.path();
+            if path.is_dir() {
+                newest(&path)
+            } else {
+                entry
+                    .metadata()
+                    .and_then(|m| m.modified())
+                    .unwrap_or(UNIX_EPOCH)
+            }
+        })
+        .max()
+        .unwrap_or(UNIX_EPOCH)
+}
+
+/// The viewer example next to this test binary (`target/PROFILE/examples`),
+/// built after the last change to the library or the example.
 fn viewer_binary() -> PathBuf {
     let exe = std::env::current_exe().expect("the test binary's path");
     let profile_dir = exe
@@ -33,9 +57,17 @@ fn viewer_binary() -> PathBuf {
         .and_then(Path::parent)
         .expect("tests run from target/PROFILE/deps");
     let path = profile_dir.join("examples/viewer");
+    let built = std::fs::metadata(&path).and_then(|m| m.modified());
+    let built = built.unwrap_or_else(|_| panic!("{} is missing: run `{BUILD}`", path.display()));
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let sources = ["src", "kernels", "examples"]
+        .map(|d| newest(&root.join(d)))
+        .into_iter()
+        .max()
+        .unwrap_or(UNIX_EPOCH);
     assert!(
-        path.is_file(),
-        "{} is missing: build it with `cargo test --all-targets --features viewer`",
+        built >= sources,
+        "{} is older than the sources: run `{BUILD}`",
         path.display()
     );
     path
