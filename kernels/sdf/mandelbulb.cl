@@ -1,8 +1,7 @@
 /* Mandelbulb of any real power, with acos/atan2/sin/cos. */
-real mandelbulb(real3 p, real power, int iterations, real escape, real* trap) {
-    /* The ball of radius `ball` holds the set (proof: cpu::sdf::mandelbulb_radius);
+real mandelbulb(real3 p, real power, int iterations, real escape, real ball, real* trap) {
+    /* The ball of radius `ball` = 2^(1 / (power - 1)) holds the set (proof: cpu::sdf::mandelbulb_radius);
        beyond 1.5 times its radius (MANDELBULB_FAR_FIELD), its distance alone. */
-    real ball = pow(R(2.0), R(1.0) / (power - R(1.0)));
     real r0 = length(p);
     real outer = r0 - ball;
     if (r0 > R(1.5) * ball) {

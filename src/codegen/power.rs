@@ -91,19 +91,15 @@ pub(crate) fn mandelbulb_helper(n: u32) -> String {
     .expect("String");
     writeln!(
         code,
-        "real {name}(real3 p, int iterations, real escape, real* trap) {{"
+        "real {name}(real3 p, int iterations, real escape, real ball, real* trap) {{"
     )
     .expect("String");
-    // The far field, as in the generic helper: the ball of radius
-    // 2^(1 / (n - 1)) holds the set (proof: cpu::sdf::mandelbulb_radius).
-    writeln!(
-        code,
-        "    real ball = pow(R(2.0), R(1.0) / R({}.0));\n    real r0 = length(p);\n    \
-         real outer = r0 - ball;\n    if (r0 > R(1.5) * ball) {{\n        *trap = R(1.0);\n        \
-         return outer;\n    }}",
-        n - 1
-    )
-    .expect("String");
+    // The far field, as in the generic helper: the ball of radius `ball`,
+    // 2^(1 / (n - 1)), holds the set (proof: cpu::sdf::mandelbulb_radius).
+    code.push_str(
+        "    real r0 = length(p);\n    real outer = r0 - ball;\n    \
+         if (r0 > R(1.5) * ball) {\n        *trap = R(1.0);\n        return outer;\n    }\n",
+    );
     code.push_str(
         "    real3 z = p;\n    real dr = R(1.0);\n    real t = R(1.0);\n    \
          for (int i = 0; i < iterations; i++) {\n        real r = length(z);\n        \

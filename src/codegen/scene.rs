@@ -7,6 +7,7 @@ use std::collections::{BTreeMap, BTreeSet};
 use super::writer::Writer;
 use crate::cpu::integer_power;
 use crate::ir::{Ir, NodeId, Scalar};
+use crate::quality::Precision;
 use crate::scene::{CsgOp, CustomShape, Kind};
 
 /// The variables holding one node's result.
@@ -219,14 +220,25 @@ impl<'a> SceneEmitter<'a> {
                         w(self, f.power)
                     ),
                 };
+                // The radius of the ball that holds the set: a literal when
+                // the power is baked, rounded as the CPU computes it.
+                let ball = match f.power {
+                    Scalar::Baked(p) => self.w.float(match self.w.precision() {
+                        Precision::F32 => f64::from(crate::cpu::sdf::mandelbulb_radius(p as f32)),
+                        Precision::F64 => crate::cpu::sdf::mandelbulb_radius(p),
+                    }),
+                    Scalar::Dynamic(_) => {
+                        format!("pow(R(2.0), R(1.0) / ({} - R(1.0)))", w(self, f.power))
+                    }
+                };
                 match integer_power(f.power) {
                     Some(power) => {
                         self.powers.insert(power);
-                        let args = format!("{p}, {n}, {escape}");
+                        let args = format!("{p}, {n}, {escape}, {ball}");
                         self.fractal_call(id, &super::power::helper_name(power), &args)
                     }
                     None => {
-                        let args = format!("{p}, {}, {n}, {escape}", w(self, f.power));
+                        let args = format!("{p}, {}, {n}, {escape}, {ball}", w(self, f.power));
                         self.fractal(id, "mandelbulb", args)
                     }
                 }

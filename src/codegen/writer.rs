@@ -60,6 +60,11 @@ impl Writer {
         literal(v, self.precision)
     }
 
+    /// The precision literals are written in.
+    pub(crate) fn precision(&self) -> Precision {
+        self.precision
+    }
+
     /// A scalar parameter: a literal, or a read of the parameter buffer.
     pub(crate) fn scalar(&self, s: Scalar) -> String {
         match s {

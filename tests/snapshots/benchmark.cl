@@ -87,8 +87,7 @@ real2 smooth_min(real a, real b, real k) {
 
 /* ---- mandelbulb_p8 ---- */
 /* Mandelbulb of power 8, unrolled: no loop over the power, no trigonometry. */
-real mandelbulb_p8(real3 p, int iterations, real escape, real* trap) {
-    real ball = pow(R(2.0), R(1.0) / R(7.0));
+real mandelbulb_p8(real3 p, int iterations, real escape, real ball, real* trap) {
     real r0 = length(p);
     real outer = r0 - ball;
     if (r0 > R(1.5) * ball) {
@@ -150,7 +149,7 @@ real DE(real3 p0, __global const real* params) {
     real3 p2 = p1 / 0.6f;
     real3 p3 = (real3)(p2.x, -p2.z, p2.y);
     real t0;
-    real d0 = mandelbulb_p8(p3, 8, 2.0f, &t0);
+    real d0 = mandelbulb_p8(p3, 8, 2.0f, 1.1040895f, &t0);
     real d2 = d0 * 0.6f;
     real3 p4 = p0 - (real3)(0.0f, (-0.75f), 0.0f);
     real d5 = sd_cylinder(p4, 0.35f, 0.2f);
@@ -195,7 +194,7 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     real3 p2 = p1 / 0.6f;
     real3 p3 = (real3)(p2.x, -p2.z, p2.y);
     real t0;
-    real d0 = mandelbulb_p8(p3, 8, 2.0f, &t0);
+    real d0 = mandelbulb_p8(p3, 8, 2.0f, 1.1040895f, &t0);
     real3 c0 = DEFAULT_COLOR;
     real d2 = d0 * 0.6f;
     real3 c3 = (real3)(0.9f, 0.6f, 0.35f);

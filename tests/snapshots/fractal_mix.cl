@@ -41,10 +41,9 @@ real sd_plane(real3 p, real3 n, real offset) {
 
 /* ---- mandelbulb ---- */
 /* Mandelbulb of any real power, with acos/atan2/sin/cos. */
-real mandelbulb(real3 p, real power, int iterations, real escape, real* trap) {
-    /* The ball of radius `ball` holds the set (proof: cpu::sdf::mandelbulb_radius);
+real mandelbulb(real3 p, real power, int iterations, real escape, real ball, real* trap) {
+    /* The ball of radius `ball` = 2^(1 / (power - 1)) holds the set (proof: cpu::sdf::mandelbulb_radius);
        beyond 1.5 times its radius (MANDELBULB_FAR_FIELD), its distance alone. */
-    real ball = pow(R(2.0), R(1.0) / (power - R(1.0)));
     real r0 = length(p);
     real outer = r0 - ball;
     if (r0 > R(1.5) * ball) {
@@ -158,7 +157,7 @@ real DE(real3 p0, __global const real* params) {
     real3 p2 = p1 / 0.5f;
     real3 p3 = (real3)(p2.x, -p2.z, p2.y);
     real t0;
-    real d0 = mandelbulb(p3, params[0], 8, fmin(2.0f, pow(MAGNITUDE_CAP, R(1.0) / params[0])), &t0);
+    real d0 = mandelbulb(p3, params[0], 8, fmin(2.0f, pow(MAGNITUDE_CAP, R(1.0) / params[0])), pow(R(2.0), R(1.0) / (params[0] - R(1.0))), &t0);
     real d2 = d0 * 0.5f;
     real3 p4 = p0 - (real3)(0.0f, 0.0f, (-0.6f));
     real3 p5 = p4 / 0.45f;
@@ -204,7 +203,7 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     real3 p2 = p1 / 0.5f;
     real3 p3 = (real3)(p2.x, -p2.z, p2.y);
     real t0;
-    real d0 = mandelbulb(p3, params[0], 8, fmin(2.0f, pow(MAGNITUDE_CAP, R(1.0) / params[0])), &t0);
+    real d0 = mandelbulb(p3, params[0], 8, fmin(2.0f, pow(MAGNITUDE_CAP, R(1.0) / params[0])), pow(R(2.0), R(1.0) / (params[0] - R(1.0))), &t0);
     real3 c0 = DEFAULT_COLOR;
     real d2 = d0 * 0.5f;
     real3 c3 = (real3)(0.9f, 0.55f, 0.3f);

@@ -24,8 +24,7 @@ typedef float4 real4;
 
 /* ---- mandelbulb_p8 ---- */
 /* Mandelbulb of power 8, unrolled: no loop over the power, no trigonometry. */
-real mandelbulb_p8(real3 p, int iterations, real escape, real* trap) {
-    real ball = pow(R(2.0), R(1.0) / R(7.0));
+real mandelbulb_p8(real3 p, int iterations, real escape, real ball, real* trap) {
     real r0 = length(p);
     real outer = r0 - ball;
     if (r0 > R(1.5) * ball) {
@@ -85,14 +84,14 @@ real mandelbulb_p8(real3 p, int iterations, real escape, real* trap) {
 real DE(real3 p0, __global const real* params) {
     real3 p1 = (real3)(p0.x, -p0.z, p0.y);
     real t0;
-    real d0 = mandelbulb_p8(p1, 10, 2.0f, &t0);
+    real d0 = mandelbulb_p8(p1, 10, 2.0f, 1.1040895f, &t0);
     return d0;
 }
 
 real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     real3 p1 = (real3)(p0.x, -p0.z, p0.y);
     real t0;
-    real d0 = mandelbulb_p8(p1, 10, 2.0f, &t0);
+    real d0 = mandelbulb_p8(p1, 10, 2.0f, 1.1040895f, &t0);
     real3 c0 = DEFAULT_COLOR;
     real3 c2 = (real3)(0.9f, 0.6f, 0.35f);
     *color = c2;
