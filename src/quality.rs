@@ -20,6 +20,21 @@ pub enum Precision {
 }
 
 /// Every speed-versus-accuracy knob. Start from a preset and adjust.
+///
+/// The presets, cheapest first: [`Quality::draft`], [`Quality::preview`],
+/// [`Quality::production`] and [`Quality::reference`]. Their measured
+/// cost and error are in the README ("Speed versus accuracy"), produced by
+/// `cargo run --release --example tradeoff`.
+///
+/// Two knobs decide *which* surface is drawn rather than how exactly:
+/// `hit_epsilon` (a ray stops at that fraction of a pixel from the
+/// surface, so fractal detail finer than it merges) and `normal_epsilon`
+/// (the scale the shading sees). At one sample per pixel, changing either
+/// by 20% moves edge pixels enough to cost 27 to 31 dB of PSNR on the
+/// gallery's fractals, so presets that differ in them differ in look, not
+/// only in accuracy. The others (`max_steps`, `shadow_steps`,
+/// `precision`, `over_relaxation`) converge: beyond a point they change
+/// almost nothing.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Quality {
     /// Give up on a ray after this many steps.
@@ -53,7 +68,10 @@ pub struct Quality {
 }
 
 impl Quality {
-    /// Fast previews while moving: few steps, coarse threshold, no AO.
+    /// For moving the camera: the cheapest image that still shows the
+    /// shape. Few steps, a four-pixel threshold (fine detail merges into
+    /// blobs), no occlusion, no shadows. About 4 to 5 times faster than
+    /// [`Quality::reference`] on the gallery's fractals on a CPU device.
     #[must_use]
     pub fn draft() -> Self {
         Quality {
@@ -71,19 +89,26 @@ impl Quality {
         }
     }
 
-    /// Interactive quality.
+    /// Interactive quality: every effect on, at about twice the speed of
+    /// [`Quality::reference`]. A threshold of one and a half pixels and
+    /// three occlusion samples; shadow rays get 64 steps, enough for the
+    /// shadows to match converged ones (with everything else at reference
+    /// settings, 64 shadow steps measured 47 dB or more against 256 on the
+    /// gallery's fractals, 32 steps as little as 26 dB).
     #[must_use]
     pub fn preview() -> Self {
         Quality {
             max_steps: 128,
             hit_epsilon: 1.5,
             ao_samples: 3,
-            shadow_steps: 32,
+            shadow_steps: 64,
             ..Self::draft()
         }
     }
 
-    /// Final images.
+    /// Final images: a threshold under a pixel, every effect converged
+    /// (256 march steps and 96 shadow steps change nothing measurable when
+    /// raised). Add [`Quality::supersampling`] for anti-aliasing.
     #[must_use]
     pub fn production() -> Self {
         Quality {
@@ -97,7 +122,11 @@ impl Quality {
         }
     }
 
-    /// The accuracy reference: F64, many steps, a tiny threshold.
+    /// The accuracy reference the others are measured against: F64, 2048
+    /// steps, a tenth-of-a-pixel threshold, 256 shadow steps. On fractals
+    /// it is not converged either: halving its thresholds changes its
+    /// image by as much as the presets differ from each other, at one
+    /// sample per pixel (fractal detail keeps appearing under the pixel).
     #[must_use]
     pub fn reference() -> Self {
         Quality {

@@ -3,6 +3,7 @@
 #![allow(dead_code)] // each example uses a different subset
 
 pub mod measure;
+pub mod sheet;
 
 use std::time::Instant;
 
