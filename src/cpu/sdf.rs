@@ -395,13 +395,13 @@ fn warp_bound<T: Real>(d: T, rho: T, stretch: impl Fn(T) -> T) -> T {
     d / stretch(rho + reach)
 }
 
-/// The distance bound of a twisted child (see [`warp_bound`]).
+/// The distance bound of a twisted child (see `warp_bound`).
 #[must_use]
 pub fn twist_bound<T: Real>(d: T, k: T, rho: T) -> T {
     warp_bound(d, rho, |r| twist_stretch(k, r))
 }
 
-/// The distance bound of a bent child (see [`warp_bound`]).
+/// The distance bound of a bent child (see `warp_bound`).
 #[must_use]
 pub fn bend_bound<T: Real>(d: T, k: T, rho: T) -> T {
     warp_bound(d, rho, |r| bend_stretch(k, r))
