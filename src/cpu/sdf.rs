@@ -183,6 +183,12 @@ fn angle_power<T: Real>(c: T, s: T, n: u32) -> (T, T) {
 /// bounded, and wherever the iteration stops (escaped or not) `|z| > |p| >
 /// 1`, so `ln |z| > 0` and the estimate is positive. Hence for `|p| > rho`
 /// the distance to the set is at least `|p| - rho`.
+///
+/// ```
+/// use fractal_sdf::cpu::sdf::mandelbulb_radius;
+/// assert_eq!(mandelbulb_radius(2.0_f64), 2.0);
+/// assert!((mandelbulb_radius(8.0_f64) - 1.104).abs() < 1e-3);
+/// ```
 #[must_use]
 pub fn mandelbulb_radius<T: Real>(power: T) -> T {
     T::of(2.0).powf(T::one() / (power - T::one()))
