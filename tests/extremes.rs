@@ -239,24 +239,6 @@ fn scaling_scales_distances_exactly() {
     }
 }
 
-/// A NaN anywhere in a pixel's shading turns it black; with no effects
-/// every surface and the sky are lit, so no pixel may be black.
-fn assert_no_nan(frame: &Frame, what: &str) {
-    for (x, y, p) in frame.image.enumerate_pixels() {
-        assert!(p.0[..3] != [0, 0, 0], "{what}: black pixel at ({x}, {y})");
-    }
-    for i in 0..frame.hit.len() {
-        let n = frame.normal[i];
-        assert!(n.iter().all(|c| c.is_finite()), "{what}: normal {i} {n:?}");
-        assert!(!frame.depth[i].is_nan(), "{what}: depth {i}");
-        assert_eq!(
-            frame.hit[i],
-            frame.depth[i].is_finite(),
-            "{what}: pixel {i}"
-        );
-    }
-}
-
 fn render(scene: &Scene, precision: Precision, reach: f64) -> Frame {
     let quality = Quality {
         precision,
@@ -289,7 +271,7 @@ fn renders_have_no_nan_near_far_and_on_the_surface() {
         let (frames, reach) = ([("usual", usual), ("far", far)], 3e6 * size);
         for (what, camera) in frames {
             let frame = render(&scene(camera), Precision::F32, reach);
-            assert_no_nan(&frame, &format!("{} {what}", c.name));
+            gpu::assert_no_nan(&frame, &format!("{} {what}", c.name));
         }
         // 1e-12 from the surface, looking at it (a smooth subtraction with
         // k = 1e3 leaves no surface).
@@ -303,7 +285,7 @@ fn renders_have_no_nan_near_far_and_on_the_surface() {
         }
         for precision in precisions {
             let frame = render(&scene(camera), precision, reach);
-            assert_no_nan(&frame, &format!("{} close {precision:?}", c.name));
+            gpu::assert_no_nan(&frame, &format!("{} close {precision:?}", c.name));
         }
     }
 }

@@ -64,16 +64,7 @@ fn hit_mask_and_depth_match_the_cpu_reference() {
     gpu::save("agreement_perspective", &frame.image);
     let (hits, depths) = compare(&renderer, &frame, &scene);
     eprintln!("agreement: {hits:.4} of hit masks, {depths:.4} of depths");
-    assert!(
-        hits >= 0.99,
-        "hit masks agree on {:.2}% of pixels",
-        100.0 * hits
-    );
-    assert!(
-        depths >= 0.99,
-        "depths agree on {:.2}% of hit pixels",
-        100.0 * depths
-    );
+    assert_agreement(hits, depths);
     // Misses have infinite depth and no normal; hits a unit normal.
     for i in 0..frame.hit.len() {
         let n = frame.normal[i];
@@ -105,16 +96,7 @@ fn orthographic_and_f64_match_the_cpu_reference() {
     gpu::save("agreement_orthographic", &frame.image);
     let (hits, depths) = compare(&renderer, &frame, &scene);
     eprintln!("agreement: {hits:.4} of hit masks, {depths:.4} of depths");
-    assert!(
-        hits >= 0.99,
-        "hit masks agree on {:.2}% of pixels",
-        100.0 * hits
-    );
-    assert!(
-        depths >= 0.99,
-        "depths agree on {:.2}% of hit pixels",
-        100.0 * depths
-    );
+    assert_agreement(hits, depths);
     assert!(
         frame.coverage() > 0.99,
         "the floor fills the orthographic view"
@@ -181,4 +163,18 @@ fn over_relaxation_agrees_and_takes_fewer_steps() {
 fn renderers_are_send() {
     fn send<T: Send>() {}
     send::<Renderer>();
+}
+
+/// At least 99% of hit masks, and of depths where both hit, agree.
+fn assert_agreement(hits: f64, depths: f64) {
+    assert!(
+        hits >= 0.99,
+        "hit masks agree on {:.2}% of pixels",
+        100.0 * hits
+    );
+    assert!(
+        depths >= 0.99,
+        "depths agree on {:.2}% of hit pixels",
+        100.0 * depths
+    );
 }

@@ -3,7 +3,7 @@
 #![allow(dead_code)] // each test binary uses a different subset
 
 use fractal_sdf::prelude::*;
-use fractal_sdf::render::{DeviceInfo, RenderOptions, devices};
+use fractal_sdf::render::{DeviceInfo, Frame, RenderOptions, devices};
 use fractal_sdf::scene::LightSource;
 use image::RgbaImage;
 
@@ -114,5 +114,25 @@ pub fn direction_of(light: &Light) -> Option<DVec3> {
     match light.source {
         LightSource::Directional { direction } => Some(direction.normalize()),
         LightSource::Point { .. } => None,
+    }
+}
+
+/// Fails on any sign of a NaN in a frame: a black pixel (a NaN anywhere in
+/// a pixel's shading turns it black, and the fixtures always have a lit,
+/// non-black background), a non-finite normal, a NaN depth, or a hit flag
+/// that disagrees with the depth.
+pub fn assert_no_nan(frame: &Frame, what: &str) {
+    for (x, y, p) in frame.image.enumerate_pixels() {
+        assert!(p.0[..3] != [0, 0, 0], "{what}: black pixel at ({x}, {y})");
+    }
+    for i in 0..frame.hit.len() {
+        let n = frame.normal[i];
+        assert!(n.iter().all(|c| c.is_finite()), "{what}: normal {i} {n:?}");
+        assert!(!frame.depth[i].is_nan(), "{what}: depth {i}");
+        assert_eq!(
+            frame.hit[i],
+            frame.depth[i].is_finite(),
+            "{what}: pixel {i}"
+        );
     }
 }
