@@ -109,6 +109,7 @@ fn main() -> std::process::ExitCode {
         let source = ProgramSource {
             source: kernel.source,
             precision: kernel.precision,
+            origin: kernel.origin,
         };
         let mut generated = Renderer::with_options(&scene, &options)?;
         let mut handwritten = Renderer::with_source(&scene, &options, source)?;

@@ -104,6 +104,22 @@ impl Ir {
         self.root
     }
 
+    /// The scene's outermost baked translation and the node it moves (the
+    /// origin and the root when there is none). Programs for rendering
+    /// evaluate the scene from that node, in coordinates relative to the
+    /// translation, and the host moves the camera and the lights into
+    /// those coordinates in `f64`: a scene placed far from the origin then
+    /// keeps the precision it has at the origin, in `F32` too.
+    #[must_use]
+    pub fn local_frame(&self) -> (DVec3, NodeId) {
+        match self.node(self.root) {
+            Kind::Translate { offset, child } => {
+                baked3(*offset).map_or((DVec3::ZERO, self.root), |o| (o, *child))
+            }
+            _ => (DVec3::ZERO, self.root),
+        }
+    }
+
     /// The parameter buffer's layout: one slot per dynamic parameter name.
     #[must_use]
     pub fn params(&self) -> &[ParamSlot] {

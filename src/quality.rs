@@ -26,30 +26,34 @@ pub enum Precision {
 /// cost and error are in the README ("Speed versus accuracy"), produced by
 /// `cargo run --release --example tradeoff`.
 ///
-/// Two knobs decide *which* surface is drawn rather than how exactly:
-/// `hit_epsilon` (a ray stops at that fraction of a pixel from the
-/// surface, so fractal detail finer than it merges) and `normal_epsilon`
-/// (the scale the shading sees). At one sample per pixel, changing either
-/// by 20% moves edge pixels enough to cost 27 to 31 dB of PSNR on the
-/// gallery's fractals, so presets that differ in them differ in look, not
-/// only in accuracy. The others (`max_steps`, `shadow_steps`,
-/// `precision`, `over_relaxation`) converge: beyond a point they change
-/// almost nothing.
+/// Two knobs decide *what* is drawn: `detail` (the surface lies where the
+/// distance estimate falls to that many pixel footprints, so fractal detail
+/// finer than it merges) and `normal_epsilon` (the scale the shading
+/// sees). Every preset uses the same values, so the presets differ in cost
+/// and accuracy and converge on one image, rather than drawing different
+/// surfaces. The other knobs converge: beyond a point they change almost
+/// nothing.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Quality {
     /// Give up on a ray after this many steps.
     pub max_steps: u32,
-    /// Hit threshold as a multiple of the pixel footprint at the hit distance
-    /// (1.0: the surface is resolved to about one pixel).
+    /// The drawn surface, in pixel footprints at the hit distance: a ray
+    /// hits where the distance estimate falls to `detail` footprints
+    /// (0.5: the surface is resolved to half a pixel; fractal detail finer
+    /// than that merges). Part of the look: the same in every preset.
+    pub detail: f64,
+    /// How precisely a hit is located on that surface, in pixel footprints
+    /// along the ray: the march's crossing of the surface is refined until
+    /// it is bracketed this tightly.
     pub hit_epsilon: f64,
     /// Rays stop beyond this distance from the camera.
     pub max_distance: f64,
     /// Normal finite-difference step as a multiple of the pixel footprint.
+    /// Part of the look: the same in every preset.
     pub normal_epsilon: f64,
-    /// Ambient-occlusion samples along the normal (0: no occlusion term).
+    /// Samples of the ambient-occlusion integral along the normal (0: no
+    /// occlusion term). Its reach is [`Effects::ao_distance`].
     pub ao_samples: u32,
-    /// Spacing of ambient-occlusion samples in scene units.
-    pub ao_step: f64,
     /// Maximum steps of each shadow ray (0: no shadows).
     pub shadow_steps: u32,
     /// If set, no fractal uses more than this many iterations (escape-time
@@ -58,9 +62,11 @@ pub struct Quality {
     pub fractal_iterations: Option<u32>,
     /// Kernel precision.
     pub precision: Precision,
-    /// Over-relaxation factor for sphere tracing, in `[1, 2)`; 1 is plain
-    /// sphere tracing. Larger values take longer steps and fall back when
-    /// they overshoot.
+    /// Relaxation factor ω of sphere tracing, in `[0.25, 2)`: each step is
+    /// ω times the distance estimate. 1 is plain sphere tracing; below 1
+    /// guards against estimators that overestimate (fractals) at the cost
+    /// of more steps; above 1 takes longer steps and falls back to plain
+    /// ones where they overshoot.
     pub over_relaxation: f64,
     /// Samples per pixel along each axis (N×N jittered samples; 1: one
     /// sample at the pixel centre).
@@ -68,19 +74,22 @@ pub struct Quality {
 }
 
 impl Quality {
-    /// For moving the camera: the cheapest image that still shows the
-    /// shape. Few steps, a four-pixel threshold (fine detail merges into
-    /// blobs), no occlusion, no shadows. About 4 to 5 times faster than
-    /// [`Quality::reference`] on the gallery's fractals on a CPU device.
+    /// The detail level shared by every preset, in pixel footprints.
+    pub const DETAIL: f64 = 0.5;
+    /// The normal step shared by every preset, in pixel footprints.
+    pub const NORMAL_EPSILON: f64 = 1.0;
+
+    /// For moving the camera: the cheapest image of the same surface. Few
+    /// steps, hits located to a pixel, no occlusion and no shadows.
     #[must_use]
     pub fn draft() -> Self {
         Quality {
-            max_steps: 64,
-            hit_epsilon: 4.0,
-            max_distance: 50.0,
-            normal_epsilon: 2.0,
+            max_steps: 128,
+            detail: Self::DETAIL,
+            hit_epsilon: 0.5,
+            max_distance: 100.0,
+            normal_epsilon: Self::NORMAL_EPSILON,
             ao_samples: 0,
-            ao_step: 0.05,
             shadow_steps: 0,
             fractal_iterations: None,
             precision: Precision::F32,
@@ -89,33 +98,26 @@ impl Quality {
         }
     }
 
-    /// Interactive quality: every effect on, at about twice the speed of
-    /// [`Quality::reference`]. A threshold of one and a half pixels and
-    /// three occlusion samples; shadow rays get 64 steps, enough for the
-    /// shadows to match converged ones (with everything else at reference
-    /// settings, 64 shadow steps measured 47 dB or more against 256 on the
-    /// gallery's fractals, 32 steps as little as 26 dB).
+    /// Interactive quality: every effect on, hits located to a seventh of
+    /// a pixel, three occlusion samples and 64-step shadow rays.
     #[must_use]
     pub fn preview() -> Self {
         Quality {
-            max_steps: 128,
-            hit_epsilon: 1.5,
+            max_steps: 256,
+            hit_epsilon: 0.15,
             ao_samples: 3,
             shadow_steps: 64,
             ..Self::draft()
         }
     }
 
-    /// Final images: a threshold under a pixel, every effect converged
-    /// (256 march steps and 96 shadow steps change nothing measurable when
-    /// raised). Add [`Quality::supersampling`] for anti-aliasing.
+    /// Final images: hits located to a twentieth of a pixel, every effect
+    /// converged. Add [`Quality::supersampling`] for anti-aliasing.
     #[must_use]
     pub fn production() -> Self {
         Quality {
-            max_steps: 256,
-            hit_epsilon: 0.75,
-            max_distance: 100.0,
-            normal_epsilon: 1.0,
+            max_steps: 512,
+            hit_epsilon: 0.05,
             ao_samples: 5,
             shadow_steps: 96,
             ..Self::preview()
@@ -123,16 +125,16 @@ impl Quality {
     }
 
     /// The accuracy reference the others are measured against: F64, 2048
-    /// steps, a tenth-of-a-pixel threshold, 256 shadow steps. On fractals
-    /// it is not converged either: halving its thresholds changes its
-    /// image by as much as the presets differ from each other, at one
-    /// sample per pixel (fractal detail keeps appearing under the pixel).
+    /// steps, hits located to a thousandth of a pixel, eight occlusion
+    /// samples, 256 shadow steps. It is converged: halving its relaxation
+    /// factor or dividing its `hit_epsilon` by ten changes its image by
+    /// less than the presets differ from it (see the README).
     #[must_use]
     pub fn reference() -> Self {
         Quality {
             max_steps: 2048,
-            hit_epsilon: 0.1,
-            normal_epsilon: 0.5,
+            hit_epsilon: 0.001,
+            ao_samples: 8,
             shadow_steps: 256,
             precision: Precision::F64,
             ..Self::production()
@@ -162,11 +164,12 @@ impl Quality {
             (1..=100_000).contains(&self.max_steps),
             "in 1..=100000",
         )?;
+        check("detail", self.detail, self.detail > 0.0, "> 0")?;
         check(
             "hit_epsilon",
             self.hit_epsilon,
-            self.hit_epsilon > 0.0,
-            "> 0",
+            self.hit_epsilon > 0.0 && self.hit_epsilon <= self.detail,
+            "in (0, detail]",
         )?;
         check(
             "max_distance",
@@ -186,7 +189,6 @@ impl Quality {
             self.ao_samples <= 32,
             "<= 32",
         )?;
-        check("ao_step", self.ao_step, self.ao_step > 0.0, "> 0")?;
         check(
             "shadow_steps",
             f64::from(self.shadow_steps),
@@ -204,8 +206,8 @@ impl Quality {
         check(
             "over_relaxation",
             self.over_relaxation,
-            (1.0..2.0).contains(&self.over_relaxation),
-            "in [1, 2)",
+            (0.25..2.0).contains(&self.over_relaxation),
+            "in [0.25, 2)",
         )?;
         check(
             "supersampling",
@@ -237,6 +239,9 @@ pub struct Glow {
 pub struct Effects {
     /// Ambient occlusion (needs [`Quality::ao_samples`] > 0).
     pub ambient_occlusion: bool,
+    /// Reach of ambient occlusion along the normal, in scene units:
+    /// surfaces closer than this darken a crease.
+    pub ao_distance: f64,
     /// Shadows from every light (needs [`Quality::shadow_steps`] > 0);
     /// soft where the light's softness is above 0.
     pub shadows: bool,
@@ -258,6 +263,7 @@ impl Default for Effects {
     fn default() -> Self {
         Effects {
             ambient_occlusion: true,
+            ao_distance: 0.25,
             shadows: true,
             glow: None,
             fog_density: 0.0,
@@ -299,6 +305,9 @@ impl Effects {
             if !(g.strength.is_finite() && g.strength >= 0.0) {
                 return Err(bad("glow.strength", g.strength, "finite and >= 0"));
             }
+        }
+        if !(self.ao_distance.is_finite() && self.ao_distance > 0.0) {
+            return Err(bad("ao_distance", self.ao_distance, "finite and > 0"));
         }
         if !(self.fog_density.is_finite() && self.fog_density >= 0.0) {
             return Err(bad("fog_density", self.fog_density, "finite and >= 0"));
@@ -373,5 +382,92 @@ impl Preset {
         Self::ALL
             .into_iter()
             .find(|p| p.name().eq_ignore_ascii_case(name.trim()))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn refused(q: Quality) -> &'static str {
+        match q.validate() {
+            Err(Error::Quality { setting, .. }) => setting,
+            other => panic!("expected Error::Quality, got {other:?}"),
+        }
+    }
+
+    #[test]
+    fn every_preset_is_valid_and_draws_the_same_surface() {
+        let presets = [
+            Quality::draft(),
+            Quality::preview(),
+            Quality::production(),
+            Quality::reference(),
+        ];
+        for q in presets {
+            q.validate().unwrap();
+            assert_eq!(
+                (q.detail, q.normal_epsilon),
+                (Quality::DETAIL, Quality::NORMAL_EPSILON)
+            );
+            assert_eq!(q.max_distance, Quality::reference().max_distance);
+        }
+        // Each preset locates hits at least as precisely as the one before.
+        for pair in presets.windows(2) {
+            assert!(pair[1].hit_epsilon <= pair[0].hit_epsilon);
+            assert!(pair[1].max_steps >= pair[0].max_steps);
+        }
+    }
+
+    #[test]
+    fn hits_cannot_be_located_more_loosely_than_the_detail() {
+        let q = Quality::production();
+        let loose = Quality {
+            hit_epsilon: q.detail * 1.5,
+            ..q
+        };
+        assert_eq!(refused(loose), "hit_epsilon");
+        assert_eq!(refused(Quality { detail: 0.0, ..q }), "detail");
+        Quality {
+            hit_epsilon: q.detail,
+            ..q
+        }
+        .validate()
+        .unwrap();
+    }
+
+    #[test]
+    fn relaxation_may_shorten_or_lengthen_steps_within_bounds() {
+        let q = Quality::production();
+        for ok in [0.25, 0.5, 1.0, 1.9] {
+            Quality {
+                over_relaxation: ok,
+                ..q
+            }
+            .validate()
+            .unwrap();
+        }
+        for bad in [0.2, 2.0, f64::NAN] {
+            let bad = Quality {
+                over_relaxation: bad,
+                ..q
+            };
+            assert_eq!(refused(bad), "over_relaxation");
+        }
+    }
+
+    #[test]
+    fn occlusion_needs_a_positive_reach() {
+        let e = Effects {
+            ao_distance: 0.0,
+            ..Effects::default()
+        };
+        assert!(matches!(
+            e.validate(),
+            Err(Error::Quality {
+                setting: "ao_distance",
+                ..
+            })
+        ));
     }
 }

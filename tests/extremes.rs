@@ -94,7 +94,7 @@ fn surface_points(eval: &Evaluator, size: f64) -> Vec<(DVec3, DVec3)> {
         max_steps: 20_000,
         max_distance: 10.0 * size,
         epsilon: 1e-13 * size,
-        epsilon_per_unit: 0.0,
+        ..MarchSettings::default()
     };
     directions()
         .into_iter()
@@ -292,7 +292,7 @@ fn renders_have_no_nan_near_far_and_on_the_surface() {
 
 /// The gallery Mandelbulb, and the same scene with geometry, camera and
 /// every length of the quality (reach, occlusion step) scaled by `s`.
-fn scaled_mandelbulb(s: f64) -> (Scene, Quality) {
+fn scaled_mandelbulb(s: f64) -> (Scene, Quality, Effects) {
     let unit = fractal_sdf::gallery::mandelbulb();
     let camera = Camera {
         position: unit.camera.position * s,
@@ -306,10 +306,13 @@ fn scaled_mandelbulb(s: f64) -> (Scene, Quality) {
     let quality = Quality {
         precision: Precision::F64,
         max_distance: q.max_distance * s,
-        ao_step: q.ao_step * s,
         ..q
     };
-    (scene, quality)
+    let effects = Effects {
+        ao_distance: Effects::default().ao_distance * s,
+        ..Effects::default()
+    };
+    (scene, quality, effects)
 }
 
 #[test]
@@ -320,8 +323,8 @@ fn a_scene_scaled_by_a_million_renders_the_unit_image_in_f64() {
         return;
     }
     let frame = |s: f64| {
-        let (scene, quality) = scaled_mandelbulb(s);
-        Renderer::with_options(&scene, &gpu::options(quality, Effects::default()))
+        let (scene, quality, effects) = scaled_mandelbulb(s);
+        Renderer::with_options(&scene, &gpu::options(quality, effects))
             .unwrap()
             .render_with_aovs(96, 64)
             .unwrap()
@@ -334,4 +337,45 @@ fn a_scene_scaled_by_a_million_renders_the_unit_image_in_f64() {
     assert!(db >= 40.0, "{db:.1} dB");
     assert!(unit.coverage() > 0.2);
     assert_eq!(unit.hit, big.hit);
+}
+
+/// The gallery Mandelbulb moved by `offset`, with its camera and lights.
+fn moved_mandelbulb(offset: DVec3) -> Scene {
+    let unit = fractal_sdf::gallery::mandelbulb();
+    let camera = Camera {
+        position: unit.camera.position + offset,
+        target: unit.camera.target + offset,
+        ..unit.camera
+    };
+    Scene::new(unit.geometry.clone().unwrap().translate(offset))
+        .with_camera(camera)
+        .with_lights(unit.lights.clone())
+}
+
+#[test]
+fn a_scene_ten_million_units_away_renders_the_unit_image_in_f32() {
+    let Some(_) = gpu::device() else { return };
+    // At 1e7 an f32 can only hold multiples of 1: positions in world
+    // coordinates would be useless. The renderer works relative to the
+    // scene's outermost translation, moving the camera there in f64.
+    let frame = |offset: DVec3| {
+        let quality = Quality {
+            precision: Precision::F32,
+            ..Quality::production()
+        };
+        Renderer::with_options(
+            &moved_mandelbulb(offset),
+            &gpu::options(quality, Effects::default()),
+        )
+        .unwrap()
+        .render_with_aovs(96, 64)
+        .unwrap()
+    };
+    let (unit, far) = (frame(DVec3::ZERO), frame(dvec3(1e7, -3e7, 2e7)));
+    gpu::save("extremes_far_f32", &far.image);
+    let db = psnr(&unit.image, &far.image);
+    eprintln!("moved by 3e7: {db:.1} dB");
+    assert!(db >= 40.0, "{db:.1} dB");
+    assert!(unit.coverage() > 0.2);
+    assert_eq!(unit.hit, far.hit);
 }

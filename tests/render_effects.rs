@@ -32,16 +32,15 @@ fn ambient_occlusion_darkens_the_crease_where_a_box_meets_the_floor() {
     let Some(_) = gpu::device() else { return };
     // Ambient light only, so occlusion is the only thing that varies.
     let scene = gpu::sphere_box_floor().with_lights([]);
+    // Occlusion reaching 0.5 from the surface: the crease spans a few
+    // pixels.
     let with = Effects {
         shadows: false,
+        ao_distance: 0.5,
         ..Effects::default()
     };
     let without = Effects::none();
-    // Samples up to 0.5 from the surface: the crease spans a few pixels.
-    let quality = Quality {
-        ao_step: 0.1,
-        ..gpu::quick()
-    };
+    let quality = gpu::quick();
     let on = render(&scene, quality, with);
     let off = render(&scene, quality, without);
     gpu::save("effects_ao_on", &on.image);
@@ -88,7 +87,7 @@ fn classify_shadows(scene: &Scene, frame: &Frame, light_dir: DVec3) -> (Vec<usiz
         max_steps: 512,
         max_distance: 50.0,
         epsilon: 1e-4,
-        epsilon_per_unit: 0.0,
+        ..MarchSettings::default()
     };
     // Where the ray through image position (x, y) meets the floor y = 0.
     let floor_point = |x: f64, y: f64| {

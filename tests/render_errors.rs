@@ -12,6 +12,7 @@ fn a_build_failure_carries_the_log_and_the_source() {
     let source = ProgramSource {
         source: "__kernel void render_tile(__global float* x) { x[0] = undefined_name; }\n".into(),
         precision: Precision::F32,
+        origin: DVec3::ZERO,
     };
     let err = Renderer::with_source(
         &gpu::sphere_box_floor(),

@@ -1,14 +1,16 @@
 //! The speed-versus-accuracy trade-off, measured on every fractal of the
-//! gallery: each quality preset and sweeps of `max_steps` and
-//! `hit_epsilon`, timed (median of several renders after a warm-up) and
-//! compared with a `reference` render of the same pixels (F64, 2048 steps,
-//! a tenth-of-a-pixel threshold): PSNR, SSIM, hit-mask mismatch, mean
-//! depth error, and PSNR of both images box-filtered to half size. A row
-//! `reference/2` (the reference with both thresholds halved) shows how far
-//! the reference itself is from converged. Anti-aliasing is measured apart,
-//! at half the size, against a 4×4-sample render. Prints markdown tables,
-//! writes `out/tradeoff.csv` and plots time against error in
-//! `out/tradeoff.png`.
+//! gallery: each quality preset and sweeps of `max_steps`, `hit_epsilon`
+//! and `over_relaxation`, timed (median of several renders after a
+//! warm-up) and compared with a `reference` render of the same pixels
+//! (F64, 2048 steps, hits located to a thousandth of a pixel): PSNR,
+//! SSIM, hit-mask mismatch, mean depth error, and PSNR of both images
+//! box-filtered to half size. Two rows check that the reference is
+//! converged (`reference ω/2`: half its relaxation factor; `reference
+//! ε/10`: a tenth of its `hit_epsilon`). A sweep of `detail`, which
+//! changes the surface drawn rather than the accuracy, shows how much the
+//! look depends on it. Anti-aliasing is measured apart, at half the size,
+//! against a 4×4-sample render. Prints markdown tables, writes
+//! `out/tradeoff.csv` and plots time against error in `out/tradeoff.png`.
 //!
 //! ```text
 //! cargo run --release --example tradeoff [-- --quick | --size 640x480]
@@ -36,7 +38,8 @@ const SCENES: [&str; 4] = ["mandelbulb", "menger", "julia", "sierpinski"];
 pub struct Row {
     /// Gallery scene.
     pub scene: String,
-    /// `preset`, `floor`, `max_steps`, `hit_epsilon` or `aa`.
+    /// `preset`, `floor`, `max_steps`, `hit_epsilon`, `over_relaxation`,
+    /// `detail` or `aa`.
     pub group: &'static str,
     /// What was varied, e.g. `preview` or `max_steps=64`.
     pub label: String,
@@ -137,39 +140,76 @@ fn presets() -> Vec<(String, Quality)> {
     .collect()
 }
 
-/// The reference with its hit and normal thresholds halved: its distance
+/// The reference made more careful, one knob at a time: its distance
 /// from the reference is the reference's own convergence error.
 fn floor() -> Vec<(String, Quality)> {
-    let r = Quality::reference();
-    let q = Quality {
-        hit_epsilon: r.hit_epsilon / 2.0,
-        normal_epsilon: r.normal_epsilon / 2.0,
-        ..r
-    };
-    vec![("reference/2".to_string(), q)]
+    let r = reference();
+    vec![
+        (
+            "reference ω/2".to_string(),
+            Quality {
+                over_relaxation: r.over_relaxation / 2.0,
+                ..r
+            },
+        ),
+        (
+            "reference ε/10".to_string(),
+            Quality {
+                hit_epsilon: r.hit_epsilon / 10.0,
+                ..r
+            },
+        ),
+    ]
 }
 
-/// Production quality with one knob swept.
+/// Production quality with one knob swept. `detail` is last: it changes
+/// the surface drawn, so its rows measure a change of look, not of
+/// accuracy.
 fn sweeps() -> Vec<(&'static str, Vec<(String, Quality)>)> {
     let base = Quality::production();
-    let steps = [32, 64, 128, 512]
-        .into_iter()
-        .map(|max_steps| {
-            let q = Quality { max_steps, ..base };
-            (format!("max_steps={max_steps}"), q)
-        })
-        .collect();
-    let eps = [0.25, 0.5, 1.5, 3.0]
-        .into_iter()
-        .map(|hit_epsilon| {
-            let q = Quality {
-                hit_epsilon,
-                ..base
-            };
-            (format!("hit_epsilon={hit_epsilon}"), q)
-        })
-        .collect();
-    vec![("max_steps", steps), ("hit_epsilon", eps)]
+    let sweep =
+        |name: &str, values: &[f64], set: fn(&mut Quality, f64)| -> Vec<(String, Quality)> {
+            values
+                .iter()
+                .map(|&v| {
+                    let mut q = base;
+                    set(&mut q, v);
+                    (format!("{name}={v}"), q)
+                })
+                .collect()
+        };
+    vec![
+        (
+            "max_steps",
+            sweep("max_steps", &[32.0, 64.0, 128.0, 256.0], |q, v| {
+                q.max_steps = v as u32;
+            }),
+        ),
+        (
+            "hit_epsilon",
+            sweep("hit_epsilon", &[0.01, 0.15, 0.3, 0.5], |q, v| {
+                q.hit_epsilon = v;
+            }),
+        ),
+        (
+            "over_relaxation",
+            sweep("over_relaxation", &[0.5, 1.3, 1.6, 1.9], |q, v| {
+                q.over_relaxation = v;
+            }),
+        ),
+        (
+            "detail",
+            sweep("detail", &[0.25, 0.4, 0.6, 1.0], |q, v| q.detail = v),
+        ),
+    ]
+}
+
+/// The reference at one sample per pixel.
+fn reference() -> Quality {
+    Quality {
+        supersampling: 1,
+        ..Quality::reference()
+    }
 }
 
 /// Production quality with N×N samples per pixel, N = 1 to 3.
@@ -284,11 +324,7 @@ fn main() -> std::process::ExitCode {
                 std::process::exit(2);
             };
             eprintln!("{name}: reference");
-            let reference_quality = Quality {
-                supersampling: 1,
-                ..Quality::reference()
-            };
-            let (timing, reference) = study.measure(&scene, reference_quality)?;
+            let (timing, reference) = study.measure(&scene, reference())?;
             fractal_sdf::output::save_png(&reference.image, format!("out/tradeoff_{name}.png"))?;
             let against = (timing.median_ms, &reference);
             rows.extend(study.group(name, &scene, "preset", presets(), against)?);
@@ -333,7 +369,12 @@ fn main() -> std::process::ExitCode {
         println!("March accuracy (1 sample per pixel; error against `reference`):\n");
         println!("{}", table(&rows, &["preset", "floor"]));
         println!("Sweeps of production quality:\n");
-        println!("{}", table(&rows, &["max_steps", "hit_epsilon"]));
+        println!(
+            "{}",
+            table(&rows, &["max_steps", "hit_epsilon", "over_relaxation"])
+        );
+        println!("The look: `detail` changes the surface drawn (production otherwise):\n");
+        println!("{}", table(&rows, &["detail"]));
         if rows.iter().any(|r| r.group == "aa") {
             println!(
                 "Anti-aliasing at {}x{} (speed-up: against 1x1; error: against production with 4x4 samples):\n",

@@ -11,7 +11,7 @@ const WIDTH: u32 = 1400;
 const HEIGHT: u32 = 620;
 /// PSNR is drawn up to this; an identical image (the reference itself,
 /// infinite PSNR) sits on the top edge.
-const TOP_DB: f64 = 60.0;
+const TOP_DB: f64 = 80.0;
 const COLORS: [RGBColor; 4] = [
     RGBColor(214, 39, 40),
     RGBColor(31, 119, 180),
@@ -19,7 +19,8 @@ const COLORS: [RGBColor; 4] = [
     RGBColor(148, 103, 189),
 ];
 
-/// Draws the plot of every row except the anti-aliasing ones.
+/// Draws the plot of every row except the anti-aliasing and `detail` ones
+/// (those measure a change of look, not of accuracy).
 pub fn draw(rows: &[Row], size: (u32, u32), device: &str) -> RgbaImage {
     // The font ships with the `dejavu` crate: no system fonts needed. A
     // second registration fails harmlessly.
@@ -37,7 +38,10 @@ pub fn draw(rows: &[Row], size: (u32, u32), device: &str) -> RgbaImage {
             .titled(&title, ("sans-serif", 20))
             .expect("draw into memory");
         let (left, right) = root.split_horizontally(WIDTH / 2);
-        let rows: Vec<&Row> = rows.iter().filter(|r| r.group != "aa").collect();
+        let rows: Vec<&Row> = rows
+            .iter()
+            .filter(|r| r.group != "aa" && r.group != "detail")
+            .collect();
         panel(&left, &rows, "median ms per frame", |r| r.timing.median_ms);
         panel(&right, &rows, "distance evaluations per pixel", |r| {
             r.evaluations

@@ -27,6 +27,8 @@ mod writer;
 
 pub use writer::literal;
 
+use glam::DVec3;
+
 use crate::error::{Error, Result};
 use crate::ir::{Ir, ParamSlot};
 use crate::quality::{Effects, Precision, Quality};
@@ -76,6 +78,10 @@ pub struct KernelSource {
     /// A stable 64-bit hash (FNV-1a) of `source`; equal sources have equal
     /// hashes, and changing a dynamic value never changes either.
     pub hash: u64,
+    /// Where the program's `DE` has its origin in the scene: the scene's
+    /// outermost baked translation for [`Target::Render`] (see
+    /// [`Ir::local_frame`]), zero otherwise.
+    pub origin: DVec3,
 }
 
 /// Generates the OpenCL C program for `scene`.
@@ -98,8 +104,15 @@ pub fn emit_ir(ir: &Ir, options: &Options) -> Result<KernelSource> {
     let precision = options.quality.precision;
 
     // The scene functions first, to learn which helpers they call.
+    // Rendering works in the scene's local frame (see `Ir::local_frame`);
+    // evaluation takes points where the user gives them.
+    let (origin, root) = match options.target {
+        Target::Render => ir.local_frame(),
+        Target::Evaluate => (DVec3::ZERO, ir.root()),
+    };
     let mut body = writer::Writer::new(precision);
-    let mut emitter = scene::SceneEmitter::new(ir, &mut body, options.quality.fractal_iterations);
+    let mut emitter =
+        scene::SceneEmitter::new(ir, root, &mut body, options.quality.fractal_iterations);
     emitter.emit();
     let used: Vec<&'static str> = emitter.used.iter().copied().collect();
     let customs: Vec<_> = emitter.customs.values().cloned().collect();
@@ -124,7 +137,7 @@ pub fn emit_ir(ir: &Ir, options: &Options) -> Result<KernelSource> {
     }
     w.line("/* ---- scene ---- */");
     w.raw(&body.finish());
-    Ok(finish(w, options, ir.params().to_vec()))
+    Ok(finish(w, options, ir.params().to_vec(), origin))
 }
 
 /// A complete program around hand-written scene functions: the header for
@@ -142,11 +155,16 @@ pub fn emit_handwritten(scene_functions: &str, options: &Options) -> Result<Kern
     header(&mut w, options);
     w.line("/* ---- scene (hand-written) ---- */");
     w.raw(scene_functions);
-    Ok(finish(w, options, Vec::new()))
+    Ok(finish(w, options, Vec::new(), DVec3::ZERO))
 }
 
 /// Appends the target kernel and hashes the program.
-fn finish(mut w: writer::Writer, options: &Options, params: Vec<ParamSlot>) -> KernelSource {
+fn finish(
+    mut w: writer::Writer,
+    options: &Options,
+    params: Vec<ParamSlot>,
+    origin: DVec3,
+) -> KernelSource {
     let kernel = match options.target {
         Target::Render => include_str!("../../kernels/march.cl"),
         Target::Evaluate => include_str!("../../kernels/eval.cl"),
@@ -158,6 +176,7 @@ fn finish(mut w: writer::Writer, options: &Options, params: Vec<ParamSlot>) -> K
         source,
         params,
         precision: options.quality.precision,
+        origin,
     }
 }
 
@@ -192,6 +211,7 @@ fn header(w: &mut writer::Writer, options: &Options) {
         ("DEFAULT_COLOR", rgb(crate::cpu::DEFAULT_COLOR.into())),
         ("MAX_STEPS", q.max_steps.to_string()),
         ("MAX_DISTANCE", f(q.max_distance)),
+        ("DETAIL", f(q.detail)),
         ("HIT_EPSILON", f(q.hit_epsilon)),
         ("NORMAL_EPSILON", f(q.normal_epsilon)),
         ("OVER_RELAXATION", f(q.over_relaxation)),
@@ -203,7 +223,7 @@ fn header(w: &mut writer::Writer, options: &Options) {
     let on = features(options);
     if on.contains(&"ENABLE_AO") {
         defines.push(("AO_SAMPLES", q.ao_samples.to_string()));
-        defines.push(("AO_STEP", f(q.ao_step)));
+        defines.push(("AO_DISTANCE", f(e.ao_distance)));
     }
     if on.contains(&"ENABLE_SHADOWS") {
         defines.push(("SHADOW_STEPS", q.shadow_steps.to_string()));

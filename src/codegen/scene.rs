@@ -19,6 +19,9 @@ struct Vars {
 
 pub(crate) struct SceneEmitter<'a> {
     ir: &'a Ir,
+    /// The node `DE` evaluates: the IR's root, or the node under its
+    /// outermost translation for a program in the scene's local frame.
+    root: NodeId,
     w: &'a mut Writer,
     shade: bool,
     points: usize,
@@ -32,9 +35,15 @@ pub(crate) struct SceneEmitter<'a> {
 }
 
 impl<'a> SceneEmitter<'a> {
-    pub(crate) fn new(ir: &'a Ir, w: &'a mut Writer, iteration_override: Option<u32>) -> Self {
+    pub(crate) fn new(
+        ir: &'a Ir,
+        root: NodeId,
+        w: &'a mut Writer,
+        iteration_override: Option<u32>,
+    ) -> Self {
         SceneEmitter {
             ir,
+            root,
             w,
             shade: false,
             points: 0,
@@ -58,7 +67,7 @@ impl<'a> SceneEmitter<'a> {
                 self.w
                     .open("real DE(real3 p0, __global const real* params)");
             }
-            let out = self.node(self.ir.root(), "p0");
+            let out = self.node(self.root, "p0");
             if shade {
                 self.w.line(format!("*color = {};", out.c));
                 self.w.line(format!("*trap = {};", out.t));

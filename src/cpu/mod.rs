@@ -368,18 +368,30 @@ pub struct Ray {
     pub direction: DVec3,
 }
 
-/// Sphere-tracing limits.
+/// Sphere-tracing settings: the same march as the OpenCL kernel.
+///
+/// The surface is where the distance falls to the threshold
+/// `epsilon + t * epsilon_per_unit`. The march steps by the distance to
+/// that surface, at least `refine` times the threshold, and locates the
+/// crossing to `refine` times the threshold along the ray.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct MarchSettings {
     /// Give up after this many steps.
     pub max_steps: u32,
     /// Give up beyond this distance along the ray.
     pub max_distance: f64,
-    /// A hit is a distance below `epsilon + t * epsilon_per_unit` (the
-    /// second term scales the threshold with the pixel footprint).
+    /// The hit threshold at the ray origin.
     pub epsilon: f64,
-    /// Growth of the hit threshold per unit of ray length.
+    /// Growth of the hit threshold per unit of ray length (it scales with
+    /// the pixel footprint).
     pub epsilon_per_unit: f64,
+    /// The shortest step and the precision of the located crossing, as a
+    /// fraction of the threshold; in `(0, 1]` for a bounded number of steps
+    /// along grazing rays.
+    pub refine: f64,
+    /// Relaxation factor ω, in `[0.25, 2)` (see
+    /// [`Quality::over_relaxation`](crate::quality::Quality::over_relaxation)).
+    pub over_relaxation: f64,
 }
 
 impl Default for MarchSettings {
@@ -389,6 +401,8 @@ impl Default for MarchSettings {
             max_distance: 100.0,
             epsilon: 1e-4,
             epsilon_per_unit: 0.0,
+            refine: 0.1,
+            over_relaxation: 1.0,
         }
     }
 }
@@ -406,36 +420,97 @@ pub struct Hit {
     pub min_distance: f64,
 }
 
-/// Sphere-traces `ray` through the scene.
+/// Sphere-traces `ray` through the scene, exactly as the kernel's
+/// `march_ray` does: steps of the distance to the threshold surface (no
+/// shorter than `refine` thresholds; relaxed, with the fallback, when
+/// `over_relaxation > 1`), then the crossing located by the Illinois form
+/// of regula falsi.
 #[must_use]
 pub fn march(eval: &Evaluator, ray: Ray, settings: &MarchSettings) -> Hit {
-    let mut t = 0.0;
+    let threshold = |t: f64| settings.epsilon + t * settings.epsilon_per_unit;
+    let level = |t: f64| eval.distance(ray.origin + ray.direction * t) - threshold(t);
+    let lipschitz = 1.0 + settings.epsilon_per_unit;
+    let mut omega = settings.over_relaxation;
+    let mut relaxed = false;
+    let (mut t, mut prev_t, mut prev_g) = (0.0, 0.0, 0.0);
     let mut min_distance = f64::INFINITY;
-    for step in 0..settings.max_steps {
-        let d = eval.distance(ray.origin + ray.direction * t);
-        min_distance = min_distance.min(d);
-        if d < settings.epsilon + t * settings.epsilon_per_unit {
-            return Hit {
-                hit: true,
-                depth: t,
-                steps: step + 1,
-                min_distance,
-            };
-        }
-        t += d;
-        if t > settings.max_distance {
-            return Hit {
-                hit: false,
-                depth: t,
-                steps: step + 1,
-                min_distance,
-            };
-        }
-    }
-    Hit {
-        hit: false,
-        depth: t,
-        steps: settings.max_steps,
+    let mut steps = 0;
+    let stop = |hit, depth, steps, min_distance| Hit {
+        hit,
+        depth,
+        steps,
         min_distance,
+    };
+    for i in 0..settings.max_steps {
+        let d = eval.distance(ray.origin + ray.direction * t);
+        let g = d - threshold(t);
+        steps += 1;
+        if relaxed && (g < 0.0 || prev_g + g < lipschitz * (t - prev_t)) {
+            t = prev_t + prev_g / lipschitz;
+            omega = 1.0;
+            relaxed = false;
+            continue;
+        }
+        min_distance = min_distance.min(d);
+        if g <= 0.0 {
+            if i > 0 {
+                let (depth, extra) = refine(level, (prev_t, prev_g), (t, g), |t| {
+                    settings.refine * threshold(t)
+                });
+                t = depth;
+                steps += extra;
+            }
+            return stop(true, t, steps, min_distance);
+        }
+        let plain = g / lipschitz;
+        let shortest = settings.refine * threshold(t);
+        relaxed = omega > 1.0 && omega * plain > plain.max(shortest);
+        prev_t = t;
+        prev_g = g;
+        t += (omega * plain).max(shortest);
+        if t > settings.max_distance {
+            return stop(false, t, steps, min_distance);
+        }
     }
+    stop(false, t, steps, min_distance)
+}
+
+/// Most evaluations [`march`] spends locating a crossing.
+const REFINE_LIMIT: u32 = 24;
+
+/// Locates a root of `g` between `outside` (`g > 0`) and `inside`
+/// (`g <= 0`), `(t, g(t))` pairs, until the bracket is narrower than
+/// `tolerance(t)`, by the Illinois form of regula falsi. Returns the inside
+/// end of the final bracket and the evaluations spent.
+fn refine(
+    g: impl Fn(f64) -> f64,
+    outside: (f64, f64),
+    inside: (f64, f64),
+    tolerance: impl Fn(f64) -> f64,
+) -> (f64, u32) {
+    let ((mut t0, mut g0), (mut t1, mut g1)) = (outside, inside);
+    let mut kept = 0; // the end the last step moved: -1 outside, 1 inside
+    let mut evaluations = 0;
+    while evaluations < REFINE_LIMIT && t1 - t0 > tolerance(t1) {
+        let t = (t0 + (t1 - t0) * (g0 / (g0 - g1))).clamp(t0, t1);
+        let v = g(t);
+        evaluations += 1;
+        if v > 0.0 {
+            (t0, g0) = (t, v);
+            if kept == -1 {
+                g1 *= 0.5;
+            }
+            kept = -1;
+        } else {
+            (t1, g1) = (t, v);
+            if v == 0.0 {
+                break;
+            }
+            if kept == 1 {
+                g0 *= 0.5;
+            }
+            kept = 1;
+        }
+    }
+    (t1, evaluations)
 }

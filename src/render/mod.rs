@@ -25,13 +25,13 @@
 //! - `real`, `real2`, `real3`, `real4` (`float*` or `double*`, the latter
 //!   with `#pragma OPENCL EXTENSION cl_khr_fp64 : enable`), and `R(x)`, which
 //!   turns a literal into a `real` one;
-//! - `REAL_TINY`, `MAX_STEPS`, `MAX_DISTANCE`, `HIT_EPSILON` and
+//! - `REAL_TINY`, `MAX_STEPS`, `MAX_DISTANCE`, `DETAIL`, `HIT_EPSILON` and
 //!   `NORMAL_EPSILON` (multiples of the pixel footprint), `OVER_RELAXATION`,
 //!   `SUPERSAMPLING` (N for N×N samples), `GAMMA`, `SKY_TOP`, `SKY_BOTTOM`
 //!   (`real3`), from [`Quality`](crate::quality::Quality) and
 //!   [`Effects`](crate::quality::Effects);
 //! - only for the effects that are on: `ENABLE_AO` with `AO_SAMPLES` and
-//!   `AO_STEP`; `ENABLE_SHADOWS` with `SHADOW_STEPS`; `ENABLE_GLOW` with
+//!   `AO_DISTANCE`; `ENABLE_SHADOWS` with `SHADOW_STEPS`; `ENABLE_GLOW` with
 //!   `GLOW_COLOR` and `GLOW_STRENGTH`; `ENABLE_FOG` with `FOG_DENSITY`.
 //!
 //! and the scene provides

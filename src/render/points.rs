@@ -75,6 +75,7 @@ impl PointEvaluator {
         let source = ProgramSource {
             source: kernel.source,
             precision,
+            origin: kernel.origin,
         };
         let (program, _, _) = program::build(&selected, &context, &source)?;
         Ok(PointEvaluator {

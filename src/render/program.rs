@@ -13,6 +13,7 @@ use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::{Arc, Mutex, OnceLock, PoisonError};
 use std::time::{Duration, Instant};
 
+use glam::DVec3;
 use ocl::core::{ClDeviceIdPtr, ProgramBuildInfo, ProgramBuildInfoResult};
 use ocl::{Context, Program};
 
@@ -23,13 +24,17 @@ use crate::quality::Precision;
 /// The OpenCL C program for one scene: generated header, distance
 /// functions and `kernels/march.cl` (see [`crate::render`] for the contract
 /// the source must meet).
-#[derive(Debug, Clone, PartialEq, Eq)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct ProgramSource {
     /// The complete program text.
     pub source: String,
     /// The precision its `real` type stands for; `F64` requires a device
     /// with `cl_khr_fp64`.
     pub precision: Precision,
+    /// The point of the scene that is the origin of the program's `DE`
+    /// (zero for a `DE` of world coordinates). The renderer moves the
+    /// camera and the lights by it, in `f64`, before they reach the device.
+    pub origin: DVec3,
 }
 
 /// How a renderer's program was obtained.

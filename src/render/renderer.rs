@@ -3,6 +3,7 @@
 
 use std::time::{Duration, Instant};
 
+use glam::DVec3;
 use image::RgbaImage;
 use ocl::enums::ProfilingInfo;
 use ocl::{Buffer, Context, Event, Kernel, MemFlags, Program, Queue};
@@ -118,6 +119,7 @@ fn generate(scene: &Scene, options: &RenderOptions) -> Result<ProgramSource> {
     codegen::emit(scene, &options).map(|k| ProgramSource {
         source: k.source,
         precision: k.precision,
+        origin: k.origin,
     })
 }
 
@@ -378,7 +380,13 @@ impl Renderer {
     /// # Errors
     /// As [`Viewport::new`].
     pub fn viewport(&self, width: u32, height: u32) -> Result<Viewport> {
-        Viewport::new(&self.scene.camera, width, height, self.source.precision)
+        Viewport::in_frame(
+            &self.scene.camera,
+            width,
+            height,
+            self.source.precision,
+            self.source.origin,
+        )
     }
 
     fn reprogram(&mut self, options: RenderOptions) -> Result<()> {
@@ -439,6 +447,7 @@ impl Renderer {
             &view,
             &self.values,
             &self.scene.lights,
+            self.source.origin,
         )?;
         let k = &self.kernel;
         let t = &self.targets;
@@ -656,7 +665,7 @@ impl Inputs {
             precision,
             params: RealBuffer::new(queue, precision, values.as_slice())?,
             camera: RealBuffer::new(queue, precision, &[0.0; super::viewport::CAMERA_LEN])?,
-            lights: RealBuffer::new(queue, precision, &pack_lights(lights))?,
+            lights: RealBuffer::new(queue, precision, &pack_lights(lights, DVec3::ZERO))?,
         })
     }
 
@@ -669,10 +678,11 @@ impl Inputs {
         view: &Viewport,
         values: &ParamValues,
         lights: &[Light],
+        origin: DVec3,
     ) -> Result<()> {
         self.params.write(values.as_slice())?;
-        self.camera.write(&view.pack())?;
-        let packed = pack_lights(lights);
+        self.camera.write(&view.pack(origin))?;
+        let packed = pack_lights(lights, origin);
         if packed.len() == self.lights.len() {
             self.lights.write(&packed)?;
         } else {

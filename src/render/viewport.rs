@@ -67,6 +67,24 @@ impl Viewport {
     /// [`Error::Camera`] for a degenerate camera, [`Error::Resolution`] if a
     /// side is 0.
     pub fn new(camera: &Camera, width: u32, height: u32, precision: Precision) -> Result<Self> {
+        Self::in_frame(camera, width, height, precision, DVec3::ZERO)
+    }
+
+    /// As [`Viewport::new`] for a program whose positions are relative to
+    /// the scene point `origin` (a
+    /// [`ProgramSource::origin`](crate::render::ProgramSource::origin)):
+    /// the rounding floor follows the camera's distance from `origin`, not
+    /// from the world's origin. Rays stay in world coordinates.
+    ///
+    /// # Errors
+    /// As [`Viewport::new`].
+    pub fn in_frame(
+        camera: &Camera,
+        width: u32,
+        height: u32,
+        precision: Precision,
+        origin: DVec3,
+    ) -> Result<Self> {
         if width == 0 || height == 0 {
             return Err(Error::Resolution {
                 width,
@@ -76,7 +94,8 @@ impl Viewport {
         }
         let (right, up, forward) = camera.basis()?;
         let aspect = f64::from(width) / f64::from(height);
-        let scale = camera.position.length() + (camera.target - camera.position).length();
+        let scale =
+            (camera.position - origin).length() + (camera.target - camera.position).length();
         let relative_floor = Self::relative_floor(precision);
         let (half_h, orthographic, footprint_base, footprint_per_unit) = match camera.projection {
             Projection::Perspective { fov_y_degrees } => {
@@ -149,14 +168,17 @@ impl Viewport {
     }
 
     /// The CPU reference's settings for the same march as the kernel: the
-    /// hit threshold is `quality.hit_epsilon` pixel footprints.
+    /// surface lies `quality.detail` pixel footprints out, and hits are
+    /// located to `quality.hit_epsilon` footprints.
     #[must_use]
     pub fn march_settings(&self, quality: &Quality) -> MarchSettings {
         MarchSettings {
             max_steps: quality.max_steps,
             max_distance: quality.max_distance,
-            epsilon: quality.hit_epsilon * self.footprint_base,
-            epsilon_per_unit: quality.hit_epsilon * self.footprint_per_unit,
+            epsilon: quality.detail * self.footprint_base,
+            epsilon_per_unit: quality.detail * self.footprint_per_unit,
+            refine: quality.hit_epsilon / quality.detail,
+            over_relaxation: quality.over_relaxation,
         }
     }
 
@@ -166,8 +188,11 @@ impl Viewport {
         (self.width, self.height)
     }
 
-    /// The kernel's camera buffer (layout in `kernels/march.cl`).
-    pub(crate) fn pack(&self) -> [f64; CAMERA_LEN] {
+    /// The kernel's camera buffer (layout in `kernels/march.cl`), with the
+    /// camera moved into a frame whose origin is the scene point `origin`.
+    /// The subtraction happens here in `f64`, so a camera near a distant
+    /// origin reaches an `F32` kernel with small, exact coordinates.
+    pub(crate) fn pack(&self, origin: DVec3) -> [f64; CAMERA_LEN] {
         let mut c = [0.0; CAMERA_LEN];
         let put = |c: &mut [f64; CAMERA_LEN], at: usize, v: DVec3, w: f64| {
             c[at..at + 4].copy_from_slice(&[v.x, v.y, v.z, w]);
@@ -175,7 +200,7 @@ impl Viewport {
         put(
             &mut c,
             0,
-            self.origin,
+            self.origin - origin,
             f64::from(u8::from(self.orthographic)),
         );
         put(&mut c, 4, self.right, self.half_w);
@@ -187,14 +212,16 @@ impl Viewport {
     }
 }
 
-/// The kernel's light buffer (layout in `kernels/march.cl`); at least one
-/// (unused) entry so the buffer is never empty.
-pub(crate) fn pack_lights(lights: &[Light]) -> Vec<f64> {
+/// The kernel's light buffer (layout in `kernels/march.cl`), point lights
+/// moved into the frame whose origin is the scene point `origin` (as
+/// [`Viewport::pack`]); at least one (unused) entry so the buffer is never
+/// empty.
+pub(crate) fn pack_lights(lights: &[Light], origin: DVec3) -> Vec<f64> {
     let mut out = Vec::with_capacity(LIGHT_LEN * lights.len().max(1));
     for light in lights {
         let (v, kind) = match light.source {
             LightSource::Directional { direction } => (direction.normalize(), 0.0),
-            LightSource::Point { position } => (position, 1.0),
+            LightSource::Point { position } => (position - origin, 1.0),
         };
         let radiance = light.color * light.intensity;
         out.extend_from_slice(&[v.x, v.y, v.z, kind]);
@@ -242,8 +269,10 @@ mod tests {
         let fp = view.footprint(1.0) - view.footprint(0.0);
         assert!((gap / fp - 1.0).abs() < 0.05, "{gap} vs {fp}");
         assert!(view.footprint(0.0) > 0.0);
-        let settings = view.march_settings(&Quality::production());
-        assert!((settings.epsilon_per_unit - 0.75 * fp).abs() < 1e-15);
+        let q = Quality::production();
+        let settings = view.march_settings(&q);
+        assert!((settings.epsilon_per_unit - q.detail * fp).abs() < 1e-15);
+        assert!((settings.refine * q.detail - q.hit_epsilon).abs() < 1e-15);
     }
 
     #[test]
@@ -255,7 +284,7 @@ mod tests {
         assert_eq!(a.direction, b.direction);
         assert!(((a.origin - b.origin).length() - 4.0 * 2f64.sqrt()).abs() < 1e-9);
         assert!((view.footprint(123.0) - 0.1).abs() < 1e-15);
-        assert_eq!(view.pack()[3], 1.0);
+        assert_eq!(view.pack(DVec3::ZERO)[3], 1.0);
     }
 
     #[test]
@@ -270,10 +299,15 @@ mod tests {
             Light::directional(dvec3(0.0, 2.0, 0.0)).intensity(2.0),
             Light::point(dvec3(1.0, 2.0, 3.0)).softness(0.0),
         ];
-        let packed = pack_lights(&lights);
+        let packed = pack_lights(&lights, DVec3::ZERO);
         assert_eq!(packed.len(), 2 * LIGHT_LEN);
         assert_eq!(&packed[..8], &[0.0, 1.0, 0.0, 0.0, 2.0, 2.0, 2.0, 0.05]);
         assert_eq!(&packed[8..], &[1.0, 2.0, 3.0, 1.0, 1.0, 1.0, 1.0, 0.0]);
-        assert_eq!(pack_lights(&[]).len(), LIGHT_LEN);
+        assert_eq!(pack_lights(&[], DVec3::ZERO).len(), LIGHT_LEN);
+        // Into a frame far away: point lights move, directions do not.
+        let origin = dvec3(1e7, -1e7, 3.0);
+        let moved = pack_lights(&lights, origin);
+        assert_eq!(&moved[..8], &packed[..8]);
+        assert_eq!(&moved[8..11], &[1.0 - 1e7, 2.0 + 1e7, 0.0]);
     }
 }

@@ -9,9 +9,10 @@ typedef float4 real4;
 #define DERIVATIVE_CAP 1e30f
 #define MAGNITUDE_CAP 1e18f
 #define DEFAULT_COLOR (real3)(0.8f, 0.8f, 0.8f)
-#define MAX_STEPS 256
+#define MAX_STEPS 512
 #define MAX_DISTANCE 100.0f
-#define HIT_EPSILON 0.75f
+#define DETAIL 0.5f
+#define HIT_EPSILON 0.05f
 #define NORMAL_EPSILON 1.0f
 #define OVER_RELAXATION 1.0f
 #define SUPERSAMPLING 1
@@ -19,7 +20,7 @@ typedef float4 real4;
 #define SKY_TOP (real3)(0.32f, 0.42f, 0.58f)
 #define SKY_BOTTOM (real3)(0.06f, 0.07f, 0.09f)
 #define AO_SAMPLES 5
-#define AO_STEP 0.05f
+#define AO_DISTANCE 0.25f
 #define SHADOW_STEPS 96
 
 /* ---- julia ---- */
@@ -64,8 +65,9 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
 // Appended after the generated header and the scene's distance functions.
 // It uses only:
 //   types   real, real2, real3, real4 and the literal macro R(x)
-//   consts  REAL_TINY MAX_STEPS MAX_DISTANCE HIT_EPSILON NORMAL_EPSILON
-//           OVER_RELAXATION SUPERSAMPLING GAMMA SKY_TOP SKY_BOTTOM
+//   consts  REAL_TINY MAX_STEPS MAX_DISTANCE DETAIL HIT_EPSILON
+//           NORMAL_EPSILON OVER_RELAXATION SUPERSAMPLING GAMMA SKY_TOP
+//           SKY_BOTTOM
 //   scene   real DE(real3 p, __global const real* params)
 //           real DE_shade(real3 p, __global const real* params,
 //                         real3* color, real* trap)
@@ -103,6 +105,7 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
 #define MARCH_SPECULAR R(0.25)    // Blinn-Phong specular strength
 #define MARCH_SHININESS R(32.0)   // Blinn-Phong exponent
 #define MARCH_NORMAL_EVALUATIONS 4u // DE calls of march_normal
+#define MARCH_REFINE_LIMIT 24     // most evaluations spent locating a hit
 
 typedef struct {
     real t;         // distance along the ray where the march stopped
@@ -157,11 +160,67 @@ void march_camera_ray(const MarchCamera* cam, real px, real py, int width, int h
     }
 }
 
-// Sphere tracing. A hit is a distance below HIT_EPSILON pixel footprints.
-// With OVER_RELAXATION > 1 the steps are lengthened (Keinert et al. 2014);
-// when the unbounding spheres of two consecutive points stop overlapping
-// the long step may have jumped over a surface, so the march returns to the
-// last safe point and continues with plain steps.
+// The drawn surface: where the distance estimate falls to DETAIL pixel
+// footprints. g(t) is how far the point at t along the ray lies outside it.
+real march_level(real3 ro, real3 rd, const MarchCamera* cam, real t,
+                 __global const real* params) {
+    return DE(ro + rd * t, params) - DETAIL * march_footprint(cam, t);
+}
+
+// Locates the crossing of the surface between t0 (outside, g0 > 0) and t1
+// (inside, g1 <= 0) to HIT_EPSILON pixel footprints along the ray, by the
+// Illinois form of regula falsi: exact in one evaluation where the
+// distance is linear along the ray (a plane, a sphere met head-on), and
+// superlinear elsewhere. Returns the inside end of the final bracket and
+// adds its evaluations to *steps.
+real march_refine(real3 ro, real3 rd, const MarchCamera* cam, real t0, real g0, real t1,
+                  real g1, __global const real* params, int* steps) {
+    int kept = 0; // which end the last step moved: -1 outside, 1 inside
+    for (int i = 0; i < MARCH_REFINE_LIMIT; ++i) {
+        if (t1 - t0 <= HIT_EPSILON * march_footprint(cam, t1)) {
+            break;
+        }
+        real t = clamp(t0 + (t1 - t0) * (g0 / (g0 - g1)), t0, t1);
+        real g = march_level(ro, rd, cam, t, params);
+        *steps += 1;
+        if (g > R(0.0)) {
+            t0 = t;
+            g0 = g;
+            if (kept == -1) {
+                g1 *= R(0.5);
+            }
+            kept = -1;
+        } else {
+            t1 = t;
+            g1 = g;
+            if (g == R(0.0)) {
+                break;
+            }
+            if (kept == 1) {
+                g0 *= R(0.5);
+            }
+            kept = 1;
+        }
+    }
+    return t1;
+}
+
+// Sphere tracing towards the surface DETAIL pixel footprints out: each
+// step is the distance g to that surface (divided by g's Lipschitz bound,
+// which the footprint term raises a little above 1), so for an estimator
+// that never overestimates no step passes the first crossing, however thin
+// the feature. Steps are at least HIT_EPSILON footprints long, so a ray
+// that approaches the surface at a grazing angle crosses it in a bounded
+// number of steps, and features thinner than that along the ray may be
+// missed. Once a step lands inside, march_refine locates the crossing.
+// The surface does not depend on how the march gets there: MAX_STEPS,
+// OVER_RELAXATION and HIT_EPSILON change the cost and the accuracy, not
+// the shape drawn.
+// OVER_RELAXATION below 1 shortens every step, a guard against estimators
+// that overestimate. Above 1 the steps are lengthened (Keinert et al.
+// 2014); when the unbounding spheres of two consecutive points stop
+// overlapping the long step may have jumped over a surface, so the march
+// returns to the last safe point and continues with plain steps.
 MarchResult march_ray(real3 ro, real3 rd, const MarchCamera* cam,
                       __global const real* params) {
     MarchResult r;
@@ -169,28 +228,38 @@ MarchResult march_ray(real3 ro, real3 rd, const MarchCamera* cam,
     r.closest = R(1.0);
     r.steps = 0;
     r.hit = 0;
+    const real lipschitz = R(1.0) + DETAIL * cam->footprint_per_unit;
     real omega = OVER_RELAXATION;
+    int relaxed = 0; // whether the last step was longer than a plain one
     real prev_t = R(0.0);
-    real prev_d = R(0.0);
+    real prev_g = R(0.0);
     for (int i = 0; i < MAX_STEPS; ++i) {
         real d = DE(ro + rd * r.t, params);
-        r.steps = i + 1;
-        if (omega > R(1.0) && i > 0 && (d < R(0.0) || d + prev_d < r.t - prev_t)) {
-            r.t = prev_t + prev_d;
+        real g = d - DETAIL * march_footprint(cam, r.t);
+        r.steps += 1;
+        if (relaxed && (g < R(0.0) || prev_g + g < lipschitz * (r.t - prev_t))) {
+            r.t = prev_t + prev_g / lipschitz;
             omega = R(1.0);
+            relaxed = 0;
             continue;
         }
         if (d > R(0.0)) {
             r.closest = fmin(r.closest, d / (r.t + d));
         }
-        if (d < HIT_EPSILON * march_footprint(cam, r.t)) {
+        if (g <= R(0.0)) {
             r.hit = 1;
             r.closest = R(0.0);
+            if (i > 0) {
+                r.t = march_refine(ro, rd, cam, prev_t, prev_g, r.t, g, params, &r.steps);
+            }
             return r;
         }
+        real plain = g / lipschitz;
+        real shortest = HIT_EPSILON * march_footprint(cam, r.t);
+        relaxed = omega > R(1.0) && omega * plain > fmax(plain, shortest);
         prev_t = r.t;
-        prev_d = d;
-        r.t += omega * d;
+        prev_g = g;
+        r.t += fmax(omega * plain, shortest);
         if (r.t > MAX_DISTANCE) {
             return r;
         }
@@ -209,20 +278,23 @@ real3 march_normal(real3 p, real h, real3 rd, __global const real* params) {
     return len > REAL_TINY ? g / len : -rd;
 }
 
-// Ambient occlusion: how much closer the surface is than expected at
-// AO_SAMPLES points along the normal, nearer samples weighing more.
-// 1 on an open face, towards 0 in a crease.
-// Evaluates DE AO_SAMPLES times.
+// Ambient occlusion: how much closer the surface is than expected along
+// the normal out to AO_DISTANCE, nearer points weighing more:
+//   1 - integral of w(h) clamp(h - DE(p + n h), 0, h) dh
+//     / integral of w(h) h dh,   w(h) = exp(-AO_FALLOFF h / AO_DISTANCE),
+// by the midpoint rule with AO_SAMPLES points. The integral is fixed, so
+// more samples converge on the same value rather than reaching further.
+// 1 on an open face, towards 0 in a crease. Evaluates DE AO_SAMPLES times.
+#define AO_FALLOFF R(1.5)
 real march_ambient_occlusion(real3 p, real3 n, __global const real* params) {
     real missing = R(0.0);
     real expected = R(0.0);
-    real weight = R(1.0);
-    for (int i = 1; i <= AO_SAMPLES; ++i) {
-        real h = AO_STEP * (real)i;
+    for (int i = 0; i < AO_SAMPLES; ++i) {
+        real h = AO_DISTANCE * ((real)i + R(0.5)) / (real)AO_SAMPLES;
+        real weight = exp(-AO_FALLOFF * h / AO_DISTANCE);
         real d = DE(p + n * h, params);
         missing += weight * clamp(h - d, R(0.0), h);
         expected += weight * h;
-        weight *= R(0.75);
     }
     return clamp(R(1.0) - missing / expected, R(0.0), R(1.0));
 }
@@ -348,8 +420,9 @@ real march_jitter(uint x, uint y, uint sample) {
 // the ray, +INFINITY on a miss), hit (0/1), world-space normal (0 on a
 // miss); and the cost of the pixel's colour: steps, the primary-march
 // distance evaluations of all its samples, and evaluations, every distance
-// evaluation of all its samples (primary march, normal, the step onto the
-// surface, DE_shade, occlusion and shadow rays). The extra march through
+// evaluation of all its samples (primary march, normal, DE_shade, occlusion
+// and shadow rays, and the step onto the surface of a ray that starts
+// inside it). The extra march through
 // the pixel centre that AOVs need with supersampling is not counted.
 __kernel void render_tile(__global const real* params,
                           __global const real* camera,
@@ -408,11 +481,14 @@ __kernel void render_tile(__global const real* params,
             real3 p = ro + rd * m.t;
             real footprint = march_footprint(&cam, m.t);
             n = march_normal(p, NORMAL_EPSILON * footprint, rd, params);
-            // The march stopped up to a hit threshold short of the surface:
-            // step onto it along the normal so secondary rays start there.
-            p -= n * DE(p, params);
-            total_evals += MARCH_NORMAL_EVALUATIONS + 1u;
-            color = march_shade(p, n, rd, HIT_EPSILON * footprint, params, lights, light_count,
+            total_evals += MARCH_NORMAL_EVALUATIONS;
+            if (m.t <= R(0.0)) {
+                // The ray starts inside the surface (a camera within a
+                // solid): shade the nearest point of the surface instead.
+                p -= n * DE(p, params);
+                total_evals += 1u;
+            }
+            color = march_shade(p, n, rd, DETAIL * footprint, params, lights, light_count,
                                 &total_evals);
         }
         sum += color;
