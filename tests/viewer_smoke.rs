@@ -27,9 +27,16 @@ fn in_ci() -> bool {
 
 const BUILD: &str = "cargo build --profile test --features viewer --example viewer";
 
-/// The newest modification time of the files under `dir`.
-fn newest(dir: &Path) -> SystemTime {
-    std::fs::read_dir(dir)
+/// The newest modification time of the file `path` or of the files under
+/// it.
+fn newest(path: &Path) -> SystemTime {
+    if path.is_file() {
+        return path
+            .metadata()
+            .and_then(|m| m.modified())
+            .unwrap_or(UNIX_EPOCH);
+    }
+    std::fs::read_dir(path)
         .into_iter()
         .flatten()
         .flatten()
@@ -49,7 +56,9 @@ fn newest(dir: &Path) -> SystemTime {
 }
 
 /// The viewer example next to this test binary (`target/PROFILE/examples`),
-/// built after the last change to the library or the example.
+/// built after the last change to what it is built from: the library, the
+/// kernels, the example and the examples' shared code (not the other
+/// examples, whose changes cargo rightly does not rebuild it for).
 fn viewer_binary() -> PathBuf {
     let exe = std::env::current_exe().expect("the test binary's path");
     let profile_dir = exe
@@ -60,7 +69,7 @@ fn viewer_binary() -> PathBuf {
     let built = std::fs::metadata(&path).and_then(|m| m.modified());
     let built = built.unwrap_or_else(|_| panic!("{} is missing: run `{BUILD}`", path.display()));
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
-    let sources = ["src", "kernels", "examples"]
+    let sources = ["src", "kernels", "examples/viewer.rs", "examples/common"]
         .map(|d| newest(&root.join(d)))
         .into_iter()
         .max()
