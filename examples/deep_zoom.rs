@@ -7,7 +7,12 @@
 //! - F32 against F64 (PSNR): where F32 departs from F64;
 //! - each precision against itself with the whole scene moved by a fixed
 //!   offset (bulb, camera and target together; the lights are
-//!   directional). In exact arithmetic the two images are identical, so
+//!   directional). The moved bulb is joined by a speck far outside the
+//!   view, so the offset stays inside the geometry: a scene whose root is
+//!   the translation would be rendered in the translation's frame, the
+//!   offset removed on the host in `f64` (see `Ir::local_frame`), and both
+//!   copies would be the same program with the same inputs. In exact
+//!   arithmetic the two images are identical, so
 //!   their difference is rounding alone: where it grows past 30 dB PSNR
 //!   the precision no longer carries the view. For F32 it breaks where F32
 //!   departs from F64, which validates the measure; for F64 it is the only
@@ -17,6 +22,10 @@
 //! gradient can be resolved every pixel gets the same colour. So the
 //! contrast of each image (the standard deviation of its luma, 0 to 255)
 //! is reported too, and an image below [`FLAT`] counts as broken.
+//!
+//! Then it traces shadow rays from the target point towards the key light,
+//! starting 1e-2 to 1e-12 along it, to show at which scales the point is
+//! in the shadow of the bulb's own structure.
 //!
 //! Prints a markdown table and writes a contact sheet to
 //! `out/deep_zoom.png` (rows: F32, F32 moved, F64, F64 moved).
@@ -93,14 +102,38 @@ fn surface_point() -> Result<(DVec3, DVec3)> {
 fn view(point: DVec3, direction: DVec3, decade: i32, shift: DVec3) -> Scene {
     let distance = (point - CAMERA).length() * 10f64.powi(-decade);
     let camera = Camera::look_at(point - direction * distance + shift, point + shift).fov(40.0);
-    Scene::new(bulb().translate(shift))
+    let speck = sphere(1e-3).translate(dvec3(0.0, 1e3, 0.0));
+    Scene::new(bulb().translate(shift).union(speck))
         .with_camera(camera)
         .with_lights([
-            Light::directional(dvec3(0.5, 0.8, 0.35)).softness(0.06),
+            Light::directional(KEY_LIGHT).softness(0.06),
             Light::directional(dvec3(-0.6, 0.35, -0.4))
                 .color(dvec3(0.6, 0.7, 1.0))
                 .intensity(0.3),
         ])
+}
+
+/// The key light's direction (the view's first light).
+const KEY_LIGHT: DVec3 = DVec3::new(0.5, 0.8, 0.35);
+
+/// Where a ray from `point` towards the key light, starting `offset` along
+/// it, first meets the bulb (CPU, F64), if it does: whether the target
+/// point is in the shadow of the bulb's structure at that scale.
+fn key_light_blocked(point: DVec3, offset: f64) -> Result<Option<f64>> {
+    let eval = Evaluator::new(&bulb())?;
+    let direction = KEY_LIGHT.normalize();
+    let settings = MarchSettings {
+        max_steps: 100_000,
+        max_distance: 10.0,
+        epsilon: 1e-3 * offset,
+        ..MarchSettings::default()
+    };
+    let ray = Ray {
+        origin: point + direction * offset,
+        direction,
+    };
+    let hit = cpu::march(&eval, ray, &settings);
+    Ok(hit.hit.then_some(hit.depth))
 }
 
 fn render(scene: &Scene, precision: Precision, size: (u32, u32)) -> Result<RgbaImage> {
@@ -214,6 +247,16 @@ fn main() -> std::process::ExitCode {
             label(breaks_at(&column(1), &column(3)), last),
             label(breaks_at(&column(2), &column(4)), last)
         );
+        println!(
+            "\nShadow rays from the target point towards the key light, starting that far along it:\n"
+        );
+        for exponent in [2, 4, 6, 8, 9, 10, 11, 12] {
+            let offset = 10f64.powi(-exponent);
+            match key_light_blocked(point, offset)? {
+                Some(at) => println!("- from 1e-{exponent}: blocked {at:.2e} further on"),
+                None => println!("- from 1e-{exponent}: visible"),
+            }
+        }
         let sheet = common::sheet::contact_sheet(&tiles, size);
         fractal_sdf::output::save_png(&sheet, "out/deep_zoom.png")?;
         eprintln!("wrote out/deep_zoom.png");

@@ -17,14 +17,16 @@ pub struct Frame {
     pub hit: Vec<bool>,
     /// World-space unit normal at the hit; `[0, 0, 0]` where the ray missed.
     pub normal: Vec<[f32; 3]>,
-    /// Distance evaluations of the primary march, summed over the pixel's
-    /// colour samples (a per-pixel cost map).
+    /// Distance evaluations of the primary march, including the location
+    /// of the hit, summed over the pixel's colour samples (a per-pixel cost
+    /// map).
     pub steps: Vec<u32>,
     /// Every distance evaluation the pixel's colour cost, summed over its
-    /// samples: the primary march, the normal (4), the step onto the
-    /// surface (1), the colour lookup (1), ambient occlusion and shadow
-    /// rays. With supersampling, the extra march through the pixel centre
-    /// that the other outputs need is not counted.
+    /// samples: the primary march, the normal (4), the colour lookup (1),
+    /// ambient occlusion and shadow rays, and for a ray that starts inside
+    /// a solid the step onto its surface (1). With supersampling, the extra
+    /// march through the pixel centre that the other outputs need is not
+    /// counted.
     pub evaluations: Vec<u32>,
 }
 
