@@ -79,8 +79,9 @@ impl Quality {
     /// The normal step shared by every preset, in pixel footprints.
     pub const NORMAL_EPSILON: f64 = 1.0;
 
-    /// For moving the camera: the cheapest image of the same surface. Few
-    /// steps, hits located to a pixel, no occlusion and no shadows.
+    /// For moving the camera: the cheapest image of the same surface. 128
+    /// steps (rays grazing a floor may run out), hits located to half a
+    /// pixel, no occlusion and no shadows.
     #[must_use]
     pub fn draft() -> Self {
         Quality {

@@ -492,7 +492,8 @@ fn refine(
     let mut kept = 0; // the end the last step moved: -1 outside, 1 inside
     let mut evaluations = 0;
     while evaluations < REFINE_LIMIT && t1 - t0 > tolerance(t1) {
-        let t = (t0 + (t1 - t0) * (g0 / (g0 - g1))).clamp(t0, t1);
+        // `max` then `min`, like OpenCL's `clamp`: a NaN lands on `t0`.
+        let t = (t0 + (t1 - t0) * (g0 / (g0 - g1))).max(t0).min(t1);
         let v = g(t);
         evaluations += 1;
         if v > 0.0 {

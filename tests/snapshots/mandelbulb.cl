@@ -121,6 +121,10 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
 // Everything else arrives at run time, so moving the camera or the lights
 // and changing dynamic parameters never rebuilds the program:
 //
+// Positions (the camera's origin, point lights) are relative to the
+// program's origin, the scene's outermost translation, which the host
+// subtracts in f64; DE takes points in the same frame.
+//
 // camera: 20 reals
 //   [0..2]  origin          [3]  1 for orthographic, 0 for perspective
 //   [4..6]  right (unit)    [7]  half the image width at unit distance
@@ -248,14 +252,15 @@ real march_refine(real3 ro, real3 rd, const MarchCamera* cam, real t0, real g0, 
 // Sphere tracing towards the surface DETAIL pixel footprints out: each
 // step is the distance g to that surface (divided by g's Lipschitz bound,
 // which the footprint term raises a little above 1), so for an estimator
-// that never overestimates no step passes the first crossing, however thin
-// the feature. Steps are at least HIT_EPSILON footprints long, so a ray
-// that approaches the surface at a grazing angle crosses it in a bounded
-// number of steps, and features thinner than that along the ray may be
-// missed. Once a step lands inside, march_refine locates the crossing.
-// The surface does not depend on how the march gets there: MAX_STEPS,
-// OVER_RELAXATION and HIT_EPSILON change the cost and the accuracy, not
-// the shape drawn.
+// that never overestimates a step of that distance never passes the first
+// crossing. Steps are at least HIT_EPSILON footprints long, so a ray that
+// approaches the surface at a grazing angle crosses it in a bounded number
+// of steps, and features thinner than that along the ray may be missed.
+// Once a step lands inside, march_refine locates the crossing. The surface
+// itself does not depend on how the march gets there: MAX_STEPS,
+// OVER_RELAXATION and HIT_EPSILON change the cost and how closely the
+// march finds it (thin features missed, rays that run out of steps), not
+// where it lies.
 // OVER_RELAXATION below 1 shortens every step, a guard against estimators
 // that overestimate. Above 1 the steps are lengthened (Keinert et al.
 // 2014); when the unbounding spheres of two consecutive points stop
