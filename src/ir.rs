@@ -104,19 +104,21 @@ impl Ir {
         self.root
     }
 
-    /// The scene's outermost baked translation and the node it moves (the
-    /// origin and the root when there is none). Programs for rendering
-    /// evaluate the scene from that node, in coordinates relative to the
-    /// translation, and the host moves the camera and the lights into
+    /// The scene's outermost baked translation, reached from the root
+    /// through colours only (they move nothing), with its node. Programs
+    /// for rendering leave that translation out and work in coordinates
+    /// relative to it, and the host moves the camera and the lights into
     /// those coordinates in `f64`: a scene placed far from the origin then
     /// keeps the precision it has at the origin, in `F32` too.
     #[must_use]
-    pub fn local_frame(&self) -> (DVec3, NodeId) {
-        match self.node(self.root) {
-            Kind::Translate { offset, child } => {
-                baked3(*offset).map_or((DVec3::ZERO, self.root), |o| (o, *child))
+    pub fn local_frame(&self) -> Option<(DVec3, NodeId)> {
+        let mut id = self.root;
+        loop {
+            match self.node(id) {
+                Kind::Color { child, .. } => id = *child,
+                Kind::Translate { offset, .. } => return baked3(*offset).map(|o| (o, id)),
+                _ => return None,
             }
-            _ => (DVec3::ZERO, self.root),
         }
     }
 

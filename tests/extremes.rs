@@ -339,15 +339,20 @@ fn a_scene_scaled_by_a_million_renders_the_unit_image_in_f64() {
     assert_eq!(unit.hit, big.hit);
 }
 
-/// The gallery Mandelbulb moved by `offset`, with its camera and lights.
-fn moved_mandelbulb(offset: DVec3) -> Scene {
+/// The gallery Mandelbulb moved by `offset`, with its camera and lights;
+/// `painted` puts the translation under a colour, which does not move it.
+fn moved_mandelbulb(offset: DVec3, painted: bool) -> Scene {
     let unit = fractal_sdf::gallery::mandelbulb();
     let camera = Camera {
         position: unit.camera.position + offset,
         target: unit.camera.target + offset,
         ..unit.camera
     };
-    Scene::new(unit.geometry.clone().unwrap().translate(offset))
+    let mut geometry = unit.geometry.clone().unwrap().translate(offset);
+    if painted {
+        geometry = geometry.color(dvec3(0.9, 0.6, 0.35));
+    }
+    Scene::new(geometry)
         .with_camera(camera)
         .with_lights(unit.lights.clone())
 }
@@ -358,24 +363,27 @@ fn a_scene_ten_million_units_away_renders_the_unit_image_in_f32() {
     // At 1e7 an f32 can only hold multiples of 1: positions in world
     // coordinates would be useless. The renderer works relative to the
     // scene's outermost translation, moving the camera there in f64.
-    let frame = |offset: DVec3| {
+    let frame = |offset: DVec3, painted: bool| {
         let quality = Quality {
             precision: Precision::F32,
             ..Quality::production()
         };
         Renderer::with_options(
-            &moved_mandelbulb(offset),
+            &moved_mandelbulb(offset, painted),
             &gpu::options(quality, Effects::default()),
         )
         .unwrap()
         .render_with_aovs(96, 64)
         .unwrap()
     };
-    let (unit, far) = (frame(DVec3::ZERO), frame(dvec3(1e7, -3e7, 2e7)));
-    gpu::save("extremes_far_f32", &far.image);
-    let db = psnr(&unit.image, &far.image);
-    eprintln!("moved by 3e7: {db:.1} dB");
-    assert!(db >= 40.0, "{db:.1} dB");
-    assert!(unit.coverage() > 0.2);
-    assert_eq!(unit.hit, far.hit);
+    let far = dvec3(1e7, -3e7, 2e7);
+    for painted in [false, true] {
+        let (unit, moved) = (frame(DVec3::ZERO, painted), frame(far, painted));
+        gpu::save("extremes_far_f32", &moved.image);
+        let db = psnr(&unit.image, &moved.image);
+        eprintln!("moved by 3e7 (painted: {painted}): {db:.1} dB");
+        assert!(db >= 40.0, "painted: {painted}: {db:.1} dB");
+        assert!(unit.coverage() > 0.2);
+        assert_eq!(unit.hit, moved.hit);
+    }
 }

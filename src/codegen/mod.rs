@@ -106,13 +106,18 @@ pub fn emit_ir(ir: &Ir, options: &Options) -> Result<KernelSource> {
     // The scene functions first, to learn which helpers they call.
     // Rendering works in the scene's local frame (see `Ir::local_frame`);
     // evaluation takes points where the user gives them.
-    let (origin, root) = match options.target {
+    let frame = match options.target {
         Target::Render => ir.local_frame(),
-        Target::Evaluate => (DVec3::ZERO, ir.root()),
+        Target::Evaluate => None,
     };
+    let origin = frame.map_or(DVec3::ZERO, |(offset, _)| offset);
     let mut body = writer::Writer::new(precision);
-    let mut emitter =
-        scene::SceneEmitter::new(ir, root, &mut body, options.quality.fractal_iterations);
+    let mut emitter = scene::SceneEmitter::new(
+        ir,
+        frame.map(|(_, node)| node),
+        &mut body,
+        options.quality.fractal_iterations,
+    );
     emitter.emit();
     let used: Vec<&'static str> = emitter.used.iter().copied().collect();
     let customs: Vec<_> = emitter.customs.values().cloned().collect();

@@ -19,9 +19,9 @@ struct Vars {
 
 pub(crate) struct SceneEmitter<'a> {
     ir: &'a Ir,
-    /// The node `DE` evaluates: the IR's root, or the node under its
-    /// outermost translation for a program in the scene's local frame.
-    root: NodeId,
+    /// For a program in the scene's local frame: the translation it
+    /// leaves out (see `Ir::local_frame`).
+    frame: Option<NodeId>,
     w: &'a mut Writer,
     shade: bool,
     points: usize,
@@ -37,13 +37,13 @@ pub(crate) struct SceneEmitter<'a> {
 impl<'a> SceneEmitter<'a> {
     pub(crate) fn new(
         ir: &'a Ir,
-        root: NodeId,
+        frame: Option<NodeId>,
         w: &'a mut Writer,
         iteration_override: Option<u32>,
     ) -> Self {
         SceneEmitter {
             ir,
-            root,
+            frame,
             w,
             shade: false,
             points: 0,
@@ -67,7 +67,7 @@ impl<'a> SceneEmitter<'a> {
                 self.w
                     .open("real DE(real3 p0, __global const real* params)");
             }
-            let out = self.node(self.root, "p0");
+            let out = self.node(self.ir.root(), "p0");
             if shade {
                 self.w.line(format!("*color = {};", out.c));
                 self.w.line(format!("*trap = {};", out.t));
@@ -137,6 +137,11 @@ impl<'a> SceneEmitter<'a> {
     #[allow(clippy::too_many_lines)]
     fn node(&mut self, id: NodeId, p: &str) -> Vars {
         let ir = self.ir;
+        if self.frame == Some(id) {
+            if let Kind::Translate { child, .. } = ir.node(id) {
+                return self.node(*child, p);
+            }
+        }
         let w = |this: &Self, s: Scalar| this.w.scalar(s);
         let v3 = |this: &Self, v: [Scalar; 3]| this.w.vector(v);
         match ir.node(id) {
