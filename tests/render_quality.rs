@@ -131,8 +131,8 @@ fn max_steps_and_max_distance_end_rays() {
 /// was located.
 /// Also returns the growth of the footprint per unit of depth.
 fn hit_offsets(scene: &Scene, quality: Quality) -> (Frame, Vec<f64>, f64) {
-    let renderer = Renderer::with_options(scene, &gpu::options(quality, Effects::none())).unwrap();
-    let mut renderer = renderer;
+    let mut renderer =
+        Renderer::with_options(scene, &gpu::options(quality, Effects::none())).unwrap();
     let frame = renderer.render_with_aovs(W, H).unwrap();
     let view = renderer.viewport(W, H).unwrap();
     let eval = Evaluator::new(scene.geometry.as_ref().unwrap()).unwrap();
