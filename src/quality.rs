@@ -63,10 +63,10 @@ pub struct Quality {
     /// Kernel precision.
     pub precision: Precision,
     /// Relaxation factor ω of sphere tracing, in `[0.25, 2)`: each step is
-    /// ω times the distance estimate. 1 is plain sphere tracing; below 1
-    /// guards against estimators that overestimate (fractals) at the cost
-    /// of more steps; above 1 takes longer steps and falls back to plain
-    /// ones where they overshoot.
+    /// ω times the distance to the drawn surface. 1 is plain sphere
+    /// tracing; below 1 guards against estimators that overestimate
+    /// (fractals) at the cost of more steps; above 1 takes longer steps and
+    /// falls back to plain ones where they overshoot.
     pub over_relaxation: f64,
     /// Samples per pixel along each axis (N×N jittered samples; 1: one
     /// sample at the pixel centre).
