@@ -7,22 +7,21 @@ use criterion::{Criterion, criterion_group, criterion_main};
 use fractal_sdf::codegen::{self, Options};
 use fractal_sdf::cpu::Evaluator;
 use fractal_sdf::gallery;
-use fractal_sdf::ir::Ir;
 use fractal_sdf::prelude::*;
 use std::hint::black_box;
 
 fn codegen_per_scene(c: &mut Criterion) {
     let mut group = c.benchmark_group("emit");
     for (name, scene) in gallery::all() {
+        let scene = scene.compile().unwrap();
         group.bench_function(name, |b| {
             b.iter(|| codegen::emit(black_box(&scene), &Options::default()).unwrap());
         });
     }
     group.finish();
     let scene = gallery::fractal_mix();
-    let geometry = scene.geometry.unwrap();
-    c.bench_function("lower/fractal_mix", |b| {
-        b.iter(|| Ir::lower(black_box(&geometry)).unwrap())
+    c.bench_function("compile/fractal_mix", |b| {
+        b.iter(|| black_box(&scene).compile().unwrap())
     });
 }
 

@@ -13,7 +13,7 @@ fn render(name: &str, geometry: &Node, camera: Camera) -> Result<()> {
     let settings = MarchSettings {
         max_steps: 200,
         max_distance: 20.0,
-        epsilon: 1e-3,
+        footprint_base: 1e-3,
         ..Default::default()
     };
     let light = dvec3(0.6, 0.8, 0.4).normalize();

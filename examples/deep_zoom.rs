@@ -72,7 +72,7 @@ fn surface_point() -> Result<(DVec3, DVec3)> {
     };
     let settings = MarchSettings {
         max_steps: 100_000,
-        epsilon: 1e-12,
+        footprint_base: 1e-12,
         ..MarchSettings::default()
     };
     let hit = cpu::march(&eval, ray, &settings);
@@ -125,7 +125,7 @@ fn key_light_blocked(point: DVec3, offset: f64) -> Result<Option<f64>> {
     let settings = MarchSettings {
         max_steps: 100_000,
         max_distance: 10.0,
-        epsilon: 1e-3 * offset,
+        footprint_base: 1e-3 * offset,
         ..MarchSettings::default()
     };
     let ray = Ray {

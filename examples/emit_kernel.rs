@@ -28,12 +28,13 @@ fn main() -> Result<()> {
         },
         ..Options::default()
     };
+    let scene = scene.compile()?;
     let kernel = codegen::emit(&scene, &options)?;
     print!("{}", kernel.source);
     eprintln!(
         "{name}: {} lines, {} dynamic parameters, hash {:016x}",
         kernel.source.lines().count(),
-        kernel.params.len(),
+        scene.params().slots().len(),
         kernel.hash
     );
     Ok(())

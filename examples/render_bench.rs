@@ -12,10 +12,9 @@ mod common;
 use std::fmt::Write as _;
 use std::time::Instant;
 
-use fractal_sdf::codegen::{self, Options, Target};
 use fractal_sdf::gallery;
 use fractal_sdf::prelude::*;
-use fractal_sdf::render::{ProgramSource, RenderOptions, Renderer};
+use fractal_sdf::render::{RenderOptions, Renderer};
 
 /// Median milliseconds of `runs` renders, after one warm-up.
 fn time_ms(renderer: &mut Renderer, (w, h): (u32, u32), runs: usize) -> Result<f64> {
@@ -98,21 +97,13 @@ fn main() -> std::process::ExitCode {
             effects: effects_on(),
             ..RenderOptions::default()
         };
-        let kernel = codegen::emit_handwritten(
+        let scene = scene.compile()?;
+        let mut generated = Renderer::from_compiled(scene.clone(), &options)?;
+        let mut handwritten = Renderer::with_scene_functions(
+            scene,
+            &options,
             include_str!("../benches/mandelbulb_handwritten.cl"),
-            &Options {
-                quality,
-                effects: options.effects,
-                target: Target::Render,
-            },
         )?;
-        let source = ProgramSource {
-            source: kernel.source,
-            precision: kernel.precision,
-            origin: kernel.origin,
-        };
-        let mut generated = Renderer::with_options(&scene, &options)?;
-        let mut handwritten = Renderer::with_source(&scene, &options, source)?;
         let same = fractal_sdf::metrics::psnr(
             &generated.render(size.0, size.1)?,
             &handwritten.render(size.0, size.1)?,

@@ -1,10 +1,8 @@
 /* Point evaluator: DE and DE_shade at each point, for checking the OpenCL
-   formulas against the CPU reference. out[2i] = (DE, DE_shade, trap, 0),
-   out[2i + 1] = (colour, 0). */
-__kernel void eval_points(__global const real4* points,
-                          __global const real* params,
-                          __global real4* out,
-                          uint count) {
+   formulas against the CPU reference. The header defines the argument list
+   (EVAL_POINTS_ARGS). Per point, EVAL_OUT_STRIDE reals:
+   out[2i] = (DE, DE_shade, trap, 0), out[2i + 1] = (colour, 0). */
+__kernel void eval_points(EVAL_POINTS_ARGS) {
     uint i = get_global_id(0);
     if (i >= count) {
         return;

@@ -17,30 +17,19 @@
 //           conditionals allowed in this file.
 //
 // Everything else arrives at run time, so moving the camera or the lights
-// and changing dynamic parameters never rebuilds the program:
+// and changing dynamic parameters never rebuilds the program. The header
+// defines the kernel's argument list (RENDER_TILE_ARGS) and the layouts of
+// the camera buffer (CAMERA_<field>: the offset of each field) and of the
+// light buffer (LIGHT_<field>, LIGHT_STRIDE reals per light), from the
+// tables the host packs them with (src/codegen/interface.rs).
 //
 // Positions (the camera's origin, point lights) are relative to the
 // program's origin, the scene's outermost translation, which the host
-// subtracts in f64; DE takes points in the same frame.
-//
-// camera: 20 reals
-//   [0..2]  origin          [3]  1 for orthographic, 0 for perspective
-//   [4..6]  right (unit)    [7]  half the image width at unit distance
-//                                (orthographic: in scene units)
-//   [8..10] up (unit)       [11] half the image height, likewise
-//   [12..14] forward (unit) [15] unused
-//   [16] footprint_base  [17] footprint_per_unit
-//        A pixel is footprint_base + footprint_per_unit * t scene units
-//        wide at distance t along a ray. Perspective cameras have a
-//        per-unit term and a tiny base that keeps thresholds above zero at
-//        t = 0; orthographic cameras have only the base.
-//   [18..19] unused
-//
-// lights: 8 reals per light
-//   [0..2] unit direction towards the light, or the light's position
-//   [3]    0 directional, 1 point (1/r^2 falloff)
-//   [4..6] colour * intensity (linear RGB)
-//   [7]    penumbra softness (0: hard shadows)
+// subtracts in f64; DE takes points in the same frame. A pixel is
+// footprint_base + footprint_per_unit * t scene units wide at distance t
+// along a ray: perspective cameras have a per-unit term and a tiny base that
+// keeps thresholds above zero at t = 0; orthographic cameras have only the
+// base.
 
 // Shading constants that are not quality knobs.
 #define MARCH_AMBIENT R(0.5)      // strength of the sky's hemisphere light
@@ -73,15 +62,15 @@ typedef struct {
 
 MarchCamera march_load_camera(__global const real* c) {
     MarchCamera cam;
-    cam.origin = (real3)(c[0], c[1], c[2]);
-    cam.orthographic = c[3] > R(0.5);
-    cam.right = (real3)(c[4], c[5], c[6]);
-    cam.half_w = c[7];
-    cam.up = (real3)(c[8], c[9], c[10]);
-    cam.half_h = c[11];
-    cam.forward = (real3)(c[12], c[13], c[14]);
-    cam.footprint_base = c[16];
-    cam.footprint_per_unit = c[17];
+    cam.origin = vload3(0, c + CAMERA_ORIGIN);
+    cam.orthographic = c[CAMERA_ORTHOGRAPHIC] > R(0.5);
+    cam.right = vload3(0, c + CAMERA_RIGHT);
+    cam.half_w = c[CAMERA_HALF_WIDTH];
+    cam.up = vload3(0, c + CAMERA_UP);
+    cam.half_h = c[CAMERA_HALF_HEIGHT];
+    cam.forward = vload3(0, c + CAMERA_FORWARD);
+    cam.footprint_base = c[CAMERA_FOOTPRINT_BASE];
+    cam.footprint_per_unit = c[CAMERA_FOOTPRINT_PER_UNIT];
     return cam;
 }
 
@@ -323,12 +312,12 @@ real3 march_shade(real3 p, real3 n, real3 rd, real eps, __global const real* par
     real3 lifted = p + n * eps;
 #endif
     for (int i = 0; i < light_count; ++i) {
-        __global const real* l = lights + 8 * i;
-        real3 v = (real3)(l[0], l[1], l[2]);
-        real3 radiance = (real3)(l[4], l[5], l[6]);
+        __global const real* l = lights + LIGHT_STRIDE * i;
+        real3 v = vload3(0, l + LIGHT_POSITION);
+        real3 radiance = vload3(0, l + LIGHT_RADIANCE);
         real3 to_light = v;
         real light_distance = MAX_DISTANCE;
-        if (l[3] > R(0.5)) {
+        if (l[LIGHT_KIND] > R(0.5)) {
             real3 delta = v - p;
             real dist2 = fmax(dot(delta, delta), REAL_TINY);
             light_distance = sqrt(dist2);
@@ -341,7 +330,8 @@ real3 march_shade(real3 p, real3 n, real3 rd, real eps, __global const real* par
         }
 #ifdef ENABLE_SHADOWS
         real visible =
-            march_shadow(lifted, to_light, light_distance, R(0.25) * eps, eps, l[7], params, evals);
+            march_shadow(lifted, to_light, light_distance, R(0.25) * eps, eps, l[LIGHT_SOFTNESS],
+                         params, evals);
         if (visible <= R(0.0)) {
             continue;
         }
@@ -380,23 +370,7 @@ real march_jitter(uint x, uint y, uint sample) {
 // and shadow rays, and the step onto the surface of a ray that starts
 // inside it). The extra march through
 // the pixel centre that AOVs need with supersampling is not counted.
-__kernel void render_tile(__global const real* params,
-                          __global const real* camera,
-                          __global const real* lights,
-                          const int light_count,
-                          const int width,
-                          const int height,
-                          const int x0,
-                          const int y0,
-                          const int tile_w,
-                          const int tile_h,
-                          const int write_aovs,
-                          __global uchar4* rgba,
-                          __global float* depth,
-                          __global uchar* hit_mask,
-                          __global float* normals,
-                          __global uint* steps,
-                          __global uint* evaluations) {
+__kernel void render_tile(RENDER_TILE_ARGS) {
     int lx = (int)get_global_id(0);
     int ly = (int)get_global_id(1);
     int x = x0 + lx;

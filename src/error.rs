@@ -101,6 +101,20 @@ pub enum Error {
         /// What it must be.
         expected: String,
     },
+    /// The renderer's tile side is zero.
+    #[error("tile size must be at least 1 pixel, got {value}")]
+    TileSize {
+        /// The offending tile side.
+        value: u32,
+    },
+    /// More lights than the kernel's light count can address.
+    #[error("too many lights: {count} (at most {max})")]
+    TooManyLights {
+        /// How many lights were given.
+        count: usize,
+        /// The most the renderer takes.
+        max: usize,
+    },
     /// No dynamic parameter has this name.
     #[error("the scene has no dynamic parameter named `{name}`")]
     UnknownParam {

@@ -10,8 +10,10 @@
 //! Each stage is a module and a function of the previous stage's output:
 //!
 //! 1. [`scene`]: the typed scene ([`Node`], [`Scene`]) and its builder API.
-//! 2. [`ir`]: validation and lowering to a flat arena whose parameters are
-//!    baked constants or dynamic slots.
+//! 2. [`ir`]: [`Scene::compile`] validates and lowers a scene, once, into a
+//!    [`CompiledScene`]: a flat arena whose parameters are baked constants or
+//!    dynamic slots, with every parameter rule, the camera and the lights.
+//!    Every later stage takes the compiled scene.
 //! 3. [`cpu`]: the reference evaluator (distance, colour, normal, sphere
 //!    tracing) in `f64` and `f32`; the oracle for every test.
 //! 4. `render` (feature `opencl`, on by default): the OpenCL executor —
@@ -51,10 +53,9 @@
 //!     .smooth_union(cuboid(dvec3(0.4, 0.4, 0.4)).translate(dvec3(0.5, 0.0, 0.0)), 0.2)
 //!     .color(dvec3(1.0, 0.5, 0.1))
 //!     .translate(dvec3(1.5, 0.0, 0.0));
-//! let scene = Scene::new(bulb.union(blob));
-//! scene.validate()?;
+//! let scene = Scene::new(bulb.union(blob)).compile()?;
 //!
-//! let eval = cpu::Evaluator::new(scene.geometry.as_ref().unwrap())?;
+//! let eval = cpu::Evaluator::from_compiled(&scene);
 //! // Far from everything, the distance is positive and finite...
 //! let far = eval.distance(dvec3(0.0, 5.0, 0.0));
 //! assert!(far > 3.0 && far.is_finite());
@@ -83,6 +84,7 @@ pub mod cpu;
 pub mod error;
 pub mod gallery;
 pub mod ir;
+pub mod math;
 pub mod metrics;
 pub mod output;
 pub mod quality;
@@ -95,12 +97,14 @@ pub mod testing;
 pub mod timing;
 
 pub use error::{Error, Result};
+pub use ir::CompiledScene;
 pub use scene::{Node, Scene};
 
 /// Everything needed to write scenes: `use fractal_sdf::prelude::*;`.
 pub mod prelude {
     pub use crate::cpu;
     pub use crate::error::{Error, Result};
+    pub use crate::ir::CompiledScene;
     pub use crate::quality::{Effects, Glow, Precision, Preset, Quality};
     pub use crate::scene::{
         Axis, Camera, Light, Mandelbulb, Menger, Node, Param, Param3, Projection, QuaternionJulia,

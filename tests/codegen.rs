@@ -6,7 +6,7 @@ use fractal_sdf::ir::Ir;
 use fractal_sdf::prelude::*;
 
 fn source(geometry: Node, options: &Options) -> String {
-    codegen::emit(&Scene::new(geometry), options)
+    codegen::emit(&Scene::new(geometry).compile().unwrap(), options)
         .unwrap()
         .source
 }
@@ -92,19 +92,20 @@ fn integer_power_eight_uses_the_trig_free_form() {
     // A dynamic power cannot be specialised.
     let src = source(mandelbulb(param("power", 8.0)), &Options::default());
     assert!(src.contains(
-        "mandelbulb(p0, params[0], 12, fmin(2.0f, pow(MAGNITUDE_CAP, R(1.0) / params[0])), pow(R(2.0), R(1.0) / (params[0] - R(1.0))), &t0)"
+        "mandelbulb(p0, params[0] /* power */, 12, fmin(2.0f, pow(MAGNITUDE_CAP, R(1.0) / params[0] /* power */)), pow(R(2.0), R(1.0) / (params[0] /* power */ - R(1.0))), &t0)"
     ));
 }
 
 #[test]
 fn dynamic_values_keep_the_source_but_change_the_distance() {
     let scene = |r: f64| Scene::new(sphere(param("radius", r)).translate(dvec3(0.5, 0.0, 0.0)));
-    let a = codegen::emit(&scene(1.0), &Options::default()).unwrap();
-    let b = codegen::emit(&scene(2.0), &Options::default()).unwrap();
+    let (one, two) = (scene(1.0).compile().unwrap(), scene(2.0).compile().unwrap());
+    let a = codegen::emit(&one, &Options::default()).unwrap();
+    let b = codegen::emit(&two, &Options::default()).unwrap();
     assert_eq!(a.source, b.source);
     assert_eq!(a.hash, b.hash);
-    assert_eq!(a.params[0].default, 1.0);
-    assert_eq!(b.params[0].default, 2.0);
+    assert_eq!(one.params().slots()[0].default, 1.0);
+    assert_eq!(two.params().slots()[0].default, 2.0);
 
     let mut eval = cpu::Evaluator::new(scene(1.0).geometry.as_ref().unwrap()).unwrap();
     let p = dvec3(3.0, 0.0, 0.0);
@@ -115,8 +116,16 @@ fn dynamic_values_keep_the_source_but_change_the_distance() {
 
 #[test]
 fn baked_values_change_the_source_and_hash() {
-    let a = codegen::emit(&Scene::new(sphere(1.0)), &Options::default()).unwrap();
-    let b = codegen::emit(&Scene::new(sphere(1.5)), &Options::default()).unwrap();
+    let a = codegen::emit(
+        &Scene::new(sphere(1.0)).compile().unwrap(),
+        &Options::default(),
+    )
+    .unwrap();
+    let b = codegen::emit(
+        &Scene::new(sphere(1.5)).compile().unwrap(),
+        &Options::default(),
+    )
+    .unwrap();
     assert_ne!(a.source, b.source);
     assert_ne!(a.hash, b.hash);
 }
@@ -182,6 +191,15 @@ fn chains_of_baked_transforms_fold_into_one_node() {
 fn dynamic_parameter_names_never_reach_the_source() {
     let name = "r\"); } __kernel void evil() { /*";
     let src = source(sphere(param(name, 1.0)), &Options::default());
-    assert!(!src.contains("evil"));
-    assert!(src.contains("params[0]"));
+    // The name is only a comment beside its slot, with every character
+    // that could end the comment or start code replaced.
+    assert!(!src.contains("evil()"));
+    assert!(!src.contains("/*\";"), "{src}");
+    assert!(
+        src.contains("params[0] /* r??? ? __kernel void evil?? ? /? */"),
+        "{src}"
+    );
+    for line in src.lines().filter(|l| l.contains("evil")) {
+        assert!(line.contains("sd_sphere(p0, params[0] /* r??? "), "{line}");
+    }
 }

@@ -72,7 +72,7 @@ proptest! {
         let mut points = Vec::new();
         for ray in rays {
             let hit = cpu::march(&eval, ray, &cpu::MarchSettings {
-                epsilon: 1e-7,
+                footprint_base: 1e-7,
                 max_distance: 20.0,
                 ..Default::default()
             });

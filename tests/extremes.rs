@@ -93,7 +93,7 @@ fn surface_points(eval: &Evaluator, size: f64) -> Vec<(DVec3, DVec3)> {
     let settings = MarchSettings {
         max_steps: 20_000,
         max_distance: 10.0 * size,
-        epsilon: 1e-13 * size,
+        footprint_base: 1e-13 * size,
         ..MarchSettings::default()
     };
     directions()

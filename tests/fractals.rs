@@ -445,14 +445,14 @@ fn mandelbulb_far_field_never_overestimates() {
     }
     // The bound is the ball's exact distance, so rays from far away lose
     // nothing: one step from r = 1e6 lands on the ball.
-    let ball = sdf::mandelbulb_radius(8.0);
+    let ball = fractal_sdf::math::mandelbulb_radius(8.0);
     assert!((ball - 2f64.powf(1.0 / 7.0)).abs() < 1e-15);
     let far = eval.distance(dvec3(0.0, 0.0, 1e6));
     assert!((far - (1e6 - ball)).abs() < 1e-6, "{far}");
     // A ray from r = 10 towards the origin reaches the surface where a ray
     // from r = 3 does (it used to jump past the bulb).
     let settings = cpu::MarchSettings {
-        epsilon: 1e-6,
+        footprint_base: 1e-6,
         ..cpu::MarchSettings::default()
     };
     let ray = |z: f64| cpu::Ray {
@@ -478,7 +478,7 @@ fn mandelbulb_far_field_never_overestimates() {
 #[test]
 fn mandelbulb_bounding_ball_holds_the_set() {
     for power in [2.0, 3.0, 7.5, 16.0, 64.0] {
-        let ball = sdf::mandelbulb_radius(power);
+        let ball = fractal_sdf::math::mandelbulb_radius(power);
         for u in directions(200) {
             let p = u * (ball * (1.0 + 1e-9));
             // Every |z_k| (k = 1..=8) exceeds |z_0| = |p|.

@@ -8,7 +8,8 @@
 //! `approx::relative_eq!` and an explicit epsilon.
 
 use approx::relative_eq;
-use fractal_sdf::cpu::{DEFAULT_COLOR, Evaluator, V3};
+use fractal_sdf::cpu::{Evaluator, V3};
+use fractal_sdf::math::DEFAULT_COLOR;
 use fractal_sdf::prelude::*;
 use fractal_sdf::testing::{bounded_node, point, rotation, scene_node};
 use proptest::prelude::*;

@@ -86,7 +86,7 @@ fn classify_shadows(scene: &Scene, frame: &Frame, light_dir: DVec3) -> (Vec<usiz
     let settings = MarchSettings {
         max_steps: 512,
         max_distance: 50.0,
-        epsilon: 1e-4,
+        footprint_base: 1e-4,
         ..MarchSettings::default()
     };
     // Where the ray through image position (x, y) meets the floor y = 0.

@@ -4,20 +4,16 @@
 mod gpu;
 
 use fractal_sdf::prelude::*;
-use fractal_sdf::render::{DeviceSelector, ProgramSource, RenderOptions, Renderer, devices};
+use fractal_sdf::render::{DeviceSelector, RenderOptions, Renderer, devices};
 
 #[test]
 fn a_build_failure_carries_the_log_and_the_source() {
     let Some(_) = gpu::device() else { return };
-    let source = ProgramSource {
-        source: "__kernel void render_tile(__global float* x) { x[0] = undefined_name; }\n".into(),
-        precision: Precision::F32,
-        origin: DVec3::ZERO,
-    };
-    let err = Renderer::with_source(
-        &gpu::sphere_box_floor(),
+    let functions = "real DE(real3 p, __global const real* params) { return undefined_name; }\n";
+    let err = Renderer::with_scene_functions(
+        gpu::sphere_box_floor().compile().unwrap(),
         &RenderOptions::default(),
-        source.clone(),
+        functions,
     )
     .unwrap_err();
     match &err {
@@ -28,7 +24,11 @@ fn a_build_failure_carries_the_log_and_the_source() {
         } => {
             assert!(!device.is_empty());
             assert!(log.contains("undefined_name"), "log: {log}");
-            assert_eq!(kernel_source, &source.source);
+            assert!(kernel_source.contains(functions), "the source is kept");
+            assert!(
+                kernel_source.contains("render_tile"),
+                "the whole program is kept"
+            );
         }
         other => panic!("expected Error::Build, got {other:?}"),
     }
@@ -81,16 +81,8 @@ fn invalid_settings_are_refused_before_anything_runs() {
         ..RenderOptions::default()
     };
     let err = Renderer::with_options(&scene, &no_tiles).unwrap_err();
-    assert!(
-        matches!(
-            err,
-            Error::Quality {
-                setting: "tile_size",
-                ..
-            }
-        ),
-        "{err}"
-    );
+    assert!(matches!(err, Error::TileSize { value: 0 }), "{err}");
+    assert_eq!(err.to_string(), "tile size must be at least 1 pixel, got 0");
 
     let err = Renderer::new(&Scene::empty(), Quality::draft()).unwrap_err();
     assert!(matches!(err, Error::EmptyScene), "{err}");

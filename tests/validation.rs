@@ -455,12 +455,15 @@ fn dynamic_parameters_are_checked_when_set() {
     let err = eval.set_param("r", -1.0).unwrap_err();
     assert!(
         matches!(&err, Error::OutOfRange { node, param, value, expected }
-            if node == "dynamic parameter" && param == "r" && *value == -1.0 && expected == ">= 0"),
+            if node == "sphere" && param == "radius" && *value == -1.0 && expected == ">= 0"),
         "{err:?}"
     );
+    // The same text a baked value gets.
+    let baked = Scene::new(sphere(-1.0)).validate().unwrap_err();
+    assert_eq!(err.to_string(), baked.to_string());
     let err = eval.set_param("r", f64::NAN).unwrap_err();
     assert!(
-        matches!(&err, Error::NonFinite { param, .. } if param == "r"),
+        matches!(&err, Error::NonFinite { param, .. } if param == "radius"),
         "{err:?}"
     );
     let err = eval.set_param("radius", 2.0).unwrap_err();

@@ -1,7 +1,8 @@
 //! Compiles a scene to OpenCL C.
 //!
 //! The program is, in a fixed order: a header (precision typedefs, the
-//! quality constants and one `#define` per effect that is on), the helper
+//! quality constants, the kernel interface from [`interface`] and one
+//! `#define` per effect that is on), the helper
 //! functions from `kernels/sdf/` that the scene uses and nothing else, the
 //! scene's `DE()` and `DE_shade()`, and the target's kernel (the marcher, or
 //! a point evaluator for tests).
@@ -13,26 +14,29 @@
 //! use fractal_sdf::prelude::*;
 //! use fractal_sdf::codegen::{self, Options};
 //!
-//! let scene = Scene::new(sphere(param("radius", 1.0)));
+//! let scene = Scene::new(sphere(param("radius", 1.0))).compile()?;
 //! let kernel = codegen::emit(&scene, &Options::default())?;
-//! assert!(kernel.source.contains("sd_sphere(p0, params[0])"));
+//! assert!(kernel.source.contains("sd_sphere(p0, params[0] /* radius */)"));
 //! assert!(!kernel.source.contains("mandelbulb"));
 //! # Ok::<(), fractal_sdf::Error>(())
 //! ```
 
 mod helpers;
+pub mod interface;
 mod power;
 mod scene;
 mod writer;
 
 pub use writer::literal;
 
+use std::sync::atomic::{AtomicU64, Ordering};
+
 use glam::DVec3;
 
-use crate::error::{Error, Result};
-use crate::ir::{Ir, ParamSlot};
+use crate::error::Result;
+use crate::ir::{CompiledScene, Ir};
+use crate::math::{DEFAULT_COLOR, DERIVATIVE_CAP, MAGNITUDE_CAP, REAL_TINY};
 use crate::quality::{Effects, Precision, Quality};
-use crate::scene::Scene;
 
 /// What the generated program is for.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
@@ -46,7 +50,7 @@ pub enum Target {
 }
 
 /// Everything that shapes the generated source besides the scene.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct Options {
     /// March and sample settings, precision.
     pub quality: Quality,
@@ -56,45 +60,115 @@ pub struct Options {
     pub target: Target,
 }
 
-impl Default for Options {
-    fn default() -> Self {
-        Options {
-            quality: Quality::default(),
-            effects: Effects::default(),
-            target: Target::Render,
+/// A lighting effect that can be compiled into the marcher. Each names an
+/// `#ifdef ENABLE_*` block of `kernels/march.cl`; code generation keeps
+/// the blocks of the effects that are on and removes the others entirely.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum Effect {
+    /// Ambient occlusion (`ENABLE_AO`).
+    AmbientOcclusion,
+    /// Shadow rays towards each light (`ENABLE_SHADOWS`).
+    Shadows,
+    /// Glow around near misses (`ENABLE_GLOW`).
+    Glow,
+    /// Distance fog (`ENABLE_FOG`).
+    Fog,
+}
+
+impl Effect {
+    /// Every effect, in the order their switches appear in the header.
+    pub const ALL: [Effect; 4] = [
+        Effect::AmbientOcclusion,
+        Effect::Shadows,
+        Effect::Glow,
+        Effect::Fog,
+    ];
+
+    /// The preprocessor switch naming the effect's blocks.
+    #[must_use]
+    pub fn switch(self) -> &'static str {
+        match self {
+            Effect::AmbientOcclusion => "ENABLE_AO",
+            Effect::Shadows => "ENABLE_SHADOWS",
+            Effect::Glow => "ENABLE_GLOW",
+            Effect::Fog => "ENABLE_FOG",
         }
+    }
+
+    /// The effects `options` compile in: those that are on and cost
+    /// something (an occlusion or shadow sample count of 0, a glow
+    /// strength or fog density of 0, leaves the effect out).
+    #[must_use]
+    pub fn enabled(options: &Options) -> Vec<Effect> {
+        let (q, e) = (&options.quality, &options.effects);
+        Effect::ALL
+            .into_iter()
+            .filter(|effect| match effect {
+                Effect::AmbientOcclusion => e.ambient_occlusion && q.ao_samples > 0,
+                Effect::Shadows => e.shadows && q.shadow_steps > 0,
+                Effect::Glow => e.glow.is_some_and(|g| g.strength > 0.0),
+                Effect::Fog => e.fog_density > 0.0,
+            })
+            .collect()
     }
 }
 
-/// A generated program and what the executor needs to run it.
+/// A generated program and what the executor needs to run it: the one
+/// type for a program's source, generated or hand-written.
 #[derive(Debug, Clone, PartialEq)]
 pub struct KernelSource {
     /// The complete OpenCL C source.
     pub source: String,
-    /// The parameter buffer's layout, slot by slot.
-    pub params: Vec<ParamSlot>,
-    /// The precision the source was generated for.
+    /// The precision the source was generated for; `F64` requires a device
+    /// with `cl_khr_fp64`.
     pub precision: Precision,
     /// A stable 64-bit hash (FNV-1a) of `source`; equal sources have equal
     /// hashes, and changing a dynamic value never changes either.
     pub hash: u64,
     /// Where the program's `DE` has its origin in the scene: the scene's
     /// outermost baked translation for [`Target::Render`] (see
-    /// [`Ir::local_frame`]), zero otherwise.
+    /// [`Ir::local_frame`]), zero otherwise. The renderer moves the camera
+    /// and the lights by it, in `f64`, before they reach the device.
     pub origin: DVec3,
+    /// Where the target kernel (`kernels/march.cl` or `kernels/eval.cl`,
+    /// after effect selection) starts in `source`.
+    pub kernel_start: usize,
 }
 
-/// Generates the OpenCL C program for `scene`.
+impl KernelSource {
+    /// The scene's part of the program: header, helpers, `DE` and
+    /// `DE_shade`.
+    #[must_use]
+    pub fn scene_part(&self) -> &str {
+        &self.source[..self.kernel_start]
+    }
+
+    /// The target kernel, as appended after the scene's part.
+    #[must_use]
+    pub fn kernel_part(&self) -> &str {
+        &self.source[self.kernel_start..]
+    }
+}
+
+static EMISSIONS: AtomicU64 = AtomicU64::new(0);
+
+/// How many programs code generation has written in this process.
+/// Changing a renderer's camera, lights or dynamic parameters writes none.
+#[must_use]
+pub fn emissions() -> u64 {
+    EMISSIONS.load(Ordering::Relaxed)
+}
+
+/// Generates the OpenCL C program for a compiled scene.
 ///
 /// # Errors
-/// Any validation error of the scene, quality or effects.
-pub fn emit(scene: &Scene, options: &Options) -> Result<KernelSource> {
-    scene.validate()?;
-    let geometry = scene.geometry.as_ref().ok_or(Error::EmptyScene)?;
-    emit_ir(&Ir::lower(geometry)?, options)
+/// A validation error of the quality or effects.
+pub fn emit(scene: &CompiledScene, options: &Options) -> Result<KernelSource> {
+    emit_ir(scene.ir(), options)
 }
 
-/// Generates the program for already lowered geometry.
+/// Generates the program for lowered geometry alone (the camera and lights
+/// never shape the source).
 ///
 /// # Errors
 /// A validation error of the quality or effects.
@@ -112,6 +186,7 @@ pub fn emit_ir(ir: &Ir, options: &Options) -> Result<KernelSource> {
     };
     let origin = frame.map_or(DVec3::ZERO, |(offset, _)| offset);
     let mut body = writer::Writer::new(precision);
+    body.name_slots(ir.params().iter().map(|s| s.name.as_str()));
     let mut emitter = scene::SceneEmitter::new(
         ir,
         frame.map(|(_, node)| node),
@@ -119,15 +194,15 @@ pub fn emit_ir(ir: &Ir, options: &Options) -> Result<KernelSource> {
         options.quality.fractal_iterations,
     );
     emitter.emit();
-    let used: Vec<&'static str> = emitter.used.iter().copied().collect();
+    let used = std::mem::take(&mut emitter.used);
     let customs: Vec<_> = emitter.customs.values().cloned().collect();
     let powers: Vec<u32> = emitter.powers.iter().copied().collect();
 
     let mut w = writer::Writer::new(precision);
     header(&mut w, options);
-    for helper in helpers::closure(&used) {
-        w.line(format!("/* ---- {} ---- */", helper.name));
-        w.raw(helper.source);
+    for helper in helpers::closure(used) {
+        w.line(format!("/* ---- {} ---- */", helper.name()));
+        w.raw(helper.source());
         w.line("");
     }
     for n in powers {
@@ -142,7 +217,7 @@ pub fn emit_ir(ir: &Ir, options: &Options) -> Result<KernelSource> {
     }
     w.line("/* ---- scene ---- */");
     w.raw(&body.finish());
-    Ok(finish(w, options, ir.params().to_vec(), origin))
+    Ok(finish(w, options, origin))
 }
 
 /// A complete program around hand-written scene functions: the header for
@@ -160,28 +235,39 @@ pub fn emit_handwritten(scene_functions: &str, options: &Options) -> Result<Kern
     header(&mut w, options);
     w.line("/* ---- scene (hand-written) ---- */");
     w.raw(scene_functions);
-    Ok(finish(w, options, Vec::new(), DVec3::ZERO))
+    Ok(finish(w, options, DVec3::ZERO))
 }
 
-/// Appends the target kernel and hashes the program.
-fn finish(
-    mut w: writer::Writer,
-    options: &Options,
-    params: Vec<ParamSlot>,
-    origin: DVec3,
-) -> KernelSource {
+/// The target kernel for `options`, with the blocks of the effects that are
+/// off removed: what every program for these options ends with.
+#[must_use]
+pub fn target_kernel(options: &Options) -> String {
     let kernel = match options.target {
         Target::Render => include_str!("../../kernels/march.cl"),
         Target::Evaluate => include_str!("../../kernels/eval.cl"),
     };
-    w.raw(&select_features(kernel, &features(options)));
+    select_effects(kernel, &Effect::enabled(options))
+}
+
+/// Appends the target kernel and hashes the program.
+fn finish(mut w: writer::Writer, options: &Options, origin: DVec3) -> KernelSource {
+    EMISSIONS.fetch_add(1, Ordering::Relaxed);
+    w.line(format!(
+        "/* ---- kernel: {} ---- */",
+        match options.target {
+            Target::Render => "march.cl",
+            Target::Evaluate => "eval.cl",
+        }
+    ));
+    let kernel_start = w.len();
+    w.raw(&target_kernel(options));
     let source = w.finish();
     KernelSource {
         hash: fnv1a(source.as_bytes()),
         source,
-        params,
         precision: options.quality.precision,
         origin,
+        kernel_start,
     }
 }
 
@@ -210,10 +296,10 @@ fn header(w: &mut writer::Writer, options: &Options) {
     let f = |v: f64| w.float(v);
     let rgb = |c: glam::DVec3| format!("(real3)({}, {}, {})", f(c.x), f(c.y), f(c.z));
     let mut defines = vec![
-        ("REAL_TINY", f(1e-30)),
-        ("DERIVATIVE_CAP", f(1e30)),
-        ("MAGNITUDE_CAP", f(1e18)),
-        ("DEFAULT_COLOR", rgb(crate::cpu::DEFAULT_COLOR.into())),
+        ("REAL_TINY", f(REAL_TINY)),
+        ("DERIVATIVE_CAP", f(DERIVATIVE_CAP)),
+        ("MAGNITUDE_CAP", f(MAGNITUDE_CAP)),
+        ("DEFAULT_COLOR", rgb(DEFAULT_COLOR.into())),
         ("MAX_STEPS", q.max_steps.to_string()),
         ("MAX_DISTANCE", f(q.max_distance)),
         ("DETAIL", f(q.detail)),
@@ -225,51 +311,36 @@ fn header(w: &mut writer::Writer, options: &Options) {
         ("SKY_TOP", rgb(e.sky_top)),
         ("SKY_BOTTOM", rgb(e.sky_bottom)),
     ];
-    let on = features(options);
-    if on.contains(&"ENABLE_AO") {
+    let on = Effect::enabled(options);
+    if on.contains(&Effect::AmbientOcclusion) {
         defines.push(("AO_SAMPLES", q.ao_samples.to_string()));
         defines.push(("AO_DISTANCE", f(e.ao_distance)));
     }
-    if on.contains(&"ENABLE_SHADOWS") {
+    if on.contains(&Effect::Shadows) {
         defines.push(("SHADOW_STEPS", q.shadow_steps.to_string()));
     }
-    if let Some(glow) = e.glow.filter(|_| on.contains(&"ENABLE_GLOW")) {
+    if let Some(glow) = e.glow.filter(|_| on.contains(&Effect::Glow)) {
         defines.push(("GLOW_COLOR", rgb(glow.color)));
         defines.push(("GLOW_STRENGTH", f(glow.strength)));
     }
-    if on.contains(&"ENABLE_FOG") {
+    if on.contains(&Effect::Fog) {
         defines.push(("FOG_DENSITY", f(e.fog_density)));
     }
     for (name, value) in defines {
         w.line(format!("#define {name} {value}"));
     }
+    for effect in on {
+        w.line(format!("#define {}", effect.switch()));
+    }
+    w.line("/* The kernel interface (src/codegen/interface.rs). */");
+    w.raw(&interface::defines(options.target));
     w.line("");
-}
-
-/// The effect switches that are on. Each names an `#ifdef` block of the
-/// kernels; blocks that are off are removed from the source entirely.
-fn features(options: &Options) -> Vec<&'static str> {
-    let (q, e) = (&options.quality, &options.effects);
-    let mut on = Vec::new();
-    if e.ambient_occlusion && q.ao_samples > 0 {
-        on.push("ENABLE_AO");
-    }
-    if e.shadows && q.shadow_steps > 0 {
-        on.push("ENABLE_SHADOWS");
-    }
-    if e.glow.is_some_and(|g| g.strength > 0.0) {
-        on.push("ENABLE_GLOW");
-    }
-    if e.fog_density > 0.0 {
-        on.push("ENABLE_FOG");
-    }
-    on
 }
 
 /// Resolves the kernels' `#ifdef ENABLE_*` / `#else` / `#endif` blocks:
 /// keeps the lines of features that are on and drops the rest, so a
 /// disabled effect leaves no code at all. Other directives pass through.
-fn select_features(kernel: &str, on: &[&str]) -> String {
+fn select_effects(kernel: &str, on: &[Effect]) -> String {
     // One entry per open feature block: (is it being kept, was the
     // enclosing text being kept).
     let mut stack: Vec<(bool, bool)> = Vec::new();
@@ -279,8 +350,9 @@ fn select_features(kernel: &str, on: &[&str]) -> String {
         let directive = line.trim_start();
         if let Some(name) = directive.strip_prefix("#ifdef ENABLE_") {
             let name = format!("ENABLE_{}", name.trim());
-            stack.push((on.contains(&name.as_str()), keep));
-            keep = keep && on.contains(&name.as_str());
+            let taken = on.iter().any(|e| e.switch() == name);
+            stack.push((taken, keep));
+            keep = keep && taken;
         } else if directive.starts_with("#else") && !stack.is_empty() {
             let (taken, outer) = stack.last_mut().expect("checked non-empty");
             *taken = !*taken;

@@ -95,7 +95,7 @@ pub(crate) fn mandelbulb_helper(n: u32) -> String {
     )
     .expect("String");
     // The far field, as in the generic helper: the ball of radius `ball`,
-    // 2^(1 / (n - 1)), holds the set (proof: cpu::sdf::mandelbulb_radius).
+    // 2^(1 / (n - 1)), holds the set (proof: math::mandelbulb_radius).
     code.push_str(
         "    real r0 = length(p);\n    real outer = r0 - ball;\n    \
          if (r0 > R(1.5) * ball) {\n        *trap = R(1.0);\n        return outer;\n    }\n",

@@ -1,20 +1,78 @@
 //! Emits a scene's distance functions from the IR: straight-line code, one
-//! block per node, children before parents. The same walk writes `DE`
-//! (distance only) and `DE_shade` (distance, colour and orbit trap).
+//! block per node, children before parents, each block headed by a comment
+//! naming the node. The same walk writes `DE` (distance only) and
+//! `DE_shade` (distance, colour and orbit trap).
+//!
+//! Leaves are table-driven: [`leaf_function`] names each primitive's
+//! library function, and its arguments are the node's parameters in the
+//! order [`Kind::try_map`](crate::scene::Kind) lists them, the one list of
+//! every node's parameters.
 
 use std::collections::{BTreeMap, BTreeSet};
+use std::convert::Infallible;
 
+use super::helpers::Helper;
 use super::writer::Writer;
-use crate::cpu::integer_power;
-use crate::ir::{Ir, NodeId, Scalar};
+use crate::ir::{Ir, IrNode, NodeId, Scalar, Vector};
+use crate::math::{escape_radius, integer_power, mandelbulb_radius, rotation_rows};
 use crate::quality::Precision;
-use crate::scene::{CsgOp, CustomShape, Kind};
+use crate::scene::{
+    CsgOp, CustomShape, Kind, MAX_ESCAPE_ITERATIONS, MAX_FOLD_ITERATIONS, Mapper, ParamSpec,
+};
 
-/// The variables holding one node's result.
+/// One node's result: the variable holding its distance, and expressions
+/// for its colour and orbit trap (a variable only where one is computed,
+/// so `DE_shade` declares nothing it does not read).
 struct Vars {
     d: String,
     c: String,
     t: String,
+}
+
+/// The library function and helper file of each primitive: the table that
+/// drives leaf emission. Its arguments are the node's parameters in
+/// `try_map` order.
+fn leaf_function(node: &IrNode) -> Option<(Helper, &'static str)> {
+    Some(match node {
+        Kind::Sphere { .. } => (Helper::Sphere, "sd_sphere"),
+        Kind::Cuboid { .. } => (Helper::Cuboid, "sd_box"),
+        Kind::RoundBox { .. } => (Helper::RoundBox, "sd_round_box"),
+        Kind::Torus { .. } => (Helper::Torus, "sd_torus"),
+        Kind::Cylinder { .. } => (Helper::Cylinder, "sd_cylinder"),
+        Kind::Capsule { .. } => (Helper::Capsule, "sd_capsule"),
+        Kind::Plane { .. } => (Helper::Plane, "sd_plane"),
+        Kind::Octahedron { .. } => (Helper::Octahedron, "sd_octahedron"),
+        Kind::CappedCone { .. } => (Helper::CappedCone, "sd_capped_cone"),
+        Kind::Ellipsoid { .. } => (Helper::Ellipsoid, "sd_ellipsoid"),
+        _ => return None,
+    })
+}
+
+/// Collects a node's parameters as source expressions, in `try_map` order.
+struct Arguments<'w> {
+    w: &'w Writer,
+    out: Vec<String>,
+}
+
+impl Mapper<Scalar, Vector, NodeId> for Arguments<'_> {
+    type S2 = ();
+    type V2 = ();
+    type C2 = ();
+    type E = Infallible;
+
+    fn scalar(&mut self, s: &Scalar, _: ParamSpec<'_>) -> Result<(), Infallible> {
+        self.out.push(self.w.scalar(*s));
+        Ok(())
+    }
+
+    fn vector(&mut self, v: &Vector, _: ParamSpec<'_>) -> Result<(), Infallible> {
+        self.out.push(self.w.vector(*v));
+        Ok(())
+    }
+
+    fn child(&mut self, _: &NodeId) -> Result<(), Infallible> {
+        Ok(())
+    }
 }
 
 pub(crate) struct SceneEmitter<'a> {
@@ -26,8 +84,8 @@ pub(crate) struct SceneEmitter<'a> {
     shade: bool,
     points: usize,
     iteration_override: Option<u32>,
-    /// Names of the helper functions the emitted code calls.
-    pub(crate) used: BTreeSet<&'static str>,
+    /// The helper files the emitted code calls.
+    pub(crate) used: BTreeSet<Helper>,
     /// The custom shapes the emitted code calls, by name.
     pub(crate) customs: BTreeMap<String, CustomShape>,
     /// The integer Mandelbulb powers that need a specialised helper.
@@ -67,7 +125,7 @@ impl<'a> SceneEmitter<'a> {
                 self.w
                     .open("real DE(real3 p0, __global const real* params)");
             }
-            let out = self.node(self.ir.root(), "p0");
+            let out = self.node(self.ir.root(), "p0", true);
             if shade {
                 self.w.line(format!("*color = {};", out.c));
                 self.w.line(format!("*trap = {};", out.t));
@@ -94,24 +152,37 @@ impl<'a> SceneEmitter<'a> {
             .map_or(own, |cap| own.min(cap).clamp(min, max))
     }
 
+    /// Heads a node's own code with a comment naming it: the last steps of
+    /// its path, as validation errors name it.
+    fn label(&mut self, id: NodeId) {
+        self.w.comment(&self.ir.path_tail(id, 3));
+    }
+
+    /// The node's parameters as source expressions, in `try_map` order.
+    fn arguments(&self, node: &IrNode) -> String {
+        let mut args = Arguments {
+            w: &*self.w,
+            out: Vec::new(),
+        };
+        let Ok(_) = node.try_map(&mut args);
+        args.out.join(", ")
+    }
+
     /// A leaf: its distance expression, default colour, trap 1.
-    fn leaf(&mut self, id: NodeId, helper: &'static str, expr: String) -> Vars {
-        if !helper.is_empty() {
-            self.used.insert(helper);
+    fn leaf(&mut self, id: NodeId, expr: String) -> Vars {
+        let d = format!("d{}", id.index());
+        self.w.line(format!("real {d} = {expr};"));
+        Vars {
+            d,
+            c: "DEFAULT_COLOR".into(),
+            t: "R(1.0)".into(),
         }
-        let v = vars(id);
-        self.w.line(format!("real {} = {expr};", v.d));
-        if self.shade {
-            self.w.line(format!("real3 {} = DEFAULT_COLOR;", v.c));
-            self.w.line(format!("real {} = R(1.0);", v.t));
-        }
-        v
     }
 
     /// A fractal: the helper writes the trap through a pointer.
-    fn fractal(&mut self, id: NodeId, helper: &'static str, args: String) -> Vars {
+    fn fractal(&mut self, id: NodeId, helper: Helper, args: &str) -> Vars {
         self.used.insert(helper);
-        self.fractal_call(id, helper, &args)
+        self.fractal_call(id, helper.name(), args)
     }
 
     /// A call of a fractal function (library or specialised).
@@ -120,10 +191,10 @@ impl<'a> SceneEmitter<'a> {
         self.w.line(format!("real {};", v.t));
         self.w
             .line(format!("real {} = {function}({args}, &{});", v.d, v.t));
-        if self.shade {
-            self.w.line(format!("real3 {} = DEFAULT_COLOR;", v.c));
+        Vars {
+            c: "DEFAULT_COLOR".into(),
+            ..v
         }
-        v
     }
 
     /// A node that changes only the child's distance, by `expr` of `{d}`.
@@ -134,100 +205,37 @@ impl<'a> SceneEmitter<'a> {
         Vars { d, ..child }
     }
 
-    #[allow(clippy::too_many_lines)]
-    fn node(&mut self, id: NodeId, p: &str) -> Vars {
+    /// Emits node `id` at point `p`. `needs_color` is false below a colour
+    /// node, which paints over whatever colour its child computes, so none
+    /// is computed.
+    fn node(&mut self, id: NodeId, p: &str, needs_color: bool) -> Vars {
         let ir = self.ir;
+        let node = ir.node(id);
         if self.frame == Some(id) {
-            if let Kind::Translate { child, .. } = ir.node(id) {
-                return self.node(*child, p);
+            if let Kind::Translate { child, .. } = node {
+                return self.node(*child, p, needs_color);
             }
+        }
+        if !matches!(
+            node,
+            Kind::Csg { .. } | Kind::Color { .. } | Kind::Round { .. } | Kind::Onion { .. }
+        ) {
+            self.label(id);
+        }
+        if let Some((helper, function)) = leaf_function(node) {
+            self.used.insert(helper);
+            let args = self.arguments(node);
+            return self.leaf(id, format!("{function}({p}, {args})"));
         }
         let w = |this: &Self, s: Scalar| this.w.scalar(s);
         let v3 = |this: &Self, v: [Scalar; 3]| this.w.vector(v);
-        match ir.node(id) {
-            Kind::Sphere { radius } => {
-                let e = format!("sd_sphere({p}, {})", w(self, *radius));
-                self.leaf(id, "sphere", e)
-            }
-            Kind::Cuboid { half_extents } => {
-                let e = format!("sd_box({p}, {})", v3(self, *half_extents));
-                self.leaf(id, "cuboid", e)
-            }
-            Kind::RoundBox {
-                half_extents,
-                radius,
-            } => {
-                let e = format!(
-                    "sd_round_box({p}, {}, {})",
-                    v3(self, *half_extents),
-                    w(self, *radius)
-                );
-                self.leaf(id, "round_box", e)
-            }
-            Kind::Torus {
-                major_radius,
-                minor_radius,
-            } => {
-                let e = format!(
-                    "sd_torus({p}, {}, {})",
-                    w(self, *major_radius),
-                    w(self, *minor_radius)
-                );
-                self.leaf(id, "torus", e)
-            }
-            Kind::Cylinder {
-                radius,
-                half_height,
-            } => {
-                let e = format!(
-                    "sd_cylinder({p}, {}, {})",
-                    w(self, *radius),
-                    w(self, *half_height)
-                );
-                self.leaf(id, "cylinder", e)
-            }
-            Kind::Capsule { a, b, radius } => {
-                let e = format!(
-                    "sd_capsule({p}, {}, {}, {})",
-                    v3(self, *a),
-                    v3(self, *b),
-                    w(self, *radius)
-                );
-                self.leaf(id, "capsule", e)
-            }
-            Kind::Plane { normal, offset } => {
-                let e = format!("sd_plane({p}, {}, {})", v3(self, *normal), w(self, *offset));
-                self.leaf(id, "plane", e)
-            }
-            Kind::Octahedron { size } => {
-                let e = format!("sd_octahedron({p}, {})", w(self, *size));
-                self.leaf(id, "octahedron", e)
-            }
-            Kind::CappedCone {
-                half_height,
-                bottom_radius,
-                top_radius,
-            } => {
-                let e = format!(
-                    "sd_capped_cone({p}, {}, {}, {})",
-                    w(self, *half_height),
-                    w(self, *bottom_radius),
-                    w(self, *top_radius)
-                );
-                self.leaf(id, "capped_cone", e)
-            }
-            Kind::Ellipsoid { radii } => {
-                let e = format!("sd_ellipsoid({p}, {})", v3(self, *radii));
-                self.leaf(id, "ellipsoid", e)
-            }
+        match node {
             Kind::Mandelbulb(f) => {
-                let n = self.iterations(f.iterations, (1, crate::scene::MAX_ESCAPE_ITERATIONS));
+                let n = self.iterations(f.iterations, (1, MAX_ESCAPE_ITERATIONS));
                 // The escape radius: a literal when power and bailout are
                 // baked, as the CPU computes it.
                 let escape = match (f.power, f.bailout) {
-                    (Scalar::Baked(p), Scalar::Baked(b)) => {
-                        self.w.float(crate::cpu::sdf::escape_radius(p, b))
-                    }
+                    (Scalar::Baked(p), Scalar::Baked(b)) => self.w.float(escape_radius(p, b)),
                     _ => format!(
                         "fmin({}, pow(MAGNITUDE_CAP, R(1.0) / {}))",
                         w(self, f.bailout),
@@ -238,8 +246,8 @@ impl<'a> SceneEmitter<'a> {
                 // the power is baked, rounded as the CPU computes it.
                 let ball = match f.power {
                     Scalar::Baked(p) => self.w.float(match self.w.precision() {
-                        Precision::F32 => f64::from(crate::cpu::sdf::mandelbulb_radius(p as f32)),
-                        Precision::F64 => crate::cpu::sdf::mandelbulb_radius(p),
+                        Precision::F32 => f64::from(mandelbulb_radius(p as f32)),
+                        Precision::F64 => mandelbulb_radius(p),
                     }),
                     Scalar::Dynamic(_) => {
                         format!("pow(R(2.0), R(1.0) / ({} - R(1.0)))", w(self, f.power))
@@ -253,80 +261,82 @@ impl<'a> SceneEmitter<'a> {
                     }
                     None => {
                         let args = format!("{p}, {}, {n}, {escape}, {ball}", w(self, f.power));
-                        self.fractal(id, "mandelbulb", args)
+                        self.fractal(id, Helper::Mandelbulb, &args)
                     }
                 }
             }
             Kind::Menger(f) => {
-                let n = self.iterations(f.iterations, (0, crate::scene::MAX_FOLD_ITERATIONS));
+                let n = self.iterations(f.iterations, (0, MAX_FOLD_ITERATIONS));
                 let args = format!("{p}, {n}, {}", w(self, f.scale));
-                self.fractal(id, "menger", args)
+                self.fractal(id, Helper::Menger, &args)
             }
             Kind::Julia(f) => {
-                let n = self.iterations(f.iterations, (1, crate::scene::MAX_ESCAPE_ITERATIONS));
+                let n = self.iterations(f.iterations, (1, MAX_ESCAPE_ITERATIONS));
                 let [cx, cy, cz, cw] = f.c.map(|s| w(self, s));
                 let args = format!(
                     "{p}, (real4)({cx}, {cy}, {cz}, {cw}), {}, {n}, {}",
                     w(self, f.slice_w),
                     w(self, f.bailout)
                 );
-                self.fractal(id, "julia", args)
+                self.fractal(id, Helper::Julia, &args)
             }
             Kind::Sierpinski(f) => {
-                let n = self.iterations(f.iterations, (0, crate::scene::MAX_FOLD_ITERATIONS));
+                let n = self.iterations(f.iterations, (0, MAX_FOLD_ITERATIONS));
                 let args = format!("{p}, {n}, {}", w(self, f.scale));
-                self.fractal(id, "sierpinski", args)
+                self.fractal(id, Helper::Sierpinski, &args)
             }
             Kind::Translate { offset, child } => {
                 let q = self.point(format!("{p} - {}", v3(self, *offset)));
-                self.node(*child, &q)
+                self.node(*child, &q, needs_color)
             }
             Kind::Rotate { axis, angle, child } => {
                 let q = match angle {
                     Scalar::Baked(a) => {
-                        let rows = crate::cpu::rotation_rows(*axis, -a);
+                        let rows = rotation_rows(*axis, -a);
                         let [x, y, z] = rows.map(|r| self.dot_row([r.x, r.y, r.z], p));
                         self.point(format!("(real3)({x}, {y}, {z})"))
                     }
                     Scalar::Dynamic(_) => {
-                        self.used.insert("rotate");
+                        self.used.insert(Helper::Rotate);
                         let k = v3(self, axis.to_array().map(Scalar::Baked));
                         let a = format!("-{}", w(self, *angle));
                         self.point(format!("rotate_axis({p}, {k}, {a})"))
                     }
                 };
-                self.node(*child, &q)
+                self.node(*child, &q, needs_color)
             }
             Kind::Scale { factor, child } => {
                 let f = w(self, *factor);
                 let q = self.point(format!("{p} / {f}"));
-                let c = self.node(*child, &q);
+                let c = self.node(*child, &q, needs_color);
                 self.post(id, c, &format!("{{d}} * {f}"))
             }
             Kind::Mirror { axis, child } => {
                 let q = self.point(p.to_string());
                 let a = ["x", "y", "z"][axis.index()];
                 self.w.line(format!("{q}.{a} = fabs({q}.{a});"));
-                self.node(*child, &q)
+                self.node(*child, &q, needs_color)
             }
             Kind::Round { radius, child } => {
-                let c = self.node(*child, p);
+                let c = self.node(*child, p, needs_color);
+                self.label(id);
                 let r = w(self, *radius);
                 self.post(id, c, &format!("{{d}} - {r}"))
             }
             Kind::Onion { thickness, child } => {
-                let c = self.node(*child, p);
+                let c = self.node(*child, p, needs_color);
+                self.label(id);
                 let t = w(self, *thickness);
                 self.post(id, c, &format!("fabs({{d}}) - {t}"))
             }
             Kind::Elongate { extents, child } => {
                 let h = v3(self, *extents);
                 let q = self.point(format!("{p} - clamp({p}, -{h}, {h})"));
-                self.node(*child, &q)
+                self.node(*child, &q, needs_color)
             }
             Kind::Repeat { period, child } => {
                 let q = self.repeat(p, *period, None);
-                self.node(*child, &q)
+                self.node(*child, &q, needs_color)
             }
             Kind::RepeatLimited {
                 period,
@@ -334,7 +344,7 @@ impl<'a> SceneEmitter<'a> {
                 child,
             } => {
                 let q = self.repeat(p, *period, Some(*limit));
-                self.node(*child, &q)
+                self.node(*child, &q, needs_color)
             }
             Kind::Twist { rate, child } => {
                 let k = w(self, *rate);
@@ -344,8 +354,8 @@ impl<'a> SceneEmitter<'a> {
                 let q = self.point(format!(
                     "(real3)(k{i} * {p}.x - s{i} * {p}.z, {p}.y, s{i} * {p}.x + k{i} * {p}.z)"
                 ));
-                let c = self.node(*child, &q);
-                self.used.insert("warp");
+                let c = self.node(*child, &q, needs_color);
+                self.used.insert(Helper::Warp);
                 let rho = format!("hypot({p}.x, {p}.z)");
                 self.post(id, c, &format!("twist_bound({{d}}, {k}, {rho})"))
             }
@@ -357,8 +367,8 @@ impl<'a> SceneEmitter<'a> {
                 let q = self.point(format!(
                     "(real3)(k{i} * {p}.x - s{i} * {p}.y, s{i} * {p}.x + k{i} * {p}.y, {p}.z)"
                 ));
-                let c = self.node(*child, &q);
-                self.used.insert("warp");
+                let c = self.node(*child, &q, needs_color);
+                self.used.insert(Helper::Warp);
                 let rho = format!("hypot({p}.x, {p}.y)");
                 self.post(id, c, &format!("bend_bound({{d}}, {k}, {rho})"))
             }
@@ -368,29 +378,28 @@ impl<'a> SceneEmitter<'a> {
                 a,
                 b,
             } => {
-                let (a, b) = (self.node(*a, p), self.node(*b, p));
-                self.csg(id, *op, *smoothing, &a, &b)
+                let (a, b) = (self.node(*a, p, needs_color), self.node(*b, p, needs_color));
+                self.label(id);
+                self.csg(id, *op, *smoothing, &a, &b, needs_color)
             }
-            Kind::Custom { shape, args } => {
-                let mut call = format!("{}({p}", shape.function_name());
-                for a in args {
-                    call.push_str(", ");
-                    call.push_str(&w(self, *a));
-                }
-                call.push(')');
+            Kind::Custom { shape, .. } => {
                 self.customs.insert(shape.name().to_string(), shape.clone());
-                self.leaf(id, "", call)
+                let args = self.arguments(node);
+                let comma = if args.is_empty() { "" } else { ", " };
+                self.leaf(id, format!("{}({p}{comma}{args})", shape.function_name()))
             }
             Kind::Color { color, child } => {
-                let c = self.node(*child, p);
-                if !self.shade {
+                let c = self.node(*child, p, false);
+                if !self.shade || !needs_color {
                     return c;
                 }
+                self.label(id);
                 let v = vars(id);
                 self.w
                     .line(format!("real3 {} = {};", v.c, v3(self, *color)));
                 Vars { c: v.c, ..c }
             }
+            _ => unreachable!("leaves are emitted from the table above"),
         }
     }
 
@@ -442,7 +451,15 @@ impl<'a> SceneEmitter<'a> {
 
     /// Every boolean is a (smooth) minimum of signed operands, as in
     /// `cpu::combine`.
-    fn csg(&mut self, id: NodeId, op: CsgOp, k: Option<Scalar>, a: &Vars, b: &Vars) -> Vars {
+    fn csg(
+        &mut self,
+        id: NodeId,
+        op: CsgOp,
+        k: Option<Scalar>,
+        a: &Vars,
+        b: &Vars,
+        needs_color: bool,
+    ) -> Vars {
         let i = id.index();
         let (x, y) = match op {
             CsgOp::Union => (a.d.clone(), b.d.clone()),
@@ -453,41 +470,56 @@ impl<'a> SceneEmitter<'a> {
         let v = vars(id);
         self.w.line(format!("real x{i} = {x};"));
         self.w.line(format!("real y{i} = {y};"));
-        match k {
+        let blend = match k {
             Some(k) => {
-                self.used.insert("smooth_min");
+                self.used.insert(Helper::SmoothMin);
                 let k = self.w.scalar(k);
                 self.w
                     .line(format!("real2 m{i} = smooth_min(x{i}, y{i}, {k});"));
                 self.w.line(format!("real {} = {sign}m{i}.x;", v.d));
-                if self.shade {
-                    let mix = |u: &str, w: &str| format!("mix({u}, {w}, m{i}.y)");
-                    self.w.line(format!(
-                        "real3 {} = x{i} < y{i} ? {} : {};",
-                        v.c,
-                        mix(&a.c, &b.c),
-                        mix(&b.c, &a.c)
-                    ));
-                    self.w.line(format!(
-                        "real {} = x{i} < y{i} ? {} : {};",
-                        v.t,
-                        mix(&a.t, &b.t),
-                        mix(&b.t, &a.t)
-                    ));
-                }
+                Some(format!("m{i}.y"))
             }
             None => {
                 self.w
                     .line(format!("real {} = {sign}fmin(x{i}, y{i});", v.d));
-                if self.shade {
-                    self.w
-                        .line(format!("real3 {} = x{i} < y{i} ? {} : {};", v.c, a.c, b.c));
-                    self.w
-                        .line(format!("real {} = x{i} < y{i} ? {} : {};", v.t, a.t, b.t));
-                }
+                None
             }
+        };
+        if !self.shade {
+            return v;
         }
-        v
+        let near = format!("x{i} < y{i}");
+        let c = if needs_color {
+            self.choose("real3", &v.c, &near, (&a.c, &b.c), blend.as_deref())
+        } else {
+            v.c
+        };
+        let t = self.choose("real", &v.t, &near, (&a.t, &b.t), blend.as_deref());
+        Vars { d: v.d, c, t }
+    }
+
+    /// The colour or trap of a boolean: the nearer operand's, blended
+    /// towards the other's by `blend` across a smooth seam, as
+    /// `cpu::combine` computes it. Equal operands need no code (the blend
+    /// of a value with itself is that value).
+    fn choose(
+        &mut self,
+        ty: &str,
+        var: &str,
+        near: &str,
+        (a, b): (&str, &str),
+        blend: Option<&str>,
+    ) -> String {
+        if a == b {
+            return a.to_string();
+        }
+        let (first, second) = match blend {
+            Some(m) => (format!("mix({a}, {b}, {m})"), format!("mix({b}, {a}, {m})")),
+            None => (a.to_string(), b.to_string()),
+        };
+        self.w
+            .line(format!("{ty} {var} = {near} ? {first} : {second};"));
+        var.to_string()
     }
 }
 

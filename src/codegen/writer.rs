@@ -11,6 +11,8 @@ pub(crate) struct Writer {
     out: String,
     indent: usize,
     precision: Precision,
+    /// Each parameter slot's name, as a comment safe to emit.
+    slot_names: Vec<String>,
 }
 
 impl Writer {
@@ -19,7 +21,24 @@ impl Writer {
             out: String::new(),
             indent: 0,
             precision,
+            slot_names: Vec::new(),
         }
+    }
+
+    /// Names the parameter slots, so each read of the buffer says which
+    /// parameter it is.
+    pub(crate) fn name_slots<'n>(&mut self, names: impl IntoIterator<Item = &'n str>) {
+        self.slot_names = names.into_iter().map(comment_text).collect();
+    }
+
+    /// Bytes written so far.
+    pub(crate) fn len(&self) -> usize {
+        self.out.len()
+    }
+
+    /// Writes a `/* ... */` comment line; `text` is made safe for a comment.
+    pub(crate) fn comment(&mut self, text: &str) {
+        self.line(format!("/* {} */", comment_text(text)));
     }
 
     /// Writes one line at the current indentation.
@@ -69,7 +88,10 @@ impl Writer {
     pub(crate) fn scalar(&self, s: Scalar) -> String {
         match s {
             Scalar::Baked(v) => self.float(v),
-            Scalar::Dynamic(slot) => format!("params[{slot}]"),
+            Scalar::Dynamic(slot) => match self.slot_names.get(slot as usize) {
+                Some(name) => format!("params[{slot}] /* {name} */"),
+                None => format!("params[{slot}]"),
+            },
         }
     }
 
@@ -86,6 +108,21 @@ impl Writer {
     pub(crate) fn finish(self) -> String {
         self.out
     }
+}
+
+/// `text` as comment text: characters outside a plain set (letters, digits,
+/// space and `_ . : / - [ ]`) become `?`, so no user string can close the
+/// comment, continue a line or smuggle a directive.
+fn comment_text(text: &str) -> String {
+    text.chars()
+        .map(|c| {
+            if c.is_ascii_alphanumeric() || " _.:/-[]".contains(c) {
+                c
+            } else {
+                '?'
+            }
+        })
+        .collect()
 }
 
 /// Formats `v` as an OpenCL C literal of `precision` that reads back as
@@ -144,6 +181,15 @@ mod tests {
             let d = literal(v, Precision::F64);
             assert_eq!(d.trim_matches(['(', ')']).parse::<f64>().unwrap(), v, "{d}");
         }
+    }
+
+    #[test]
+    fn comments_cannot_be_closed_by_user_text() {
+        assert_eq!(comment_text("radius"), "radius");
+        assert_eq!(comment_text("a*/ b\nc\\"), "a?/ b?c?");
+        let mut w = Writer::new(Precision::F32);
+        w.name_slots(["*/ evil();"]);
+        assert_eq!(w.scalar(Scalar::Dynamic(0)), "params[0] /* ?/ evil??? */");
     }
 
     #[test]

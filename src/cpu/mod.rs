@@ -5,20 +5,17 @@
 //! test compares against. It is written for clarity and exactness, not
 //! speed.
 
-mod real;
 pub mod sdf;
 
 use glam::DVec3;
 
-pub use real::{Real, V3, v3};
+use crate::math::{DEFAULT_COLOR, integer_power, rotation_rows};
+pub use crate::math::{Real, V3, v3};
 use sdf::Estimate;
 
 use crate::error::Result;
-use crate::ir::{Ir, NodeId, ParamValues, Scalar};
+use crate::ir::{CompiledScene, Ir, NodeId, ParamValues, Scalar};
 use crate::scene::{CsgOp, Kind, Node};
-
-/// The colour given to surfaces that no `color` node paints.
-pub const DEFAULT_COLOR: [f64; 3] = [0.8, 0.8, 0.8];
 
 /// What the scene is like at one point.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -53,6 +50,13 @@ impl Evaluator {
     /// Any validation error of the geometry.
     pub fn new(geometry: &Node) -> Result<Self> {
         Ok(Self::from_ir(Ir::lower(geometry)?))
+    }
+
+    /// An evaluator for a compiled scene's geometry (nothing is lowered
+    /// again); dynamic parameters start at their defaults.
+    #[must_use]
+    pub fn from_compiled(scene: &CompiledScene) -> Self {
+        Self::from_ir(scene.ir().clone())
     }
 
     /// An evaluator for an already lowered scene.
@@ -275,32 +279,6 @@ impl Evaluator {
     }
 }
 
-/// The trig-free integer form applies when the power is a baked integer.
-/// Code generation makes the same choice.
-#[must_use]
-pub fn integer_power(power: Scalar) -> Option<u32> {
-    match power {
-        #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss)]
-        Scalar::Baked(v) if v.fract() == 0.0 && (2.0..=64.0).contains(&v) => Some(v as u32),
-        _ => None,
-    }
-}
-
-/// The rows of the matrix rotating by `angle` around the unit `axis`,
-/// computed in `f64`.
-///
-/// Entries within `1e-15` of 0 or ±1 are snapped to them, so quarter turns
-/// are exact permutations (and code generation can drop the zero terms).
-#[must_use]
-pub fn rotation_rows(axis: DVec3, angle: f64) -> [V3<f64>; 3] {
-    let snap = |v: f64| {
-        let r = v.round();
-        if (v - r).abs() < 1e-15 { r } else { v }
-    };
-    let m = glam::DMat3::from_axis_angle(axis, angle).transpose();
-    [m.x_axis, m.y_axis, m.z_axis].map(|row| V3::from(row).map(snap))
-}
-
 /// `row · p` as `row.x p.x + row.y p.y + row.z p.z`, left to right, leaving
 /// out zero entries (adding an exact zero changes nothing).
 fn dot_row<T: Real>(row: V3<T>, p: V3<T>) -> T {
@@ -368,82 +346,99 @@ pub struct Ray {
     pub direction: DVec3,
 }
 
-/// Sphere-tracing settings: the same march as the OpenCL kernel.
+/// Sphere-tracing settings: the same march, with the same names, as the
+/// kernel's `march_ray`.
 ///
-/// The surface is where the distance falls to the threshold
-/// `epsilon + t * epsilon_per_unit`. The march steps by the distance to
-/// that surface, at least `refine` times the threshold, and locates the
-/// crossing to `refine` times the threshold along the ray.
+/// A pixel covers `footprint(t) = footprint_base + footprint_per_unit · t`
+/// scene units at distance `t` along a ray. The drawn surface is where the
+/// distance falls to `detail` footprints; the march steps by the distance
+/// to that surface, no shorter than `hit_epsilon` footprints, and locates
+/// the crossing to `hit_epsilon` footprints along the ray.
+/// [`Viewport::march_settings`](crate::render::Viewport::march_settings)
+/// gives the settings of a rendered image.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct MarchSettings {
-    /// Give up after this many steps.
+    /// Give up after this many steps (`MAX_STEPS`).
     pub max_steps: u32,
-    /// Give up beyond this distance along the ray.
+    /// Give up beyond this distance along the ray (`MAX_DISTANCE`).
     pub max_distance: f64,
-    /// The hit threshold at the ray origin.
-    pub epsilon: f64,
-    /// Growth of the hit threshold per unit of ray length (it scales with
-    /// the pixel footprint).
-    pub epsilon_per_unit: f64,
-    /// The shortest step and the precision of the located crossing, as a
-    /// fraction of the threshold; in `(0, 1]` for a bounded number of steps
-    /// along grazing rays.
-    pub refine: f64,
-    /// Relaxation factor ω, in `[0.25, 2)` (see
+    /// The pixel footprint at the ray origin, in scene units.
+    pub footprint_base: f64,
+    /// Growth of the pixel footprint per unit of ray length.
+    pub footprint_per_unit: f64,
+    /// The drawn surface, in footprints (`DETAIL`).
+    pub detail: f64,
+    /// The shortest step and the precision of the located crossing, in
+    /// footprints (`HIT_EPSILON`); at most `detail` for a bounded number of
+    /// steps along grazing rays.
+    pub hit_epsilon: f64,
+    /// Relaxation factor ω, in `[0.25, 2)` (`OVER_RELAXATION`; see
     /// [`Quality::over_relaxation`](crate::quality::Quality::over_relaxation)).
     pub over_relaxation: f64,
 }
 
+impl MarchSettings {
+    /// Scene units covered by one pixel at distance `t` along a ray.
+    #[must_use]
+    pub fn footprint(&self, t: f64) -> f64 {
+        self.footprint_base + self.footprint_per_unit * t
+    }
+}
+
 impl Default for MarchSettings {
+    /// A fixed footprint of `1e-4` (the surface where the distance falls to
+    /// `1e-4`), hits located to a tenth of it, 256 steps, 100 units.
     fn default() -> Self {
         MarchSettings {
             max_steps: 256,
             max_distance: 100.0,
-            epsilon: 1e-4,
-            epsilon_per_unit: 0.0,
-            refine: 0.1,
+            footprint_base: 1e-4,
+            footprint_per_unit: 0.0,
+            detail: 1.0,
+            hit_epsilon: 0.1,
             over_relaxation: 1.0,
         }
     }
 }
 
-/// The result of tracing one ray.
+/// The result of tracing one ray (the kernel's `MarchResult`).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Hit {
     /// Whether a surface was reached.
     pub hit: bool,
-    /// Distance along the ray where the march stopped.
+    /// Distance along the ray where the march stopped (`t`).
     pub depth: f64,
     /// Steps (distance evaluations) taken.
     pub steps: u32,
-    /// The smallest distance seen along the ray (drives glow).
-    pub min_distance: f64,
+    /// The angle of the nearest miss: the smallest `d / (t + d)` seen along
+    /// the ray, 1 at most, 0 on a hit (drives glow).
+    pub closest: f64,
 }
 
 /// Sphere-traces `ray` through the scene, exactly as the kernel's
-/// `march_ray` does: steps of the distance to the threshold surface (no
-/// shorter than `refine` thresholds; relaxed, with the fallback, when
+/// `march_ray` does: steps of the distance to the drawn surface (no
+/// shorter than `hit_epsilon` footprints; relaxed, with the fallback, when
 /// `over_relaxation > 1`), then the crossing located by the Illinois form
 /// of regula falsi.
 #[must_use]
 pub fn march(eval: &Evaluator, ray: Ray, settings: &MarchSettings) -> Hit {
-    let threshold = |t: f64| settings.epsilon + t * settings.epsilon_per_unit;
-    let level = |t: f64| eval.distance(ray.origin + ray.direction * t) - threshold(t);
-    let lipschitz = 1.0 + settings.epsilon_per_unit;
+    let surface = |t: f64| settings.detail * settings.footprint(t);
+    let level = |t: f64| eval.distance(ray.origin + ray.direction * t) - surface(t);
+    let lipschitz = 1.0 + settings.detail * settings.footprint_per_unit;
     let mut omega = settings.over_relaxation;
     let mut relaxed = false;
     let (mut t, mut prev_t, mut prev_g) = (0.0, 0.0, 0.0);
-    let mut min_distance = f64::INFINITY;
+    let mut closest: f64 = 1.0;
     let mut steps = 0;
-    let stop = |hit, depth, steps, min_distance| Hit {
+    let stop = |hit, depth, steps, closest| Hit {
         hit,
         depth,
         steps,
-        min_distance,
+        closest,
     };
     for i in 0..settings.max_steps {
         let d = eval.distance(ray.origin + ray.direction * t);
-        let g = d - threshold(t);
+        let g = d - surface(t);
         steps += 1;
         if relaxed && (g < 0.0 || prev_g + g < lipschitz * (t - prev_t)) {
             t = prev_t + prev_g / lipschitz;
@@ -451,28 +446,30 @@ pub fn march(eval: &Evaluator, ray: Ray, settings: &MarchSettings) -> Hit {
             relaxed = false;
             continue;
         }
-        min_distance = min_distance.min(d);
+        if d > 0.0 {
+            closest = closest.min(d / (t + d));
+        }
         if g <= 0.0 {
             if i > 0 {
                 let (depth, extra) = refine(level, (prev_t, prev_g), (t, g), |t| {
-                    settings.refine * threshold(t)
+                    settings.hit_epsilon * settings.footprint(t)
                 });
                 t = depth;
                 steps += extra;
             }
-            return stop(true, t, steps, min_distance);
+            return stop(true, t, steps, 0.0);
         }
         let plain = g / lipschitz;
-        let shortest = settings.refine * threshold(t);
+        let shortest = settings.hit_epsilon * settings.footprint(t);
         relaxed = omega > 1.0 && omega * plain > plain.max(shortest);
         prev_t = t;
         prev_g = g;
         t += (omega * plain).max(shortest);
         if t > settings.max_distance {
-            return stop(false, t, steps, min_distance);
+            return stop(false, t, steps, closest);
         }
     }
-    stop(false, t, steps, min_distance)
+    stop(false, t, steps, closest)
 }
 
 /// Most evaluations [`march`] spends locating a crossing.

@@ -7,7 +7,7 @@
 //! (quaternion Julia), White/Nylander and Hart (Mandelbulb) and Knighty's
 //! kaleidoscopic IFS (Menger, Sierpinski).
 
-use super::real::{Real, V3, v3};
+use crate::math::{Real, V3, escape_radius, mandelbulb_radius, v3};
 
 /// Exact distance to a sphere of radius `r` at the origin.
 #[must_use]
@@ -130,14 +130,6 @@ pub struct Estimate<T> {
     pub trap: T,
 }
 
-/// The radius beyond which a Mandelbulb orbit escapes: `bailout`, or less
-/// where `r^power` would pass [`Real::magnitude_cap`] (`1e18`). Computed in
-/// `f64`; code generation emits the same value as a literal.
-#[must_use]
-pub fn escape_radius(power: f64, bailout: f64) -> f64 {
-    bailout.min(<f64 as Real>::magnitude_cap().powf(1.0 / power))
-}
-
 /// `x^n` by binary exponentiation (the same multiplications as the OpenCL
 /// twin `pow_int`).
 #[must_use]
@@ -169,29 +161,6 @@ fn angle_power<T: Real>(c: T, s: T, n: u32) -> (T, T) {
         e >>= 1;
     }
     (rc, rs)
-}
-
-/// The radius `2^(1 / (power - 1))` of the ball that holds the Mandelbulb
-/// of `power`, and every point where its estimate is at most 0, for any
-/// number of iterations and any bailout.
-///
-/// Proof. The power map scales lengths exactly, `|z^n| = |z|^n` (it is a
-/// unit direction times `r^n`). Let `|p| > rho`, so `|p|^(n-1) > 2`. If
-/// `|z_k| >= |p|` (true for `z_0 = p`), then `|z_(k+1)| = |z_k^n + p| >=
-/// |z_k|^n - |p| >= |z_k| (|z_k|^(n-1) - 1) >= |z_k| (|p|^(n-1) - 1) >
-/// |z_k|`. So the orbit grows strictly (and without bound): it never stays
-/// bounded, and wherever the iteration stops (escaped or not) `|z| > |p| >
-/// 1`, so `ln |z| > 0` and the estimate is positive. Hence for `|p| > rho`
-/// the distance to the set is at least `|p| - rho`.
-///
-/// ```
-/// use fractal_sdf::cpu::sdf::mandelbulb_radius;
-/// assert_eq!(mandelbulb_radius(2.0_f64), 2.0);
-/// assert!((mandelbulb_radius(8.0_f64) - 1.104).abs() < 1e-3);
-/// ```
-#[must_use]
-pub fn mandelbulb_radius<T: Real>(power: T) -> T {
-    T::of(2.0).powf(T::one() / (power - T::one()))
 }
 
 /// Beyond `MANDELBULB_FAR_FIELD` times [`mandelbulb_radius`] the

@@ -18,9 +18,10 @@
 //!
 //! # The program contract
 //!
-//! A program is one OpenCL C 1.2 source ([`ProgramSource`]): a header, the
-//! scene's distance functions, then `kernels/march.cl` (the marcher and
-//! shading, kernel `render_tile`). The header defines:
+//! A program is one OpenCL C 1.2 source
+//! ([`KernelSource`](crate::codegen::KernelSource)): a header, the scene's
+//! distance functions, then `kernels/march.cl` (the marcher and shading,
+//! kernel `render_tile`). The header defines:
 //!
 //! - `real`, `real2`, `real3`, `real4` (`float*` or `double*`, the latter
 //!   with `#pragma OPENCL EXTENSION cl_khr_fp64 : enable`), and `R(x)`, which
@@ -32,7 +33,12 @@
 //!   [`Effects`](crate::quality::Effects);
 //! - only for the effects that are on: `ENABLE_AO` with `AO_SAMPLES` and
 //!   `AO_DISTANCE`; `ENABLE_SHADOWS` with `SHADOW_STEPS`; `ENABLE_GLOW` with
-//!   `GLOW_COLOR` and `GLOW_STRENGTH`; `ENABLE_FOG` with `FOG_DENSITY`.
+//!   `GLOW_COLOR` and `GLOW_STRENGTH`; `ENABLE_FOG` with `FOG_DENSITY`;
+//! - the kernel interface from
+//!   [`codegen::interface`](crate::codegen::interface): the argument lists
+//!   `RENDER_TILE_ARGS` and `EVAL_POINTS_ARGS`, the camera buffer's field
+//!   offsets `CAMERA_*` and the light buffer's `LIGHT_*` and
+//!   `LIGHT_STRIDE`.
 //!
 //! and the scene provides
 //!
@@ -59,7 +65,7 @@ pub use aov::Frame;
 pub use device::{DEVICE_ENV, DeviceInfo, DeviceKind, DeviceSelector, devices};
 pub use dispatch::{DEFAULT_TILE_SIZE, MAX_IMAGE_SIDE};
 pub use points::{PointEvaluator, PointSample};
-pub use program::{BuildInfo, ProgramSource, program_builds};
+pub use program::{BuildInfo, program_builds};
 pub use renderer::{RenderOptions, Renderer};
 pub use viewport::Viewport;
 

@@ -7,10 +7,11 @@ use ocl::{Kernel, Queue};
 
 use super::buffer::RealBuffer;
 use super::device::{self, DeviceInfo, DeviceSelector, Selected, opencl};
-use super::program::{self, ProgramSource};
+use super::program;
+use crate::codegen::interface::{EVAL_OUT_STRIDE, EVAL_POINTS, EvalArg};
 use crate::codegen::{self, Options, Target};
 use crate::error::Result;
-use crate::ir::{Ir, ParamValues};
+use crate::ir::{CompiledScene, Ir, ParamValues};
 use crate::quality::{Precision, Quality};
 use crate::scene::Node;
 
@@ -51,15 +52,31 @@ pub struct PointEvaluator {
 }
 
 impl PointEvaluator {
-    /// Generates and builds the evaluation program for `geometry` in
-    /// `precision` on the selected device.
+    /// Lowers `geometry`, then generates and builds its evaluation
+    /// program in `precision` on the selected device.
     ///
     /// # Errors
     /// Validation errors, [`Error::NoPlatform`](crate::Error::NoPlatform),
     /// [`Error::Fp64Unsupported`](crate::Error::Fp64Unsupported),
     /// [`Error::Build`](crate::Error::Build).
     pub fn new(geometry: &Node, precision: Precision, selector: &DeviceSelector) -> Result<Self> {
-        let ir = Ir::lower(geometry)?;
+        Self::from_ir(&Ir::lower(geometry)?, precision, selector)
+    }
+
+    /// The evaluation program for a compiled scene's geometry (nothing is
+    /// lowered again).
+    ///
+    /// # Errors
+    /// As [`PointEvaluator::new`], less validation.
+    pub fn from_compiled(
+        scene: &CompiledScene,
+        precision: Precision,
+        selector: &DeviceSelector,
+    ) -> Result<Self> {
+        Self::from_ir(scene.ir(), precision, selector)
+    }
+
+    fn from_ir(ir: &Ir, precision: Precision, selector: &DeviceSelector) -> Result<Self> {
         let options = Options {
             quality: Quality {
                 precision,
@@ -68,15 +85,10 @@ impl PointEvaluator {
             target: Target::Evaluate,
             ..Options::default()
         };
-        let kernel = codegen::emit_ir(&ir, &options)?;
+        let source = codegen::emit_ir(ir, &options)?;
         let selected = device::select(selector)?;
         let context = program::context(&selected)?;
         let queue = Queue::new(&context, selected.device, None).map_err(opencl)?;
-        let source = ProgramSource {
-            source: kernel.source,
-            precision,
-            origin: kernel.origin,
-        };
         let (program, _, _) = program::build(&selected, &context, &source)?;
         Ok(PointEvaluator {
             selected,
@@ -114,7 +126,7 @@ impl PointEvaluator {
         let q = &self.queue;
         let input = RealBuffer::new(q, self.precision, &packed)?;
         let params = RealBuffer::new(q, self.precision, self.values.as_slice())?;
-        let output = RealBuffer::output(q, self.precision, points.len() * 8)?;
+        let output = RealBuffer::output(q, self.precision, points.len() * EVAL_OUT_STRIDE)?;
         let count = u32::try_from(points.len()).map_err(opencl)?;
         let mut builder = Kernel::builder();
         builder
@@ -122,17 +134,24 @@ impl PointEvaluator {
             .name("eval_points")
             .queue(q.clone())
             .global_work_size(points.len());
-        input.push_arg(&mut builder);
-        params.push_arg(&mut builder);
-        output.push_arg(&mut builder);
-        builder.arg(count);
+        for (arg, _) in EVAL_POINTS {
+            match arg {
+                EvalArg::Points => input.push_arg(&mut builder),
+                EvalArg::Params => params.push_arg(&mut builder),
+                EvalArg::Out => output.push_arg(&mut builder),
+                EvalArg::Count => {
+                    builder.arg(count);
+                }
+            }
+        }
         let kernel = builder.build().map_err(opencl)?;
-        // SAFETY: the kernel reads `count` points and writes 8 reals per
-        // point, exactly the sizes of the buffers bound above.
+        // SAFETY: the kernel reads `count` points and writes
+        // EVAL_OUT_STRIDE reals per point, exactly the sizes of the buffers
+        // bound above.
         unsafe { kernel.enq().map_err(opencl)? };
         let out = output.read()?;
         Ok(out
-            .chunks_exact(8)
+            .chunks_exact(EVAL_OUT_STRIDE)
             .map(|c| PointSample {
                 distance: c[0],
                 shade_distance: c[1],

@@ -6,36 +6,18 @@
 //! Contexts are shared per device because a program belongs to one.
 
 use std::collections::HashMap;
-use std::collections::hash_map::DefaultHasher;
 use std::ffi::CString;
-use std::hash::{Hash, Hasher};
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::{Arc, Mutex, OnceLock, PoisonError};
 use std::time::{Duration, Instant};
 
-use glam::DVec3;
 use ocl::core::{ClDeviceIdPtr, ProgramBuildInfo, ProgramBuildInfoResult};
 use ocl::{Context, Program};
 
 use super::device::{DeviceInfo, Selected, opencl};
+use crate::codegen::KernelSource;
 use crate::error::{Error, Result};
 use crate::quality::Precision;
-
-/// The OpenCL C program for one scene: generated header, distance
-/// functions and `kernels/march.cl` (see [`crate::render`] for the contract
-/// the source must meet).
-#[derive(Debug, Clone, PartialEq)]
-pub struct ProgramSource {
-    /// The complete program text.
-    pub source: String,
-    /// The precision its `real` type stands for; `F64` requires a device
-    /// with `cl_khr_fp64`.
-    pub precision: Precision,
-    /// The point of the scene that is the origin of the program's `DE`
-    /// (zero for a `DE` of world coordinates). The renderer moves the
-    /// camera and the lights by it, in `f64`, before they reach the device.
-    pub origin: DVec3,
-}
 
 /// How a renderer's program was obtained.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -49,7 +31,8 @@ pub struct BuildInfo {
     pub build_time: Duration,
     /// Whether the program came from the process-wide cache.
     pub cached: bool,
-    /// A 64-bit hash of the source, to tell programs apart in logs.
+    /// The source's hash ([`KernelSource::hash`]), to tell programs apart
+    /// in logs.
     pub source_hash: u64,
 }
 
@@ -123,7 +106,7 @@ pub(crate) fn build_options(info: &DeviceInfo) -> String {
 pub(crate) fn build(
     selected: &Selected,
     context: &Context,
-    source: &ProgramSource,
+    source: &KernelSource,
 ) -> Result<(Program, BuildInfo, bool)> {
     if source.precision == Precision::F64 {
         selected.info.require_fp64()?;
@@ -152,14 +135,12 @@ pub(crate) fn build(
             b
         }
     };
-    let mut hasher = DefaultHasher::new();
-    source.source.hash(&mut hasher);
     let info = BuildInfo {
         device: selected.info.label(),
         options,
         build_time: built.build_time,
         cached: !compiled_now,
-        source_hash: hasher.finish(),
+        source_hash: source.hash,
     };
     Ok((built.program, info, compiled_now))
 }

@@ -12,11 +12,12 @@ use super::aov::Frame;
 use super::buffer::RealBuffer;
 use super::device::{self, DeviceInfo, DeviceSelector, Selected, opencl};
 use super::dispatch::{self, DEFAULT_TILE_SIZE, MAX_IMAGE_SIDE};
-use super::program::{self, BuildInfo, ProgramSource};
+use super::program::{self, BuildInfo};
 use super::viewport::{Viewport, pack_lights};
-use crate::codegen;
+use crate::codegen::interface::{RENDER_TILE, RenderArg, camera};
+use crate::codegen::{self, KernelSource};
 use crate::error::{Error, Result};
-use crate::ir::{Ir, ParamValues};
+use crate::ir::{CompiledScene, ParamValues};
 use crate::quality::{Effects, Precision, Quality};
 use crate::scene::{Camera, Light, Scene};
 use crate::timing::FrameTiming;
@@ -47,35 +48,15 @@ impl Default for RenderOptions {
     }
 }
 
-/// The kernel's argument positions (see `render_tile` in `march.cl`).
-mod arg {
-    pub const PARAMS: u32 = 0;
-    pub const CAMERA: u32 = 1;
-    pub const LIGHTS: u32 = 2;
-    pub const LIGHT_COUNT: u32 = 3;
-    pub const WIDTH: u32 = 4;
-    pub const HEIGHT: u32 = 5;
-    pub const X0: u32 = 6;
-    pub const Y0: u32 = 7;
-    pub const TILE_W: u32 = 8;
-    pub const TILE_H: u32 = 9;
-    pub const WRITE_AOVS: u32 = 10;
-    pub const RGBA: u32 = 11;
-    pub const DEPTH: u32 = 12;
-    pub const HIT: u32 = 13;
-    pub const NORMALS: u32 = 14;
-    pub const STEPS: u32 = 15;
-    pub const EVALUATIONS: u32 = 16;
-}
-
 const KERNEL_NAME: &str = "render_tile";
 
 /// Renders one scene on one OpenCL device.
 ///
-/// The program is compiled once (or taken from the process-wide cache);
-/// changing dynamic parameters, the camera or the lights between frames
-/// only rewrites small buffers. Changing the quality or effects generates
-/// a new program.
+/// It is built from a [`CompiledScene`]: the scene is validated and lowered
+/// once, and the program generated and compiled once (or taken from the
+/// process-wide cache). Changing dynamic parameters, the camera or the
+/// lights between frames only rewrites small buffers and never runs code
+/// generation; changing the quality or effects generates a new program.
 ///
 /// ```no_run
 /// use fractal_sdf::prelude::*;
@@ -95,10 +76,11 @@ pub struct Renderer {
     selected: Selected,
     context: Context,
     queue: Queue,
-    scene: Scene,
+    scene: CompiledScene,
     options: RenderOptions,
     values: ParamValues,
-    source: ProgramSource,
+    functions: SceneFunctions,
+    source: KernelSource,
     build: BuildInfo,
     builds: u64,
     kernel: Kernel,
@@ -108,19 +90,31 @@ pub struct Renderer {
     timing: Option<FrameTiming>,
 }
 
-/// Generates the program for a scene. This is the one place that turns a
-/// scene into OpenCL C.
-fn generate(scene: &Scene, options: &RenderOptions) -> Result<ProgramSource> {
+/// Where a renderer's `DE` and `DE_shade` come from.
+#[derive(Debug, Clone)]
+enum SceneFunctions {
+    /// Code generation, from the compiled scene.
+    Generated,
+    /// Hand-written functions, kept through quality and effect changes.
+    HandWritten(String),
+}
+
+/// The program for a scene's functions and options. This is the one place
+/// the renderer runs code generation.
+fn generate(
+    scene: &CompiledScene,
+    functions: &SceneFunctions,
+    options: &RenderOptions,
+) -> Result<KernelSource> {
     let options = codegen::Options {
         quality: options.quality,
         effects: options.effects,
         target: codegen::Target::Render,
     };
-    codegen::emit(scene, &options).map(|k| ProgramSource {
-        source: k.source,
-        precision: k.precision,
-        origin: k.origin,
-    })
+    match functions {
+        SceneFunctions::Generated => codegen::emit(scene, &options),
+        SceneFunctions::HandWritten(f) => codegen::emit_handwritten(f, &options),
+    }
 }
 
 impl Renderer {
@@ -139,36 +133,62 @@ impl Renderer {
         )
     }
 
-    /// A renderer for `scene` with explicit options.
+    /// A renderer for `scene` with explicit options: compiles the scene
+    /// and calls [`Renderer::from_compiled`].
     ///
     /// # Errors
-    /// Scene, quality and effects validation errors; [`Error::NoPlatform`],
-    /// [`Error::NoDevice`]; [`Error::Fp64Unsupported`] for `F64` on a device
-    /// without it; [`Error::Build`] with the compiler log and the source.
+    /// See [`Renderer::from_compiled`].
     pub fn with_options(scene: &Scene, options: &RenderOptions) -> Result<Self> {
-        validate(scene, options)?;
-        let source = generate(scene, options)?;
-        Self::with_source(scene, options, source)
+        Self::from_compiled(scene.compile()?, options)
     }
 
-    /// A renderer running a given program for `scene`: the source must meet
-    /// the contract in [`crate::render`]. The scene supplies the dynamic
-    /// parameters, the camera and the lights.
+    /// A renderer for a compiled scene (nothing is validated or lowered
+    /// again).
     ///
     /// # Errors
-    /// As [`Renderer::with_options`].
-    pub fn with_source(
-        scene: &Scene,
+    /// Quality, effects and [`Error::TileSize`] errors;
+    /// [`Error::NoPlatform`], [`Error::NoDevice`];
+    /// [`Error::Fp64Unsupported`] for `F64` on a device without it;
+    /// [`Error::Build`] with the compiler log and the source.
+    pub fn from_compiled(scene: CompiledScene, options: &RenderOptions) -> Result<Self> {
+        Self::build(scene, options, SceneFunctions::Generated)
+    }
+
+    /// A renderer running hand-written scene functions: `scene_functions`
+    /// defines `DE` and `DE_shade` as the contract in [`crate::render`]
+    /// says, and the program around them is generated for the options (see
+    /// [`codegen::emit_handwritten`]); quality and effect changes keep
+    /// them. The scene supplies the dynamic parameters, the camera and the
+    /// lights. For experiments and for measuring generated code against
+    /// hand-written code.
+    ///
+    /// # Errors
+    /// As [`Renderer::from_compiled`].
+    pub fn with_scene_functions(
+        scene: CompiledScene,
         options: &RenderOptions,
-        source: ProgramSource,
+        scene_functions: impl Into<String>,
     ) -> Result<Self> {
-        validate(scene, options)?;
-        let geometry = scene.geometry.as_ref().ok_or(Error::EmptyScene)?;
-        let values = Ir::lower(geometry)?.default_values();
+        Self::build(
+            scene,
+            options,
+            SceneFunctions::HandWritten(scene_functions.into()),
+        )
+    }
+
+    fn build(
+        scene: CompiledScene,
+        options: &RenderOptions,
+        functions: SceneFunctions,
+    ) -> Result<Self> {
+        validate(options)?;
+        check_light_count(scene.lights())?;
+        let source = generate(&scene, &functions, options)?;
+        let values = scene.default_values();
         let selected = device::select(&options.device)?;
         let context = program::context(&selected)?;
         let queue = profiling_queue(&context, &selected)?;
-        let inputs = Inputs::new(&queue, source.precision, &values, &scene.lights)?;
+        let inputs = Inputs::new(&queue, source.precision, &values, scene.lights())?;
         let targets = Targets::new(&queue, 1, 1, true)?;
         let (program, build, compiled) = program::build(&selected, &context, &source)?;
         let kernel = make_kernel(&program, &queue, &inputs, &targets)?;
@@ -177,9 +197,10 @@ impl Renderer {
             selected,
             context,
             queue,
-            scene: scene.clone(),
+            scene,
             options: options.clone(),
             values,
+            functions,
             source,
             build,
             builds: u64::from(compiled),
@@ -266,7 +287,9 @@ impl Renderer {
     /// Sets a dynamic parameter for the next frames (no recompilation).
     ///
     /// # Errors
-    /// [`Error::UnknownParam`], or the parameter's range error.
+    /// [`Error::UnknownParam`], or the error a baked value would get: the
+    /// parameter's own rule, or a rule relating it to other parameters
+    /// (see [`ParamValues::set`]).
     pub fn set_param(&mut self, name: &str, value: f64) -> Result<()> {
         self.values.set(name, value)
     }
@@ -282,40 +305,38 @@ impl Renderer {
     /// # Errors
     /// [`Error::Camera`] if the camera is degenerate.
     pub fn set_camera(&mut self, camera: Camera) -> Result<()> {
-        camera.validate()?;
-        self.scene.camera = camera;
-        Ok(())
+        self.scene.set_camera(camera)
     }
 
     /// The camera.
     #[must_use]
     pub fn camera(&self) -> &Camera {
-        &self.scene.camera
+        self.scene.camera()
     }
 
     /// Replaces the lights, any number of them. The lights and their count
-    /// are kernel arguments, so this recompiles nothing — unless the
-    /// program generator specialises on the lights, in which case the
-    /// program for the new set is built (or taken from the cache).
+    /// are kernel arguments: this never generates or compiles code.
     ///
     /// # Errors
-    /// The first invalid light, as [`Scene::validate`] reports it; build
-    /// errors as for [`Renderer::with_options`].
+    /// The first invalid light, as [`Scene::compile`] reports it;
+    /// [`Error::TooManyLights`].
     pub fn set_lights(&mut self, lights: impl IntoIterator<Item = Light>) -> Result<()> {
-        let scene = self.scene.clone().with_lights(lights);
-        scene.validate()?;
-        let source = generate(&scene, &self.options)?;
-        self.scene = scene;
-        if source != self.source {
-            self.load(source)?;
-        }
-        Ok(())
+        let lights: Vec<Light> = lights.into_iter().collect();
+        check_light_count(&lights)?;
+        self.scene.set_lights(lights)
     }
 
     /// The lights.
     #[must_use]
     pub fn lights(&self) -> &[Light] {
-        &self.scene.lights
+        self.scene.lights()
+    }
+
+    /// The compiled scene this renderer draws, with the current camera and
+    /// lights.
+    #[must_use]
+    pub fn scene(&self) -> &CompiledScene {
+        &self.scene
     }
 
     /// Changes the quality: a new program (compiled unless cached).
@@ -370,7 +391,7 @@ impl Renderer {
 
     /// The OpenCL C source of the current program.
     #[must_use]
-    pub fn source(&self) -> &ProgramSource {
+    pub fn source(&self) -> &KernelSource {
         &self.source
     }
 
@@ -381,7 +402,7 @@ impl Renderer {
     /// As [`Viewport::new`].
     pub fn viewport(&self, width: u32, height: u32) -> Result<Viewport> {
         Viewport::in_frame(
-            &self.scene.camera,
+            self.scene.camera(),
             width,
             height,
             self.source.precision,
@@ -390,8 +411,8 @@ impl Renderer {
     }
 
     fn reprogram(&mut self, options: RenderOptions) -> Result<()> {
-        validate(&self.scene, &options)?;
-        let source = generate(&self.scene, &options)?;
+        validate(&options)?;
+        let source = generate(&self.scene, &self.functions, &options)?;
         self.load(source)?;
         self.options = options;
         Ok(())
@@ -399,7 +420,7 @@ impl Renderer {
 
     /// Switches to the program `source` (built now or taken from the
     /// cache).
-    fn load(&mut self, source: ProgramSource) -> Result<()> {
+    fn load(&mut self, source: KernelSource) -> Result<()> {
         let (program, build, compiled) = program::build(&self.selected, &self.context, &source)?;
         let precision_changed = source.precision != self.source.precision;
         if precision_changed {
@@ -407,7 +428,7 @@ impl Renderer {
                 &self.queue,
                 source.precision,
                 &self.values,
-                &self.scene.lights,
+                self.scene.lights(),
             )?;
         }
         self.kernel = make_kernel(&program, &self.queue, &self.inputs, &self.targets)?;
@@ -446,34 +467,28 @@ impl Renderer {
             &self.kernel,
             &view,
             &self.values,
-            &self.scene.lights,
+            self.scene.lights(),
             self.source.origin,
         )?;
         let k = &self.kernel;
         let t = &self.targets;
-        let set = |i: u32, v: i32| k.set_arg(i, v).map_err(opencl);
+        let set = |a: RenderArg, v: i32| k.set_arg(a.index(), v).map_err(opencl);
         #[allow(clippy::cast_possible_wrap)] // sizes are at most MAX_IMAGE_SIDE
         {
-            set(arg::WIDTH, width as i32)?;
-            set(arg::HEIGHT, height as i32)?;
+            set(RenderArg::Width, width as i32)?;
+            set(RenderArg::Height, height as i32)?;
         }
-        set(arg::WRITE_AOVS, i32::from(aovs))?;
-        k.set_arg(arg::RGBA, &t.rgba).map_err(opencl)?;
-        k.set_arg(arg::DEPTH, &t.depth).map_err(opencl)?;
-        k.set_arg(arg::HIT, &t.hit).map_err(opencl)?;
-        k.set_arg(arg::NORMALS, &t.normals).map_err(opencl)?;
-        k.set_arg(arg::STEPS, &t.steps).map_err(opencl)?;
-        k.set_arg(arg::EVALUATIONS, &t.evaluations)
-            .map_err(opencl)?;
+        set(RenderArg::WriteAovs, i32::from(aovs))?;
+        t.bind(k)?;
         let launched = Instant::now();
         let mut events = Vec::new();
         for tile in dispatch::tiles(width, height, self.options.tile_size) {
             #[allow(clippy::cast_possible_wrap)]
             {
-                set(arg::X0, tile.x as i32)?;
-                set(arg::Y0, tile.y as i32)?;
-                set(arg::TILE_W, tile.width as i32)?;
-                set(arg::TILE_H, tile.height as i32)?;
+                set(RenderArg::X0, tile.x as i32)?;
+                set(RenderArg::Y0, tile.y as i32)?;
+                set(RenderArg::TileWidth, tile.width as i32)?;
+                set(RenderArg::TileHeight, tile.height as i32)?;
             }
             let global = dispatch::global_size(tile, self.local);
             // SAFETY: every buffer argument is alive in `self`, and the
@@ -555,15 +570,24 @@ fn check_device_memory(info: &DeviceInfo, width: u32, height: u32, aovs: bool) -
     Ok(())
 }
 
-fn validate(scene: &Scene, options: &RenderOptions) -> Result<()> {
-    scene.validate()?;
+fn validate(options: &RenderOptions) -> Result<()> {
     options.quality.validate()?;
     options.effects.validate()?;
     if options.tile_size == 0 {
-        return Err(Error::Quality {
-            setting: "tile_size",
-            value: 0.0,
-            expected: ">= 1".into(),
+        return Err(Error::TileSize {
+            value: options.tile_size,
+        });
+    }
+    Ok(())
+}
+
+/// The light count is an `int` kernel argument.
+fn check_light_count(lights: &[Light]) -> Result<()> {
+    const MAX: usize = i32::MAX as usize;
+    if lights.len() > MAX {
+        return Err(Error::TooManyLights {
+            count: lights.len(),
+            max: MAX,
         });
     }
     Ok(())
@@ -614,21 +638,47 @@ fn host_vec<T: Default + Clone>(width: u32, height: u32, per_pixel: usize) -> Re
     Ok(v)
 }
 
+/// The kernel with every argument bound: buffers to the current ones,
+/// scalars to 0 until a frame sets them. Positions come from
+/// [`RENDER_TILE`], the one list of `render_tile`'s arguments.
 fn make_kernel(program: &Program, queue: &Queue, inputs: &Inputs, t: &Targets) -> Result<Kernel> {
     let mut b = Kernel::builder();
     b.program(program).name(KERNEL_NAME).queue(queue.clone());
-    inputs.params.push_arg(&mut b);
-    inputs.camera.push_arg(&mut b);
-    inputs.lights.push_arg(&mut b);
-    for _ in arg::LIGHT_COUNT..=arg::WRITE_AOVS {
-        b.arg(0i32);
+    for (arg, _) in RENDER_TILE {
+        match arg {
+            RenderArg::Params => inputs.params.push_arg(&mut b),
+            RenderArg::Camera => inputs.camera.push_arg(&mut b),
+            RenderArg::Lights => inputs.lights.push_arg(&mut b),
+            RenderArg::Rgba => {
+                b.arg(&t.rgba);
+            }
+            RenderArg::Depth => {
+                b.arg(&t.depth);
+            }
+            RenderArg::Hit => {
+                b.arg(&t.hit);
+            }
+            RenderArg::Normals => {
+                b.arg(&t.normals);
+            }
+            RenderArg::Steps => {
+                b.arg(&t.steps);
+            }
+            RenderArg::Evaluations => {
+                b.arg(&t.evaluations);
+            }
+            RenderArg::LightCount
+            | RenderArg::Width
+            | RenderArg::Height
+            | RenderArg::X0
+            | RenderArg::Y0
+            | RenderArg::TileWidth
+            | RenderArg::TileHeight
+            | RenderArg::WriteAovs => {
+                b.arg(0i32);
+            }
+        }
     }
-    b.arg(&t.rgba)
-        .arg(&t.depth)
-        .arg(&t.hit)
-        .arg(&t.normals)
-        .arg(&t.steps)
-        .arg(&t.evaluations);
     b.build().map_err(opencl)
 }
 
@@ -664,7 +714,7 @@ impl Inputs {
         Ok(Inputs {
             precision,
             params: RealBuffer::new(queue, precision, values.as_slice())?,
-            camera: RealBuffer::new(queue, precision, &[0.0; super::viewport::CAMERA_LEN])?,
+            camera: RealBuffer::new(queue, precision, &[0.0; camera::LEN])?,
             lights: RealBuffer::new(queue, precision, &pack_lights(lights, DVec3::ZERO))?,
         })
     }
@@ -688,12 +738,15 @@ impl Inputs {
         } else {
             self.lights = RealBuffer::new(queue, self.precision, &packed)?;
         }
-        self.params.set_arg(kernel, arg::PARAMS)?;
-        self.camera.set_arg(kernel, arg::CAMERA)?;
-        self.lights.set_arg(kernel, arg::LIGHTS)?;
-        let count =
-            i32::try_from(lights.len()).map_err(|_| Error::OpenCl("too many lights".into()))?;
-        kernel.set_arg(arg::LIGHT_COUNT, count).map_err(opencl)
+        self.params.set_arg(kernel, RenderArg::Params.index())?;
+        self.camera.set_arg(kernel, RenderArg::Camera.index())?;
+        self.lights.set_arg(kernel, RenderArg::Lights.index())?;
+        check_light_count(lights)?;
+        #[allow(clippy::cast_possible_truncation, clippy::cast_possible_wrap)] // checked above
+        let count = lights.len() as i32;
+        kernel
+            .set_arg(RenderArg::LightCount.index(), count)
+            .map_err(opencl)
     }
 }
 
@@ -734,6 +787,22 @@ impl Targets {
         let pixels = u64::from(width) * u64::from(height);
         let aov = if aovs { pixels } else { 1 };
         vec![pixels * 4, aov * 4, aov, aov * 12, aov * 4, aov * 4]
+    }
+
+    /// Binds the output buffers to their arguments.
+    fn bind(&self, k: &Kernel) -> Result<()> {
+        k.set_arg(RenderArg::Rgba.index(), &self.rgba)
+            .map_err(opencl)?;
+        k.set_arg(RenderArg::Depth.index(), &self.depth)
+            .map_err(opencl)?;
+        k.set_arg(RenderArg::Hit.index(), &self.hit)
+            .map_err(opencl)?;
+        k.set_arg(RenderArg::Normals.index(), &self.normals)
+            .map_err(opencl)?;
+        k.set_arg(RenderArg::Steps.index(), &self.steps)
+            .map_err(opencl)?;
+        k.set_arg(RenderArg::Evaluations.index(), &self.evaluations)
+            .map_err(opencl)
     }
 
     fn fits(&self, width: u32, height: u32, aovs: bool) -> bool {

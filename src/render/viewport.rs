@@ -1,20 +1,17 @@
 //! The camera as the kernel sees it: the ray through each pixel and the
 //! size of a pixel at each distance, plus the packed light list.
 //!
-//! Nothing here touches OpenCL; the layouts match the comment at the top of
-//! `kernels/march.cl`.
+//! Nothing here touches OpenCL; the buffers are packed from the layouts in
+//! [`codegen::interface`](crate::codegen::interface), which the kernel
+//! reads through the header's `#define`s.
 
 use glam::DVec3;
 
+use crate::codegen::interface::{camera, light, put};
 use crate::cpu::{MarchSettings, Ray};
 use crate::error::{Error, Result};
 use crate::quality::{Precision, Quality};
 use crate::scene::{Camera, Light, LightSource, Projection};
-
-/// Reals in the packed camera buffer.
-pub(crate) const CAMERA_LEN: usize = 20;
-/// Reals per light in the packed light buffer.
-pub(crate) const LIGHT_LEN: usize = 8;
 
 /// A camera fixed to an image size: the rays the kernel traces and the
 /// pixel footprint that scales its hit threshold.
@@ -72,7 +69,7 @@ impl Viewport {
 
     /// As [`Viewport::new`] for a program whose positions are relative to
     /// the scene point `origin` (a
-    /// [`ProgramSource::origin`](crate::render::ProgramSource::origin)):
+    /// [`KernelSource::origin`](crate::codegen::KernelSource::origin)):
     /// the rounding floor follows the camera's distance from `origin`, not
     /// from the world's origin. Rays stay in world coordinates.
     ///
@@ -167,17 +164,17 @@ impl Viewport {
         self.footprint_base + self.footprint_per_unit * t
     }
 
-    /// The CPU reference's settings for the same march as the kernel: the
-    /// surface lies `quality.detail` pixel footprints out, and hits are
-    /// located to `quality.hit_epsilon` footprints.
+    /// The CPU reference's settings for the same march as the kernel: this
+    /// viewport's pixel footprints, and the quality's march knobs.
     #[must_use]
     pub fn march_settings(&self, quality: &Quality) -> MarchSettings {
         MarchSettings {
             max_steps: quality.max_steps,
             max_distance: quality.max_distance,
-            epsilon: quality.detail * self.footprint_base,
-            epsilon_per_unit: quality.detail * self.footprint_per_unit,
-            refine: quality.hit_epsilon / quality.detail,
+            footprint_base: self.footprint_base,
+            footprint_per_unit: self.footprint_per_unit,
+            detail: quality.detail,
+            hit_epsilon: quality.hit_epsilon,
             over_relaxation: quality.over_relaxation,
         }
     }
@@ -188,47 +185,50 @@ impl Viewport {
         (self.width, self.height)
     }
 
-    /// The kernel's camera buffer (layout in `kernels/march.cl`), with the
-    /// camera moved into a frame whose origin is the scene point `origin`.
-    /// The subtraction happens here in `f64`, so a camera near a distant
-    /// origin reaches an `F32` kernel with small, exact coordinates.
-    pub(crate) fn pack(&self, origin: DVec3) -> [f64; CAMERA_LEN] {
-        let mut c = [0.0; CAMERA_LEN];
-        let put = |c: &mut [f64; CAMERA_LEN], at: usize, v: DVec3, w: f64| {
-            c[at..at + 4].copy_from_slice(&[v.x, v.y, v.z, w]);
-        };
+    /// The kernel's camera buffer ([`camera`] layout), with the camera
+    /// moved into a frame whose origin is the scene point `origin`. The
+    /// subtraction happens here in `f64`, so a camera near a distant origin
+    /// reaches an `F32` kernel with small, exact coordinates.
+    pub(crate) fn pack(&self, origin: DVec3) -> [f64; camera::LEN] {
+        let mut c = [0.0; camera::LEN];
+        put(&mut c, camera::ORIGIN, &(self.origin - origin).to_array());
         put(
             &mut c,
-            0,
-            self.origin - origin,
-            f64::from(u8::from(self.orthographic)),
+            camera::ORTHOGRAPHIC,
+            &[f64::from(u8::from(self.orthographic))],
         );
-        put(&mut c, 4, self.right, self.half_w);
-        put(&mut c, 8, self.up, self.half_h);
-        put(&mut c, 12, self.forward, 0.0);
-        c[16] = self.footprint_base;
-        c[17] = self.footprint_per_unit;
+        put(&mut c, camera::RIGHT, &self.right.to_array());
+        put(&mut c, camera::HALF_WIDTH, &[self.half_w]);
+        put(&mut c, camera::UP, &self.up.to_array());
+        put(&mut c, camera::HALF_HEIGHT, &[self.half_h]);
+        put(&mut c, camera::FORWARD, &self.forward.to_array());
+        put(&mut c, camera::FOOTPRINT_BASE, &[self.footprint_base]);
+        put(
+            &mut c,
+            camera::FOOTPRINT_PER_UNIT,
+            &[self.footprint_per_unit],
+        );
         c
     }
 }
 
-/// The kernel's light buffer (layout in `kernels/march.cl`), point lights
-/// moved into the frame whose origin is the scene point `origin` (as
+/// The kernel's light buffer ([`light`] layout), point lights moved into
+/// the frame whose origin is the scene point `origin` (as
 /// [`Viewport::pack`]); at least one (unused) entry so the buffer is never
 /// empty.
 pub(crate) fn pack_lights(lights: &[Light], origin: DVec3) -> Vec<f64> {
-    let mut out = Vec::with_capacity(LIGHT_LEN * lights.len().max(1));
-    for light in lights {
-        let (v, kind) = match light.source {
-            LightSource::Directional { direction } => (direction.normalize(), 0.0),
-            LightSource::Point { position } => (position - origin, 1.0),
+    let mut out = vec![0.0; light::STRIDE * lights.len().max(1)];
+    for (entry, l) in out.chunks_exact_mut(light::STRIDE).zip(lights) {
+        let (v, kind) = match l.source {
+            LightSource::Directional { direction } => {
+                (direction.normalize(), light::KIND_DIRECTIONAL)
+            }
+            LightSource::Point { position } => (position - origin, light::KIND_POINT),
         };
-        let radiance = light.color * light.intensity;
-        out.extend_from_slice(&[v.x, v.y, v.z, kind]);
-        out.extend_from_slice(&[radiance.x, radiance.y, radiance.z, light.softness]);
-    }
-    if out.is_empty() {
-        out.resize(LIGHT_LEN, 0.0);
+        put(entry, light::POSITION, &v.to_array());
+        put(entry, light::KIND, &[kind]);
+        put(entry, light::RADIANCE, &(l.color * l.intensity).to_array());
+        put(entry, light::SOFTNESS, &[l.softness]);
     }
     out
 }
@@ -271,8 +271,11 @@ mod tests {
         assert!(view.footprint(0.0) > 0.0);
         let q = Quality::production();
         let settings = view.march_settings(&q);
-        assert!((settings.epsilon_per_unit - q.detail * fp).abs() < 1e-15);
-        assert!((settings.refine * q.detail - q.hit_epsilon).abs() < 1e-15);
+        assert_eq!(settings.footprint(1.0), view.footprint(1.0));
+        assert_eq!(
+            (settings.detail, settings.hit_epsilon),
+            (q.detail, q.hit_epsilon)
+        );
     }
 
     #[test]
@@ -284,7 +287,7 @@ mod tests {
         assert_eq!(a.direction, b.direction);
         assert!(((a.origin - b.origin).length() - 4.0 * 2f64.sqrt()).abs() < 1e-9);
         assert!((view.footprint(123.0) - 0.1).abs() < 1e-15);
-        assert_eq!(view.pack(DVec3::ZERO)[3], 1.0);
+        assert_eq!(view.pack(DVec3::ZERO)[camera::ORTHOGRAPHIC.offset], 1.0);
     }
 
     #[test]
@@ -300,10 +303,10 @@ mod tests {
             Light::point(dvec3(1.0, 2.0, 3.0)).softness(0.0),
         ];
         let packed = pack_lights(&lights, DVec3::ZERO);
-        assert_eq!(packed.len(), 2 * LIGHT_LEN);
+        assert_eq!(packed.len(), 2 * light::STRIDE);
         assert_eq!(&packed[..8], &[0.0, 1.0, 0.0, 0.0, 2.0, 2.0, 2.0, 0.05]);
         assert_eq!(&packed[8..], &[1.0, 2.0, 3.0, 1.0, 1.0, 1.0, 1.0, 0.0]);
-        assert_eq!(pack_lights(&[], DVec3::ZERO).len(), LIGHT_LEN);
+        assert_eq!(pack_lights(&[], DVec3::ZERO).len(), light::STRIDE);
         // Into a frame far away: point lights move, directions do not.
         let origin = dvec3(1e7, -1e7, 3.0);
         let moved = pack_lights(&lights, origin);

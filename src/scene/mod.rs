@@ -1,8 +1,8 @@
 //! Scenes as typed Rust values: geometry ([`Node`]), lights and a camera.
 //!
-//! Building never fails; [`Scene::validate`] (which every renderer and
-//! code generator calls first) reports the first bad value as a typed
-//! [`Error`] naming the node's path and the parameter.
+//! Building never fails; [`Scene::compile`] validates and lowers a scene
+//! once, reporting the first bad value as a typed [`Error`] naming the
+//! node's path and the parameter.
 
 pub mod build;
 mod custom;
@@ -230,7 +230,8 @@ impl Light {
         self
     }
 
-    fn validate(&self, index: usize) -> Result<()> {
+    /// Checks the light, which is `light[index]` in error messages.
+    pub(crate) fn validate(&self, index: usize) -> Result<()> {
         let node = format!("light[{index}]");
         let vector = |name: &str, v: DVec3, nonzero: bool| -> Result<()> {
             if let Some(bad) = v.to_array().into_iter().find(|c| !c.is_finite()) {
@@ -334,21 +335,5 @@ impl Scene {
     pub fn with_lights(mut self, lights: impl IntoIterator<Item = Light>) -> Self {
         self.lights = lights.into_iter().collect();
         self
-    }
-
-    /// Checks every value in the scene: geometry parameters, camera and
-    /// lights.
-    ///
-    /// # Errors
-    /// The first problem found, as a typed [`Error`] naming the node path and
-    /// the parameter.
-    pub fn validate(&self) -> Result<()> {
-        let geometry = self.geometry.as_ref().ok_or(Error::EmptyScene)?;
-        crate::ir::Ir::lower(geometry)?;
-        self.camera.validate()?;
-        for (i, light) in self.lights.iter().enumerate() {
-            light.validate(i)?;
-        }
-        Ok(())
     }
 }

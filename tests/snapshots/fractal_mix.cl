@@ -22,6 +22,41 @@ typedef float4 real4;
 #define AO_SAMPLES 5
 #define AO_DISTANCE 0.25f
 #define SHADOW_STEPS 96
+#define ENABLE_AO
+#define ENABLE_SHADOWS
+/* The kernel interface (src/codegen/interface.rs). */
+#define RENDER_TILE_ARGS \
+    __global const real* params, \
+    __global const real* camera, \
+    __global const real* lights, \
+    const int light_count, \
+    const int width, \
+    const int height, \
+    const int x0, \
+    const int y0, \
+    const int tile_w, \
+    const int tile_h, \
+    const int write_aovs, \
+    __global uchar4* rgba, \
+    __global float* depth, \
+    __global uchar* hit_mask, \
+    __global float* normals, \
+    __global uint* steps, \
+    __global uint* evaluations
+#define CAMERA_ORIGIN 0
+#define CAMERA_ORTHOGRAPHIC 3
+#define CAMERA_RIGHT 4
+#define CAMERA_HALF_WIDTH 7
+#define CAMERA_UP 8
+#define CAMERA_HALF_HEIGHT 11
+#define CAMERA_FORWARD 12
+#define CAMERA_FOOTPRINT_BASE 15
+#define CAMERA_FOOTPRINT_PER_UNIT 16
+#define LIGHT_POSITION 0
+#define LIGHT_KIND 3
+#define LIGHT_RADIANCE 4
+#define LIGHT_SOFTNESS 7
+#define LIGHT_STRIDE 8
 
 /* ---- sphere ---- */
 real sd_sphere(real3 p, real r) {
@@ -154,45 +189,65 @@ real2 smooth_min(real a, real b, real k) {
 
 /* ---- scene ---- */
 real DE(real3 p0, __global const real* params) {
+    /* .../a:smooth_union/a:smooth_union/a:translate */
     real3 p1 = p0 - (real3)((-1.1f), 0.0f, 0.0f);
+    /* .../a:translate/color/scale */
     real3 p2 = p1 / 0.5f;
+    /* .../color/scale/rotate */
     real3 p3 = (real3)(p2.x, -p2.z, p2.y);
+    /* .../scale/rotate/mandelbulb */
     real t0;
-    real d0 = mandelbulb(p3, params[0], 8, fmin(2.0f, pow(MAGNITUDE_CAP, R(1.0) / params[0])), pow(R(2.0), R(1.0) / (params[0] - R(1.0))), &t0);
+    real d0 = mandelbulb(p3, params[0] /* power */, 8, fmin(2.0f, pow(MAGNITUDE_CAP, R(1.0) / params[0] /* power */)), pow(R(2.0), R(1.0) / (params[0] /* power */ - R(1.0))), &t0);
     real d2 = d0 * 0.5f;
+    /* .../a:smooth_union/a:smooth_union/b:translate */
     real3 p4 = p0 - (real3)(0.0f, 0.0f, (-0.6f));
+    /* .../color/smooth_subtract/a:scale */
     real3 p5 = p4 / 0.45f;
+    /* .../smooth_subtract/a:scale/menger */
     real t5;
     real d5 = menger(p5, 3, 3.0f, &t5);
     real d6 = d5 * 0.45f;
+    /* .../color/smooth_subtract/b:sphere */
     real d7 = sd_sphere(p4, 0.55f);
+    /* .../b:translate/color/smooth_subtract */
     real x8 = -d6;
     real y8 = d7;
     real2 m8 = smooth_min(x8, y8, 0.05f);
     real d8 = -m8.x;
+    /* .../a:smooth_union/a:smooth_union/a:smooth_union */
     real x11 = d2;
     real y11 = d8;
     real2 m11 = smooth_min(x11, y11, 0.1f);
     real d11 = m11.x;
+    /* .../a:smooth_union/a:smooth_union/b:translate */
     real3 p6 = p0 - (real3)(1.1f, 0.0f, 0.0f);
+    /* .../b:translate/color/scale */
     real3 p7 = p6 / 0.5f;
+    /* .../color/scale/julia */
     real t12;
     real d12 = julia(p7, (real4)((-0.2f), 0.6f, 0.2f, 0.2f), 0.0f, 12, 4.0f, &t12);
     real d13 = d12 * 0.5f;
+    /* union/a:smooth_union/a:smooth_union */
     real x16 = d11;
     real y16 = d13;
     real2 m16 = smooth_min(x16, y16, 0.1f);
     real d16 = m16.x;
+    /* union/a:smooth_union/b:translate */
     real3 p8 = p0 - (real3)(0.0f, 0.0f, 0.7f);
+    /* .../b:translate/color/scale */
     real3 p9 = p8 / 0.35f;
+    /* .../color/scale/sierpinski */
     real t17;
     real d17 = sierpinski(p9, 5, 2.0f, &t17);
     real d18 = d17 * 0.35f;
+    /* union/a:smooth_union */
     real x21 = d16;
     real y21 = d18;
     real2 m21 = smooth_min(x21, y21, 0.1f);
     real d21 = m21.x;
+    /* union/b:color/plane */
     real d22 = sd_plane(p0, (real3)(0.0f, 1.0f, 0.0f), 0.55f);
+    /* union */
     real x24 = d21;
     real y24 = d22;
     real d24 = fmin(x24, y24);
@@ -200,540 +255,90 @@ real DE(real3 p0, __global const real* params) {
 }
 
 real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
+    /* .../a:smooth_union/a:smooth_union/a:translate */
     real3 p1 = p0 - (real3)((-1.1f), 0.0f, 0.0f);
+    /* .../a:translate/color/scale */
     real3 p2 = p1 / 0.5f;
+    /* .../color/scale/rotate */
     real3 p3 = (real3)(p2.x, -p2.z, p2.y);
+    /* .../scale/rotate/mandelbulb */
     real t0;
-    real d0 = mandelbulb(p3, params[0], 8, fmin(2.0f, pow(MAGNITUDE_CAP, R(1.0) / params[0])), pow(R(2.0), R(1.0) / (params[0] - R(1.0))), &t0);
-    real3 c0 = DEFAULT_COLOR;
+    real d0 = mandelbulb(p3, params[0] /* power */, 8, fmin(2.0f, pow(MAGNITUDE_CAP, R(1.0) / params[0] /* power */)), pow(R(2.0), R(1.0) / (params[0] /* power */ - R(1.0))), &t0);
     real d2 = d0 * 0.5f;
+    /* .../a:smooth_union/a:translate/color */
     real3 c3 = (real3)(0.9f, 0.55f, 0.3f);
+    /* .../a:smooth_union/a:smooth_union/b:translate */
     real3 p4 = p0 - (real3)(0.0f, 0.0f, (-0.6f));
+    /* .../color/smooth_subtract/a:scale */
     real3 p5 = p4 / 0.45f;
+    /* .../smooth_subtract/a:scale/menger */
     real t5;
     real d5 = menger(p5, 3, 3.0f, &t5);
-    real3 c5 = DEFAULT_COLOR;
     real d6 = d5 * 0.45f;
+    /* .../color/smooth_subtract/b:sphere */
     real d7 = sd_sphere(p4, 0.55f);
-    real3 c7 = DEFAULT_COLOR;
-    real t7 = R(1.0);
+    /* .../b:translate/color/smooth_subtract */
     real x8 = -d6;
     real y8 = d7;
     real2 m8 = smooth_min(x8, y8, 0.05f);
     real d8 = -m8.x;
-    real3 c8 = x8 < y8 ? mix(c5, c7, m8.y) : mix(c7, c5, m8.y);
-    real t8 = x8 < y8 ? mix(t5, t7, m8.y) : mix(t7, t5, m8.y);
+    real t8 = x8 < y8 ? mix(t5, R(1.0), m8.y) : mix(R(1.0), t5, m8.y);
+    /* .../a:smooth_union/b:translate/color */
     real3 c9 = (real3)(0.8f, 0.8f, 0.75f);
+    /* .../a:smooth_union/a:smooth_union/a:smooth_union */
     real x11 = d2;
     real y11 = d8;
     real2 m11 = smooth_min(x11, y11, 0.1f);
     real d11 = m11.x;
     real3 c11 = x11 < y11 ? mix(c3, c9, m11.y) : mix(c9, c3, m11.y);
     real t11 = x11 < y11 ? mix(t0, t8, m11.y) : mix(t8, t0, m11.y);
+    /* .../a:smooth_union/a:smooth_union/b:translate */
     real3 p6 = p0 - (real3)(1.1f, 0.0f, 0.0f);
+    /* .../b:translate/color/scale */
     real3 p7 = p6 / 0.5f;
+    /* .../color/scale/julia */
     real t12;
     real d12 = julia(p7, (real4)((-0.2f), 0.6f, 0.2f, 0.2f), 0.0f, 12, 4.0f, &t12);
-    real3 c12 = DEFAULT_COLOR;
     real d13 = d12 * 0.5f;
+    /* .../a:smooth_union/b:translate/color */
     real3 c14 = (real3)(0.4f, 0.7f, 0.95f);
+    /* union/a:smooth_union/a:smooth_union */
     real x16 = d11;
     real y16 = d13;
     real2 m16 = smooth_min(x16, y16, 0.1f);
     real d16 = m16.x;
     real3 c16 = x16 < y16 ? mix(c11, c14, m16.y) : mix(c14, c11, m16.y);
     real t16 = x16 < y16 ? mix(t11, t12, m16.y) : mix(t12, t11, m16.y);
+    /* union/a:smooth_union/b:translate */
     real3 p8 = p0 - (real3)(0.0f, 0.0f, 0.7f);
+    /* .../b:translate/color/scale */
     real3 p9 = p8 / 0.35f;
+    /* .../color/scale/sierpinski */
     real t17;
     real d17 = sierpinski(p9, 5, 2.0f, &t17);
-    real3 c17 = DEFAULT_COLOR;
     real d18 = d17 * 0.35f;
+    /* .../a:smooth_union/b:translate/color */
     real3 c19 = (real3)(0.95f, 0.8f, 0.4f);
+    /* union/a:smooth_union */
     real x21 = d16;
     real y21 = d18;
     real2 m21 = smooth_min(x21, y21, 0.1f);
     real d21 = m21.x;
     real3 c21 = x21 < y21 ? mix(c16, c19, m21.y) : mix(c19, c16, m21.y);
     real t21 = x21 < y21 ? mix(t16, t17, m21.y) : mix(t17, t16, m21.y);
+    /* union/b:color/plane */
     real d22 = sd_plane(p0, (real3)(0.0f, 1.0f, 0.0f), 0.55f);
-    real3 c22 = DEFAULT_COLOR;
-    real t22 = R(1.0);
+    /* union/b:color */
     real3 c23 = (real3)(0.55f, 0.55f, 0.6f);
+    /* union */
     real x24 = d21;
     real y24 = d22;
     real d24 = fmin(x24, y24);
     real3 c24 = x24 < y24 ? c21 : c23;
-    real t24 = x24 < y24 ? t21 : t22;
+    real t24 = x24 < y24 ? t21 : R(1.0);
     *color = c24;
     *trap = t24;
     return d24;
 }
 
-// march.cl — the reusable sphere tracer and shading.
-//
-// Appended after the generated header and the scene's distance functions.
-// It uses only:
-//   types   real, real2, real3, real4 and the literal macro R(x)
-//   consts  REAL_TINY MAX_STEPS MAX_DISTANCE DETAIL HIT_EPSILON
-//           NORMAL_EPSILON OVER_RELAXATION SUPERSAMPLING GAMMA SKY_TOP
-//           SKY_BOTTOM
-//   scene   real DE(real3 p, __global const real* params)
-//           real DE_shade(real3 p, __global const real* params,
-//                         real3* color, real* trap)
-//   effects: the code of each effect (ambient occlusion, shadows, glow,
-//           fog) sits in a conditional block named ENABLE_<effect>, with
-//           its constants defined by the header only when it is on. Code
-//           generation resolves these blocks itself and leaves out every
-//           effect that is off, so they are the only preprocessor
-//           conditionals allowed in this file.
-//
-// Everything else arrives at run time, so moving the camera or the lights
-// and changing dynamic parameters never rebuilds the program:
-//
-// Positions (the camera's origin, point lights) are relative to the
-// program's origin, the scene's outermost translation, which the host
-// subtracts in f64; DE takes points in the same frame.
-//
-// camera: 20 reals
-//   [0..2]  origin          [3]  1 for orthographic, 0 for perspective
-//   [4..6]  right (unit)    [7]  half the image width at unit distance
-//                                (orthographic: in scene units)
-//   [8..10] up (unit)       [11] half the image height, likewise
-//   [12..14] forward (unit) [15] unused
-//   [16] footprint_base  [17] footprint_per_unit
-//        A pixel is footprint_base + footprint_per_unit * t scene units
-//        wide at distance t along a ray. Perspective cameras have a
-//        per-unit term and a tiny base that keeps thresholds above zero at
-//        t = 0; orthographic cameras have only the base.
-//   [18..19] unused
-//
-// lights: 8 reals per light
-//   [0..2] unit direction towards the light, or the light's position
-//   [3]    0 directional, 1 point (1/r^2 falloff)
-//   [4..6] colour * intensity (linear RGB)
-//   [7]    penumbra softness (0: hard shadows)
-
-// Shading constants that are not quality knobs.
-#define MARCH_AMBIENT R(0.5)      // strength of the sky's hemisphere light
-#define MARCH_SPECULAR R(0.25)    // Blinn-Phong specular strength
-#define MARCH_SHININESS R(32.0)   // Blinn-Phong exponent
-#define MARCH_NORMAL_EVALUATIONS 4u // DE calls of march_normal
-#define MARCH_REFINE_LIMIT 24     // most evaluations spent locating a hit
-
-typedef struct {
-    real t;         // distance along the ray where the march stopped
-    real closest;   // smallest d / (t + d) seen: the angle of the nearest miss
-    int steps;      // distance evaluations
-    int hit;        // 1 if the surface was reached
-} MarchResult;
-
-typedef struct {
-    real3 origin;
-    real3 right;
-    real3 up;
-    real3 forward;
-    real half_w;
-    real half_h;
-    real footprint_base;
-    real footprint_per_unit;
-    int orthographic;
-} MarchCamera;
-
-MarchCamera march_load_camera(__global const real* c) {
-    MarchCamera cam;
-    cam.origin = (real3)(c[0], c[1], c[2]);
-    cam.orthographic = c[3] > R(0.5);
-    cam.right = (real3)(c[4], c[5], c[6]);
-    cam.half_w = c[7];
-    cam.up = (real3)(c[8], c[9], c[10]);
-    cam.half_h = c[11];
-    cam.forward = (real3)(c[12], c[13], c[14]);
-    cam.footprint_base = c[16];
-    cam.footprint_per_unit = c[17];
-    return cam;
-}
-
-// Scene units covered by one pixel at distance t along a ray.
-real march_footprint(const MarchCamera* cam, real t) {
-    return cam->footprint_base + cam->footprint_per_unit * t;
-}
-
-// The ray through image position (px, py) in pixels, (0, 0) being the top
-// left corner of the image.
-void march_camera_ray(const MarchCamera* cam, real px, real py, int width, int height,
-                      real3* ro, real3* rd) {
-    real u = (R(2.0) * px / (real)width - R(1.0)) * cam->half_w;
-    real v = (R(1.0) - R(2.0) * py / (real)height) * cam->half_h;
-    if (cam->orthographic) {
-        *ro = cam->origin + cam->right * u + cam->up * v;
-        *rd = cam->forward;
-    } else {
-        *ro = cam->origin;
-        *rd = normalize(cam->forward + cam->right * u + cam->up * v);
-    }
-}
-
-// The drawn surface: where the distance estimate falls to DETAIL pixel
-// footprints. g(t) is how far the point at t along the ray lies outside it.
-real march_level(real3 ro, real3 rd, const MarchCamera* cam, real t,
-                 __global const real* params) {
-    return DE(ro + rd * t, params) - DETAIL * march_footprint(cam, t);
-}
-
-// Locates the crossing of the surface between t0 (outside, g0 > 0) and t1
-// (inside, g1 <= 0) to HIT_EPSILON pixel footprints along the ray, by the
-// Illinois form of regula falsi: exact in one evaluation where the
-// distance is linear along the ray (a plane, a sphere met head-on), and
-// superlinear elsewhere. Returns the inside end of the final bracket and
-// adds its evaluations to *steps.
-real march_refine(real3 ro, real3 rd, const MarchCamera* cam, real t0, real g0, real t1,
-                  real g1, __global const real* params, int* steps) {
-    int kept = 0; // which end the last step moved: -1 outside, 1 inside
-    for (int i = 0; i < MARCH_REFINE_LIMIT; ++i) {
-        if (t1 - t0 <= HIT_EPSILON * march_footprint(cam, t1)) {
-            break;
-        }
-        real t = clamp(t0 + (t1 - t0) * (g0 / (g0 - g1)), t0, t1);
-        real g = march_level(ro, rd, cam, t, params);
-        *steps += 1;
-        if (g > R(0.0)) {
-            t0 = t;
-            g0 = g;
-            if (kept == -1) {
-                g1 *= R(0.5);
-            }
-            kept = -1;
-        } else {
-            t1 = t;
-            g1 = g;
-            if (g == R(0.0)) {
-                break;
-            }
-            if (kept == 1) {
-                g0 *= R(0.5);
-            }
-            kept = 1;
-        }
-    }
-    return t1;
-}
-
-// Sphere tracing towards the surface DETAIL pixel footprints out: each
-// step is the distance g to that surface (divided by g's Lipschitz bound,
-// which the footprint term raises a little above 1), so for an estimator
-// that never overestimates a step of that distance never passes the first
-// crossing. Steps are at least HIT_EPSILON footprints long, so a ray that
-// approaches the surface at a grazing angle crosses it in a bounded number
-// of steps, and features thinner than that along the ray may be missed.
-// Once a step lands inside, march_refine locates the crossing. The surface
-// itself does not depend on how the march gets there: MAX_STEPS,
-// OVER_RELAXATION and HIT_EPSILON change the cost and how closely the
-// march finds it (thin features missed, rays that run out of steps), not
-// where it lies.
-// OVER_RELAXATION below 1 shortens every step, a guard against estimators
-// that overestimate. Above 1 the steps are lengthened (Keinert et al.
-// 2014); when the unbounding spheres of two consecutive points stop
-// overlapping the long step may have jumped over a surface, so the march
-// returns to the last safe point and continues with plain steps.
-MarchResult march_ray(real3 ro, real3 rd, const MarchCamera* cam,
-                      __global const real* params) {
-    MarchResult r;
-    r.t = R(0.0);
-    r.closest = R(1.0);
-    r.steps = 0;
-    r.hit = 0;
-    const real lipschitz = R(1.0) + DETAIL * cam->footprint_per_unit;
-    real omega = OVER_RELAXATION;
-    int relaxed = 0; // whether the last step was longer than a plain one
-    real prev_t = R(0.0);
-    real prev_g = R(0.0);
-    for (int i = 0; i < MAX_STEPS; ++i) {
-        real d = DE(ro + rd * r.t, params);
-        real g = d - DETAIL * march_footprint(cam, r.t);
-        r.steps += 1;
-        if (relaxed && (g < R(0.0) || prev_g + g < lipschitz * (r.t - prev_t))) {
-            r.t = prev_t + prev_g / lipschitz;
-            omega = R(1.0);
-            relaxed = 0;
-            continue;
-        }
-        if (d > R(0.0)) {
-            r.closest = fmin(r.closest, d / (r.t + d));
-        }
-        if (g <= R(0.0)) {
-            r.hit = 1;
-            r.closest = R(0.0);
-            if (i > 0) {
-                r.t = march_refine(ro, rd, cam, prev_t, prev_g, r.t, g, params, &r.steps);
-            }
-            return r;
-        }
-        real plain = g / lipschitz;
-        real shortest = HIT_EPSILON * march_footprint(cam, r.t);
-        relaxed = omega > R(1.0) && omega * plain > fmax(plain, shortest);
-        prev_t = r.t;
-        prev_g = g;
-        r.t += fmax(omega * plain, shortest);
-        if (r.t > MAX_DISTANCE) {
-            return r;
-        }
-    }
-    return r;
-}
-
-// Unit normal by tetrahedral differences (MARCH_NORMAL_EVALUATIONS
-// evaluations) with step h.
-real3 march_normal(real3 p, real h, real3 rd, __global const real* params) {
-    const real2 k = (real2)(R(1.0), R(-1.0));
-    real3 g = k.xyy * DE(p + k.xyy * h, params) + k.yyx * DE(p + k.yyx * h, params)
-            + k.yxy * DE(p + k.yxy * h, params) + k.xxx * DE(p + k.xxx * h, params);
-    real len = length(g);
-    // A flat gradient (inside a thin feature, or at a cusp): face the viewer.
-    return len > REAL_TINY ? g / len : -rd;
-}
-
-// Ambient occlusion: how much closer the surface is than expected along
-// the normal out to AO_DISTANCE, nearer points weighing more:
-//   1 - integral of w(h) clamp(h - DE(p + n h), 0, h) dh
-//     / integral of w(h) h dh,   w(h) = exp(-AO_FALLOFF h / AO_DISTANCE),
-// by the midpoint rule with AO_SAMPLES points. The integral is fixed, so
-// more samples converge on the same value rather than reaching further.
-// 1 on an open face, towards 0 in a crease. Evaluates DE AO_SAMPLES times.
-#define AO_FALLOFF R(1.5)
-real march_ambient_occlusion(real3 p, real3 n, __global const real* params) {
-    real missing = R(0.0);
-    real expected = R(0.0);
-    for (int i = 0; i < AO_SAMPLES; ++i) {
-        real h = AO_DISTANCE * ((real)i + R(0.5)) / (real)AO_SAMPLES;
-        real weight = exp(-AO_FALLOFF * h / AO_DISTANCE);
-        real d = DE(p + n * h, params);
-        missing += weight * clamp(h - d, R(0.0), h);
-        expected += weight * h;
-    }
-    return clamp(R(1.0) - missing / expected, R(0.0), R(1.0));
-}
-
-// Visibility of a light from ro along rd, from distance start to max_t: 0
-// in full shadow, 1 fully lit. softness 0 gives a hard shadow; above 0,
-// Quilez's improved soft shadow (2018) with a penumbra that grows with
-// softness. The ray is blocked where it comes within eps of a surface;
-// callers pass a fraction of the surface hit threshold so shadows are not
-// fattened by a pixel where objects nearly touch. Adds its DE evaluations
-// to *evals.
-real march_shadow(real3 ro, real3 rd, real max_t, real eps, real start, real softness,
-                  __global const real* params, uint* evals) {
-    real visible = R(1.0);
-    real prev_h = R(1e20);
-    real t = start;
-    for (int i = 0; i < SHADOW_STEPS && t < max_t; ++i) {
-        real h = DE(ro + rd * t, params);
-        *evals += 1u;
-        if (h < eps) {
-            return R(0.0);
-        }
-        if (softness > R(0.0)) {
-            // The closest point to the surface between this sample and the
-            // previous one, estimated from the two distance spheres. They
-            // cross only if h < 2 prev_h, always true of an exact distance
-            // but not of every estimator (or after a minimum-length step);
-            // otherwise use this sample's own distance.
-            real y = h < R(2.0) * prev_h ? h * h / (R(2.0) * prev_h) : R(0.0);
-            real side = sqrt(fmax(h * h - y * y, R(0.0)));
-            visible = fmin(visible, side / (softness * fmax(t - y, REAL_TINY)));
-            prev_h = h;
-        }
-        t += fmax(h, eps);
-    }
-    visible = clamp(visible, R(0.0), R(1.0));
-    return visible * visible * (R(3.0) - R(2.0) * visible);
-}
-
-// Orbit-trap tint: a cosine palette that fades to white as the trap reaches
-// 1, so non-fractal surfaces (trap 1) keep their colour exactly.
-real3 march_trap_tint(real trap) {
-    real t = clamp(trap, R(0.0), R(1.0));
-    real3 phase = (real3)(R(0.0), R(0.1), R(0.2)) + t;
-    real3 palette = R(0.5) + R(0.5) * cos(R(6.28318530717958648) * phase);
-    return mix(palette, (real3)(R(1.0)), t);
-}
-
-// Background at image row py: SKY_BOTTOM at the bottom, SKY_TOP at the top.
-real3 march_background(real py, int height) {
-    real v = clamp(R(1.0) - py / (real)height, R(0.0), R(1.0));
-    return mix(SKY_BOTTOM, SKY_TOP, v);
-}
-
-// Lit colour of the surface point p with normal n, seen along rd. Adds its
-// distance evaluations (DE_shade, occlusion, shadow rays) to *evals.
-real3 march_shade(real3 p, real3 n, real3 rd, real eps, __global const real* params,
-                  __global const real* lights, int light_count, uint* evals) {
-    real3 albedo;
-    real trap;
-    DE_shade(p, params, &albedo, &trap);
-    *evals += 1u;
-    albedo *= march_trap_tint(trap);
-
-    real occlusion = R(1.0);
-    occlusion = march_ambient_occlusion(p, n, params);
-    *evals += (uint)AO_SAMPLES;
-    real3 sky = mix(SKY_BOTTOM, SKY_TOP, R(0.5) + R(0.5) * n.y);
-    real3 color = albedo * sky * (MARCH_AMBIENT * occlusion);
-
-    // Shadow rays start one hit threshold off the surface and are blocked
-    // within a quarter of it, so a surface does not shadow itself.
-    real3 lifted = p + n * eps;
-    for (int i = 0; i < light_count; ++i) {
-        __global const real* l = lights + 8 * i;
-        real3 v = (real3)(l[0], l[1], l[2]);
-        real3 radiance = (real3)(l[4], l[5], l[6]);
-        real3 to_light = v;
-        real light_distance = MAX_DISTANCE;
-        if (l[3] > R(0.5)) {
-            real3 delta = v - p;
-            real dist2 = fmax(dot(delta, delta), REAL_TINY);
-            light_distance = sqrt(dist2);
-            to_light = delta / light_distance;
-            radiance /= dist2;
-        }
-        real ndl = dot(n, to_light);
-        if (ndl <= R(0.0)) {
-            continue;
-        }
-        real visible =
-            march_shadow(lifted, to_light, light_distance, R(0.25) * eps, eps, l[7], params, evals);
-        if (visible <= R(0.0)) {
-            continue;
-        }
-        radiance *= visible;
-        real3 half_vector = normalize(to_light - rd);
-        real specular = MARCH_SPECULAR * pow(fmax(dot(n, half_vector), R(0.0)), MARCH_SHININESS);
-        color += radiance * (albedo * ndl + specular * ndl);
-    }
-    return color;
-}
-
-// Deterministic per-sample jitter in [0, 1): the same image every run.
-uint march_hash(uint x) {
-    x ^= x >> 16;
-    x *= 0x7feb352dU;
-    x ^= x >> 15;
-    x *= 0x846ca68bU;
-    x ^= x >> 16;
-    return x;
-}
-
-real march_jitter(uint x, uint y, uint sample) {
-    uint h = march_hash(x ^ march_hash(y ^ march_hash(sample)));
-    return (real)(h >> 8) * R(5.9604644775390625e-8); // 2^-24
-}
-
-// One launch shades the tile [x0, x0 + tile_w) x [y0, y0 + tile_h) of a
-// width x height image. The global size may be rounded up past the tile.
-//
-// AOVs describe the ray through the pixel centre: depth (distance along
-// the ray, +INFINITY on a miss), hit (0/1), world-space normal (0 on a
-// miss); and the cost of the pixel's colour: steps, the primary-march
-// distance evaluations of all its samples, and evaluations, every distance
-// evaluation of all its samples (primary march, normal, DE_shade, occlusion
-// and shadow rays, and the step onto the surface of a ray that starts
-// inside it). The extra march through
-// the pixel centre that AOVs need with supersampling is not counted.
-__kernel void render_tile(__global const real* params,
-                          __global const real* camera,
-                          __global const real* lights,
-                          const int light_count,
-                          const int width,
-                          const int height,
-                          const int x0,
-                          const int y0,
-                          const int tile_w,
-                          const int tile_h,
-                          const int write_aovs,
-                          __global uchar4* rgba,
-                          __global float* depth,
-                          __global uchar* hit_mask,
-                          __global float* normals,
-                          __global uint* steps,
-                          __global uint* evaluations) {
-    int lx = (int)get_global_id(0);
-    int ly = (int)get_global_id(1);
-    int x = x0 + lx;
-    int y = y0 + ly;
-    if (lx >= tile_w || ly >= tile_h || x >= width || y >= height) {
-        return;
-    }
-    MarchCamera cam = march_load_camera(camera);
-
-    real3 sum = (real3)(R(0.0));
-    uint total_steps = 0;
-    uint total_evals = 0;
-    MarchResult centre = {R(0.0), R(1.0), 0, 0};
-    real3 centre_normal = (real3)(R(0.0));
-    for (int s = 0; s < SUPERSAMPLING * SUPERSAMPLING; ++s) {
-        real jx = R(0.5);
-        real jy = R(0.5);
-        if (SUPERSAMPLING > 1) {
-            uint pixel = (uint)y * (uint)width + (uint)x;
-            jx = ((real)(s % SUPERSAMPLING) + march_jitter(pixel, (uint)s, 0u))
-                 / (real)SUPERSAMPLING;
-            jy = ((real)(s / SUPERSAMPLING) + march_jitter(pixel, (uint)s, 1u))
-                 / (real)SUPERSAMPLING;
-        }
-        real px = (real)x + jx;
-        real py = (real)y + jy;
-        real3 ro;
-        real3 rd;
-        march_camera_ray(&cam, px, py, width, height, &ro, &rd);
-        MarchResult m = march_ray(ro, rd, &cam, params);
-        total_steps += (uint)m.steps;
-        total_evals += (uint)m.steps;
-
-        real3 background = march_background(py, height);
-        real3 color = background;
-        real3 n = (real3)(R(0.0));
-        if (m.hit) {
-            real3 p = ro + rd * m.t;
-            real footprint = march_footprint(&cam, m.t);
-            n = march_normal(p, NORMAL_EPSILON * footprint, rd, params);
-            total_evals += MARCH_NORMAL_EVALUATIONS;
-            if (m.t <= R(0.0)) {
-                // The ray starts inside the surface (a camera within a
-                // solid): shade the nearest point of the surface instead.
-                p -= n * DE(p, params);
-                total_evals += 1u;
-            }
-            color = march_shade(p, n, rd, DETAIL * footprint, params, lights, light_count,
-                                &total_evals);
-        }
-        sum += color;
-        if (s == 0) {
-            centre = m;
-            centre_normal = n;
-        }
-    }
-    real3 color = sum / (real)(SUPERSAMPLING * SUPERSAMPLING);
-    real3 out = pow(clamp(color, R(0.0), R(1.0)), (real3)(R(1.0) / GAMMA));
-    int idx = y * width + x;
-    rgba[idx] = (uchar4)(convert_uchar3_sat_rte(convert_float3(out) * 255.0f), (uchar)255);
-
-    if (write_aovs) {
-        if (SUPERSAMPLING > 1) {
-            // The colour samples are jittered: trace the pixel centre.
-            real3 ro;
-            real3 rd;
-            march_camera_ray(&cam, (real)x + R(0.5), (real)y + R(0.5), width, height, &ro, &rd);
-            centre = march_ray(ro, rd, &cam, params);
-            centre_normal = (real3)(R(0.0));
-            if (centre.hit) {
-                real h = NORMAL_EPSILON * march_footprint(&cam, centre.t);
-                centre_normal = march_normal(ro + rd * centre.t, h, rd, params);
-            }
-        }
-        depth[idx] = centre.hit ? (float)centre.t : INFINITY;
-        hit_mask[idx] = (uchar)centre.hit;
-        vstore3(convert_float3(centre_normal), idx, normals);
-        steps[idx] = total_steps;
-        evaluations[idx] = total_evals;
-    }
-}
+/* ---- kernel: march.cl ---- */

@@ -1,214 +1,58 @@
-//! The intermediate representation: a validated scene lowered to a flat
-//! arena of nodes whose parameters are either baked constants or slots in a
-//! parameter buffer.
-//!
-//! Lowering is where validation happens: every parameter is checked against
-//! its [`Rule`], and dynamic parameters are given slots. The CPU reference
-//! ([`crate::cpu`]) and code generation both read the IR, never the scene
-//! tree.
+//! Lowering: validates a scene tree and writes it into the IR arena,
+//! folding what can be folded at compile time.
 
 use std::collections::HashMap;
+use std::sync::Arc;
 
 use glam::{DQuat, DVec3};
 
+use super::params::{Constraint, ParamLayout, ParamSlot, Relation, check_rule};
+use super::{Ir, IrNode, NodeId, Scalar, Vector, baked3};
 use crate::error::{Error, Result};
-use crate::scene::{CustomShape, Kind, Mapper, Node, Param, Param3, ParamSpec, Rule};
+use crate::scene::{CustomShape, Kind, Mapper, Node, NodeKind, Param, Param3, ParamSpec, Rule};
 
-/// A handle to a node in an [`Ir`] arena.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
-pub struct NodeId(u32);
-
-impl NodeId {
-    /// The node's index in [`Ir::nodes`].
-    #[must_use]
-    pub fn index(self) -> usize {
-        self.0 as usize
-    }
-}
-
-/// A lowered scalar parameter.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub enum Scalar {
-    /// A constant, emitted as a literal.
-    Baked(f64),
-    /// Index of a slot in the parameter buffer.
-    Dynamic(u32),
-}
-
-/// A lowered vector parameter.
-pub type Vector = [Scalar; 3];
-
-/// A lowered node: children are arena handles.
-pub type IrNode = Kind<Scalar, Vector, NodeId>;
-
-/// One slot of the parameter buffer.
-#[derive(Debug, Clone, PartialEq)]
-pub struct ParamSlot {
-    /// The dynamic parameter's name.
-    pub name: String,
-    /// Its initial value.
-    pub default: f64,
-    /// What every value set later must satisfy.
-    pub rule: Rule,
-    /// Where it was first used, for error messages (`node path`, `param`).
-    pub used_at: (String, String),
-}
-
-/// A scene's geometry, lowered and validated.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Ir {
-    nodes: Vec<IrNode>,
-    root: NodeId,
-    slots: Vec<ParamSlot>,
-}
-
-impl Ir {
-    /// Validates `geometry` and lowers it. Children are stored before their
-    /// parents, so the root is the last node.
-    ///
-    /// # Errors
-    /// The first invalid parameter, iteration count or zero direction, with
-    /// the node's path (such as `smooth_union/a:translate/sphere`).
-    pub fn lower(geometry: &Node) -> Result<Ir> {
-        let mut lowering = Lowering {
-            nodes: Vec::new(),
-            slots: Vec::new(),
-            slot_by_name: HashMap::new(),
-            path: String::new(),
-            operand: None,
-            customs: HashMap::new(),
-        };
-        let root = lowering.lower(geometry, geometry.kind().name().to_string())?;
-        Ok(Ir {
-            nodes: lowering.nodes,
-            root,
+/// Validates and lowers `geometry` (see [`Ir::lower`]).
+pub(super) fn lower(geometry: &Node) -> Result<Ir> {
+    let mut lowering = Lowering {
+        nodes: Vec::new(),
+        labels: Vec::new(),
+        parents: Vec::new(),
+        slots: Vec::new(),
+        constraints: Vec::new(),
+        slot_by_name: HashMap::new(),
+        path: String::new(),
+        operand: None,
+        customs: HashMap::new(),
+    };
+    let label = label(geometry.kind());
+    let root = lowering.lower(geometry, label.clone(), label)?;
+    Ok(Ir {
+        nodes: lowering.nodes,
+        labels: lowering.labels,
+        parents: lowering.parents,
+        root,
+        params: Arc::new(ParamLayout {
             slots: lowering.slots,
-        })
-    }
-
-    /// Every node; children come before parents.
-    #[must_use]
-    pub fn nodes(&self) -> &[IrNode] {
-        &self.nodes
-    }
-
-    /// The node behind a handle.
-    #[must_use]
-    pub fn node(&self, id: NodeId) -> &IrNode {
-        &self.nodes[id.index()]
-    }
-
-    /// The root of the geometry.
-    #[must_use]
-    pub fn root(&self) -> NodeId {
-        self.root
-    }
-
-    /// The scene's outermost baked translation, reached from the root
-    /// through colours only (they move nothing), with its node. Programs
-    /// for rendering leave that translation out and work in coordinates
-    /// relative to it, and the host moves the camera and the lights into
-    /// those coordinates in `f64`: a scene placed far from the origin then
-    /// keeps the precision it has at the origin, in `F32` too.
-    #[must_use]
-    pub fn local_frame(&self) -> Option<(DVec3, NodeId)> {
-        let mut id = self.root;
-        loop {
-            match self.node(id) {
-                Kind::Color { child, .. } => id = *child,
-                Kind::Translate { offset, .. } => return baked3(*offset).map(|o| (o, id)),
-                _ => return None,
-            }
-        }
-    }
-
-    /// The parameter buffer's layout: one slot per dynamic parameter name.
-    #[must_use]
-    pub fn params(&self) -> &[ParamSlot] {
-        &self.slots
-    }
-
-    /// The parameter buffer filled with every slot's default.
-    #[must_use]
-    pub fn default_values(&self) -> ParamValues {
-        ParamValues {
-            names: self.slots.iter().map(|s| s.name.clone()).collect(),
-            rules: self.slots.iter().map(|s| s.rule).collect(),
-            values: self.slots.iter().map(|s| s.default).collect(),
-        }
-    }
+            constraints: lowering.constraints,
+        }),
+    })
 }
 
-/// Values for the dynamic parameters of one [`Ir`], checked as they are set.
-#[derive(Debug, Clone, PartialEq)]
-pub struct ParamValues {
-    names: Vec<String>,
-    rules: Vec<Rule>,
-    values: Vec<f64>,
-}
-
-impl ParamValues {
-    /// Sets the dynamic parameter `name`.
-    ///
-    /// # Errors
-    /// [`Error::UnknownParam`] if there is no such parameter,
-    /// [`Error::NonFinite`] or [`Error::OutOfRange`] if `value` breaks the
-    /// parameter's rule.
-    pub fn set(&mut self, name: &str, value: f64) -> Result<()> {
-        let slot = self
-            .names
-            .iter()
-            .position(|n| n == name)
-            .ok_or_else(|| Error::UnknownParam { name: name.into() })?;
-        check_rule("dynamic parameter", name, value, self.rules[slot])?;
-        self.values[slot] = value;
-        Ok(())
+/// A node's name in paths: its kind, or a custom shape's own name.
+fn label(kind: &NodeKind) -> String {
+    match kind {
+        Kind::Custom { shape, .. } => shape.name().to_string(),
+        other => other.name().to_string(),
     }
-
-    /// The current value of `name`, if it exists.
-    #[must_use]
-    pub fn get(&self, name: &str) -> Option<f64> {
-        let slot = self.names.iter().position(|n| n == name)?;
-        Some(self.values[slot])
-    }
-
-    /// The values in slot order, as the parameter buffer holds them.
-    #[must_use]
-    pub fn as_slice(&self) -> &[f64] {
-        &self.values
-    }
-}
-
-/// The vector's value if every component is baked.
-fn baked3(v: Vector) -> Option<DVec3> {
-    match v {
-        [Scalar::Baked(x), Scalar::Baked(y), Scalar::Baked(z)] => Some(DVec3::new(x, y, z)),
-        _ => None,
-    }
-}
-
-fn check_rule(node: &str, param: &str, value: f64, rule: Rule) -> Result<()> {
-    if !value.is_finite() {
-        return Err(Error::NonFinite {
-            node: node.into(),
-            param: param.into(),
-            value,
-        });
-    }
-    if !rule.accepts(value) {
-        return Err(Error::OutOfRange {
-            node: node.into(),
-            param: param.into(),
-            value,
-            expected: rule.describe(),
-        });
-    }
-    Ok(())
 }
 
 struct Lowering {
     nodes: Vec<IrNode>,
+    labels: Vec<String>,
+    parents: Vec<Option<NodeId>>,
     slots: Vec<ParamSlot>,
+    /// Rules between parameters that read dynamic ones.
+    constraints: Vec<Constraint>,
     slot_by_name: HashMap<String, u32>,
     /// The path of the node being lowered.
     path: String,
@@ -219,7 +63,7 @@ struct Lowering {
 }
 
 impl Lowering {
-    fn lower(&mut self, node: &Node, path: String) -> Result<NodeId> {
+    fn lower(&mut self, node: &Node, path: String, label: String) -> Result<NodeId> {
         let saved = std::mem::replace(&mut self.path, path);
         let kind = node.kind();
         check_structure(kind, &self.path)?;
@@ -232,11 +76,54 @@ impl Lowering {
         );
         let lowered = kind.try_map(self)?;
         self.operand = saved_operand;
+        self.relate(&lowered)?;
         self.path = saved;
         let folded = self.fold(lowered);
         let id = NodeId(u32::try_from(self.nodes.len()).expect("fewer than 2^32 nodes"));
+        for child in folded.children() {
+            self.parents[child.index()] = Some(id);
+        }
         self.nodes.push(folded);
+        self.labels.push(label);
+        self.parents.push(None);
         Ok(id)
+    }
+
+    /// Checks the rules that relate a node's parameters on their current
+    /// values (baked, or the defaults of dynamic ones), and keeps those that
+    /// read dynamic parameters for [`ParamValues::set`](super::ParamValues::set).
+    fn relate(&mut self, node: &IrNode) -> Result<()> {
+        let relation = match node {
+            Kind::RoundBox {
+                half_extents,
+                radius,
+            } => Some((
+                "radius",
+                Relation::AtMostSmallest {
+                    value: *radius,
+                    bound: *half_extents,
+                    bound_name: "half extent",
+                },
+            )),
+            Kind::Plane { normal, .. } => Some(("normal", Relation::NonZero { vector: *normal })),
+            _ => None,
+        };
+        let Some((param, relation)) = relation else {
+            return Ok(());
+        };
+        let constraint = Constraint {
+            node: self.path.clone(),
+            param,
+            relation,
+        };
+        constraint.check(|s| match s {
+            Scalar::Baked(v) => v,
+            Scalar::Dynamic(slot) => self.slots[slot as usize].default,
+        })?;
+        if constraint.is_dynamic() {
+            self.constraints.push(constraint);
+        }
+        Ok(())
     }
 
     /// Folds what can be folded at compile time: chains of baked
@@ -348,6 +235,8 @@ impl Lowering {
         match merged {
             Some(m) => {
                 self.nodes.pop();
+                self.labels.pop();
+                self.parents.pop();
                 // The merged node may fold again with what is below it.
                 self.fold(m)
             }
@@ -424,14 +313,15 @@ impl Mapper<Param, Param3, Node> for Lowering {
             }
             None => "",
         };
-        let path = format!("{}/{}{}", self.path, label, c.kind().name());
-        self.lower(c, path)
+        let label = format!("{label}{}", self::label(c.kind()));
+        let path = format!("{}/{label}", self.path);
+        self.lower(c, path, label)
     }
 }
 
-/// Checks what the per-parameter rules cannot: iteration ranges, zero
-/// directions and relations between parameters (on their default values).
-fn check_structure(kind: &crate::scene::NodeKind, path: &str) -> Result<()> {
+/// Checks what is not a parameter: iteration ranges, rotation axes and a
+/// custom shape's argument count.
+fn check_structure(kind: &NodeKind, path: &str) -> Result<()> {
     if let (Some(value), Some((min, max))) = (kind.iterations(), kind.iteration_range()) {
         if !(min..=max).contains(&value) {
             return Err(Error::Iterations {
@@ -463,12 +353,6 @@ fn check_structure(kind: &crate::scene::NodeKind, path: &str) -> Result<()> {
                 return Err(zero("axis"));
             }
         }
-        Kind::Plane { normal, .. } => {
-            let n = normal.default_value();
-            if n.is_finite() && n.length() == 0.0 {
-                return Err(zero("normal"));
-            }
-        }
         Kind::Custom { shape, args } if args.len() != shape.arity() => {
             return Err(Error::CustomShape {
                 name: shape.name().into(),
@@ -478,20 +362,6 @@ fn check_structure(kind: &crate::scene::NodeKind, path: &str) -> Result<()> {
                     args.len()
                 ),
             });
-        }
-        Kind::RoundBox {
-            half_extents,
-            radius,
-        } => {
-            let (r, b) = (radius.default_value(), half_extents.default_value());
-            if r > b.min_element() {
-                return Err(Error::OutOfRange {
-                    node: path.into(),
-                    param: "radius".into(),
-                    value: r,
-                    expected: format!("<= the smallest half extent ({})", b.min_element()),
-                });
-            }
         }
         _ => {}
     }

@@ -13,18 +13,18 @@ pub trait Real: Float + FloatConst + std::fmt::Debug + Send + Sync + 'static {
     /// The smallest magnitude used to guard divisions and logarithms. The
     /// OpenCL kernels use the same value (`1e-30`, a normal `f32`).
     fn tiny() -> Self {
-        Self::of(1e-30)
+        Self::of(super::REAL_TINY)
     }
     /// The cap on fractal running derivatives, so they never overflow to
     /// infinity (`1e30` in both precisions).
     fn derivative_cap() -> Self {
-        Self::of(1e30)
+        Self::of(super::DERIVATIVE_CAP)
     }
     /// The largest magnitude an escape-time iteration may produce (`1e18`
     /// in both precisions): the squared length of a vector this long stays
     /// below `f32::MAX`, and dividing it by a capped derivative stays tiny.
     fn magnitude_cap() -> Self {
-        Self::of(1e18)
+        Self::of(super::MAGNITUDE_CAP)
     }
 }
 

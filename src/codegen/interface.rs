@@ -1,0 +1,242 @@
+//! The kernel interface, defined once: the argument lists of the kernels
+//! and the layouts of the camera and light buffers.
+//!
+//! The generated header turns these tables into `#define`s
+//! (`RENDER_TILE_ARGS`, `CAMERA_ORIGIN`, `LIGHT_STRIDE`, ...), which
+//! `kernels/march.cl` and `kernels/eval.cl` use in place of positions and
+//! offsets of their own, and the executor binds arguments and packs buffers
+//! from the same tables. Neither side can drift from the other.
+
+use std::fmt::Write as _;
+
+/// A field of a packed buffer of reals: where it starts and how many reals
+/// it spans.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Field {
+    /// The name the kernel sees, after the buffer's prefix
+    /// (`CAMERA_ORIGIN`).
+    pub name: &'static str,
+    /// The index of its first real.
+    pub offset: usize,
+    /// How many reals it spans (3 for a vector).
+    pub len: usize,
+}
+
+const fn field(name: &'static str, offset: usize, len: usize) -> Field {
+    Field { name, offset, len }
+}
+
+/// The camera buffer (`camera` argument of `render_tile`).
+pub mod camera {
+    use super::{Field, field};
+
+    /// The ray origin (perspective) or the image centre (orthographic),
+    /// relative to the program's origin.
+    pub const ORIGIN: Field = field("ORIGIN", 0, 3);
+    /// 1 for an orthographic camera, 0 for a perspective one.
+    pub const ORTHOGRAPHIC: Field = field("ORTHOGRAPHIC", 3, 1);
+    /// The unit vector to the right of the image.
+    pub const RIGHT: Field = field("RIGHT", 4, 3);
+    /// Half the image width at unit distance (orthographic: in scene
+    /// units).
+    pub const HALF_WIDTH: Field = field("HALF_WIDTH", 7, 1);
+    /// The unit vector up the image.
+    pub const UP: Field = field("UP", 8, 3);
+    /// Half the image height, likewise.
+    pub const HALF_HEIGHT: Field = field("HALF_HEIGHT", 11, 1);
+    /// The unit view direction.
+    pub const FORWARD: Field = field("FORWARD", 12, 3);
+    /// The pixel footprint at distance 0 along a ray.
+    pub const FOOTPRINT_BASE: Field = field("FOOTPRINT_BASE", 15, 1);
+    /// The growth of the pixel footprint per unit along a ray.
+    pub const FOOTPRINT_PER_UNIT: Field = field("FOOTPRINT_PER_UNIT", 16, 1);
+    /// Every field, in buffer order.
+    pub const FIELDS: [Field; 9] = [
+        ORIGIN,
+        ORTHOGRAPHIC,
+        RIGHT,
+        HALF_WIDTH,
+        UP,
+        HALF_HEIGHT,
+        FORWARD,
+        FOOTPRINT_BASE,
+        FOOTPRINT_PER_UNIT,
+    ];
+    /// Reals in the buffer.
+    pub const LEN: usize = 17;
+}
+
+/// One light's entry in the light buffer (`lights` argument of
+/// `render_tile`), repeated every [`STRIDE`](light::STRIDE) reals.
+pub mod light {
+    use super::{Field, field};
+
+    /// The unit direction towards a directional light, or a point light's
+    /// position relative to the program's origin.
+    pub const POSITION: Field = field("POSITION", 0, 3);
+    /// [`KIND_DIRECTIONAL`] or [`KIND_POINT`].
+    pub const KIND: Field = field("KIND", 3, 1);
+    /// Colour times intensity, linear RGB.
+    pub const RADIANCE: Field = field("RADIANCE", 4, 3);
+    /// The penumbra softness (0: hard shadows).
+    pub const SOFTNESS: Field = field("SOFTNESS", 7, 1);
+    /// Every field, in buffer order.
+    pub const FIELDS: [Field; 4] = [POSITION, KIND, RADIANCE, SOFTNESS];
+    /// Reals per light.
+    pub const STRIDE: usize = 8;
+    /// The `KIND` of a directional light.
+    pub const KIND_DIRECTIONAL: f64 = 0.0;
+    /// The `KIND` of a point light (falling off with `1/r²`).
+    pub const KIND_POINT: f64 = 1.0;
+}
+
+/// The arguments of the rendering kernel `render_tile`, in order.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[allow(missing_docs)] // Each is described by its declaration in `RENDER_TILE`.
+pub enum RenderArg {
+    Params,
+    Camera,
+    Lights,
+    LightCount,
+    Width,
+    Height,
+    X0,
+    Y0,
+    TileWidth,
+    TileHeight,
+    WriteAovs,
+    Rgba,
+    Depth,
+    Hit,
+    Normals,
+    Steps,
+    Evaluations,
+}
+
+/// `render_tile`'s declarations, in argument order: the one list of its
+/// arguments.
+pub const RENDER_TILE: [(RenderArg, &str); 17] = [
+    (RenderArg::Params, "__global const real* params"),
+    (RenderArg::Camera, "__global const real* camera"),
+    (RenderArg::Lights, "__global const real* lights"),
+    (RenderArg::LightCount, "const int light_count"),
+    (RenderArg::Width, "const int width"),
+    (RenderArg::Height, "const int height"),
+    (RenderArg::X0, "const int x0"),
+    (RenderArg::Y0, "const int y0"),
+    (RenderArg::TileWidth, "const int tile_w"),
+    (RenderArg::TileHeight, "const int tile_h"),
+    (RenderArg::WriteAovs, "const int write_aovs"),
+    (RenderArg::Rgba, "__global uchar4* rgba"),
+    (RenderArg::Depth, "__global float* depth"),
+    (RenderArg::Hit, "__global uchar* hit_mask"),
+    (RenderArg::Normals, "__global float* normals"),
+    (RenderArg::Steps, "__global uint* steps"),
+    (RenderArg::Evaluations, "__global uint* evaluations"),
+];
+
+impl RenderArg {
+    /// The argument's position in `render_tile`.
+    #[must_use]
+    pub fn index(self) -> u32 {
+        let i = RENDER_TILE
+            .iter()
+            .position(|(a, _)| *a == self)
+            .expect("every argument is in RENDER_TILE");
+        u32::try_from(i).expect("few arguments")
+    }
+}
+
+/// The arguments of the point-evaluation kernel `eval_points`, in order.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[allow(missing_docs)] // Each is described by its declaration in `EVAL_POINTS`.
+pub enum EvalArg {
+    Points,
+    Params,
+    Out,
+    Count,
+}
+
+/// `eval_points`' declarations, in argument order.
+pub const EVAL_POINTS: [(EvalArg, &str); 4] = [
+    (EvalArg::Points, "__global const real4* points"),
+    (EvalArg::Params, "__global const real* params"),
+    (EvalArg::Out, "__global real4* out"),
+    (EvalArg::Count, "const uint count"),
+];
+
+/// Reals `eval_points` writes per point: `(DE, DE_shade, trap, 0)` then
+/// `(colour, 0)`.
+pub const EVAL_OUT_STRIDE: usize = 8;
+
+/// The header's `#define`s of the interface of `target`'s kernel: its
+/// argument list and the layouts of its buffers.
+pub(crate) fn defines(target: super::Target) -> String {
+    let mut out = String::new();
+    let w = &mut out;
+    match target {
+        super::Target::Render => {
+            let _ = writeln!(w, "#define RENDER_TILE_ARGS \\\n    {}", args(&RENDER_TILE));
+            for f in camera::FIELDS {
+                let _ = writeln!(w, "#define CAMERA_{} {}", f.name, f.offset);
+            }
+            for f in light::FIELDS {
+                let _ = writeln!(w, "#define LIGHT_{} {}", f.name, f.offset);
+            }
+            let _ = writeln!(w, "#define LIGHT_STRIDE {}", light::STRIDE);
+        }
+        super::Target::Evaluate => {
+            let _ = writeln!(w, "#define EVAL_POINTS_ARGS \\\n    {}", args(&EVAL_POINTS));
+            let _ = writeln!(w, "#define EVAL_OUT_STRIDE {EVAL_OUT_STRIDE}");
+        }
+    }
+    out
+}
+
+/// A kernel's declarations as the body of a multi-line `#define`.
+fn args<A>(list: &[(A, &str)]) -> String {
+    let decls: Vec<&str> = list.iter().map(|(_, d)| *d).collect();
+    decls.join(", \\\n    ")
+}
+
+/// Writes `values` into `field` of `buffer` (of a layout above).
+///
+/// # Panics
+/// If `values` is not as long as the field.
+pub(crate) fn put(buffer: &mut [f64], field: Field, values: &[f64]) {
+    assert_eq!(
+        values.len(),
+        field.len,
+        "field {} spans {} reals",
+        field.name,
+        field.len
+    );
+    buffer[field.offset..field.offset + field.len].copy_from_slice(values);
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Fields tile their buffer: in order, without gaps or overlaps.
+    #[test]
+    fn layouts_tile_their_buffers() {
+        for (fields, len) in [
+            (&camera::FIELDS[..], camera::LEN),
+            (&light::FIELDS[..], light::STRIDE),
+        ] {
+            let mut next = 0;
+            for f in fields {
+                assert_eq!(
+                    f.offset, next,
+                    "{} starts where the last field ends",
+                    f.name
+                );
+                next += f.len;
+            }
+            assert_eq!(next, len);
+        }
+        assert_eq!(RenderArg::Evaluations.index(), 16);
+        assert_eq!(RenderArg::Params.index(), 0);
+    }
+}

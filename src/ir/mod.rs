@@ -1,0 +1,178 @@
+//! The intermediate representation: a validated scene lowered to a flat
+//! arena of nodes whose parameters are either baked constants or slots in a
+//! parameter buffer.
+//!
+//! Lowering is where validation happens, once: every parameter is checked
+//! against its [`Rule`](crate::scene::Rule), rules that relate parameters
+//! are checked (and kept, when they read dynamic ones, for
+//! [`ParamValues::set`]), and dynamic parameters are given slots.
+//! [`Scene::compile`](crate::Scene::compile) lowers the geometry and checks
+//! the camera and lights into a [`CompiledScene`], the value every later
+//! stage receives: the CPU reference ([`crate::cpu`]), code generation
+//! ([`crate::codegen`]) and the renderer read it, never the scene tree.
+
+mod compiled;
+mod lower;
+mod params;
+
+use std::sync::Arc;
+use std::sync::atomic::{AtomicU64, Ordering};
+
+use glam::DVec3;
+
+pub use compiled::CompiledScene;
+pub use params::{Constraint, ParamLayout, ParamSlot, ParamValues, Relation};
+
+use crate::error::Result;
+use crate::scene::{Kind, Node};
+
+/// A handle to a node in an [`Ir`] arena.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub struct NodeId(u32);
+
+impl NodeId {
+    /// The node's index in [`Ir::nodes`].
+    #[must_use]
+    pub fn index(self) -> usize {
+        self.0 as usize
+    }
+}
+
+/// A lowered scalar parameter.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Scalar {
+    /// A constant, emitted as a literal.
+    Baked(f64),
+    /// Index of a slot in the parameter buffer.
+    Dynamic(u32),
+}
+
+/// A lowered vector parameter.
+pub type Vector = [Scalar; 3];
+
+/// A lowered node: children are arena handles.
+pub type IrNode = Kind<Scalar, Vector, NodeId>;
+
+/// A scene's geometry, lowered and validated.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Ir {
+    nodes: Vec<IrNode>,
+    /// Each node's step in its path (`b:torus`), and its parent: the path
+    /// of any node is rebuilt on demand, so deep scenes keep one short
+    /// label per node.
+    labels: Vec<String>,
+    parents: Vec<Option<NodeId>>,
+    root: NodeId,
+    params: Arc<ParamLayout>,
+}
+
+static LOWERINGS: AtomicU64 = AtomicU64::new(0);
+
+/// How many times geometry has been lowered in this process. Building a
+/// renderer, an evaluator or a program from a [`CompiledScene`] lowers
+/// nothing; each [`Scene::compile`](crate::Scene::compile) lowers once.
+#[must_use]
+pub fn lowerings() -> u64 {
+    LOWERINGS.load(Ordering::Relaxed)
+}
+
+impl Ir {
+    /// Validates `geometry` and lowers it. Children are stored before their
+    /// parents, so the root is the last node.
+    ///
+    /// # Errors
+    /// The first invalid parameter, iteration count or zero direction, with
+    /// the node's path (such as `smooth_union/a:translate/sphere`).
+    pub fn lower(geometry: &Node) -> Result<Ir> {
+        LOWERINGS.fetch_add(1, Ordering::Relaxed);
+        lower::lower(geometry)
+    }
+
+    /// Every node; children come before parents.
+    #[must_use]
+    pub fn nodes(&self) -> &[IrNode] {
+        &self.nodes
+    }
+
+    /// The node behind a handle.
+    #[must_use]
+    pub fn node(&self, id: NodeId) -> &IrNode {
+        &self.nodes[id.index()]
+    }
+
+    /// The root of the geometry.
+    #[must_use]
+    pub fn root(&self) -> NodeId {
+        self.root
+    }
+
+    /// The path of a node, as validation errors name it
+    /// (`union/b:torus`).
+    #[must_use]
+    pub fn path(&self, id: NodeId) -> String {
+        self.path_tail(id, usize::MAX)
+    }
+
+    /// The last `steps` steps of a node's path, after `.../` when the path is
+    /// longer: a label that stays short in deep scenes.
+    #[must_use]
+    pub fn path_tail(&self, id: NodeId, steps: usize) -> String {
+        let mut labels = vec![self.labels[id.index()].as_str()];
+        let mut at = id;
+        while let Some(parent) = self.parents[at.index()] {
+            if labels.len() == steps {
+                labels.push("...");
+                break;
+            }
+            labels.push(&self.labels[parent.index()]);
+            at = parent;
+        }
+        labels.reverse();
+        labels.join("/")
+    }
+
+    /// The scene's outermost baked translation, reached from the root
+    /// through colours only (they move nothing), with its node. Programs
+    /// for rendering leave that translation out and work in coordinates
+    /// relative to it, and the host moves the camera and the lights into
+    /// those coordinates in `f64`: a scene placed far from the origin then
+    /// keeps the precision it has at the origin, in `F32` too.
+    #[must_use]
+    pub fn local_frame(&self) -> Option<(DVec3, NodeId)> {
+        let mut id = self.root;
+        loop {
+            match self.node(id) {
+                Kind::Color { child, .. } => id = *child,
+                Kind::Translate { offset, .. } => return baked3(*offset).map(|o| (o, id)),
+                _ => return None,
+            }
+        }
+    }
+
+    /// The parameter buffer's slots: one per dynamic parameter name.
+    #[must_use]
+    pub fn params(&self) -> &[ParamSlot] {
+        self.params.slots()
+    }
+
+    /// The parameter buffer's layout: its slots and the rules between
+    /// parameters that [`ParamValues::set`] keeps.
+    #[must_use]
+    pub fn layout(&self) -> &ParamLayout {
+        &self.params
+    }
+
+    /// The parameter buffer filled with every slot's default.
+    #[must_use]
+    pub fn default_values(&self) -> ParamValues {
+        ParamValues::defaults(Arc::clone(&self.params))
+    }
+}
+
+/// The vector's value if every component is baked.
+pub(crate) fn baked3(v: Vector) -> Option<DVec3> {
+    match v {
+        [Scalar::Baked(x), Scalar::Baked(y), Scalar::Baked(z)] => Some(DVec3::new(x, y, z)),
+        _ => None,
+    }
+}

@@ -1,0 +1,221 @@
+//! The parameter buffer: one slot per dynamic parameter, every rule its
+//! values must keep (its own, and those that relate it to other
+//! parameters), and the values themselves, checked as they are set.
+
+use std::sync::Arc;
+
+use super::{Scalar, Vector};
+use crate::error::{Error, Result};
+use crate::scene::Rule;
+
+/// One slot of the parameter buffer.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ParamSlot {
+    /// The dynamic parameter's name.
+    pub name: String,
+    /// Its initial value.
+    pub default: f64,
+    /// What every value set later must satisfy.
+    pub rule: Rule,
+    /// Where it was first used, for error messages (`node path`, `param`).
+    pub used_at: (String, String),
+}
+
+/// A rule that relates several parameters of one node.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Relation {
+    /// `value` is at most the smallest component of `bound` (a round box's
+    /// edge radius and its half extents).
+    AtMostSmallest {
+        /// The limited parameter.
+        value: Scalar,
+        /// The vector whose smallest component limits it.
+        bound: Vector,
+        /// What `bound` is, for the message (`"half extent"`).
+        bound_name: &'static str,
+    },
+    /// The vector is not zero (a plane's normal, which is normalised).
+    NonZero {
+        /// The vector.
+        vector: Vector,
+    },
+}
+
+/// A [`Relation`] at one node, with the parameter it is reported against.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Constraint {
+    /// The node's path, as in every validation error.
+    pub node: String,
+    /// The parameter the error names.
+    pub param: &'static str,
+    /// What must hold.
+    pub relation: Relation,
+}
+
+impl Constraint {
+    /// Checks the relation with parameter values from `value`; the error is
+    /// the same whether the values are baked or dynamic.
+    pub(crate) fn check(&self, value: impl Fn(Scalar) -> f64) -> Result<()> {
+        match &self.relation {
+            Relation::AtMostSmallest {
+                value: v,
+                bound,
+                bound_name,
+            } => {
+                let (v, smallest) = (
+                    value(*v),
+                    bound.map(&value).into_iter().fold(f64::INFINITY, f64::min),
+                );
+                if v > smallest {
+                    return Err(Error::OutOfRange {
+                        node: self.node.clone(),
+                        param: self.param.into(),
+                        value: v,
+                        expected: format!("<= the smallest {bound_name} ({smallest})"),
+                    });
+                }
+            }
+            Relation::NonZero { vector } => {
+                if vector.iter().all(|s| value(*s) == 0.0) {
+                    return Err(Error::ZeroVector {
+                        node: self.node.clone(),
+                        param: self.param.into(),
+                    });
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// The dynamic slots the relation reads.
+    fn slots(&self) -> impl Iterator<Item = u32> + '_ {
+        let scalars: Vec<Scalar> = match &self.relation {
+            Relation::AtMostSmallest { value, bound, .. } => std::iter::once(*value)
+                .chain(bound.iter().copied())
+                .collect(),
+            Relation::NonZero { vector } => vector.to_vec(),
+        };
+        scalars.into_iter().filter_map(|s| match s {
+            Scalar::Dynamic(slot) => Some(slot),
+            Scalar::Baked(_) => None,
+        })
+    }
+
+    /// Whether the relation reads any dynamic parameter (otherwise lowering
+    /// has checked it for good).
+    pub(crate) fn is_dynamic(&self) -> bool {
+        self.slots().next().is_some()
+    }
+}
+
+/// The layout of the parameter buffer: its slots and every rule between
+/// them.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct ParamLayout {
+    pub(crate) slots: Vec<ParamSlot>,
+    pub(crate) constraints: Vec<Constraint>,
+}
+
+impl ParamLayout {
+    /// The slots, in buffer order.
+    #[must_use]
+    pub fn slots(&self) -> &[ParamSlot] {
+        &self.slots
+    }
+
+    /// The rules that relate parameters and read at least one dynamic one.
+    #[must_use]
+    pub fn constraints(&self) -> &[Constraint] {
+        &self.constraints
+    }
+}
+
+/// Values for the dynamic parameters of one scene, checked as they are set
+/// against every rule a baked value would have to keep, with the same
+/// error.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ParamValues {
+    layout: Arc<ParamLayout>,
+    values: Vec<f64>,
+}
+
+impl ParamValues {
+    /// Every slot at its default.
+    pub(crate) fn defaults(layout: Arc<ParamLayout>) -> Self {
+        let values = layout.slots.iter().map(|s| s.default).collect();
+        ParamValues { layout, values }
+    }
+
+    /// Sets the dynamic parameter `name`.
+    ///
+    /// # Errors
+    /// [`Error::UnknownParam`] if there is no such parameter; otherwise the
+    /// error a baked `value` would get at lowering: [`Error::NonFinite`] or
+    /// [`Error::OutOfRange`] if it breaks the parameter's rule, or a rule
+    /// relating it to the node's other parameters (a round box's radius
+    /// above its smallest half extent, a plane normal that becomes zero).
+    pub fn set(&mut self, name: &str, value: f64) -> Result<()> {
+        let slot = self
+            .layout
+            .slots
+            .iter()
+            .position(|s| s.name == name)
+            .ok_or_else(|| Error::UnknownParam { name: name.into() })?;
+        let spec = &self.layout.slots[slot];
+        check_rule(&spec.used_at.0, &spec.used_at.1, value, spec.rule)?;
+        let old = std::mem::replace(&mut self.values[slot], value);
+        let slot = u32::try_from(slot).expect("slots are numbered in u32");
+        let broken = self
+            .layout
+            .constraints
+            .iter()
+            .filter(|c| c.slots().any(|s| s == slot))
+            .try_for_each(|c| c.check(|s| self.value(s)));
+        if broken.is_err() {
+            self.values[slot as usize] = old;
+        }
+        broken
+    }
+
+    /// The current value of `name`, if it exists.
+    #[must_use]
+    pub fn get(&self, name: &str) -> Option<f64> {
+        let slot = self.layout.slots.iter().position(|s| s.name == name)?;
+        Some(self.values[slot])
+    }
+
+    /// The value of a lowered scalar: its literal, or its slot's value.
+    #[must_use]
+    pub fn value(&self, s: Scalar) -> f64 {
+        match s {
+            Scalar::Baked(v) => v,
+            Scalar::Dynamic(slot) => self.values[slot as usize],
+        }
+    }
+
+    /// The values in slot order, as the parameter buffer holds them.
+    #[must_use]
+    pub fn as_slice(&self) -> &[f64] {
+        &self.values
+    }
+}
+
+/// A value's own rule, with the error every validation reports.
+pub(crate) fn check_rule(node: &str, param: &str, value: f64, rule: Rule) -> Result<()> {
+    if !value.is_finite() {
+        return Err(Error::NonFinite {
+            node: node.into(),
+            param: param.into(),
+            value,
+        });
+    }
+    if !rule.accepts(value) {
+        return Err(Error::OutOfRange {
+            node: node.into(),
+            param: param.into(),
+            value,
+            expected: rule.describe(),
+        });
+    }
+    Ok(())
+}

@@ -1,0 +1,89 @@
+//! Math shared by the CPU reference ([`crate::cpu`]) and code generation
+//! ([`crate::codegen`]): the numeric guards both twins use, the scalar types
+//! the reference is generic over, and the values that code generation bakes
+//! into literals exactly as the reference computes them. Keeping them here,
+//! outside both stages, is what lets the two twins agree without either
+//! reaching into the other.
+
+mod real;
+
+use glam::DVec3;
+
+pub use real::{Real, V3, v3};
+
+use crate::ir::Scalar;
+
+/// The smallest magnitude used to guard divisions and logarithms, in both
+/// twins (`REAL_TINY` in the kernels; a normal `f32`).
+pub const REAL_TINY: f64 = 1e-30;
+
+/// The cap on fractal running derivatives, so they never overflow to
+/// infinity (`DERIVATIVE_CAP` in the kernels).
+pub const DERIVATIVE_CAP: f64 = 1e30;
+
+/// The largest magnitude an escape-time iteration may produce
+/// (`MAGNITUDE_CAP` in the kernels): the squared length of a vector this
+/// long stays below `f32::MAX`, and dividing it by a capped derivative
+/// stays tiny.
+pub const MAGNITUDE_CAP: f64 = 1e18;
+
+/// The linear RGB colour of surfaces that no `color` node paints
+/// (`DEFAULT_COLOR` in the kernels).
+pub const DEFAULT_COLOR: [f64; 3] = [0.8, 0.8, 0.8];
+
+/// The radius beyond which a Mandelbulb orbit escapes: `bailout`, or less
+/// where `r^power` would pass [`MAGNITUDE_CAP`]. Computed in
+/// `f64`; code generation emits the same value as a literal.
+#[must_use]
+pub fn escape_radius(power: f64, bailout: f64) -> f64 {
+    bailout.min(MAGNITUDE_CAP.powf(1.0 / power))
+}
+
+/// The radius `2^(1 / (power - 1))` of the ball that holds the Mandelbulb
+/// of `power`, and every point where its estimate is at most 0, for any
+/// number of iterations and any bailout.
+///
+/// Proof. The power map scales lengths exactly, `|z^n| = |z|^n` (it is a
+/// unit direction times `r^n`). Let `|p| > rho`, so `|p|^(n-1) > 2`. If
+/// `|z_k| >= |p|` (true for `z_0 = p`), then `|z_(k+1)| = |z_k^n + p| >=
+/// |z_k|^n - |p| >= |z_k| (|z_k|^(n-1) - 1) >= |z_k| (|p|^(n-1) - 1) >
+/// |z_k|`. So the orbit grows strictly (and without bound): it never stays
+/// bounded, and wherever the iteration stops (escaped or not) `|z| > |p| >
+/// 1`, so `ln |z| > 0` and the estimate is positive. Hence for `|p| > rho`
+/// the distance to the set is at least `|p| - rho`.
+///
+/// ```
+/// use fractal_sdf::math::mandelbulb_radius;
+/// assert_eq!(mandelbulb_radius(2.0_f64), 2.0);
+/// assert!((mandelbulb_radius(8.0_f64) - 1.104).abs() < 1e-3);
+/// ```
+#[must_use]
+pub fn mandelbulb_radius<T: Real>(power: T) -> T {
+    T::of(2.0).powf(T::one() / (power - T::one()))
+}
+
+/// The trig-free integer form applies when the power is a baked integer.
+/// Code generation makes the same choice.
+#[must_use]
+pub fn integer_power(power: Scalar) -> Option<u32> {
+    match power {
+        #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss)]
+        Scalar::Baked(v) if v.fract() == 0.0 && (2.0..=64.0).contains(&v) => Some(v as u32),
+        _ => None,
+    }
+}
+
+/// The rows of the matrix rotating by `angle` around the unit `axis`,
+/// computed in `f64`.
+///
+/// Entries within `1e-15` of 0 or ±1 are snapped to them, so quarter turns
+/// are exact permutations (and code generation can drop the zero terms).
+#[must_use]
+pub fn rotation_rows(axis: DVec3, angle: f64) -> [V3<f64>; 3] {
+    let snap = |v: f64| {
+        let r = v.round();
+        if (v - r).abs() < 1e-15 { r } else { v }
+    };
+    let m = glam::DMat3::from_axis_angle(axis, angle).transpose();
+    [m.x_axis, m.y_axis, m.z_axis].map(|row| V3::from(row).map(snap))
+}
