@@ -38,7 +38,6 @@ use fractal_sdf::cpu::{self, Evaluator, MarchSettings, Ray};
 use fractal_sdf::metrics::psnr;
 use fractal_sdf::prelude::*;
 use fractal_sdf::render::{RenderOptions, Renderer};
-use image::RgbaImage;
 
 /// Iterations of the bulb: each resolves detail about 8 times finer, so
 /// 16 keep structure in view down to about 1e-14.

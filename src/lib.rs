@@ -32,6 +32,10 @@
 //! - [`timing`]: per-frame timings, frame statistics and the resolution
 //!   choice of an interactive view.
 //!
+//! Images are [`image::RgbaImage`]s. The [`image`] crate (with PNG
+//! support) is re-exported, so cropping, converting or saving them needs no
+//! dependency of your own: `use fractal_sdf::image::RgbaImage;`.
+//!
 //! With the `proptest` feature, the `testing` module offers strategies for valid
 //! scenes and checkers for the distance invariants (Lipschitz bound, never
 //! overestimating, exactness), to property-test your own nodes.
@@ -97,6 +101,10 @@ pub mod timing;
 pub use error::{Error, Result};
 pub use scene::{Node, Scene};
 
+/// The [`image`](https://docs.rs/image) crate, whose `RgbaImage` every
+/// render returns, with its PNG codec.
+pub use image;
+
 /// Everything needed to write scenes: `use fractal_sdf::prelude::*;`.
 pub mod prelude {
     pub use crate::cpu;
@@ -108,4 +116,5 @@ pub mod prelude {
         menger, octahedron, param, param3, plane, round_box, sierpinski, sphere, torus,
     };
     pub use glam::{DQuat, DVec3, EulerRot, Vec3, dvec3, vec3};
+    pub use image::RgbaImage;
 }

@@ -17,8 +17,10 @@ use crate::error::{Error, Result};
 /// half-written image and a failed write leaves any earlier file intact.
 ///
 /// ```
+/// use fractal_sdf::image::{self, Rgba, RgbaImage};
+///
 /// let dir = std::env::temp_dir().join("fractal-sdf-doc");
-/// let image = image::RgbaImage::from_pixel(2, 2, image::Rgba([255, 0, 0, 255]));
+/// let image = RgbaImage::from_pixel(2, 2, Rgba([255, 0, 0, 255]));
 /// fractal_sdf::output::save_png(&image, dir.join("nested/red.png"))?;
 /// assert_eq!(image::open(dir.join("nested/red.png")).unwrap().to_rgba8(), image);
 /// # std::fs::remove_dir_all(dir).ok();
