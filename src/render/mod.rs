@@ -63,4 +63,4 @@ pub use program::{BuildInfo, ProgramSource, program_builds};
 pub use renderer::{RenderOptions, Renderer};
 pub use viewport::Viewport;
 
-pub use crate::timing::FrameTiming;
+pub use crate::view::FrameTiming;
