@@ -137,17 +137,10 @@ fn key_light_blocked(point: DVec3, offset: f64) -> Result<Option<f64>> {
 
 fn render(scene: &Scene, precision: Precision, size: (u32, u32)) -> Result<RgbaImage> {
     let options = RenderOptions {
-        quality: Quality {
-            precision,
-            max_steps: 1024,
-            ..Quality::production()
-        },
+        quality: Quality::production().precision(precision).max_steps(1024),
         // Occlusion samples a fixed distance in scene units: at a deep
         // zoom that is far outside the view. Shadows scale with the view.
-        effects: Effects {
-            ambient_occlusion: false,
-            ..Effects::default()
-        },
+        effects: Effects::default().ambient_occlusion(false),
         ..RenderOptions::default()
     };
     Renderer::with_options(scene, &options)?.render(size.0, size.1)
