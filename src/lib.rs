@@ -107,6 +107,7 @@ pub use scene::{Node, Scene};
 pub use image;
 
 // The renderer names `FrameTiming` by this crate-internal path.
+#[cfg(feature = "opencl")]
 use view::timing;
 
 /// Everything needed to write scenes: `use fractal_sdf::prelude::*;`.
