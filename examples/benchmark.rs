@@ -18,7 +18,7 @@ use std::time::{Duration, Instant};
 use fractal_sdf::gallery;
 use fractal_sdf::prelude::*;
 use fractal_sdf::render::{RenderOptions, Renderer};
-use fractal_sdf::timing::FrameStats;
+use fractal_sdf::view::FrameStats;
 
 const HELP: &str = "\
 fractal-sdf benchmark: time the benchmark scene along its camera path.

@@ -38,7 +38,6 @@ use fractal_sdf::cpu::{self, Evaluator, MarchSettings, Ray};
 use fractal_sdf::metrics::psnr;
 use fractal_sdf::prelude::*;
 use fractal_sdf::render::{RenderOptions, Renderer};
-use image::RgbaImage;
 
 /// Iterations of the bulb: each resolves detail about 8 times finer, so
 /// 16 keep structure in view down to about 1e-14.
@@ -138,17 +137,10 @@ fn key_light_blocked(point: DVec3, offset: f64) -> Result<Option<f64>> {
 
 fn render(scene: &Scene, precision: Precision, size: (u32, u32)) -> Result<RgbaImage> {
     let options = RenderOptions {
-        quality: Quality {
-            precision,
-            max_steps: 1024,
-            ..Quality::production()
-        },
+        quality: Quality::production().precision(precision).max_steps(1024),
         // Occlusion samples a fixed distance in scene units: at a deep
         // zoom that is far outside the view. Shadows scale with the view.
-        effects: Effects {
-            ambient_occlusion: false,
-            ..Effects::default()
-        },
+        effects: Effects::default().ambient_occlusion(false),
         ..RenderOptions::default()
     };
     Renderer::with_options(scene, &options)?.render(size.0, size.1)

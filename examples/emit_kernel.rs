@@ -22,10 +22,7 @@ fn main() -> Result<()> {
         std::process::exit(2);
     };
     let options = Options {
-        quality: Quality {
-            precision,
-            ..Quality::default()
-        },
+        quality: Quality::default().precision(precision),
         ..Options::default()
     };
     let scene = scene.compile()?;

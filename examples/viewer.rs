@@ -2,10 +2,9 @@
 //!
 //! `cargo run --release --features viewer --example viewer -- fractal_mix`
 //!
-//! The camera, key bindings, settings and resolution choice live in the
-//! library (`fractal_sdf::control`, `fractal_sdf::timing`); this file only
-//! connects them to a `winit` window and a `softbuffer` surface. Run with
-//! `--help` for every option.
+//! The camera, keys, settings and resolution choice live in the library
+//! (`fractal_sdf::view`); this file only connects them to a `winit` window
+//! and a `softbuffer` surface. Run with `--help` for every option.
 
 mod common;
 
@@ -15,12 +14,13 @@ use std::rc::Rc;
 use std::time::{Duration, Instant};
 
 use fractal_sdf::animation::Motion;
-use fractal_sdf::control::{Action, FlyCamera, KeyScript, Movement, ViewSettings};
 use fractal_sdf::prelude::*;
 use fractal_sdf::render::{RenderOptions, Renderer};
-use fractal_sdf::timing::{ResolutionScaler, reduced_size};
+use fractal_sdf::view::{
+    Action, FlyCamera, Key, KeyScript, Movement, ResolutionScaler, ViewSettings, blit_scaled,
+    reduced_size,
+};
 use fractal_sdf::{gallery, output};
-use image::RgbaImage;
 use winit::application::ApplicationHandler;
 use winit::dpi::PhysicalSize;
 use winit::event::{ElementState, MouseButton, MouseScrollDelta, WindowEvent};
@@ -79,8 +79,8 @@ fn parse_args() -> Result<Option<Args>> {
     if a.contains(["-h", "--help"]) {
         print!("{HELP}");
         println!("KEYS:");
-        for (key, what) in Action::KEYS {
-            println!("  {key:<24} {what}");
+        for action in Action::ALL {
+            println!("  {:<24} {}", action.key(), action.description());
         }
         return Ok(None);
     }
@@ -308,8 +308,8 @@ impl Viewer {
         // nothing.
         if self.scripted != Some(self.frame) {
             self.scripted = Some(self.frame);
-            let script: Vec<Action> = self.args.keys.keys_at(self.frame).collect();
-            for action in script {
+            let script: Vec<Key> = self.args.keys.keys_at(self.frame).collect();
+            for action in script.into_iter().filter_map(Action::for_key) {
                 self.act(action, event_loop)?;
             }
         }
@@ -411,7 +411,7 @@ impl Viewer {
         };
         surface.pixels.resize(w, h).map_err(display_error)?;
         let mut buffer = surface.pixels.buffer_mut().map_err(display_error)?;
-        output::blit_scaled(image, width, height, &mut buffer);
+        blit_scaled(image, width, height, &mut buffer);
         buffer.present().map_err(display_error)
     }
 
@@ -480,12 +480,12 @@ impl ApplicationHandler for Viewer {
                 let PhysicalKey::Code(code) = event.physical_key else {
                     return;
                 };
-                let Some(name) = key_name(code) else { return };
+                let Some(key) = key_of(code) else { return };
                 let pressed = event.state == ElementState::Pressed;
-                if self.keys.set(name, pressed) || !pressed || event.repeat {
+                if self.keys.set(key, pressed) || !pressed || event.repeat {
                     return;
                 }
-                if let Some(action) = Action::for_key(name) {
+                if let Some(action) = Action::for_key(key) {
                     if let Err(e) = self.act(action, event_loop) {
                         self.fail(event_loop, e);
                     }
@@ -526,30 +526,66 @@ impl ApplicationHandler for Viewer {
     }
 }
 
-/// The library's name for a physical key (see `fractal_sdf::control`).
-fn key_name(code: KeyCode) -> Option<&'static str> {
+/// The library's key for a physical key, if it has one.
+fn key_of(code: KeyCode) -> Option<Key> {
     Some(match code {
-        KeyCode::KeyW => "w",
-        KeyCode::KeyA => "a",
-        KeyCode::KeyS => "s",
-        KeyCode::KeyD => "d",
-        KeyCode::KeyQ => "q",
-        KeyCode::KeyE => "e",
-        KeyCode::ArrowUp => "arrowup",
-        KeyCode::ArrowDown => "arrowdown",
-        KeyCode::ArrowLeft => "arrowleft",
-        KeyCode::ArrowRight => "arrowright",
-        KeyCode::KeyO => "o",
-        KeyCode::KeyH => "h",
-        KeyCode::KeyG => "g",
-        KeyCode::KeyR => "r",
-        KeyCode::Digit1 => "1",
-        KeyCode::Digit2 => "2",
-        KeyCode::Digit3 => "3",
-        KeyCode::Digit4 => "4",
-        KeyCode::Space => "space",
-        KeyCode::F12 => "f12",
-        KeyCode::Escape => "escape",
+        KeyCode::KeyA => Key::A,
+        KeyCode::KeyB => Key::B,
+        KeyCode::KeyC => Key::C,
+        KeyCode::KeyD => Key::D,
+        KeyCode::KeyE => Key::E,
+        KeyCode::KeyF => Key::F,
+        KeyCode::KeyG => Key::G,
+        KeyCode::KeyH => Key::H,
+        KeyCode::KeyI => Key::I,
+        KeyCode::KeyJ => Key::J,
+        KeyCode::KeyK => Key::K,
+        KeyCode::KeyL => Key::L,
+        KeyCode::KeyM => Key::M,
+        KeyCode::KeyN => Key::N,
+        KeyCode::KeyO => Key::O,
+        KeyCode::KeyP => Key::P,
+        KeyCode::KeyQ => Key::Q,
+        KeyCode::KeyR => Key::R,
+        KeyCode::KeyS => Key::S,
+        KeyCode::KeyT => Key::T,
+        KeyCode::KeyU => Key::U,
+        KeyCode::KeyV => Key::V,
+        KeyCode::KeyW => Key::W,
+        KeyCode::KeyX => Key::X,
+        KeyCode::KeyY => Key::Y,
+        KeyCode::KeyZ => Key::Z,
+        KeyCode::Digit0 => Key::Digit0,
+        KeyCode::Digit1 => Key::Digit1,
+        KeyCode::Digit2 => Key::Digit2,
+        KeyCode::Digit3 => Key::Digit3,
+        KeyCode::Digit4 => Key::Digit4,
+        KeyCode::Digit5 => Key::Digit5,
+        KeyCode::Digit6 => Key::Digit6,
+        KeyCode::Digit7 => Key::Digit7,
+        KeyCode::Digit8 => Key::Digit8,
+        KeyCode::Digit9 => Key::Digit9,
+        KeyCode::F1 => Key::F1,
+        KeyCode::F2 => Key::F2,
+        KeyCode::F3 => Key::F3,
+        KeyCode::F4 => Key::F4,
+        KeyCode::F5 => Key::F5,
+        KeyCode::F6 => Key::F6,
+        KeyCode::F7 => Key::F7,
+        KeyCode::F8 => Key::F8,
+        KeyCode::F9 => Key::F9,
+        KeyCode::F10 => Key::F10,
+        KeyCode::F11 => Key::F11,
+        KeyCode::F12 => Key::F12,
+        KeyCode::ArrowUp => Key::ArrowUp,
+        KeyCode::ArrowDown => Key::ArrowDown,
+        KeyCode::ArrowLeft => Key::ArrowLeft,
+        KeyCode::ArrowRight => Key::ArrowRight,
+        KeyCode::Space => Key::Space,
+        KeyCode::Enter => Key::Enter,
+        KeyCode::Escape => Key::Escape,
+        KeyCode::Tab => Key::Tab,
+        KeyCode::Backspace => Key::Backspace,
         _ => return None,
     })
 }

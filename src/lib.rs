@@ -29,10 +29,16 @@
 //!   TOML) and [`Motion`](animation::Motion)s of dynamic parameters.
 //! - [`sequence`]: numbered frame files, frame ranges and resuming; with
 //!   `opencl`, rendering a path to them.
-//! - [`control`]: a fly-through camera, key bindings and view settings for
-//!   interactive viewers, independent of any window toolkit.
-//! - [`timing`]: per-frame timings, frame statistics and the resolution
-//!   choice of an interactive view.
+//! - [`view`]: interactive viewing, independent of any window toolkit: a
+//!   fly-through camera, the [`Key`](view::Key)s and what they do, view
+//!   settings, key scripts, the resolution choice while the view moves,
+//!   frame timings and statistics, and copying a frame into a window.
+//! - [`metrics`]: comparing images (PSNR, SSIM, hit masks, depth buffers),
+//!   to measure how far a render is from a reference.
+//!
+//! Images are [`image::RgbaImage`]s. The [`image`] crate (with PNG
+//! support) is re-exported, so cropping, converting or saving them needs no
+//! dependency of your own: `use fractal_sdf::image::RgbaImage;`.
 //!
 //! With the `proptest` feature, the `testing` module offers strategies for valid
 //! scenes and checkers for the distance invariants (Lipschitz bound, never
@@ -79,7 +85,6 @@
 
 pub mod animation;
 pub mod codegen;
-pub mod control;
 pub mod cpu;
 pub mod error;
 pub mod gallery;
@@ -94,11 +99,19 @@ pub mod scene;
 pub mod sequence;
 #[cfg(feature = "proptest")]
 pub mod testing;
-pub mod timing;
+pub mod view;
 
 pub use error::{Error, Result};
 pub use ir::CompiledScene;
 pub use scene::{Node, Scene};
+
+/// The [`image`](https://docs.rs/image) crate, whose `RgbaImage` every
+/// render returns, with its PNG codec.
+pub use image;
+
+// The renderer names `FrameTiming` by this crate-internal path.
+#[cfg(feature = "opencl")]
+use view::timing;
 
 /// Everything needed to write scenes: `use fractal_sdf::prelude::*;`.
 pub mod prelude {
@@ -112,4 +125,5 @@ pub mod prelude {
         menger, octahedron, param, param3, plane, round_box, sierpinski, sphere, torus,
     };
     pub use glam::{DQuat, DVec3, EulerRot, Vec3, dvec3, vec3};
+    pub use image::RgbaImage;
 }

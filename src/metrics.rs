@@ -1,9 +1,19 @@
-//! Image error metrics for measuring render accuracy: PSNR, SSIM, and
-//! comparisons of hit masks and depth buffers.
+//! Comparing images: how far a render is from a reference — after
+//! changing a [`Quality`](crate::quality::Quality) knob, a device or the
+//! precision — as numbers a test can bound.
+//!
+//! - [`psnr`] and [`ssim`] compare two colour images (higher is closer;
+//!   identical images give infinity and 1);
+//! - [`mask_mismatch`] and [`mean_depth_error`] compare the per-pixel hit
+//!   flags and depths of two renders (the renderer's `Frame`, feature
+//!   `opencl`), where the colours alone would hide a missed surface.
+//!
+//! The crate's own accuracy tests and the `tradeoff` example measure with
+//! these.
 //!
 //! ```
+//! use fractal_sdf::image::{Rgba, RgbaImage};
 //! use fractal_sdf::metrics::{psnr, ssim};
-//! use image::{Rgba, RgbaImage};
 //!
 //! let a = RgbaImage::from_pixel(16, 16, Rgba([100, 150, 200, 255]));
 //! let mut b = a.clone();

@@ -219,6 +219,114 @@ impl Quality {
     }
 }
 
+/// Builder methods, one per knob: each returns the settings with that knob
+/// changed, so a preset is adjusted in one expression. Like the fields,
+/// they check nothing; [`Quality::validate`] (which every renderer runs)
+/// reports a bad value.
+///
+/// ```
+/// use fractal_sdf::prelude::*;
+///
+/// let q = Quality::production()
+///     .supersampling(2)
+///     .max_steps(1024)
+///     .fractal_iterations(8)
+///     .precision(Precision::F64);
+/// assert_eq!((q.supersampling, q.max_steps), (2, 1024));
+/// assert_eq!(q.fractal_iterations, Some(8));
+/// // Every other knob is the preset's.
+/// assert_eq!(q.hit_epsilon, Quality::production().hit_epsilon);
+/// q.validate()?;
+/// assert!(Quality::draft().over_relaxation(2.5).validate().is_err());
+/// # Ok::<(), fractal_sdf::Error>(())
+/// ```
+impl Quality {
+    /// Gives up on a ray after `steps` steps (1 to 100 000).
+    #[must_use]
+    pub fn max_steps(mut self, steps: u32) -> Self {
+        self.max_steps = steps;
+        self
+    }
+
+    /// Sets the drawn surface, in pixel footprints (> 0): a ray hits where
+    /// the distance estimate falls to `detail` footprints. Changes the
+    /// look, not only the cost; every preset uses [`Quality::DETAIL`].
+    #[must_use]
+    pub fn detail(mut self, detail: f64) -> Self {
+        self.detail = detail;
+        self
+    }
+
+    /// Locates hits on the surface to `epsilon` pixel footprints along the
+    /// ray (in `(0, detail]`).
+    #[must_use]
+    pub fn hit_epsilon(mut self, epsilon: f64) -> Self {
+        self.hit_epsilon = epsilon;
+        self
+    }
+
+    /// Stops rays beyond `distance` from the camera (> 0), in scene units.
+    #[must_use]
+    pub fn max_distance(mut self, distance: f64) -> Self {
+        self.max_distance = distance;
+        self
+    }
+
+    /// Sets the normals' finite-difference step, in pixel footprints (> 0).
+    /// Changes the look; every preset uses [`Quality::NORMAL_EPSILON`].
+    #[must_use]
+    pub fn normal_epsilon(mut self, epsilon: f64) -> Self {
+        self.normal_epsilon = epsilon;
+        self
+    }
+
+    /// Takes `samples` ambient-occlusion samples (0 to 32; 0: no occlusion).
+    #[must_use]
+    pub fn ao_samples(mut self, samples: u32) -> Self {
+        self.ao_samples = samples;
+        self
+    }
+
+    /// Marches each shadow ray at most `steps` steps (up to 10 000; 0: no
+    /// shadows).
+    #[must_use]
+    pub fn shadow_steps(mut self, steps: u32) -> Self {
+        self.shadow_steps = steps;
+        self
+    }
+
+    /// Caps every fractal's iterations at `cap` (1 to 256), or lifts the
+    /// cap with `None`.
+    #[must_use]
+    pub fn fractal_iterations(mut self, cap: impl Into<Option<u32>>) -> Self {
+        self.fractal_iterations = cap.into();
+        self
+    }
+
+    /// Sets the kernel's floating-point precision.
+    #[must_use]
+    pub fn precision(mut self, precision: Precision) -> Self {
+        self.precision = precision;
+        self
+    }
+
+    /// Sets the relaxation factor ω of sphere tracing, in `[0.25, 2)`
+    /// (1: plain sphere tracing).
+    #[must_use]
+    pub fn over_relaxation(mut self, omega: f64) -> Self {
+        self.over_relaxation = omega;
+        self
+    }
+
+    /// Takes `n`×`n` jittered samples per pixel (1 to 8; 1: one sample at
+    /// the pixel centre, no anti-aliasing).
+    #[must_use]
+    pub fn supersampling(mut self, n: u32) -> Self {
+        self.supersampling = n;
+        self
+    }
+}
+
 impl Default for Quality {
     /// [`Quality::production`].
     fn default() -> Self {
@@ -233,6 +341,14 @@ pub struct Glow {
     pub color: DVec3,
     /// Strength; 0.5 is subtle, 2 is strong.
     pub strength: f64,
+}
+
+impl Glow {
+    /// A glow of `color` (linear RGB) and `strength`.
+    #[must_use]
+    pub fn new(color: DVec3, strength: f64) -> Self {
+        Glow { color, strength }
+    }
 }
 
 /// Lighting effects. Each one that is off is left out of the kernel.
@@ -322,6 +438,84 @@ impl Effects {
             return Err(bad("gamma", self.gamma, "> 0"));
         }
         Ok(())
+    }
+}
+
+/// Builder methods, one per setting, as for [`Quality`]: each returns the
+/// effects with that setting changed; [`Effects::validate`] checks them.
+///
+/// ```
+/// use fractal_sdf::prelude::*;
+///
+/// let effects = Effects::default()
+///     .shadows(false)
+///     .glow(Glow::new(dvec3(0.6, 0.75, 1.0), 0.6))
+///     .fog_density(0.05);
+/// assert!(effects.ambient_occlusion && !effects.shadows);
+/// assert_eq!(effects.glow.map(|g| g.strength), Some(0.6));
+/// assert_eq!(effects.glow(None).glow, None);
+/// effects.validate()?;
+/// # Ok::<(), fractal_sdf::Error>(())
+/// ```
+impl Effects {
+    /// Turns ambient occlusion on or off (on needs
+    /// [`Quality::ao_samples`] > 0).
+    #[must_use]
+    pub fn ambient_occlusion(mut self, on: bool) -> Self {
+        self.ambient_occlusion = on;
+        self
+    }
+
+    /// Sets the reach of ambient occlusion along the normal, in scene
+    /// units (> 0).
+    #[must_use]
+    pub fn ao_distance(mut self, distance: f64) -> Self {
+        self.ao_distance = distance;
+        self
+    }
+
+    /// Turns shadows on or off (on needs [`Quality::shadow_steps`] > 0).
+    #[must_use]
+    pub fn shadows(mut self, on: bool) -> Self {
+        self.shadows = on;
+        self
+    }
+
+    /// Sets the glow, or turns it off with `None`.
+    #[must_use]
+    pub fn glow(mut self, glow: impl Into<Option<Glow>>) -> Self {
+        self.glow = glow.into();
+        self
+    }
+
+    /// Sets the fog: the fraction of light lost per unit of distance
+    /// (>= 0; 0: no fog).
+    #[must_use]
+    pub fn fog_density(mut self, density: f64) -> Self {
+        self.fog_density = density;
+        self
+    }
+
+    /// Sets the background colour at the top of the image (linear RGB).
+    #[must_use]
+    pub fn sky_top(mut self, color: DVec3) -> Self {
+        self.sky_top = color;
+        self
+    }
+
+    /// Sets the background colour at the bottom of the image (linear RGB).
+    #[must_use]
+    pub fn sky_bottom(mut self, color: DVec3) -> Self {
+        self.sky_bottom = color;
+        self
+    }
+
+    /// Sets the output gamma (> 0; 2.2 for sRGB-like output, 1 for
+    /// linear).
+    #[must_use]
+    pub fn gamma(mut self, gamma: f64) -> Self {
+        self.gamma = gamma;
+        self
     }
 }
 

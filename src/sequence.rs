@@ -21,7 +21,7 @@ use crate::error::{Error, Result};
 use crate::{
     animation::{CameraPath, Motion},
     render::Renderer,
-    timing::FrameTiming,
+    view::FrameTiming,
 };
 
 /// The file name of frame `index`: `frame_00042.png`.

@@ -16,7 +16,9 @@ use std::process::{Child, Command, Stdio};
 use std::thread::sleep;
 use std::time::{Duration, Instant, SystemTime, UNIX_EPOCH};
 
-use image::RgbaImage;
+use fractal_sdf::image::{self, RgbaImage};
+use fractal_sdf::quality::Preset;
+use fractal_sdf::view::{Action, Key, KeyScript};
 
 /// How long to wait for a window, a file or an exit before failing.
 const PATIENCE: Duration = Duration::from_secs(120);
@@ -220,7 +222,9 @@ fn scripted_keys_change_the_headless_screenshot() {
     };
     let plain = shot("plain.png", None);
     // `h` switches the shadows off before frame 1.
-    let unshadowed = shot("unshadowed.png", Some("h"));
+    assert_eq!(Action::for_key(Key::H), Some(Action::ToggleShadows));
+    let script = KeyScript::new([(1, Key::H)]).unwrap().to_string();
+    let unshadowed = shot("unshadowed.png", Some(&script));
     let again = shot("again.png", None);
     gpu::save("viewer_plain", &plain);
     gpu::save("viewer_unshadowed", &unshadowed);
@@ -278,6 +282,14 @@ fn real_key_presses_reach_the_window() {
         );
     };
     let shot = |i: u32| dir.join(format!("screenshot_{i:03}.png"));
+    // xdotool takes X key names: F12, 1 and Escape are the library's
+    // `Key::F12`, `Key::Digit1` and `Key::Escape`.
+    assert_eq!(Action::for_key(Key::F12), Some(Action::Screenshot));
+    assert_eq!(
+        Action::for_key(Key::Digit1),
+        Some(Action::Quality(Preset::Draft))
+    );
+    assert_eq!(Action::for_key(Key::Escape), Some(Action::Quit));
     key("F12");
     wait_for("the first screenshot", || shot(0).is_file());
     key("1"); // draft quality: no ambient occlusion, no shadows

@@ -3,6 +3,7 @@
 
 use std::time::{Duration, Instant};
 
+use fractal_sdf::image::Rgba;
 use fractal_sdf::metrics::{mask_mismatch, mean_depth_error, psnr, ssim};
 use fractal_sdf::prelude::*;
 use fractal_sdf::render::{Frame, Renderer};
@@ -86,9 +87,9 @@ pub fn compare(frame: &Frame, reference: &Frame) -> Errors {
 }
 
 /// The image at half the resolution, each pixel the mean of a 2×2 block.
-pub fn half(image: &image::RgbaImage) -> image::RgbaImage {
+pub fn half(image: &RgbaImage) -> RgbaImage {
     let (w, h) = ((image.width() / 2).max(1), (image.height() / 2).max(1));
-    image::RgbaImage::from_fn(w, h, |x, y| {
+    RgbaImage::from_fn(w, h, |x, y| {
         let mut sum = [0u32; 4];
         for (dx, dy) in [(0, 0), (1, 0), (0, 1), (1, 1)] {
             let p = image.get_pixel(
@@ -100,7 +101,7 @@ pub fn half(image: &image::RgbaImage) -> image::RgbaImage {
             }
         }
         #[allow(clippy::cast_possible_truncation)] // a mean of four bytes
-        image::Rgba(sum.map(|v| ((v + 2) / 4) as u8))
+        Rgba(sum.map(|v| ((v + 2) / 4) as u8))
     })
 }
 

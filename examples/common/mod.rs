@@ -66,17 +66,8 @@ pub fn render_to_png(
 /// supersampling and a soft glow.
 pub fn gallery_options() -> RenderOptions {
     RenderOptions {
-        quality: Quality {
-            supersampling: 2,
-            ..Quality::production()
-        },
-        effects: Effects {
-            glow: Some(Glow {
-                color: dvec3(0.6, 0.75, 1.0),
-                strength: 0.6,
-            }),
-            ..Effects::default()
-        },
+        quality: Quality::production().supersampling(2),
+        effects: Effects::default().glow(Glow::new(dvec3(0.6, 0.75, 1.0), 0.6)),
         ..RenderOptions::default()
     }
 }

@@ -1,6 +1,6 @@
 //! A labelled contact sheet of render tiles (the `deep_zoom` study).
 
-use image::RgbaImage;
+use fractal_sdf::image::{self, RgbaImage};
 use plotters::prelude::*;
 
 /// Row names of [`contact_sheet`], top to bottom.

@@ -1,7 +1,7 @@
 //! The trade-off plot: error (PSNR against the reference) over time per
 //! frame and over distance evaluations per pixel, one colour per scene.
 
-use image::RgbaImage;
+use fractal_sdf::image::RgbaImage;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 

@@ -69,4 +69,4 @@ pub use program::{BuildInfo, program_builds};
 pub use renderer::{RenderOptions, Renderer};
 pub use viewport::Viewport;
 
-pub use crate::timing::FrameTiming;
+pub use crate::view::FrameTiming;

@@ -112,27 +112,39 @@ pub fn ellipsoid(radii: impl Into<Param3>) -> Node {
     .into()
 }
 
-/// A Mandelbulb of `power` with 12 iterations and bailout 2. Build a
-/// [`Mandelbulb`] for other settings.
+/// A Mandelbulb of `power` with 12 iterations and bailout 2, centred on
+/// the origin. It lies in the ball of radius `2^(1/(power - 1))` about the
+/// origin (about 1.104 for power 8, which reaches it; 2 for power 2),
+/// whatever the iterations and bailout. Build a [`Mandelbulb`] for other
+/// settings.
 #[must_use]
 pub fn mandelbulb(power: impl Into<Param>) -> Node {
     Mandelbulb::new(power).into()
 }
 
-/// The classic Menger sponge (scale 3) with `iterations` levels.
+/// The classic Menger sponge (scale 3) with `iterations` levels. It fills
+/// the cube `[-1, 1]^3`: 0 levels is that solid cube, and every level keeps
+/// its eight corners.
 #[must_use]
 pub fn menger(iterations: u32) -> Node {
     Menger::new(iterations).into()
 }
 
 /// A quaternion Julia set for the constant `c` = (x, y, z, w), with 12
-/// iterations, bailout 4 and the slice w = 0.
+/// iterations, bailout 4 and the slice w = 0, centred on the origin. It
+/// lies in the ball of radius `(1 + sqrt(1 + 4|c|)) / 2` about the origin
+/// (beyond it every orbit grows): 1 for `c = 0`, about 1.47 for
+/// `[-0.2, 0.6, 0.2, 0.2]`, 2 for `|c| = 2`.
 #[must_use]
 pub fn julia(c: [f64; 4]) -> Node {
     QuaternionJulia::new(c.map(Param::from)).into()
 }
 
 /// The classic Sierpinski tetrahedron (scale 2) with `iterations` levels.
+/// It lies in the regular tetrahedron with vertices `(1, 1, 1)`,
+/// `(-1, -1, 1)`, `(1, -1, -1)` and `(-1, 1, -1)` (inside the cube
+/// `[-1, 1]^3`): 0 levels is that solid tetrahedron, and every level keeps
+/// the four vertices.
 #[must_use]
 pub fn sierpinski(iterations: u32) -> Node {
     Sierpinski::new(iterations).into()

@@ -49,6 +49,10 @@ pub enum CsgOp {
 /// The Mandelbulb: the escape-time fractal of the "triplex" power map
 /// `z -> z^power + p` in spherical coordinates (White and Nylander).
 ///
+/// Extent: the set lies in the ball of radius `2^(1/(power - 1))` about the
+/// origin, for any iterations and bailout (beyond it every orbit grows);
+/// that is about 1.104 for power 8, which reaches it, and 2 for power 2.
+///
 /// Distance estimate: `0.5 * ln(r) * r / dr` with the running derivative
 /// `dr`, a bound (it does not overestimate within the sampled tests). The
 /// orbit trap is the smallest `|z|` the orbit reaches, mapped to `[0, 1]`.
@@ -64,8 +68,9 @@ pub struct Mandelbulb<S = Param> {
 
 /// The Menger sponge as a folding (KIFS) fractal in the cube `[-1, 1]^3`.
 ///
-/// Scale 3 is the classic sponge; other scales in `[2, 4]` give related
-/// sponges. Distance: the exact box distance of the folded point divided by
+/// Extent: for every scale and level the sponge fills that cube: it lies in
+/// it and keeps its eight corners. Scale 3 is the classic sponge; other
+/// scales in `[2, 4]` give related sponges. Distance: the exact box distance of the folded point divided by
 /// `scale^iterations`, a bound. Iterations 0 is the solid cube.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Menger<S = Param> {
@@ -76,6 +81,12 @@ pub struct Menger<S = Param> {
 }
 
 /// A quaternion Julia set `z -> z^2 + c`, sliced at `w = slice_w`.
+///
+/// Extent: the 4D set lies in the ball of radius
+/// `R = (1 + sqrt(1 + 4|c|)) / 2` about the origin (beyond it every orbit
+/// grows), so the slice lies in the 3D ball of radius `sqrt(R^2 - w^2)`
+/// and is empty for `|w| > R`. `R` is 1 for `c = 0` (the unit ball) and 2
+/// for `|c| = 2`.
 ///
 /// Distance estimate: `0.5 * |z| * ln|z| / |dz|`, a bound.
 #[derive(Debug, Clone, PartialEq)]
@@ -93,7 +104,9 @@ pub struct QuaternionJulia<S = Param> {
 /// The Sierpinski tetrahedron as a folding (KIFS) fractal, with vertices at
 /// `(1,1,1)`, `(-1,-1,1)`, `(1,-1,-1)` and `(-1,1,-1)`.
 ///
-/// Scale 2 is the classic gasket; other scales in `[1.5, 4]` give related
+/// Extent: for every scale and level it lies in the solid tetrahedron of
+/// those vertices (inside the cube `[-1, 1]^3`) and keeps the four
+/// vertices. Scale 2 is the classic gasket; other scales in `[1.5, 4]` give related
 /// sets. Distance: a tetrahedron bound of the folded point divided by
 /// `scale^iterations`, a bound. Iterations 0 is the solid tetrahedron.
 #[derive(Debug, Clone, PartialEq)]

@@ -1,32 +1,12 @@
-//! Interactive control, without a window: a fly-through camera
-//! ([`FlyCamera`]), the keys that move it ([`Movement`]), the keys that
-//! change what is drawn ([`Action`], [`ViewSettings`]) and scripted key
-//! presses for unattended runs ([`KeyScript`]).
-//!
-//! A window toolkit only has to translate its events into key names (`"w"`,
-//! `"g"`, `"3"`, `"f12"`, ...) and mouse deltas; everything else is here and
-//! tested.
-//!
-//! ```
-//! use fractal_sdf::control::{Action, FlyCamera, Movement};
-//! use fractal_sdf::prelude::*;
-//!
-//! let start = Camera::look_at(dvec3(0.0, 0.0, 5.0), DVec3::ZERO);
-//! let mut fly = FlyCamera::from_camera(&start);
-//! let mut keys = Movement::default();
-//! assert!(keys.set("w", true));
-//! fly.speed = 2.0;
-//! fly.advance(keys, 0.5); // one unit towards the target
-//! let camera = fly.camera(&start);
-//! assert!((camera.position.z - 4.0).abs() < 1e-9);
-//! assert_eq!(Action::for_key("g"), Some(Action::ToggleGlow));
-//! ```
+//! The fly-through camera ([`FlyCamera`]), the keys that move it
+//! ([`Movement`]), and the keys that change what is drawn ([`Action`],
+//! [`ViewSettings`]).
 
 use std::f64::consts::{FRAC_PI_2, TAU};
 
 use glam::{DVec3, dvec3};
 
-use crate::error::{Error, Result};
+use super::Key;
 use crate::quality::{Effects, Glow, Preset, Quality};
 use crate::scene::Camera;
 
@@ -168,16 +148,16 @@ pub struct Movement {
 }
 
 impl Movement {
-    /// Records a press (`pressed`) or release of the key `name`; returns
-    /// whether it is a movement key.
-    pub fn set(&mut self, name: &str, pressed: bool) -> bool {
-        let held = match name {
-            "w" | "arrowup" => &mut self.forward,
-            "s" | "arrowdown" => &mut self.back,
-            "a" | "arrowleft" => &mut self.left,
-            "d" | "arrowright" => &mut self.right,
-            "e" => &mut self.up,
-            "q" => &mut self.down,
+    /// Records a press (`pressed`) or release of `key`; returns whether it
+    /// is a movement key.
+    pub fn set(&mut self, key: Key, pressed: bool) -> bool {
+        let held = match key {
+            Key::W | Key::ArrowUp => &mut self.forward,
+            Key::S | Key::ArrowDown => &mut self.back,
+            Key::A | Key::ArrowLeft => &mut self.left,
+            Key::D | Key::ArrowRight => &mut self.right,
+            Key::E => &mut self.up,
+            Key::Q => &mut self.down,
             _ => return false,
         };
         *held = pressed;
@@ -202,8 +182,10 @@ impl Movement {
     }
 }
 
-/// What a key press asks for, other than movement.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+/// What a key press asks for, other than movement. Each action has one
+/// key ([`Action::key`]); the keys without one are free for the window's
+/// own use.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum Action {
     /// `o`: ambient occlusion on or off.
     ToggleAmbientOcclusion,
@@ -224,35 +206,62 @@ pub enum Action {
 }
 
 impl Action {
-    /// Every action key and what it does, for help texts.
-    pub const KEYS: [(&'static str, &'static str); 8] = [
-        ("o", "toggle ambient occlusion"),
-        ("h", "toggle shadows"),
-        ("g", "toggle glow"),
-        ("1-4", "quality: draft, preview, production, reference"),
-        ("space", "pause or resume the animation"),
-        ("r", "reset the camera"),
-        ("f12", "save a screenshot"),
-        ("escape", "quit"),
+    /// Every action, in the order a help text lists them.
+    pub const ALL: [Action; 11] = [
+        Action::ToggleAmbientOcclusion,
+        Action::ToggleShadows,
+        Action::ToggleGlow,
+        Action::Quality(Preset::Draft),
+        Action::Quality(Preset::Preview),
+        Action::Quality(Preset::Production),
+        Action::Quality(Preset::Reference),
+        Action::ToggleAnimation,
+        Action::ResetCamera,
+        Action::Screenshot,
+        Action::Quit,
     ];
 
-    /// The action of the key `name` (lower case, as in [`Action::KEYS`]).
+    /// The key that asks for this action.
     #[must_use]
-    pub fn for_key(name: &str) -> Option<Action> {
-        Some(match name {
-            "o" => Action::ToggleAmbientOcclusion,
-            "h" => Action::ToggleShadows,
-            "g" => Action::ToggleGlow,
-            "1" => Action::Quality(Preset::Draft),
-            "2" => Action::Quality(Preset::Preview),
-            "3" => Action::Quality(Preset::Production),
-            "4" => Action::Quality(Preset::Reference),
-            "space" => Action::ToggleAnimation,
-            "r" => Action::ResetCamera,
-            "f12" => Action::Screenshot,
-            "escape" => Action::Quit,
-            _ => return None,
-        })
+    pub fn key(self) -> Key {
+        match self {
+            Action::ToggleAmbientOcclusion => Key::O,
+            Action::ToggleShadows => Key::H,
+            Action::ToggleGlow => Key::G,
+            Action::Quality(Preset::Draft) => Key::Digit1,
+            Action::Quality(Preset::Preview) => Key::Digit2,
+            Action::Quality(Preset::Production) => Key::Digit3,
+            Action::Quality(Preset::Reference) => Key::Digit4,
+            Action::ToggleAnimation => Key::Space,
+            Action::ResetCamera => Key::R,
+            Action::Screenshot => Key::F12,
+            Action::Quit => Key::Escape,
+        }
+    }
+
+    /// The action `key` asks for, if any (movement keys have none: see
+    /// [`Movement::set`]).
+    #[must_use]
+    pub fn for_key(key: Key) -> Option<Action> {
+        Self::ALL.into_iter().find(|a| a.key() == key)
+    }
+
+    /// What the action does, for help texts, such as `toggle glow`.
+    #[must_use]
+    pub fn description(self) -> &'static str {
+        match self {
+            Action::ToggleAmbientOcclusion => "toggle ambient occlusion",
+            Action::ToggleShadows => "toggle shadows",
+            Action::ToggleGlow => "toggle glow",
+            Action::Quality(Preset::Draft) => "draft quality",
+            Action::Quality(Preset::Preview) => "preview quality",
+            Action::Quality(Preset::Production) => "production quality",
+            Action::Quality(Preset::Reference) => "reference quality",
+            Action::ToggleAnimation => "pause or resume the animation",
+            Action::ResetCamera => "reset the camera",
+            Action::Screenshot => "save a screenshot",
+            Action::Quit => "quit",
+        }
     }
 }
 
@@ -340,82 +349,6 @@ impl ViewSettings {
     }
 }
 
-/// Key presses scheduled by frame number, for unattended runs: `"g,3"`
-/// presses `g` before frame 1 and `3` before frame 2; `"g@5,3@5"` presses
-/// both before frame 5. A key without `@FRAME` comes one frame after the
-/// previous key (the first at frame 1, so frame 0 shows the start).
-///
-/// ```
-/// use fractal_sdf::control::{Action, KeyScript};
-/// let script = KeyScript::parse("g, 3@4, o")?;
-/// assert_eq!(script.keys_at(1).collect::<Vec<_>>(), [Action::ToggleGlow]);
-/// assert_eq!(script.keys_at(4).count(), 1);
-/// assert_eq!(script.last_frame(), Some(5));
-/// assert!(KeyScript::parse("z").is_err());
-/// # Ok::<(), fractal_sdf::Error>(())
-/// ```
-#[derive(Debug, Clone, PartialEq, Eq, Default)]
-pub struct KeyScript {
-    presses: Vec<(u64, Action)>,
-}
-
-impl KeyScript {
-    /// Parses a comma-separated list of `KEY` or `KEY@FRAME` (keys as in
-    /// [`Action::KEYS`]; spaces around items are ignored).
-    ///
-    /// # Errors
-    /// [`Error::Invalid`] naming an unknown key or a bad frame number.
-    pub fn parse(text: &str) -> Result<Self> {
-        let bad = |reason: String| Error::Invalid {
-            what: "key script",
-            reason,
-        };
-        let mut presses = Vec::new();
-        let mut next = 1u64;
-        for item in text.split(',').map(str::trim).filter(|s| !s.is_empty()) {
-            let (key, frame) = match item.split_once('@') {
-                Some((key, frame)) => {
-                    let frame = frame
-                        .trim()
-                        .parse::<u64>()
-                        .map_err(|_| bad(format!("`{item}`: the frame must be a whole number")))?;
-                    (key.trim(), frame)
-                }
-                None => (item, next),
-            };
-            let key = key.to_ascii_lowercase();
-            let action = Action::for_key(&key).ok_or_else(|| {
-                let known: Vec<&str> = Action::KEYS.iter().map(|(k, _)| *k).collect();
-                bad(format!("unknown key `{key}` (keys: {})", known.join(", ")))
-            })?;
-            presses.push((frame, action));
-            next = frame + 1;
-        }
-        presses.sort_by_key(|&(frame, _)| frame);
-        Ok(KeyScript { presses })
-    }
-
-    /// The actions pressed before frame `frame`, in script order.
-    pub fn keys_at(&self, frame: u64) -> impl Iterator<Item = Action> + '_ {
-        self.presses
-            .iter()
-            .filter(move |(f, _)| *f == frame)
-            .map(|&(_, a)| a)
-    }
-
-    /// The frame of the last press, if any.
-    #[must_use]
-    pub fn last_frame(&self) -> Option<u64> {
-        self.presses.last().map(|&(f, _)| f)
-    }
-
-    /// Whether the script presses nothing.
-    #[must_use]
-    pub fn is_empty(&self) -> bool {
-        self.presses.is_empty()
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -425,9 +358,9 @@ mod tests {
         assert!(a.abs_diff_eq(b, 1e-12), "{a} != {b}");
     }
 
-    fn held(keys: &[&str]) -> Movement {
+    fn held(keys: &[Key]) -> Movement {
         let mut m = Movement::default();
-        for k in keys {
+        for &k in keys {
             assert!(m.set(k, true), "{k} is a movement key");
         }
         m
@@ -461,32 +394,32 @@ mod tests {
         // Looking down +x: forward is +x, right is +z.
         let mut fly = FlyCamera::new(DVec3::ZERO, DVec3::X);
         fly.speed = 4.0;
-        assert!(fly.advance(held(&["w"]), 0.5));
+        assert!(fly.advance(held(&[Key::W]), 0.5));
         close(fly.position, dvec3(2.0, 0.0, 0.0));
-        fly.advance(held(&["d"]), 0.25);
+        fly.advance(held(&[Key::D]), 0.25);
         close(fly.position, dvec3(2.0, 0.0, 1.0));
-        fly.advance(held(&["e"]), 0.25);
+        fly.advance(held(&[Key::E]), 0.25);
         assert_relative_eq!(fly.position.y, 1.0, epsilon = 1e-12);
-        fly.advance(held(&["q", "s"]), 0.25);
+        fly.advance(held(&[Key::Q, Key::S]), 0.25);
         let diagonal = dvec3(-1.0, -1.0, 0.0).normalize();
         close(fly.position, dvec3(2.0, 1.0, 1.0) + diagonal);
         // Opposite keys cancel; nothing held or no time moves nothing.
         let before = fly.position;
-        assert!(!fly.advance(held(&["a", "d"]), 1.0));
+        assert!(!fly.advance(held(&[Key::A, Key::D]), 1.0));
         assert!(!fly.advance(Movement::default(), 1.0));
-        assert!(!fly.advance(held(&["w"]), 0.0));
-        assert!(!fly.advance(held(&["w"]), f64::NAN));
+        assert!(!fly.advance(held(&[Key::W]), 0.0));
+        assert!(!fly.advance(held(&[Key::W]), f64::NAN));
         assert_eq!(fly.position, before);
     }
 
     #[test]
     fn releasing_a_key_stops_it() {
-        let mut m = held(&["w", "arrowleft"]);
+        let mut m = held(&[Key::W, Key::ArrowLeft]);
         assert_eq!(m.axes(), [-1.0, 0.0, 1.0]);
-        m.set("w", false);
-        m.set("arrowleft", false);
+        m.set(Key::W, false);
+        m.set(Key::ArrowLeft, false);
         assert!(!m.is_moving());
-        assert!(!m.set("g", true), "g is not a movement key");
+        assert!(!m.set(Key::G, true), "g is not a movement key");
     }
 
     #[test]
@@ -549,37 +482,26 @@ mod tests {
         assert!(!s.apply(Action::Quality(Preset::Production)), "no change");
         assert!(!s.apply(Action::Screenshot));
         assert_eq!(s.summary(), "production, glow");
-        // Every listed key has an action, and only those do.
-        for (key, _) in Action::KEYS {
-            if key != "1-4" {
-                assert!(Action::for_key(key).is_some(), "{key}");
-            }
-        }
-        for (key, preset) in ["1", "2", "3", "4"].into_iter().zip(Preset::ALL) {
-            assert_eq!(Action::for_key(key), Some(Action::Quality(preset)));
-        }
-        assert_eq!(Action::for_key("w"), None);
     }
 
     #[test]
-    fn key_scripts_schedule_presses_by_frame() {
-        let s = KeyScript::parse("g,3").unwrap();
-        assert_eq!(s.keys_at(0).count(), 0);
-        assert_eq!(s.keys_at(1).collect::<Vec<_>>(), [Action::ToggleGlow]);
-        assert_eq!(
-            s.keys_at(2).collect::<Vec<_>>(),
-            [Action::Quality(Preset::Production)]
-        );
-        let s = KeyScript::parse(" G@7 , o@2, h ").unwrap();
-        assert_eq!(s.last_frame(), Some(7));
-        assert_eq!(s.keys_at(3).collect::<Vec<_>>(), [Action::ToggleShadows]);
-        assert_eq!(s.keys_at(7).collect::<Vec<_>>(), [Action::ToggleGlow]);
-        let both = KeyScript::parse("g@5,1@5").unwrap();
-        assert_eq!(both.keys_at(5).count(), 2);
-        assert!(KeyScript::parse("").unwrap().is_empty());
-        let err = KeyScript::parse("g,x").unwrap_err().to_string();
-        assert!(err.contains("unknown key `x`"), "{err}");
-        let err = KeyScript::parse("g@soon").unwrap_err().to_string();
-        assert!(err.contains("`g@soon`"), "{err}");
+    fn each_action_has_its_own_key_and_no_movement_key_has_one() {
+        for action in Action::ALL {
+            assert_eq!(Action::for_key(action.key()), Some(action));
+            assert!(!Movement::default().set(action.key(), true), "{action:?}");
+        }
+        let mut keys: Vec<Key> = Action::ALL.iter().map(|a| a.key()).collect();
+        keys.sort_unstable();
+        keys.dedup();
+        assert_eq!(keys.len(), Action::ALL.len());
+        for (key, preset) in [Key::Digit1, Key::Digit2, Key::Digit3, Key::Digit4]
+            .into_iter()
+            .zip(Preset::ALL)
+        {
+            assert_eq!(Action::for_key(key), Some(Action::Quality(preset)));
+        }
+        for key in [Key::W, Key::ArrowUp, Key::Z, Key::Digit5] {
+            assert_eq!(Action::for_key(key), None);
+        }
     }
 }

@@ -1,23 +1,11 @@
 //! Frame times: what one frame cost ([`FrameTiming`]), statistics over many
 //! frames ([`FrameStats`]), and the render-resolution choice of an
-//! interactive view ([`ResolutionScaler`]).
-//!
-//! ```
-//! use std::time::Duration;
-//! use fractal_sdf::timing::FrameStats;
-//!
-//! let mut stats = FrameStats::new();
-//! for ms in [20, 25, 30] {
-//!     stats.push(Duration::from_millis(ms));
-//! }
-//! assert_eq!(stats.count(), 3);
-//! assert_eq!(stats.mean(), Some(Duration::from_millis(25)));
-//! assert_eq!(stats.max_fps(), Some(50.0)); // 1 / 20 ms
-//! ```
+//! interactive view ([`ResolutionScaler`], [`reduced_size`]).
 
 use std::time::Duration;
 
-/// What one rendered frame cost.
+/// What one rendered frame cost, as the renderer reports it
+/// (`render::Renderer::last_timing`, feature `opencl`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub struct FrameTiming {
     /// Time the device spent running the ray-marching kernel, summed over
@@ -36,6 +24,19 @@ pub struct FrameTiming {
 
 /// Running statistics over frame times: count, total, minimum, maximum,
 /// mean, and the frame rates they imply.
+///
+/// ```
+/// use std::time::Duration;
+/// use fractal_sdf::view::FrameStats;
+///
+/// let mut stats = FrameStats::new();
+/// for ms in [20, 25, 30] {
+///     stats.push(Duration::from_millis(ms));
+/// }
+/// assert_eq!(stats.count(), 3);
+/// assert_eq!(stats.mean(), Some(Duration::from_millis(25)));
+/// assert_eq!(stats.max_fps(), Some(50.0)); // 1 / 20 ms
+/// ```
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub struct FrameStats {
     count: u64,
@@ -126,7 +127,7 @@ pub fn fps(frame: Duration) -> Option<f64> {
 ///
 /// ```
 /// use std::time::Duration;
-/// use fractal_sdf::timing::ResolutionScaler;
+/// use fractal_sdf::view::ResolutionScaler;
 ///
 /// let mut s = ResolutionScaler::new(Duration::from_millis(50), 8);
 /// assert_eq!(s.next(true), Some(2)); // moving: start at half size
