@@ -109,10 +109,6 @@ pub use scene::{Node, Scene};
 /// render returns, with its PNG codec.
 pub use image;
 
-// The renderer names `FrameTiming` by this crate-internal path.
-#[cfg(feature = "opencl")]
-use view::timing;
-
 /// Everything needed to write scenes: `use fractal_sdf::prelude::*;`.
 pub mod prelude {
     pub use crate::cpu;

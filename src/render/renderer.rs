@@ -20,7 +20,7 @@ use crate::error::{Error, Result};
 use crate::ir::{CompiledScene, ParamValues};
 use crate::quality::{Effects, Precision, Quality};
 use crate::scene::{Camera, Light, Scene};
-use crate::timing::FrameTiming;
+use crate::view::FrameTiming;
 
 /// Everything that decides how a scene is rendered, apart from the scene.
 #[derive(Debug, Clone, PartialEq)]

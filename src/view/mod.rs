@@ -65,8 +65,7 @@ mod blit;
 mod control;
 mod key;
 mod script;
-// `pub(crate)` for the crate-internal path `crate::timing` (see lib.rs).
-pub(crate) mod timing;
+mod timing;
 
 pub use blit::blit_scaled;
 pub use control::{Action, FlyCamera, Movement, ViewSettings};
