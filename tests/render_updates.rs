@@ -4,7 +4,7 @@
 mod gpu;
 
 use fractal_sdf::prelude::*;
-use fractal_sdf::render::Renderer;
+use fractal_sdf::render::{RenderOptions, Renderer};
 
 #[test]
 fn camera_lights_and_parameters_change_the_image_without_a_rebuild() {
@@ -150,4 +150,32 @@ fn f64_renders_where_the_device_supports_it() {
     // Precision can change on the fly.
     r.set_quality(gpu::quick()).unwrap();
     assert_eq!(r.render(48, 32).unwrap(), f32_frame.image);
+}
+
+#[test]
+fn hand_written_functions_survive_lights_quality_and_effects() {
+    let Some(_) = gpu::device() else { return };
+    let functions = include_str!("../benches/mandelbulb_handwritten.cl");
+    let scene = fractal_sdf::gallery::mandelbulb().compile().unwrap();
+    let mut r =
+        Renderer::with_scene_functions(scene, &RenderOptions::default(), functions).unwrap();
+    let hand_written = |r: &Renderer| r.source().source.contains(functions);
+    assert!(hand_written(&r));
+    r.set_lights([gpu::sun(0.1)]).unwrap();
+    assert!(
+        hand_written(&r),
+        "set_lights swapped in a generated program"
+    );
+    r.set_quality(Quality::draft()).unwrap();
+    assert!(
+        hand_written(&r),
+        "set_quality swapped in a generated program"
+    );
+    r.set_effects(Effects::default().ambient_occlusion(false))
+        .unwrap();
+    assert!(
+        hand_written(&r),
+        "set_effects swapped in a generated program"
+    );
+    assert!(!r.source().source.contains("#define ENABLE_AO"));
 }

@@ -596,3 +596,43 @@ proptest! {
         }
     }
 }
+
+/// A dynamic value keeps every rule that relates it to other parameters,
+/// with the error a baked value gets.
+#[test]
+fn dynamic_values_keep_relational_rules() {
+    let node = round_box(dvec3(0.5, 0.5, 0.5), param("r", 0.1));
+    let mut eval = cpu::Evaluator::new(&node).unwrap();
+    let err = eval.set_param("r", 0.9).unwrap_err();
+    let baked = Scene::new(round_box(dvec3(0.5, 0.5, 0.5), 0.9))
+        .validate()
+        .unwrap_err();
+    assert_eq!(err.to_string(), baked.to_string());
+    assert_eq!(
+        err.to_string(),
+        "round_box: parameter `radius` must be <= the smallest half extent (0.5), got 0.9"
+    );
+    // The refused value is not kept: the box is still a box.
+    assert_eq!(eval.values().get("r"), Some(0.1));
+    assert!((eval.distance(DVec3::ZERO) + 0.5).abs() < 1e-12);
+    eval.set_param("r", 0.5).unwrap();
+
+    // A dynamic half extent below a baked radius, likewise.
+    let node = round_box(param3("b", dvec3(0.5, 0.5, 0.5)), 0.2);
+    let mut eval = cpu::Evaluator::new(&node).unwrap();
+    let err = eval.set_param("b.y", 0.1).unwrap_err();
+    assert!(
+        err.to_string()
+            .contains("<= the smallest half extent (0.1), got 0.2"),
+        "{err}"
+    );
+
+    // A plane's dynamic normal cannot become zero.
+    let node = plane(param3("n", dvec3(0.0, 1.0, 0.0)), 0.0);
+    let mut eval = cpu::Evaluator::new(&node).unwrap();
+    eval.set_param("n.y", 0.0).unwrap_err();
+    eval.set_param("n.x", 1.0).unwrap();
+    eval.set_param("n.y", 0.0).unwrap();
+    let err = eval.set_param("n.x", 0.0).unwrap_err();
+    assert!(matches!(err, Error::ZeroVector { .. }), "{err}");
+}
