@@ -12,10 +12,10 @@ use std::path::{Path, PathBuf};
 /// `FrameTiming` the renderer reports.
 const STAGES: &[(&str, &[&str])] = &[
     ("error", &[]),
+    ("math", &[]),
     ("quality", &["error"]),
-    ("scene", &["error"]),
-    ("ir", &["error", "scene"]),
-    ("math", &["ir"]),
+    ("scene", &["error", "math"]),
+    ("ir", &["error", "math", "scene"]),
     ("cpu", &["error", "scene", "ir", "math"]),
     ("codegen", &["error", "scene", "ir", "math", "quality"]),
     (

@@ -29,6 +29,15 @@ struct Vars {
     t: String,
 }
 
+/// What entering a node leaves to do.
+enum Step {
+    /// The node is emitted (a leaf).
+    Done(Vars),
+    /// Its children, with their points and whether they need a colour, come
+    /// next; the node is finished when it is left.
+    Descend(Vec<(NodeId, String, bool)>),
+}
+
 /// The library function and helper file of each primitive: the table that
 /// drives leaf emission. Its arguments are the node's parameters in
 /// `try_map` order.
@@ -205,15 +214,48 @@ impl<'a> SceneEmitter<'a> {
         Vars { d, ..child }
     }
 
-    /// Emits node `id` at point `p`. `needs_color` is false below a colour
-    /// node, which paints over whatever colour its child computes, so none
-    /// is computed.
-    fn node(&mut self, id: NodeId, p: &str, needs_color: bool) -> Vars {
+    /// Emits the tree under `root` at point `p` without recursion: a work
+    /// list enters each node (its comment, and the lines that compute its
+    /// children's point) and leaves it after its children (the lines that
+    /// combine their results), in the order a recursive walk would.
+    /// `needs_color` is false below a colour node, which paints over
+    /// whatever colour its child computes, so none is computed.
+    fn node(&mut self, root: NodeId, p: &str, needs_color: bool) -> Vars {
+        enum Task {
+            Enter(NodeId, String, bool),
+            Leave(NodeId, String, bool, usize),
+        }
+        let mut tasks = vec![Task::Enter(root, p.to_string(), needs_color)];
+        let mut results: Vec<Vars> = Vec::new();
+        while let Some(task) = tasks.pop() {
+            match task {
+                Task::Enter(id, p, needs_color) => match self.enter(id, &p, needs_color) {
+                    Step::Done(v) => results.push(v),
+                    Step::Descend(children) => {
+                        tasks.push(Task::Leave(id, p, needs_color, children.len()));
+                        for (child, q, color) in children.into_iter().rev() {
+                            tasks.push(Task::Enter(child, q, color));
+                        }
+                    }
+                },
+                Task::Leave(id, p, needs_color, n) => {
+                    let children = results.split_off(results.len() - n);
+                    let v = self.leave(id, &p, needs_color, children);
+                    results.push(v);
+                }
+            }
+        }
+        results.pop().expect("the root has a result")
+    }
+
+    /// Entering a node: a leaf is emitted whole; any other node emits what
+    /// comes before its children and names them with their points.
+    fn enter(&mut self, id: NodeId, p: &str, needs_color: bool) -> Step {
         let ir = self.ir;
         let node = ir.node(id);
         if self.frame == Some(id) {
             if let Kind::Translate { child, .. } = node {
-                return self.node(*child, p, needs_color);
+                return Step::Descend(vec![(*child, p.to_string(), needs_color)]);
             }
         }
         if !matches!(
@@ -225,7 +267,7 @@ impl<'a> SceneEmitter<'a> {
         if let Some((helper, function)) = leaf_function(node) {
             self.used.insert(helper);
             let args = self.arguments(node);
-            return self.leaf(id, format!("{function}({p}, {args})"));
+            return Step::Done(self.leaf(id, format!("{function}({p}, {args})")));
         }
         let w = |this: &Self, s: Scalar| this.w.scalar(s);
         let v3 = |this: &Self, v: [Scalar; 3]| this.w.vector(v);
@@ -253,22 +295,22 @@ impl<'a> SceneEmitter<'a> {
                         format!("pow(R(2.0), R(1.0) / ({} - R(1.0)))", w(self, f.power))
                     }
                 };
-                match integer_power(f.power) {
+                match f.power.baked().and_then(integer_power) {
                     Some(power) => {
                         self.powers.insert(power);
                         let args = format!("{p}, {n}, {escape}, {ball}");
-                        self.fractal_call(id, &super::power::helper_name(power), &args)
+                        Step::Done(self.fractal_call(id, &super::power::helper_name(power), &args))
                     }
                     None => {
                         let args = format!("{p}, {}, {n}, {escape}, {ball}", w(self, f.power));
-                        self.fractal(id, Helper::Mandelbulb, &args)
+                        Step::Done(self.fractal(id, Helper::Mandelbulb, &args))
                     }
                 }
             }
             Kind::Menger(f) => {
                 let n = self.iterations(f.iterations, (0, MAX_FOLD_ITERATIONS));
                 let args = format!("{p}, {n}, {}", w(self, f.scale));
-                self.fractal(id, Helper::Menger, &args)
+                Step::Done(self.fractal(id, Helper::Menger, &args))
             }
             Kind::Julia(f) => {
                 let n = self.iterations(f.iterations, (1, MAX_ESCAPE_ITERATIONS));
@@ -278,16 +320,16 @@ impl<'a> SceneEmitter<'a> {
                     w(self, f.slice_w),
                     w(self, f.bailout)
                 );
-                self.fractal(id, Helper::Julia, &args)
+                Step::Done(self.fractal(id, Helper::Julia, &args))
             }
             Kind::Sierpinski(f) => {
                 let n = self.iterations(f.iterations, (0, MAX_FOLD_ITERATIONS));
                 let args = format!("{p}, {n}, {}", w(self, f.scale));
-                self.fractal(id, Helper::Sierpinski, &args)
+                Step::Done(self.fractal(id, Helper::Sierpinski, &args))
             }
             Kind::Translate { offset, child } => {
                 let q = self.point(format!("{p} - {}", v3(self, *offset)));
-                self.node(*child, &q, needs_color)
+                Step::Descend(vec![(*child, q, needs_color)])
             }
             Kind::Rotate { axis, angle, child } => {
                 let q = match angle {
@@ -303,40 +345,30 @@ impl<'a> SceneEmitter<'a> {
                         self.point(format!("rotate_axis({p}, {k}, {a})"))
                     }
                 };
-                self.node(*child, &q, needs_color)
+                Step::Descend(vec![(*child, q, needs_color)])
             }
             Kind::Scale { factor, child } => {
                 let f = w(self, *factor);
                 let q = self.point(format!("{p} / {f}"));
-                let c = self.node(*child, &q, needs_color);
-                self.post(id, c, &format!("{{d}} * {f}"))
+                Step::Descend(vec![(*child, q, needs_color)])
             }
             Kind::Mirror { axis, child } => {
                 let q = self.point(p.to_string());
                 let a = ["x", "y", "z"][axis.index()];
                 self.w.line(format!("{q}.{a} = fabs({q}.{a});"));
-                self.node(*child, &q, needs_color)
+                Step::Descend(vec![(*child, q, needs_color)])
             }
-            Kind::Round { radius, child } => {
-                let c = self.node(*child, p, needs_color);
-                self.label(id);
-                let r = w(self, *radius);
-                self.post(id, c, &format!("{{d}} - {r}"))
-            }
-            Kind::Onion { thickness, child } => {
-                let c = self.node(*child, p, needs_color);
-                self.label(id);
-                let t = w(self, *thickness);
-                self.post(id, c, &format!("fabs({{d}}) - {t}"))
+            Kind::Round { child, .. } | Kind::Onion { child, .. } => {
+                Step::Descend(vec![(*child, p.to_string(), needs_color)])
             }
             Kind::Elongate { extents, child } => {
                 let h = v3(self, *extents);
                 let q = self.point(format!("{p} - clamp({p}, -{h}, {h})"));
-                self.node(*child, &q, needs_color)
+                Step::Descend(vec![(*child, q, needs_color)])
             }
             Kind::Repeat { period, child } => {
                 let q = self.repeat(p, *period, None);
-                self.node(*child, &q, needs_color)
+                Step::Descend(vec![(*child, q, needs_color)])
             }
             Kind::RepeatLimited {
                 period,
@@ -344,7 +376,7 @@ impl<'a> SceneEmitter<'a> {
                 child,
             } => {
                 let q = self.repeat(p, *period, Some(*limit));
-                self.node(*child, &q, needs_color)
+                Step::Descend(vec![(*child, q, needs_color)])
             }
             Kind::Twist { rate, child } => {
                 let k = w(self, *rate);
@@ -354,10 +386,7 @@ impl<'a> SceneEmitter<'a> {
                 let q = self.point(format!(
                     "(real3)(k{i} * {p}.x - s{i} * {p}.z, {p}.y, s{i} * {p}.x + k{i} * {p}.z)"
                 ));
-                let c = self.node(*child, &q, needs_color);
-                self.used.insert(Helper::Warp);
-                let rho = format!("hypot({p}.x, {p}.z)");
-                self.post(id, c, &format!("twist_bound({{d}}, {k}, {rho})"))
+                Step::Descend(vec![(*child, q, needs_color)])
             }
             Kind::Bend { rate, child } => {
                 let k = w(self, *rate);
@@ -367,39 +396,83 @@ impl<'a> SceneEmitter<'a> {
                 let q = self.point(format!(
                     "(real3)(k{i} * {p}.x - s{i} * {p}.y, s{i} * {p}.x + k{i} * {p}.y, {p}.z)"
                 ));
-                let c = self.node(*child, &q, needs_color);
-                self.used.insert(Helper::Warp);
-                let rho = format!("hypot({p}.x, {p}.y)");
-                self.post(id, c, &format!("bend_bound({{d}}, {k}, {rho})"))
+                Step::Descend(vec![(*child, q, needs_color)])
             }
-            Kind::Csg {
-                op,
-                smoothing,
-                a,
-                b,
-            } => {
-                let (a, b) = (self.node(*a, p, needs_color), self.node(*b, p, needs_color));
-                self.label(id);
-                self.csg(id, *op, *smoothing, &a, &b, needs_color)
-            }
+            Kind::Csg { a, b, .. } => Step::Descend(vec![
+                (*a, p.to_string(), needs_color),
+                (*b, p.to_string(), needs_color),
+            ]),
             Kind::Custom { shape, .. } => {
                 self.customs.insert(shape.name().to_string(), shape.clone());
                 let args = self.arguments(node);
                 let comma = if args.is_empty() { "" } else { ", " };
-                self.leaf(id, format!("{}({p}{comma}{args})", shape.function_name()))
+                Step::Done(self.leaf(id, format!("{}({p}{comma}{args})", shape.function_name())))
             }
-            Kind::Color { color, child } => {
-                let c = self.node(*child, p, false);
+            Kind::Color { child, .. } => Step::Descend(vec![(*child, p.to_string(), false)]),
+            _ => unreachable!("leaves are emitted from the table above"),
+        }
+    }
+
+    /// Leaving a node after its children: the lines that combine their
+    /// results.
+    fn leave(&mut self, id: NodeId, p: &str, needs_color: bool, children: Vec<Vars>) -> Vars {
+        let mut children = children.into_iter();
+        let mut child = || children.next().expect("each child has a result");
+        let node = self.ir.node(id);
+        if self.frame == Some(id) {
+            return child();
+        }
+        let w = |this: &Self, s: Scalar| this.w.scalar(s);
+        match node {
+            Kind::Scale { factor, .. } => {
+                let f = w(self, *factor);
+                let c = child();
+                self.post(id, c, &format!("{{d}} * {f}"))
+            }
+            Kind::Round { radius, .. } => {
+                let c = child();
+                self.label(id);
+                let r = w(self, *radius);
+                self.post(id, c, &format!("{{d}} - {r}"))
+            }
+            Kind::Onion { thickness, .. } => {
+                let c = child();
+                self.label(id);
+                let t = w(self, *thickness);
+                self.post(id, c, &format!("fabs({{d}}) - {t}"))
+            }
+            Kind::Twist { rate, .. } => {
+                let k = w(self, *rate);
+                self.used.insert(Helper::Warp);
+                let rho = format!("hypot({p}.x, {p}.z)");
+                let c = child();
+                self.post(id, c, &format!("twist_bound({{d}}, {k}, {rho})"))
+            }
+            Kind::Bend { rate, .. } => {
+                let k = w(self, *rate);
+                self.used.insert(Helper::Warp);
+                let rho = format!("hypot({p}.x, {p}.y)");
+                let c = child();
+                self.post(id, c, &format!("bend_bound({{d}}, {k}, {rho})"))
+            }
+            Kind::Csg { op, smoothing, .. } => {
+                let (a, b) = (child(), child());
+                self.label(id);
+                self.csg(id, *op, *smoothing, &a, &b, needs_color)
+            }
+            Kind::Color { color, .. } => {
+                let c = child();
                 if !self.shade || !needs_color {
                     return c;
                 }
                 self.label(id);
                 let v = vars(id);
-                self.w
-                    .line(format!("real3 {} = {};", v.c, v3(self, *color)));
+                let rgb = self.w.vector(*color);
+                self.w.line(format!("real3 {} = {rgb};", v.c));
                 Vars { c: v.c, ..c }
             }
-            _ => unreachable!("leaves are emitted from the table above"),
+            // Nodes that only move the point pass their child's result on.
+            _ => child(),
         }
     }
 

@@ -14,7 +14,7 @@ pub use crate::math::{Real, V3, v3};
 use sdf::Estimate;
 
 use crate::error::Result;
-use crate::ir::{CompiledScene, Ir, NodeId, ParamValues, Scalar};
+use crate::ir::{CompiledScene, Ir, IrNode, NodeId, ParamValues, Scalar};
 use crate::scene::{CsgOp, Kind, Node};
 
 /// What the scene is like at one point.
@@ -102,7 +102,7 @@ impl Evaluator {
     /// Distance, colour and orbit trap at `p`.
     #[must_use]
     pub fn sample<T: Real>(&self, p: V3<T>) -> Sample<T> {
-        self.eval(self.ir.root(), p)
+        self.eval(p)
     }
 
     /// The unit surface normal at `p` by central differences with step `h`.
@@ -143,11 +143,76 @@ impl Evaluator {
         }
     }
 
-    #[allow(clippy::too_many_lines)]
-    fn eval<T: Real>(&self, id: NodeId, p: V3<T>) -> Sample<T> {
+    /// Evaluates the scene at `p` without recursion, whatever its depth,
+    /// in two passes over the arena (children come before parents): from
+    /// the root down, the point each node sees; from the leaves up, each
+    /// node's sample from its children's.
+    fn eval<T: Real>(&self, p: V3<T>) -> Sample<T> {
+        let nodes = self.ir.nodes();
+        let mut points = vec![p; nodes.len()];
+        for (i, node) in nodes.iter().enumerate().rev() {
+            let q = self.child_point(node, points[i]);
+            for child in node.children() {
+                points[child.index()] = q;
+            }
+        }
+        let unset = Self::leaf(T::zero());
+        let mut samples = vec![unset; nodes.len()];
+        for (i, node) in nodes.iter().enumerate() {
+            samples[i] = self.sample_at(node, points[i], &samples);
+        }
+        samples[self.ir.root().index()]
+    }
+
+    /// The point a node's children see, for the point `p` it sees.
+    fn child_point<T: Real>(&self, node: &IrNode, p: V3<T>) -> V3<T> {
         let s = |x: Scalar| self.scalar::<T>(x);
         let v = |x: [Scalar; 3]| self.vector::<T>(x);
-        match self.ir.node(id) {
+        match node {
+            Kind::Translate { offset, .. } => p - v(*offset),
+            Kind::Rotate { axis, angle, .. } => match angle {
+                // A baked rotation is a constant matrix (no trigonometry per
+                // evaluation); code generation emits the same rows.
+                Scalar::Baked(a) => {
+                    let [r0, r1, r2] = rotation_rows(*axis, -a).map(|r| r.cast::<T>());
+                    v3(dot_row(r0, p), dot_row(r1, p), dot_row(r2, p))
+                }
+                Scalar::Dynamic(_) => {
+                    let k = V3::<f64>::from(*axis).cast::<T>();
+                    rotate(p, k, -s(*angle))
+                }
+            },
+            Kind::Scale { factor, .. } => p / s(*factor),
+            Kind::Mirror { axis, .. } => {
+                let i = axis.index();
+                p.with(i, p.get(i).abs())
+            }
+            Kind::Elongate { extents, .. } => {
+                let h = v(*extents);
+                p - p.zip(h, |c, e| c.max(-e).min(e))
+            }
+            Kind::Repeat { period, .. } => repeat(p, v(*period), None),
+            Kind::RepeatLimited { period, limit, .. } => repeat(p, v(*period), Some(*limit)),
+            Kind::Twist { rate, .. } => {
+                let (sn, cs) = (s(*rate) * p.y).sin_cos();
+                v3(cs * p.x - sn * p.z, p.y, sn * p.x + cs * p.z)
+            }
+            Kind::Bend { rate, .. } => {
+                let (sn, cs) = (s(*rate) * p.x).sin_cos();
+                v3(cs * p.x - sn * p.y, sn * p.x + cs * p.y, p.z)
+            }
+            _ => p,
+        }
+    }
+
+    /// A node's sample at the point `p` it sees, from its children's
+    /// samples (already in `done`).
+    #[allow(clippy::too_many_lines)]
+    fn sample_at<T: Real>(&self, node: &IrNode, p: V3<T>, done: &[Sample<T>]) -> Sample<T> {
+        let s = |x: Scalar| self.scalar::<T>(x);
+        let v = |x: [Scalar; 3]| self.vector::<T>(x);
+        let of = |c: &NodeId| done[c.index()];
+        match node {
             Kind::Sphere { radius } => Self::leaf(sdf::sphere(p, s(*radius))),
             Kind::Cuboid { half_extents } => Self::leaf(sdf::cuboid(p, v(*half_extents))),
             Kind::RoundBox {
@@ -181,7 +246,7 @@ impl Evaluator {
                 s(f.power),
                 f.iterations,
                 s(f.bailout),
-                integer_power(f.power),
+                f.power.baked().and_then(integer_power),
             )),
             Kind::Menger(f) => Self::fractal(sdf::menger(p, f.iterations, s(f.scale))),
             Kind::Julia(f) => Self::fractal(sdf::julia(
@@ -192,69 +257,35 @@ impl Evaluator {
                 s(f.bailout),
             )),
             Kind::Sierpinski(f) => Self::fractal(sdf::sierpinski(p, f.iterations, s(f.scale))),
-            Kind::Translate { offset, child } => self.eval(*child, p - v(*offset)),
-            Kind::Rotate { axis, angle, child } => match angle {
-                // A baked rotation is a constant matrix (no trigonometry per
-                // evaluation); code generation emits the same rows.
-                Scalar::Baked(a) => {
-                    let [r0, r1, r2] = rotation_rows(*axis, -a).map(|r| r.cast::<T>());
-                    self.eval(*child, v3(dot_row(r0, p), dot_row(r1, p), dot_row(r2, p)))
-                }
-                Scalar::Dynamic(_) => {
-                    let k = V3::<f64>::from(*axis).cast::<T>();
-                    self.eval(*child, rotate(p, k, -s(*angle)))
-                }
-            },
+            Kind::Translate { child, .. }
+            | Kind::Rotate { child, .. }
+            | Kind::Mirror { child, .. }
+            | Kind::Elongate { child, .. }
+            | Kind::Repeat { child, .. }
+            | Kind::RepeatLimited { child, .. } => of(child),
             Kind::Scale { factor, child } => {
-                let f = s(*factor);
-                let mut out = self.eval(*child, p / f);
-                out.distance = out.distance * f;
+                let mut out = of(child);
+                out.distance = out.distance * s(*factor);
                 out
             }
-            Kind::Mirror { axis, child } => {
-                let i = axis.index();
-                self.eval(*child, p.with(i, p.get(i).abs()))
-            }
             Kind::Round { radius, child } => {
-                let mut out = self.eval(*child, p);
+                let mut out = of(child);
                 out.distance = out.distance - s(*radius);
                 out
             }
             Kind::Onion { thickness, child } => {
-                let mut out = self.eval(*child, p);
+                let mut out = of(child);
                 out.distance = out.distance.abs() - s(*thickness);
                 out
             }
-            Kind::Elongate { extents, child } => {
-                let h = v(*extents);
-                self.eval(*child, p - p.zip(h, |c, e| c.max(-e).min(e)))
-            }
-            Kind::Repeat { period, child } => {
-                let c = v(*period);
-                self.eval(*child, repeat(p, c, None))
-            }
-            Kind::RepeatLimited {
-                period,
-                limit,
-                child,
-            } => {
-                let c = v(*period);
-                self.eval(*child, repeat(p, c, Some(*limit)))
-            }
             Kind::Twist { rate, child } => {
-                let k = s(*rate);
-                let (sn, cs) = (k * p.y).sin_cos();
-                let q = v3(cs * p.x - sn * p.z, p.y, sn * p.x + cs * p.z);
-                let mut out = self.eval(*child, q);
-                out.distance = sdf::twist_bound(out.distance, k, p.x.hypot(p.z));
+                let mut out = of(child);
+                out.distance = sdf::twist_bound(out.distance, s(*rate), p.x.hypot(p.z));
                 out
             }
             Kind::Bend { rate, child } => {
-                let k = s(*rate);
-                let (sn, cs) = (k * p.x).sin_cos();
-                let q = v3(cs * p.x - sn * p.y, sn * p.x + cs * p.y, p.z);
-                let mut out = self.eval(*child, q);
-                out.distance = sdf::bend_bound(out.distance, k, p.x.hypot(p.y));
+                let mut out = of(child);
+                out.distance = sdf::bend_bound(out.distance, s(*rate), p.x.hypot(p.y));
                 out
             }
             Kind::Csg {
@@ -264,7 +295,7 @@ impl Evaluator {
                 b,
             } => {
                 let k = smoothing.map_or(T::zero(), s);
-                combine(*op, k, self.eval(*a, p), self.eval(*b, p))
+                combine(*op, k, of(a), of(b))
             }
             Kind::Custom { shape, args } => {
                 let args: Vec<f64> = args.iter().map(|a| self.scalar::<f64>(*a)).collect();
@@ -273,7 +304,7 @@ impl Evaluator {
             }
             Kind::Color { color, child } => Sample {
                 color: v(*color),
-                ..self.eval(*child, p)
+                ..of(child)
             },
         }
     }

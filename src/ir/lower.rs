@@ -9,31 +9,54 @@ use glam::{DQuat, DVec3};
 use super::params::{Constraint, ParamLayout, ParamSlot, Relation, check_rule};
 use super::{Ir, IrNode, NodeId, Scalar, Vector, baked3};
 use crate::error::{Error, Result};
+use crate::math::normalize;
 use crate::scene::{CustomShape, Kind, Mapper, Node, NodeKind, Param, Param3, ParamSpec, Rule};
 
-/// Validates and lowers `geometry` (see [`Ir::lower`]).
+/// Validates and lowers `geometry` (see [`Ir::lower`]) without recursion,
+/// whatever its depth: a work list visits each node twice, on the way down
+/// (its own checks and parameters, in the order a recursive walk would
+/// meet them) and on the way up (rules relating its parameters, folding,
+/// and its place in the arena after its children).
 pub(super) fn lower(geometry: &Node) -> Result<Ir> {
-    let mut lowering = Lowering {
+    let mut l = Lowering {
+        visits: vec![Visit {
+            node: Some(geometry.clone()),
+            parent: None,
+            label: label(geometry.kind()),
+            lowered: None,
+            id: None,
+        }],
+        current: 0,
+        pending: Vec::new(),
         nodes: Vec::new(),
         labels: Vec::new(),
         parents: Vec::new(),
         slots: Vec::new(),
         constraints: Vec::new(),
         slot_by_name: HashMap::new(),
-        path: String::new(),
         operand: None,
         customs: HashMap::new(),
     };
-    let label = label(geometry.kind());
-    let root = lowering.lower(geometry, label.clone(), label)?;
+    let mut work = vec![(0, Step::Down)];
+    while let Some((v, step)) = work.pop() {
+        match step {
+            Step::Down => {
+                l.down(v)?;
+                work.push((v, Step::Up));
+                work.extend(l.pending.drain(..).rev().map(|c| (c, Step::Down)));
+            }
+            Step::Up => l.up(v)?,
+        }
+    }
+    let root = l.visits[0].id.expect("the root is lowered last");
     Ok(Ir {
-        nodes: lowering.nodes,
-        labels: lowering.labels,
-        parents: lowering.parents,
+        nodes: l.nodes,
+        labels: l.labels,
+        parents: l.parents,
         root,
         params: Arc::new(ParamLayout {
-            slots: lowering.slots,
-            constraints: lowering.constraints,
+            slots: l.slots,
+            constraints: l.constraints,
         }),
     })
 }
@@ -46,7 +69,30 @@ fn label(kind: &NodeKind) -> String {
     }
 }
 
+#[derive(Clone, Copy)]
+enum Step {
+    Down,
+    Up,
+}
+
+/// One node of the user's tree met by the walk.
+struct Visit {
+    node: Option<Node>,
+    parent: Option<usize>,
+    /// Its step in paths (`b:torus`).
+    label: String,
+    /// Its parameters, lowered on the way down; children are visit indices.
+    lowered: Option<Kind<Scalar, Vector, usize>>,
+    /// Its node in the arena, once lowered on the way up.
+    id: Option<NodeId>,
+}
+
 struct Lowering {
+    visits: Vec<Visit>,
+    /// The visit being lowered on the way down.
+    current: usize,
+    /// The children the current visit's parameters mapping met, in order.
+    pending: Vec<usize>,
     nodes: Vec<IrNode>,
     labels: Vec<String>,
     parents: Vec<Option<NodeId>>,
@@ -54,45 +100,74 @@ struct Lowering {
     /// Rules between parameters that read dynamic ones.
     constraints: Vec<Constraint>,
     slot_by_name: HashMap<String, u32>,
-    /// The path of the node being lowered.
-    path: String,
-    /// For a boolean being lowered: how many operands were lowered so far.
+    /// For a boolean being lowered: how many operands were met so far.
     operand: Option<usize>,
     /// The custom shapes met so far, by name.
     customs: HashMap<String, CustomShape>,
 }
 
 impl Lowering {
-    fn lower(&mut self, node: &Node, path: String, label: String) -> Result<NodeId> {
-        let saved = std::mem::replace(&mut self.path, path);
+    /// The path of a visit (`union/b:torus`), built only when needed: for
+    /// an error, or where a dynamic parameter is first used.
+    fn path(&self, v: usize) -> String {
+        let mut steps = vec![self.visits[v].label.as_str()];
+        let mut at = v;
+        while let Some(parent) = self.visits[at].parent {
+            steps.push(&self.visits[parent].label);
+            at = parent;
+        }
+        steps.reverse();
+        steps.join("/")
+    }
+
+    /// On the way down: the node's own checks and parameters; its children
+    /// become visits in `pending`.
+    fn down(&mut self, v: usize) -> Result<()> {
+        self.current = v;
+        // The user's node is needed only here.
+        let node = self.visits[v]
+            .node
+            .take()
+            .expect("each node is visited once");
         let kind = node.kind();
-        check_structure(kind, &self.path)?;
+        check_structure(kind, || self.path(v))?;
         if let Kind::Custom { shape, .. } = kind {
             self.check_custom(shape)?;
         }
-        let saved_operand = std::mem::replace(
-            &mut self.operand,
-            matches!(kind, Kind::Csg { .. }).then_some(0),
-        );
-        let lowered = kind.try_map(self)?;
-        self.operand = saved_operand;
-        self.relate(&lowered)?;
-        self.path = saved;
-        let folded = self.fold(lowered);
+        self.operand = matches!(kind, Kind::Csg { .. }).then_some(0);
+        let mut lowered = kind.try_map(self)?;
+        if let Kind::Rotate { axis, .. } = &mut lowered {
+            *axis = normalize(*axis).expect("check_structure refuses other axes");
+        }
+        self.visits[v].lowered = Some(lowered);
+        Ok(())
+    }
+
+    /// On the way up, after every child: the rules relating the node's
+    /// parameters, folding, and its place in the arena.
+    fn up(&mut self, v: usize) -> Result<()> {
+        let lowered = self.visits[v]
+            .lowered
+            .take()
+            .expect("lowered on the way down");
+        let Ok(node) = lowered.try_map(&mut Children(&self.visits));
+        self.relate(&node, v)?;
+        let folded = self.fold(node);
         let id = NodeId(u32::try_from(self.nodes.len()).expect("fewer than 2^32 nodes"));
         for child in folded.children() {
             self.parents[child.index()] = Some(id);
         }
         self.nodes.push(folded);
-        self.labels.push(label);
+        self.labels.push(std::mem::take(&mut self.visits[v].label));
         self.parents.push(None);
-        Ok(id)
+        self.visits[v].id = Some(id);
+        Ok(())
     }
 
     /// Checks the rules that relate a node's parameters on their current
     /// values (baked, or the defaults of dynamic ones), and keeps those that
     /// read dynamic parameters for [`ParamValues::set`](super::ParamValues::set).
-    fn relate(&mut self, node: &IrNode) -> Result<()> {
+    fn relate(&mut self, node: &IrNode, v: usize) -> Result<()> {
         let relation = match node {
             Kind::RoundBox {
                 half_extents,
@@ -111,16 +186,21 @@ impl Lowering {
         let Some((param, relation)) = relation else {
             return Ok(());
         };
-        let constraint = Constraint {
-            node: self.path.clone(),
+        let mut constraint = Constraint {
+            node: String::new(),
             param,
             relation,
         };
-        constraint.check(|s| match s {
+        let defaults = |s: Scalar| match s {
             Scalar::Baked(v) => v,
             Scalar::Dynamic(slot) => self.slots[slot as usize].default,
-        })?;
-        if constraint.is_dynamic() {
+        };
+        let dynamic = constraint.is_dynamic();
+        if dynamic || constraint.check(defaults).is_err() {
+            constraint.node = self.path(v);
+            constraint.check(defaults)?;
+        }
+        if dynamic {
             self.constraints.push(constraint);
         }
         Ok(())
@@ -237,7 +317,8 @@ impl Lowering {
                 self.nodes.pop();
                 self.labels.pop();
                 self.parents.pop();
-                // The merged node may fold again with what is below it.
+                // The merged node may fold again with what is below it
+                // (once at most: what is below was folded already).
                 self.fold(m)
             }
             None => node,
@@ -260,7 +341,8 @@ impl Lowering {
     }
 
     fn lower_param(&mut self, p: &Param, param: &str, rule: Rule) -> Result<Scalar> {
-        check_rule(&self.path, param, p.default_value(), rule)?;
+        let v = self.current;
+        check_rule(|| self.path(v), param, p.default_value(), rule)?;
         match p {
             Param::Value(v) => Ok(Scalar::Baked(*v)),
             Param::Dynamic { name, default } => {
@@ -276,7 +358,7 @@ impl Lowering {
                     name: name.clone(),
                     default: *default,
                     rule,
-                    used_at: (self.path.clone(), param.into()),
+                    used_at: (self.path(v), param.into()),
                 });
                 self.slot_by_name.insert(name.clone(), slot);
                 Ok(Scalar::Dynamic(slot))
@@ -288,7 +370,7 @@ impl Lowering {
 impl Mapper<Param, Param3, Node> for Lowering {
     type S2 = Scalar;
     type V2 = Vector;
-    type C2 = NodeId;
+    type C2 = usize;
     type E = Error;
 
     fn scalar(&mut self, s: &Param, spec: ParamSpec<'_>) -> Result<Scalar> {
@@ -304,28 +386,61 @@ impl Mapper<Param, Param3, Node> for Lowering {
         ])
     }
 
-    fn child(&mut self, c: &Node) -> Result<NodeId> {
+    /// Meets a child: it becomes a visit, lowered after this node's
+    /// parameters.
+    fn child(&mut self, c: &Node) -> Result<usize> {
         // Operands of a boolean are told apart by `a:` and `b:`.
-        let label = match self.operand {
+        let operand = match self.operand {
             Some(n) => {
                 self.operand = Some(n + 1);
                 if n == 0 { "a:" } else { "b:" }
             }
             None => "",
         };
-        let label = format!("{label}{}", self::label(c.kind()));
-        let path = format!("{}/{label}", self.path);
-        self.lower(c, path, label)
+        let at = self.visits.len();
+        self.visits.push(Visit {
+            node: Some(c.clone()),
+            parent: Some(self.current),
+            label: format!("{operand}{}", label(c.kind())),
+            lowered: None,
+            id: None,
+        });
+        self.pending.push(at);
+        Ok(at)
+    }
+}
+
+/// Replaces a lowered node's child visits by their nodes in the arena.
+struct Children<'a>(&'a [Visit]);
+
+impl Mapper<Scalar, Vector, usize> for Children<'_> {
+    type S2 = Scalar;
+    type V2 = Vector;
+    type C2 = NodeId;
+    type E = std::convert::Infallible;
+
+    fn scalar(&mut self, s: &Scalar, _: ParamSpec<'_>) -> Result<Scalar, Self::E> {
+        Ok(*s)
+    }
+
+    fn vector(&mut self, v: &Vector, _: ParamSpec<'_>) -> Result<Vector, Self::E> {
+        Ok(*v)
+    }
+
+    fn child(&mut self, c: &usize) -> Result<NodeId, Self::E> {
+        Ok(self.0[*c]
+            .id
+            .expect("children are lowered before their parent"))
     }
 }
 
 /// Checks what is not a parameter: iteration ranges, rotation axes and a
 /// custom shape's argument count.
-fn check_structure(kind: &NodeKind, path: &str) -> Result<()> {
+fn check_structure(kind: &NodeKind, path: impl Fn() -> String) -> Result<()> {
     if let (Some(value), Some((min, max))) = (kind.iterations(), kind.iteration_range()) {
         if !(min..=max).contains(&value) {
             return Err(Error::Iterations {
-                node: path.into(),
+                node: path(),
                 value,
                 min,
                 max,
@@ -333,14 +448,14 @@ fn check_structure(kind: &NodeKind, path: &str) -> Result<()> {
         }
     }
     let zero = |param: &str| Error::ZeroVector {
-        node: path.into(),
+        node: path(),
         param: param.into(),
     };
     match kind {
         Kind::Rotate { axis, .. } => {
             if !axis.is_finite() {
                 return Err(Error::NonFinite {
-                    node: path.into(),
+                    node: path(),
                     param: "axis".into(),
                     value: axis
                         .to_array()
@@ -349,7 +464,7 @@ fn check_structure(kind: &NodeKind, path: &str) -> Result<()> {
                         .unwrap_or(f64::NAN),
                 });
             }
-            if axis.length() == 0.0 {
+            if normalize(*axis).is_none() {
                 return Err(zero("axis"));
             }
         }
@@ -357,7 +472,8 @@ fn check_structure(kind: &NodeKind, path: &str) -> Result<()> {
             return Err(Error::CustomShape {
                 name: shape.name().into(),
                 reason: format!(
-                    "{path}: expects {} parameter values, got {}",
+                    "{}: expects {} parameter values, got {}",
+                    path(),
                     shape.arity(),
                     args.len()
                 ),

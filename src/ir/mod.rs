@@ -47,6 +47,17 @@ pub enum Scalar {
     Dynamic(u32),
 }
 
+impl Scalar {
+    /// The value, if it is baked.
+    #[must_use]
+    pub fn baked(self) -> Option<f64> {
+        match self {
+            Scalar::Baked(v) => Some(v),
+            Scalar::Dynamic(_) => None,
+        }
+    }
+}
+
 /// A lowered vector parameter.
 pub type Vector = [Scalar; 3];
 

@@ -162,7 +162,7 @@ impl ParamValues {
             .position(|s| s.name == name)
             .ok_or_else(|| Error::UnknownParam { name: name.into() })?;
         let spec = &self.layout.slots[slot];
-        check_rule(&spec.used_at.0, &spec.used_at.1, value, spec.rule)?;
+        check_rule(|| spec.used_at.0.clone(), &spec.used_at.1, value, spec.rule)?;
         let old = std::mem::replace(&mut self.values[slot], value);
         let slot = u32::try_from(slot).expect("slots are numbered in u32");
         let broken = self
@@ -201,17 +201,22 @@ impl ParamValues {
 }
 
 /// A value's own rule, with the error every validation reports.
-pub(crate) fn check_rule(node: &str, param: &str, value: f64, rule: Rule) -> Result<()> {
+pub(crate) fn check_rule(
+    node: impl FnOnce() -> String,
+    param: &str,
+    value: f64,
+    rule: Rule,
+) -> Result<()> {
     if !value.is_finite() {
         return Err(Error::NonFinite {
-            node: node.into(),
+            node: node(),
             param: param.into(),
             value,
         });
     }
     if !rule.accepts(value) {
         return Err(Error::OutOfRange {
-            node: node.into(),
+            node: node(),
             param: param.into(),
             value,
             expected: rule.describe(),

@@ -1,17 +1,15 @@
 //! Math shared by the CPU reference ([`crate::cpu`]) and code generation
 //! ([`crate::codegen`]): the numeric guards both twins use, the scalar types
-//! the reference is generic over, and the values that code generation bakes
-//! into literals exactly as the reference computes them. Keeping them here,
-//! outside both stages, is what lets the two twins agree without either
-//! reaching into the other.
+//! the reference is generic over, the values that code generation bakes
+//! into literals exactly as the reference computes them, and robust vector
+//! normalisation. Keeping them here, below every stage, is what lets the two
+//! twins agree without either reaching into the other.
 
 mod real;
 
 use glam::DVec3;
 
 pub use real::{Real, V3, v3};
-
-use crate::ir::Scalar;
 
 /// The smallest magnitude used to guard divisions and logarithms, in both
 /// twins (`REAL_TINY` in the kernels; a normal `f32`).
@@ -62,15 +60,34 @@ pub fn mandelbulb_radius<T: Real>(power: T) -> T {
     T::of(2.0).powf(T::one() / (power - T::one()))
 }
 
-/// The trig-free integer form applies when the power is a baked integer.
-/// Code generation makes the same choice.
+/// The Mandelbulb power as an integer, when the trig-free integer form
+/// applies to a baked `power`: an integer in `[2, 64]`. The CPU reference
+/// and code generation make the same choice through it.
 #[must_use]
-pub fn integer_power(power: Scalar) -> Option<u32> {
-    match power {
-        #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss)]
-        Scalar::Baked(v) if v.fract() == 0.0 && (2.0..=64.0).contains(&v) => Some(v as u32),
-        _ => None,
+pub fn integer_power(power: f64) -> Option<u32> {
+    #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss)]
+    (power.fract() == 0.0 && (2.0..=64.0).contains(&power)).then_some(power as u32)
+}
+
+/// `v` scaled to unit length, computed without overflow or underflow
+/// however large or small its components (it is first divided by its
+/// largest component); `None` for a zero or non-finite vector.
+///
+/// ```
+/// use fractal_sdf::math::normalize;
+/// use glam::dvec3;
+/// assert_eq!(normalize(dvec3(0.0, 1e200, 0.0)), Some(dvec3(0.0, 1.0, 0.0)));
+/// assert_eq!(normalize(dvec3(3e-300, 0.0, 4e-300)), Some(dvec3(0.6, 0.0, 0.8)));
+/// assert_eq!(normalize(dvec3(0.0, 0.0, 0.0)), None);
+/// ```
+#[must_use]
+pub fn normalize(v: DVec3) -> Option<DVec3> {
+    let largest = v.abs().max_element();
+    if !(largest.is_finite() && largest > 0.0) {
+        return None;
     }
+    let scaled = v / largest;
+    Some(scaled / scaled.length())
 }
 
 /// The rows of the matrix rotating by `angle` around the unit `axis`,

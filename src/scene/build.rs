@@ -7,7 +7,7 @@
 //!
 //! [`Scene::validate`]: super::Scene::validate
 
-use glam::{DQuat, DVec3, EulerRot};
+use glam::{DQuat, DVec3, DVec4, EulerRot};
 
 use super::node::{Axis, CsgOp, Kind, Mandelbulb, Menger, Node, QuaternionJulia, Sierpinski};
 use super::param::{Param, Param3};
@@ -262,19 +262,28 @@ impl Node {
     /// zero axis is reported by validation).
     #[must_use]
     pub fn rotate(self, axis: impl Into<DVec3>, angle: impl Into<Param>) -> Node {
-        let axis = axis.into();
         Kind::Rotate {
-            axis: axis.try_normalize().unwrap_or(axis),
+            axis: axis.into(),
             angle: angle.into(),
             child: self,
         }
         .into()
     }
 
-    /// Rotates the node by a quaternion (normalised here).
+    /// Rotates the node by a quaternion of any non-zero length (normalised
+    /// here without overflow). A quaternion that is zero or not finite is
+    /// no rotation: validation reports it as a zero or non-finite `axis`.
     #[must_use]
     pub fn rotate_quat(self, rotation: DQuat) -> Node {
-        let (axis, angle) = rotation.normalize().to_axis_angle();
+        if !rotation.is_finite() {
+            return self.rotate(DVec3::NAN, 0.0);
+        }
+        let largest = DVec4::from(rotation).abs().max_element();
+        if largest == 0.0 {
+            return self.rotate(DVec3::ZERO, 0.0);
+        }
+        let scaled = DQuat::from_vec4(DVec4::from(rotation) / largest);
+        let (axis, angle) = scaled.normalize().to_axis_angle();
         if angle == 0.0 || !axis.is_finite() {
             return self.rotate(DVec3::Y, 0.0);
         }

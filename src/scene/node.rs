@@ -2,6 +2,9 @@
 //! tree ([`Node`]) and the lowered IR, so every node type, its parameters
 //! and their validity rules are written down exactly once.
 
+use std::fmt;
+use std::sync::{Arc, OnceLock};
+
 use glam::DVec3;
 
 use super::custom::CustomShape;
@@ -444,6 +447,26 @@ impl<S, V, C> Kind<S, V, C> {
         }
     }
 
+    /// The node's children, mutably, in order (`a` before `b`).
+    pub(crate) fn children_mut(&mut self) -> Vec<&mut C> {
+        match self {
+            Kind::Translate { child, .. }
+            | Kind::Rotate { child, .. }
+            | Kind::Scale { child, .. }
+            | Kind::Mirror { child, .. }
+            | Kind::Round { child, .. }
+            | Kind::Onion { child, .. }
+            | Kind::Elongate { child, .. }
+            | Kind::Repeat { child, .. }
+            | Kind::RepeatLimited { child, .. }
+            | Kind::Twist { child, .. }
+            | Kind::Bend { child, .. }
+            | Kind::Color { child, .. } => vec![child],
+            Kind::Csg { a, b, .. } => vec![a, b],
+            _ => vec![],
+        }
+    }
+
     /// The node's children, in order (`a` before `b`).
     #[must_use]
     pub fn children(&self) -> Vec<&C> {
@@ -599,7 +622,7 @@ impl<S, V, C> Kind<S, V, C> {
                 child: m.child(child)?,
             },
             Kind::Rotate { axis, angle, child } => Kind::Rotate {
-                axis: axis.normalize_or_zero(),
+                axis: *axis,
                 angle: m.scalar(angle, spec("angle", Finite))?,
                 child: m.child(child)?,
             },
@@ -681,10 +704,12 @@ pub type NodeKind = Kind<Param, Param3, Node>;
 ///
 /// Build nodes with the free functions ([`sphere`](super::sphere),
 /// [`mandelbulb`](super::mandelbulb), ...) and combine them with the methods
-/// in [`build`](super::build). A `Node` is a plain value: clone it, compare
-/// it, keep it in a `Vec`.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Node(Box<NodeKind>);
+/// in [`build`](super::build). A `Node` is a plain value: clone it (cheaply:
+/// subtrees are shared), compare it, keep it in a `Vec`. Nothing about a
+/// node recurses on its depth: dropping, comparing, printing and compiling
+/// a chain of a million nodes needs no deeper stack than one node.
+#[derive(Clone)]
+pub struct Node(Arc<NodeKind>);
 
 impl Node {
     /// The node's kind and parameters.
@@ -692,11 +717,121 @@ impl Node {
     pub fn kind(&self) -> &NodeKind {
         &self.0
     }
+
+    /// The number of nodes in the tree below and including this one, and
+    /// its depth (1 for a leaf), counted without recursion.
+    #[must_use]
+    pub fn size_and_depth(&self) -> (usize, usize) {
+        let (mut size, mut depth) = (0, 0);
+        let mut stack = vec![(self, 1)];
+        while let Some((node, level)) = stack.pop() {
+            size += 1;
+            depth = depth.max(level);
+            stack.extend(node.kind().children().into_iter().map(|c| (c, level + 1)));
+        }
+        (size, depth)
+    }
+
+    /// A shared leaf that stands in for the children a dropped node gives
+    /// up (see `Drop`).
+    fn placeholder() -> Node {
+        static PLACEHOLDER: OnceLock<Node> = OnceLock::new();
+        PLACEHOLDER
+            .get_or_init(|| {
+                Node(Arc::new(Kind::Sphere {
+                    radius: Param::Value(0.0),
+                }))
+            })
+            .clone()
+    }
 }
 
 impl From<NodeKind> for Node {
     fn from(kind: NodeKind) -> Self {
-        Node(Box::new(kind))
+        Node(Arc::new(kind))
+    }
+}
+
+impl Drop for Node {
+    /// Drops the tree without recursion: a node this handle owns alone
+    /// gives its children to a work list before it goes (replacing them with
+    /// a shared placeholder), so each drop frees one node.
+    fn drop(&mut self) {
+        let Some(kind) = Arc::get_mut(&mut self.0) else {
+            return;
+        };
+        let mut orphans: Vec<Node> = Vec::new();
+        for child in kind.children_mut() {
+            orphans.push(std::mem::replace(child, Node::placeholder()));
+        }
+        while let Some(mut node) = orphans.pop() {
+            if let Some(kind) = Arc::get_mut(&mut node.0) {
+                for child in kind.children_mut() {
+                    orphans.push(std::mem::replace(child, Node::placeholder()));
+                }
+            }
+        }
+    }
+}
+
+impl PartialEq for Node {
+    /// Structural equality, compared without recursion (shared subtrees
+    /// are equal at once).
+    fn eq(&self, other: &Self) -> bool {
+        let mut pairs = vec![(self, other)];
+        while let Some((a, b)) = pairs.pop() {
+            if Arc::ptr_eq(&a.0, &b.0) {
+                continue;
+            }
+            if shallow(a.kind()) != shallow(b.kind()) {
+                return false;
+            }
+            pairs.extend(a.kind().children().into_iter().zip(b.kind().children()));
+        }
+        true
+    }
+}
+
+/// A node's own values with its children left out, for comparing one level.
+fn shallow(kind: &NodeKind) -> Kind<Param, Param3, ()> {
+    struct Values;
+    impl Mapper<Param, Param3, Node> for Values {
+        type S2 = Param;
+        type V2 = Param3;
+        type C2 = ();
+        type E = std::convert::Infallible;
+        fn scalar(&mut self, s: &Param, _: ParamSpec<'_>) -> Result<Param, Self::E> {
+            Ok(s.clone())
+        }
+        fn vector(&mut self, v: &Param3, _: ParamSpec<'_>) -> Result<Param3, Self::E> {
+            Ok(v.clone())
+        }
+        fn child(&mut self, _: &Node) -> Result<(), Self::E> {
+            Ok(())
+        }
+    }
+    let Ok(values) = kind.try_map(&mut Values);
+    values
+}
+
+/// Trees deeper than this print as a summary.
+const DEBUG_DEPTH: usize = 64;
+
+impl fmt::Debug for Node {
+    /// The node's kind, as `Kind`'s `Debug` prints it; a tree deeper than 64
+    /// levels prints as a summary (its root kind, size and depth), so
+    /// printing never recurses deeply.
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let (size, depth) = self.size_and_depth();
+        if depth > DEBUG_DEPTH {
+            return f
+                .debug_struct("Node")
+                .field("kind", &self.kind().name())
+                .field("nodes", &size)
+                .field("depth", &depth)
+                .finish_non_exhaustive();
+        }
+        fmt::Debug::fmt(self.kind(), f)
     }
 }
 
