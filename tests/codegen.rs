@@ -203,3 +203,73 @@ fn dynamic_parameter_names_never_reach_the_source() {
         assert!(line.contains("sd_sphere(p0, params[0] /* r??? "), "{line}");
     }
 }
+
+/// Every variable `DE` and `DE_shade` declare is read afterwards: no colour
+/// or trap is computed that a colour node paints over, and no blend of a
+/// value with itself.
+#[test]
+fn generated_functions_declare_nothing_they_do_not_read() {
+    let painted_union = sphere(1.0)
+        .union(cuboid(dvec3(0.5, 0.5, 0.5)).color(dvec3(0.0, 1.0, 0.0)))
+        .smooth_union(torus(1.0, 0.2), 0.1)
+        .color(dvec3(1.0, 0.0, 0.0));
+    let mut scenes: Vec<(String, Scene)> = fractal_sdf::gallery::all()
+        .into_iter()
+        .map(|(name, scene)| (name.to_string(), scene))
+        .collect();
+    scenes.push(("painted union".into(), Scene::new(painted_union)));
+    for (name, scene) in scenes {
+        let compiled = scene.compile().unwrap();
+        let src = codegen::emit(&compiled, &Options::default()).unwrap().source;
+        for function in ["real DE(", "real DE_shade("] {
+            let start = src.find(function).unwrap();
+            let body = &src[start..start + src[start..].find("\n}\n").unwrap()];
+            let lines: Vec<&str> = body.lines().collect();
+            for (i, line) in lines.iter().enumerate() {
+                let Some(declared) = declared_variable(line) else { continue };
+                let read = lines[i + 1..].iter().any(|later| mentions(later, declared))
+                    || line.matches(declared).count() > 1;
+                assert!(read, "{name}: `{declared}` is never read in {function}...\n{line}");
+            }
+        }
+    }
+}
+
+/// The variable a line such as `    real3 c4 = ...;` or `    real t0;`
+/// declares.
+fn declared_variable(line: &str) -> Option<&str> {
+    let rest = line.trim_start();
+    let rest = ["real3 ", "real2 ", "real "]
+        .iter()
+        .find_map(|ty| rest.strip_prefix(ty))?;
+    let end = rest.find([' ', ';'])?;
+    Some(&rest[..end])
+}
+
+/// Whether `line` uses the identifier `name` (not as part of a longer one).
+fn mentions(line: &str, name: &str) -> bool {
+    line.match_indices(name).any(|(at, _)| {
+        let before = line[..at].chars().next_back();
+        let after = line[at + name.len()..].chars().next();
+        let ident = |c: Option<char>| c.is_some_and(|c| c.is_ascii_alphanumeric() || c == '_');
+        !ident(before) && !ident(after)
+    })
+}
+
+/// Each block of generated code says which node it comes from, and each
+/// dynamic read which parameter it is.
+#[test]
+fn generated_blocks_name_their_nodes_and_parameters() {
+    let node = sphere(param("radius", 1.0))
+        .union(torus(1.0, 0.2).translate(dvec3(0.0, 2.0, 0.0)))
+        .color(dvec3(1.0, 0.5, 0.0));
+    let src = source(node, &Options::default());
+    assert!(src.contains("/* color/union/a:sphere */"), "{src}");
+    assert!(src.contains("/* color/union/b:translate/torus */"), "{src}");
+    assert!(src.contains("/* color/union */"), "{src}");
+    assert!(src.contains("sd_sphere(p0, params[0] /* radius */)"), "{src}");
+    // Deep paths keep their last steps only.
+    let deep = (0..10).fold(sphere(1.0), |n, _| n.round(0.01));
+    let src = source(deep, &Options::default());
+    assert!(src.contains("/* .../round/round/sphere */"), "{src}");
+}
