@@ -406,3 +406,25 @@ fn occlusion_does_not_darken_a_magnified_view() {
         }
     }
 }
+
+/// A camera inside a solid shades the nearest point of the surface, seen
+/// from no distance: there is no view to scale occlusion to, and it keeps
+/// `ao_distance`. (Scaled to the view, it reached only into the
+/// Mandelbulb's interior, and the image was black.)
+#[test]
+fn occlusion_seen_from_inside_a_solid_keeps_its_reach() {
+    let Some(_) = gpu::device() else { return };
+    let bulb = fractal_sdf::gallery::mandelbulb().geometry.unwrap();
+    let camera = Camera::look_at(dvec3(0.41, 0.29, 0.56), dvec3(0.0, -0.12, 0.0)).fov(40.0);
+    let scene = Scene::new(bulb).with_camera(camera).with_lights([]);
+    let effects = Effects {
+        shadows: false,
+        ..Effects::default()
+    };
+    let on = render(&scene, gpu::quick(), effects);
+    let off = render(&scene, gpu::quick(), Effects::none());
+    assert!(on.depth.iter().all(|&d| d == 0.0), "the camera is inside");
+    let (with, without) = (surface_brightness(&on), surface_brightness(&off));
+    eprintln!("inside the bulb: surface luma {with:.1} with occlusion, {without:.1} without");
+    assert!(with > 0.2 * without, "{with} against {without}");
+}

@@ -526,14 +526,17 @@ __kernel void render_tile(__global const real* params,
             real footprint = march_footprint(&cam, m.t);
             n = march_normal(p, NORMAL_EPSILON * footprint, rd, params);
             total_evals += MARCH_NORMAL_EVALUATIONS;
+            real view_height = footprint * (real)height;
             if (m.t <= R(0.0)) {
                 // The ray starts inside the surface (a camera within a
                 // solid): shade the nearest point of the surface instead.
+                // No view to scale occlusion to: it keeps AO_DISTANCE.
                 p -= n * DE(p, params);
                 total_evals += 1u;
+                view_height = (real)INFINITY;
             }
-            color = march_shade(p, n, rd, DETAIL * footprint, footprint * (real)height, params,
-                                lights, light_count, &total_evals);
+            color = march_shade(p, n, rd, DETAIL * footprint, view_height, params, lights,
+                                light_count, &total_evals);
         }
         sum += color;
         if (s == 0) {
