@@ -248,7 +248,8 @@ pub struct Effects {
     /// height), so a magnified view is shaded like the view unmagnified
     /// and the image does not change with the resolution. The default 0.25
     /// is kept wherever the image is more than 1.25 units high at the
-    /// surface: a scene of unit size seen from a few units away.
+    /// surface (a scene of unit size seen from a few units away), and by a
+    /// camera inside a solid, which sees the surface from no distance.
     pub ao_distance: f64,
     /// Shadows from every light (needs [`Quality::shadow_steps`] > 0);
     /// soft where the light's softness is above 0.
