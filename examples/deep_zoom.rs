@@ -27,8 +27,15 @@
 //! starting 1e-2 to 1e-12 along it, to show at which scales the point is
 //! in the shadow of the bulb's own structure.
 //!
-//! Prints a markdown table and writes a contact sheet to
-//! `out/deep_zoom.png` (rows: F32, F32 moved, F64, F64 moved).
+//! These renders leave ambient occlusion out, so they measure the geometry
+//! and the lights alone. A fifth render per magnification, in F64, has
+//! occlusion on: its reach follows the view (see `Effects::ao_distance`),
+//! so it should darken the creases about as much at every magnification.
+//! Its mean luma is reported against the same render without occlusion.
+//!
+//! Prints markdown tables and writes a contact sheet to
+//! `out/deep_zoom.png` (rows: F32, F32 moved, F64, F64 moved, F64 with
+//! occlusion).
 //!
 //! `cargo run --release --example deep_zoom [-- --size 160x120] [--decades 14]`
 
@@ -135,23 +142,39 @@ fn key_light_blocked(point: DVec3, offset: f64) -> Result<Option<f64>> {
     Ok(hit.hit.then_some(hit.depth))
 }
 
-fn render(scene: &Scene, precision: Precision, size: (u32, u32)) -> Result<RgbaImage> {
+fn render(
+    scene: &Scene,
+    precision: Precision,
+    occlusion: bool,
+    size: (u32, u32),
+) -> Result<RgbaImage> {
     let options = RenderOptions {
         quality: Quality::production().precision(precision).max_steps(1024),
-        // Occlusion samples a fixed distance in scene units: at a deep
-        // zoom that is far outside the view. Shadows scale with the view.
-        effects: Effects::default().ambient_occlusion(false),
+        effects: Effects::default().ambient_occlusion(occlusion),
         ..RenderOptions::default()
     };
     Renderer::with_options(scene, &options)?.render(size.0, size.1)
 }
 
-/// The standard deviation of an image's luma (0 to 255).
-fn contrast(image: &RgbaImage) -> f64 {
-    let luma: Vec<f64> = image
+/// An image's luma (0 to 255), pixel by pixel.
+fn luma(image: &RgbaImage) -> Vec<f64> {
+    image
         .pixels()
         .map(|p| 0.299 * f64::from(p[0]) + 0.587 * f64::from(p[1]) + 0.114 * f64::from(p[2]))
-        .collect();
+        .collect()
+}
+
+/// The mean of an image's luma (0 to 255).
+fn brightness(image: &RgbaImage) -> f64 {
+    let luma = luma(image);
+    #[allow(clippy::cast_precision_loss)]
+    let n = luma.len() as f64;
+    luma.iter().sum::<f64>() / n
+}
+
+/// The standard deviation of an image's luma (0 to 255).
+fn contrast(image: &RgbaImage) -> f64 {
+    let luma = luma(image);
     #[allow(clippy::cast_precision_loss)]
     let n = luma.len() as f64;
     let mean = luma.iter().sum::<f64>() / n;
@@ -183,14 +206,16 @@ fn main() -> std::process::ExitCode {
             .unwrap_or_default();
         eprintln!("surface point {point:.17} on {device}");
         let mut rows = Vec::new();
+        let mut brightnesses = Vec::new();
         let mut tiles = Vec::new();
         for decade in 0..=decades {
             let here = view(point, direction, decade, DVec3::ZERO);
             let moved = view(point, direction, decade, SHIFT);
-            let f32_here = render(&here, Precision::F32, size)?;
-            let f32_moved = render(&moved, Precision::F32, size)?;
-            let f64_here = render(&here, Precision::F64, size)?;
-            let f64_moved = render(&moved, Precision::F64, size)?;
+            let f32_here = render(&here, Precision::F32, false, size)?;
+            let f32_moved = render(&moved, Precision::F32, false, size)?;
+            let f64_here = render(&here, Precision::F64, false, size)?;
+            let f64_moved = render(&moved, Precision::F64, false, size)?;
+            let f64_occluded = render(&here, Precision::F64, true, size)?;
             let row = [
                 psnr(&f32_here, &f64_here),
                 psnr(&f32_here, &f32_moved),
@@ -202,8 +227,14 @@ fn main() -> std::process::ExitCode {
                 "1e{decade:<2}  F32 vs F64 {:6.1} dB  F32 moved {:6.1} dB  F64 moved {:6.1} dB  contrast {:5.1} {:5.1}",
                 row[0], row[1], row[2], row[3], row[4]
             );
+            let lit = [brightness(&f64_here), brightness(&f64_occluded)];
+            eprintln!(
+                "      F64 mean luma {:5.1} without occlusion, {:5.1} with",
+                lit[0], lit[1]
+            );
             rows.push(row);
-            tiles.push([f32_here, f32_moved, f64_here, f64_moved]);
+            brightnesses.push(lit);
+            tiles.push([f32_here, f32_moved, f64_here, f64_moved, f64_occluded]);
         }
         let column = |i: usize| rows.iter().map(|r| r[i]).collect::<Vec<_>>();
         let db = |v: f64| {
@@ -239,6 +270,14 @@ fn main() -> std::process::ExitCode {
             label(breaks_at(&column(1), &column(3)), last),
             label(breaks_at(&column(2), &column(4)), last)
         );
+        println!(
+            "\nAmbient occlusion in F64 at each magnification: mean luma (0 to 255) without and with it, and their ratio.\n"
+        );
+        println!("| magnification | without occlusion | with occlusion | ratio |");
+        println!("|---|---:|---:|---:|");
+        for (decade, [off, on]) in brightnesses.iter().enumerate() {
+            println!("| 1e{decade} | {off:.1} | {on:.1} | {:.2} |", on / off);
+        }
         println!(
             "\nShadow rays from the target point towards the key light, starting that far along it:\n"
         );

@@ -357,7 +357,15 @@ pub struct Effects {
     /// Ambient occlusion (needs [`Quality::ao_samples`] > 0).
     pub ambient_occlusion: bool,
     /// Reach of ambient occlusion along the normal, in scene units:
-    /// surfaces closer than this darken a crease.
+    /// surfaces closer than this darken a crease. Where a fifth of the
+    /// image's height at the surface's distance is shorter, occlusion
+    /// reaches that far instead (in perspective, `0.4 tan(fov / 2)` times
+    /// the distance along the ray; orthographic, a fifth of the visible
+    /// height), so a magnified view is shaded like the view unmagnified
+    /// and the image does not change with the resolution. The default 0.25
+    /// is kept wherever the image is more than 1.25 units high at the
+    /// surface (a scene of unit size seen from a few units away), and by a
+    /// camera inside a solid, which sees the surface from no distance.
     pub ao_distance: f64,
     /// Shadows from every light (needs [`Quality::shadow_steps`] > 0);
     /// soft where the light's softness is above 0.

@@ -4,20 +4,21 @@ use fractal_sdf::image::{self, RgbaImage};
 use plotters::prelude::*;
 
 /// Row names of [`contact_sheet`], top to bottom.
-pub const ROWS: [&str; 4] = ["F32", "F32 moved", "F64", "F64 moved"];
+pub const ROWS: [&str; 5] = ["F32", "F32 moved", "F64", "F64 moved", "F64 + AO"];
 
 const LEFT: u32 = 90;
 const TOP: u32 = 24;
 
-/// Lays out `columns` (one per magnification decade, four tiles each, in
+/// Lays out `columns` (one per magnification decade, one tile per row, in
 /// the order of [`ROWS`]) with the decade above each column and the row
 /// names on the left.
-pub fn contact_sheet(columns: &[[RgbaImage; 4]], tile: (u32, u32)) -> RgbaImage {
+pub fn contact_sheet(columns: &[[RgbaImage; ROWS.len()]], tile: (u32, u32)) -> RgbaImage {
     let cols = u32::try_from(columns.len()).expect("a few columns");
-    let (w, h) = (LEFT + cols * (tile.0 + 2), TOP + 4 * (tile.1 + 2));
+    let rows = u32::try_from(ROWS.len()).expect("a few rows");
+    let (w, h) = (LEFT + cols * (tile.0 + 2), TOP + rows * (tile.1 + 2));
     let mut sheet = RgbaImage::from_pixel(w, h, image::Rgba([255, 255, 255, 255]));
     for (c, tiles) in (0..cols).zip(columns) {
-        for (r, img) in (0..4u32).zip(tiles) {
+        for (r, img) in (0..rows).zip(tiles) {
             let x = LEFT + c * (tile.0 + 2);
             let y = TOP + r * (tile.1 + 2);
             image::imageops::replace(&mut sheet, img, i64::from(x), i64::from(y));
@@ -35,7 +36,7 @@ pub fn contact_sheet(columns: &[[RgbaImage; 4]], tile: (u32, u32)) -> RgbaImage 
             area.draw_text(&format!("1e{c}"), &style, (x, 4))
                 .expect("draw into memory");
         }
-        for (r, name) in (0..4u32).zip(ROWS) {
+        for (r, name) in (0..rows).zip(ROWS) {
             let y = i32::try_from(TOP + r * (tile.1 + 2) + tile.1 / 2 - 8).unwrap_or(0);
             area.draw_text(name, &style, (6, y))
                 .expect("draw into memory");

@@ -211,19 +211,31 @@ real3 march_normal(real3 p, real h, real3 rd, __global const real* params) {
 }
 
 // Ambient occlusion: how much closer the surface is than expected along
-// the normal out to AO_DISTANCE, nearer points weighing more:
+// the normal out to a reach r, nearer points weighing more:
 //   1 - integral of w(h) clamp(h - DE(p + n h), 0, h) dh
-//     / integral of w(h) h dh,   w(h) = exp(-AO_FALLOFF h / AO_DISTANCE),
+//     / integral of w(h) h dh,   w(h) = exp(-AO_FALLOFF h / r),
 // by the midpoint rule with AO_SAMPLES points. The integral is fixed, so
 // more samples converge on the same value rather than reaching further.
 // 1 on an open face, towards 0 in a crease. Evaluates DE AO_SAMPLES times.
+//
+// The reach r is AO_DISTANCE, or AO_VIEW_FRACTION of view_height (the
+// height the image covers at p's distance: 2 tan(fov / 2) t in
+// perspective, the visible height in orthographic) where that is shorter.
+// The second is an angle, the same at every resolution, so a view
+// magnified any number of times is occluded like the view unmagnified
+// rather than by structure far outside it. With the default AO_DISTANCE
+// (0.25), a scene of unit size seen from a few units (view_height above
+// 1.25) keeps AO_DISTANCE.
 #define AO_FALLOFF R(1.5)
-real march_ambient_occlusion(real3 p, real3 n, __global const real* params) {
+#define AO_VIEW_FRACTION R(0.2)
+real march_ambient_occlusion(real3 p, real3 n, real view_height,
+                             __global const real* params) {
+    real reach = fmax(fmin(AO_DISTANCE, AO_VIEW_FRACTION * view_height), REAL_TINY);
     real missing = R(0.0);
     real expected = R(0.0);
     for (int i = 0; i < AO_SAMPLES; ++i) {
-        real h = AO_DISTANCE * ((real)i + R(0.5)) / (real)AO_SAMPLES;
-        real weight = exp(-AO_FALLOFF * h / AO_DISTANCE);
+        real h = reach * ((real)i + R(0.5)) / (real)AO_SAMPLES;
+        real weight = exp(-AO_FALLOFF * h / reach);
         real d = DE(p + n * h, params);
         missing += weight * clamp(h - d, R(0.0), h);
         expected += weight * h;
@@ -281,10 +293,12 @@ real3 march_background(real py, int height) {
     return mix(SKY_BOTTOM, SKY_TOP, v);
 }
 
-// Lit colour of the surface point p with normal n, seen along rd. Adds its
-// distance evaluations (DE_shade, occlusion, shadow rays) to *evals.
-real3 march_shade(real3 p, real3 n, real3 rd, real eps, __global const real* params,
-                  __global const real* lights, int light_count, uint* evals) {
+// Lit colour of the surface point p with normal n, seen along rd; the
+// image is view_height scene units high at p's distance. Adds its distance
+// evaluations (DE_shade, occlusion, shadow rays) to *evals.
+real3 march_shade(real3 p, real3 n, real3 rd, real eps, real view_height,
+                  __global const real* params, __global const real* lights, int light_count,
+                  uint* evals) {
     real3 albedo;
     real trap;
     DE_shade(p, params, &albedo, &trap);
@@ -292,7 +306,7 @@ real3 march_shade(real3 p, real3 n, real3 rd, real eps, __global const real* par
     albedo *= march_trap_tint(trap);
 
     real occlusion = R(1.0);
-    occlusion = march_ambient_occlusion(p, n, params);
+    occlusion = march_ambient_occlusion(p, n, view_height, params);
     *evals += (uint)AO_SAMPLES;
     real3 sky = mix(SKY_BOTTOM, SKY_TOP, R(0.5) + R(0.5) * n.y);
     real3 color = albedo * sky * (MARCH_AMBIENT * occlusion);
@@ -399,14 +413,17 @@ __kernel void render_tile(RENDER_TILE_ARGS) {
             real footprint = march_footprint(&cam, m.t);
             n = march_normal(p, NORMAL_EPSILON * footprint, rd, params);
             total_evals += MARCH_NORMAL_EVALUATIONS;
+            real view_height = footprint * (real)height;
             if (m.t <= R(0.0)) {
                 // The ray starts inside the surface (a camera within a
                 // solid): shade the nearest point of the surface instead.
+                // No view to scale occlusion to: it keeps AO_DISTANCE.
                 p -= n * DE(p, params);
                 total_evals += 1u;
+                view_height = (real)INFINITY;
             }
-            color = march_shade(p, n, rd, DETAIL * footprint, params, lights, light_count,
-                                &total_evals);
+            color = march_shade(p, n, rd, DETAIL * footprint, view_height, params, lights,
+                                light_count, &total_evals);
         }
         sum += color;
         if (s == 0) {
