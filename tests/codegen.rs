@@ -220,16 +220,23 @@ fn generated_functions_declare_nothing_they_do_not_read() {
     scenes.push(("painted union".into(), Scene::new(painted_union)));
     for (name, scene) in scenes {
         let compiled = scene.compile().unwrap();
-        let src = codegen::emit(&compiled, &Options::default()).unwrap().source;
+        let src = codegen::emit(&compiled, &Options::default())
+            .unwrap()
+            .source;
         for function in ["real DE(", "real DE_shade("] {
             let start = src.find(function).unwrap();
             let body = &src[start..start + src[start..].find("\n}\n").unwrap()];
             let lines: Vec<&str> = body.lines().collect();
             for (i, line) in lines.iter().enumerate() {
-                let Some(declared) = declared_variable(line) else { continue };
+                let Some(declared) = declared_variable(line) else {
+                    continue;
+                };
                 let read = lines[i + 1..].iter().any(|later| mentions(later, declared))
                     || line.matches(declared).count() > 1;
-                assert!(read, "{name}: `{declared}` is never read in {function}...\n{line}");
+                assert!(
+                    read,
+                    "{name}: `{declared}` is never read in {function}...\n{line}"
+                );
             }
         }
     }
@@ -267,7 +274,10 @@ fn generated_blocks_name_their_nodes_and_parameters() {
     assert!(src.contains("/* color/union/a:sphere */"), "{src}");
     assert!(src.contains("/* color/union/b:translate/torus */"), "{src}");
     assert!(src.contains("/* color/union */"), "{src}");
-    assert!(src.contains("sd_sphere(p0, params[0] /* radius */)"), "{src}");
+    assert!(
+        src.contains("sd_sphere(p0, params[0] /* radius */)"),
+        "{src}"
+    );
     // Deep paths keep their last steps only.
     let deep = (0..10).fold(sphere(1.0), |n, _| n.round(0.01));
     let src = source(deep, &Options::default());
