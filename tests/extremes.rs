@@ -149,7 +149,7 @@ fn distances_are_finite_on_the_cpu_in_both_precisions() {
 fn distances_are_finite_on_the_device_in_both_precisions() {
     let Some(device) = gpu::device() else { return };
     let mut precisions = vec![Precision::F32];
-    if device.fp64 {
+    if gpu::fp64(&device) {
         precisions.push(Precision::F64);
     }
     for c in cases() {
@@ -280,7 +280,7 @@ fn renders_have_no_nan_near_far_and_on_the_surface() {
         };
         let camera = Camera::look_at(p - d * 1e-12, p + d * size);
         let mut precisions = vec![Precision::F32];
-        if device.fp64 {
+        if gpu::fp64(&device) {
             precisions.push(Precision::F64);
         }
         for precision in precisions {
@@ -319,8 +319,7 @@ fn scaled_mandelbulb(s: f64) -> (Scene, Quality, Effects) {
 #[test]
 fn a_scene_scaled_by_a_million_renders_the_unit_image_in_f64() {
     let Some(device) = gpu::device() else { return };
-    if !device.fp64 {
-        eprintln!("note: no fp64 on {}", device.label());
+    if !gpu::fp64(&device) {
         return;
     }
     let frame = |s: f64| {

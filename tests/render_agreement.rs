@@ -87,7 +87,7 @@ fn orthographic_and_f64_match_the_cpu_reference() {
     let camera = Camera::look_at(dvec3(2.0, 2.5, 3.0), dvec3(0.0, 0.3, 0.0)).orthographic(3.0);
     let scene = scene.with_camera(camera);
     let mut quality = Quality::production();
-    if device.fp64 {
+    if gpu::fp64(&device) {
         quality.precision = Precision::F64;
     }
     let mut renderer =

@@ -373,10 +373,8 @@ fn occlusion_does_not_darken_a_magnified_view() {
         ..Effects::default()
     };
     let mut cases = vec![(1e-3, Precision::F32)];
-    if device.fp64 {
+    if gpu::fp64(&device) {
         cases.push((1e-6, Precision::F64));
-    } else {
-        eprintln!("note: no fp64 on {}", device.label());
     }
     for (name, scene, tolerance) in scenes {
         let frame = |s: f64, precision: Precision| {

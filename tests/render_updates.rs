@@ -131,7 +131,7 @@ fn f64_renders_where_the_device_supports_it() {
         ..gpu::quick()
     };
     let result = Renderer::new(&gpu::sphere_box_floor(), quality);
-    if !device.fp64 {
+    if !gpu::fp64(&device) {
         assert!(matches!(result, Err(Error::Fp64Unsupported { .. })));
         return;
     }

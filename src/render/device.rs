@@ -128,6 +128,15 @@ impl DeviceSelector {
         }
     }
 
+    /// The device this selector picks, as a renderer built with it would
+    /// (the [`DEVICE_ENV`] variable applies to automatic selection).
+    ///
+    /// # Errors
+    /// [`Error::NoPlatform`], [`Error::NoDevice`].
+    pub fn resolve(&self) -> Result<DeviceInfo> {
+        select(self).map(|s| s.info)
+    }
+
     fn is_auto(&self) -> bool {
         self.platform.is_none() && self.device.is_none()
     }

@@ -3,28 +3,63 @@
 #![allow(dead_code)] // each test binary uses a different subset
 
 use fractal_sdf::prelude::*;
-use fractal_sdf::render::{DeviceInfo, Frame, RenderOptions, devices};
+use fractal_sdf::render::{DeviceInfo, DeviceSelector, Frame, RenderOptions};
 use fractal_sdf::scene::LightSource;
 use image::RgbaImage;
 
-/// The device the tests will render on, or `None` where no OpenCL platform
-/// is installed: the test then returns early with a note. Under `CI=true`
-/// a missing platform fails the test instead.
+/// Whether a missing OpenCL device (or fp64 on it) must fail the tests
+/// rather than skip them: under `make test` (`FRACTAL_SDF_REQUIRE_DEVICE=1`,
+/// which installs PoCL first) and in CI.
+pub fn required() -> bool {
+    std::env::var("FRACTAL_SDF_REQUIRE_DEVICE").is_ok_and(|v| v == "1")
+        || std::env::var("CI").is_ok_and(|v| v == "true" || v == "1")
+}
+
+/// Records a skipped check where `make test` prints it after the run
+/// (`target/tmp/skipped.txt`), and on stderr.
+pub fn skipped(what: &str, why: &str) {
+    use std::io::Write as _;
+    let note = format!("{}: {what}: {why}", env!("CARGO_CRATE_NAME"));
+    eprintln!("note: skipped {note}");
+    let path = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join("skipped.txt");
+    if let Ok(mut file) = std::fs::OpenOptions::new()
+        .create(true)
+        .append(true)
+        .open(path)
+    {
+        let _ = writeln!(file, "{note}");
+    }
+}
+
+/// The device the tests render on, the one a renderer picks by itself; or
+/// `None` where no OpenCL platform is installed: the test then returns
+/// early and the skip is recorded. Where a device is [`required`], its
+/// absence fails the test instead.
 pub fn device() -> Option<DeviceInfo> {
-    let in_ci = std::env::var("CI").is_ok_and(|v| v == "true" || v == "1");
-    match devices() {
-        Ok(list) if !list.is_empty() => Some(list[0].clone()),
-        Ok(_) | Err(Error::NoPlatform { .. }) => {
-            let why = devices().err().map_or_else(
-                || "an OpenCL platform without devices".to_string(),
-                |e| e.to_string(),
-            );
-            assert!(!in_ci, "CI=true requires OpenCL: {why}");
-            eprintln!("note: skipping OpenCL render test: {why}");
+    match DeviceSelector::auto().resolve() {
+        Ok(device) => Some(device),
+        Err(e @ (Error::NoPlatform { .. } | Error::NoDevice { .. })) => {
+            assert!(!required(), "OpenCL is required here: {e}");
+            skipped("OpenCL render test", &e.to_string());
             None
         }
-        Err(other) => panic!("listing OpenCL devices failed: {other}"),
+        Err(other) => panic!("choosing an OpenCL device failed: {other}"),
     }
+}
+
+/// Whether `device` runs `F64` kernels. Where a device is [`required`],
+/// one without fp64 fails the test (PoCL has it); elsewhere the skip is
+/// recorded.
+pub fn fp64(device: &DeviceInfo) -> bool {
+    if !device.fp64 {
+        assert!(
+            !required(),
+            "fp64 is required here, and {} lacks it",
+            device.label()
+        );
+        skipped("F64 check", &format!("no fp64 on {}", device.label()));
+    }
+    device.fp64
 }
 
 /// Saves an image for inspection when `FRACTAL_SDF_TEST_OUT` names a
