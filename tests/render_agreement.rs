@@ -153,11 +153,12 @@ fn over_relaxation_finds_the_same_surface_in_fewer_steps() {
     assert!(m2 < m1, "over-relaxation saves steps: {m2} vs {m1}");
 }
 
-#[test]
-fn renderers_are_send() {
+// A renderer can move to another thread: checked when this file compiles,
+// not counted as a test.
+const _: fn() = || {
     fn send<T: Send>() {}
     send::<Renderer>();
-}
+};
 
 /// At least 99% of hit masks, and of depths where both hit, agree.
 fn assert_agreement(hits: f64, depths: f64) {

@@ -93,7 +93,7 @@ fn quality_and_effects_changes_rebuild_once_then_hit_the_cache() {
     let mut r = Renderer::new(&scene, quality).unwrap();
     assert_eq!(r.builds(), 1);
     assert!(!r.build_info().cached);
-    assert!(r.build_info().build_time.as_nanos() > 0);
+    let first = r.build_info().clone();
     assert!(r.build_info().device.contains(&r.device().name));
     let plain = r.render(32, 24).unwrap();
 
@@ -112,6 +112,9 @@ fn quality_and_effects_changes_rebuild_once_then_hit_the_cache() {
     let twin = Renderer::new(&scene, quality).unwrap();
     assert_eq!(twin.builds(), 0);
     assert!(twin.build_info().cached);
+    // ...and reports the build it was compiled in.
+    assert_eq!(twin.build_info().build_time, first.build_time);
+    assert_eq!(twin.build_info().source_hash, first.source_hash);
 
     // Quality is compiled in.
     r.set_quality(Quality {
