@@ -20,6 +20,12 @@ export FRACTAL_SDF_REQUIRE_DEVICE=1
 skipped=target/tmp/skipped.txt
 rm -f "$skipped"
 
+# Property tests draw their cases from a fixed seed here, so a failure
+# reproduces exactly: rerun with the seed printed below. Failing cases are
+# also kept in tests/*.proptest-regressions and tried first on every run.
+export PROPTEST_RNG_SEED=${PROPTEST_RNG_SEED:-20261201}
+printf '==> proptest seed: PROPTEST_RNG_SEED=%s\n' "$PROPTEST_RNG_SEED"
+
 step "$CARGO" fmt --all -- --check
 step "$CARGO" clippy --all-targets --all-features -- -D warnings
 # The binary tests/viewer_smoke.rs runs (`cargo test` builds examples only as

@@ -11,7 +11,7 @@ use fractal_sdf::prelude::*;
 use fractal_sdf::render::Renderer;
 use fractal_sdf::testing::scene_node;
 use proptest::prelude::*;
-use proptest::test_runner::{Config, TestRunner};
+use proptest::test_runner::{Config, FileFailurePersistence, TestRunner};
 
 fn cases(default: u32) -> u32 {
     std::env::var("FUZZ_CASES")
@@ -27,7 +27,11 @@ fn random_scenes_build_and_render_without_nan() {
     }
     let mut runner = TestRunner::new(Config {
         cases: cases(64),
-        failure_persistence: None,
+        // A failing scene is kept, and tried first on every later run.
+        failure_persistence: Some(Box::new(FileFailurePersistence::Direct(
+            "tests/fuzz.proptest-regressions",
+        ))),
+        source_file: Some(file!()),
         ..Config::default()
     });
     let effects = Effects {
