@@ -8,6 +8,7 @@ mod gpu;
 #[path = "../examples/common/hex_prism.rs"]
 mod hex_prism;
 
+use fractal_sdf::codegen::{self, Options, Target};
 use fractal_sdf::prelude::*;
 use fractal_sdf::render::DeviceSelector;
 use fractal_sdf::scene::{CustomShape, Rule};
@@ -168,4 +169,196 @@ fn custom_shape_definitions_are_checked() {
         Scene::new(node).validate(),
         Err(Error::OutOfRange { .. })
     ));
+}
+
+/// The reason a parameter name is refused, if it is.
+fn refusal(param: &str) -> Option<String> {
+    match CustomShape::new(
+        "shape",
+        &[(param, Rule::Finite)],
+        |_, _| 0.0,
+        "return R(0.0);",
+    ) {
+        Ok(_) => None,
+        Err(Error::CustomShape { name, reason }) => {
+            assert_eq!(name, "shape");
+            assert!(reason.contains(&format!("`{param}`")), "{reason}");
+            Some(reason)
+        }
+        Err(other) => panic!("{param}: {other}"),
+    }
+}
+
+#[test]
+fn names_with_a_meaning_in_opencl_or_the_program_are_refused() {
+    for name in [
+        "p",
+        "params",
+        "DETAIL",
+        "GAMMA",
+        "R",
+        "REAL_TINY",
+        "MAX_STEPS",
+        "CAMERA_ORIGIN",
+        "LIGHT_STRIDE",
+        "RENDER_TILE_ARGS",
+        "EVAL_POINTS_ARGS",
+        "ENABLE_AO",
+        "M_PI",
+        "FLT_MAX",
+        "real",
+        "real3",
+        "real16",
+        "float3",
+        "double",
+        "uint",
+        "half",
+        "kernel",
+        "__kernel",
+        "global",
+        "constant",
+        "restrict",
+        "return",
+        "sin",
+        "length",
+        "clamp",
+        "fabs",
+        "mix",
+        "convert_float",
+        "native_sqrt",
+        "vload3",
+        "__x",
+        "_Hidden",
+        "DE",
+        "DE_shade",
+        "sd_sphere",
+        "sd_future",
+        "twist_bound",
+        "march_ray",
+        "render_tile",
+        "eval_points",
+        "custom_gyroid",
+        "mandelbulb_p8",
+        "cl_khr_fp64",
+    ] {
+        assert!(refusal(name).is_some(), "`{name}` is accepted");
+    }
+    for name in [
+        "radius",
+        "half_length",
+        "thickness",
+        "k",
+        "t",
+        "x0",
+        "Radius",
+        "m_pi",
+    ] {
+        assert_eq!(refusal(name), None, "`{name}` is refused");
+    }
+}
+
+/// The names `source` defines at file scope: macros, typedefs and
+/// functions (lines that start a declaration with a name before `(`).
+fn defined_names(source: &str) -> Vec<String> {
+    let word = |s: &str| -> String {
+        s.chars()
+            .take_while(|c| c.is_ascii_alphanumeric() || *c == '_')
+            .collect()
+    };
+    let mut names = Vec::new();
+    for line in source.lines() {
+        if let Some(rest) = line.trim_start().strip_prefix("#define ") {
+            names.push(word(rest.trim_start()));
+        } else if let Some(rest) = line.strip_prefix("typedef ") {
+            if let Some(name) = rest
+                .strip_suffix(';')
+                .and_then(|r| r.split_whitespace().last())
+            {
+                names.push(name.to_string());
+            }
+        } else if line.starts_with("} ") && line.ends_with(';') {
+            names.push(word(line[2..].trim_start())); // typedef struct { ... } Name;
+        } else if line.starts_with(|c: char| c.is_ascii_alphabetic() || c == '_')
+            && line.contains('(')
+            && !line.starts_with("typedef")
+        {
+            let head = &line[..line.find('(').unwrap()];
+            names.push(word(head.split_whitespace().last().unwrap_or("")));
+        }
+    }
+    names.retain(|n| !n.is_empty());
+    names
+}
+
+/// Every `#define`, typedef and function any generated program holds is
+/// refused as a parameter name: read from programs for a scene with every
+/// helper, in both precisions, for both targets, every effect on.
+#[test]
+fn every_name_the_code_generator_defines_is_refused() {
+    let b = || cuboid(dvec3(0.5, 0.3, 0.4));
+    let every_helper = sphere(0.5)
+        .union(b().rotate(dvec3(1.0, 2.0, 0.5), 0.7))
+        .union(round_box(dvec3(0.5, 0.4, 0.3), 0.1))
+        .union(torus(0.7, 0.2).twist(1.5))
+        .union(cylinder(0.4, 0.6).bend(0.9))
+        .union(capsule(dvec3(-0.3, -0.5, 0.1), dvec3(0.4, 0.6, -0.2), 0.25))
+        .union(plane(dvec3(0.2, 1.0, -0.3), 0.4))
+        .union(octahedron(0.9).smooth_union(capped_cone(0.6, 0.5, 0.2), 0.3))
+        .union(ellipsoid(dvec3(0.7, 0.4, 0.5)))
+        .union(mandelbulb(8.0).union(mandelbulb(7.3)))
+        .union(menger(3).union(julia([-0.2, 0.6, 0.2, 0.2])))
+        .union(sierpinski(4));
+    let scene = Scene::new(every_helper).compile().unwrap();
+    let effects = Effects {
+        ambient_occlusion: true,
+        shadows: true,
+        glow: Some(Glow::new(DVec3::ONE, 1.0)),
+        fog_density: 0.5,
+        ..Effects::default()
+    };
+    let mut checked = 0;
+    for precision in [Precision::F32, Precision::F64] {
+        for target in [Target::Render, Target::Evaluate] {
+            let options = Options {
+                quality: Quality {
+                    precision,
+                    ..Quality::default()
+                },
+                effects,
+                target,
+            };
+            let source = codegen::emit(&scene, &options).unwrap().source;
+            let names = defined_names(&source);
+            for must in [
+                "DETAIL",
+                "REAL_TINY",
+                "real3",
+                "sd_sphere",
+                "mandelbulb_p8",
+                "DE_shade",
+            ] {
+                assert!(names.iter().any(|n| n == must), "{must} not read");
+            }
+            for name in names {
+                assert!(
+                    refusal(&name).is_some(),
+                    "`{name}` is accepted ({precision:?}, {target:?})"
+                );
+                checked += 1;
+            }
+        }
+    }
+    assert!(checked > 200, "{checked}");
+}
+
+#[test]
+fn shape_names_are_free_identifiers() {
+    // Shape names are free (the function is `custom_NAME`), as long as
+    // they are identifiers.
+    for name in ["DETAIL", "sin", "real", "p"] {
+        let shape = CustomShape::new(name, &[], |p, _| p.length(), "return length(p);").unwrap();
+        assert_eq!(shape.function_name(), format!("custom_{name}"));
+    }
+    let long = "x".repeat(49);
+    assert!(CustomShape::new(&long, &[], |_, _| 0.0, "return R(0.0);").is_err());
 }

@@ -23,6 +23,7 @@
 
 mod helpers;
 pub mod interface;
+pub(crate) mod names;
 mod power;
 mod scene;
 mod writer;

@@ -30,6 +30,7 @@ use glam::DVec3;
 
 use super::node::{Kind, Node, Rule};
 use super::param::Param;
+use crate::codegen::names;
 use crate::error::{Error, Result};
 
 /// The Rust distance function of a custom shape: the point and the
@@ -45,10 +46,35 @@ pub type CpuDistance = dyn Fn(DVec3, &[f64]) -> f64 + Send + Sync;
 /// shape. The CPU function runs in `f64` (also when the CPU reference
 /// evaluates in `f32`).
 ///
-/// The name and parameter names become OpenCL identifiers, so they must be
-/// ASCII identifiers (`[A-Za-z_][A-Za-z0-9_]*`, at most 48 characters); the
-/// generated function is namespaced as `custom_NAME`. The body is code you
-/// write and is emitted as given.
+/// # Names
+///
+/// The name and the parameter names become OpenCL identifiers, so they
+/// must be ASCII identifiers (`[A-Za-z_][A-Za-z0-9_]*`, at most 48
+/// characters). A parameter may not be called `p` (the point) nor take a
+/// name that OpenCL C or the generated program already gives a meaning to:
+///
+/// - OpenCL C keywords, qualifiers and type names, vector types included
+///   (`kernel`, `float3`, `real`, `real3`), and built-in functions (`sin`,
+///   `length`, `clamp`, `half_sqrt`, and the families `convert_*`,
+///   `as_TYPE`, `vload*`, `native_*`, `atomic_*`, ...);
+/// - names reserved for the compiler: starting with `__`, or with `_` and
+///   a capital;
+/// - names in capitals (no lower-case letter), which macros use: the
+///   generated header's (`DETAIL`, `GAMMA`, `R`, `MAX_STEPS`,
+///   `CAMERA_ORIGIN`, ...) and OpenCL's (`M_PI`, `FLT_MAX`);
+/// - `params` (the generated functions' buffer of dynamic parameter
+///   values) and the prefixes of generated names: `custom_`, `sd_`,
+///   `march_`, `cl_`, and the specialised Mandelbulbs `mandelbulb_pN`;
+/// - every other name the generated program defines or calls (its
+///   typedefs, helper functions such as `twist_bound`, `DE` and `DE_shade`),
+///   read from the program's own header, helper library and kernels.
+///
+/// The shape's function, `custom_NAME`, may not be a name the generated
+/// program already defines or calls. Write parameter names in lower case
+/// (`radius`, `half_length`) and none of these rules gets in the way. A
+/// refused name is an [`Error::CustomShape`] saying which rule it breaks.
+///
+/// The body is code you write and is emitted as given.
 #[derive(Clone)]
 pub struct CustomShape(Arc<Inner>);
 
@@ -64,8 +90,9 @@ impl CustomShape {
     /// distance function and its OpenCL C body.
     ///
     /// # Errors
-    /// [`Error::CustomShape`] if a name is not a valid identifier, a
-    /// parameter name repeats or shadows `p`, or the body is empty.
+    /// [`Error::CustomShape`] if a name is not a valid identifier or is
+    /// reserved (see [Names](CustomShape#names)), a parameter name repeats
+    /// or is `p`, or the body is empty.
     pub fn new(
         name: &str,
         params: &[(&str, Rule)],
@@ -77,13 +104,21 @@ impl CustomShape {
             reason,
         };
         check_identifier(name).map_err(|r| bad(format!("name {r}")))?;
-        let mut seen: Vec<&str> = vec!["p"];
+        let function = format!("custom_{name}");
+        if let Some(why) = names::generated(&function) {
+            return Err(bad(format!("its OpenCL function `{function}` {why}")));
+        }
+        let mut seen: Vec<&str> = Vec::new();
         for (param, _) in params {
             check_identifier(param).map_err(|r| bad(format!("parameter `{param}` {r}")))?;
+            if *param == "p" {
+                return Err(bad("parameter `p` shadows the point `p`".into()));
+            }
+            if let Some(why) = names::reserved(param) {
+                return Err(bad(format!("parameter `{param}` {why}")));
+            }
             if seen.contains(param) {
-                return Err(bad(format!(
-                    "parameter name `{param}` is used twice or shadows `p`"
-                )));
+                return Err(bad(format!("parameter name `{param}` is used twice")));
             }
             seen.push(param);
         }
