@@ -362,3 +362,79 @@ fn shape_names_are_free_identifiers() {
     let long = "x".repeat(49);
     assert!(CustomShape::new(&long, &[], |_, _| 0.0, "return R(0.0);").is_err());
 }
+
+fn ball() -> CustomShape {
+    CustomShape::new(
+        "ball",
+        &[],
+        |p, _| p.length() - 1.0,
+        "return length(p) - R(1.0);",
+    )
+    .unwrap()
+}
+
+fn ball_of(radius: f64) -> CustomShape {
+    CustomShape::new(
+        "ball",
+        &[],
+        move |p, _| p.length() - radius,
+        "return length(p) - R(1.0);",
+    )
+    .unwrap()
+}
+
+#[test]
+fn two_shapes_of_one_name_must_be_one_definition() {
+    // The same constructor, a capture-free closure: one shape.
+    assert_eq!(ball(), ball());
+    Scene::new(
+        ball()
+            .node(Vec::<f64>::new())
+            .union(ball().node(Vec::<f64>::new())),
+    )
+    .validate()
+    .unwrap();
+    // The same name, parameters and body, another Rust function: refused,
+    // or the CPU would compute two shapes where the device has one.
+    let other = CustomShape::new(
+        "ball",
+        &[],
+        |p, _| p.length() - 2.0,
+        "return length(p) - R(1.0);",
+    )
+    .unwrap();
+    assert_ne!(ball(), other);
+    let err = Scene::new(
+        ball()
+            .node(Vec::<f64>::new())
+            .union(other.node(Vec::<f64>::new())),
+    )
+    .validate()
+    .unwrap_err();
+    match &err {
+        Error::CustomShape { name, reason } => {
+            assert_eq!(name, "ball");
+            assert!(reason.contains("CPU functions differ"), "{reason}");
+            assert!(reason.contains("union/b:ball"), "{reason}");
+        }
+        other => panic!("{other}"),
+    }
+    // A closure that captures a value: only clones of one handle agree.
+    let (one, two) = (ball_of(1.0), ball_of(2.0));
+    assert_ne!(one, two);
+    let err = Scene::new(
+        one.node(Vec::<f64>::new())
+            .union(two.node(Vec::<f64>::new())),
+    )
+    .validate()
+    .unwrap_err();
+    assert!(err.to_string().contains("clone"), "{err}");
+    let clone = one.clone();
+    assert_eq!(one, clone);
+    Scene::new(
+        one.node(Vec::<f64>::new())
+            .union(clone.node(Vec::<f64>::new())),
+    )
+    .validate()
+    .unwrap();
+}

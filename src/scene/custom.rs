@@ -23,6 +23,7 @@
 //! # Ok::<(), fractal_sdf::Error>(())
 //! ```
 
+use std::any::TypeId;
 use std::fmt;
 use std::sync::Arc;
 
@@ -75,6 +76,20 @@ pub type CpuDistance = dyn Fn(DVec3, &[f64]) -> f64 + Send + Sync;
 /// refused name is an [`Error::CustomShape`] saying which rule it breaks.
 ///
 /// The body is code you write and is emitted as given.
+///
+/// # One definition per name
+///
+/// A scene may use a shape many times, but one name stands for one
+/// definition, because the program holds one `custom_NAME`. Two handles
+/// are the same shape when one is a clone of the other, or when they have
+/// the same name, parameters (names and rules) and OpenCL body and their
+/// CPU functions are of the same type *that holds no data*: a function
+/// item or a closure that captures nothing, whose type fixes what it
+/// computes. A closure that captures values, a function pointer or a boxed
+/// closure may compute something else in each handle, so such shapes are
+/// the same only as clones of one handle: define the shape once and clone
+/// it. Lowering refuses two different shapes of one name in a scene
+/// ([`Error::CustomShape`]).
 #[derive(Clone)]
 pub struct CustomShape(Arc<Inner>);
 
@@ -82,6 +97,9 @@ struct Inner {
     name: String,
     params: Vec<(String, Rule)>,
     cpu: Box<CpuDistance>,
+    /// The CPU function's type, when it holds no data (so the type alone
+    /// says what it computes); `None` otherwise.
+    cpu_type: Option<TypeId>,
     opencl: String,
 }
 
@@ -93,12 +111,10 @@ impl CustomShape {
     /// [`Error::CustomShape`] if a name is not a valid identifier or is
     /// reserved (see [Names](CustomShape#names)), a parameter name repeats
     /// or is `p`, or the body is empty.
-    pub fn new(
-        name: &str,
-        params: &[(&str, Rule)],
-        cpu: impl Fn(DVec3, &[f64]) -> f64 + Send + Sync + 'static,
-        opencl_body: &str,
-    ) -> Result<Self> {
+    pub fn new<F>(name: &str, params: &[(&str, Rule)], cpu: F, opencl_body: &str) -> Result<Self>
+    where
+        F: Fn(DVec3, &[f64]) -> f64 + Send + Sync + 'static,
+    {
         let bad = |reason: String| Error::CustomShape {
             name: name.chars().take(48).collect(),
             reason,
@@ -129,6 +145,7 @@ impl CustomShape {
             name: name.into(),
             params: params.iter().map(|(n, r)| ((*n).to_string(), *r)).collect(),
             cpu: Box::new(cpu),
+            cpu_type: (std::mem::size_of::<F>() == 0).then(TypeId::of::<F>),
             opencl: opencl_body.into(),
         })))
     }
@@ -190,19 +207,39 @@ impl CustomShape {
         .into()
     }
 
-    /// Whether two handles define the same shape: the same name, parameters
-    /// and OpenCL body.
-    fn same_definition(&self, other: &Self) -> bool {
-        Arc::ptr_eq(&self.0, &other.0)
-            || (self.0.name == other.0.name
-                && self.0.params == other.0.params
-                && self.0.opencl == other.0.opencl)
+    /// What tells `other` apart from this shape, or `None` if the two are
+    /// the same shape (see [One definition per
+    /// name](CustomShape#one-definition-per-name)).
+    #[must_use]
+    pub fn difference(&self, other: &Self) -> Option<&'static str> {
+        let (a, b) = (&self.0, &other.0);
+        if Arc::ptr_eq(a, b) {
+            None
+        } else if a.name != b.name {
+            Some("the names differ")
+        } else if a.params != b.params {
+            Some("the parameters (names or rules) differ")
+        } else if a.opencl != b.opencl {
+            Some("the OpenCL bodies differ")
+        } else if a.cpu_type.is_none() || b.cpu_type.is_none() {
+            Some(
+                "a CPU function holds data (a closure that captures values, a function pointer \
+                 or a boxed closure), so only clones of one handle are known to agree: define \
+                 the shape once and clone it",
+            )
+        } else if a.cpu_type != b.cpu_type {
+            Some("the CPU functions differ")
+        } else {
+            None
+        }
     }
 }
 
+/// Two handles are equal when they are the same shape: see [One definition
+/// per name](CustomShape#one-definition-per-name).
 impl PartialEq for CustomShape {
     fn eq(&self, other: &Self) -> bool {
-        self.same_definition(other)
+        self.difference(other).is_none()
     }
 }
 
