@@ -121,25 +121,66 @@ fn a_twin_that_drifted_from_its_reference_is_caught() {
     assert_eq!(err.violations, 100, "{err}");
 }
 
+/// The gyroid with a typo on the second line of its body.
+fn misspelt_gyroid() -> Node {
+    CustomShape::new(
+        "gyroid",
+        &[("thickness", Rule::NonNegative)],
+        |p, a| (p.x.sin() * p.y.cos()).abs() - a[0],
+        "real g = sin(p.x) * cos(p.y);\n    retur fabs(g) - thickness;",
+    )
+    .unwrap()
+    .node([0.1])
+}
+
 #[test]
-fn a_custom_body_that_does_not_compile_reports_the_build_log() {
+fn a_custom_body_that_does_not_compile_is_reported_by_its_own_line() {
     if gpu::device().is_none() {
         return;
     }
+    let scene = Scene::new(misspelt_gyroid().union(sphere(1.0)));
+    let err = fractal_sdf::render::Renderer::new(&scene, Quality::draft()).unwrap_err();
+    let shown = err.to_string();
+    match err {
+        Error::CustomShapeBuild {
+            shape,
+            line,
+            text,
+            message,
+            build,
+            ..
+        } => {
+            assert_eq!(shape, "gyroid");
+            assert_eq!(line, 2, "{shown}");
+            assert_eq!(text.trim(), "retur fabs(g) - thickness;");
+            assert!(message.contains("retur"), "{message}");
+            // The whole failure is kept: the full log and program.
+            assert!(build.build_log().is_some_and(|log| log.contains("retur")));
+            assert!(
+                build
+                    .kernel_source()
+                    .is_some_and(|s| s.contains("real custom_gyroid(real3 p, real thickness)"))
+            );
+        }
+        other => panic!("expected a custom shape build error, got {other}"),
+    }
+    assert!(
+        shown.starts_with(
+            "custom shape `gyroid`, line 2 of its body: `retur fabs(g) - thickness;`: "
+        ),
+        "{shown}"
+    );
+    // A body whose last line breaks is found in the evaluation program too.
     let broken = CustomShape::new("broken", &[], |p, _| p.length(), "return length(p) +;")
         .unwrap()
         .node(Vec::<f64>::new());
     let err =
-        fractal_sdf::render::Renderer::new(&Scene::new(broken), Quality::draft()).unwrap_err();
-    match err {
-        Error::Build {
-            log, kernel_source, ..
-        } => {
-            assert!(!log.is_empty());
-            assert!(kernel_source.contains("real custom_broken(real3 p)"));
-        }
-        other => panic!("expected a build error, got {other}"),
-    }
+        fractal_sdf::render::PointEvaluator::new(&broken, Precision::F32, &DeviceSelector::auto())
+            .unwrap_err();
+    assert!(
+        matches!(&err, Error::CustomShapeBuild { shape, line: 1, .. } if shape == "broken"),
+        "{err}"
+    );
 }
 
 #[test]

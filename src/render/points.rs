@@ -58,7 +58,8 @@ impl PointEvaluator {
     /// # Errors
     /// Validation errors, [`Error::NoPlatform`](crate::Error::NoPlatform),
     /// [`Error::Fp64Unsupported`](crate::Error::Fp64Unsupported),
-    /// [`Error::Build`](crate::Error::Build).
+    /// [`Error::Build`](crate::Error::Build),
+    /// [`Error::CustomShapeBuild`](crate::Error::CustomShapeBuild).
     pub fn new(geometry: &Node, precision: Precision, selector: &DeviceSelector) -> Result<Self> {
         Self::from_ir(&Ir::lower(geometry)?, precision, selector)
     }

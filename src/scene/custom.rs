@@ -75,7 +75,13 @@ pub type CpuDistance = dyn Fn(DVec3, &[f64]) -> f64 + Send + Sync;
 /// (`radius`, `half_length`) and none of these rules gets in the way. A
 /// refused name is an [`Error::CustomShape`] saying which rule it breaks.
 ///
-/// The body is code you write and is emitted as given.
+/// # Build errors
+///
+/// The body is code you write and is emitted as given. If the OpenCL
+/// compiler rejects it, rendering fails with
+/// [`Error::CustomShapeBuild`], which names the shape and quotes the line
+/// of the body (counted from 1, the first line of the string you gave) the
+/// compiler complained about.
 ///
 /// # One definition per name
 ///
