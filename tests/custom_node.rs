@@ -119,6 +119,19 @@ fn a_twin_that_drifted_from_its_reference_is_caught() {
     .unwrap_err();
     assert_eq!(err.check, Check::DeviceMatchesCpu);
     assert_eq!(err.violations, 100, "{err}");
+    // The report keeps the program the device ran, and says where it is.
+    let program = err.program.as_deref().expect("the program is kept");
+    assert!(
+        program
+            .source
+            .contains("real custom_drifted_sphere(real3 p, real radius)")
+    );
+    let path = program.path.as_ref().expect("the program is saved");
+    assert_eq!(std::fs::read_to_string(path).unwrap(), program.source);
+    assert!(
+        err.to_string().contains(&path.display().to_string()),
+        "{err}"
+    );
 }
 
 /// The gyroid with a typo on the second line of its body.
@@ -181,6 +194,31 @@ fn a_custom_body_that_does_not_compile_is_reported_by_its_own_line() {
         matches!(&err, Error::CustomShapeBuild { shape, line: 1, .. } if shape == "broken"),
         "{err}"
     );
+}
+
+#[test]
+fn a_device_check_that_does_not_build_is_a_build_failure_with_its_program() {
+    if gpu::device().is_none() {
+        return;
+    }
+    let points = random_points(10, 1.0, 5);
+    let f = check_device_matches_cpu(
+        &misspelt_gyroid(),
+        &DeviceSelector::auto(),
+        Precision::F32,
+        &points,
+        1e-4,
+    )
+    .unwrap_err();
+    assert_eq!(f.check, Check::Build);
+    let shown = f.to_string();
+    assert!(!shown.contains("does not validate"), "{shown}");
+    assert!(shown.contains("line 2 of its body"), "{shown}");
+    let program = f.program.as_deref().expect("the program is kept");
+    assert!(program.source.contains("real custom_gyroid("));
+    let path = program.path.as_ref().expect("the program is saved");
+    assert_eq!(std::fs::read_to_string(path).unwrap(), program.source);
+    assert!(shown.contains(&path.display().to_string()), "{shown}");
 }
 
 #[test]

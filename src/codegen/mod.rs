@@ -190,6 +190,13 @@ impl KernelSource {
             .find_map(|r| r.body_line(line).map(|l| (r, l)))
     }
 
+    /// The hash [`KernelSource::hash`] holds for a program of text
+    /// `source`.
+    #[must_use]
+    pub fn hash_of(source: &str) -> u64 {
+        fnv1a(source.as_bytes())
+    }
+
     /// Line `line` of the program (counted from 1), if there is one.
     #[must_use]
     pub fn line(&self, line: usize) -> Option<&str> {

@@ -47,6 +47,7 @@ pub struct PointEvaluator {
     selected: Selected,
     queue: Queue,
     program: ocl::Program,
+    source: codegen::KernelSource,
     precision: Precision,
     values: ParamValues,
 }
@@ -95,9 +96,16 @@ impl PointEvaluator {
             selected,
             queue,
             program,
+            source,
             precision,
             values: ir.default_values(),
         })
+    }
+
+    /// The generated program it runs.
+    #[must_use]
+    pub fn source(&self) -> &codegen::KernelSource {
+        &self.source
     }
 
     /// The device it runs on.
