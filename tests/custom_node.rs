@@ -442,6 +442,33 @@ fn shape_names_are_free_identifiers() {
     assert!(CustomShape::new(&long, &[], |_, _| 0.0, "return R(0.0);").is_err());
 }
 
+#[test]
+fn a_broken_rule_names_the_shape_and_its_parameter() {
+    let prism = hex_prism::hex_prism().unwrap();
+    let scene = Scene::new(sphere(1.0).union(prism.node([-1.0, 0.5])));
+    match scene.validate() {
+        Err(Error::OutOfRange { node, param, .. }) => {
+            assert_eq!(node, "union/b:hex_prism");
+            assert_eq!(param, "radius");
+        }
+        other => panic!("expected an out-of-range error, got {other:?}"),
+    }
+    let err = Scene::new(prism.node([0.5, f64::NAN]))
+        .validate()
+        .unwrap_err();
+    assert!(
+        err.to_string()
+            .starts_with("hex_prism: parameter `half_length`"),
+        "{err}"
+    );
+    // A dynamic value set later is checked against the same rule.
+    let node = prism.node([param("r", 0.5), 0.5.into()]);
+    let mut eval = cpu::Evaluator::new(&node.union(sphere(1.0))).unwrap();
+    let err = eval.set_param("r", -2.0).unwrap_err().to_string();
+    assert!(err.contains("hex_prism") && err.contains("radius"), "{err}");
+    assert!(!err.contains("custom"), "{err}");
+}
+
 fn ball() -> CustomShape {
     CustomShape::new(
         "ball",
