@@ -163,6 +163,32 @@ pub enum Error {
         /// The complete generated source.
         kernel_source: String,
     },
+    /// The OpenCL compiler rejected the body of a custom shape: the
+    /// message is about a line of the shape's definition, told as a line
+    /// of its body (see [`CustomShape`](crate::scene::CustomShape)). The
+    /// whole build failure, with the full log and program, is `build`.
+    #[error("custom shape `{shape}`, {}: {message}", custom_place(*line, text))]
+    CustomShapeBuild {
+        /// The shape's name.
+        shape: String,
+        /// The line of the body the compiler complained about, counted
+        /// from 1 (the first line of the string the shape was given); 0
+        /// for the function's signature, one past the body's last line for
+        /// its closing brace.
+        line: usize,
+        /// The column in that line, counted from 1 (0 if the compiler did
+        /// not say).
+        column: usize,
+        /// That line, as written.
+        text: String,
+        /// The compiler's message about it.
+        message: String,
+        /// The build failure as the compiler reported it: an
+        /// [`Error::Build`] with the device, the full log (about lines of
+        /// the whole program) and the program.
+        #[source]
+        build: Box<Error>,
+    },
     /// Any other OpenCL failure.
     #[error("OpenCL error: {0}")]
     OpenCl(String),
@@ -178,6 +204,39 @@ pub enum Error {
     /// Encoding an image failed.
     #[error("image encoding failed: {0}")]
     Image(#[from] image::ImageError),
+}
+
+impl Error {
+    /// The compiler's build log, for a build failure ([`Error::Build`] or
+    /// [`Error::CustomShapeBuild`]).
+    #[must_use]
+    pub fn build_log(&self) -> Option<&str> {
+        match self {
+            Error::Build { log, .. } => Some(log),
+            Error::CustomShapeBuild { build, .. } => build.build_log(),
+            _ => None,
+        }
+    }
+
+    /// The complete program that failed to build, for a build failure
+    /// ([`Error::Build`] or [`Error::CustomShapeBuild`]).
+    #[must_use]
+    pub fn kernel_source(&self) -> Option<&str> {
+        match self {
+            Error::Build { kernel_source, .. } => Some(kernel_source),
+            Error::CustomShapeBuild { build, .. } => build.kernel_source(),
+            _ => None,
+        }
+    }
+}
+
+/// Where in a custom shape's definition a compiler message points.
+fn custom_place(line: usize, text: &str) -> String {
+    if line == 0 {
+        format!("in its signature `{}`", text.trim())
+    } else {
+        format!("line {line} of its body: `{}`", text.trim())
+    }
 }
 
 /// `Result` with the crate's [`Error`].

@@ -51,8 +51,8 @@ mod membership;
 mod strategy;
 
 pub use check::{
-    Check, DistanceField, Failure, LIPSCHITZ_TOLERANCE, ROUNDING_ALLOWANCE, SHELL_FACTOR,
-    check_exact, check_lipschitz, check_never_overestimates,
+    Check, DistanceField, Failure, GeneratedProgram, LIPSCHITZ_TOLERANCE, ROUNDING_ALLOWANCE,
+    SHELL_FACTOR, check_exact, check_lipschitz, check_never_overestimates,
 };
 #[cfg(feature = "opencl")]
 pub use device::{check_device_matches_cpu, random_points, spicy_points};

@@ -203,7 +203,7 @@ fn args<A>(list: &[(A, &str)]) -> String {
 ///
 /// # Panics
 /// If `values` is not as long as the field.
-pub(crate) fn put(buffer: &mut [f64], field: Field, values: &[f64]) {
+pub fn put(buffer: &mut [f64], field: Field, values: &[f64]) {
     assert_eq!(
         values.len(),
         field.len,

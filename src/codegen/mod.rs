@@ -23,6 +23,7 @@
 
 mod helpers;
 pub mod interface;
+pub(crate) mod names;
 mod power;
 mod scene;
 mod writer;
@@ -133,6 +134,36 @@ pub struct KernelSource {
     /// Where the target kernel (`kernels/march.cl` or `kernels/eval.cl`,
     /// after effect selection) starts in `source`.
     pub kernel_start: usize,
+    /// Where each custom shape's function lies in `source`, in order, so
+    /// that a compiler message about a line of the program can be told as
+    /// a line of the shape's body.
+    pub custom_regions: Vec<CustomRegion>,
+}
+
+/// Where a custom shape's OpenCL function lies in a generated program: its
+/// signature on line `first_line - 1`, the body as given on lines
+/// `first_line .. first_line + lines`, and the closing brace after them.
+/// Lines are counted from 1, as compilers count them.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct CustomRegion {
+    /// The shape's name.
+    pub shape: String,
+    /// The program line holding the first line of the body.
+    pub first_line: usize,
+    /// How many lines the body has.
+    pub lines: usize,
+}
+
+impl CustomRegion {
+    /// The line of the shape's definition that program line `line` is:
+    /// 0 for the signature, `1..=lines` for the body's lines (the first
+    /// line of the string the shape was given is 1), `lines + 1` for the
+    /// closing brace; `None` outside the definition.
+    #[must_use]
+    pub fn body_line(&self, line: usize) -> Option<usize> {
+        (line + 1 >= self.first_line && line <= self.first_line + self.lines)
+            .then(|| line + 1 - self.first_line)
+    }
 }
 
 impl KernelSource {
@@ -147,6 +178,29 @@ impl KernelSource {
     #[must_use]
     pub fn kernel_part(&self) -> &str {
         &self.source[self.kernel_start..]
+    }
+
+    /// The custom shape whose definition holds program line `line`
+    /// (counted from 1), and which line of the definition it is (see
+    /// [`CustomRegion::body_line`]).
+    #[must_use]
+    pub fn custom_line(&self, line: usize) -> Option<(&CustomRegion, usize)> {
+        self.custom_regions
+            .iter()
+            .find_map(|r| r.body_line(line).map(|l| (r, l)))
+    }
+
+    /// The hash [`KernelSource::hash`] holds for a program of text
+    /// `source`.
+    #[must_use]
+    pub fn hash_of(source: &str) -> u64 {
+        fnv1a(source.as_bytes())
+    }
+
+    /// Line `line` of the program (counted from 1), if there is one.
+    #[must_use]
+    pub fn line(&self, line: usize) -> Option<&str> {
+        self.source.lines().nth(line.checked_sub(1)?)
     }
 }
 
@@ -210,14 +264,24 @@ pub fn emit_ir(ir: &Ir, options: &Options) -> Result<KernelSource> {
         w.raw(&power::mandelbulb_helper(n));
         w.line("");
     }
+    let mut custom_regions = Vec::with_capacity(customs.len());
     for shape in &customs {
         w.line(format!("/* ---- custom shape {} ---- */", shape.name()));
-        w.raw(&shape.opencl_definition());
+        let definition = shape.opencl_definition();
+        // The signature takes one line, the closing brace another.
+        custom_regions.push(CustomRegion {
+            shape: shape.name().to_string(),
+            first_line: w.lines() + 2,
+            lines: definition.matches('\n').count() - 2,
+        });
+        w.raw(&definition);
         w.line("");
     }
     w.line("/* ---- scene ---- */");
     w.raw(&body.finish());
-    Ok(finish(w, options, origin))
+    let mut kernel = finish(w, options, origin);
+    kernel.custom_regions = custom_regions;
+    Ok(kernel)
 }
 
 /// A complete program around hand-written scene functions: the header for
@@ -268,6 +332,7 @@ fn finish(mut w: writer::Writer, options: &Options, origin: DVec3) -> KernelSour
         precision: options.quality.precision,
         origin,
         kernel_start,
+        custom_regions: Vec::new(),
     }
 }
 

@@ -36,6 +36,11 @@ impl Writer {
         self.out.len()
     }
 
+    /// Lines written so far (newlines).
+    pub(crate) fn lines(&self) -> usize {
+        self.out.matches('\n').count()
+    }
+
     /// Writes a `/* ... */` comment line; `text` is made safe for a comment.
     pub(crate) fn comment(&mut self, text: &str) {
         self.line(format!("/* {} */", comment_text(text)));

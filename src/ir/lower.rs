@@ -325,14 +325,20 @@ impl Lowering {
         }
     }
 
-    /// One definition per custom shape name in a scene.
+    /// One definition per custom shape name in a scene (see
+    /// [`CustomShape::difference`]).
     fn check_custom(&mut self, shape: &CustomShape) -> Result<()> {
         match self.customs.get(shape.name()) {
-            Some(known) if known != shape => Err(Error::CustomShape {
-                name: shape.name().into(),
-                reason: "two different shapes with this name are used in one scene".into(),
-            }),
-            Some(_) => Ok(()),
+            Some(known) => match known.difference(shape) {
+                Some(why) => Err(Error::CustomShape {
+                    name: shape.name().into(),
+                    reason: format!(
+                        "{}: two different shapes with this name are used in one scene ({why})",
+                        self.path(self.current)
+                    ),
+                }),
+                None => Ok(()),
+            },
             None => {
                 self.customs.insert(shape.name().into(), shape.clone());
                 Ok(())

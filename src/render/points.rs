@@ -47,6 +47,7 @@ pub struct PointEvaluator {
     selected: Selected,
     queue: Queue,
     program: ocl::Program,
+    source: codegen::KernelSource,
     precision: Precision,
     values: ParamValues,
 }
@@ -58,7 +59,8 @@ impl PointEvaluator {
     /// # Errors
     /// Validation errors, [`Error::NoPlatform`](crate::Error::NoPlatform),
     /// [`Error::Fp64Unsupported`](crate::Error::Fp64Unsupported),
-    /// [`Error::Build`](crate::Error::Build).
+    /// [`Error::Build`](crate::Error::Build),
+    /// [`Error::CustomShapeBuild`](crate::Error::CustomShapeBuild).
     pub fn new(geometry: &Node, precision: Precision, selector: &DeviceSelector) -> Result<Self> {
         Self::from_ir(&Ir::lower(geometry)?, precision, selector)
     }
@@ -94,9 +96,16 @@ impl PointEvaluator {
             selected,
             queue,
             program,
+            source,
             precision,
             values: ir.default_values(),
         })
+    }
+
+    /// The generated program it runs.
+    #[must_use]
+    pub fn source(&self) -> &codegen::KernelSource {
+        &self.source
     }
 
     /// The device it runs on.

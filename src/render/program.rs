@@ -129,7 +129,7 @@ pub(crate) fn build(
     let built = match &*slot {
         Some(b) => b.clone(),
         None => {
-            let b = compile(selected, context, &source.source, &options)?;
+            let b = compile(selected, context, source, &options)?;
             BUILDS.fetch_add(1, Ordering::Relaxed);
             *slot = Some(b.clone());
             b
@@ -145,7 +145,13 @@ pub(crate) fn build(
     Ok((built.program, info, compiled_now))
 }
 
-fn compile(selected: &Selected, context: &Context, source: &str, options: &str) -> Result<Built> {
+fn compile(
+    selected: &Selected,
+    context: &Context,
+    kernel: &KernelSource,
+    options: &str,
+) -> Result<Built> {
+    let source = kernel.source.as_str();
     let failed = |log: String| Error::Build {
         device: selected.info.label(),
         log,
@@ -167,10 +173,225 @@ fn compile(selected: &Selected, context: &Context, source: &str, options: &str) 
             Ok(ProgramBuildInfoResult::BuildLog(log)) if !log.trim().is_empty() => log,
             _ => e.to_string(),
         };
-        return Err(failed(log.trim_end_matches('\0').trim_end().to_string()));
+        let log = log.trim_end_matches('\0').trim_end().to_string();
+        return Err(build_error(selected.info.label(), log, kernel));
     }
     Ok(Built {
         program: Program::from(program),
         build_time,
     })
+}
+
+/// The error for a failed build: [`Error::CustomShapeBuild`] when the log
+/// has an error about a line of a custom shape's definition (the first
+/// such error), [`Error::Build`] otherwise.
+fn build_error(device: String, log: String, kernel: &KernelSource) -> Error {
+    let custom = diagnostics(&log).into_iter().find_map(|d| {
+        let (region, line) = kernel.custom_line(d.line)?;
+        Some((region.shape.clone(), line, d))
+    });
+    let build = Error::Build {
+        device,
+        log,
+        kernel_source: kernel.source.clone(),
+    };
+    match custom {
+        Some((shape, line, d)) => Error::CustomShapeBuild {
+            shape,
+            line,
+            column: d.column,
+            text: kernel.line(d.line).unwrap_or_default().to_string(),
+            message: d.message,
+            build: Box::new(build),
+        },
+        None => build,
+    }
+}
+
+/// An error message of a build log, with where in the program it points.
+#[derive(Debug, PartialEq)]
+struct Diagnostic {
+    line: usize,
+    column: usize,
+    message: String,
+}
+
+/// The errors of a build log that say where they are, in order.
+///
+/// Compilers write a location as `FILE:LINE:COL` (the file a temporary
+/// path, `<stdin>`, `<kernel>`, `<source>` or a number) with the severity
+/// before it (PoCL: `error: FILE:L:C: message`) or after it (clang, NVIDIA,
+/// AMD, Intel: `FILE:L:C: error: message`). The first `:LINE:COL` of a line
+/// is taken: where a macro was expanded, PoCL adds the macro's own place
+/// after it (`<Spelling=...>`). Warnings and notes are skipped.
+fn diagnostics(log: &str) -> Vec<Diagnostic> {
+    log.lines()
+        .filter_map(|text| {
+            let severity = ["error:", "warning:", "note:"]
+                .iter()
+                .filter_map(|s| text.find(s).map(|at| (at, *s)))
+                .min()?;
+            if severity.1 != "error:" {
+                return None;
+            }
+            let (line, column, end) = location(text)?;
+            let mut message = text[end..].trim_start();
+            if message.starts_with("<Spelling=") {
+                message = message.find('>').map_or("", |e| &message[e + 1..]);
+            }
+            let message = message.trim_start_matches([':', ' ']);
+            let message = message
+                .strip_prefix("fatal error:")
+                .or_else(|| message.strip_prefix("error:"))
+                .unwrap_or(message)
+                .trim();
+            Some(Diagnostic {
+                line,
+                column,
+                message: message.to_string(),
+            })
+        })
+        .collect()
+}
+
+/// The first `:LINE:COL` of `text`: the line, the column and where the
+/// location ends.
+fn location(text: &str) -> Option<(usize, usize, usize)> {
+    let bytes = text.as_bytes();
+    let number = |from: usize| {
+        let len = bytes[from..]
+            .iter()
+            .take_while(|b| b.is_ascii_digit())
+            .count();
+        (len > 0).then(|| (text[from..from + len].parse::<usize>().ok(), from + len))
+    };
+    text.match_indices(':').find_map(|(at, _)| {
+        let (line, after) = number(at + 1)?;
+        if bytes.get(after) != Some(&b':') {
+            return None;
+        }
+        let (column, end) = number(after + 1)?;
+        Some((line?, column?, end))
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::codegen::CustomRegion;
+    use glam::DVec3;
+
+    fn program() -> KernelSource {
+        let source: String = (1..=20).map(|i| format!("line {i}\n")).collect();
+        KernelSource {
+            source,
+            precision: Precision::F32,
+            hash: 0,
+            origin: DVec3::ZERO,
+            kernel_start: 0,
+            // Signature on line 9, body on lines 10 and 11, brace on 12.
+            custom_regions: vec![CustomRegion {
+                shape: "gyroid".into(),
+                first_line: 10,
+                lines: 2,
+            }],
+        }
+    }
+
+    #[test]
+    fn locations_are_read_from_every_compilers_log_format() {
+        for (log, line, column, message) in [
+            (
+                "error: /root/.cache/pocl/kcache/tempfile_EzTwFz.cl:64:3: use of undeclared \
+                 identifier 'retur'",
+                64,
+                3,
+                "use of undeclared identifier 'retur'",
+            ),
+            (
+                "error: /tmp/t.cl:62:29 <Spelling=/tmp/t.cl:14:16>: expected ')'",
+                62,
+                29,
+                "expected ')'",
+            ),
+            (
+                "<stdin>:11:5: error: expected expression",
+                11,
+                5,
+                "expected expression",
+            ),
+            (
+                "<kernel>:7:1: error: unknown type name 'x'",
+                7,
+                1,
+                "unknown type name 'x'",
+            ),
+            (
+                "1:40:12: error: use of undeclared identifier",
+                40,
+                12,
+                "use of undeclared identifier",
+            ),
+            (
+                "input.cl:3:9: fatal error: 'x.h' file not found",
+                3,
+                9,
+                "'x.h' file not found",
+            ),
+        ] {
+            assert_eq!(
+                diagnostics(log),
+                vec![Diagnostic {
+                    line,
+                    column,
+                    message: message.into()
+                }],
+                "{log}"
+            );
+        }
+        let log = "warning: /tmp/t.cl:5:1: unused\n<stdin>:9:1: note: here\n2 errors generated.";
+        assert!(diagnostics(log).is_empty());
+    }
+
+    #[test]
+    fn an_error_in_a_custom_body_names_the_shape_and_its_line() {
+        let log = "warning: /tmp/t.cl:2:1: something\n\
+                   error: /tmp/t.cl:4:1: an error elsewhere\n\
+                   error: /tmp/t.cl:11:6: expected expression\n\
+                   2 errors generated."
+            .to_string();
+        match build_error("dev".into(), log.clone(), &program()) {
+            Error::CustomShapeBuild {
+                shape,
+                line,
+                column,
+                text,
+                message,
+                build,
+            } => {
+                assert_eq!((shape.as_str(), line, column), ("gyroid", 2, 6));
+                assert_eq!(text, "line 11");
+                assert_eq!(message, "expected expression");
+                assert!(matches!(*build, Error::Build { .. }));
+                assert_eq!(build.build_log(), Some(log.as_str()));
+                assert_eq!(build.kernel_source(), Some(program().source.as_str()));
+            }
+            other => panic!("{other:?}"),
+        }
+        let signature = build_error("dev".into(), "<stdin>:9:3: error: bad".into(), &program());
+        assert!(
+            signature
+                .to_string()
+                .starts_with("custom shape `gyroid`, in its signature `line 9`: bad"),
+            "{signature}"
+        );
+        for outside in [
+            "<stdin>:8:1: error: x",
+            "<stdin>:13:1: error: x",
+            "no location",
+        ] {
+            let err = build_error("dev".into(), outside.into(), &program());
+            assert!(matches!(err, Error::Build { .. }), "{outside}: {err:?}");
+        }
+    }
 }

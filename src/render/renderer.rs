@@ -149,7 +149,9 @@ impl Renderer {
     /// Quality, effects and [`Error::TileSize`] errors;
     /// [`Error::NoPlatform`], [`Error::NoDevice`];
     /// [`Error::Fp64Unsupported`] for `F64` on a device without it;
-    /// [`Error::Build`] with the compiler log and the source.
+    /// [`Error::Build`] with the compiler log and the source, or
+    /// [`Error::CustomShapeBuild`] when the compiler rejects a custom
+    /// shape's body.
     pub fn from_compiled(scene: CompiledScene, options: &RenderOptions) -> Result<Self> {
         Self::build(scene, options, SceneFunctions::Generated)
     }

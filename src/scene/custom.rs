@@ -23,6 +23,7 @@
 //! # Ok::<(), fractal_sdf::Error>(())
 //! ```
 
+use std::any::TypeId;
 use std::fmt;
 use std::sync::Arc;
 
@@ -30,6 +31,7 @@ use glam::DVec3;
 
 use super::node::{Kind, Node, Rule};
 use super::param::Param;
+use crate::codegen::names;
 use crate::error::{Error, Result};
 
 /// The Rust distance function of a custom shape: the point and the
@@ -45,10 +47,55 @@ pub type CpuDistance = dyn Fn(DVec3, &[f64]) -> f64 + Send + Sync;
 /// shape. The CPU function runs in `f64` (also when the CPU reference
 /// evaluates in `f32`).
 ///
-/// The name and parameter names become OpenCL identifiers, so they must be
-/// ASCII identifiers (`[A-Za-z_][A-Za-z0-9_]*`, at most 48 characters); the
-/// generated function is namespaced as `custom_NAME`. The body is code you
-/// write and is emitted as given.
+/// # Names
+///
+/// The name and the parameter names become OpenCL identifiers, so they
+/// must be ASCII identifiers (`[A-Za-z_][A-Za-z0-9_]*`, at most 48
+/// characters). A parameter may not be called `p` (the point) nor take a
+/// name that OpenCL C or the generated program already gives a meaning to:
+///
+/// - OpenCL C keywords, qualifiers and type names, vector types included
+///   (`kernel`, `float3`, `real`, `real3`), and built-in functions (`sin`,
+///   `length`, `clamp`, `half_sqrt`, and the families `convert_*`,
+///   `as_TYPE`, `vload*`, `native_*`, `atomic_*`, ...);
+/// - names reserved for the compiler: starting with `__`, or with `_` and
+///   a capital;
+/// - names in capitals (no lower-case letter), which macros use: the
+///   generated header's (`DETAIL`, `GAMMA`, `R`, `MAX_STEPS`,
+///   `CAMERA_ORIGIN`, ...) and OpenCL's (`M_PI`, `FLT_MAX`);
+/// - `params` (the generated functions' buffer of dynamic parameter
+///   values) and the prefixes of generated names: `custom_`, `sd_`,
+///   `march_`, `cl_`, and the specialised Mandelbulbs `mandelbulb_pN`;
+/// - every other name the generated program defines or calls (its
+///   typedefs, helper functions such as `twist_bound`, `DE` and `DE_shade`),
+///   read from the program's own header, helper library and kernels.
+///
+/// The shape's function, `custom_NAME`, may not be a name the generated
+/// program already defines or calls. Write parameter names in lower case
+/// (`radius`, `half_length`) and none of these rules gets in the way. A
+/// refused name is an [`Error::CustomShape`] saying which rule it breaks.
+///
+/// # Build errors
+///
+/// The body is code you write and is emitted as given. If the OpenCL
+/// compiler rejects it, rendering fails with
+/// [`Error::CustomShapeBuild`], which names the shape and quotes the line
+/// of the body (counted from 1, the first line of the string you gave) the
+/// compiler complained about.
+///
+/// # One definition per name
+///
+/// A scene may use a shape many times, but one name stands for one
+/// definition, because the program holds one `custom_NAME`. Two handles
+/// are the same shape when one is a clone of the other, or when they have
+/// the same name, parameters (names and rules) and OpenCL body and their
+/// CPU functions are of the same type *that holds no data*: a function
+/// item or a closure that captures nothing, whose type fixes what it
+/// computes. A closure that captures values, a function pointer or a boxed
+/// closure may compute something else in each handle, so such shapes are
+/// the same only as clones of one handle: define the shape once and clone
+/// it. Lowering refuses two different shapes of one name in a scene
+/// ([`Error::CustomShape`]).
 #[derive(Clone)]
 pub struct CustomShape(Arc<Inner>);
 
@@ -56,6 +103,9 @@ struct Inner {
     name: String,
     params: Vec<(String, Rule)>,
     cpu: Box<CpuDistance>,
+    /// The CPU function's type, when it holds no data (so the type alone
+    /// says what it computes); `None` otherwise.
+    cpu_type: Option<TypeId>,
     opencl: String,
 }
 
@@ -64,26 +114,33 @@ impl CustomShape {
     /// distance function and its OpenCL C body.
     ///
     /// # Errors
-    /// [`Error::CustomShape`] if a name is not a valid identifier, a
-    /// parameter name repeats or shadows `p`, or the body is empty.
-    pub fn new(
-        name: &str,
-        params: &[(&str, Rule)],
-        cpu: impl Fn(DVec3, &[f64]) -> f64 + Send + Sync + 'static,
-        opencl_body: &str,
-    ) -> Result<Self> {
+    /// [`Error::CustomShape`] if a name is not a valid identifier or is
+    /// reserved (see [Names](CustomShape#names)), a parameter name repeats
+    /// or is `p`, or the body is empty.
+    pub fn new<F>(name: &str, params: &[(&str, Rule)], cpu: F, opencl_body: &str) -> Result<Self>
+    where
+        F: Fn(DVec3, &[f64]) -> f64 + Send + Sync + 'static,
+    {
         let bad = |reason: String| Error::CustomShape {
             name: name.chars().take(48).collect(),
             reason,
         };
         check_identifier(name).map_err(|r| bad(format!("name {r}")))?;
-        let mut seen: Vec<&str> = vec!["p"];
+        let function = format!("custom_{name}");
+        if let Some(why) = names::generated(&function) {
+            return Err(bad(format!("its OpenCL function `{function}` {why}")));
+        }
+        let mut seen: Vec<&str> = Vec::new();
         for (param, _) in params {
             check_identifier(param).map_err(|r| bad(format!("parameter `{param}` {r}")))?;
+            if *param == "p" {
+                return Err(bad("parameter `p` shadows the point `p`".into()));
+            }
+            if let Some(why) = names::reserved(param) {
+                return Err(bad(format!("parameter `{param}` {why}")));
+            }
             if seen.contains(param) {
-                return Err(bad(format!(
-                    "parameter name `{param}` is used twice or shadows `p`"
-                )));
+                return Err(bad(format!("parameter name `{param}` is used twice")));
             }
             seen.push(param);
         }
@@ -94,6 +151,7 @@ impl CustomShape {
             name: name.into(),
             params: params.iter().map(|(n, r)| ((*n).to_string(), *r)).collect(),
             cpu: Box::new(cpu),
+            cpu_type: (std::mem::size_of::<F>() == 0).then(TypeId::of::<F>),
             opencl: opencl_body.into(),
         })))
     }
@@ -155,19 +213,39 @@ impl CustomShape {
         .into()
     }
 
-    /// Whether two handles define the same shape: the same name, parameters
-    /// and OpenCL body.
-    fn same_definition(&self, other: &Self) -> bool {
-        Arc::ptr_eq(&self.0, &other.0)
-            || (self.0.name == other.0.name
-                && self.0.params == other.0.params
-                && self.0.opencl == other.0.opencl)
+    /// What tells `other` apart from this shape, or `None` if the two are
+    /// the same shape (see [One definition per
+    /// name](CustomShape#one-definition-per-name)).
+    #[must_use]
+    pub fn difference(&self, other: &Self) -> Option<&'static str> {
+        let (a, b) = (&self.0, &other.0);
+        if Arc::ptr_eq(a, b) {
+            None
+        } else if a.name != b.name {
+            Some("the names differ")
+        } else if a.params != b.params {
+            Some("the parameters (names or rules) differ")
+        } else if a.opencl != b.opencl {
+            Some("the OpenCL bodies differ")
+        } else if a.cpu_type.is_none() || b.cpu_type.is_none() {
+            Some(
+                "a CPU function holds data (a closure that captures values, a function pointer \
+                 or a boxed closure), so only clones of one handle are known to agree: define \
+                 the shape once and clone it",
+            )
+        } else if a.cpu_type != b.cpu_type {
+            Some("the CPU functions differ")
+        } else {
+            None
+        }
     }
 }
 
+/// Two handles are equal when they are the same shape: see [One definition
+/// per name](CustomShape#one-definition-per-name).
 impl PartialEq for CustomShape {
     fn eq(&self, other: &Self) -> bool {
-        self.same_definition(other)
+        self.difference(other).is_none()
     }
 }
 

@@ -1,6 +1,7 @@
 //! Invariant checkers: Lipschitz bound, never overestimating, exactness.
 
 use std::fmt;
+use std::path::PathBuf;
 
 use glam::DVec3;
 
@@ -39,6 +40,11 @@ pub enum Check {
     Exact,
     /// The OpenCL twin agrees with the CPU reference (distance and colour).
     DeviceMatchesCpu,
+    /// The generated OpenCL program builds.
+    Build,
+    /// The device can run the check (there is an OpenCL platform and
+    /// device, with double precision if asked, and the kernel runs).
+    Device,
 }
 
 /// A broken invariant: the worst violation a checker found, and how many
@@ -54,6 +60,12 @@ pub enum Check {
 /// | `Lipschitz` | `[p, q]` | `[d(p), d(q)]` | `\|d(p) - d(q)\| / \|p - q\|` | the bound |
 /// | `NeverOverestimates` | `[p, q]`, `q` inside | `[d(p)]` | `d(p)` | `\|p - q\|` |
 /// | `Exact` | `[p]` | `[d(p), analytic(p)]` | `\|d(p) - analytic(p)\|` | the tolerance at `p` |
+/// | `DeviceMatchesCpu` | `[p]` | `[device, cpu]` | the relative error | the tolerance |
+/// | `Build`, `Device` | none | none | 0 | 0 |
+///
+/// A check that ran generated OpenCL code keeps the program in `program`
+/// (and saves it to a file it names), so a failure can be read against the
+/// code that produced it.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Failure {
     /// Which invariant broke.
@@ -70,9 +82,25 @@ pub struct Failure {
     pub violations: usize,
     /// How many inputs were checked.
     pub checked: usize,
-    /// For `Valid`, the validation error; for `Finite`, what was not
-    /// finite.
+    /// For `Valid`, the validation error; for `Build` and `Device`, the
+    /// error (for a custom shape's body, the line of the body and the
+    /// compiler's message); for `Finite` and `DeviceMatchesCpu`, which
+    /// value.
     pub detail: String,
+    /// The generated OpenCL program, for checks that ran one (or tried to
+    /// build it).
+    pub program: Option<Box<GeneratedProgram>>,
+}
+
+/// The generated OpenCL program a device check ran, or failed to build.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct GeneratedProgram {
+    /// The complete source.
+    pub source: String,
+    /// Where the failing check saved it: a file in the temporary directory
+    /// named after the program's hash, or `None` if it could not be
+    /// written.
+    pub path: Option<PathBuf>,
 }
 
 impl Failure {
@@ -104,6 +132,7 @@ impl Failure {
             violations: 1,
             checked: 1,
             detail: String::new(),
+            program: None,
         }
     }
 
@@ -118,10 +147,29 @@ impl Failure {
 
 impl fmt::Display for Failure {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        self.describe(f)?;
+        match self.program.as_deref() {
+            Some(GeneratedProgram {
+                path: Some(path), ..
+            }) => write!(f, "\ngenerated program: {}", path.display()),
+            Some(_) => write!(f, "\ngenerated program: kept in `Failure::program`"),
+            None => Ok(()),
+        }
+    }
+}
+
+impl Failure {
+    fn describe(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         let (p, v) = (&self.points, &self.values);
         let tally = |noun: &str| format!("{} of {} {noun} fail", self.violations, self.checked);
         match self.check {
             Check::Valid => write!(f, "the node does not validate: {}", self.detail),
+            Check::Build => write!(
+                f,
+                "the generated OpenCL program does not build: {}",
+                self.detail
+            ),
+            Check::Device => write!(f, "the device cannot run the check: {}", self.detail),
             Check::Finite => write!(
                 f,
                 "{} is not finite at p = {}: {}",

@@ -2,8 +2,10 @@
 
 use glam::DVec3;
 
-use super::check::{Check, Failure, Tally};
+use super::check::{Check, Failure, GeneratedProgram, Tally};
+use crate::codegen::KernelSource;
 use crate::cpu::Evaluator;
+use crate::error::Error;
 use crate::quality::Precision;
 use crate::render::{DeviceSelector, PointEvaluator};
 use crate::scene::Node;
@@ -59,9 +61,13 @@ pub fn spicy_points() -> Vec<DVec3> {
 /// Good tolerances: `1e-4` for F32 and `1e-10` for F64.
 ///
 /// # Errors
-/// [`Check::Valid`] if the node does not validate or the program cannot be
-/// built or run (the detail says why); otherwise the point with the largest
-/// relative error.
+/// [`Check::Valid`] if the node does not validate; [`Check::Build`] if the
+/// generated program does not build (the detail has the compiler's
+/// message, for a custom shape the line of its body); [`Check::Device`] if
+/// there is no device to run it on or running it fails; otherwise the
+/// point with the largest relative error. Every failure after code
+/// generation keeps the generated program ([`Failure::program`]) and says
+/// where it saved it.
 ///
 /// ```no_run
 /// use fractal_sdf::prelude::*;
@@ -79,13 +85,13 @@ pub fn check_device_matches_cpu(
     points: &[DVec3],
     tolerance: f64,
 ) -> Result<(), Failure> {
-    let invalid = |detail: String| Failure {
-        detail,
+    let cpu = Evaluator::new(node).map_err(|e| Failure {
+        detail: e.to_string(),
         ..Failure::new(Check::Valid, vec![], vec![], 0.0, 0.0)
-    };
-    let cpu = Evaluator::new(node).map_err(|e| invalid(e.to_string()))?;
-    let twin = PointEvaluator::new(node, precision, device).map_err(|e| invalid(e.to_string()))?;
-    let got = twin.eval(points).map_err(|e| invalid(e.to_string()))?;
+    })?;
+    let twin = PointEvaluator::new(node, precision, device).map_err(not_run)?;
+    let keep = |failure: Failure| keep_source(failure, twin.source());
+    let got = twin.eval(points).map_err(|e| keep(not_run(e)))?;
     let mut tally = Tally::new();
     for (&p, g) in points.iter().zip(&got) {
         let (distance, color) = match precision {
@@ -133,5 +139,45 @@ pub fn check_device_matches_cpu(
             None => tally.pass(),
         }
     }
-    tally.finish()
+    tally.finish().map_err(keep)
+}
+
+/// The failure for a device check that could not run: the program did not
+/// build ([`Check::Build`], with the program), or the device could not be
+/// found or run it ([`Check::Device`]).
+fn not_run(error: Error) -> Failure {
+    let source = error.kernel_source().map(str::to_string);
+    let check = if source.is_some() {
+        Check::Build
+    } else {
+        Check::Device
+    };
+    let failure = Failure {
+        detail: error.to_string(),
+        ..Failure::new(check, vec![], vec![], 0.0, 0.0)
+    };
+    match source {
+        Some(source) => {
+            let hash = KernelSource::hash_of(&source);
+            with_source(failure, source, hash)
+        }
+        None => failure,
+    }
+}
+
+/// `failure` with the program the check ran.
+fn keep_source(failure: Failure, source: &KernelSource) -> Failure {
+    with_source(failure, source.source.clone(), source.hash)
+}
+
+/// `failure` with `source`, saved to a file named after its hash in the
+/// temporary directory (overwritten by the next failure of the same
+/// program, which has the same text).
+fn with_source(failure: Failure, source: String, hash: u64) -> Failure {
+    let path = std::env::temp_dir().join(format!("fractal-sdf-{hash:016x}.cl"));
+    let path = std::fs::write(&path, &source).is_ok().then_some(path);
+    Failure {
+        program: Some(Box::new(GeneratedProgram { source, path })),
+        ..failure
+    }
 }
