@@ -55,10 +55,8 @@ fn orbit(scene: &Scene, seconds: f64) -> Result<CameraPath> {
 }
 
 fn read_path(file: &Path) -> Result<CameraPath> {
-    let text = std::fs::read_to_string(file).map_err(|source| Error::Io {
-        path: file.to_path_buf(),
-        source,
-    })?;
+    let text = std::fs::read_to_string(file)
+        .map_err(|source| Error::io(file, "cannot read the camera path", source))?;
     CameraPath::from_toml(&text)
 }
 
