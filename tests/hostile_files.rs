@@ -417,6 +417,14 @@ fn numbers_in_messages_are_readable() {
         CameraPath::orbit(DVec3::ZERO, 1.0, 1.0, -1e300, 8).unwrap_err(),
         Sequence::for_duration("d", 24.0, -1e300).unwrap_err(),
         Sequence::new("d", -1e-320, 3).unwrap_err(),
+        Scene::new(sphere(1.0))
+            .with_camera(Camera::look_at(dvec3(0.0, 0.0, 5.0), DVec3::ZERO).fov(1e300))
+            .validate()
+            .unwrap_err(),
+        Scene::new(sphere(1.0))
+            .with_camera(Camera::look_at(dvec3(0.0, 0.0, 5.0), DVec3::ZERO).orthographic(-1e300))
+            .validate()
+            .unwrap_err(),
     ];
     for err in &errors {
         let text = err.to_string();
