@@ -295,15 +295,11 @@ fn main() -> std::process::ExitCode {
             );
         }
         if let Some(dir) = std::path::Path::new(&csv).parent() {
-            std::fs::create_dir_all(dir).map_err(|source| Error::Io {
-                path: dir.to_path_buf(),
-                source,
-            })?;
+            std::fs::create_dir_all(dir)
+                .map_err(|source| Error::io(dir, "cannot create the directory", source))?;
         }
-        std::fs::write(&csv, text).map_err(|source| Error::Io {
-            path: csv.clone().into(),
-            source,
-        })?;
+        std::fs::write(&csv, text)
+            .map_err(|source| Error::io(&csv, "cannot write the table", source))?;
         println!("-> {csv}");
         Ok(())
     })

@@ -131,13 +131,10 @@ fn main() -> std::process::ExitCode {
             size.0, size.1
         )
         .expect("String");
-        std::fs::create_dir_all("out").map_err(|source| Error::Io {
-            path: "out".into(),
-            source,
-        })?;
-        std::fs::write("out/render_bench.csv", csv).map_err(|source| Error::Io {
-            path: "out/render_bench.csv".into(),
-            source,
+        std::fs::create_dir_all("out")
+            .map_err(|source| Error::io("out", "cannot create the directory", source))?;
+        std::fs::write("out/render_bench.csv", csv).map_err(|source| {
+            Error::io("out/render_bench.csv", "cannot write the table", source)
         })?;
         Ok(())
     })

@@ -55,10 +55,8 @@ fn orbit(scene: &Scene, seconds: f64) -> Result<CameraPath> {
 }
 
 fn read_path(file: &Path) -> Result<CameraPath> {
-    let text = std::fs::read_to_string(file).map_err(|source| Error::Io {
-        path: file.to_path_buf(),
-        source,
-    })?;
+    let text = std::fs::read_to_string(file)
+        .map_err(|source| Error::io(file, "cannot read the camera path", source))?;
     CameraPath::from_toml(&text)
 }
 
@@ -128,9 +126,9 @@ fn main() -> std::process::ExitCode {
             Some(r) => parse_range(r, seq.frames())?,
             None => 0..seq.frames(),
         };
-        let todo = seq.remaining(range.clone());
+        let todo = seq.remaining(range.clone(), size);
         println!(
-            "{name}: frames {}..{} of {} at {fps} fps, {}x{}, {} quality -> {}/ ({} on disk already)",
+            "{name}: frames {}..{} of {} at {fps} fps, {}x{}, {} quality -> {}/ ({} whole on disk already)",
             range.start,
             range.end,
             seq.frames(),
@@ -163,7 +161,7 @@ fn main() -> std::process::ExitCode {
             })?;
             bar.finish();
         }
-        if seq.remaining(0..seq.frames()).is_empty() {
+        if seq.remaining(0..seq.frames(), size).is_empty() {
             encode(&seq, &video)?;
         } else {
             println!("some frames are still missing: run again without --frames to finish");

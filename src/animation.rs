@@ -24,7 +24,7 @@ use std::f64::consts::TAU;
 use glam::{DVec3, dvec3};
 use serde::{Deserialize, Serialize};
 
-use crate::error::{Error, Result};
+use crate::error::{Error, Result, fmt_value};
 use crate::scene::Camera;
 
 /// The camera's position and target at a time, in seconds.
@@ -59,16 +59,29 @@ pub struct CameraPath {
 }
 
 impl CameraPath {
+    /// The most keyframes a path may have (56 MiB of keyframes), so that
+    /// no count given by a caller or a file makes a path that cannot be
+    /// held in memory.
+    pub const MAX_KEYFRAMES: usize = 1 << 20;
+
     /// A path through `keyframes`.
     ///
     /// # Errors
-    /// [`Error::Animation`] if there are fewer than two keyframes, a value is
-    /// not finite, or times do not strictly increase.
+    /// [`Error::Animation`] if there are fewer than two keyframes or more
+    /// than [`CameraPath::MAX_KEYFRAMES`], a value is not finite, or times
+    /// do not strictly increase.
     pub fn new(keyframes: Vec<Keyframe>) -> Result<Self> {
         let bad = |reason: String| Err(Error::Animation { reason });
         if keyframes.len() < 2 {
             return bad(format!(
                 "a path needs at least 2 keyframes, got {}",
+                keyframes.len()
+            ));
+        }
+        if keyframes.len() > Self::MAX_KEYFRAMES {
+            return bad(format!(
+                "a path has at most {} keyframes, got {}",
+                Self::MAX_KEYFRAMES,
                 keyframes.len()
             ));
         }
@@ -101,8 +114,9 @@ impl CameraPath {
     /// ```
     ///
     /// # Errors
-    /// [`Error::Animation`] if a value is not finite or `duration` is not
-    /// positive.
+    /// [`Error::Animation`] if a value is not finite, `duration` is not
+    /// positive or `segments` is at least [`CameraPath::MAX_KEYFRAMES`];
+    /// nothing is allocated before these checks.
     pub fn orbit(
         target: DVec3,
         radius: f64,
@@ -110,11 +124,34 @@ impl CameraPath {
         duration: f64,
         segments: u32,
     ) -> Result<Self> {
+        let bad = |reason: String| Err(Error::Animation { reason });
         let segments = segments.max(4);
         if !(duration.is_finite() && duration > 0.0) {
-            return Err(Error::Animation {
-                reason: format!("an orbit's duration must be > 0, got {duration}"),
-            });
+            return bad(format!(
+                "an orbit's duration must be a finite number > 0, got {}",
+                fmt_value(duration)
+            ));
+        }
+        if let Some((name, value)) = [("radius", radius), ("height", height)]
+            .into_iter()
+            .find(|(_, v)| !v.is_finite())
+        {
+            return bad(format!(
+                "an orbit's {name} must be finite, got {}",
+                fmt_value(value)
+            ));
+        }
+        if !target.is_finite() {
+            let [x, y, z] = target.to_array().map(|v| fmt_value(v).to_string());
+            return bad(format!(
+                "an orbit's target must be finite, got [{x}, {y}, {z}]"
+            ));
+        }
+        if segments as usize >= Self::MAX_KEYFRAMES {
+            return bad(format!(
+                "an orbit has at most {} segments, got {segments}",
+                Self::MAX_KEYFRAMES - 1
+            ));
         }
         let keyframes = (0..=segments)
             .map(|i| {
@@ -156,11 +193,9 @@ impl CameraPath {
     pub fn sample(&self, time: f64) -> (DVec3, DVec3) {
         let k = &self.keyframes;
         let t = time.clamp(self.start(), self.end());
-        // The segment k[i]..k[i + 1] containing t.
-        let i = k
-            .windows(2)
-            .position(|w| t <= w[1].time)
-            .unwrap_or(k.len() - 2);
+        // The segment k[i]..k[i + 1] containing t: the first with
+        // t <= k[i + 1].time (times increase, so a binary search).
+        let i = k[1..].partition_point(|e| e.time < t).min(k.len() - 2);
         let last = k.len() - 1;
         // Neighbours beyond the ends are reflected (2 p_end - p_inner), so the
         // path leaves and enters its ends in a straight line.
@@ -311,6 +346,74 @@ impl Motion {
                     .map(|(axis, v)| (format!("{name}.{axis}"), v))
                     .collect()
             }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn orbits_refuse_counts_they_cannot_hold_before_allocating() {
+        let max = CameraPath::MAX_KEYFRAMES;
+        for segments in [u32::MAX, u32::try_from(max).unwrap()] {
+            let err = CameraPath::orbit(DVec3::ZERO, 1.0, 0.0, 1.0, segments).unwrap_err();
+            assert!(
+                err.to_string()
+                    .contains(&format!("at most {} segments, got {segments}", max - 1)),
+                "{err}"
+            );
+        }
+        let path =
+            CameraPath::orbit(DVec3::ZERO, 1.0, 0.0, 1.0, u32::try_from(max - 1).unwrap()).unwrap();
+        assert_eq!(path.keyframes().len(), max);
+        // A binary search finds the segment: a quarter turn is at +x.
+        let (p, _) = path.sample(0.25);
+        assert!((p - dvec3(1.0, 0.0, 0.0)).length() < 1e-9, "{p}");
+    }
+
+    #[test]
+    fn orbit_errors_name_the_bad_argument() {
+        let err = |r: f64, h: f64, d: f64, t: DVec3| {
+            CameraPath::orbit(t, r, h, d, 8).unwrap_err().to_string()
+        };
+        assert!(
+            err(1.0, 0.0, f64::NAN, DVec3::ZERO)
+                .contains("duration must be a finite number > 0, got NaN")
+        );
+        assert!(err(1.0, 0.0, -1e300, DVec3::ZERO).contains("got -1e300"));
+        assert!(
+            err(f64::INFINITY, 0.0, 1.0, DVec3::ZERO).contains("radius must be finite, got inf")
+        );
+        assert!(err(1.0, f64::NAN, 1.0, DVec3::ZERO).contains("height must be finite, got NaN"));
+        let text = err(1.0, 0.0, 1.0, dvec3(1e300, f64::NAN, 0.0));
+        assert!(
+            text.contains("target must be finite, got [1e300, NaN, 0]"),
+            "{text}"
+        );
+    }
+
+    #[test]
+    fn paths_have_a_bounded_number_of_keyframes() {
+        let key = |i: usize| {
+            #[allow(clippy::cast_precision_loss)]
+            Keyframe::new(i as f64, DVec3::ZERO, DVec3::X)
+        };
+        let keys: Vec<Keyframe> = (0..=CameraPath::MAX_KEYFRAMES).map(key).collect();
+        let err = CameraPath::new(keys).unwrap_err().to_string();
+        assert!(
+            err.contains("at most 1048576 keyframes, got 1048577"),
+            "{err}"
+        );
+        // The segment search agrees with a linear one.
+        let keys: Vec<Keyframe> = [0.0, 0.5, 2.0, 2.5, 7.0]
+            .iter()
+            .map(|&t| Keyframe::new(t, dvec3(t, t * t, 1.0), DVec3::ZERO))
+            .collect();
+        let path = CameraPath::new(keys.clone()).unwrap();
+        for (t, p) in keys.iter().map(|k| (k.time, k.position)) {
+            assert!((path.sample(t).0 - DVec3::from(p)).length() < 1e-12, "{t}");
         }
     }
 }

@@ -1,5 +1,6 @@
 //! The crate's one error type.
 
+use std::fmt;
 use std::path::PathBuf;
 
 /// Everything that can go wrong, from a bad scene value to an OpenCL build
@@ -8,7 +9,7 @@ use std::path::PathBuf;
 #[non_exhaustive]
 pub enum Error {
     /// A parameter is NaN or infinite.
-    #[error("{node}: parameter `{param}` must be finite, got {value}")]
+    #[error("{node}: parameter `{param}` must be finite, got {}", fmt_value(*.value))]
     NonFinite {
         /// Path of the node in the scene, such as `root/union.a/sphere`.
         node: String,
@@ -18,7 +19,7 @@ pub enum Error {
         value: f64,
     },
     /// A parameter is finite but outside its allowed range.
-    #[error("{node}: parameter `{param}` must be {expected}, got {value}")]
+    #[error("{node}: parameter `{param}` must be {expected}, got {}", fmt_value(*.value))]
     OutOfRange {
         /// Path of the node in the scene.
         node: String,
@@ -92,7 +93,7 @@ pub enum Error {
         reason: String,
     },
     /// A quality setting is out of range.
-    #[error("quality setting `{setting}` must be {expected}, got {value}")]
+    #[error("quality setting `{setting}` must be {expected}, got {}", fmt_value(*.value))]
     Quality {
         /// The setting's name.
         setting: &'static str,
@@ -193,10 +194,13 @@ pub enum Error {
     #[error("OpenCL error: {0}")]
     OpenCl(String),
     /// Reading or writing a file failed.
-    #[error("{path}: {source}")]
+    #[error("{path}: {action}: {source}")]
     Io {
-        /// The file.
+        /// The file that was to be read or written (for an image, the
+        /// target named by the caller, never a temporary file).
         path: PathBuf,
+        /// What failed, such as `"cannot write the image"`.
+        action: String,
         /// The underlying error.
         #[source]
         source: std::io::Error,
@@ -228,6 +232,15 @@ impl Error {
             _ => None,
         }
     }
+
+    /// [`Error::Io`]: `action` failed on `path` with `source`.
+    pub fn io(path: impl Into<PathBuf>, action: impl Into<String>, source: std::io::Error) -> Self {
+        Error::Io {
+            path: path.into(),
+            action: action.into(),
+            source,
+        }
+    }
 }
 
 /// Where in a custom shape's definition a compiler message points.
@@ -239,5 +252,107 @@ fn custom_place(line: usize, text: &str) -> String {
     }
 }
 
+/// A number as error messages write it: in the shortest form that reads
+/// back to the same value, in scientific notation when it is very large or
+/// very small (`1e300`, `-2.5e-7`), plainly otherwise (`0.25`, `-3`,
+/// `NaN`, `inf`), so a message never holds hundreds of digits.
+///
+/// ```
+/// use fractal_sdf::error::fmt_value;
+/// assert_eq!(fmt_value(1e300).to_string(), "1e300");
+/// assert_eq!(fmt_value(-2.5e-7).to_string(), "-2.5e-7");
+/// assert_eq!(fmt_value(0.25).to_string(), "0.25");
+/// assert_eq!(fmt_value(f64::NAN).to_string(), "NaN");
+/// ```
+#[must_use]
+pub fn fmt_value(value: f64) -> impl fmt::Display {
+    FmtValue(value)
+}
+
+struct FmtValue(f64);
+
+impl fmt::Display for FmtValue {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let v = self.0;
+        let magnitude = v.abs();
+        if v.is_finite() && (magnitude >= 1e16 || (magnitude != 0.0 && magnitude < 1e-5)) {
+            write!(f, "{v:e}")
+        } else {
+            write!(f, "{v}")
+        }
+    }
+}
+
 /// `Result` with the crate's [`Error`].
 pub type Result<T, E = Error> = std::result::Result<T, E>;
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn numbers_in_messages_are_short_and_exact() {
+        let cases = [
+            (1e300, "1e300"),
+            (-1e300, "-1e300"),
+            (f64::MAX, "1.7976931348623157e308"),
+            (1e16, "1e16"),
+            (9_999_999_999_999_998.0, "9999999999999998"),
+            (123_456.5, "123456.5"),
+            (0.1, "0.1"),
+            (1e-5, "0.00001"),
+            (9.5e-6, "9.5e-6"),
+            (f64::MIN_POSITIVE, "2.2250738585072014e-308"),
+            (5e-324, "5e-324"),
+            (0.0, "0"),
+            (-0.0, "-0"),
+            (f64::NAN, "NaN"),
+            (f64::INFINITY, "inf"),
+            (f64::NEG_INFINITY, "-inf"),
+        ];
+        for (v, text) in cases {
+            let shown = fmt_value(v).to_string();
+            assert_eq!(shown, text);
+            if v.is_finite() {
+                assert_eq!(
+                    shown.parse::<f64>().unwrap().to_bits(),
+                    v.to_bits(),
+                    "{text}"
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn every_number_of_a_message_goes_through_the_helper() {
+        let node = || "root/torus".to_string();
+        let param = || "minor_radius".to_string();
+        let errors = [
+            Error::NonFinite {
+                node: node(),
+                param: param(),
+                value: f64::NEG_INFINITY,
+            },
+            Error::OutOfRange {
+                node: node(),
+                param: param(),
+                value: -1e300,
+                expected: ">= 0".into(),
+            },
+            Error::Quality {
+                setting: "gamma",
+                value: 1e-300,
+                expected: "> 0".into(),
+            },
+        ];
+        let texts: Vec<String> = errors.iter().map(ToString::to_string).collect();
+        assert_eq!(
+            texts,
+            [
+                "root/torus: parameter `minor_radius` must be finite, got -inf",
+                "root/torus: parameter `minor_radius` must be >= 0, got -1e300",
+                "quality setting `gamma` must be > 0, got 1e-300",
+            ]
+        );
+    }
+}

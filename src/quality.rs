@@ -422,10 +422,16 @@ impl Effects {
             value,
             expected: expected.into(),
         };
+        // The first component that is NaN, infinite or negative (a
+        // minimum would hide a NaN).
+        let wrong = |c: DVec3| {
+            c.to_array()
+                .into_iter()
+                .find(|v| !(v.is_finite() && *v >= 0.0))
+        };
         if let Some(g) = self.glow {
-            let lowest = g.color.min_element();
-            if !(g.color.is_finite() && lowest >= 0.0) {
-                return Err(bad("glow.color", lowest, "finite and >= 0"));
+            if let Some(v) = wrong(g.color) {
+                return Err(bad("glow.color", v, "finite and >= 0"));
             }
             if !(g.strength.is_finite() && g.strength >= 0.0) {
                 return Err(bad("glow.strength", g.strength, "finite and >= 0"));
@@ -438,8 +444,8 @@ impl Effects {
             return Err(bad("fog_density", self.fog_density, "finite and >= 0"));
         }
         for (name, c) in [("sky_top", self.sky_top), ("sky_bottom", self.sky_bottom)] {
-            if !(c.is_finite() && c.min_element() >= 0.0) {
-                return Err(bad(name, c.min_element(), "finite and >= 0"));
+            if let Some(v) = wrong(c) {
+                return Err(bad(name, v, "finite and >= 0"));
             }
         }
         if !(self.gamma.is_finite() && self.gamma > 0.0) {

@@ -1,6 +1,7 @@
 //! Frame sequences: a camera path rendered to numbered PNGs
 //! (`frame_00000.png`, `frame_00001.png`, ...) at a frame rate, resumable
-//! (frames already on disk are skipped) and renderable in sub-ranges.
+//! (whole frames already on disk are skipped; cut-short ones are rendered
+//! again) and renderable in sub-ranges.
 //!
 //! ```
 //! use fractal_sdf::sequence::{Sequence, parse_range};
@@ -16,7 +17,7 @@
 use std::ops::Range;
 use std::path::{Path, PathBuf};
 
-use crate::error::{Error, Result};
+use crate::error::{Error, Result, fmt_value};
 #[cfg(feature = "opencl")]
 use crate::{
     animation::{CameraPath, Motion},
@@ -43,22 +44,46 @@ pub struct Sequence {
     frames: u32,
 }
 
+fn invalid(reason: String) -> Error {
+    Error::Invalid {
+        what: "frame sequence",
+        reason,
+    }
+}
+
+/// [`Error::Invalid`] unless `fps` is a positive finite number.
+fn check_fps(fps: f64) -> Result<()> {
+    if fps.is_finite() && fps > 0.0 {
+        Ok(())
+    } else {
+        Err(invalid(format!(
+            "the frame rate must be a finite number > 0, got {}",
+            fmt_value(fps)
+        )))
+    }
+}
+
 impl Sequence {
+    /// The most frames a sequence may have: almost 5 days at 24 frames per
+    /// second. Lists of a sequence's frames ([`Sequence::remaining`]) stay
+    /// below 40 MB.
+    pub const MAX_FRAMES: u32 = 10_000_000;
+
     /// A sequence of `frames` frames at `fps`.
     ///
     /// # Errors
     /// [`Error::Invalid`] if `fps` is not a positive finite number or
-    /// `frames` is 0.
+    /// `frames` is 0 or above [`Sequence::MAX_FRAMES`].
     pub fn new(dir: impl Into<PathBuf>, fps: f64, frames: u32) -> Result<Self> {
-        let bad = |reason: String| Error::Invalid {
-            what: "frame sequence",
-            reason,
-        };
-        if !(fps.is_finite() && fps > 0.0) {
-            return Err(bad(format!("the frame rate must be > 0, got {fps}")));
-        }
+        check_fps(fps)?;
         if frames == 0 {
-            return Err(bad("a sequence needs at least 1 frame".into()));
+            return Err(invalid("a sequence needs at least 1 frame".into()));
+        }
+        if frames > Self::MAX_FRAMES {
+            return Err(invalid(format!(
+                "{frames} frames are too many (at most {})",
+                Self::MAX_FRAMES
+            )));
         }
         Ok(Sequence {
             dir: dir.into(),
@@ -72,15 +97,28 @@ impl Sequence {
     /// a looping path (such as an orbit) repeats without a doubled frame.
     ///
     /// # Errors
-    /// As [`Sequence::new`], and [`Error::Invalid`] for a duration that is
-    /// not a positive finite number or needs more than `u32::MAX` frames.
+    /// [`Error::Invalid`] naming the argument that is wrong: a frame rate
+    /// or a duration that is not a positive finite number, or the two
+    /// together needing more than [`Sequence::MAX_FRAMES`] frames.
     pub fn for_duration(dir: impl Into<PathBuf>, fps: f64, seconds: f64) -> Result<Self> {
+        check_fps(fps)?;
+        if !(seconds.is_finite() && seconds > 0.0) {
+            return Err(invalid(format!(
+                "the duration must be a finite number > 0, got {} s",
+                fmt_value(seconds)
+            )));
+        }
+        // Both are positive and finite: the product is positive, maybe
+        // infinite.
         let count = (seconds * fps).round();
-        if !(seconds.is_finite() && seconds > 0.0 && count <= f64::from(u32::MAX)) {
-            return Err(Error::Invalid {
-                what: "frame sequence",
-                reason: format!("the duration must be > 0 and finite, got {seconds} s"),
-            });
+        if count > f64::from(Self::MAX_FRAMES) {
+            return Err(invalid(format!(
+                "{} s at {} frames per second is {} frames, too many (at most {})",
+                fmt_value(seconds),
+                fmt_value(fps),
+                fmt_value(count),
+                Self::MAX_FRAMES
+            )));
         }
         #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss)]
         let frames = (count as u32).max(1);
@@ -117,10 +155,17 @@ impl Sequence {
         f64::from(index) / self.fps
     }
 
-    /// The frames of `range` that are not on disk yet, in order.
+    /// The frames of `range` (clipped to the sequence) that are not on
+    /// disk as whole `width` × `height` PNGs, in order: missing frames, and
+    /// frames that [`verify_png`](crate::output::verify_png) rejects — cut
+    /// short (by a copy that was interrupted, a full disk), of another
+    /// size, not PNGs — which rendering writes again.
     #[must_use]
-    pub fn remaining(&self, range: Range<u32>) -> Vec<u32> {
-        range.filter(|&i| !self.frame_path(i).is_file()).collect()
+    pub fn remaining(&self, range: Range<u32>, (width, height): (u32, u32)) -> Vec<u32> {
+        let range = range.start..range.end.min(self.frames);
+        range
+            .filter(|&i| crate::output::verify_png(self.frame_path(i), (width, height)).is_err())
+            .collect()
     }
 
     /// The arguments of the `ffmpeg` command that encodes the frames into
@@ -165,8 +210,9 @@ impl Sequence {
     /// Pass [`Sequence::remaining`] as `indices` to resume a sequence.
     ///
     /// # Errors
-    /// The first render, parameter or file error; the frames saved before
-    /// it stay on disk.
+    /// [`Error::Invalid`], before anything is rendered, for an index that
+    /// is not a frame of the sequence; then the first render, parameter or
+    /// file error; the frames saved before it stay on disk.
     pub fn render(
         &self,
         renderer: &mut Renderer,
@@ -176,6 +222,12 @@ impl Sequence {
         (width, height): (u32, u32),
         mut on_frame: impl FnMut(&RenderedFrame),
     ) -> Result<()> {
+        if let Some(&index) = indices.iter().find(|&&i| i >= self.frames) {
+            return Err(invalid(format!(
+                "frame {index} is not in the sequence (frames 0..{})",
+                self.frames
+            )));
+        }
         let base = *renderer.camera();
         for &index in indices {
             let t = self.time(index);
@@ -281,6 +333,54 @@ mod tests {
     }
 
     #[test]
+    fn errors_blame_the_argument_that_is_wrong() {
+        let message = |fps: f64, seconds: f64| {
+            let err = Sequence::for_duration("d", fps, seconds).unwrap_err();
+            assert!(matches!(err, Error::Invalid { .. }), "{err}");
+            err.to_string()
+        };
+        for fps in [f64::NAN, f64::INFINITY, 0.0, -24.0] {
+            for seconds in [1.0, f64::NAN] {
+                let err = message(fps, seconds);
+                assert!(err.contains("frame rate"), "{fps}, {seconds}: {err}");
+            }
+        }
+        for seconds in [f64::NAN, f64::NEG_INFINITY, 0.0, -1.0] {
+            let err = message(24.0, seconds);
+            assert!(err.contains("duration"), "{seconds}: {err}");
+        }
+        let err = message(1e300, 1e300);
+        assert!(
+            err.contains("1e300 s at 1e300 frames per second is inf frames"),
+            "{err}"
+        );
+        let err = message(1e3, 1e5);
+        assert!(
+            err.contains("is 100000000 frames, too many (at most 10000000)"),
+            "{err}"
+        );
+        assert_eq!(
+            Sequence::for_duration("d", 1e-300, 1.0).unwrap().frames(),
+            1,
+            "rounds up to one frame"
+        );
+    }
+
+    #[test]
+    fn frame_counts_are_bounded() {
+        let max = Sequence::MAX_FRAMES;
+        assert_eq!(Sequence::new("d", 24.0, max).unwrap().frames(), max);
+        for frames in [max + 1, u32::MAX] {
+            let err = Sequence::new("d", 24.0, frames).unwrap_err().to_string();
+            assert!(err.contains("too many"), "{err}");
+        }
+        // Lists of frames never reach past the sequence.
+        let s = Sequence::new("/nonexistent-fractal-sdf", 24.0, 3).unwrap();
+        assert_eq!(s.remaining(0..u32::MAX, (4, 4)), [0, 1, 2]);
+        assert!(s.remaining(u32::MAX - 1..u32::MAX, (4, 4)).is_empty());
+    }
+
+    #[test]
     fn ranges_parse_like_rust_ranges() {
         assert_eq!(parse_range("0..24", 24).unwrap(), 0..24);
         assert_eq!(parse_range(" 2 .. 5 ", 24).unwrap(), 2..5);
@@ -298,19 +398,25 @@ mod tests {
     }
 
     #[test]
-    fn remaining_skips_frames_on_disk() {
+    fn remaining_skips_only_whole_frames_on_disk() {
+        use image::RgbaImage;
         let dir = std::env::temp_dir().join(format!("fractal-sdf-seq-{}", std::process::id()));
         let _ = std::fs::remove_dir_all(&dir);
         std::fs::create_dir_all(&dir).unwrap();
-        let s = Sequence::new(&dir, 24.0, 6).unwrap();
-        assert_eq!(s.remaining(0..6), [0, 1, 2, 3, 4, 5]);
-        for i in [0, 2, 3] {
-            std::fs::write(s.frame_path(i), b"png").unwrap();
+        let size = (6, 4);
+        let s = Sequence::new(&dir, 24.0, 8).unwrap();
+        assert_eq!(s.remaining(0..8, size), [0, 1, 2, 3, 4, 5, 6, 7]);
+        for i in [0, 2, 3, 6, 7] {
+            crate::output::save_png(&RgbaImage::new(size.0, size.1), s.frame_path(i)).unwrap();
         }
         // A directory with a frame's name is not a frame.
         std::fs::create_dir(s.frame_path(5)).unwrap();
-        assert_eq!(s.remaining(0..6), [1, 4, 5]);
-        assert_eq!(s.remaining(2..4), Vec::<u32>::new());
+        // Frame 6 was cut short, frame 7 has another size.
+        let whole = std::fs::read(s.frame_path(6)).unwrap();
+        std::fs::write(s.frame_path(6), &whole[..whole.len() - 5]).unwrap();
+        crate::output::save_png(&RgbaImage::new(5, 4), s.frame_path(7)).unwrap();
+        assert_eq!(s.remaining(0..8, size), [1, 4, 5, 6, 7]);
+        assert_eq!(s.remaining(2..4, size), Vec::<u32>::new());
         std::fs::remove_dir_all(dir).unwrap();
     }
 

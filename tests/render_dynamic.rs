@@ -102,11 +102,11 @@ fn a_sequence_renders_its_frames_and_resumes() {
     })
     .unwrap();
     assert_eq!(seen, [0, 2]);
-    assert_eq!(seq.remaining(0..4), [1, 3]);
-    let todo = seq.remaining(0..4);
+    assert_eq!(seq.remaining(0..4, (32, 24)), [1, 3]);
+    let todo = seq.remaining(0..4, (32, 24));
     seq.render(&mut r, &path, &motions, &todo, (32, 24), |_| {})
         .unwrap();
-    assert!(seq.remaining(0..4).is_empty());
+    assert!(seq.remaining(0..4, (32, 24)).is_empty());
     let frame = |i| image::open(seq.frame_path(i)).unwrap().to_rgba8();
     assert_eq!(frame(0).dimensions(), (32, 24));
     assert_ne!(frame(0), frame(1), "the camera moves along the path");

@@ -313,10 +313,8 @@ fn main() -> std::process::ExitCode {
             .map(|d| d.name.clone())
             .unwrap_or_default();
         eprintln!("{}x{} on {device}", size.0, size.1);
-        std::fs::create_dir_all("out").map_err(|e| Error::Io {
-            path: "out".into(),
-            source: e,
-        })?;
+        std::fs::create_dir_all("out")
+            .map_err(|e| Error::io("out", "cannot create the directory", e))?;
         let mut rows = Vec::new();
         for name in &scenes {
             let Some(scene) = fractal_sdf::gallery::by_name(name) else {
@@ -384,10 +382,8 @@ fn main() -> std::process::ExitCode {
             println!("{}", table(&rows, &["aa"]));
         }
         let csv_path = "out/tradeoff.csv";
-        std::fs::write(csv_path, csv(&rows, &device)).map_err(|e| Error::Io {
-            path: csv_path.into(),
-            source: e,
-        })?;
+        std::fs::write(csv_path, csv(&rows, &device))
+            .map_err(|e| Error::io(csv_path, "cannot write the table", e))?;
         let plot_path = "out/tradeoff.png";
         fractal_sdf::output::save_png(&plot::draw(&rows, size, &device), plot_path)?;
         eprintln!("wrote {csv_path} and {plot_path}");

@@ -5,7 +5,7 @@
 use std::sync::Arc;
 
 use super::{Scalar, Vector};
-use crate::error::{Error, Result};
+use crate::error::{Error, Result, fmt_value};
 use crate::scene::Rule;
 
 /// One slot of the parameter buffer.
@@ -71,7 +71,7 @@ impl Constraint {
                         node: self.node.clone(),
                         param: self.param.into(),
                         value: v,
-                        expected: format!("<= the smallest {bound_name} ({smallest})"),
+                        expected: format!("<= the smallest {bound_name} ({})", fmt_value(smallest)),
                     });
                 }
             }

@@ -54,8 +54,10 @@
 
 mod aov;
 mod buffer;
+mod cache;
 mod device;
 mod dispatch;
+mod memory;
 mod points;
 mod program;
 mod renderer;
@@ -65,7 +67,7 @@ pub use aov::Frame;
 pub use device::{DEVICE_ENV, DeviceInfo, DeviceKind, DeviceSelector, devices};
 pub use dispatch::{DEFAULT_TILE_SIZE, MAX_IMAGE_SIDE};
 pub use points::{PointEvaluator, PointSample};
-pub use program::{BuildInfo, program_builds};
+pub use program::{BuildInfo, PROGRAM_CACHE_CAPACITY, program_builds};
 pub use renderer::{RenderOptions, Renderer};
 pub use viewport::Viewport;
 

@@ -12,6 +12,7 @@ use super::aov::Frame;
 use super::buffer::RealBuffer;
 use super::device::{self, DeviceInfo, DeviceSelector, Selected, opencl};
 use super::dispatch::{self, DEFAULT_TILE_SIZE, MAX_IMAGE_SIDE};
+use super::memory::{available_host_memory, check_host_memory, frame_host_bytes};
 use super::program::{self, BuildInfo};
 use super::viewport::{Viewport, pack_lights};
 use crate::codegen::interface::{RENDER_TILE, RenderArg, camera};
@@ -217,9 +218,12 @@ impl Renderer {
     /// Renders a `width` × `height` image.
     ///
     /// # Errors
-    /// [`Error::Resolution`] for a zero side, a side above 32768 or an image
-    /// whose buffers cannot be allocated; [`Error::OpenCl`] if the device
-    /// fails.
+    /// [`Error::Resolution`] for a zero side, a side above 32768, an image
+    /// whose buffers the device cannot hold, or one whose host memory (the
+    /// copies read back, and a CPU device's buffers) exceeds what the
+    /// machine has available (`MemAvailable`, and the process's cgroup
+    /// limit, on Linux) — each with the numbers; [`Error::OpenCl`] if the
+    /// device fails.
     pub fn render(&mut self, width: u32, height: u32) -> Result<RgbaImage> {
         let start = Instant::now();
         let kernel = self.run(width, height, false)?;
@@ -457,10 +461,17 @@ impl Renderer {
         self.timing = None;
         check_size(width, height)?;
         let view = self.viewport(width, height)?;
-        if !self.targets.fits(width, height, aovs) {
+        let info = &self.selected.info;
+        if self.targets.fits(width, height, aovs) {
+            let host = frame_host_bytes(info, width, height, aovs, None);
+            check_host_memory(width, height, host, available_host_memory())?;
+        } else {
             // Free the old buffers first so their memory can be reused.
             self.targets = Targets::new(&self.queue, 1, 1, false)?;
-            check_device_memory(&self.selected.info, width, height, aovs)?;
+            check_device_memory(info, width, height, aovs)?;
+            let device = Targets::bytes(width, height, aovs).iter().sum();
+            let host = frame_host_bytes(info, width, height, aovs, Some(device));
+            check_host_memory(width, height, host, available_host_memory())?;
             self.targets = Targets::new(&self.queue, width, height, aovs)
                 .map_err(|e| too_large(width, height, &format!("{e}")))?;
         }

@@ -23,7 +23,7 @@ pub use node::{
 };
 pub use param::{Param, Param3, param, param3};
 
-use crate::error::{Error, Result};
+use crate::error::{Error, Result, fmt_value};
 
 /// How the camera projects the scene.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -128,7 +128,8 @@ impl Camera {
                 if !(fov_y_degrees > 0.0 && fov_y_degrees < 180.0) {
                     return Err(Error::Camera {
                         reason: format!(
-                            "vertical field of view must be in (0, 180) degrees, got {fov_y_degrees}"
+                            "vertical field of view must be in (0, 180) degrees, got {}",
+                            fmt_value(fov_y_degrees)
                         ),
                     });
                 }
@@ -136,7 +137,10 @@ impl Camera {
             Projection::Orthographic { height } => {
                 if !(height > 0.0 && height.is_finite()) {
                     return Err(Error::Camera {
-                        reason: format!("orthographic height must be > 0, got {height}"),
+                        reason: format!(
+                            "orthographic height must be > 0, got {}",
+                            fmt_value(height)
+                        ),
                     });
                 }
             }

@@ -68,27 +68,40 @@ impl KeyScript {
     /// items are ignored, and so is the case of key names).
     ///
     /// # Errors
-    /// [`Error::Invalid`] naming an unknown key, a key without an action
-    /// or a bad frame number.
+    /// [`Error::Invalid`] naming an unknown key, a key without an action,
+    /// a bad frame number (frames are `0..=u64::MAX`) or a key that would
+    /// come after the last frame.
     pub fn parse(text: &str) -> Result<Self> {
         let mut presses = Vec::new();
-        let mut next = 1u64;
+        // The frame of a key without `@FRAME`; `None` after the last frame.
+        let mut next = Some(1u64);
         for item in text.split(',').map(str::trim).filter(|s| !s.is_empty()) {
             let (key, frame) = match item.split_once('@') {
                 Some((key, frame)) => {
                     let frame = frame.trim().parse::<u64>().map_err(|_| {
-                        invalid(format!("`{item}`: the frame must be a whole number"))
+                        invalid(format!(
+                            "`{item}`: the frame must be a whole number from 0 to {}",
+                            u64::MAX
+                        ))
                     })?;
                     (key, frame)
                 }
-                None => (item, next),
+                None => (
+                    item,
+                    next.ok_or_else(|| {
+                        invalid(format!(
+                            "`{item}` would come after frame {}, the last one",
+                            u64::MAX
+                        ))
+                    })?,
+                ),
             };
             let key = key.parse::<Key>().map_err(|e| match e {
                 Error::Invalid { reason, .. } => invalid(reason),
                 other => other,
             })?;
             presses.push((frame, key));
-            next = frame + 1;
+            next = frame.checked_add(1);
         }
         Self::new(presses)
     }
@@ -174,6 +187,33 @@ mod tests {
         let err = KeyScript::parse("w@3").unwrap_err().to_string();
         assert!(err.contains("`w` has no action"), "{err}");
         assert!(KeyScript::new([(1, Key::ArrowUp)]).is_err());
+    }
+
+    #[test]
+    fn frame_numbers_never_wrap() {
+        let last = u64::MAX;
+        let s = KeyScript::parse(&format!("g@{last}")).unwrap();
+        assert_eq!(s.last_frame(), Some(last));
+        assert_eq!(s.to_string().parse::<KeyScript>().unwrap(), s);
+        let err = KeyScript::parse(&format!("g@{last},h")).unwrap_err();
+        assert!(matches!(err, Error::Invalid { .. }), "{err}");
+        assert!(
+            err.to_string()
+                .contains(&format!("`h` would come after frame {last}, the last one")),
+            "{err}"
+        );
+        // A key after the last frame is fine once an explicit frame follows.
+        let s = KeyScript::parse(&format!("g@{},h,o@3", last - 1)).unwrap();
+        assert_eq!(s.last_frame(), Some(last));
+        for text in [
+            "g@18446744073709551616",
+            "g@-1",
+            "g@1e3",
+            "g@99999999999999999999999",
+        ] {
+            let err = KeyScript::parse(text).unwrap_err().to_string();
+            assert!(err.contains("whole number from 0 to"), "{text}: {err}");
+        }
     }
 
     #[test]

@@ -52,10 +52,11 @@ impl FrameStats {
         Self::default()
     }
 
-    /// Adds one frame's time.
+    /// Adds one frame's time. The count and the total saturate (at
+    /// `u64::MAX` frames and [`Duration::MAX`]) instead of overflowing.
     pub fn push(&mut self, frame: Duration) {
-        self.count += 1;
-        self.total += frame;
+        self.count = self.count.saturating_add(1);
+        self.total = self.total.saturating_add(frame);
         self.min = Some(self.min.map_or(frame, |m| m.min(frame)));
         self.max = Some(self.max.map_or(frame, |m| m.max(frame)));
     }
@@ -234,6 +235,18 @@ mod tests {
         approx::assert_relative_eq!(s.mean_fps().unwrap(), 40.0, epsilon = 1e-9);
         approx::assert_relative_eq!(s.min_fps().unwrap(), 25.0, epsilon = 1e-9);
         approx::assert_relative_eq!(s.max_fps().unwrap(), 100.0, epsilon = 1e-9);
+    }
+
+    #[test]
+    fn huge_frame_times_saturate() {
+        let mut s = FrameStats::new();
+        s.push(Duration::MAX);
+        s.push(Duration::MAX);
+        assert_eq!(s.total(), Duration::MAX);
+        assert_eq!(s.count(), 2);
+        assert_eq!(s.max(), Some(Duration::MAX));
+        assert_eq!(s.mean(), Some(Duration::MAX / 2));
+        assert!(s.mean_fps().unwrap() > 0.0);
     }
 
     #[test]

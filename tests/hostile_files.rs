@@ -1,0 +1,491 @@
+//! Hostile input through the public API — files, memory and messages: a
+//! killed write, a truncated frame, links, full and unwritable targets,
+//! zero, huge and odd sizes, overflowing frame and keyframe counts and
+//! script numbers. Each gives a typed, readable error or correct output;
+//! none crashes, hangs or writes something wrong silently.
+
+mod gpu;
+
+use std::fs::{self, File};
+use std::path::{Path, PathBuf};
+use std::time::{Duration, SystemTime};
+
+use fractal_sdf::animation::{CameraPath, Keyframe};
+use fractal_sdf::error::fmt_value;
+use fractal_sdf::image::{self, Rgba, RgbaImage};
+use fractal_sdf::output::{STALE_TEMPORARY_AGE, save_png, verify_png};
+use fractal_sdf::prelude::*;
+use fractal_sdf::sequence::{Sequence, parse_range};
+use fractal_sdf::view::{FrameStats, KeyScript};
+
+fn scratch(name: &str) -> PathBuf {
+    let dir =
+        std::env::temp_dir().join(format!("fractal-sdf-hostile-{name}-{}", std::process::id()));
+    let _ = fs::remove_dir_all(&dir);
+    fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+fn names(dir: &Path) -> Vec<String> {
+    let mut names: Vec<String> = fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    names.sort();
+    names
+}
+
+fn picture(width: u32, height: u32) -> RgbaImage {
+    RgbaImage::from_fn(width, height, |x, y| {
+        Rgba([(x * 7) as u8, (y * 13) as u8, (x ^ y) as u8, 255])
+    })
+}
+
+/// `err` is an [`Error::Io`] naming exactly `target`, whose message says
+/// `what`; returns the message.
+fn io_error_naming(err: &Error, target: &Path, what: &str) -> String {
+    let text = err.to_string();
+    match err {
+        Error::Io { path, .. } => assert_eq!(path, target, "{text}"),
+        other => panic!("expected Error::Io for {}, got {other:?}", target.display()),
+    }
+    assert!(
+        text.starts_with(&format!("{}: ", target.display())),
+        "{text}"
+    );
+    assert!(text.contains(what), "{what:?} not in {text}");
+    text
+}
+
+/// A process id that no process has.
+fn dead_pid() -> u32 {
+    (4_000_000..u32::MAX)
+        .find(|pid| !Path::new(&format!("/proc/{pid}")).exists())
+        .unwrap()
+}
+
+// ---------------------------------------------------------------- files
+
+#[test]
+fn a_killed_writes_temporary_files_are_removed_by_the_next_write() {
+    let dir = scratch("stale");
+    let target = dir.join("img.png");
+    let temp = |pid: u32, n: u32| dir.join(format!(".img.png.{pid}-{n}.png.tmp"));
+    let has_proc = Path::new("/proc/self").exists();
+    // Left by a writer that was killed: its process is gone.
+    let dead = temp(dead_pid(), 0);
+    fs::write(&dead, vec![0u8; 4096]).unwrap();
+    // A live process (init) writing: kept...
+    let live = temp(1, 3);
+    fs::write(&live, b"in flight").unwrap();
+    // ...unless nobody wrote to it for the stale age.
+    let abandoned = temp(1, 4);
+    fs::write(&abandoned, b"old").unwrap();
+    File::options()
+        .write(true)
+        .open(&abandoned)
+        .unwrap()
+        .set_modified(SystemTime::now() - STALE_TEMPORARY_AGE - Duration::from_secs(1))
+        .unwrap();
+    // This process's id, but not written by it: an earlier process that
+    // had the same id (as in a container, where ids repeat).
+    let reused = temp(std::process::id(), 999_999_999);
+    fs::write(&reused, b"x").unwrap();
+    // Another image's stale temporary file, and files that only look alike.
+    let other = dir.join(format!(".other.png.{}-1.png.tmp", dead_pid()));
+    fs::write(&other, b"x").unwrap();
+    for keep in ["notes.png.tmp", ".img.png.12x-1.png.tmp", ".img.png"] {
+        fs::write(dir.join(keep), b"mine").unwrap();
+    }
+    save_png(&picture(9, 7), &target).unwrap();
+    assert_eq!(image::open(&target).unwrap().to_rgba8(), picture(9, 7));
+    let left = names(&dir);
+    assert!(!abandoned.exists() && !reused.exists(), "{left:?}");
+    assert!(live.exists(), "a live writer's file is kept: {left:?}");
+    if has_proc {
+        assert_eq!(
+            left,
+            [
+                ".img.png",
+                ".img.png.1-3.png.tmp",
+                ".img.png.12x-1.png.tmp",
+                "img.png",
+                "notes.png.tmp"
+            ]
+        );
+    }
+    fs::remove_dir_all(dir).unwrap();
+}
+
+#[test]
+fn a_truncated_frame_is_not_done_and_is_rendered_again() {
+    let dir = scratch("resume");
+    let size = (24, 16);
+    let seq = Sequence::new(&dir, 4.0, 6).unwrap();
+    for i in 0..6 {
+        save_png(&picture(size.0, size.1), seq.frame_path(i)).unwrap();
+    }
+    assert!(seq.remaining(0..6, size).is_empty());
+    // 1: killed copy; 2: empty; 3: other size; 4: not a PNG; 5: a directory.
+    let whole = fs::read(seq.frame_path(1)).unwrap();
+    fs::write(seq.frame_path(1), &whole[..whole.len() / 2]).unwrap();
+    fs::write(seq.frame_path(2), b"").unwrap();
+    save_png(&picture(16, 24), seq.frame_path(3)).unwrap();
+    fs::write(seq.frame_path(4), vec![b'x'; whole.len()]).unwrap();
+    fs::remove_file(seq.frame_path(5)).unwrap();
+    fs::create_dir(seq.frame_path(5)).unwrap();
+    assert_eq!(seq.remaining(0..6, size), [1, 2, 3, 4, 5]);
+    assert_eq!(seq.remaining(0..6, (16, 24)), [0, 1, 2, 4, 5]);
+    for (i, what) in [
+        (1, "truncated"),
+        (2, "truncated: 0 bytes"),
+        (3, "the image is 16x24, expected 24x16"),
+        (4, "no PNG signature"),
+        (5, "not a regular file"),
+    ] {
+        let err = verify_png(seq.frame_path(i), size).unwrap_err().to_string();
+        assert!(err.contains(what), "{i}: {err}");
+        assert!(err.contains(&*seq.frame_path(i).to_string_lossy()), "{err}");
+    }
+    fs::remove_dir(seq.frame_path(5)).unwrap();
+    if gpu::device().is_some() {
+        use fractal_sdf::render::Renderer;
+        let mut renderer = Renderer::new(&Scene::new(sphere(1.0)), Quality::draft()).unwrap();
+        let path = CameraPath::orbit(DVec3::ZERO, 4.0, 1.0, 1.5, 8).unwrap();
+        let todo = seq.remaining(0..6, size);
+        seq.render(&mut renderer, &path, &[], &todo, size, |_| {})
+            .unwrap();
+        assert!(seq.remaining(0..6, size).is_empty());
+        // Indices outside the sequence are refused before anything runs.
+        let err = seq
+            .render(&mut renderer, &path, &[], &[0, 6], size, |_| {
+                panic!("nothing is rendered")
+            })
+            .unwrap_err();
+        assert!(
+            err.to_string()
+                .contains("frame 6 is not in the sequence (frames 0..6)"),
+            "{err}"
+        );
+    }
+    fs::remove_dir_all(dir).unwrap();
+}
+
+#[cfg(unix)]
+#[test]
+fn links_are_written_through_and_stay_links() {
+    use std::os::unix::fs::symlink;
+    let dir = scratch("links");
+    let is_link = |p: &Path| fs::symlink_metadata(p).unwrap().file_type().is_symlink();
+    let image = picture(5, 3);
+    // Relative, absolute, a chain, into another directory, dangling.
+    fs::create_dir(dir.join("real")).unwrap();
+    fs::write(dir.join("real/a.png"), b"old").unwrap();
+    symlink("real/a.png", dir.join("rel.png")).unwrap();
+    symlink(dir.join("real/a.png"), dir.join("abs.png")).unwrap();
+    symlink("rel.png", dir.join("chain.png")).unwrap();
+    symlink("real/new/b.png", dir.join("dangling.png")).unwrap();
+    for link in ["rel.png", "abs.png", "chain.png", "dangling.png"] {
+        let link = dir.join(link);
+        fs::write(dir.join("real/a.png"), b"old").unwrap();
+        save_png(&image, &link).unwrap();
+        assert!(is_link(&link), "{} was replaced", link.display());
+        assert_eq!(image::open(&link).unwrap().to_rgba8(), image);
+    }
+    assert!(is_link(dir.join("rel.png").as_path()) && is_link(&dir.join("chain.png")));
+    assert_eq!(
+        image::open(dir.join("real/new/b.png")).unwrap().to_rgba8(),
+        image
+    );
+    assert_eq!(names(&dir.join("real")), ["a.png", "new"]);
+    // A loop is an error naming the link.
+    symlink("loop_b.png", dir.join("loop_a.png")).unwrap();
+    symlink("loop_a.png", dir.join("loop_b.png")).unwrap();
+    let target = dir.join("loop_a.png");
+    let err = save_png(&image, &target).unwrap_err();
+    io_error_naming(&err, &target, "cannot follow the symbolic link");
+    assert!(is_link(&target));
+    fs::remove_dir_all(dir).unwrap();
+}
+
+#[test]
+fn a_full_device_is_an_error_naming_it_and_stays_a_device() {
+    let full = Path::new("/dev/full");
+    if !full.exists() {
+        eprintln!("note: no /dev/full");
+        return;
+    }
+    let err = save_png(&picture(64, 64), full).unwrap_err();
+    let text = io_error_naming(&err, full, "cannot write the image");
+    assert!(text.contains("No space left on device"), "{text}");
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::FileTypeExt;
+        assert!(fs::metadata(full).unwrap().file_type().is_char_device());
+    }
+}
+
+#[test]
+fn unwritable_targets_are_errors_naming_the_target() {
+    let dir = scratch("unwritable");
+    // A file where a directory is needed.
+    fs::write(dir.join("file"), b"x").unwrap();
+    let target = dir.join("file/sub/img.png");
+    let err = save_png(&picture(2, 2), &target).unwrap_err();
+    io_error_naming(&err, &target, "cannot create the directory");
+    // A directory where the image goes: refused, untouched.
+    fs::create_dir_all(dir.join("taken.png/inner")).unwrap();
+    let target = dir.join("taken.png");
+    let err = save_png(&picture(2, 2), &target).unwrap_err();
+    io_error_naming(&err, &target, "cannot replace a directory with an image");
+    assert!(dir.join("taken.png/inner").is_dir());
+    // A file system that takes no new files.
+    if Path::new("/proc/self").exists() {
+        let target = Path::new("/proc/fractal-sdf-hostile.png");
+        let err = save_png(&picture(2, 2), target).unwrap_err();
+        let text = io_error_naming(&err, target, "cannot create the temporary file");
+        assert!(!target.exists(), "{text}");
+    }
+    // A directory without write permission (root may write anyway).
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::PermissionsExt;
+        let locked = dir.join("locked");
+        fs::create_dir(&locked).unwrap();
+        fs::set_permissions(&locked, fs::Permissions::from_mode(0o555)).unwrap();
+        let root = File::create(locked.join("probe")).is_ok();
+        let _ = fs::remove_file(locked.join("probe"));
+        let target = locked.join("img.png");
+        let result = save_png(&picture(2, 2), &target);
+        fs::set_permissions(&locked, fs::Permissions::from_mode(0o755)).unwrap();
+        if root {
+            result.unwrap();
+        } else {
+            let err = result.unwrap_err();
+            io_error_naming(&err, &target, "Permission denied");
+        }
+    }
+    // No temporary file is left anywhere.
+    let left = names(&dir);
+    assert!(left.iter().all(|n| !n.ends_with(".tmp")), "{left:?}");
+    fs::remove_dir_all(dir).unwrap();
+}
+
+#[test]
+fn zero_huge_and_odd_sizes() {
+    let dir = scratch("sizes");
+    for (w, h) in [(0, 0), (0, 7), (7, 0)] {
+        let target = dir.join(format!("{w}x{h}.png"));
+        let err = save_png(&RgbaImage::new(w, h), &target).unwrap_err();
+        assert!(
+            matches!(err, Error::Resolution { width, height, .. } if (width, height) == (w, h)),
+            "{err}"
+        );
+        assert!(
+            err.to_string().contains(&*target.to_string_lossy()),
+            "{err}"
+        );
+        assert!(!target.exists());
+    }
+    for (w, h) in [(1, 1), (1, 1000), (1000, 1), (257, 3), (3, 257), (4099, 2)] {
+        let target = dir.join(format!("{w}x{h}.png"));
+        let image = picture(w, h);
+        save_png(&image, &target).unwrap();
+        verify_png(&target, (w, h)).unwrap();
+        assert_eq!(image::open(&target).unwrap().to_rgba8(), image);
+    }
+    // Paths that name no file.
+    for target in ["", "nowhere-fractal-sdf/.."] {
+        let err = save_png(&picture(2, 2), target).unwrap_err();
+        io_error_naming(&err, Path::new(target), "the path names no file");
+    }
+    // A name that is only dots and spaces, a long name.
+    for name in [" .png", "..png", &format!("{}.png", "n".repeat(200))] {
+        let target = dir.join(name);
+        save_png(&picture(2, 2), &target).unwrap();
+        verify_png(&target, (2, 2)).unwrap();
+    }
+    assert!(names(&dir).iter().all(|n| !n.ends_with(".tmp")));
+    fs::remove_dir_all(dir).unwrap();
+}
+
+// --------------------------------------------------------------- memory
+
+#[test]
+fn counts_that_cannot_be_held_are_typed_errors() {
+    // An orbit of u32::MAX segments would need 240 GB of keyframes.
+    let err = CameraPath::orbit(DVec3::ZERO, 3.0, 1.0, 10.0, u32::MAX).unwrap_err();
+    assert!(matches!(err, Error::Animation { .. }), "{err}");
+    assert!(
+        err.to_string()
+            .contains("at most 1048575 segments, got 4294967295"),
+        "{err}"
+    );
+    // Four-segment orbits and the largest allowed both work.
+    for segments in [0, 1, 4] {
+        let path = CameraPath::orbit(DVec3::ZERO, 3.0, 1.0, 10.0, segments).unwrap();
+        assert_eq!(path.keyframes().len(), 5);
+    }
+    // Frame counts: u32::MAX frames would be a 16 GiB frame list.
+    for frames in [Sequence::MAX_FRAMES + 1, u32::MAX] {
+        let err = Sequence::new("out/seq", 24.0, frames).unwrap_err();
+        assert!(matches!(err, Error::Invalid { .. }), "{err}");
+    }
+    for (fps, seconds) in [
+        (1e9, 1e9),
+        (f64::MAX, f64::MAX),
+        (24.0, 1e300),
+        (1e300, 1.0),
+    ] {
+        let err = Sequence::for_duration("out/seq", fps, seconds).unwrap_err();
+        assert!(err.to_string().contains("too many"), "{err}");
+        assert!(err.to_string().len() < 160, "{err}");
+    }
+    let seq = Sequence::new(std::env::temp_dir().join("fractal-sdf-none"), 24.0, 10).unwrap();
+    assert_eq!(seq.remaining(0..u32::MAX, (8, 8)).len(), 10);
+    assert_eq!(parse_range("..", seq.frames()).unwrap(), 0..10);
+    assert!(parse_range("0..4294967295", seq.frames()).is_err());
+    assert!(parse_range("..=4294967295", seq.frames()).is_err());
+    assert!(parse_range("99999999999999999999", seq.frames()).is_err());
+    // A path of more keyframes than allowed, from TOML.
+    let keys = CameraPath::MAX_KEYFRAMES + 1;
+    #[allow(clippy::cast_precision_loss)]
+    let many: Vec<Keyframe> = (0..keys)
+        .map(|i| Keyframe::new(i as f64, DVec3::ZERO, DVec3::X))
+        .collect();
+    assert!(matches!(
+        CameraPath::new(many),
+        Err(Error::Animation { .. })
+    ));
+    // Frame statistics saturate instead of overflowing.
+    let mut stats = FrameStats::new();
+    for _ in 0..3 {
+        stats.push(Duration::MAX);
+    }
+    assert_eq!(stats.total(), Duration::MAX);
+    assert_eq!(stats.count(), 3);
+}
+
+#[test]
+fn script_numbers_never_wrap() {
+    let last = u64::MAX;
+    let err = KeyScript::parse("g@18446744073709551615,h").unwrap_err();
+    assert!(matches!(err, Error::Invalid { .. }), "{err}");
+    assert!(
+        err.to_string().contains("after frame 18446744073709551615"),
+        "{err}"
+    );
+    assert_eq!(
+        KeyScript::parse("g@18446744073709551615")
+            .unwrap()
+            .last_frame(),
+        Some(last)
+    );
+    for text in [
+        "g@18446744073709551616",
+        "g@340282366920938463463374607431768211456",
+        "g@-1",
+        "g@+-1",
+        "g@0x10",
+        "g@1.5",
+        "g@",
+    ] {
+        let err = KeyScript::parse(text).unwrap_err();
+        assert!(matches!(err, Error::Invalid { .. }), "{text}: {err}");
+        assert!(err.to_string().contains("whole number"), "{text}: {err}");
+    }
+    // Many keys: one frame apart, in order.
+    let text = vec!["g"; 10_000].join(",");
+    assert_eq!(KeyScript::parse(&text).unwrap().last_frame(), Some(10_000));
+}
+
+// ------------------------------------------------------------- messages
+
+#[test]
+fn numbers_in_messages_are_readable() {
+    let errors = [
+        Scene::new(torus(1.0, -1e300)).validate().unwrap_err(),
+        Scene::new(sphere(-1e-300)).validate().unwrap_err(),
+        Scene::new(sphere(f64::NEG_INFINITY))
+            .validate()
+            .unwrap_err(),
+        Effects::default()
+            .fog_density(-1e300)
+            .validate()
+            .unwrap_err(),
+        Effects::default().gamma(-5e-324).validate().unwrap_err(),
+        CameraPath::orbit(DVec3::ZERO, 1.0, 1.0, -1e300, 8).unwrap_err(),
+        Sequence::for_duration("d", 24.0, -1e300).unwrap_err(),
+        Sequence::new("d", -1e-320, 3).unwrap_err(),
+        Scene::new(sphere(1.0))
+            .with_camera(Camera::look_at(dvec3(0.0, 0.0, 5.0), DVec3::ZERO).fov(1e300))
+            .validate()
+            .unwrap_err(),
+        Scene::new(sphere(1.0))
+            .with_camera(Camera::look_at(dvec3(0.0, 0.0, 5.0), DVec3::ZERO).orthographic(-1e300))
+            .validate()
+            .unwrap_err(),
+    ];
+    for err in &errors {
+        let text = err.to_string();
+        assert!(text.len() < 120, "{text}");
+        assert!(
+            ["e300", "e-300", "5e-324", "-inf", "e-320", "-1e300"]
+                .iter()
+                .any(|n| text.contains(n)),
+            "{text}"
+        );
+    }
+    assert_eq!(fmt_value(1e300).to_string(), "1e300");
+    assert_eq!(fmt_value(0.5).to_string(), "0.5");
+}
+
+#[test]
+fn nan_colours_are_reported_as_nan() {
+    let nan = f64::NAN;
+    for color in [
+        dvec3(nan, 0.0, 0.0),
+        dvec3(1.0, nan, 0.0),
+        dvec3(0.0, 0.0, nan),
+    ] {
+        let glow = Effects::default().glow(Glow::new(color, 1.0));
+        let sky = Effects::default().sky_top(color);
+        let light =
+            Scene::new(sphere(1.0)).with_lights([Light::directional(DVec3::Y).color(color)]);
+        for err in [
+            glow.validate().unwrap_err(),
+            sky.validate().unwrap_err(),
+            light.validate().unwrap_err(),
+        ] {
+            let text = err.to_string();
+            assert!(text.ends_with("got NaN"), "{text}");
+        }
+    }
+    // A negative component is reported as itself, not hidden by another.
+    let err = Effects::default()
+        .glow(Glow::new(dvec3(1.0, -2.0, nan), 1.0))
+        .validate()
+        .unwrap_err();
+    assert!(err.to_string().ends_with("got -2"), "{err}");
+}
+
+#[test]
+fn sequence_errors_blame_the_right_argument() {
+    let text = |fps: f64, seconds: f64| {
+        Sequence::for_duration("d", fps, seconds)
+            .unwrap_err()
+            .to_string()
+    };
+    assert_eq!(
+        text(f64::NAN, 1.0),
+        "invalid frame sequence: the frame rate must be a finite number > 0, got NaN"
+    );
+    assert_eq!(
+        text(24.0, f64::NAN),
+        "invalid frame sequence: the duration must be a finite number > 0, got NaN s"
+    );
+    assert!(text(-1.0, -1.0).contains("frame rate"));
+    assert!(text(f64::INFINITY, 1.0).contains("frame rate"));
+    assert!(text(24.0, f64::INFINITY).contains("duration"));
+    assert!(text(24.0, 0.0).contains("duration"));
+}
