@@ -361,6 +361,11 @@ pub fn sierpinski<T: Real>(p: V3<T>, iterations: u32, scale: T) -> Estimate<T> {
 /// The quaternion Julia distance estimate `0.25 ln(|z|^2) sqrt(|z|^2 /
 /// |dz|^2)` for `z -> z^2 + c`, the point being `(p, w)` with the real part
 /// first.
+///
+/// The loop stops before the running derivative would pass
+/// [`Real::derivative_cap`]: capped, it let `|z|` keep growing and inflated
+/// the estimate (by a factor of 256 at a point 3.1e-5 from a connected set
+/// with bailout 1e6 and 36 iterations).
 #[must_use]
 pub fn julia<T: Real>(p: V3<T>, c: [T; 4], w: T, iterations: u32, bailout: T) -> Estimate<T> {
     let mut z = [p.x, p.y, p.z, w];
@@ -370,7 +375,11 @@ pub fn julia<T: Real>(p: V3<T>, c: [T; 4], w: T, iterations: u32, bailout: T) ->
     let mut trap = mz2;
     let bailout2 = bailout * bailout;
     for _ in 0..iterations {
-        md2 = (md2 * T::of(4.0) * mz2).min(T::derivative_cap());
+        let next = md2 * T::of(4.0) * mz2;
+        if next > T::derivative_cap() {
+            break;
+        }
+        md2 = next;
         let two_x = T::of(2.0) * z[0];
         z = [
             z[0] * z[0] - z[1] * z[1] - z[2] * z[2] - z[3] * z[3] + c[0],

@@ -32,7 +32,11 @@ real julia(real3 p, real4 c, real w, int iterations, real bailout, real* trap) {
     real t = mz2;
     real bailout2 = bailout * bailout;
     for (int i = 0; i < iterations; i++) {
-        md2 = fmin(md2 * R(4.0) * mz2, DERIVATIVE_CAP);
+        real next = md2 * R(4.0) * mz2;
+        if (next > DERIVATIVE_CAP) {
+            break;
+        }
+        md2 = next;
         real two_x = R(2.0) * z.x;
         z = (real4)(z.x * z.x - z.y * z.y - z.z * z.z - z.w * z.w, two_x * z.y, two_x * z.z, two_x * z.w) + c;
         mz2 = dot(z, z);
