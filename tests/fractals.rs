@@ -552,6 +552,56 @@ fn julia_interior_beyond_the_unit_ball_is_measured() {
     assert!(fixture.distance(DVec3::ZERO) < -1e13);
 }
 
+/// Far from the set the escape-time estimate grows like `0.5 r ln r`,
+/// faster than the distance: for the fixture it was 11.5 at (10, 0, 0),
+/// whose distance to the set is at most 9.43, and 6.9e6 at 1e6 (a factor
+/// of 6.9), and a ray from 10 units stepped past the set. Beyond 1.5 times
+/// the radius of the ball that holds the set it is now 0.9 times the
+/// distance to that ball.
+#[test]
+fn julia_far_field_never_overestimates() {
+    let eval = cpu::Evaluator::new(&fixtures::julia_scene()).unwrap();
+    let inside = |p| julia_inside(p, JULIA_C, 0.0, 12 + 64, 4.0);
+    let shell = |r: f64| -> Vec<DVec3> { directions(400).map(|u| u * r).collect() };
+    for r in [1.0, 1.5, 2.0, 2.2, 2.5, 3.0, 4.5, 7.0, 10.0, 100.0, 1e6] {
+        if let Err(e) = check_never_overestimates(&eval, inside, &shell(r), 8) {
+            panic!("at r = {r}: {e}");
+        }
+    }
+    // The farthest point inside along +x: (r, 0, 0) is at most r - tip from
+    // the set.
+    let tip = (0..=1200)
+        .map(|i| f64::from(i) * 1e-3)
+        .filter(|&x| inside(dvec3(x, 0.0, 0.0)))
+        .fold(0.0, f64::max);
+    assert!(tip > 0.5, "{tip}");
+    let ball = sdf::julia_radius(JULIA_C);
+    for r in [5.0, 10.0, 1e6] {
+        let d = eval.distance(dvec3(r, 0.0, 0.0));
+        assert!(d <= r - tip, "at r = {r}: {d}");
+        assert!((d - 0.9 * (r - ball)).abs() <= 1e-9 * r, "at r = {r}: {d}");
+    }
+    // A ray from 10 units reaches the surface where a ray from 2 does (it
+    // used to step past the set).
+    let settings = cpu::MarchSettings {
+        epsilon: 1e-6,
+        ..cpu::MarchSettings::default()
+    };
+    let ray = |z: f64| cpu::Ray {
+        origin: dvec3(0.1, 0.05, z),
+        direction: dvec3(0.0, 0.0, -1.0),
+    };
+    let (from_far, from_near) = (
+        cpu::march(&eval, ray(10.0), &settings),
+        cpu::march(&eval, ray(2.0), &settings),
+    );
+    assert!(from_far.hit && from_near.hit, "{from_far:?} {from_near:?}");
+    assert!(
+        ((from_far.depth - 8.0) - from_near.depth).abs() < 1e-4,
+        "{from_far:?} vs {from_near:?}"
+    );
+}
+
 /// Regression: r^power overflowed for valid settings (power 55 with
 /// bailout 1e6 in f64, power 18 with bailout 365242 in f32), giving an
 /// infinite distance.
