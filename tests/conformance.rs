@@ -53,6 +53,16 @@ fn nodes() -> Vec<(&'static str, Node)> {
         ("mandelbulb_dynamic", mandelbulb(param("power", 5.0))),
         ("menger", menger(4)),
         ("julia", julia([-0.2, 0.6, 0.2, 0.2])),
+        // Outside the Mandelbrot set, and a bailout below 2.5 radii: the
+        // proven bound.
+        ("julia_dust", julia([0.2548, -0.4865, -0.4641, 0.0956])),
+        (
+            "julia_dynamic_bailout_2",
+            QuaternionJulia::new([param("cx", -1.3), 0.1.into(), 0.0.into(), 0.0.into()])
+                .bailout(2.0)
+                .slice_w(0.2)
+                .into(),
+        ),
         ("sierpinski", sierpinski(6)),
         ("translate", b().translate(dvec3(0.3, -0.2, 0.1))),
         ("rotate", b().rotate(dvec3(1.0, 2.0, 0.5), 0.7)),

@@ -83,7 +83,10 @@ pub struct Menger<S = Param> {
     pub scale: S,
 }
 
-/// A quaternion Julia set `z -> z^2 + c`, sliced at `w = slice_w`.
+/// A quaternion Julia set `z -> z^2 + c`, sliced at `w = slice_w`: the
+/// points whose orbits stay within the bailout (for a bailout of at least
+/// `1/2 + sqrt(1/4 + |c|)`, the radius of the ball that holds the set, the
+/// whole filled Julia set).
 ///
 /// Extent: the 4D set lies in the ball of radius
 /// `R = (1 + sqrt(1 + 4|c|)) / 2` about the origin (beyond it every orbit
@@ -91,7 +94,26 @@ pub struct Menger<S = Param> {
 /// and is empty for `|w| > R`. `R` is 1 for `c = 0` (the unit ball) and 2
 /// for `|c| = 2`.
 ///
-/// Distance estimate: `0.5 * |z| * ln|z| / |dz|`, a bound.
+/// Distance: a bound for every valid `c`, whether the set is connected or
+/// dust and `c` baked or dynamic (proven, or measured where said so);
+/// [`cpu::sdf::julia`](crate::cpu::sdf::julia) has the details.
+///
+/// - Far away (beyond 1.5 ball radii): 0.9 times the distance to the ball.
+/// - Where it is safe, the escape-time estimate `0.5 |z| ln|z| / |dz|`:
+///   the bailout is at least 2.5 ball radii and the critical orbit `0, c,
+///   c^2 + c, ...` stays within 0.9 for the iterations used and 2 more.
+///   Measured, not proven: below the distance at points that escape within
+///   the iterations; at points that do not, at most a thin band above 0
+///   (about 0.06 with 4 iterations, 0.016 with 8, 0.009 with 12).
+/// - Elsewhere, no more than a proven bound: positive only where the orbit
+///   proves escape, 0 or less where it stays within the bailout. That is
+///   the case when `c' = c.x + i |(c.y, c.z, c.w)|` is outside the
+///   Mandelbrot set (its complex Julia set is then dust, and the
+///   escape-time estimate overestimates by any factor near the set) or the
+///   critical orbit reaches beyond the unit ball (as for a cycle out there,
+///   which makes that estimate positive inside the set). The bound is
+///   smaller than the escape-time estimate, most of all near the set, so
+///   such sets take more steps and are drawn a little fatter.
 #[derive(Debug, Clone, PartialEq)]
 pub struct QuaternionJulia<S = Param> {
     /// The constant `c` as (x, y, z, w).
