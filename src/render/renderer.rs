@@ -13,7 +13,7 @@ use super::buffer::RealBuffer;
 use super::device::{self, DeviceInfo, DeviceSelector, Selected, opencl};
 use super::dispatch::{self, DEFAULT_TILE_SIZE, MAX_IMAGE_SIDE};
 use super::program::{self, BuildInfo};
-use super::viewport::{Viewport, pack_lights};
+use super::viewport::{Viewport, check_frame_inputs, pack_lights};
 use crate::codegen::interface::{RENDER_TILE, RenderArg, camera};
 use crate::codegen::{self, KernelSource};
 use crate::error::{Error, Result};
@@ -185,6 +185,7 @@ impl Renderer {
         check_light_count(scene.lights())?;
         let source = generate(&scene, &functions, options)?;
         let values = scene.default_values();
+        check_inputs(&scene, &values, &source)?;
         let selected = device::select(&options.device)?;
         let context = program::context(&selected)?;
         let queue = profiling_queue(&context, &selected)?;
@@ -289,9 +290,11 @@ impl Renderer {
     /// # Errors
     /// [`Error::UnknownParam`], or the error a baked value would get: the
     /// parameter's own rule, or a rule relating it to other parameters
-    /// (see [`ParamValues::set`]).
+    /// (see [`ParamValues::set`]), or [`Error::Precision`] for a value the
+    /// program's precision cannot compute with.
     pub fn set_param(&mut self, name: &str, value: f64) -> Result<()> {
-        self.values.set(name, value)
+        let limits = self.source.precision.limits();
+        self.values.set_within(name, value, limits)
     }
 
     /// The current value of a dynamic parameter.
@@ -303,8 +306,12 @@ impl Renderer {
     /// Moves the camera (no recompilation).
     ///
     /// # Errors
-    /// [`Error::Camera`] if the camera is degenerate.
+    /// [`Error::Camera`] if the camera is degenerate; [`Error::Precision`]
+    /// if the program's precision cannot compute with it.
     pub fn set_camera(&mut self, camera: Camera) -> Result<()> {
+        let view = Viewport::in_frame(&camera, 1, 1, self.source.precision, self.source.origin)?;
+        let limits = self.source.precision.limits();
+        check_frame_inputs(&view, &[], self.source.origin, limits)?;
         self.scene.set_camera(camera)
     }
 
@@ -319,11 +326,16 @@ impl Renderer {
     ///
     /// # Errors
     /// The first invalid light, as [`Scene::compile`] reports it;
-    /// [`Error::TooManyLights`].
+    /// [`Error::TooManyLights`]; [`Error::Precision`] for a light the
+    /// program's precision cannot compute with.
     pub fn set_lights(&mut self, lights: impl IntoIterator<Item = Light>) -> Result<()> {
         let lights: Vec<Light> = lights.into_iter().collect();
         check_light_count(&lights)?;
-        self.scene.set_lights(lights)
+        let mut scene = self.scene.clone();
+        scene.set_lights(lights)?;
+        check_inputs(&scene, &self.values, &self.source)?;
+        self.scene = scene;
+        Ok(())
     }
 
     /// The lights.
@@ -413,6 +425,7 @@ impl Renderer {
     fn reprogram(&mut self, options: RenderOptions) -> Result<()> {
         validate(&options)?;
         let source = generate(&self.scene, &self.functions, &options)?;
+        check_inputs(&self.scene, &self.values, &source)?;
         self.load(source)?;
         self.options = options;
         Ok(())
@@ -462,6 +475,12 @@ impl Renderer {
             self.targets = Targets::new(&self.queue, width, height, aovs)
                 .map_err(|e| too_large(width, height, &format!("{e}")))?;
         }
+        check_frame_inputs(
+            &view,
+            self.scene.lights(),
+            self.source.origin,
+            self.source.precision.limits(),
+        )?;
         self.inputs.upload(
             &self.queue,
             &self.kernel,
@@ -570,9 +589,19 @@ fn check_device_memory(info: &DeviceInfo, width: u32, height: u32, aovs: bool) -
     Ok(())
 }
 
+/// Checks what a program's frames hand its kernel against the limits of
+/// its precision: the dynamic values, and the camera and lights as packed
+/// for a 1 × 1 image (each frame checks its own size again).
+fn check_inputs(scene: &CompiledScene, values: &ParamValues, source: &KernelSource) -> Result<()> {
+    let limits = source.precision.limits();
+    values.check_within(limits)?;
+    let view = Viewport::in_frame(scene.camera(), 1, 1, source.precision, source.origin)?;
+    check_frame_inputs(&view, scene.lights(), source.origin, limits)
+}
+
 fn validate(options: &RenderOptions) -> Result<()> {
     options.quality.validate()?;
-    options.effects.validate()?;
+    options.effects.validate_for(options.quality.precision)?;
     if options.tile_size == 0 {
         return Err(Error::TileSize {
             value: options.tile_size,
