@@ -151,6 +151,25 @@ pub enum Error {
         /// The parameter's name.
         name: String,
     },
+    /// A render was cancelled through its `render::CancelToken` before
+    /// every tile was launched.
+    #[error("render cancelled after {tiles} of {total} tiles")]
+    Cancelled {
+        /// Tiles launched before the cancellation was seen.
+        tiles: usize,
+        /// Tiles in the image.
+        total: usize,
+    },
+    /// A render ran past its deadline before every tile was launched.
+    #[error("render passed its deadline of {deadline:?} after {tiles} of {total} tiles")]
+    Deadline {
+        /// The time the render was given.
+        deadline: std::time::Duration,
+        /// Tiles launched before the deadline passed.
+        tiles: usize,
+        /// Tiles in the image.
+        total: usize,
+    },
     /// No OpenCL platform is installed.
     #[error(
         "no OpenCL platform found ({detail}); install one, e.g. on Debian: \

@@ -10,6 +10,7 @@ use ocl::{Buffer, Context, Event, Kernel, MemFlags, Program, Queue};
 
 use super::aov::Frame;
 use super::buffer::RealBuffer;
+use super::cancel::CancelToken;
 use super::device::{self, DeviceInfo, DeviceSelector, Selected, opencl};
 use super::dispatch::{self, DEFAULT_TILE_SIZE, MAX_IMAGE_SIDE};
 use super::program::{self, BuildInfo};
@@ -31,22 +32,39 @@ pub struct RenderOptions {
     pub effects: Effects,
     /// Which OpenCL device to use.
     pub device: DeviceSelector,
-    /// Side of the square tiles the image is launched in, in pixels.
+    /// Side of the square tiles the image is launched in, in pixels. Each
+    /// tile is one kernel launch, which cannot be interrupted: smaller
+    /// tiles make [`RenderOptions::deadline`] and
+    /// [`RenderOptions::cancel`] take effect sooner.
     pub tile_size: u32,
+    /// The longest a frame may take: once it has passed, no further tile is
+    /// launched and the frame fails with [`Error::Deadline`] (after the
+    /// tiles in flight finish). `None`: no limit.
+    pub deadline: Option<Duration>,
+    /// A token that stops a frame between tiles, from any thread (see
+    /// [`CancelToken`]); the frame fails with [`Error::Cancelled`].
+    pub cancel: Option<CancelToken>,
 }
 
 impl Default for RenderOptions {
     /// Production quality, default effects, automatic device, 256-pixel
-    /// tiles.
+    /// tiles, no deadline, no cancellation.
     fn default() -> Self {
         RenderOptions {
             quality: Quality::default(),
             effects: Effects::default(),
             device: DeviceSelector::default(),
             tile_size: DEFAULT_TILE_SIZE,
+            deadline: None,
+            cancel: None,
         }
     }
 }
+
+/// Tiles in flight at once: the next tile is launched when the one before
+/// the last has finished, so the device stays busy while the renderer
+/// can still stop between tiles.
+const TILES_IN_FLIGHT: usize = 2;
 
 const KERNEL_NAME: &str = "render_tile";
 
@@ -217,8 +235,11 @@ impl Renderer {
     ///
     /// # Errors
     /// [`Error::Resolution`] for a zero side, a side above 32768 or an image
-    /// whose buffers cannot be allocated; [`Error::OpenCl`] if the device
-    /// fails.
+    /// whose buffers cannot be allocated; [`Error::Precision`] for a camera
+    /// or lights the program's precision cannot compute with at this size;
+    /// [`Error::Cancelled`] or [`Error::Deadline`] when
+    /// [`RenderOptions::cancel`] or [`RenderOptions::deadline`] stops the
+    /// frame between tiles; [`Error::OpenCl`] if the device fails.
     pub fn render(&mut self, width: u32, height: u32) -> Result<RgbaImage> {
         let start = Instant::now();
         let kernel = self.run(width, height, false)?;
@@ -462,6 +483,27 @@ impl Renderer {
         });
     }
 
+    /// The error that stops a frame before its next tile, if any: a
+    /// cancelled token, or a deadline that has passed.
+    fn stop(&self, launched: Instant, tiles: usize, total: usize) -> Option<Error> {
+        if self
+            .options
+            .cancel
+            .as_ref()
+            .is_some_and(CancelToken::is_cancelled)
+        {
+            return Some(Error::Cancelled { tiles, total });
+        }
+        match self.options.deadline {
+            Some(deadline) if launched.elapsed() >= deadline => Some(Error::Deadline {
+                deadline,
+                tiles,
+                total,
+            }),
+            _ => None,
+        }
+    }
+
     /// Uploads the frame's inputs, launches every tile and waits for them.
     /// Returns the kernel time and whether it comes from profiling events.
     fn run(&mut self, width: u32, height: u32, aovs: bool) -> Result<(Duration, bool)> {
@@ -500,8 +542,18 @@ impl Renderer {
         set(RenderArg::WriteAovs, i32::from(aovs))?;
         t.bind(k)?;
         let launched = Instant::now();
-        let mut events = Vec::new();
+        let mut events: Vec<Event> = Vec::new();
+        let total = dispatch::tiles(width, height, self.options.tile_size).count();
         for tile in dispatch::tiles(width, height, self.options.tile_size) {
+            if let Some(stop) = self.stop(launched, events.len(), total) {
+                // Let the tiles in flight finish before the buffers are
+                // touched again.
+                self.queue.finish().map_err(opencl)?;
+                return Err(stop);
+            }
+            if let Some(before) = events.len().checked_sub(TILES_IN_FLIGHT) {
+                events[before].wait_for().map_err(opencl)?;
+            }
             #[allow(clippy::cast_possible_wrap)]
             {
                 set(RenderArg::X0, tile.x as i32)?;
