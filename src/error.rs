@@ -30,6 +30,29 @@ pub enum Error {
         /// What the value must be, such as `">= 0"`.
         expected: String,
     },
+    /// A finite value the kernel's precision cannot compute with: its
+    /// magnitude passes one of the precision's limits
+    /// ([`math::Limits`](crate::math::Limits)), so its squares, products or
+    /// quotients in the kernel would overflow, underflow or fall below
+    /// what the precision resolves.
+    #[error(
+        "{node}: `{param}` = {value} cannot be represented safely in {precision} \
+         (its magnitude passes the limit {limit:e}); {}",
+        precision_hint(precision)
+    )]
+    Precision {
+        /// Path of the node in the scene, or `camera`, `light[i]`,
+        /// `quality`, `effects`.
+        node: String,
+        /// The parameter's or setting's name.
+        param: String,
+        /// The offending value.
+        value: f64,
+        /// The precision: `"F32"` or `"F64"`.
+        precision: &'static str,
+        /// The limit it passes (see [`math::Limits`](crate::math::Limits)).
+        limit: f64,
+    },
     /// A fractal's iteration count is outside its allowed range.
     #[error("{node}: iterations must be in {min}..={max}, got {value}")]
     Iterations {
@@ -128,6 +151,25 @@ pub enum Error {
     ConflictingParam {
         /// The parameter's name.
         name: String,
+    },
+    /// A render was cancelled through its `render::CancelToken` before
+    /// every tile was launched.
+    #[error("render cancelled after {tiles} of {total} tiles")]
+    Cancelled {
+        /// Tiles launched before the cancellation was seen.
+        tiles: usize,
+        /// Tiles in the image.
+        total: usize,
+    },
+    /// A render ran past its deadline before every tile was launched.
+    #[error("render passed its deadline of {deadline:?} after {tiles} of {total} tiles")]
+    Deadline {
+        /// The time the render was given.
+        deadline: std::time::Duration,
+        /// Tiles launched before the deadline passed.
+        tiles: usize,
+        /// Tiles in the image.
+        total: usize,
     },
     /// No OpenCL platform is installed.
     #[error(
@@ -280,6 +322,15 @@ impl fmt::Display for FmtValue {
         } else {
             write!(f, "{v}")
         }
+    }
+}
+
+/// What an [`Error::Precision`] suggests.
+fn precision_hint(precision: &str) -> &'static str {
+    if precision == "F32" {
+        "render in Precision::F64, or rescale the scene"
+    } else {
+        "rescale the scene"
     }
 }
 

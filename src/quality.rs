@@ -2,11 +2,14 @@
 //! lighting effects to compile in ([`Effects`]).
 //!
 //! Both are plain data read by code generation: an effect that is off, or a
-//! sample count of zero, produces no code at all.
+//! sample count of zero, produces no code at all. [`Precision`] also says
+//! which magnitudes the kernel can compute with ([`Precision::limits`]), the
+//! bounds every scene value, camera, light, knob and effect setting keeps.
 
 use glam::DVec3;
 
 use crate::error::{Error, Result};
+use crate::math::{F32_LIMITS, F64_LIMITS, Limits, Magnitude};
 
 /// Floating-point precision of the generated kernel.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
@@ -17,6 +20,70 @@ pub enum Precision {
     /// 64-bit floats via `cl_khr_fp64`: for deep zooms and huge or tiny
     /// scales. Slower, and not every device has it.
     F64,
+}
+
+impl Precision {
+    /// The magnitudes a kernel of this precision computes with safely
+    /// (the table and the reasons are in [`math::Limits`](crate::math::Limits)):
+    ///
+    /// | precision | values at most | sizes 0 or at least | knobs in footprints at least |
+    /// |---|---|---|---|
+    /// | `F32` | `1e18` | `1e-18` | `2^-20` (about `9.5e-7`) |
+    /// | `F64` | `1e150` | `1e-150` | `2^-49` (about `1.8e-15`) |
+    ///
+    /// Scene values keep the `F64` limits when a scene is compiled, and
+    /// the limits of the kernel's precision when a program is generated
+    /// and a renderer uploads its inputs; a value beyond them is an
+    /// [`Error::Precision`].
+    ///
+    /// ```
+    /// use fractal_sdf::prelude::*;
+    /// assert_eq!(Precision::F32.limits().max, 1e18);
+    /// assert_eq!(Precision::F64.limits().min, 1e-150);
+    /// ```
+    #[must_use]
+    pub fn limits(self) -> &'static Limits {
+        match self {
+            Precision::F32 => &F32_LIMITS,
+            Precision::F64 => &F64_LIMITS,
+        }
+    }
+}
+
+/// A setting's magnitude against `limits`, as [`Error::Precision`] at the
+/// node `quality` or `effects`.
+fn within(
+    node: &str,
+    setting: &str,
+    value: f64,
+    magnitude: Magnitude,
+    limits: &Limits,
+) -> Result<()> {
+    match limits.crossed(value, magnitude) {
+        None => Ok(()),
+        Some(limit) => Err(Error::Precision {
+            node: node.into(),
+            param: setting.into(),
+            value,
+            precision: limits.precision,
+            limit,
+        }),
+    }
+}
+
+/// A knob measured in pixel footprints: at least the precision's
+/// resolution, at most its largest value.
+fn footprints(setting: &str, value: f64, limits: &Limits) -> Result<()> {
+    if value < limits.resolution {
+        return Err(Error::Precision {
+            node: "quality".into(),
+            param: setting.into(),
+            value,
+            precision: limits.precision,
+            limit: limits.resolution,
+        });
+    }
+    within("quality", setting, value, Magnitude::Size, limits)
 }
 
 /// Every speed-versus-accuracy knob. Start from a preset and adjust.
@@ -33,6 +100,17 @@ pub enum Precision {
 /// and accuracy and converge on one image, rather than drawing different
 /// surfaces. The other knobs converge: beyond a point they change almost
 /// nothing.
+///
+/// Every knob is also bounded by what [`Quality::precision`] can compute
+/// with ([`Precision::limits`]; checked by [`Quality::validate`], which
+/// every renderer and code generation run): `detail`, `hit_epsilon` and
+/// `normal_epsilon` are thresholds in pixel footprints and must be at
+/// least the precision's resolution (`2^-20`, about `9.5e-7`, in `F32`;
+/// `2^-49`, about `1.8e-15`, in `F64`) and at most its largest value
+/// (`1e18` in `F32`, `1e150` in `F64`); `max_distance` lies between the
+/// smallest size and the largest value (`1e-18` to `1e18` in `F32`,
+/// `1e-150` to `1e150` in `F64`). [`Effects`] values keep the same
+/// bounds on sizes.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Quality {
     /// Give up on a ray after this many steps.
@@ -142,11 +220,35 @@ impl Quality {
         }
     }
 
-    /// Checks every knob.
+    /// Checks every knob, for the knob's own range and for what
+    /// [`Quality::precision`] can compute with: `detail`, `hit_epsilon`
+    /// and `normal_epsilon` are thresholds in pixel footprints, so each is
+    /// at least the precision's resolution (`Precision::limits`; about
+    /// `9.5e-7` in `F32`, `1.8e-15` in `F64`: below it a threshold is finer
+    /// than positions can be told apart, and in `F32` it underflows to 0,
+    /// so the march can no longer stop); `max_distance` is a size within
+    /// the precision's limits.
     ///
     /// # Errors
-    /// [`Error::Quality`] naming the first bad setting.
+    /// [`Error::Quality`] naming the first setting outside its own range;
+    /// [`Error::Precision`] for one the precision cannot compute with.
     pub fn validate(&self) -> Result<()> {
+        self.check_ranges()?;
+        let limits = self.precision.limits();
+        footprints("detail", self.detail, limits)?;
+        footprints("hit_epsilon", self.hit_epsilon, limits)?;
+        footprints("normal_epsilon", self.normal_epsilon, limits)?;
+        within(
+            "quality",
+            "max_distance",
+            self.max_distance,
+            Magnitude::Size,
+            limits,
+        )
+    }
+
+    /// Each knob's own range.
+    fn check_ranges(&self) -> Result<()> {
         let check = |setting: &'static str, value: f64, ok: bool, expected: &str| {
             if ok && value.is_finite() {
                 Ok(())
@@ -412,11 +514,47 @@ impl Effects {
         }
     }
 
-    /// Checks every value.
+    /// Checks every value, for its own range and for the `F64` limits
+    /// (the widest; a renderer checks its own precision's with
+    /// [`Effects::validate_for`]).
     ///
     /// # Errors
-    /// [`Error::Quality`] naming the first bad setting.
+    /// As [`Effects::validate_for`].
     pub fn validate(&self) -> Result<()> {
+        self.validate_for(Precision::F64)
+    }
+
+    /// Checks every value, for its own range and for what a kernel of
+    /// `precision` can compute with: each is a size within
+    /// [`Precision::limits`].
+    ///
+    /// # Errors
+    /// [`Error::Quality`] naming the first setting outside its own range;
+    /// [`Error::Precision`] for one the precision cannot compute with.
+    pub fn validate_for(&self, precision: Precision) -> Result<()> {
+        self.check_ranges()?;
+        let limits = precision.limits();
+        let size =
+            |setting: &str, value: f64| within("effects", setting, value, Magnitude::Size, limits);
+        let rgb = |setting: &str, c: DVec3| -> Result<()> {
+            for (value, axis) in c.to_array().into_iter().zip(["x", "y", "z"]) {
+                size(&format!("{setting}.{axis}"), value)?;
+            }
+            Ok(())
+        };
+        if let Some(g) = self.glow {
+            rgb("glow.color", g.color)?;
+            size("glow.strength", g.strength)?;
+        }
+        size("ao_distance", self.ao_distance)?;
+        size("fog_density", self.fog_density)?;
+        rgb("sky_top", self.sky_top)?;
+        rgb("sky_bottom", self.sky_bottom)?;
+        size("gamma", self.gamma)
+    }
+
+    /// Each value's own range.
+    fn check_ranges(&self) -> Result<()> {
         let bad = |setting: &'static str, value: f64, expected: &str| Error::Quality {
             setting,
             value,

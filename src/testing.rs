@@ -14,6 +14,9 @@
 //!   closure `Fn(DVec3) -> f64`. [`check_device_matches_cpu`] (feature
 //!   `opencl`) runs a node's generated OpenCL code on a device and compares
 //!   it with the CPU reference.
+//! - [`parameter_sites`] and [`substitute`] list and replace every scalar
+//!   parameter of any node kind, from the one list of every node's
+//!   parameters: for driving hostile values through every parameter.
 //! - Membership tests ([`mandelbulb_inside`], [`julia_inside`],
 //!   [`menger_inside`], [`sierpinski_inside`]) decide whether a point is in
 //!   a fractal without using any distance-estimator code: they are the
@@ -48,6 +51,7 @@ mod check;
 #[cfg(feature = "opencl")]
 mod device;
 mod membership;
+mod sites;
 mod strategy;
 
 pub use check::{
@@ -57,6 +61,7 @@ pub use check::{
 #[cfg(feature = "opencl")]
 pub use device::{check_device_matches_cpu, random_points, spicy_points};
 pub use membership::{julia_inside, mandelbulb_inside, menger_inside, sierpinski_inside};
+pub use sites::{Site, parameter_sites, substitute};
 pub use strategy::{
     bounded_node, capped_cone_node, capsule_node, cuboid_node, cylinder_node, ellipsoid_node,
     exact_node, exact_primitive, fractal_node, julia_node, mandelbulb_node, menger_node,

@@ -13,7 +13,7 @@ use std::path::{Path, PathBuf};
 const STAGES: &[(&str, &[&str])] = &[
     ("error", &[]),
     ("math", &[]),
-    ("quality", &["error"]),
+    ("quality", &["error", "math"]),
     ("scene", &["error", "math"]),
     ("ir", &["error", "math", "scene"]),
     ("cpu", &["error", "scene", "ir", "math"]),

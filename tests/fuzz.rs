@@ -121,6 +121,7 @@ proptest! {
                     | Error::OutOfRange { .. }
                     | Error::Iterations { .. }
                     | Error::ZeroVector { .. }
+                    | Error::Precision { .. }
             ), "{}", e);
         }
     }
@@ -131,7 +132,7 @@ proptest! {
         let camera = Camera::look_at(dvec3(0.0, 0.0, v), DVec3::ZERO).fov(fov);
         match Scene::new(sphere(1.0)).with_camera(camera).validate() {
             Ok(()) => prop_assert!(v.is_finite() && v != 0.0 && fov > 0.0 && fov < 180.0),
-            Err(e) => prop_assert!(matches!(e, Error::Camera { .. }), "{}", e),
+            Err(e) => prop_assert!(matches!(e, Error::Camera { .. } | Error::Precision { .. }), "{}", e),
         }
     }
 }

@@ -1,8 +1,9 @@
 /* Distance bounds for warped children (twist, bend): with the warp's local
-   stretch L(rho), d / L(rho + |d| / L(rho)) never overestimates. */
+   stretch L(rho), d / L(rho + |d| / L(rho)) never overestimates. The
+   twist's root is a hypot, so a large rate never makes L infinite. */
 real twist_stretch(real k, real rho) {
     real a = R(0.5) * fabs(k) * rho;
-    return a + sqrt(R(1.0) + a * a);
+    return a + hypot(R(1.0), a);
 }
 
 real bend_stretch(real k, real rho) {

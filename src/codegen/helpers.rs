@@ -5,6 +5,7 @@
 /// scene calls and emits those (with their dependencies) and no others.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash)]
 pub(crate) enum Helper {
+    Length,
     Sphere,
     Cuboid,
     RoundBox,
@@ -34,7 +35,8 @@ macro_rules! source {
 impl Helper {
     /// Every helper, each after the helpers it depends on: the order they
     /// are emitted in.
-    pub(crate) const ALL: [Helper; 18] = [
+    pub(crate) const ALL: [Helper; 19] = [
+        Helper::Length,
         Helper::Sphere,
         Helper::Cuboid,
         Helper::RoundBox,
@@ -67,6 +69,7 @@ impl Helper {
 
     fn file(self) -> (&'static str, &'static str) {
         match self {
+            Helper::Length => ("length", source!("length")),
             Helper::Sphere => ("sphere", source!("sphere")),
             Helper::Cuboid => ("cuboid", source!("cuboid")),
             Helper::RoundBox => ("round_box", source!("round_box")),
@@ -92,6 +95,7 @@ impl Helper {
     pub(crate) fn deps(self) -> &'static [Helper] {
         match self {
             Helper::Menger => &[Helper::Cuboid],
+            Helper::Ellipsoid => &[Helper::Length],
             Helper::Sierpinski => &[Helper::Tetrahedron],
             _ => &[],
         }

@@ -224,12 +224,21 @@ pub fn emit(scene: &CompiledScene, options: &Options) -> Result<KernelSource> {
 /// Generates the program for lowered geometry alone (the camera and lights
 /// never shape the source).
 ///
+/// Every value written as a literal is first checked against the limits of
+/// the program's precision ([`Precision::limits`]): a baked scene value,
+/// quality knob or effect setting that precision cannot compute with is an
+/// [`Error::Precision`](crate::Error::Precision) naming it, never a
+/// program that fails to build or draws nothing.
+///
 /// # Errors
-/// A validation error of the quality or effects.
+/// A validation error of the quality or effects;
+/// [`Error::Precision`](crate::Error::Precision) for a baked value beyond
+/// the precision's limits, with its node's path.
 pub fn emit_ir(ir: &Ir, options: &Options) -> Result<KernelSource> {
     options.quality.validate()?;
-    options.effects.validate()?;
+    options.effects.validate_for(options.quality.precision)?;
     let precision = options.quality.precision;
+    ir.check_limits(precision.limits())?;
 
     // The scene functions first, to learn which helpers they call.
     // Rendering works in the scene's local frame (see `Ir::local_frame`);
@@ -294,7 +303,7 @@ pub fn emit_ir(ir: &Ir, options: &Options) -> Result<KernelSource> {
 /// A validation error of the quality or effects.
 pub fn emit_handwritten(scene_functions: &str, options: &Options) -> Result<KernelSource> {
     options.quality.validate()?;
-    options.effects.validate()?;
+    options.effects.validate_for(options.quality.precision)?;
     let mut w = writer::Writer::new(options.quality.precision);
     header(&mut w, options);
     w.line("/* ---- scene (hand-written) ---- */");

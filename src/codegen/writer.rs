@@ -78,8 +78,9 @@ impl Writer {
 
     /// A float literal of the kernel's precision that reads back as exactly
     /// `v` rounded to that precision: `1.0f`, `(-0.5f)`, `1e-30f`. F64 has no
-    /// suffix. Non-finite values never reach code generation (validation
-    /// rejects them); if one did, this panics rather than emit `inf`.
+    /// suffix. Values the precision cannot hold never reach code generation
+    /// (validation and the precision's limits refuse them); if one did,
+    /// this panics rather than emit `inf`.
     pub(crate) fn float(&self, v: f64) -> String {
         literal(v, self.precision)
     }
@@ -135,12 +136,18 @@ fn comment_text(text: &str) -> String {
 /// has no suffix). Negative values are parenthesised.
 ///
 /// # Panics
-/// If `v` is NaN or infinite.
+/// If `v` is NaN or infinite, or finite but beyond `f32` in an F32
+/// literal (it would read back as infinity).
 #[must_use]
 pub fn literal(v: f64, precision: Precision) -> String {
+    #[allow(clippy::cast_possible_truncation)]
+    let fits = match precision {
+        Precision::F32 => (v as f32).is_finite(),
+        Precision::F64 => v.is_finite(),
+    };
     assert!(
-        v.is_finite(),
-        "non-finite literal {v} reached code generation"
+        fits,
+        "non-finite literal {v} reached code generation for {precision:?}"
     );
     let mut s = String::new();
     match precision {
@@ -201,5 +208,11 @@ mod tests {
     #[should_panic(expected = "non-finite")]
     fn non_finite_literals_are_refused() {
         let _ = literal(f64::NAN, Precision::F32);
+    }
+
+    #[test]
+    #[should_panic(expected = "non-finite")]
+    fn literals_beyond_f32_are_refused() {
+        let _ = literal(1e39, Precision::F32);
     }
 }

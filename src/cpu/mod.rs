@@ -9,7 +9,7 @@ pub mod sdf;
 
 use glam::DVec3;
 
-use crate::math::{DEFAULT_COLOR, integer_power, rotation_rows};
+use crate::math::{DEFAULT_COLOR, integer_power, normalize, rotation_rows};
 pub use crate::math::{Real, V3, v3};
 use sdf::Estimate;
 
@@ -114,7 +114,7 @@ impl Evaluator {
             d(p + DVec3::Y * h) - d(p - DVec3::Y * h),
             d(p + DVec3::Z * h) - d(p - DVec3::Z * h),
         );
-        g.try_normalize().unwrap_or(DVec3::Y)
+        normalize(g).unwrap_or(DVec3::Y)
     }
 
     fn scalar<T: Real>(&self, s: Scalar) -> T {

@@ -56,10 +56,17 @@ pub fn capsule<T: Real>(p: V3<T>, a: V3<T>, b: V3<T>, r: T) -> T {
 }
 
 /// Exact distance to the half-space `dot(p, n) + offset <= 0` (`n` is
-/// normalised here; a zero `n` gives the constant `offset`).
+/// normalised here, after dividing it by its largest component so that no
+/// square of a tiny or huge component is formed; a zero `n` gives the
+/// constant `offset`).
 #[must_use]
 pub fn plane<T: Real>(p: V3<T>, n: V3<T>, offset: T) -> T {
-    let n = n / n.length().max(T::tiny());
+    let m = n.abs().max_element();
+    let mut n = n;
+    if m > T::zero() {
+        n = n / m;
+        n = n / n.length();
+    }
     p.dot(n) + offset
 }
 
@@ -106,19 +113,25 @@ pub fn capped_cone<T: Real>(p: V3<T>, h: T, r1: T, r2: T) -> T {
 
 /// A distance bound for an axis-aligned ellipsoid with semi-axes `r`.
 ///
-/// Outside, Quilez's `k0 (k0 - 1) / k1`. Inside, that formula overestimates
-/// (by up to the ratio of the longest to the shortest semi-axis, and it is
-/// 0 at the centre), so the interior uses `(k0 - 1) min(r)`: scaling by
-/// `1 / r` stretches no length by more than `1 / min(r)`, so this never
-/// exceeds the true depth.
+/// Outside, Quilez's `k0 (k0 - 1) / k1` with `k0 = |p / r|` and
+/// `k1 = |p / r²|`, computed as `(k0 - 1) / |u / r|` with `u = (p / r) / k0`
+/// (the same value, as `k1 = k0 |u / r|`) and with lengths that scale
+/// first ([`V3::safe_length`]): no square of `p / r` or `p / r²` is
+/// formed, so radii from the smallest to the largest a precision allows
+/// give a finite bound, never above `|p|`. Inside, that formula
+/// overestimates (by up to the ratio of the longest to the shortest
+/// semi-axis, and it is 0 at the centre), so the interior uses
+/// `(k0 - 1) min(r)`: scaling by `1 / r` stretches no length by more than
+/// `1 / min(r)`, so this never exceeds the true depth.
 #[must_use]
 pub fn ellipsoid<T: Real>(p: V3<T>, r: V3<T>) -> T {
-    let k0 = (p / r).length();
+    let q = p / r;
+    let k0 = q.safe_length();
     if k0 < T::one() {
         return (k0 - T::one()) * r.min_element();
     }
-    let k1 = (p / (r * r)).length();
-    k0 * (k0 - T::one()) / k1.max(T::tiny())
+    let k1 = (q / k0 / r).safe_length();
+    (k0 - T::one()) / k1.max(T::tiny())
 }
 
 /// A distance estimate with its orbit trap in `[0, 1]`.
@@ -594,10 +607,12 @@ pub fn smooth_min<T: Real>(a: T, b: T, k: T) -> (T, T) {
 
 /// The twist's local Lipschitz factor `t/2 + sqrt(1 + t^2/4)` at
 /// `t = |k| rho`: the largest stretch of the map `p -> rotate_y(k p.y) p` at
-/// distance `rho` from the y axis.
+/// distance `rho` from the y axis. The root is a `hypot`, so a large `t`
+/// gives a large factor rather than an infinite one (which would make
+/// every distance 0).
 fn twist_stretch<T: Real>(k: T, rho: T) -> T {
     let half = T::of(0.5) * k.abs() * rho;
-    half + (T::one() + half * half).sqrt()
+    half + T::one().hypot(half)
 }
 
 /// The bend's local Lipschitz factor `1 + |k| rho` at distance `rho` from

@@ -9,7 +9,7 @@ use glam::{DQuat, DVec3};
 use super::params::{Constraint, ParamLayout, ParamSlot, Relation, check_rule};
 use super::{Ir, IrNode, NodeId, Scalar, Vector, baked3};
 use crate::error::{Error, Result};
-use crate::math::normalize;
+use crate::math::{F64_LIMITS, normalize, reduce_angle};
 use crate::scene::{CustomShape, Kind, Mapper, Node, NodeKind, Param, Param3, ParamSpec, Rule};
 
 /// Validates and lowers `geometry` (see [`Ir::lower`]) without recursion,
@@ -49,7 +49,7 @@ pub(super) fn lower(geometry: &Node) -> Result<Ir> {
         }
     }
     let root = l.visits[0].id.expect("the root is lowered last");
-    Ok(Ir {
+    let ir = Ir {
         nodes: l.nodes,
         labels: l.labels,
         parents: l.parents,
@@ -58,7 +58,12 @@ pub(super) fn lower(geometry: &Node) -> Result<Ir> {
             slots: l.slots,
             constraints: l.constraints,
         }),
-    })
+    };
+    // Every value was checked as it was met; folding multiplies and adds
+    // them (nested scales, chained translations), so the folded values are
+    // checked again.
+    ir.check_limits(&F64_LIMITS)?;
+    Ok(ir)
 }
 
 /// A node's name in paths: its kind, or a custom shape's own name.
@@ -136,8 +141,24 @@ impl Lowering {
         }
         self.operand = matches!(kind, Kind::Csg { .. }).then_some(0);
         let mut lowered = kind.try_map(self)?;
-        if let Kind::Rotate { axis, .. } = &mut lowered {
-            *axis = normalize(*axis).expect("check_structure refuses other axes");
+        match &mut lowered {
+            Kind::Rotate { axis, angle, .. } => {
+                *axis = normalize(*axis).expect("check_structure refuses other axes");
+                // Both twins turn by the reduced angle (dynamic ones are
+                // reduced as they are set).
+                if let Scalar::Baked(a) = angle {
+                    *a = reduce_angle(*a);
+                }
+            }
+            // A baked normal is normalised here, in `f64`, whatever its
+            // length: both twins receive the same unit vector. A zero one
+            // is left for `relate` to refuse.
+            Kind::Plane { normal, .. } => {
+                if let Some(unit) = baked3(*normal).and_then(normalize) {
+                    *normal = unit.to_array().map(Scalar::Baked);
+                }
+            }
+            _ => {}
         }
         self.visits[v].lowered = Some(lowered);
         Ok(())
@@ -348,7 +369,8 @@ impl Lowering {
 
     fn lower_param(&mut self, p: &Param, param: &str, rule: Rule) -> Result<Scalar> {
         let v = self.current;
-        check_rule(|| self.path(v), param, p.default_value(), rule)?;
+        let baked = matches!(p, Param::Value(_));
+        check_rule(|| self.path(v), param, p.default_value(), rule, baked)?;
         match p {
             Param::Value(v) => Ok(Scalar::Baked(*v)),
             Param::Dynamic { name, default } => {

@@ -24,7 +24,8 @@ pub use compiled::CompiledScene;
 pub use params::{Constraint, ParamLayout, ParamSlot, ParamValues, Relation};
 
 use crate::error::Result;
-use crate::scene::{Kind, Node};
+use crate::math::Limits;
+use crate::scene::{Kind, Mapper, Node, ParamSpec};
 
 /// A handle to a node in an [`Ir`] arena.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
@@ -160,6 +161,25 @@ impl Ir {
         }
     }
 
+    /// Checks every baked value against the `limits` of a kernel
+    /// precision: code generation does, before it writes any value as a
+    /// literal of that precision. Dynamic values are checked where they are
+    /// uploaded ([`ParamValues::check_within`]).
+    ///
+    /// # Errors
+    /// [`Error::Precision`](crate::Error::Precision) for the first baked
+    /// value beyond `limits`, with its node's path.
+    pub fn check_limits(&self, limits: &Limits) -> Result<()> {
+        for (i, node) in self.nodes.iter().enumerate() {
+            let id = NodeId(u32::try_from(i).expect("fewer than 2^32 nodes"));
+            node.try_map(&mut BakedLimits {
+                limits,
+                node: || self.path(id),
+            })?;
+        }
+        Ok(())
+    }
+
     /// The parameter buffer's slots: one per dynamic parameter name.
     #[must_use]
     pub fn params(&self) -> &[ParamSlot] {
@@ -177,6 +197,46 @@ impl Ir {
     #[must_use]
     pub fn default_values(&self) -> ParamValues {
         ParamValues::defaults(Arc::clone(&self.params))
+    }
+}
+
+/// Checks the baked values of one node against a precision's limits.
+struct BakedLimits<'a, F> {
+    limits: &'a Limits,
+    node: F,
+}
+
+impl<F: Fn() -> String> Mapper<Scalar, Vector, NodeId> for BakedLimits<'_, F> {
+    type S2 = ();
+    type V2 = ();
+    type C2 = ();
+    type E = crate::error::Error;
+
+    fn scalar(&mut self, s: &Scalar, spec: ParamSpec<'_>) -> Result<()> {
+        match s {
+            Scalar::Baked(v) => {
+                params::check_limits(&self.node, spec.name, *v, spec.rule, true, self.limits)
+            }
+            Scalar::Dynamic(_) => Ok(()),
+        }
+    }
+
+    fn vector(&mut self, v: &Vector, spec: ParamSpec<'_>) -> Result<()> {
+        for (s, axis) in v.iter().zip(["x", "y", "z"]) {
+            let name = format!("{}.{axis}", spec.name);
+            self.scalar(
+                s,
+                ParamSpec {
+                    name: &name,
+                    ..spec
+                },
+            )?;
+        }
+        Ok(())
+    }
+
+    fn child(&mut self, _: &NodeId) -> Result<()> {
+        Ok(())
     }
 }
 

@@ -6,6 +6,7 @@ use std::sync::Arc;
 
 use super::{Scalar, Vector};
 use crate::error::{Error, Result, fmt_value};
+use crate::math::{F64_LIMITS, Limits, reduce_angle};
 use crate::scene::Rule;
 
 /// One slot of the parameter buffer.
@@ -140,9 +141,13 @@ pub struct ParamValues {
 }
 
 impl ParamValues {
-    /// Every slot at its default.
+    /// Every slot at its default (angles reduced).
     pub(crate) fn defaults(layout: Arc<ParamLayout>) -> Self {
-        let values = layout.slots.iter().map(|s| s.default).collect();
+        let values = layout
+            .slots
+            .iter()
+            .map(|s| stored(s.rule, s.default))
+            .collect();
         ParamValues { layout, values }
     }
 
@@ -155,6 +160,17 @@ impl ParamValues {
     /// relating it to the node's other parameters (a round box's radius
     /// above its smallest half extent, a plane normal that becomes zero).
     pub fn set(&mut self, name: &str, value: f64) -> Result<()> {
+        self.set_within(name, value, &F64_LIMITS)
+    }
+
+    /// Sets the dynamic parameter `name`, as [`ParamValues::set`], for a
+    /// kernel of the precision whose `limits` are given: a value it cannot
+    /// compute with is refused as well.
+    ///
+    /// # Errors
+    /// As [`ParamValues::set`], and [`Error::Precision`] for a value beyond
+    /// `limits`.
+    pub fn set_within(&mut self, name: &str, value: f64, limits: &Limits) -> Result<()> {
         let slot = self
             .layout
             .slots
@@ -162,7 +178,22 @@ impl ParamValues {
             .position(|s| s.name == name)
             .ok_or_else(|| Error::UnknownParam { name: name.into() })?;
         let spec = &self.layout.slots[slot];
-        check_rule(|| spec.used_at.0.clone(), &spec.used_at.1, value, spec.rule)?;
+        check_rule(
+            || spec.used_at.0.clone(),
+            &spec.used_at.1,
+            value,
+            spec.rule,
+            false,
+        )?;
+        let value = stored(spec.rule, value);
+        check_limits(
+            || spec.used_at.0.clone(),
+            &spec.used_at.1,
+            value,
+            spec.rule,
+            false,
+            limits,
+        )?;
         let old = std::mem::replace(&mut self.values[slot], value);
         let slot = u32::try_from(slot).expect("slots are numbered in u32");
         let broken = self
@@ -177,7 +208,22 @@ impl ParamValues {
         broken
     }
 
-    /// The current value of `name`, if it exists.
+    /// Checks every current value against the `limits` of a kernel
+    /// precision: what a renderer does before it uploads them.
+    ///
+    /// # Errors
+    /// [`Error::Precision`] for the first value beyond `limits`, naming the
+    /// node and parameter where it is first used.
+    pub fn check_within(&self, limits: &Limits) -> Result<()> {
+        for (slot, &value) in self.layout.slots.iter().zip(&self.values) {
+            let (node, param) = &slot.used_at;
+            check_limits(|| node.clone(), param, value, slot.rule, false, limits)?;
+        }
+        Ok(())
+    }
+
+    /// The current value of `name`, if it exists (an angle reduced modulo
+    /// a full turn).
     #[must_use]
     pub fn get(&self, name: &str) -> Option<f64> {
         let slot = self.layout.slots.iter().position(|s| s.name == name)?;
@@ -200,12 +246,47 @@ impl ParamValues {
     }
 }
 
-/// A value's own rule, with the error every validation reports.
-pub(crate) fn check_rule(
+/// How a slot keeps a value: an angle reduced modulo a full turn, every
+/// other value as it is.
+fn stored(rule: Rule, value: f64) -> f64 {
+    if rule == Rule::Angle {
+        reduce_angle(value)
+    } else {
+        value
+    }
+}
+
+/// A value's magnitude against the `limits` of a precision, for a value
+/// under `rule`, baked or dynamic ([`Rule::magnitude`]).
+pub(crate) fn check_limits(
     node: impl FnOnce() -> String,
     param: &str,
     value: f64,
     rule: Rule,
+    baked: bool,
+    limits: &Limits,
+) -> Result<()> {
+    match limits.crossed(value, rule.magnitude(baked)) {
+        None => Ok(()),
+        Some(limit) => Err(Error::Precision {
+            node: node(),
+            param: param.into(),
+            value,
+            precision: limits.precision,
+            limit,
+        }),
+    }
+}
+
+/// A value's own rule, and the `F64` limits every scene value keeps (the
+/// CPU reference computes in `f64`), with the error every validation
+/// reports.
+pub(crate) fn check_rule(
+    node: impl Fn() -> String,
+    param: &str,
+    value: f64,
+    rule: Rule,
+    baked: bool,
 ) -> Result<()> {
     if !value.is_finite() {
         return Err(Error::NonFinite {
@@ -222,5 +303,5 @@ pub(crate) fn check_rule(
             expected: rule.describe(),
         });
     }
-    Ok(())
+    check_limits(node, param, value, rule, baked, &F64_LIMITS)
 }

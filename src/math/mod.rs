@@ -1,14 +1,17 @@
 //! Math shared by the CPU reference ([`crate::cpu`]) and code generation
 //! ([`crate::codegen`]): the numeric guards both twins use, the scalar types
 //! the reference is generic over, the values that code generation bakes
-//! into literals exactly as the reference computes them, and robust vector
-//! normalisation. Keeping them here, below every stage, is what lets the two
+//! into literals exactly as the reference computes them, robust vector
+//! normalisation, and the magnitudes each kernel precision can compute
+//! with ([`Limits`]). Keeping them here, below every stage, is what lets the two
 //! twins agree without either reaching into the other.
 
+mod limits;
 mod real;
 
 use glam::DVec3;
 
+pub use limits::{F32_LIMITS, F64_LIMITS, Limits, Magnitude, reduce_angle};
 pub use real::{Real, V3, v3};
 
 /// The smallest magnitude used to guard divisions and logarithms, in both

@@ -113,6 +113,20 @@ impl<T: Real> V3<T> {
         self.dot(self).sqrt()
     }
 
+    /// Euclidean length without overflow or underflow in the squares: the
+    /// vector is divided by its largest component first (the kernels'
+    /// `safe_length`, in `kernels/sdf/length.cl`). A zero or non-finite
+    /// vector gives [`V3::length`].
+    #[must_use]
+    pub fn safe_length(self) -> T {
+        let m = self.abs().max_element();
+        if m > T::zero() && m.is_finite() {
+            m * (self / m).length()
+        } else {
+            self.length()
+        }
+    }
+
     /// Component-wise absolute value.
     #[must_use]
     pub fn abs(self) -> Self {

@@ -55,6 +55,7 @@
 mod aov;
 mod buffer;
 mod cache;
+mod cancel;
 mod device;
 mod dispatch;
 mod memory;
@@ -64,6 +65,7 @@ mod renderer;
 mod viewport;
 
 pub use aov::Frame;
+pub use cancel::CancelToken;
 pub use device::{DEVICE_ENV, DeviceInfo, DeviceKind, DeviceSelector, devices};
 pub use dispatch::{DEFAULT_TILE_SIZE, MAX_IMAGE_SIDE};
 pub use points::{PointEvaluator, PointSample};

@@ -69,7 +69,9 @@ impl PointEvaluator {
     /// lowered again).
     ///
     /// # Errors
-    /// As [`PointEvaluator::new`], less validation.
+    /// As [`PointEvaluator::new`], less validation;
+    /// [`Error::Precision`](crate::Error::Precision) for a baked value or a
+    /// dynamic default that `precision` cannot compute with.
     pub fn from_compiled(
         scene: &CompiledScene,
         precision: Precision,
@@ -88,6 +90,8 @@ impl PointEvaluator {
             ..Options::default()
         };
         let source = codegen::emit_ir(ir, &options)?;
+        let values = ir.default_values();
+        values.check_within(precision.limits())?;
         let selected = device::select(selector)?;
         let context = program::context(&selected)?;
         let queue = Queue::new(&context, selected.device, None).map_err(opencl)?;
@@ -98,7 +102,7 @@ impl PointEvaluator {
             program,
             source,
             precision,
-            values: ir.default_values(),
+            values,
         })
     }
 
@@ -117,9 +121,10 @@ impl PointEvaluator {
     /// Sets a dynamic parameter for later evaluations.
     ///
     /// # Errors
-    /// See [`ParamValues::set`].
+    /// See [`ParamValues::set_within`]: the parameter's rules, and the
+    /// limits of the program's precision.
     pub fn set_param(&mut self, name: &str, value: f64) -> Result<()> {
-        self.values.set(name, value)
+        self.values.set_within(name, value, self.precision.limits())
     }
 
     /// Evaluates every point (rounded to the program's precision).

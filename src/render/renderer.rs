@@ -10,11 +10,12 @@ use ocl::{Buffer, Context, Event, Kernel, MemFlags, Program, Queue};
 
 use super::aov::Frame;
 use super::buffer::RealBuffer;
+use super::cancel::CancelToken;
 use super::device::{self, DeviceInfo, DeviceSelector, Selected, opencl};
 use super::dispatch::{self, DEFAULT_TILE_SIZE, MAX_IMAGE_SIDE};
 use super::memory::{available_host_memory, check_host_memory, frame_host_bytes};
 use super::program::{self, BuildInfo};
-use super::viewport::{Viewport, pack_lights};
+use super::viewport::{Viewport, check_frame_inputs, pack_lights};
 use crate::codegen::interface::{RENDER_TILE, RenderArg, camera};
 use crate::codegen::{self, KernelSource};
 use crate::error::{Error, Result};
@@ -32,22 +33,39 @@ pub struct RenderOptions {
     pub effects: Effects,
     /// Which OpenCL device to use.
     pub device: DeviceSelector,
-    /// Side of the square tiles the image is launched in, in pixels.
+    /// Side of the square tiles the image is launched in, in pixels. Each
+    /// tile is one kernel launch, which cannot be interrupted: smaller
+    /// tiles make [`RenderOptions::deadline`] and
+    /// [`RenderOptions::cancel`] take effect sooner.
     pub tile_size: u32,
+    /// The longest a frame may take: once it has passed, no further tile is
+    /// launched and the frame fails with [`Error::Deadline`] (after the
+    /// tiles in flight finish). `None`: no limit.
+    pub deadline: Option<Duration>,
+    /// A token that stops a frame between tiles, from any thread (see
+    /// [`CancelToken`]); the frame fails with [`Error::Cancelled`].
+    pub cancel: Option<CancelToken>,
 }
 
 impl Default for RenderOptions {
     /// Production quality, default effects, automatic device, 256-pixel
-    /// tiles.
+    /// tiles, no deadline, no cancellation.
     fn default() -> Self {
         RenderOptions {
             quality: Quality::default(),
             effects: Effects::default(),
             device: DeviceSelector::default(),
             tile_size: DEFAULT_TILE_SIZE,
+            deadline: None,
+            cancel: None,
         }
     }
 }
+
+/// Tiles in flight at once: the next tile is launched when the one before
+/// the last has finished, so the device stays busy while the renderer
+/// can still stop between tiles.
+const TILES_IN_FLIGHT: usize = 2;
 
 const KERNEL_NAME: &str = "render_tile";
 
@@ -188,6 +206,7 @@ impl Renderer {
         check_light_count(scene.lights())?;
         let source = generate(&scene, &functions, options)?;
         let values = scene.default_values();
+        check_inputs(&scene, &values, &source)?;
         let selected = device::select(&options.device)?;
         let context = program::context(&selected)?;
         let queue = profiling_queue(&context, &selected)?;
@@ -222,8 +241,11 @@ impl Renderer {
     /// whose buffers the device cannot hold, or one whose host memory (the
     /// copies read back, and a CPU device's buffers) exceeds what the
     /// machine has available (`MemAvailable`, and the process's cgroup
-    /// limit, on Linux) — each with the numbers; [`Error::OpenCl`] if the
-    /// device fails.
+    /// limit, on Linux) — each with the numbers; [`Error::Precision`] for a
+    /// camera or lights the program's precision cannot compute with at this
+    /// size; [`Error::Cancelled`] or [`Error::Deadline`] when
+    /// [`RenderOptions::cancel`] or [`RenderOptions::deadline`] stops the
+    /// frame between tiles; [`Error::OpenCl`] if the device fails.
     pub fn render(&mut self, width: u32, height: u32) -> Result<RgbaImage> {
         let start = Instant::now();
         let kernel = self.run(width, height, false)?;
@@ -295,9 +317,11 @@ impl Renderer {
     /// # Errors
     /// [`Error::UnknownParam`], or the error a baked value would get: the
     /// parameter's own rule, or a rule relating it to other parameters
-    /// (see [`ParamValues::set`]).
+    /// (see [`ParamValues::set`]), or [`Error::Precision`] for a value the
+    /// program's precision cannot compute with.
     pub fn set_param(&mut self, name: &str, value: f64) -> Result<()> {
-        self.values.set(name, value)
+        let limits = self.source.precision.limits();
+        self.values.set_within(name, value, limits)
     }
 
     /// The current value of a dynamic parameter.
@@ -309,8 +333,12 @@ impl Renderer {
     /// Moves the camera (no recompilation).
     ///
     /// # Errors
-    /// [`Error::Camera`] if the camera is degenerate.
+    /// [`Error::Camera`] if the camera is degenerate; [`Error::Precision`]
+    /// if the program's precision cannot compute with it.
     pub fn set_camera(&mut self, camera: Camera) -> Result<()> {
+        let view = Viewport::in_frame(&camera, 1, 1, self.source.precision, self.source.origin)?;
+        let limits = self.source.precision.limits();
+        check_frame_inputs(&view, &[], self.source.origin, limits)?;
         self.scene.set_camera(camera)
     }
 
@@ -325,11 +353,16 @@ impl Renderer {
     ///
     /// # Errors
     /// The first invalid light, as [`Scene::compile`] reports it;
-    /// [`Error::TooManyLights`].
+    /// [`Error::TooManyLights`]; [`Error::Precision`] for a light the
+    /// program's precision cannot compute with.
     pub fn set_lights(&mut self, lights: impl IntoIterator<Item = Light>) -> Result<()> {
         let lights: Vec<Light> = lights.into_iter().collect();
         check_light_count(&lights)?;
-        self.scene.set_lights(lights)
+        let mut scene = self.scene.clone();
+        scene.set_lights(lights)?;
+        check_inputs(&scene, &self.values, &self.source)?;
+        self.scene = scene;
+        Ok(())
     }
 
     /// The lights.
@@ -419,6 +452,7 @@ impl Renderer {
     fn reprogram(&mut self, options: RenderOptions) -> Result<()> {
         validate(&options)?;
         let source = generate(&self.scene, &self.functions, &options)?;
+        check_inputs(&self.scene, &self.values, &source)?;
         self.load(source)?;
         self.options = options;
         Ok(())
@@ -455,6 +489,27 @@ impl Renderer {
         });
     }
 
+    /// The error that stops a frame before its next tile, if any: a
+    /// cancelled token, or a deadline that has passed.
+    fn stop(&self, launched: Instant, tiles: usize, total: usize) -> Option<Error> {
+        if self
+            .options
+            .cancel
+            .as_ref()
+            .is_some_and(CancelToken::is_cancelled)
+        {
+            return Some(Error::Cancelled { tiles, total });
+        }
+        match self.options.deadline {
+            Some(deadline) if launched.elapsed() >= deadline => Some(Error::Deadline {
+                deadline,
+                tiles,
+                total,
+            }),
+            _ => None,
+        }
+    }
+
     /// Uploads the frame's inputs, launches every tile and waits for them.
     /// Returns the kernel time and whether it comes from profiling events.
     fn run(&mut self, width: u32, height: u32, aovs: bool) -> Result<(Duration, bool)> {
@@ -475,6 +530,12 @@ impl Renderer {
             self.targets = Targets::new(&self.queue, width, height, aovs)
                 .map_err(|e| too_large(width, height, &format!("{e}")))?;
         }
+        check_frame_inputs(
+            &view,
+            self.scene.lights(),
+            self.source.origin,
+            self.source.precision.limits(),
+        )?;
         self.inputs.upload(
             &self.queue,
             &self.kernel,
@@ -494,8 +555,18 @@ impl Renderer {
         set(RenderArg::WriteAovs, i32::from(aovs))?;
         t.bind(k)?;
         let launched = Instant::now();
-        let mut events = Vec::new();
+        let mut events: Vec<Event> = Vec::new();
+        let total = dispatch::tiles(width, height, self.options.tile_size).count();
         for tile in dispatch::tiles(width, height, self.options.tile_size) {
+            if let Some(stop) = self.stop(launched, events.len(), total) {
+                // Let the tiles in flight finish before the buffers are
+                // touched again.
+                self.queue.finish().map_err(opencl)?;
+                return Err(stop);
+            }
+            if let Some(before) = events.len().checked_sub(TILES_IN_FLIGHT) {
+                events[before].wait_for().map_err(opencl)?;
+            }
             #[allow(clippy::cast_possible_wrap)]
             {
                 set(RenderArg::X0, tile.x as i32)?;
@@ -583,9 +654,19 @@ fn check_device_memory(info: &DeviceInfo, width: u32, height: u32, aovs: bool) -
     Ok(())
 }
 
+/// Checks what a program's frames hand its kernel against the limits of
+/// its precision: the dynamic values, and the camera and lights as packed
+/// for a 1 × 1 image (each frame checks its own size again).
+fn check_inputs(scene: &CompiledScene, values: &ParamValues, source: &KernelSource) -> Result<()> {
+    let limits = source.precision.limits();
+    values.check_within(limits)?;
+    let view = Viewport::in_frame(scene.camera(), 1, 1, source.precision, source.origin)?;
+    check_frame_inputs(&view, scene.lights(), source.origin, limits)
+}
+
 fn validate(options: &RenderOptions) -> Result<()> {
     options.quality.validate()?;
-    options.effects.validate()?;
+    options.effects.validate_for(options.quality.precision)?;
     if options.tile_size == 0 {
         return Err(Error::TileSize {
             value: options.tile_size,

@@ -7,9 +7,10 @@
 
 use glam::DVec3;
 
-use crate::codegen::interface::{camera, light, put};
+use crate::codegen::interface::{Field, camera, light, put};
 use crate::cpu::{MarchSettings, Ray};
 use crate::error::{Error, Result};
+use crate::math::{Limits, Magnitude, normalize};
 use crate::quality::{Precision, Quality};
 use crate::scene::{Camera, Light, LightSource, Projection};
 
@@ -133,10 +134,7 @@ impl Viewport {
     /// ```
     #[must_use]
     pub fn relative_floor(precision: Precision) -> f64 {
-        match precision {
-            Precision::F32 => 8.0 * f64::from(f32::EPSILON),
-            Precision::F64 => 8.0 * f64::EPSILON,
-        }
+        precision.limits().resolution
     }
 
     /// The ray through image position `(x, y)` in pixels, `(0, 0)` being the
@@ -153,7 +151,8 @@ impl Viewport {
         } else {
             Ray {
                 origin: self.origin,
-                direction: (self.forward + self.right * u + self.up * v).normalize(),
+                direction: normalize(self.forward + self.right * u + self.up * v)
+                    .unwrap_or(self.forward),
             }
         }
     }
@@ -212,6 +211,85 @@ impl Viewport {
     }
 }
 
+/// Checks what a frame hands the kernel, the packed camera and lights,
+/// against the `limits` of its precision: the camera's position in the
+/// program's frame, its projection (half the view's width and height) and
+/// pixel footprints; each point light's position, each light's radiance
+/// (colour times intensity) and softness. Unit vectors (the camera's
+/// basis, light directions) are normalised in `f64` and need no check.
+///
+/// # Errors
+/// [`Error::Precision`] naming `camera` or `light[i]` and the value.
+pub(crate) fn check_frame_inputs(
+    view: &Viewport,
+    lights: &[Light],
+    origin: DVec3,
+    limits: &Limits,
+) -> Result<()> {
+    let check = |node: &str, param: &str, values: &[f64], magnitude| {
+        for &value in values {
+            if let Some(limit) = limits.crossed(value, magnitude) {
+                return Err(Error::Precision {
+                    node: node.into(),
+                    param: param.into(),
+                    value,
+                    precision: limits.precision,
+                    limit,
+                });
+            }
+        }
+        Ok(())
+    };
+    let c = view.pack(origin);
+    let at = |f: Field| &c[f.offset..f.offset + f.len];
+    let (extent, footprint) = if view.orthographic {
+        ("orthographic height", "orthographic height per pixel")
+    } else {
+        ("field of view", "distance to the scene")
+    };
+    check(
+        "camera",
+        "position",
+        at(camera::ORIGIN),
+        Magnitude::Coordinate,
+    )?;
+    check("camera", extent, at(camera::HALF_WIDTH), Magnitude::Size)?;
+    check("camera", extent, at(camera::HALF_HEIGHT), Magnitude::Size)?;
+    check(
+        "camera",
+        footprint,
+        at(camera::FOOTPRINT_BASE),
+        Magnitude::Size,
+    )?;
+    check(
+        "camera",
+        "field of view per pixel",
+        at(camera::FOOTPRINT_PER_UNIT),
+        Magnitude::Size,
+    )?;
+    let packed = pack_lights(lights, origin);
+    for (i, (entry, l)) in packed.chunks_exact(light::STRIDE).zip(lights).enumerate() {
+        let node = format!("light[{i}]");
+        let at = |f: Field| &entry[f.offset..f.offset + f.len];
+        if matches!(l.source, LightSource::Point { .. }) {
+            check(
+                &node,
+                "position",
+                at(light::POSITION),
+                Magnitude::Coordinate,
+            )?;
+        }
+        check(
+            &node,
+            "color × intensity",
+            at(light::RADIANCE),
+            Magnitude::Size,
+        )?;
+        check(&node, "softness", at(light::SOFTNESS), Magnitude::Size)?;
+    }
+    Ok(())
+}
+
 /// The kernel's light buffer ([`light`] layout), point lights moved into
 /// the frame whose origin is the scene point `origin` (as
 /// [`Viewport::pack`]); at least one (unused) entry so the buffer is never
@@ -220,9 +298,11 @@ pub(crate) fn pack_lights(lights: &[Light], origin: DVec3) -> Vec<f64> {
     let mut out = vec![0.0; light::STRIDE * lights.len().max(1)];
     for (entry, l) in out.chunks_exact_mut(light::STRIDE).zip(lights) {
         let (v, kind) = match l.source {
-            LightSource::Directional { direction } => {
-                (direction.normalize(), light::KIND_DIRECTIONAL)
-            }
+            LightSource::Directional { direction } => (
+                // Validation refuses a zero direction; any length is fine.
+                normalize(direction).unwrap_or(DVec3::ZERO),
+                light::KIND_DIRECTIONAL,
+            ),
             LightSource::Point { position } => (position - origin, light::KIND_POINT),
         };
         put(entry, light::POSITION, &v.to_array());

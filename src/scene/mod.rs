@@ -24,6 +24,7 @@ pub use node::{
 pub use param::{Param, Param3, param, param3};
 
 use crate::error::{Error, Result, fmt_value};
+use crate::math::{F64_LIMITS, Magnitude, normalize};
 
 /// How the camera projects the scene.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -89,24 +90,32 @@ impl Camera {
         self
     }
 
-    /// The orthonormal camera basis `(right, up, forward)`.
+    /// The orthonormal camera basis `(right, up, forward)`, normalised
+    /// robustly ([`math::normalize`](crate::math::normalize)): an `up` or a
+    /// view of any finite length gives the same basis.
     ///
     /// # Errors
     /// [`Error::Camera`] if the camera is degenerate (see [`Camera::validate`]).
     pub fn basis(&self) -> Result<(DVec3, DVec3, DVec3)> {
         self.validate()?;
-        let forward = (self.target - self.position).normalize();
-        let right = forward.cross(self.up).normalize();
+        let unit = |v: DVec3| normalize(v).expect("validate refuses zero vectors");
+        let forward = unit(self.target - self.position);
+        let right = unit(forward.cross(unit(self.up)));
         let up = right.cross(forward);
         Ok((right, up, forward))
     }
 
     /// Checks that the camera can form an image: finite vectors, target
-    /// different from position, up not parallel to the view, field of view
-    /// in (0°, 180°), orthographic height > 0.
+    /// different from position, up not zero nor parallel to the view (its
+    /// length does not matter), field of view in (0°, 180°), orthographic
+    /// height > 0; and that position, target and height are within the
+    /// magnitudes the CPU reference and an `F64` kernel compute with
+    /// ([`Precision::limits`](crate::quality::Precision::limits)). A
+    /// renderer also checks them against its own precision.
     ///
     /// # Errors
-    /// [`Error::Camera`] saying what is wrong.
+    /// [`Error::Camera`] saying what is wrong; [`Error::Precision`] for a
+    /// value beyond the `F64` limits.
     pub fn validate(&self) -> Result<()> {
         let bad = |reason: &str| {
             Err(Error::Camera {
@@ -116,12 +125,19 @@ impl Camera {
         if !(self.position.is_finite() && self.target.is_finite() && self.up.is_finite()) {
             return bad("position, target and up must be finite");
         }
+        for (name, v) in [("position", self.position), ("target", self.target)] {
+            within("camera", name, v, Magnitude::Coordinate)?;
+        }
         let view = self.target - self.position;
         if view.length() <= f64::EPSILON * self.position.length().max(1.0) {
             return bad("target equals position");
         }
-        if view.normalize().cross(self.up).length() < 1e-9 {
-            return bad("up is zero or parallel to the view direction");
+        let Some(up) = normalize(self.up) else {
+            return bad("up is zero");
+        };
+        let forward = normalize(view).expect("a view longer than zero");
+        if forward.cross(up).length() < 1e-9 {
+            return bad("up is parallel to the view direction");
         }
         match self.projection {
             Projection::Perspective { fov_y_degrees } => {
@@ -143,6 +159,7 @@ impl Camera {
                         ),
                     });
                 }
+                within_scalar("camera", "orthographic height", height, Magnitude::Size)?;
             }
         }
         Ok(())
@@ -234,7 +251,11 @@ impl Light {
         self
     }
 
-    /// Checks the light, which is `light[index]` in error messages.
+    /// Checks the light, which is `light[index]` in error messages: finite
+    /// values, a direction that is not zero (its length does not matter:
+    /// it is normalised robustly), colour, intensity and softness at least
+    /// 0, and every value but the direction within the `F64` limits
+    /// ([`Precision::limits`](crate::quality::Precision::limits)).
     pub(crate) fn validate(&self, index: usize) -> Result<()> {
         let node = format!("light[{index}]");
         let vector = |name: &str, v: DVec3, nonzero: bool| -> Result<()> {
@@ -245,7 +266,7 @@ impl Light {
                     value: bad,
                 });
             }
-            if nonzero && v.length() == 0.0 {
+            if nonzero && normalize(v).is_none() {
                 return Err(Error::ZeroVector {
                     node: node.clone(),
                     param: name.into(),
@@ -255,7 +276,10 @@ impl Light {
         };
         match self.source {
             LightSource::Directional { direction } => vector("direction", direction, true)?,
-            LightSource::Point { position } => vector("position", position, false)?,
+            LightSource::Point { position } => {
+                vector("position", position, false)?;
+                within(&node, "position", position, Magnitude::Coordinate)?;
+            }
         }
         vector("color", self.color, false)?;
         let scalars = [
@@ -273,8 +297,33 @@ impl Light {
                 });
             }
         }
-        Ok(())
+        within(&node, "color", self.color, Magnitude::Size)?;
+        within_scalar(&node, "intensity", self.intensity, Magnitude::Size)?;
+        within_scalar(&node, "softness", self.softness, Magnitude::Size)
     }
+}
+
+/// A camera or light value against the `F64` limits, which every scene
+/// value keeps.
+fn within_scalar(node: &str, param: &str, value: f64, magnitude: Magnitude) -> Result<()> {
+    match F64_LIMITS.crossed(value, magnitude) {
+        None => Ok(()),
+        Some(limit) => Err(Error::Precision {
+            node: node.into(),
+            param: param.into(),
+            value,
+            precision: F64_LIMITS.precision,
+            limit,
+        }),
+    }
+}
+
+/// Each component of a camera or light vector against the `F64` limits.
+fn within(node: &str, param: &str, v: DVec3, magnitude: Magnitude) -> Result<()> {
+    for (value, axis) in v.to_array().into_iter().zip(["x", "y", "z"]) {
+        within_scalar(node, &format!("{param}.{axis}"), value, magnitude)?;
+    }
+    Ok(())
 }
 
 /// Geometry, lights and a camera: everything needed to render a picture.

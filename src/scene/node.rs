@@ -9,6 +9,7 @@ use glam::DVec3;
 
 use super::custom::CustomShape;
 use super::param::{Param, Param3};
+use crate::math::Magnitude;
 
 /// The largest iteration count accepted by the escape-time fractals
 /// (Mandelbulb, quaternion Julia).
@@ -194,7 +195,10 @@ pub enum Kind<S, V, C> {
     /// The half-space `dot(p, normal) + offset <= 0`, normal normalised.
     /// Exact.
     Plane {
-        /// The outward normal; must not be zero (it is normalised).
+        /// The outward normal; must not be zero. Only its direction counts:
+        /// a baked normal of any finite length is normalised in `f64` when
+        /// the scene is compiled, a dynamic one by both twins after scaling
+        /// it by its largest component.
         normal: V,
         /// Signed offset along the normal.
         offset: S,
@@ -242,7 +246,9 @@ pub enum Kind<S, V, C> {
     Rotate {
         /// The rotation axis, normalised; must not be zero.
         axis: DVec3,
-        /// The angle in radians.
+        /// The angle in radians, any finite value: it is reduced modulo a
+        /// full turn ([`math::reduce_angle`](crate::math::reduce_angle))
+        /// before either twin uses it, baked or dynamic.
         angle: S,
         /// The rotated node.
         child: C,
@@ -359,17 +365,30 @@ pub enum Kind<S, V, C> {
     },
 }
 
-/// What a parameter must satisfy. Every rule also requires a finite value.
+/// What a parameter must satisfy. Every rule also requires a finite value,
+/// within the magnitudes the kernels can compute with (see
+/// [`Rule::magnitude`] and [`math::Limits`](crate::math::Limits)).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Rule {
-    /// Any finite value.
+    /// Any finite value: a coordinate, an offset or a rate (at most the
+    /// largest magnitude of the precision).
     Finite,
-    /// At least 0.
+    /// At least 0: a size (0, or between the smallest and the largest
+    /// magnitude of the precision).
     NonNegative,
-    /// Greater than 0.
+    /// Greater than 0: a size, as for `NonNegative`.
     Positive,
     /// Within `[min, max]`.
     Range(f64, f64),
+    /// Any finite angle in radians. Angles are reduced modulo a full turn
+    /// (see [`math::reduce_angle`](crate::math::reduce_angle)) before the
+    /// CPU reference or a kernel uses them, so no magnitude limit applies.
+    Angle,
+    /// A component of a direction, which is normalised: any finite value.
+    /// A baked direction is normalised in `f64` when the scene is compiled,
+    /// so no magnitude limit applies to it; the components of a dynamic one
+    /// reach the kernel as they are, and are held to the limits of a size.
+    Direction,
 }
 
 impl Rule {
@@ -378,7 +397,7 @@ impl Rule {
     pub fn accepts(self, v: f64) -> bool {
         v.is_finite()
             && match self {
-                Rule::Finite => true,
+                Rule::Finite | Rule::Angle | Rule::Direction => true,
                 Rule::NonNegative => v >= 0.0,
                 Rule::Positive => v > 0.0,
                 Rule::Range(lo, hi) => (lo..=hi).contains(&v),
@@ -389,10 +408,27 @@ impl Rule {
     #[must_use]
     pub fn describe(self) -> String {
         match self {
-            Rule::Finite => "finite".into(),
+            Rule::Finite | Rule::Angle | Rule::Direction => "finite".into(),
             Rule::NonNegative => ">= 0".into(),
             Rule::Positive => "> 0".into(),
             Rule::Range(lo, hi) => format!("in [{lo}, {hi}]"),
+        }
+    }
+
+    /// How the kernels use a value under this rule, which decides the
+    /// magnitude limits it keeps: sizes (`NonNegative`, `Positive`) are
+    /// squared and divided by, so they are 0 or at least the precision's
+    /// smallest size; coordinates (`Finite`, `Range`) are only added and
+    /// multiplied; angles and baked directions are reduced or normalised
+    /// in `f64` first, and keep none.
+    #[must_use]
+    pub fn magnitude(self, baked: bool) -> Magnitude {
+        match self {
+            Rule::Finite | Rule::Range(..) => Magnitude::Coordinate,
+            Rule::NonNegative | Rule::Positive => Magnitude::Size,
+            Rule::Angle => Magnitude::Free,
+            Rule::Direction if baked => Magnitude::Free,
+            Rule::Direction => Magnitude::Size,
         }
     }
 }
@@ -562,7 +598,7 @@ impl<S, V, C> Kind<S, V, C> {
     where
         M: Mapper<S, V, C>,
     {
-        use Rule::{Finite, NonNegative, Positive, Range};
+        use Rule::{Angle, Direction, Finite, NonNegative, Positive, Range};
         Ok(match self {
             Kind::Sphere { radius } => Kind::Sphere {
                 radius: m.scalar(radius, spec("radius", NonNegative))?,
@@ -597,7 +633,7 @@ impl<S, V, C> Kind<S, V, C> {
                 radius: m.scalar(radius, spec("radius", NonNegative))?,
             },
             Kind::Plane { normal, offset } => Kind::Plane {
-                normal: m.vector(normal, spec("normal", Finite))?,
+                normal: m.vector(normal, spec("normal", Direction))?,
                 offset: m.scalar(offset, spec("offset", Finite))?,
             },
             Kind::Octahedron { size } => Kind::Octahedron {
@@ -645,7 +681,7 @@ impl<S, V, C> Kind<S, V, C> {
             },
             Kind::Rotate { axis, angle, child } => Kind::Rotate {
                 axis: *axis,
-                angle: m.scalar(angle, spec("angle", Finite))?,
+                angle: m.scalar(angle, spec("angle", Angle))?,
                 child: m.child(child)?,
             },
             Kind::Scale { factor, child } => Kind::Scale {

@@ -83,17 +83,24 @@ real sd_cylinder(real3 p, real r, real h) {
 }
 
 /* ---- plane ---- */
+/* n is scaled by its largest component before it is normalised, so no
+   square of a tiny or huge component is formed (cpu: sdf::plane). */
 real sd_plane(real3 p, real3 n, real offset) {
-    n = n / fmax(length(n), REAL_TINY);
+    real m = fmax(fmax(fabs(n.x), fabs(n.y)), fabs(n.z));
+    if (m > R(0.0)) {
+        n = n / m;
+        n = n / length(n);
+    }
     return dot(p, n) + offset;
 }
 
 /* ---- warp ---- */
 /* Distance bounds for warped children (twist, bend): with the warp's local
-   stretch L(rho), d / L(rho + |d| / L(rho)) never overestimates. */
+   stretch L(rho), d / L(rho + |d| / L(rho)) never overestimates. The
+   twist's root is a hypot, so a large rate never makes L infinite. */
 real twist_stretch(real k, real rho) {
     real a = R(0.5) * fabs(k) * rho;
-    return a + sqrt(R(1.0) + a * a);
+    return a + hypot(R(1.0), a);
 }
 
 real bend_stretch(real k, real rho) {

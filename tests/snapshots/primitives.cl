@@ -58,6 +58,14 @@ typedef float4 real4;
 #define LIGHT_SOFTNESS 7
 #define LIGHT_STRIDE 8
 
+/* ---- length ---- */
+/* Euclidean length without overflow or underflow in the squares: v is
+   divided by its largest component first (cpu: V3::safe_length). */
+real safe_length(real3 v) {
+    real m = fmax(fmax(fabs(v.x), fabs(v.y)), fabs(v.z));
+    return m > R(0.0) && isfinite(m) ? m * length(v / m) : length(v);
+}
+
 /* ---- sphere ---- */
 real sd_sphere(real3 p, real r) {
     return length(p) - r;
@@ -97,8 +105,14 @@ real sd_capsule(real3 p, real3 a, real3 b, real r) {
 }
 
 /* ---- plane ---- */
+/* n is scaled by its largest component before it is normalised, so no
+   square of a tiny or huge component is formed (cpu: sdf::plane). */
 real sd_plane(real3 p, real3 n, real offset) {
-    n = n / fmax(length(n), REAL_TINY);
+    real m = fmax(fmax(fabs(n.x), fabs(n.y)), fabs(n.z));
+    if (m > R(0.0)) {
+        n = n / m;
+        n = n / length(n);
+    }
     return dot(p, n) + offset;
 }
 
@@ -138,13 +152,17 @@ real sd_capped_cone(real3 p, real h, real r1, real r2) {
 }
 
 /* ---- ellipsoid ---- */
+/* Quilez's bound k0 (k0 - 1) / k1, with k0 = |p / r| and k1 = |p / r^2|,
+   computed as (k0 - 1) / |u / r| with u = (p / r) / k0, so no square of
+   p / r or p / r^2 is formed (cpu: sdf::ellipsoid). */
 real sd_ellipsoid(real3 p, real3 r) {
-    real k0 = length(p / r);
+    real3 q = p / r;
+    real k0 = safe_length(q);
     if (k0 < R(1.0)) {
         return (k0 - R(1.0)) * fmin(fmin(r.x, r.y), r.z);
     }
-    real k1 = length(p / (r * r));
-    return k0 * (k0 - R(1.0)) / fmax(k1, REAL_TINY);
+    real k1 = safe_length(q / k0 / r);
+    return (k0 - R(1.0)) / fmax(k1, REAL_TINY);
 }
 
 /* ---- scene ---- */
