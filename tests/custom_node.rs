@@ -251,13 +251,21 @@ fn custom_shape_definitions_are_checked() {
 }
 
 /// The reason a parameter name is refused, if it is.
+/// Why a shape with parameter `param` is refused: by `CustomShape::new`
+/// (OpenCL's words, reserved spellings), or when a program using it is
+/// generated (names the program itself defines or calls).
 fn refusal(param: &str) -> Option<String> {
-    match CustomShape::new(
+    let made = CustomShape::new(
         "shape",
         &[(param, Rule::Finite)],
         |_, _| 0.0,
         "return R(0.0);",
-    ) {
+    )
+    .and_then(|shape| {
+        let scene = Scene::new(shape.node([0.0])).compile()?;
+        codegen::emit(&scene, &codegen::Options::default())
+    });
+    match made {
         Ok(_) => None,
         Err(Error::CustomShape { name, reason }) => {
             assert_eq!(name, "shape");

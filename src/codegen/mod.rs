@@ -275,6 +275,9 @@ pub fn emit_ir(ir: &Ir, options: &Options) -> Result<KernelSource> {
     }
     let mut custom_regions = Vec::with_capacity(customs.len());
     for shape in &customs {
+        names::check_custom(shape)?;
+    }
+    for shape in &customs {
         w.line(format!("/* ---- custom shape {} ---- */", shape.name()));
         let definition = shape.opencl_definition();
         // The signature takes one line, the closing brace another.

@@ -29,9 +29,9 @@ use std::sync::Arc;
 
 use glam::DVec3;
 
+use super::names;
 use super::node::{Kind, Node, Rule};
 use super::param::Param;
-use crate::codegen::names;
 use crate::error::{Error, Result};
 
 /// The Rust distance function of a custom shape: the point and the
@@ -126,10 +126,6 @@ impl CustomShape {
             reason,
         };
         check_identifier(name).map_err(|r| bad(format!("name {r}")))?;
-        let function = format!("custom_{name}");
-        if let Some(why) = names::generated(&function) {
-            return Err(bad(format!("its OpenCL function `{function}` {why}")));
-        }
         let mut seen: Vec<&str> = Vec::new();
         for (param, _) in params {
             check_identifier(param).map_err(|r| bad(format!("parameter `{param}` {r}")))?;

@@ -6,6 +6,7 @@
 
 pub mod build;
 mod custom;
+pub(crate) mod names;
 mod node;
 mod param;
 
