@@ -110,13 +110,16 @@ impl Xvfb {
         let first = 100 + (std::process::id() % 100) * 4 + slot * 2;
         for n in (first..first + 50).filter(|n| !Path::new(&format!("/tmp/.X{n}-lock")).exists()) {
             let display = format!(":{n}");
+            let socket = format!("/tmp/.X11-unix/X{n}");
+            // No lock file, so a socket left here belongs to a server that
+            // is gone: remove it, or it would pass for this server's.
+            let _ = std::fs::remove_file(&socket);
             let mut child = Command::new("Xvfb")
                 .args([&display, "-screen", "0", "320x240x24", "-nolisten", "tcp"])
                 .stdout(Stdio::null())
                 .stderr(Stdio::null())
                 .spawn()
                 .expect("Xvfb starts");
-            let socket = format!("/tmp/.X11-unix/X{n}");
             let start = Instant::now();
             while start.elapsed() < Duration::from_secs(20) {
                 let exited = child.try_wait().ok().flatten().is_some();
@@ -249,6 +252,7 @@ fn real_key_presses_reach_the_window() {
         .arg("--shots")
         .arg(&dir)
         .stdout(Stdio::null())
+        .stderr(Stdio::piped())
         .spawn()
         .expect("the viewer starts");
     let xdotool = |args: &[&str]| {
@@ -261,10 +265,13 @@ fn real_key_presses_reach_the_window() {
     };
     let mut window = String::new();
     wait_for("the viewer's window", || {
-        assert!(
-            viewer.try_wait().unwrap().is_none(),
-            "the viewer exited early"
-        );
+        if let Some(status) = viewer.try_wait().unwrap() {
+            let mut said = String::new();
+            if let Some(mut err) = viewer.stderr.take() {
+                let _ = std::io::Read::read_to_string(&mut err, &mut said);
+            }
+            panic!("the viewer exited early ({status}): {said}");
+        }
         let found = xdotool(&["search", "--name", "^csg "]);
         window = String::from_utf8_lossy(&found.stdout)
             .lines()
