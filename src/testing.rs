@@ -7,9 +7,11 @@
 //!   are exact), [`bounded_node`] (distances are 1-Lipschitz bounds),
 //!   [`fractal_node`] and [`scene_node`] (anything).
 //! - Checkers ([`check_lipschitz`], [`check_never_overestimates`],
-//!   [`check_exact`]) examine every input, and on failure return the worst
-//!   violation as a [`Failure`] that says where, what was measured and what
-//!   was allowed. They accept anything that is a [`DistanceField`]: a
+//!   [`check_exact`]) examine every input, return what they tested
+//!   ([`Tested`]) and fail when that is below their minimum, and on failure
+//!   return the worst violation as a [`Failure`] that says where, what was
+//!   measured and what was allowed. [`near_surface_points`] samples where
+//!   an estimate is most at risk, using only a membership test. They accept anything that is a [`DistanceField`]: a
 //!   [`Node`](crate::Node), a [`cpu::Evaluator`](crate::cpu::Evaluator) or a
 //!   closure `Fn(DVec3) -> f64`. [`check_device_matches_cpu`] (feature
 //!   `opencl`) runs a node's generated OpenCL code on a device and compares
@@ -51,16 +53,19 @@ mod check;
 #[cfg(feature = "opencl")]
 mod device;
 mod membership;
+mod sample;
 mod sites;
 mod strategy;
 
 pub use check::{
-    Check, DistanceField, Failure, GeneratedProgram, LIPSCHITZ_TOLERANCE, ROUNDING_ALLOWANCE,
-    SHELL_FACTOR, check_exact, check_lipschitz, check_never_overestimates,
+    Check, DistanceField, Failure, GeneratedProgram, LIPSCHITZ_TOLERANCE, MIN_BALL_FRACTION,
+    ROUNDING_ALLOWANCE, SHELL_FACTOR, Tested, check_exact, check_lipschitz,
+    check_never_overestimates,
 };
 #[cfg(feature = "opencl")]
 pub use device::{check_device_matches_cpu, random_points, spicy_points};
 pub use membership::{julia_inside, mandelbulb_inside, menger_inside, sierpinski_inside};
+pub use sample::near_surface_points;
 pub use sites::{Site, parameter_sites, substitute};
 pub use strategy::{
     bounded_node, capped_cone_node, capsule_node, cuboid_node, cylinder_node, ellipsoid_node,

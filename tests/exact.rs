@@ -27,7 +27,8 @@ fn spicy_points() -> Vec<DVec3> {
 fn check_node(node: &Node, random: &[DVec3]) -> Result<(), Failure> {
     let analytic = |p| exact_distance(node, p).expect("an exact node");
     check_exact(node, analytic, random, TOLERANCE)?;
-    check_exact(node, analytic, &spicy_points(), TOLERANCE)
+    check_exact(node, analytic, &spicy_points(), TOLERANCE)?;
+    Ok(())
 }
 
 macro_rules! exact {
@@ -83,6 +84,9 @@ proptest! {
                 }
             }
         }
+        // A shape no ray reaches (a zero-size one) has nothing near its
+        // surface to probe here: `degenerate_shapes_are_exact` covers it.
+        prop_assume!(!points.is_empty(), "no ray reached the surface");
         check_node(&node, &points)?;
     }
 }

@@ -101,29 +101,41 @@ proptest! {
     }
 
     /// The twisted geometry is the child's, seen through the twist map
-    /// (a rotation about y by `-rate * y`, computed here with quaternions).
+    /// (a rotation about y by `-rate * y`, computed here with quaternions),
+    /// at points spread through `[-3, 3]^3` and points near its surface.
     #[test]
     fn twist_never_overestimates(
         child in bounded_node(),
         rate in -6.0..6.0f64,
-        points in prop::collection::vec(point(3.0), 16),
+        points in prop::collection::vec(point(3.0), 8),
+        seed in any::<u64>(),
     ) {
         let untwisted = cpu::Evaluator::new(&child)?;
         let inside = |p: DVec3| untwisted.distance(DQuat::from_rotation_y(-rate * p.y) * p) <= 0.0;
-        check_never_overestimates(&child.twist(rate), inside, &points, 16)?;
+        let near = testing::near_surface_points(inside, 3.0, 0.5, 32, seed);
+        // A child whose surface (almost) misses the ball has little near it
+        // to test.
+        prop_assume!(near.len() >= 16, "little surface within 3 of the origin");
+        check_never_overestimates(&child.twist(rate), inside, &[points, near].concat(), 16)?;
     }
 
     /// The bent geometry is the child's, seen through the bend map (a
-    /// rotation about z by `rate * x`).
+    /// rotation about z by `rate * x`), at points spread through
+    /// `[-3, 3]^3` and points near its surface.
     #[test]
     fn bend_never_overestimates(
         child in bounded_node(),
         rate in -6.0..6.0f64,
-        points in prop::collection::vec(point(3.0), 16),
+        points in prop::collection::vec(point(3.0), 8),
+        seed in any::<u64>(),
     ) {
         let unbent = cpu::Evaluator::new(&child)?;
         let inside = |p: DVec3| unbent.distance(DQuat::from_rotation_z(rate * p.x) * p) <= 0.0;
-        check_never_overestimates(&child.bend(rate), inside, &points, 16)?;
+        let near = testing::near_surface_points(inside, 3.0, 0.5, 32, seed);
+        // A child whose surface (almost) misses the ball has little near it
+        // to test.
+        prop_assume!(near.len() >= 16, "little surface within 3 of the origin");
+        check_never_overestimates(&child.bend(rate), inside, &[points, near].concat(), 16)?;
     }
 
     /// Outside, the ellipsoid bound is at most the true distance; inside,

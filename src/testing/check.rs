@@ -23,6 +23,29 @@ pub const ROUNDING_ALLOWANCE: f64 = 16.0 * f64::EPSILON;
 /// `1 - SHELL_FACTOR` or less go unnoticed.
 pub const SHELL_FACTOR: f64 = 1.0 - 1e-6;
 
+/// The least share of a [`check_never_overestimates`] run's points that
+/// must have a positive distance, so that balls (the property itself) and
+/// not only signs were tested: a point set that is almost all inside the
+/// set says little about overestimating. Sample near the surface with
+/// [`near_surface_points`](super::near_surface_points) to meet it.
+pub const MIN_BALL_FRACTION: f64 = 0.125;
+
+/// What a checker examined. Every checker returns it on success, and fails
+/// with [`Check::TooFewTested`] when the count is below its minimum (at
+/// least one input; for [`check_never_overestimates`], balls around at
+/// least [`MIN_BALL_FRACTION`] of the points).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct Tested {
+    /// Inputs examined: points, or pairs for [`check_lipschitz`].
+    pub inputs: usize,
+    /// For [`check_never_overestimates`]: balls tested, one around every
+    /// point with a positive distance. Equal to `inputs` elsewhere.
+    pub balls: usize,
+    /// For [`check_never_overestimates`]: points with `d(p) <= 0` whose
+    /// membership was checked. Zero elsewhere.
+    pub signs: usize,
+}
+
 /// Which invariant a [`Failure`] breaks. Non-exhaustive: more checks
 /// (such as agreement between a device and the CPU reference) can join.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
@@ -36,6 +59,12 @@ pub enum Check {
     Lipschitz,
     /// No point closer than `d(p)` to `p` is inside the set.
     NeverOverestimates,
+    /// A point where `d(p) < 0` (the field says "inside") is outside the
+    /// set.
+    Sign,
+    /// Too few inputs were tested for the check to mean anything: `measured`
+    /// is how many were, `allowed` the minimum.
+    TooFewTested,
     /// `d(p)` equals the analytic distance.
     Exact,
     /// The OpenCL twin agrees with the CPU reference (distance and colour).
@@ -59,6 +88,8 @@ pub enum Check {
 /// | `Finite` | `[p]` | `[value]` | the value | 0 |
 /// | `Lipschitz` | `[p, q]` | `[d(p), d(q)]` | `\|d(p) - d(q)\| / \|p - q\|` | the bound |
 /// | `NeverOverestimates` | `[p, q]`, `q` inside | `[d(p)]` | `d(p)` | `\|p - q\|` |
+/// | `Sign` | `[p]`, outside | `[d(p)]` | `-d(p)` | the rounding allowance |
+/// | `TooFewTested` | none | none | inputs tested | the minimum |
 /// | `Exact` | `[p]` | `[d(p), analytic(p)]` | `\|d(p) - analytic(p)\|` | the tolerance at `p` |
 /// | `DeviceMatchesCpu` | `[p]` | `[device, cpu]` | the relative error | the tolerance |
 /// | `Build`, `Device` | none | none | 0 | 0 |
@@ -188,6 +219,18 @@ impl Failure {
                 v[1],
                 tally("pairs")
             ),
+            Check::Sign => write!(
+                f,
+                "wrong sign: d(p) = {} < 0 says p = {} is inside, but it is outside the set; {}",
+                v[0],
+                p[0],
+                tally("points with d <= 0")
+            ),
+            Check::TooFewTested => write!(
+                f,
+                "too few inputs tested: {} {} of {}, below the minimum of {}",
+                self.measured, self.detail, self.checked, self.allowed
+            ),
             Check::NeverOverestimates if self.allowed == 0.0 => write!(
                 f,
                 "overestimates: d(p) = {} > 0 at p = {}, which is itself inside the set; {}",
@@ -287,6 +330,19 @@ impl Tally {
         }
     }
 
+    /// Ends a check whose every input was tested the one way: the worst
+    /// violation, or too few inputs (none), or what was tested.
+    pub(crate) fn finish(self) -> Result<Tested, Failure> {
+        let inputs = self.checked;
+        self.outcome()?;
+        at_least(inputs, 1, "inputs", inputs)?;
+        Ok(Tested {
+            inputs,
+            balls: inputs,
+            signs: 0,
+        })
+    }
+
     pub(crate) fn pass(&mut self) {
         self.checked += 1;
     }
@@ -303,7 +359,7 @@ impl Tally {
         }
     }
 
-    pub(crate) fn finish(self) -> Result<(), Failure> {
+    fn outcome(self) -> Result<(), Failure> {
         match self.worst {
             None => Ok(()),
             Some(worst) => Err(Failure {
@@ -313,6 +369,26 @@ impl Tally {
             }),
         }
     }
+}
+
+/// Fails with [`Check::TooFewTested`] when `tested` is below `minimum`.
+fn at_least(tested: usize, minimum: usize, what: &str, of: usize) -> Result<(), Failure> {
+    if tested >= minimum {
+        return Ok(());
+    }
+    #[allow(clippy::cast_precision_loss)]
+    Err(Failure {
+        detail: what.into(),
+        violations: 1,
+        checked: of,
+        ..Failure::new(
+            Check::TooFewTested,
+            vec![],
+            vec![],
+            tested as f64,
+            minimum as f64,
+        )
+    })
 }
 
 fn rounding(p: DVec3, q: DVec3, a: f64, b: f64) -> f64 {
@@ -349,7 +425,7 @@ pub fn check_lipschitz<F: DistanceField + ?Sized>(
     field: &F,
     bound: f64,
     pairs: &[(DVec3, DVec3)],
-) -> Result<(), Failure> {
+) -> Result<Tested, Failure> {
     assert!(
         bound > 0.0 && bound.is_finite(),
         "the Lipschitz bound must be finite and > 0"
@@ -421,15 +497,24 @@ impl SplitMix {
 /// overestimating step would land), `samples` points on the ball's
 /// boundary (at [`SHELL_FACTOR`] times the radius) and `samples` points
 /// spread uniformly through its interior, in directions drawn by a
-/// generator seeded from `p`. Points with `d(p) <= 0` are skipped.
+/// generator seeded from `p`. A point with `d(p) <= 0` (the field says
+/// "inside or on the surface") must itself be inside the set, give or take
+/// rounding: otherwise the field has the wrong sign there ([`Check::Sign`]).
 ///
 /// `inside` should be an independent description of the set, such as the
-/// membership tests in this module or a simpler field's sign.
+/// membership tests in this module or a simpler field's sign. The property
+/// is at risk near the surface, where balls are small and the set's detail
+/// is fine: [`near_surface_points`](super::near_surface_points) draws
+/// points there from `inside` alone.
+///
+/// Returns how many balls and signs were tested.
 ///
 /// # Errors
 /// The ball whose inside point gives the largest overestimate factor
-/// `d(p) / |p - q|` (`q` the inside point nearest to `p`), or the first
-/// non-finite distance.
+/// `d(p) / |p - q|` (`q` the inside point nearest to `p`), else the worst
+/// wrong sign, or the first non-finite distance; or
+/// [`Check::TooFewTested`] when fewer than [`MIN_BALL_FRACTION`] of the
+/// points (and at least one) had a positive distance.
 ///
 /// ```
 /// use fractal_sdf::prelude::*;
@@ -453,15 +538,22 @@ pub fn check_never_overestimates<F: DistanceField + ?Sized>(
     inside: impl Fn(DVec3) -> bool,
     points: &[DVec3],
     samples: usize,
-) -> Result<(), Failure> {
+) -> Result<Tested, Failure> {
     let d = field.distance_fn()?;
     let mut tally = Tally::new();
+    let mut signs = Tally::new();
     for (i, &p) in points.iter().enumerate() {
         let dp = d(p);
         if !dp.is_finite() {
             return Err(Failure::not_finite("the distance", p, dp, i + 1));
         }
         if dp <= 0.0 {
+            let allowed = rounding(p, p, dp, 0.0);
+            if -dp > allowed && !inside(p) {
+                signs.fail(Failure::new(Check::Sign, vec![p], vec![dp], -dp, allowed));
+            } else {
+                signs.pass();
+            }
             continue;
         }
         let descent = -gradient(&d, p, dp).unwrap_or(DVec3::ZERO);
@@ -490,7 +582,26 @@ pub fn check_never_overestimates<F: DistanceField + ?Sized>(
             None => tally.pass(),
         }
     }
-    tally.finish()
+    let tested = Tested {
+        inputs: points.len(),
+        balls: tally.checked,
+        signs: signs.checked,
+    };
+    tally.outcome()?;
+    signs.outcome()?;
+    #[allow(
+        clippy::cast_possible_truncation,
+        clippy::cast_sign_loss,
+        clippy::cast_precision_loss
+    )]
+    let minimum = ((points.len() as f64 * MIN_BALL_FRACTION).ceil() as usize).max(1);
+    at_least(
+        tested.balls,
+        minimum,
+        "points with a positive distance (balls)",
+        points.len(),
+    )?;
+    Ok(tested)
 }
 
 /// The unit gradient of `d` at `p` by central differences, with a step
@@ -527,7 +638,7 @@ pub fn check_exact<F: DistanceField + ?Sized>(
     analytic: impl Fn(DVec3) -> f64,
     points: &[DVec3],
     tolerance: f64,
-) -> Result<(), Failure> {
+) -> Result<Tested, Failure> {
     let d = field.distance_fn()?;
     let mut tally = Tally::new();
     for (i, &p) in points.iter().enumerate() {

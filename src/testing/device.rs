@@ -2,7 +2,7 @@
 
 use glam::DVec3;
 
-use super::check::{Check, Failure, GeneratedProgram, Tally};
+use super::check::{Check, Failure, GeneratedProgram, Tally, Tested};
 use crate::codegen::KernelSource;
 use crate::cpu::Evaluator;
 use crate::error::Error;
@@ -84,7 +84,7 @@ pub fn check_device_matches_cpu(
     precision: Precision,
     points: &[DVec3],
     tolerance: f64,
-) -> Result<(), Failure> {
+) -> Result<Tested, Failure> {
     let cpu = Evaluator::new(node).map_err(|e| Failure {
         detail: e.to_string(),
         ..Failure::new(Check::Valid, vec![], vec![], 0.0, 0.0)
