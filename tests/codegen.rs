@@ -177,7 +177,11 @@ fn chains_of_baked_transforms_fold_into_one_node() {
     let by_hand = {
         let q = DQuat::from_axis_angle(DVec3::Z, -0.5) * p;
         let s = (q / 0.5 - dvec3(1.0, 2.0, 0.0)).length() - 1.0;
-        (s * 0.5).min(fractal_sdf::cpu::sdf::torus(p.into(), 1.0, 0.2))
+        // The torus about y: the distance to the circle of radius 1 in the
+        // xz plane, less the tube's radius.
+        let ring = dvec3(p.x, 0.0, p.z).normalize() * 1.0;
+        let torus = p.distance(ring) - 0.2;
+        (s * 0.5).min(torus)
     };
     approx::assert_relative_eq!(unfolded.distance(p), by_hand, epsilon = 1e-12);
     let src = source(chain, &Options::default());

@@ -4,15 +4,15 @@
 //! and are finite everywhere.
 //!
 //! Tolerances: the device result `g` and the CPU reference `c` (evaluated in
-//! the same precision) must satisfy `|g - c| <= tol * max(1, |c|)` with
-//! `tol = 1e-4` for F32 and `1e-10` for F64, at every point. Colours must
-//! agree to the same tolerance. The check is the public
-//! `testing::check_device_matches_cpu`.
+//! the same precision) must satisfy `|g - c| <= tol * max(1, |c|)` at every
+//! point, colours too; see [`tolerance`] for the values and where they come
+//! from. The check is the public `testing::check_device_matches_cpu`, and
+//! each run prints the worst error it measured.
 
 mod gpu;
 
 use fractal_sdf::prelude::*;
-use fractal_sdf::render::{DeviceSelector, PointEvaluator};
+use fractal_sdf::render::{DeviceInfo, DeviceKind, DeviceSelector, PointEvaluator};
 use fractal_sdf::scene::{CustomShape, Rule};
 use fractal_sdf::testing::{check_device_matches_cpu, random_points, spicy_points};
 
@@ -104,30 +104,61 @@ fn nodes() -> Vec<(&'static str, Node)> {
     v
 }
 
+/// The tolerance per precision and device class. On a CPU device (PoCL,
+/// where `make test` and CI run) the worst errors measured over every node
+/// below and 10,065 points are 3.6e-6 in F32 (`mandelbulb_dynamic`: the
+/// trigonometric map through many iterations) and 7.8e-16 in F64
+/// (`julia_dynamic_bailout_2`); the tolerances are about 5 and 13 times
+/// those. Other devices (GPUs) are not measured here: their single-precision
+/// built-ins may be several ulps from correctly rounded (OpenCL C allows up
+/// to 4 for `sin`, `cos` and `atan2`, 16 for `pow`), which the iterated
+/// fractal maps amplify, so they keep the looser 1e-4 and 1e-10 until a
+/// measurement says otherwise.
+fn tolerance(precision: Precision, device: &DeviceInfo) -> f64 {
+    match (precision, device.kind) {
+        (Precision::F32, DeviceKind::Cpu) => 2e-5,
+        (Precision::F64, DeviceKind::Cpu) => 1e-14,
+        (Precision::F32, _) => 1e-4,
+        (Precision::F64, _) => 1e-10,
+    }
+}
+
 fn check_all(precision: Precision) {
-    if gpu::device().is_none() {
+    let Some(device) = gpu::device() else {
+        return;
+    };
+    if precision == Precision::F64 && !gpu::fp64(&device) {
         return;
     }
     let mut points = random_points(10_000, 2.5, 0x5eed);
     points.extend(spicy_points());
-    let tolerance = match precision {
-        Precision::F32 => 1e-4,
-        Precision::F64 => 1e-10,
-    };
+    let tolerance = tolerance(precision, &device);
+    let mut worst = (0.0, "");
     let failures: Vec<String> = nodes()
         .into_iter()
         .filter_map(|(name, node)| {
-            check_device_matches_cpu(
+            match check_device_matches_cpu(
                 &node,
                 &DeviceSelector::auto(),
                 precision,
                 &points,
                 tolerance,
-            )
-            .err()
-            .map(|f| format!("{name} ({precision:?}): {f}"))
+            ) {
+                Ok(tested) => {
+                    assert_eq!(tested.inputs, points.len());
+                    if tested.worst * tolerance > worst.0 {
+                        worst = (tested.worst * tolerance, name);
+                    }
+                    None
+                }
+                Err(f) => Some(format!("{name} ({precision:?}): {f}")),
+            }
         })
         .collect();
+    eprintln!(
+        "{precision:?}: worst relative error {:.2e} ({}), tolerance {tolerance:.0e}",
+        worst.0, worst.1
+    );
     assert!(failures.is_empty(), "{}", failures.join("\n"));
 }
 

@@ -1,5 +1,5 @@
 //! Golden renders: every gallery scene at 96×64 compared with the committed
-//! reference images in `tests/golden/` (PSNR ≥ 40 dB). After an intended
+//! reference images in `tests/golden/` (PSNR at least [`min_psnr`]). After an intended
 //! change to shading or a scene, regenerate them with `make golden`
 //! (`UPDATE_GOLDEN=1 cargo test --test golden`) and look at the new images.
 
@@ -9,10 +9,23 @@ use std::path::PathBuf;
 
 use fractal_sdf::metrics::psnr;
 use fractal_sdf::prelude::*;
-use fractal_sdf::render::Renderer;
+use fractal_sdf::render::{DeviceInfo, DeviceKind, Renderer};
 
 const SIZE: (u32, u32) = (96, 64);
-const MIN_PSNR: f64 = 40.0;
+/// The least PSNR a render must reach against its reference. On a CPU
+/// device (PoCL, which made the references and runs `make test` and CI)
+/// every render measured bit-identical (infinite PSNR); 60 dB still
+/// admits rounding-level changes, such as a different host CPU fusing
+/// multiply-adds differently (60 dB is a mean squared error of 0.065
+/// levels: a few hundred channels off by one), and fails a narrowed
+/// penumbra (45 and 51 dB on two scenes). GPUs are not measured here and
+/// keep 40 dB.
+fn min_psnr(device: &DeviceInfo) -> f64 {
+    match device.kind {
+        DeviceKind::Cpu => 60.0,
+        _ => 40.0,
+    }
+}
 
 fn path(name: &str) -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
@@ -22,9 +35,10 @@ fn path(name: &str) -> PathBuf {
 
 #[test]
 fn gallery_renders_match_the_golden_images() {
-    if gpu::device().is_none() {
+    let Some(device) = gpu::device() else {
         return;
-    }
+    };
+    let min = min_psnr(&device);
     // Only an explicit `1` rewrites the references.
     let update = std::env::var("UPDATE_GOLDEN").as_deref() == Ok("1");
     let mut report = Vec::new();
@@ -45,9 +59,9 @@ fn gallery_renders_match_the_golden_images() {
             .to_rgba8();
         let db = psnr(&image, &golden);
         report.push(format!("{name}: {db:.1} dB"));
-        if db < MIN_PSNR {
+        if db < min {
             gpu::save(&format!("golden_{name}_actual"), &image);
-            failures.push(format!("{name}: PSNR {db:.1} dB < {MIN_PSNR} dB"));
+            failures.push(format!("{name}: PSNR {db:.1} dB < {min} dB"));
         }
     }
     eprintln!("{}", report.join("\n"));

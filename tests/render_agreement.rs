@@ -2,51 +2,85 @@
 
 mod gpu;
 
-use fractal_sdf::cpu::{self, Evaluator};
+use fractal_sdf::cpu::{self, Evaluator, Ray};
 use fractal_sdf::prelude::*;
 use fractal_sdf::render::{Frame, Renderer};
+use fractal_sdf::scene::Projection;
+
+/// The ray through the centre of pixel `(x, y)` of a `w` x `h` image,
+/// derived here from the camera's definition (a look-at frame with `up`
+/// made orthogonal, rows from the top), not with the library's viewport.
+fn pixel_ray(camera: &Camera, w: u32, h: u32, x: u32, y: u32) -> Ray {
+    let forward = (camera.target - camera.position).normalize();
+    let right = forward.cross(camera.up).normalize();
+    let up = right.cross(forward);
+    let aspect = f64::from(w) / f64::from(h);
+    // -1..1 across the image, at the pixel's centre.
+    let sx = 2.0 * (f64::from(x) + 0.5) / f64::from(w) - 1.0;
+    let sy = 1.0 - 2.0 * (f64::from(y) + 0.5) / f64::from(h);
+    match camera.projection {
+        Projection::Perspective { fov_y_degrees } => {
+            let half = (fov_y_degrees.to_radians() / 2.0).tan();
+            Ray {
+                origin: camera.position,
+                direction: (forward + right * (sx * half * aspect) + up * (sy * half)).normalize(),
+            }
+        }
+        Projection::Orthographic { height } => Ray {
+            origin: camera.position
+                + right * (sx * height / 2.0 * aspect)
+                + up * (sy * height / 2.0),
+            direction: forward,
+        },
+    }
+}
+
+/// Pixels whose hit, or depth where both hit, may disagree with the CPU
+/// reference. Measured on PoCL: none, on 6,144 perspective and 4,800
+/// orthographic F64 pixels, and none between plain and over-relaxed
+/// marches. Two allow for a silhouette pixel where both marches end
+/// within rounding of the hit threshold on another host.
+const ALLOWED_MISMATCHES: usize = 2;
 
 /// Compares a frame's hit mask and depth with `cpu::march` on the same rays
-/// and thresholds; returns (hit agreement, depth agreement among pixels
-/// both hit).
-fn compare(renderer: &Renderer, frame: &Frame, scene: &Scene) -> (f64, f64) {
+/// and thresholds; returns the pixels whose hit differs and the pixels
+/// both hit whose depth differs.
+fn compare(renderer: &Renderer, frame: &Frame, scene: &Scene) -> (usize, usize) {
     let (w, h) = (frame.width(), frame.height());
     let view = renderer.viewport(w, h).unwrap();
     let settings = view.march_settings(&renderer.options().quality);
     let eval = Evaluator::new(scene.geometry.as_ref().unwrap()).unwrap();
-    let (mut same_hit, mut both, mut same_depth) = (0, 0, 0);
+    let (mut hit_mismatches, mut depth_mismatches) = (0, 0);
     let mut worst = 0.0f64;
     for y in 0..h {
         for x in 0..w {
             let i = frame.index(x, y);
-            let reference = cpu::march(
-                &eval,
-                view.ray(f64::from(x) + 0.5, f64::from(y) + 0.5),
-                &settings,
+            let ray = pixel_ray(&scene.camera, w, h, x, y);
+            let theirs = view.ray(f64::from(x) + 0.5, f64::from(y) + 0.5);
+            assert!(
+                ray.origin.abs_diff_eq(theirs.origin, 1e-12)
+                    && ray.direction.abs_diff_eq(theirs.direction, 1e-12),
+                "pixel ({x}, {y}): {ray:?} from the camera, {theirs:?} from the viewport"
             );
-            if reference.hit == frame.hit[i] {
-                same_hit += 1;
+            let reference = cpu::march(&eval, ray, &settings);
+            if reference.hit != frame.hit[i] {
+                hit_mismatches += 1;
             }
             if reference.hit && frame.hit[i] {
-                both += 1;
                 let t = reference.depth;
                 // Both marches locate the crossing to `hit_epsilon`
                 // footprints; float rounding may change a step.
                 let tolerance = 1e-4 * t + view.footprint(t) * settings_eps(renderer);
                 let error = (f64::from(frame.depth[i]) - t).abs();
                 worst = worst.max(error / tolerance);
-                if error <= tolerance {
-                    same_depth += 1;
+                if error > tolerance {
+                    depth_mismatches += 1;
                 }
             }
         }
     }
-    let pixels = f64::from(w * h);
     eprintln!("largest depth error: {worst:.3} of the tolerance");
-    (
-        f64::from(same_hit) / pixels,
-        f64::from(same_depth) / f64::from(both.max(1)),
-    )
+    (hit_mismatches, depth_mismatches)
 }
 
 fn settings_eps(renderer: &Renderer) -> f64 {
@@ -63,7 +97,7 @@ fn hit_mask_and_depth_match_the_cpu_reference() {
     let frame = renderer.render_with_aovs(96, 64).unwrap();
     gpu::save("agreement_perspective", &frame.image);
     let (hits, depths) = compare(&renderer, &frame, &scene);
-    eprintln!("agreement: {hits:.4} of hit masks, {depths:.4} of depths");
+    eprintln!("disagreeing: {hits} hit masks, {depths} depths");
     assert_agreement(hits, depths);
     // Misses have infinite depth and no normal; hits a unit normal.
     for i in 0..frame.hit.len() {
@@ -95,7 +129,7 @@ fn orthographic_and_f64_match_the_cpu_reference() {
     let frame = renderer.render_with_aovs(80, 60).unwrap();
     gpu::save("agreement_orthographic", &frame.image);
     let (hits, depths) = compare(&renderer, &frame, &scene);
-    eprintln!("agreement: {hits:.4} of hit masks, {depths:.4} of depths");
+    eprintln!("disagreeing: {hits} hit masks, {depths} depths");
     assert_agreement(hits, depths);
     assert!(
         frame.coverage() > 0.99,
@@ -138,14 +172,7 @@ fn over_relaxation_finds_the_same_surface_in_fewer_steps() {
         }
     }
     eprintln!("over-relaxed: {same_hit} same hits of 6144, {same_depth} of {both} same depths");
-    assert!(
-        same_hit * 100 >= 6144 * 99,
-        "{same_hit} of 6144 hit masks agree"
-    );
-    assert!(
-        same_depth * 100 >= both * 99,
-        "{same_depth} of {both} hits on the same surface"
-    );
+    assert_agreement(6144 - same_hit, both - same_depth);
     let mean =
         |f: &Frame| f.steps.iter().map(|&s| f64::from(s)).sum::<f64>() / f.steps.len() as f64;
     let (m1, m2) = (mean(&plain), mean(&relaxed));
@@ -160,16 +187,15 @@ const _: fn() = || {
     send::<Renderer>();
 };
 
-/// At least 99% of hit masks, and of depths where both hit, agree.
-fn assert_agreement(hits: f64, depths: f64) {
+/// At most [`ALLOWED_MISMATCHES`] hit masks, and depths where both hit,
+/// disagree.
+fn assert_agreement(hits: usize, depths: usize) {
     assert!(
-        hits >= 0.99,
-        "hit masks agree on {:.2}% of pixels",
-        100.0 * hits
+        hits <= ALLOWED_MISMATCHES,
+        "{hits} hit masks disagree (at most {ALLOWED_MISMATCHES} may)"
     );
     assert!(
-        depths >= 0.99,
-        "depths agree on {:.2}% of hit pixels",
-        100.0 * depths
+        depths <= ALLOWED_MISMATCHES,
+        "{depths} depths disagree where both hit (at most {ALLOWED_MISMATCHES} may)"
     );
 }

@@ -34,7 +34,7 @@ pub const MIN_BALL_FRACTION: f64 = 0.125;
 /// with [`Check::TooFewTested`] when the count is below its minimum (at
 /// least one input; for [`check_never_overestimates`], balls around at
 /// least [`MIN_BALL_FRACTION`] of the points).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct Tested {
     /// Inputs examined: points, or pairs for [`check_lipschitz`].
     pub inputs: usize,
@@ -44,6 +44,14 @@ pub struct Tested {
     /// For [`check_never_overestimates`]: points with `d(p) <= 0` whose
     /// membership was checked. Zero elsewhere.
     pub signs: usize,
+    /// How close the check came to failing: the largest measured value
+    /// over its allowance, in `[0, 1]` on success. For [`check_lipschitz`]
+    /// the steepest pair's change over its allowed change, for
+    /// [`check_exact`] and `check_device_matches_cpu` the largest error
+    /// over the tolerance; 0 for [`check_never_overestimates`], whose
+    /// balls pass or fail. A tolerance can be set from it: a stated margin
+    /// over the worst value measured.
+    pub worst: f64,
 }
 
 /// Which invariant a [`Failure`] breaks. Non-exhaustive: more checks
@@ -319,6 +327,7 @@ pub(crate) struct Tally {
     checked: usize,
     worst: Option<Failure>,
     violations: usize,
+    closest: f64,
 }
 
 impl Tally {
@@ -327,24 +336,30 @@ impl Tally {
             checked: 0,
             worst: None,
             violations: 0,
+            closest: 0.0,
         }
     }
 
     /// Ends a check whose every input was tested the one way: the worst
     /// violation, or too few inputs (none), or what was tested.
     pub(crate) fn finish(self) -> Result<Tested, Failure> {
-        let inputs = self.checked;
+        let (inputs, worst) = (self.checked, self.closest);
         self.outcome()?;
         at_least(inputs, 1, "inputs", inputs)?;
         Ok(Tested {
             inputs,
             balls: inputs,
             signs: 0,
+            worst,
         })
     }
 
-    pub(crate) fn pass(&mut self) {
+    /// A passing input that used `share` of its allowance.
+    pub(crate) fn pass(&mut self, share: f64) {
         self.checked += 1;
+        if share > self.closest {
+            self.closest = share;
+        }
     }
 
     pub(crate) fn fail(&mut self, failure: Failure) {
@@ -451,7 +466,7 @@ pub fn check_lipschitz<F: DistanceField + ?Sized>(
                 bound,
             ));
         } else {
-            tally.pass();
+            tally.pass(change / allowed);
         }
     }
     tally.finish()
@@ -552,7 +567,7 @@ pub fn check_never_overestimates<F: DistanceField + ?Sized>(
             if -dp > allowed && !inside(p) {
                 signs.fail(Failure::new(Check::Sign, vec![p], vec![dp], -dp, allowed));
             } else {
-                signs.pass();
+                signs.pass(0.0);
             }
             continue;
         }
@@ -579,13 +594,14 @@ pub fn check_never_overestimates<F: DistanceField + ?Sized>(
                 dp,
                 p.distance(q),
             )),
-            None => tally.pass(),
+            None => tally.pass(0.0),
         }
     }
     let tested = Tested {
         inputs: points.len(),
         balls: tally.checked,
         signs: signs.checked,
+        worst: 0.0,
     };
     tally.outcome()?;
     signs.outcome()?;
@@ -660,7 +676,7 @@ pub fn check_exact<F: DistanceField + ?Sized>(
                 allowed,
             ));
         } else {
-            tally.pass();
+            tally.pass(error / allowed);
         }
     }
     tally.finish()

@@ -58,7 +58,12 @@ pub fn spicy_points() -> Vec<DVec3> {
 /// for the distance and for each colour channel, `DE` and `DE_shade`
 /// return the same distance, and every value is finite.
 ///
-/// Good tolerances: `1e-4` for F32 and `1e-10` for F64.
+/// Tolerances: on PoCL (a CPU device) the crate's own conformance suite
+/// measures at worst `3.6e-6` in F32 and `7.8e-16` in F64 over every node
+/// kind and gallery scene, and holds them to `2e-5` and `1e-14`; GPUs'
+/// single-precision built-ins are less exact, so `1e-4` and `1e-10` are
+/// safer starting points there. [`Tested::worst`] says how much of the
+/// tolerance a passing run used.
 ///
 /// # Errors
 /// [`Check::Valid`] if the node does not validate; [`Check::Build`] if the
@@ -114,8 +119,10 @@ pub fn check_device_matches_cpu(
             continue;
         }
         let mut worst: Option<Failure> = None;
+        let mut largest: f64 = 0.0;
         let mut compare = |what: &str, device: f64, cpu: f64| {
             let error = (device - cpu).abs() / cpu.abs().max(1.0);
+            largest = largest.max(error);
             if error > tolerance && worst.as_ref().is_none_or(|w| error > w.measured) {
                 worst = Some(Failure {
                     detail: what.into(),
@@ -136,7 +143,7 @@ pub fn check_device_matches_cpu(
         }
         match worst {
             Some(f) => tally.fail(f),
-            None => tally.pass(),
+            None => tally.pass(largest / tolerance),
         }
     }
     tally.finish().map_err(keep)
