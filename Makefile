@@ -4,7 +4,7 @@ export CARGO
 # The viewer's scene: `make viewer SCENE=menger`.
 SCENE ?= fractal_mix
 
-.PHONY: setup demo test bench viewer snapshots golden fmt
+.PHONY: setup demo test bench viewer snapshots golden fmt mutants
 
 setup:
 	@echo "==> setup: system packages"
@@ -19,6 +19,10 @@ test: setup
 
 viewer: setup
 	$(CARGO) run --release --features viewer --example viewer -- $(SCENE)
+
+# How many deliberate bugs the tests catch (not part of `make test`).
+mutants: setup
+	@bash scripts/mutants.sh
 
 bench:
 	@echo "==> bench"

@@ -11,6 +11,7 @@ REQUIRED_PACKAGES=(
     pocl-opencl-icd    # PoCL: a CPU OpenCL implementation, so no GPU is required
     clinfo             # lists OpenCL platforms/devices; used for the check below
     pkg-config
+    python3            # scripts/mutate_kernels.py (`make mutants`)
     # The viewer example's window (feature `viewer`) and its smoke test:
     xvfb               # a virtual X server, so the viewer runs without a display
     xdotool            # sends real key presses to the viewer's window

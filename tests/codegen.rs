@@ -290,3 +290,41 @@ fn generated_blocks_name_their_nodes_and_parameters() {
     let src = source(deep, &Options::default());
     assert!(src.contains("/* .../round/round/sphere */"), "{src}");
 }
+
+/// `n` spheres of different sizes and colours, placed with `Scene::add`.
+fn added_spheres(n: u32) -> Scene {
+    (0..n).fold(Scene::empty(), |scene, i| {
+        let t = f64::from(i) / f64::from(n);
+        scene.add(
+            sphere(0.1 + t)
+                .translate(dvec3(t, 0.0, -t))
+                .color(dvec3(t, 0.5, 0.5)),
+        )
+    })
+}
+
+#[test]
+fn wide_unions_become_one_loop_over_a_table() {
+    let emit =
+        |scene: Scene| codegen::emit(&scene.compile().unwrap(), &Options::default()).unwrap();
+    let small = emit(added_spheres(1_000));
+    let large = emit(added_spheres(5_000));
+    // The code is one operand's, whatever the count: only the loop's bound
+    // and the digits of node numbers in names differ.
+    assert!(large.source.len() - small.source.len() < 100);
+    assert!(
+        small.source.contains("for (uint i = 0u; i < 999u; i++)"),
+        "{}",
+        small.scene_part()
+    );
+    // Every member's values, in order: colour, offset, radius.
+    assert_eq!(small.constants.len(), 7 * 999);
+    let t = 1.0 / 1000.0;
+    assert_eq!(&small.constants[..7], &[t, 0.5, 0.5, t, 0.0, -t, 0.1 + t]);
+    // Fewer than MIN_INSTANCES alike operands are written out.
+    let few = emit(added_spheres(
+        u32::try_from(codegen::MIN_INSTANCES).unwrap(),
+    ));
+    assert!(!few.source.contains("for (uint i"), "{}", few.scene_part());
+    assert!(few.constants.is_empty());
+}

@@ -30,6 +30,29 @@ fn gyroid() -> CustomShape {
     .expect("a valid custom shape")
 }
 
+/// Wide unions emitted as loops over tables: 40 coloured spheres and 24
+/// scaled, rounded boxes (two groups of instances, one with a dynamic
+/// rounding radius), among a torus and a plane that stay unrolled.
+fn instanced() -> Node {
+    let mut scene = Scene::new(torus(0.5, 0.1)).add(plane(DVec3::Y, 2.0));
+    for i in 0..40 {
+        let t = f64::from(i) / 40.0;
+        let at = dvec3((t * 19.0).sin(), (t * 7.0).cos(), 2.0 * t - 1.0) * 1.5;
+        scene = scene.add(
+            sphere(0.1 + 0.2 * t)
+                .translate(at)
+                .color(dvec3(t, 1.0 - t, 0.5)),
+        );
+    }
+    for i in 0..24 {
+        let t = f64::from(i) / 24.0;
+        let at = dvec3(2.0 * t - 1.0, 0.4, (t * 11.0).sin());
+        let block = cuboid(dvec3(0.2, 0.1 + t * 0.1, 0.15)).round(param("rounding", 0.03));
+        scene = scene.add(block.scale(0.5 + t).translate(at));
+    }
+    scene.geometry.expect("the scene has geometry")
+}
+
 /// One node of every kind, and composites.
 fn nodes() -> Vec<(&'static str, Node)> {
     let s = || sphere(0.6);
@@ -96,6 +119,7 @@ fn nodes() -> Vec<(&'static str, Node)> {
         ),
         ("color", s().color(dvec3(0.2, 0.4, 0.9))),
         ("custom", gyroid().node([0.1]).intersect(sphere(1.5))),
+        ("instanced_union", instanced()),
     ];
     for (name, scene) in fractal_sdf::gallery::all() {
         let name: &'static str = Box::leak(format!("gallery_{name}").into_boxed_str());

@@ -28,6 +28,7 @@ mod power;
 mod scene;
 mod writer;
 
+pub use scene::MIN_INSTANCES;
 pub use writer::literal;
 
 use std::sync::atomic::{AtomicU64, Ordering};
@@ -138,6 +139,13 @@ pub struct KernelSource {
     /// that a compiler message about a line of the program can be told as
     /// a line of the shape's body.
     pub custom_regions: Vec<CustomRegion>,
+    /// Values the program reads from its parameter buffer after the
+    /// dynamic parameters (whose values fill the first slots): the baked
+    /// values of instanced union operands, one row per instance (see
+    /// [`MIN_INSTANCES`]). The parameter buffer a host passes holds the
+    /// dynamic values followed by these. Like dynamic values, they never
+    /// change the source or its hash.
+    pub constants: Vec<f64>,
 }
 
 /// Where a custom shape's OpenCL function lies in a generated program: its
@@ -167,6 +175,17 @@ impl CustomRegion {
 }
 
 impl KernelSource {
+    /// The contents of the program's parameter buffer for the dynamic
+    /// values `values` (one per slot): the values, then
+    /// [`constants`](Self::constants).
+    #[must_use]
+    pub fn param_buffer(&self, values: &[f64]) -> Vec<f64> {
+        let mut buffer = Vec::with_capacity(values.len() + self.constants.len());
+        buffer.extend_from_slice(values);
+        buffer.extend_from_slice(&self.constants);
+        buffer
+    }
+
     /// The scene's part of the program: header, helpers, `DE` and
     /// `DE_shade`.
     #[must_use]
@@ -260,6 +279,7 @@ pub fn emit_ir(ir: &Ir, options: &Options) -> Result<KernelSource> {
     let used = std::mem::take(&mut emitter.used);
     let customs: Vec<_> = emitter.customs.values().cloned().collect();
     let powers: Vec<u32> = emitter.powers.iter().copied().collect();
+    let constants = std::mem::take(&mut emitter.constants);
 
     let mut w = writer::Writer::new(precision);
     header(&mut w, options);
@@ -293,6 +313,7 @@ pub fn emit_ir(ir: &Ir, options: &Options) -> Result<KernelSource> {
     w.raw(&body.finish());
     let mut kernel = finish(w, options, origin);
     kernel.custom_regions = custom_regions;
+    kernel.constants = constants;
     Ok(kernel)
 }
 
@@ -345,6 +366,7 @@ fn finish(mut w: writer::Writer, options: &Options, origin: DVec3) -> KernelSour
         origin,
         kernel_start,
         custom_regions: Vec::new(),
+        constants: Vec::new(),
     }
 }
 

@@ -7,12 +7,21 @@
 //! library function, and its arguments are the node's parameters in the
 //! order [`Kind::try_map`](crate::scene::Kind) lists them, the one list of
 //! every node's parameters.
+//!
+//! Wide unions are instanced: the operands of one tree of hard unions that
+//! differ only in baked values (at least [`MIN_INSTANCES`] of them, such as
+//! thousands of coloured spheres placed with `Scene::add`) become one loop
+//! over a table of those values, which the program reads from the
+//! parameter buffer after the dynamic parameters. The code stays the size
+//! of one operand however many there are, and computes what the unrolled
+//! code would.
 
-use std::collections::{BTreeMap, BTreeSet};
+use std::collections::{BTreeMap, BTreeSet, HashMap};
 use std::convert::Infallible;
+use std::fmt::Write as _;
 
 use super::helpers::Helper;
-use super::writer::Writer;
+use super::writer::{INSTANCE_SLOT, Writer};
 use crate::ir::{Ir, IrNode, NodeId, Scalar, Vector};
 use crate::math::{escape_radius, integer_power, mandelbulb_radius, rotation_rows};
 use crate::quality::Precision;
@@ -84,6 +93,123 @@ impl Mapper<Scalar, Vector, NodeId> for Arguments<'_> {
     }
 }
 
+/// The fewest operands of one tree of hard unions, alike but for their
+/// baked values, that code generation emits as one loop over a table of
+/// those values (see [`KernelSource::constants`](super::KernelSource)).
+pub const MIN_INSTANCES: usize = 16;
+
+/// Rewrites a node's baked values as entries of an instance's table row,
+/// in `try_map` order, and collects the values.
+struct Rewrite {
+    values: Vec<f64>,
+}
+
+impl Rewrite {
+    fn slot(&mut self, s: Scalar) -> Scalar {
+        match s {
+            Scalar::Baked(v) => {
+                let entry = u32::try_from(self.values.len()).unwrap_or(u32::MAX);
+                self.values.push(v);
+                Scalar::Dynamic(INSTANCE_SLOT.saturating_add(entry))
+            }
+            dynamic @ Scalar::Dynamic(_) => dynamic,
+        }
+    }
+}
+
+impl Mapper<Scalar, Vector, NodeId> for Rewrite {
+    type S2 = Scalar;
+    type V2 = Vector;
+    type C2 = NodeId;
+    type E = Infallible;
+
+    fn scalar(&mut self, s: &Scalar, _: ParamSpec<'_>) -> Result<Scalar, Infallible> {
+        Ok(self.slot(*s))
+    }
+
+    fn vector(&mut self, v: &Vector, _: ParamSpec<'_>) -> Result<Vector, Infallible> {
+        Ok(v.map(|s| self.slot(s)))
+    }
+
+    fn child(&mut self, c: &NodeId) -> Result<NodeId, Infallible> {
+        Ok(*c)
+    }
+}
+
+/// Forgets a node's children, so that what is left describes its shape.
+struct Shape;
+
+impl Mapper<Scalar, Vector, NodeId> for Shape {
+    type S2 = Scalar;
+    type V2 = Vector;
+    type C2 = ();
+    type E = Infallible;
+
+    fn scalar(&mut self, s: &Scalar, _: ParamSpec<'_>) -> Result<Scalar, Infallible> {
+        Ok(*s)
+    }
+
+    fn vector(&mut self, v: &Vector, _: ParamSpec<'_>) -> Result<Vector, Infallible> {
+        Ok(*v)
+    }
+
+    fn child(&mut self, _: &NodeId) -> Result<(), Infallible> {
+        Ok(())
+    }
+}
+
+/// An instanceable operand: a chain of nodes whose code depends on their
+/// baked values only through the literals it reads (primitives, and the
+/// transforms, colours and modifiers that take no decision on a value).
+struct Instance {
+    /// The chain, rewritten to read its baked values from a table row.
+    chain: Vec<(NodeId, IrNode)>,
+    /// Its shape: equal for operands that differ only in baked values.
+    shape: String,
+    /// Its baked values, in the order of the table row.
+    values: Vec<f64>,
+}
+
+/// The operand under `root` as an instance, if it is one.
+fn instance(ir: &Ir, root: NodeId) -> Option<Instance> {
+    let mut rewrite = Rewrite { values: Vec::new() };
+    let (mut chain, mut shape) = (Vec::new(), String::new());
+    let mut at = Some(root);
+    while let Some(id) = at {
+        let node = ir.node(id);
+        let plain = matches!(
+            node,
+            Kind::Translate { .. }
+                | Kind::Scale { .. }
+                | Kind::Color { .. }
+                | Kind::Round { .. }
+                | Kind::Onion { .. }
+                | Kind::Elongate { .. }
+                | Kind::Mirror { .. }
+        );
+        if !plain && leaf_function(node).is_none() {
+            return None;
+        }
+        let Ok(rewritten) = node.try_map(&mut rewrite);
+        let Ok(kind) = rewritten.try_map(&mut Shape);
+        write!(shape, "{kind:?};").expect("writing to a String cannot fail");
+        at = rewritten.children().first().map(|&&c| c);
+        chain.push((id, rewritten));
+    }
+    Some(Instance {
+        chain,
+        shape,
+        values: rewrite.values,
+    })
+}
+
+/// A union tree entered as one: its union nodes (whose names the results
+/// are combined under) and the results of its instanced groups.
+struct Cluster {
+    unions: Vec<NodeId>,
+    groups: Vec<Vars>,
+}
+
 pub(crate) struct SceneEmitter<'a> {
     ir: &'a Ir,
     /// For a program in the scene's local frame: the translation it
@@ -99,6 +225,14 @@ pub(crate) struct SceneEmitter<'a> {
     pub(crate) customs: BTreeMap<String, CustomShape>,
     /// The integer Mandelbulb powers that need a specialised helper.
     pub(crate) powers: BTreeSet<u32>,
+    /// The instances' table rows, read from `params[slots + i]`.
+    pub(crate) constants: Vec<f64>,
+    /// How many slots the dynamic parameters take before the tables.
+    slots: usize,
+    /// While a loop body is emitted: its nodes, reading the table row.
+    instance: HashMap<NodeId, IrNode>,
+    /// Union trees entered as one, until they are left.
+    clusters: HashMap<NodeId, Cluster>,
 }
 
 impl<'a> SceneEmitter<'a> {
@@ -118,6 +252,10 @@ impl<'a> SceneEmitter<'a> {
             used: BTreeSet::new(),
             customs: BTreeMap::new(),
             powers: BTreeSet::new(),
+            constants: Vec::new(),
+            slots: ir.params().len(),
+            instance: HashMap::new(),
+            clusters: HashMap::new(),
         }
     }
 
@@ -126,6 +264,8 @@ impl<'a> SceneEmitter<'a> {
         for shade in [false, true] {
             self.shade = shade;
             self.points = 0;
+            // Both functions lay out the same tables.
+            self.constants.clear();
             if shade {
                 self.w.open(
                     "real DE_shade(real3 p0, __global const real* params, real3* color, real* trap)",
@@ -252,10 +392,27 @@ impl<'a> SceneEmitter<'a> {
     /// comes before its children and names them with their points.
     fn enter(&mut self, id: NodeId, p: &str, needs_color: bool) -> Step {
         let ir = self.ir;
-        let node = ir.node(id);
+        let rewritten;
+        let node = match self.instance.get(&id) {
+            Some(n) => {
+                rewritten = n.clone();
+                &rewritten
+            }
+            None => ir.node(id),
+        };
         if self.frame == Some(id) {
             if let Kind::Translate { child, .. } = node {
                 return Step::Descend(vec![(*child, p.to_string(), needs_color)]);
+            }
+        }
+        if let Kind::Csg {
+            op: CsgOp::Union,
+            smoothing: None,
+            ..
+        } = node
+        {
+            if let Some(step) = self.instanced_union(id, p, needs_color) {
+                return step;
             }
         }
         if !matches!(
@@ -416,9 +573,19 @@ impl<'a> SceneEmitter<'a> {
     /// Leaving a node after its children: the lines that combine their
     /// results.
     fn leave(&mut self, id: NodeId, p: &str, needs_color: bool, children: Vec<Vars>) -> Vars {
+        if let Some(cluster) = self.clusters.remove(&id) {
+            return self.combine(id, cluster, children, needs_color);
+        }
         let mut children = children.into_iter();
         let mut child = || children.next().expect("each child has a result");
-        let node = self.ir.node(id);
+        let rewritten;
+        let node = match self.instance.get(&id) {
+            Some(n) => {
+                rewritten = n.clone();
+                &rewritten
+            }
+            None => self.ir.node(id),
+        };
         if self.frame == Some(id) {
             return child();
         }
@@ -474,6 +641,147 @@ impl<'a> SceneEmitter<'a> {
             // Nodes that only move the point pass their child's result on.
             _ => child(),
         }
+    }
+
+    /// Enters the union tree under `id` as one: its operands that differ
+    /// only in baked values, at least [`MIN_INSTANCES`] alike, are emitted
+    /// now as one loop each, and the others are its children. `None` (the
+    /// union is entered as usual) when no such group exists.
+    fn instanced_union(&mut self, id: NodeId, p: &str, needs_color: bool) -> Option<Step> {
+        let ir = self.ir;
+        let (mut operands, mut unions) = (Vec::new(), Vec::new());
+        let mut stack = vec![id];
+        while let Some(at) = stack.pop() {
+            match ir.node(at) {
+                Kind::Csg {
+                    op: CsgOp::Union,
+                    smoothing: None,
+                    a,
+                    b,
+                } => {
+                    unions.push(at);
+                    stack.push(*b);
+                    stack.push(*a);
+                }
+                _ => operands.push(at),
+            }
+        }
+        if operands.len() < MIN_INSTANCES {
+            return None;
+        }
+        // Operands grouped by shape, groups in the order they first appear.
+        let mut order: Vec<String> = Vec::new();
+        let mut groups: HashMap<String, Vec<(NodeId, Vec<f64>)>> = HashMap::new();
+        for &operand in &operands {
+            if let Some(Instance { shape, values, .. }) = instance(ir, operand) {
+                let group = groups.entry(shape.clone()).or_insert_with(|| {
+                    order.push(shape);
+                    Vec::new()
+                });
+                group.push((operand, values));
+            }
+        }
+        order.retain(|shape| groups[shape].len() >= MIN_INSTANCES);
+        if order.is_empty() {
+            return None;
+        }
+        let mut looped = BTreeSet::new();
+        let mut results = Vec::new();
+        for shape in &order {
+            let members = &groups[shape];
+            looped.extend(members.iter().map(|(operand, _)| *operand));
+            results.push(self.instance_loop(members, p, needs_color));
+        }
+        self.clusters.insert(
+            id,
+            Cluster {
+                unions,
+                groups: results,
+            },
+        );
+        let rest = operands.into_iter().filter(|o| !looped.contains(o));
+        Some(Step::Descend(
+            rest.map(|o| (o, p.to_string(), needs_color)).collect(),
+        ))
+    }
+
+    /// One loop over a group of instances: the first member's code, reading
+    /// each member's values from its row of the table. Keeps the nearest
+    /// member's colour and trap (the later one on a tie, as the unrolled
+    /// unions would).
+    fn instance_loop(
+        &mut self,
+        members: &[(NodeId, Vec<f64>)],
+        p: &str,
+        needs_color: bool,
+    ) -> Vars {
+        let (first, _) = members[0];
+        let chain = instance(self.ir, first)
+            .expect("members are instances")
+            .chain;
+        let stride = members[0].1.len();
+        let start = self.slots + self.constants.len();
+        for (_, values) in members {
+            self.constants.extend_from_slice(values);
+        }
+        let r = first.index();
+        let (d, c, t) = (format!("dg{r}"), format!("cg{r}"), format!("tg{r}"));
+        let colour = self.shade && needs_color;
+        self.w.comment(&format!(
+            "{} instances of {}: {stride} values each from params[{start}]",
+            members.len(),
+            self.ir.path_tail(first, 2)
+        ));
+        self.w.line(format!("real {d} = INFINITY;"));
+        if colour {
+            self.w.line(format!("real3 {c} = DEFAULT_COLOR;"));
+        }
+        if self.shade {
+            self.w.line(format!("real {t} = R(1.0);"));
+        }
+        self.w
+            .open(format!("for (uint i = 0u; i < {}u; i++)", members.len()));
+        self.w.line(format!(
+            "__global const real* q = params + {start}u + i * {stride}u;"
+        ));
+        self.instance = chain.into_iter().collect();
+        let v = self.node(first, p, needs_color);
+        self.instance.clear();
+        if self.shade {
+            self.w.open(format!("if ({} <= {d})", v.d));
+            self.w.line(format!("{d} = {};", v.d));
+            if colour {
+                self.w.line(format!("{c} = {};", v.c));
+            }
+            self.w.line(format!("{t} = {};", v.t));
+            self.w.close();
+        } else {
+            self.w.line(format!("{d} = fmin({d}, {});", v.d));
+        }
+        self.w.close();
+        Vars {
+            d,
+            c: if colour { c } else { "DEFAULT_COLOR".into() },
+            t: if self.shade { t } else { "R(1.0)".into() },
+        }
+    }
+
+    /// Leaving a union tree entered as one: its other operands' results and
+    /// its groups' combined, pairwise, under the names of its union nodes.
+    fn combine(
+        &mut self,
+        id: NodeId,
+        cluster: Cluster,
+        children: Vec<Vars>,
+        needs_color: bool,
+    ) -> Vars {
+        self.label(id);
+        let mut results = children.into_iter().chain(cluster.groups);
+        let mut acc = results.next().expect("a union tree has an operand");
+        for (union, next) in cluster.unions.into_iter().zip(results) {
+            acc = self.csg(union, CsgOp::Union, None, &acc, &next, needs_color);
+        }
+        acc
     }
 
     /// `row · p` as the CPU's `dot_row` computes it: non-zero terms, left to

@@ -6,6 +6,11 @@ use std::fmt::Write as _;
 use crate::ir::Scalar;
 use crate::quality::Precision;
 
+/// Slot numbers from here up name the entries of the current instance's
+/// table row (`q[slot - INSTANCE_SLOT]`) while an instanced union's loop
+/// body is emitted: no scene has a billion dynamic parameters.
+pub(crate) const INSTANCE_SLOT: u32 = 1 << 30;
+
 /// Accumulates OpenCL C source with an indentation level.
 pub(crate) struct Writer {
     out: String,
@@ -94,6 +99,9 @@ impl Writer {
     pub(crate) fn scalar(&self, s: Scalar) -> String {
         match s {
             Scalar::Baked(v) => self.float(v),
+            Scalar::Dynamic(slot) if slot >= INSTANCE_SLOT => {
+                format!("q[{}]", slot - INSTANCE_SLOT)
+            }
             Scalar::Dynamic(slot) => match self.slot_names.get(slot as usize) {
                 Some(name) => format!("params[{slot}] /* {name} */"),
                 None => format!("params[{slot}]"),

@@ -139,7 +139,11 @@ impl PointEvaluator {
         let packed: Vec<f64> = points.iter().flat_map(|p| [p.x, p.y, p.z, 0.0]).collect();
         let q = &self.queue;
         let input = RealBuffer::new(q, self.precision, &packed)?;
-        let params = RealBuffer::new(q, self.precision, self.values.as_slice())?;
+        let params = RealBuffer::new(
+            q,
+            self.precision,
+            &self.source.param_buffer(self.values.as_slice()),
+        )?;
         let output = RealBuffer::output(q, self.precision, points.len() * EVAL_OUT_STRIDE)?;
         let count = u32::try_from(points.len()).map_err(opencl)?;
         let mut builder = Kernel::builder();

@@ -210,7 +210,7 @@ impl Renderer {
         let selected = device::select(&options.device)?;
         let context = program::context(&selected)?;
         let queue = profiling_queue(&context, &selected)?;
-        let inputs = Inputs::new(&queue, source.precision, &values, scene.lights())?;
+        let inputs = Inputs::new(&queue, &source, &values, scene.lights())?;
         let targets = Targets::new(&queue, 1, 1, true)?;
         let (program, build, compiled) = program::build(&selected, &context, &source)?;
         let kernel = make_kernel(&program, &queue, &inputs, &targets)?;
@@ -462,14 +462,10 @@ impl Renderer {
     /// cache).
     fn load(&mut self, source: KernelSource) -> Result<()> {
         let (program, build, compiled) = program::build(&self.selected, &self.context, &source)?;
-        let precision_changed = source.precision != self.source.precision;
-        if precision_changed {
-            self.inputs = Inputs::new(
-                &self.queue,
-                source.precision,
-                &self.values,
-                self.scene.lights(),
-            )?;
+        let inputs_changed =
+            source.precision != self.source.precision || source.constants != self.source.constants;
+        if inputs_changed {
+            self.inputs = Inputs::new(&self.queue, &source, &self.values, self.scene.lights())?;
         }
         self.kernel = make_kernel(&program, &self.queue, &self.inputs, &self.targets)?;
         self.local = local_size(&self.kernel, &self.selected)?;
@@ -799,15 +795,18 @@ struct Inputs {
 }
 
 impl Inputs {
+    /// The buffers for `source`: its parameter buffer holds the dynamic
+    /// values, which each frame rewrites, then the program's constants.
     fn new(
         queue: &Queue,
-        precision: Precision,
+        source: &KernelSource,
         values: &ParamValues,
         lights: &[Light],
     ) -> Result<Self> {
+        let precision = source.precision;
         Ok(Inputs {
             precision,
-            params: RealBuffer::new(queue, precision, values.as_slice())?,
+            params: RealBuffer::new(queue, precision, &source.param_buffer(values.as_slice()))?,
             camera: RealBuffer::new(queue, precision, &[0.0; camera::LEN])?,
             lights: RealBuffer::new(queue, precision, &pack_lights(lights, DVec3::ZERO))?,
         })
@@ -824,6 +823,7 @@ impl Inputs {
         lights: &[Light],
         origin: DVec3,
     ) -> Result<()> {
+        // The dynamic values only: the constants after them stay.
         self.params.write(values.as_slice())?;
         self.camera.write(&view.pack(origin))?;
         let packed = pack_lights(lights, origin);
