@@ -1,7 +1,9 @@
 //! The cost of a very deep scene: `Scene::add` called N times (a union
 //! chain N levels deep), then compiled, turned into OpenCL C, evaluated once
-//! on the CPU and dropped. Nothing in the crate recurses on the depth, so
-//! this runs on a small stack.
+//! on the CPU, rendered on the OpenCL device and dropped. Nothing in the
+//! crate recurses on the depth, so this runs on a small stack; the spheres
+//! differ only in their positions, so the program loops over a table of
+//! them instead of spelling each out.
 //!
 //! `cargo run --release --example deep_scene [-- 100000]`
 
@@ -9,6 +11,7 @@ use std::time::Instant;
 
 use fractal_sdf::codegen::{self, Options};
 use fractal_sdf::prelude::*;
+use fractal_sdf::render::{RenderOptions, Renderer};
 
 fn main() -> fractal_sdf::Result<()> {
     let n: usize = std::env::args()
@@ -45,16 +48,33 @@ fn run(n: usize) -> fractal_sdf::Result<()> {
     let t = Instant::now();
     let source = codegen::emit(&compiled, &Options::default())?;
     println!(
-        "emit: {:?} ({:.1} MB of OpenCL C)",
+        "emit: {:?} ({:.1} kB of OpenCL C, {} table values)",
         t.elapsed(),
-        source.source.len() as f64 / 1e6
+        source.source.len() as f64 / 1e3,
+        source.constants.len()
     );
     let eval = cpu::Evaluator::from_compiled(&compiled);
     let t = Instant::now();
     let d = eval.distance(dvec3(0.0, 0.0, 3.0));
     println!("one CPU distance: {:?} (d = {d:.4})", t.elapsed());
+    let scene = scene.with_camera(Camera::look_at(dvec3(2.2, 1.7, 2.9), DVec3::ZERO));
     let t = Instant::now();
-    drop((scene, compiled, eval));
+    let options = RenderOptions {
+        quality: Quality::draft(),
+        ..RenderOptions::default()
+    };
+    let mut renderer = Renderer::from_compiled(scene.compile()?, &options)?;
+    println!("renderer (build the program): {:?}", t.elapsed());
+    for frame in ["first", "second"] {
+        let t = Instant::now();
+        let image = renderer.render(64, 48)?;
+        println!("{frame} 64x48 draft frame: {:?}", t.elapsed());
+        if frame == "second" {
+            fractal_sdf::output::save_png(&image, "out/deep_scene.png")?;
+        }
+    }
+    let t = Instant::now();
+    drop((scene, compiled, eval, renderer));
     println!("drop: {:?}", t.elapsed());
     Ok(())
 }
