@@ -328,3 +328,32 @@ fn wide_unions_become_one_loop_over_a_table() {
     assert!(!few.source.contains("for (uint i"), "{}", few.scene_part());
     assert!(few.constants.is_empty());
 }
+
+#[test]
+fn effects_that_cost_nothing_leave_no_code() {
+    // Each effect switched on but given nothing to do: no samples, no
+    // steps, no strength, no density.
+    let options = Options {
+        quality: Quality {
+            ao_samples: 0,
+            shadow_steps: 0,
+            ..Quality::default()
+        },
+        effects: Effects {
+            ambient_occlusion: true,
+            shadows: true,
+            glow: Some(Glow {
+                color: dvec3(1.0, 0.5, 0.2),
+                strength: 0.0,
+            }),
+            fog_density: 0.0,
+            ..Effects::default()
+        },
+        ..Options::default()
+    };
+    assert!(codegen::Effect::enabled(&options).is_empty());
+    let src = source(sphere(1.0), &options);
+    for absent in ["AO_SAMPLES", "SHADOW_STEPS", "GLOW_", "FOG_"] {
+        assert!(!src.contains(absent), "`{absent}` with nothing to do");
+    }
+}
