@@ -357,3 +357,19 @@ fn effects_that_cost_nothing_leave_no_code() {
         assert!(!src.contains(absent), "`{absent}` with nothing to do");
     }
 }
+
+#[test]
+fn a_custom_region_maps_exactly_its_own_lines() {
+    // Signature on line 9, body on lines 10 and 11, closing brace on 12.
+    let region = codegen::CustomRegion {
+        shape: "gyroid".into(),
+        first_line: 10,
+        lines: 2,
+    };
+    let mapped: Vec<Option<usize>> = (0..15).map(|line| region.body_line(line)).collect();
+    let mut expected = vec![None; 15];
+    for (line, body) in [(9, 0), (10, 1), (11, 2), (12, 3)] {
+        expected[line] = Some(body);
+    }
+    assert_eq!(mapped, expected);
+}
