@@ -373,3 +373,18 @@ fn a_custom_region_maps_exactly_its_own_lines() {
     }
     assert_eq!(mapped, expected);
 }
+
+#[test]
+fn hash_of_is_the_program_hash_and_tells_programs_apart() {
+    let a = source_of(sphere(1.0));
+    let b = source_of(sphere(2.0));
+    assert_eq!(codegen::KernelSource::hash_of(&a.source), a.hash);
+    assert_eq!(codegen::KernelSource::hash_of(&b.source), b.hash);
+    assert_ne!(a.hash, b.hash);
+    // FNV-1a of the empty string is its offset basis.
+    assert_eq!(codegen::KernelSource::hash_of(""), 0xcbf2_9ce4_8422_2325);
+}
+
+fn source_of(node: Node) -> codegen::KernelSource {
+    codegen::emit(&Scene::new(node).compile().unwrap(), &Options::default()).unwrap()
+}
