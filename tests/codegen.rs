@@ -388,3 +388,27 @@ fn hash_of_is_the_program_hash_and_tells_programs_apart() {
 fn source_of(node: Node) -> codegen::KernelSource {
     codegen::emit(&Scene::new(node).compile().unwrap(), &Options::default()).unwrap()
 }
+
+#[test]
+fn a_custom_shape_s_region_covers_its_body_exactly() {
+    let body = "real a = p.x;\nreal b = p.y;\nreal c = p.z;\nreturn length((real3)(a, b, c)) - r;";
+    let shape = fractal_sdf::scene::CustomShape::new(
+        "blob",
+        &[("r", fractal_sdf::scene::Rule::Positive)],
+        |p, a| p.length() - a[0],
+        body,
+    )
+    .unwrap();
+    let k = source_of(shape.node([0.5]));
+    let [region] = k.custom_regions.as_slice() else {
+        panic!("{:?}", k.custom_regions)
+    };
+    assert_eq!(region.lines, 4);
+    let lines: Vec<&str> = k.source.lines().collect();
+    // Lines are counted from 1: the body's first line is `first_line`.
+    let shown: Vec<&str> = (region.first_line..region.first_line + region.lines)
+        .map(|n| lines[n - 1].trim())
+        .collect();
+    assert_eq!(shown, body.lines().map(str::trim).collect::<Vec<_>>());
+    assert!(lines[region.first_line + region.lines - 1].trim() == "}");
+}
