@@ -10,7 +10,7 @@ mod hex_prism;
 
 use fractal_sdf::codegen::{self, Options, Target};
 use fractal_sdf::prelude::*;
-use fractal_sdf::render::DeviceSelector;
+use fractal_sdf::render::{DeviceInfo, DeviceKind, DeviceSelector};
 use fractal_sdf::scene::{CustomShape, Rule};
 use fractal_sdf::testing::{
     Check, check_device_matches_cpu, check_lipschitz, check_never_overestimates, point, point_pair,
@@ -50,14 +50,29 @@ proptest! {
     }
 }
 
+/// The relative tolerance of the prism's device results. On a CPU device
+/// (PoCL) the worst errors measured over the 2,000 points below are
+/// 2.4e-7 in F32 and 1.7e-16 in F64; the tolerances are about 40 and 60
+/// times those. GPUs are not measured here and keep 1e-4 and 1e-10, as in
+/// `tests/conformance.rs`.
+fn device_tolerance(precision: Precision, device: &DeviceInfo) -> f64 {
+    match (precision, device.kind) {
+        (Precision::F32, DeviceKind::Cpu) => 1e-5,
+        (Precision::F64, DeviceKind::Cpu) => 1e-14,
+        (Precision::F32, _) => 1e-4,
+        (Precision::F64, _) => 1e-10,
+    }
+}
+
 #[test]
 fn hex_prism_twin_matches_on_the_device() {
-    if gpu::device().is_none() {
+    let Some(device) = gpu::device() else {
         return;
-    }
+    };
     let points = random_points(2000, 1.5, 11);
     let node = prism(0.45, 0.3);
-    for (precision, tolerance) in [(Precision::F32, 1e-4), (Precision::F64, 1e-10)] {
+    for precision in [Precision::F32, Precision::F64] {
+        let tolerance = device_tolerance(precision, &device);
         check_device_matches_cpu(
             &node,
             &DeviceSelector::auto(),
@@ -91,7 +106,10 @@ fn an_overestimating_shape_is_caught() {
     let err =
         check_lipschitz(&node, 1.0, &[(dvec3(2.0, 0.0, 0.0), dvec3(2.5, 0.0, 0.0))]).unwrap_err();
     assert_eq!(err.check, Check::Lipschitz);
-    assert!((err.measured - 2.0).abs() < 1e-9, "{err}");
+    // The slope between the pair is (3 - 2) / 0.5, every value a small
+    // dyadic fraction: exact (measured 0); the tolerance admits a few
+    // roundings of 2.
+    assert!((err.measured - 2.0).abs() < 1e-14, "{err}");
 }
 
 #[test]
@@ -109,6 +127,9 @@ fn a_twin_that_drifted_from_its_reference_is_caught() {
     .unwrap()
     .node([0.5]);
     let points = random_points(100, 2.0, 3);
+    // The drift is 0.5 at every point of the cube [-2, 2]^3, where the
+    // reference distance is below 3: any relative tolerance below 0.16
+    // flags all 100 points; this one is the F32 tolerance a GPU gets above.
     let err = check_device_matches_cpu(
         &drifted,
         &DeviceSelector::auto(),

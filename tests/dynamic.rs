@@ -72,10 +72,13 @@ fn a_dynamic_power_uses_the_trigonometric_form_and_follows_its_value() {
     eval.set_param("power", 3.0).unwrap();
     let after = eval.distance(p);
     assert_ne!(before, after);
-    // The same as a baked power 3 (which takes the trig-free form).
+    // The same as a baked power 3 (which takes the trig-free form), up to
+    // the two forms' different roundings: measured 3.6e-16 relative at
+    // this point. The tolerance is about 55 times that, room for another
+    // platform's `sin` and `cos` rounding differently.
     let baked = cpu::Evaluator::new(&mandelbulb(3.0)).unwrap().distance(p);
     assert!(
-        relative_eq!(after, baked, max_relative = 1e-9),
+        relative_eq!(after, baked, max_relative = 2e-14),
         "{after} vs {baked}"
     );
 }
@@ -131,6 +134,9 @@ proptest! {
         eval.set_param("r", r0 + grow)?;
         let after = eval.distance(p);
         prop_assert!(after < before);
-        prop_assert!(relative_eq!(before - after, grow, epsilon = 1e-12));
+        // A few roundings of values below 6 (an ulp is 8.9e-16): measured
+        // worst 5.8e-16 over 256 cases (PROPTEST_RNG_SEED=20261201; 8.7e-16
+        // in three other seeds); the tolerance is about 11 times the larger.
+        prop_assert!(relative_eq!(before - after, grow, epsilon = 1e-14));
     }
 }

@@ -1,5 +1,5 @@
-//! Exact primitives equal their analytic distance within 1e-9 (in f64),
-//! alone and under translate, rotate and uniform scale. The analytic
+//! Exact primitives equal their analytic distance within [`TOLERANCE`]
+//! (in f64), alone and under translate, rotate and uniform scale. The analytic
 //! distances in `common::analytic` are derived independently of
 //! `cpu::sdf` (nearest points on segments, circles and triangles, 2D
 //! polygons for solids of revolution).
@@ -11,7 +11,12 @@ use fractal_sdf::prelude::*;
 use fractal_sdf::testing::{self, Failure, check_exact, point};
 use proptest::prelude::*;
 
-const TOLERANCE: f64 = 1e-9;
+/// The largest error allowed, relative to `max(1, |d|)`: the evaluator and
+/// the independent oracle compute the same distance by different
+/// formulas, each a few roundings. Measured worst 5.8e-15 over 184,000
+/// points across the tests below (PROPTEST_RNG_SEED=20261201; 5.9e-15 at
+/// most with seeds 1 to 3); the tolerance is about 17 times that.
+const TOLERANCE: f64 = 1e-13;
 
 /// The origin, points on the axes and near the shapes' surfaces.
 fn spicy_points() -> Vec<DVec3> {
@@ -104,14 +109,17 @@ fn known_values() {
         (capped_cone(1.0, 1.0, 0.0), dvec3(0.0, 2.0, 0.0), 1.0),
     ];
     for (node, p, expected) in cases {
+        // Distances up to 5, all but one (2 / sqrt(3)) exact in binary:
+        // measured 0 for the evaluator and the oracle alike; the tolerance
+        // is about 11 ulps of 5.
         let d = cpu::Evaluator::new(&node).unwrap().distance(p);
         assert!(
-            (d - expected).abs() < 1e-12,
+            (d - expected).abs() < 1e-14,
             "{node:?} at {p}: {d} != {expected}"
         );
         let independent = exact_distance(&node, p).unwrap();
         assert!(
-            (independent - expected).abs() < 1e-12,
+            (independent - expected).abs() < 1e-14,
             "{node:?}: oracle {independent}"
         );
     }
@@ -161,7 +169,9 @@ fn the_oracle_agrees_with_brute_force_on_the_ellipsoid_of_a_sphere() {
         dvec3(0.1, -0.2, 0.3),
         dvec3(0.0, 0.0, 0.9),
     ] {
+        // Bisection to the last bit: measured worst 4.4e-16 at these 3
+        // points; the tolerance is about 20 times that.
         let d = analytic::ellipsoid_distance(p, DVec3::splat(1.0));
-        assert!((d - (p.length() - 1.0)).abs() < 1e-12, "{p}: {d}");
+        assert!((d - (p.length() - 1.0)).abs() < 1e-14, "{p}: {d}");
     }
 }

@@ -12,7 +12,9 @@ mod gpu;
 use fractal_sdf::cpu::{self, Evaluator, MarchSettings, Ray};
 use fractal_sdf::metrics::psnr;
 use fractal_sdf::prelude::*;
-use fractal_sdf::render::{DeviceSelector, Frame, PointEvaluator, RenderOptions, Renderer};
+use fractal_sdf::render::{
+    DeviceInfo, DeviceKind, DeviceSelector, Frame, PointEvaluator, RenderOptions, Renderer,
+};
 
 /// A case: a name, its geometry, and its size (cameras scale with it).
 struct Case {
@@ -194,12 +196,18 @@ fn smoothing_of_zero_is_the_hard_operation() {
             assert_eq!(s.distance(p).to_bits(), h.distance(p).to_bits(), "{p}");
         }
     }
-    // A huge radius still gives a finite bound, at most k/4 below the hard one.
+    // A huge radius still gives a finite bound, at most k/4 below the hard
+    // one. The slack is for a few roundings of values up to 1e6 in the
+    // smooth minimum (about 45 ulps); measured, it was never needed: at
+    // every one of the 40 points the bound held with 2.5e-9 |h| to spare.
     let huge = Evaluator::new(&a().smooth_union(b(), 1e3)).unwrap();
     let hard = Evaluator::new(&a().union(b())).unwrap();
     for p in extreme_points(&hard, 1.0) {
         let (d, h) = (huge.distance(p), hard.distance(p));
-        assert!(d <= h && d >= h - 250.0 - 1e-9 * h.abs(), "{p}: {d} vs {h}");
+        assert!(
+            d <= h && d >= h - 250.0 - 1e-14 * h.abs(),
+            "{p}: {d} vs {h}"
+        );
     }
 }
 
@@ -219,8 +227,11 @@ fn scaling_scales_distances_exactly() {
                 for r in [0.3, 1.1, 2.5, 40.0] {
                     let p = u * r;
                     let (d, ds) = (unit.distance(p), scaled.distance(p * s));
-                    // One rounding of p / s, then of d * s.
-                    let tol = 1e-12 * s * (1.0 + d.abs());
+                    // One rounding of p / s, then of d * s: measured worst
+                    // 6.8e-17 (relative to s (1 + |d|)) over 256 points, 4
+                    // shapes and 2 scales; the tolerance is about 70 times
+                    // that.
+                    let tol = 5e-15 * s * (1.0 + d.abs());
                     assert!(
                         (ds - s * d).abs() <= tol,
                         "{name} x{s} at {p}: {ds} vs {}",
@@ -230,7 +241,10 @@ fn scaling_scales_distances_exactly() {
                         unit.distance_f32(p.as_vec3()),
                         scaled.distance_f32((p * s).as_vec3()),
                     );
-                    let tol32 = 1e-4 * s * (1.0 + f64::from(d32).abs());
+                    // The same in f32, with p * s rounded to f32 as well:
+                    // measured worst 1.9e-7 (the sponge); the tolerance is
+                    // about 50 times that.
+                    let tol32 = 1e-5 * s * (1.0 + f64::from(d32).abs());
                     let gap = (f64::from(ds32) - s * f64::from(d32)).abs();
                     assert!(gap <= tol32, "{name} x{s} f32 at {p}: {ds32} vs {d32}");
                 }
@@ -332,15 +346,28 @@ fn a_scene_scaled_by_a_million_renders_the_unit_image_in_f64() {
     let (unit, big) = (frame(1.0), frame(1e6));
     gpu::save("extremes_unit", &unit.image);
     gpu::save("extremes_scaled", &big.image);
-    assert_same_image(&unit, &big, "scaled by 1e6");
+    assert_same_image(&unit, &big, "scaled by 1e6", &device);
 }
 
-/// `other` shows what `unit` shows: PSNR at least 40 dB, the same hit
-/// mask, and enough of the bulb in view for that to mean something.
-fn assert_same_image(unit: &Frame, other: &Frame, what: &str) {
+/// The least PSNR of a moved or scaled render against the unit one. On a
+/// CPU device (PoCL) all three comparisons below measured bit-identical
+/// (infinite PSNR); 60 dB, as for the golden images, admits rounding-level
+/// differences on another host and fails a visible change. GPUs are not
+/// measured here and keep 40 dB.
+fn min_psnr(device: &DeviceInfo) -> f64 {
+    match device.kind {
+        DeviceKind::Cpu => 60.0,
+        _ => 40.0,
+    }
+}
+
+/// `other` shows what `unit` shows: PSNR at least [`min_psnr`], the same
+/// hit mask, and enough of the bulb in view for that to mean something.
+fn assert_same_image(unit: &Frame, other: &Frame, what: &str, device: &DeviceInfo) {
     let db = psnr(&unit.image, &other.image);
+    let min_db = min_psnr(device);
     eprintln!("{what}: {db:.1} dB");
-    assert!(db >= 40.0, "{what}: {db:.1} dB");
+    assert!(db >= min_db, "{what}: {db:.1} dB, below {min_db} dB");
     assert!(unit.coverage() > 0.2);
     assert_eq!(unit.hit, other.hit, "{what}");
 }
@@ -365,7 +392,7 @@ fn moved_mandelbulb(offset: DVec3, painted: bool) -> Scene {
 
 #[test]
 fn a_scene_ten_million_units_away_renders_the_unit_image_in_f32() {
-    let Some(_) = gpu::device() else { return };
+    let Some(device) = gpu::device() else { return };
     // At 1e7 an f32 can only hold multiples of 1: positions in world
     // coordinates would be useless. The renderer works relative to the
     // scene's outermost translation, moving the camera there in f64.
@@ -386,6 +413,11 @@ fn a_scene_ten_million_units_away_renders_the_unit_image_in_f32() {
     for painted in [false, true] {
         let (unit, moved) = (frame(DVec3::ZERO, painted), frame(far, painted));
         gpu::save("extremes_far_f32", &moved.image);
-        assert_same_image(&unit, &moved, &format!("moved by 3e7 (painted: {painted})"));
+        assert_same_image(
+            &unit,
+            &moved,
+            &format!("moved by 3e7 (painted: {painted})"),
+            &device,
+        );
     }
 }

@@ -61,8 +61,13 @@ fn random_scenes_build_and_render_without_nan() {
                 prop_assert!(n.iter().all(|c| c.is_finite()), "normal {:?} at {}", n, i);
                 if frame.hit[i] {
                     prop_assert!(frame.depth[i].is_finite() && frame.depth[i] >= 0.0);
+                    // The kernel's f32 `normalize`: measured worst 1.2e-7
+                    // (one f32 ulp) over 7,963 normals (PROPTEST_RNG_SEED=
+                    // 20261201; 1.8e-7 in three other seeds, on PoCL). The
+                    // tolerance is about 55 times the larger, room for a
+                    // GPU's `normalize` a few ulps off.
                     let len = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
-                    prop_assert!((len - 1.0).abs() < 1e-3, "normal length {} at {}", len, i);
+                    prop_assert!((len - 1.0).abs() < 1e-5, "normal length {} at {}", len, i);
                 }
             }
             Ok(())

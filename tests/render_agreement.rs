@@ -57,9 +57,13 @@ fn compare(renderer: &Renderer, frame: &Frame, scene: &Scene) -> (usize, usize) 
             let i = frame.index(x, y);
             let ray = pixel_ray(&scene.camera, w, h, x, y);
             let theirs = view.ray(f64::from(x) + 0.5, f64::from(y) + 0.5);
+            // The same ray from the same f64 inputs in another order of
+            // operations: measured worst 8.9e-16 (origins) and 3.3e-16
+            // (directions) over 10,944 pixels; the tolerance is about 10
+            // and 30 times those.
             assert!(
-                ray.origin.abs_diff_eq(theirs.origin, 1e-12)
-                    && ray.direction.abs_diff_eq(theirs.direction, 1e-12),
+                ray.origin.abs_diff_eq(theirs.origin, 1e-14)
+                    && ray.direction.abs_diff_eq(theirs.direction, 1e-14),
                 "pixel ({x}, {y}): {ray:?} from the camera, {theirs:?} from the viewport"
             );
             let reference = cpu::march(&eval, ray, &settings);
@@ -69,7 +73,9 @@ fn compare(renderer: &Renderer, frame: &Frame, scene: &Scene) -> (usize, usize) 
             if reference.hit && frame.hit[i] {
                 let t = reference.depth;
                 // Both marches locate the crossing to `hit_epsilon`
-                // footprints; float rounding may change a step.
+                // footprints; float rounding may change a step. Measured:
+                // at most 0.73 of this (orthographic, F64: 0.85 of the
+                // footprint term) and 0.0025 in the perspective F32 render.
                 let tolerance = 1e-4 * t + view.footprint(t) * settings_eps(renderer);
                 let error = (f64::from(frame.depth[i]) - t).abs();
                 worst = worst.max(error / tolerance);
@@ -99,13 +105,16 @@ fn hit_mask_and_depth_match_the_cpu_reference() {
     let (hits, depths) = compare(&renderer, &frame, &scene);
     eprintln!("disagreeing: {hits} hit masks, {depths} depths");
     assert_agreement(hits, depths);
-    // Misses have infinite depth and no normal; hits a unit normal.
+    // Misses have infinite depth and no normal; hits a unit normal, to the
+    // f32 `normalize`: measured worst 1.2e-7 (one f32 ulp) over 5,760
+    // hits; the tolerance is about 80 times that, room for a GPU's
+    // `normalize` a few ulps off.
     for i in 0..frame.hit.len() {
         let n = frame.normal[i];
         let len = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
         if frame.hit[i] {
             assert!(
-                frame.depth[i].is_finite() && (len - 1.0).abs() < 1e-3,
+                frame.depth[i].is_finite() && (len - 1.0).abs() < 1e-5,
                 "pixel {i}"
             );
         } else {
@@ -167,6 +176,9 @@ fn over_relaxation_finds_the_same_surface_in_fewer_steps() {
                 both += 1;
                 let t = f64::from(plain.depth[i]);
                 let gap = (f64::from(relaxed.depth[i]) - t).abs();
+                // Measured: gaps at most 0.49 of the first term, so the
+                // second, for the f32 depths' rounding (2^-24 t each), was
+                // never needed.
                 same_depth += usize::from(gap <= 2.0 * eps * view.footprint(t) + 1e-5 * t);
             }
         }
