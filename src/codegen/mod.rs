@@ -436,29 +436,24 @@ fn header(w: &mut writer::Writer, options: &Options) {
     w.line("");
 }
 
-/// Resolves the kernels' `#ifdef ENABLE_*` / `#else` / `#endif` blocks:
-/// keeps the lines of features that are on and drops the rest, so a
-/// disabled effect leaves no code at all. Other directives pass through.
+/// Resolves the kernels' `#ifdef ENABLE_*` / `#endif` blocks (the kernels
+/// have no `#else`): keeps the lines of features that are on and drops the
+/// rest, so a disabled effect leaves no code at all. Other directives pass
+/// through.
 fn select_effects(kernel: &str, on: &[Effect]) -> String {
-    // One entry per open feature block: (is it being kept, was the
-    // enclosing text being kept).
-    let mut stack: Vec<(bool, bool)> = Vec::new();
+    // One entry per open feature block: whether the text around it was
+    // being kept.
+    let mut outer: Vec<bool> = Vec::new();
     let mut keep = true;
     let mut out = String::with_capacity(kernel.len());
     for line in kernel.lines() {
         let directive = line.trim_start();
         if let Some(name) = directive.strip_prefix("#ifdef ENABLE_") {
             let name = format!("ENABLE_{}", name.trim());
-            let taken = on.iter().any(|e| e.switch() == name);
-            stack.push((taken, keep));
-            keep = keep && taken;
-        } else if directive.starts_with("#else") && !stack.is_empty() {
-            let (taken, outer) = stack.last_mut().expect("checked non-empty");
-            *taken = !*taken;
-            keep = *outer && *taken;
-        } else if directive.starts_with("#endif") && !stack.is_empty() {
-            let (_, outer) = stack.pop().expect("checked non-empty");
-            keep = outer;
+            outer.push(keep);
+            keep = keep && on.iter().any(|e| e.switch() == name);
+        } else if directive.starts_with("#endif") && !outer.is_empty() {
+            keep = outer.pop().expect("checked non-empty");
         } else if keep {
             out.push_str(line);
             out.push('\n');
