@@ -68,6 +68,12 @@ fn nodes() -> Vec<(&'static str, Node)> {
             capsule(dvec3(-0.3, -0.5, 0.1), dvec3(0.4, 0.6, -0.2), 0.25),
         ),
         ("plane", plane(dvec3(0.2, 1.0, -0.3), 0.4)),
+        // A dynamic normal reaches the kernel as given and is normalised
+        // there.
+        (
+            "plane_dynamic_normal",
+            plane(param3("n", dvec3(0.4, 2.0, -0.6)), 0.4),
+        ),
         ("octahedron", octahedron(0.9)),
         ("capped_cone", capped_cone(0.6, 0.5, 0.2)),
         ("ellipsoid", ellipsoid(dvec3(0.7, 0.4, 0.5))),
