@@ -16,7 +16,8 @@ changed (a finite PSNR) or none did (every image identical: equivalent for
 what users see at that quality). Text snapshots are not judges: they
 would catch every mutant of the text without saying whether it matters.
 
-Usage: scripts/mutate_kernels.py [--sample N | --all] [--out DIR]
+Usage: scripts/mutate_kernels.py [--sample N | --all | --only FILE:LINE[:COLUMN] ...]
+                                 [--out DIR]
 """
 
 import argparse
@@ -30,7 +31,18 @@ import time
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent.parent
-JUDGES = ["conformance", "render_effects", "render_agreement", "smooth_oracle", "golden"]
+# The judges: every device test that checks what the kernels compute, not
+# their text. render_quality and render_sizes cover supersampling (jitter,
+# the AOVs' centre ray) and sizes that tiles do not divide.
+JUDGES = [
+    "conformance",
+    "render_effects",
+    "render_agreement",
+    "render_quality",
+    "render_sizes",
+    "smooth_oracle",
+    "golden",
+]
 TIMEOUT_S = 300
 
 SWAPS = [
@@ -134,13 +146,20 @@ def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--sample", type=int, default=60, help="mutants to run, spread evenly")
     parser.add_argument("--all", action="store_true", help="run every mutant")
+    parser.add_argument("--only", nargs="+", metavar="FILE:LINE[:COLUMN]",
+                        help="run the mutants of these lines (or columns) only")
     parser.add_argument("--out", default=str(ROOT / "target/mutants-kernels"))
     args = parser.parse_args()
 
     every = mutants()
-    chosen = every if args.all or args.sample >= len(every) else [
-        every[i * len(every) // args.sample] for i in range(args.sample)
-    ]
+    if args.only:
+        lines = set(args.only)
+        chosen = [m for m in every
+                  if f"{m[0]}:{m[1]}" in lines or f"{m[0]}:{m[1]}:{m[3] + 1}" in lines]
+    elif args.all or args.sample >= len(every):
+        chosen = every
+    else:
+        chosen = [every[i * len(every) // args.sample] for i in range(args.sample)]
     print(f"==> {len(every)} kernel mutants; running {len(chosen)}", flush=True)
     binaries = build()
     out = Path(args.out)
