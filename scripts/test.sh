@@ -2,8 +2,9 @@
 # The full check run by `make test` (and CI): format, lints, tests, docs.
 # Prints a header per step and the total wall time at the end.
 #
-# Every step uses the same features (`viewer` on), so the crate is compiled
-# once per mode.
+# Every step uses every feature (`--all-features`: the viewer's window and
+# the `proptest` testing toolkit, which the property tests require), so the
+# crate is compiled once per mode.
 set -euo pipefail
 
 CARGO=${CARGO:-cargo}
@@ -30,9 +31,9 @@ step "$CARGO" fmt --all -- --check
 step "$CARGO" clippy --all-targets --all-features -- -D warnings
 # The binary tests/viewer_smoke.rs runs (`cargo test` builds examples only as
 # test harnesses); the test profile shares the library build with the tests.
-step "$CARGO" build --profile test --features viewer --example viewer
-step "$CARGO" test --all-targets --features viewer
-step "$CARGO" test --doc --features viewer
+step "$CARGO" build --profile test --all-features --example viewer
+step "$CARGO" test --all-targets --all-features
+step "$CARGO" test --doc --all-features
 RUSTDOCFLAGS="-D warnings" step "$CARGO" doc --no-deps --features viewer
 
 if [ -s "$skipped" ]; then
