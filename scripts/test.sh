@@ -34,7 +34,9 @@ step "$CARGO" clippy --all-targets --all-features -- -D warnings
 step "$CARGO" build --profile test --all-features --example viewer
 step "$CARGO" test --all-targets --all-features
 step "$CARGO" test --doc --all-features
-RUSTDOCFLAGS="-D warnings" step "$CARGO" doc --no-deps --features viewer
+# The features docs.rs documents (`[package.metadata.docs.rs]`: all of them).
+# Its `--cfg docsrs` needs a nightly rustdoc, so it is left out here.
+RUSTDOCFLAGS="-D warnings" step "$CARGO" doc --no-deps --all-features
 
 if [ -s "$skipped" ]; then
     printf '\n==> checks skipped (see above):\n'

@@ -82,6 +82,9 @@
 //! );
 //! ```
 #![warn(missing_docs)]
+// On docs.rs (nightly rustdoc with `--cfg docsrs`), mark the items each
+// feature adds; an ordinary build never sets `docsrs`.
+#![cfg_attr(docsrs, feature(doc_cfg))]
 
 pub mod animation;
 pub mod codegen;
