@@ -28,6 +28,8 @@ export PROPTEST_RNG_SEED=${PROPTEST_RNG_SEED:-20261201}
 printf '==> proptest seed: PROPTEST_RNG_SEED=%s\n' "$PROPTEST_RNG_SEED"
 
 step "$CARGO" fmt --all -- --check
+# Every locked dependency's rust-version against ours (Cargo.toml).
+step bash scripts/msrv_check.sh
 step "$CARGO" clippy --all-targets --all-features -- -D warnings
 # The binary tests/viewer_smoke.rs runs (`cargo test` builds examples only as
 # test harnesses); the test profile shares the library build with the tests.
