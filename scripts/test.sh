@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# The full check run by `make test` (and CI): format, lints, tests, docs.
+# The full check run by `make test` (and CI): format, the minimum Rust
+# version, lints, tests, docs, and the crate as packaged for crates.io.
 # Prints a header per step and the total wall time at the end.
 #
 # Every step uses every feature (`--all-features`: the viewer's window and
@@ -39,6 +40,9 @@ step "$CARGO" test --doc --all-features
 # The features docs.rs documents (`[package.metadata.docs.rs]`: all of them).
 # Its `--cfg docsrs` needs a nightly rustdoc, so it is left out here.
 RUSTDOCFLAGS="-D warnings" step "$CARGO" doc --no-deps --all-features
+# The crate as published: built from its package, and the README's program
+# run against that package on the device.
+step bash scripts/package_check.sh
 
 if [ -s "$skipped" ]; then
     printf '\n==> checks skipped (see above):\n'
