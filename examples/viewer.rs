@@ -139,12 +139,12 @@ fn parse_args() -> Result<Option<Args>> {
     if !rest.is_empty() {
         return Err(common::usage(format!("unexpected arguments {rest:?}")));
     }
-    if let (Some(last), Some(n)) = (args.keys.last_frame(), args.frames) {
-        if last >= n {
-            return Err(common::usage(format!(
-                "--keys presses a key before frame {last}, but --frames renders frames 0..{n}"
-            )));
-        }
+    if let (Some(last), Some(n)) = (args.keys.last_frame(), args.frames)
+        && last >= n
+    {
+        return Err(common::usage(format!(
+            "--keys presses a key before frame {last}, but --frames renders frames 0..{n}"
+        )));
     }
     if args.screenshot.is_some() && args.frames.is_none() {
         return Err(common::usage("--screenshot needs --frames"));
@@ -362,14 +362,14 @@ impl Viewer {
             self.save_sharp(&path)?;
             println!("screenshot -> {}", path.display());
         }
-        if let Some(n) = self.args.frames {
-            if self.frame >= n {
-                if let Some(path) = self.args.screenshot.clone() {
-                    self.save_sharp(&path)?;
-                    println!("{n} frames -> {}", path.display());
-                }
-                event_loop.exit();
+        if let Some(n) = self.args.frames
+            && self.frame >= n
+        {
+            if let Some(path) = self.args.screenshot.clone() {
+                self.save_sharp(&path)?;
+                println!("{n} frames -> {}", path.display());
             }
+            event_loop.exit();
         }
         let busy = self.headless() || changing || self.keys.is_moving() || divisor.is_some();
         self.idle = !busy;
@@ -485,10 +485,10 @@ impl ApplicationHandler for Viewer {
                 if self.keys.set(key, pressed) || !pressed || event.repeat {
                     return;
                 }
-                if let Some(action) = Action::for_key(key) {
-                    if let Err(e) = self.act(action, event_loop) {
-                        self.fail(event_loop, e);
-                    }
+                if let Some(action) = Action::for_key(key)
+                    && let Err(e) = self.act(action, event_loop)
+                {
+                    self.fail(event_loop, e);
                 }
             }
             WindowEvent::MouseInput {

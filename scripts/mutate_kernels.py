@@ -104,7 +104,7 @@ def mutants():
 
 def build():
     """Builds the judging test binaries once; returns {name: path}."""
-    args = ["cargo", "test", "--no-run", "--features", "viewer", "--message-format=json"]
+    args = ["cargo", "test", "--no-run", "--all-features", "--message-format=json"]
     for judge in JUDGES:
         args += ["--test", judge]
     out = subprocess.run(args, cwd=ROOT, check=True, capture_output=True, text=True).stdout

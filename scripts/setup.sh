@@ -12,6 +12,7 @@ REQUIRED_PACKAGES=(
     clinfo             # lists OpenCL platforms/devices; used for the check below
     pkg-config
     python3            # scripts/mutate_kernels.py (`make mutants`)
+    jq                 # reads `cargo metadata` in scripts/msrv_check.sh
     # The viewer example's window (feature `viewer`) and its smoke test:
     xvfb               # a virtual X server, so the viewer runs without a display
     xdotool            # sends real key presses to the viewer's window
@@ -37,7 +38,7 @@ fi
 # --- System packages ----------------------------------------------------------
 if ! command -v dpkg-query >/dev/null 2>&1; then
     err "dpkg-query not found: this script supports Debian/Ubuntu only."
-    err "Install by hand: an OpenCL ICD loader, an OpenCL platform (e.g. PoCL), clinfo, pkg-config."
+    err "Install by hand: an OpenCL ICD loader, an OpenCL platform (e.g. PoCL), clinfo, pkg-config, jq."
     exit 1
 fi
 

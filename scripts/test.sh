@@ -1,9 +1,11 @@
 #!/usr/bin/env bash
-# The full check run by `make test` (and CI): format, lints, tests, docs.
+# The full check run by `make test` (and CI): format, the minimum Rust
+# version, lints, tests, docs, and the crate as packaged for crates.io.
 # Prints a header per step and the total wall time at the end.
 #
-# Every step uses the same features (`viewer` on), so the crate is compiled
-# once per mode.
+# Every step uses every feature (`--all-features`: the viewer's window and
+# the `proptest` testing toolkit, which the property tests require), so the
+# crate is compiled once per mode.
 set -euo pipefail
 
 CARGO=${CARGO:-cargo}
@@ -27,13 +29,20 @@ export PROPTEST_RNG_SEED=${PROPTEST_RNG_SEED:-20261201}
 printf '==> proptest seed: PROPTEST_RNG_SEED=%s\n' "$PROPTEST_RNG_SEED"
 
 step "$CARGO" fmt --all -- --check
+# Every locked dependency's rust-version against ours (Cargo.toml).
+step bash scripts/msrv_check.sh
 step "$CARGO" clippy --all-targets --all-features -- -D warnings
 # The binary tests/viewer_smoke.rs runs (`cargo test` builds examples only as
 # test harnesses); the test profile shares the library build with the tests.
-step "$CARGO" build --profile test --features viewer --example viewer
-step "$CARGO" test --all-targets --features viewer
-step "$CARGO" test --doc --features viewer
-RUSTDOCFLAGS="-D warnings" step "$CARGO" doc --no-deps --features viewer
+step "$CARGO" build --profile test --all-features --example viewer
+step "$CARGO" test --all-targets --all-features
+step "$CARGO" test --doc --all-features
+# The features docs.rs documents (`[package.metadata.docs.rs]`: all of them).
+# Its `--cfg docsrs` needs a nightly rustdoc, so it is left out here.
+RUSTDOCFLAGS="-D warnings" step "$CARGO" doc --no-deps --all-features
+# The crate as published: built from its package, and the README's program
+# run against that package on the device.
+step bash scripts/package_check.sh
 
 if [ -s "$skipped" ]; then
     printf '\n==> checks skipped (see above):\n'

@@ -44,7 +44,17 @@
 //! scenes and checkers for the distance invariants (Lipschitz bound, never
 //! overestimating, exactness), to property-test your own nodes.
 //!
+//! ## Features
+//!
+//! | feature | default | adds |
+//! |---|---|---|
+//! | `opencl` | on | `render`, the OpenCL executor, and rendering in [`sequence`]; needs an OpenCL loader to link and a platform to run |
+//! | `proptest` | off | `testing`, the property-testing toolkit |
+//! | `viewer` | off | the window of the repository's `viewer` example; nothing in the library |
+//!
 //! ## A tour
+//!
+//! ### Scenes
 //!
 //! Build a scene from a fractal and a smoothly blended pair of primitives,
 //! then ask the CPU reference for distances:
@@ -81,7 +91,84 @@
 //!     "union/b:torus: parameter `minor_radius` must be >= 0, got -0.2"
 //! );
 //! ```
+//!
+//! ### Rendering
+//!
+//! With the `opencl` feature (on by default), `render::Renderer` compiles a
+//! scene to OpenCL C, builds it for the first GPU (else the first OpenCL
+//! device; `FRACTAL_SDF_DEVICE` or a `DeviceSelector` chooses another) and
+//! ray-marches images in tiles. [`Quality`](quality::Quality) presets trade
+//! speed for accuracy; [`Effects`](quality::Effects) switch ambient
+//! occlusion, shadows and glow. The program is built once and cached.
+//!
+//! ```no_run
+//! # #[cfg(feature = "opencl")] {
+//! use fractal_sdf::prelude::*;
+//! use fractal_sdf::render::Renderer;
+//!
+//! let scene = Scene::new(mandelbulb(8.0).union(plane(dvec3(0.0, 1.0, 0.0), 1.2)))
+//!     .with_camera(Camera::look_at(dvec3(2.0, 1.4, 2.8), dvec3(0.0, -0.1, 0.0)));
+//! let mut renderer = Renderer::new(&scene, Quality::preview())?;
+//! let image = renderer.render(640, 480)?; // an image::RgbaImage
+//! fractal_sdf::output::save_png(&image, "out/bulb.png")?; // atomic write
+//! # }
+//! # Ok::<(), fractal_sdf::Error>(())
+//! ```
+//!
+//! Without an OpenCL platform, `Renderer::new` returns
+//! [`Error::NoPlatform`], whose message says what to install.
+//!
+//! ### Dynamic parameters
+//!
+//! Every number in a scene is either baked into the generated program (a
+//! plain `1.0`) or a named dynamic parameter (`param("radius", 1.0)`, see
+//! [`scene::param`]): a slot in a buffer, changed between frames without
+//! building a new program, and held to the same rules as a baked value. The CPU
+//! reference and the renderer (`Renderer::set_param`) take the same names;
+//! [`animation::Motion`] moves them with time.
+//!
+//! ```
+//! use fractal_sdf::prelude::*;
+//!
+//! let scene = Scene::new(sphere(param("radius", 1.0))).compile()?;
+//! let mut eval = cpu::Evaluator::from_compiled(&scene);
+//! assert!((eval.distance(dvec3(2.0, 0.0, 0.0)) - 1.0).abs() < 1e-12);
+//! eval.set_param("radius", 1.5)?;
+//! assert!((eval.distance(dvec3(2.0, 0.0, 0.0)) - 0.5).abs() < 1e-12);
+//! // A dynamic value gets the error a baked one would.
+//! assert!(eval.set_param("radius", -1.0).is_err());
+//! # Ok::<(), fractal_sdf::Error>(())
+//! ```
+//!
+//! ### Testing your own shapes
+//!
+//! With the `proptest` feature (usually in `[dev-dependencies]`, next to
+//! `proptest` itself), `testing` offers strategies that build only valid
+//! points, rays, nodes and scenes, and checkers for the invariants every
+//! distance estimate must keep: `check_lipschitz`,
+//! `check_never_overestimates`, `check_exact`, and (with `opencl`)
+//! `check_device_matches_cpu` for a shape's OpenCL twin. A checker returns
+//! the worst violation it found, which fails a proptest case:
+//!
+//! ```
+//! # #[cfg(feature = "proptest")] {
+//! use fractal_sdf::prelude::*;
+//! use fractal_sdf::testing::{check_lipschitz, point_pair};
+//! use proptest::prelude::*;
+//!
+//! proptest!(ProptestConfig::with_cases(8), |(
+//!     k in 0.0..0.5,
+//!     pairs in prop::collection::vec(point_pair(3.0, 0.5), 32),
+//! )| {
+//!     let shape = sphere(0.8).smooth_union(cuboid(dvec3(0.3, 1.0, 0.3)), k);
+//!     check_lipschitz(&shape, 1.0, &pairs)?;
+//! });
+//! # }
+//! ```
 #![warn(missing_docs)]
+// On docs.rs (nightly rustdoc with `--cfg docsrs`), mark the items each
+// feature adds; an ordinary build never sets `docsrs`.
+#![cfg_attr(docsrs, feature(doc_cfg))]
 
 pub mod animation;
 pub mod codegen;

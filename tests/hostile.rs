@@ -225,10 +225,10 @@ fn node_case(t: &mut Tally, what: &str, node: &Node, site: usize, value: f64, mo
     };
     let mut eval = Evaluator::from_compiled(&compiled);
     let mut values = compiled.default_values();
-    if mode == Mode::DynamicSet {
-        if let Err(e) = eval.set_param("h", value) {
-            return t.refused(what, &e, &label, &names);
-        }
+    if mode == Mode::DynamicSet
+        && let Err(e) = eval.set_param("h", value)
+    {
+        return t.refused(what, &e, &label, &names);
     }
     t.accepted += 1;
     // F32: what an F32 program and its uploads accept.

@@ -4,7 +4,7 @@
 //! are not blank.
 //!
 //! Needs the example binary, built by `cargo build --profile test
-//! --features viewer --example viewer` (as `make test` does first), and
+//! --all-features --example viewer` (as `make test` does first), and
 //! `Xvfb` and `xdotool` (`make setup` installs them). Without them the tests print a note and
 //! pass, except under `CI=true`, where they fail.
 #![cfg(feature = "viewer")]
@@ -27,7 +27,7 @@ fn in_ci() -> bool {
     std::env::var("CI").is_ok_and(|v| v == "true" || v == "1")
 }
 
-const BUILD: &str = "cargo build --profile test --features viewer --example viewer";
+const BUILD: &str = "cargo build --profile test --all-features --example viewer";
 
 /// The newest modification time of the file `path` or of the files under
 /// it.

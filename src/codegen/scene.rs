@@ -400,20 +400,19 @@ impl<'a> SceneEmitter<'a> {
             }
             None => ir.node(id),
         };
-        if self.frame == Some(id) {
-            if let Kind::Translate { child, .. } = node {
-                return Step::Descend(vec![(*child, p.to_string(), needs_color)]);
-            }
+        if self.frame == Some(id)
+            && let Kind::Translate { child, .. } = node
+        {
+            return Step::Descend(vec![(*child, p.to_string(), needs_color)]);
         }
         if let Kind::Csg {
             op: CsgOp::Union,
             smoothing: None,
             ..
         } = node
+            && let Some(step) = self.instanced_union(id, p, needs_color)
         {
-            if let Some(step) = self.instanced_union(id, p, needs_color) {
-                return step;
-            }
+            return step;
         }
         if !matches!(
             node,

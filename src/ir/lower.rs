@@ -465,15 +465,15 @@ impl Mapper<Scalar, Vector, usize> for Children<'_> {
 /// Checks what is not a parameter: iteration ranges, rotation axes and a
 /// custom shape's argument count.
 fn check_structure(kind: &NodeKind, path: impl Fn() -> String) -> Result<()> {
-    if let (Some(value), Some((min, max))) = (kind.iterations(), kind.iteration_range()) {
-        if !(min..=max).contains(&value) {
-            return Err(Error::Iterations {
-                node: path(),
-                value,
-                min,
-                max,
-            });
-        }
+    if let (Some(value), Some((min, max))) = (kind.iterations(), kind.iteration_range())
+        && !(min..=max).contains(&value)
+    {
+        return Err(Error::Iterations {
+            node: path(),
+            value,
+            min,
+            max,
+        });
     }
     let zero = |param: &str| Error::ZeroVector {
         node: path(),
