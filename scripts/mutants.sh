@@ -27,7 +27,7 @@ fi
 
 shard=()
 if [ "$MUTANTS_SHARD" != all ]; then
-    shard=(--shard "$MUTANTS_SHARD")
+    shard=(--shard "$MUTANTS_SHARD" --sharding round-robin)
 fi
 printf '==> Rust mutants (%s)\n' "$MUTANTS_SHARD"
 # cargo-mutants exits non-zero when a mutant survives; the summary says how
