@@ -5,8 +5,8 @@
 #   Rust: cargo-mutants over src/cpu, src/ir, src/codegen and src/testing
 #         (.cargo/mutants.toml), each mutant judged by the test files that
 #         exercise that code. Every mutant takes a rebuild, so by default one
-#         shard in MUTANTS_SHARDS (an evenly spread sample) runs:
-#         MUTANTS_SHARD=0/20. MUTANTS_SHARD=all runs every mutant.
+#         round-robin shard of 20 (every 20th mutant, spread over every
+#         file) runs: MUTANTS_SHARD=0/20. MUTANTS_SHARD=all runs them all.
 #   Kernels: scripts/mutate_kernels.py, KERNEL_SAMPLE mutants (default 60;
 #         "all" for every one) spread evenly over kernels/.
 #
