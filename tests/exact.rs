@@ -181,11 +181,18 @@ fn the_oracle_agrees_with_brute_force_on_the_ellipsoid_of_a_sphere() {
 #[test]
 fn f32_distances_and_normals() {
     let eval = cpu::Evaluator::new(&sphere(1.0).translate(dvec3(0.5, 0.0, 0.0))).unwrap();
-    for p in [dvec3(2.0, 1.0, -1.0), dvec3(0.5, 0.2, 0.0), dvec3(-3.0, 0.0, 0.25)] {
+    for p in [
+        dvec3(2.0, 1.0, -1.0),
+        dvec3(0.5, 0.2, 0.0),
+        dvec3(-3.0, 0.0, 0.25),
+    ] {
         let expected = (p - dvec3(0.5, 0.0, 0.0)).length() - 1.0;
         let d32 = eval.distance_f32(p.as_vec3());
         // f32 arithmetic on f32-rounded inputs: a few ulps of values near 3.
-        assert!((f64::from(d32) - expected).abs() < 1e-6, "{p}: {d32} vs {expected}");
+        assert!(
+            (f64::from(d32) - expected).abs() < 1e-6,
+            "{p}: {d32} vs {expected}"
+        );
         let n = eval.normal(p, 1e-5);
         let outward = (p - dvec3(0.5, 0.0, 0.0)).normalize();
         // Central differences of an exact distance: error O(h^2).

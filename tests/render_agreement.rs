@@ -211,3 +211,38 @@ fn assert_agreement(hits: usize, depths: usize) {
         "{depths} depths disagree where both hit (at most {ALLOWED_MISMATCHES} may)"
     );
 }
+
+/// With supersampling the colour samples are jittered, but the AOVs trace
+/// the pixel's centre: the same depth, hit and normal as one sample per
+/// pixel, bit for bit (the same ray through the same program).
+#[test]
+fn supersampled_aovs_trace_the_pixel_centre() {
+    let Some(_) = gpu::device() else { return };
+    let scene = gpu::sphere_box_floor();
+    let frame = |supersampling: u32| {
+        let quality = Quality {
+            supersampling,
+            ..Quality::production()
+        };
+        let mut r =
+            Renderer::with_options(&scene, &gpu::options(quality, Effects::none())).unwrap();
+        r.render_with_aovs(48, 32).unwrap()
+    };
+    let (one, four) = (frame(1), frame(2));
+    let differ = |a: &[f32], b: &[f32]| {
+        a.iter()
+            .zip(b)
+            .filter(|(x, y)| x.to_bits() != y.to_bits())
+            .count()
+    };
+    assert!(one.hit == four.hit, "hit masks differ");
+    assert_eq!(
+        differ(&one.depth, &four.depth),
+        0,
+        "pixels whose depth differs"
+    );
+    let (n1, n4): (Vec<f32>, Vec<f32>) = (one.normal.concat(), four.normal.concat());
+    assert_eq!(differ(&n1, &n4), 0, "normal components that differ");
+    // The colours differ: the jittered samples smooth the edges.
+    assert_ne!(one.image, four.image);
+}
