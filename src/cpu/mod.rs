@@ -385,8 +385,8 @@ pub struct Ray {
 /// distance falls to `detail` footprints; the march steps by the distance
 /// to that surface, no shorter than `hit_epsilon` footprints, and locates
 /// the crossing to `hit_epsilon` footprints along the ray.
-/// [`Viewport::march_settings`](crate::render::Viewport::march_settings)
-/// gives the settings of a rendered image.
+/// `render::Viewport::march_settings` (feature `opencl`) gives the
+/// settings of a rendered image.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct MarchSettings {
     /// Give up after this many steps (`MAX_STEPS`).
