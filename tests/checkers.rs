@@ -103,3 +103,55 @@ fn near_surface_points_lie_near_the_surface() {
     // A set that fills none of the ball gives no points, not a loop.
     assert!(near_surface_points(|_| false, 1.0, 0.1, 10, 1).is_empty());
 }
+
+#[test]
+fn a_failure_counts_what_was_checked_and_what_broke() {
+    // Twice the sphere's distance overestimates at every point outside.
+    let points = near_surface_points(unit_ball, 2.0, 0.5, 64, 9);
+    let outside = points.iter().filter(|&&p| !unit_ball(p)).count();
+    let err =
+        check_never_overestimates(&|p: DVec3| 2.0 * (p.length() - 1.0), unit_ball, &points, 16)
+            .unwrap_err();
+    assert_eq!((err.violations, err.checked), (outside, outside), "{err}");
+    assert!(
+        err.to_string()
+            .contains(&format!("{outside} of {outside} balls fail")),
+        "{err}"
+    );
+}
+
+#[test]
+fn spicy_points_cover_both_ends_of_each_axis() {
+    let points = fractal_sdf::testing::spicy_points();
+    let on_an_axis = |p: &&DVec3| p.to_array().iter().filter(|&&c| c != 0.0).count() == 1;
+    for p in points.iter().filter(on_an_axis) {
+        assert!(points.contains(&-*p), "{p} without {}", -*p);
+    }
+    assert!(points.contains(&DVec3::new(-1e6, 0.0, 0.0)));
+}
+
+#[test]
+fn unit_vectors_are_uniform_on_the_sphere() {
+    use proptest::strategy::{Strategy, ValueTree};
+    use proptest::test_runner::{Config, TestRng, TestRunner};
+    let mut runner = TestRunner::new_with_rng(
+        Config::default(),
+        TestRng::deterministic_rng(Config::default().rng_algorithm),
+    );
+    let strategy = fractal_sdf::testing::unit_vector();
+    let n = 4000;
+    let (mut mean, mut abs_z) = (DVec3::ZERO, 0.0);
+    for _ in 0..n {
+        let u = strategy.new_tree(&mut runner).unwrap().current();
+        assert!((u.length() - 1.0).abs() < 1e-12);
+        mean += u;
+        abs_z += u.z.abs();
+    }
+    #[allow(clippy::cast_precision_loss)]
+    let (mean, abs_z) = (mean / n as f64, abs_z / n as f64);
+    // Uniform on the sphere: mean 0 and E|z| = 1/2 (z is uniform in
+    // [-1, 1]); 4,000 samples put each within about 0.02 (three standard
+    // errors).
+    assert!(mean.length() < 0.05, "mean {mean}");
+    assert!((abs_z - 0.5).abs() < 0.02, "E|z| = {abs_z}");
+}

@@ -416,3 +416,22 @@ fn a_custom_shape_s_region_covers_its_body_exactly() {
     assert_eq!(shown, body.lines().map(str::trim).collect::<Vec<_>>());
     assert!(lines[region.first_line + region.lines - 1].trim() == "}");
 }
+
+#[test]
+fn a_custom_parameter_named_like_the_program_s_own_functions_is_refused() {
+    // `smooth_min` is a helper of the program: not an OpenCL word, so the shape
+    // is made, but the program it would join refuses it.
+    let shape = fractal_sdf::scene::CustomShape::new(
+        "blob",
+        &[("smooth_min", fractal_sdf::scene::Rule::Positive)],
+        |p, a| p.length() - a[0],
+        "return length(p) - smooth_min;",
+    )
+    .unwrap();
+    let compiled = Scene::new(shape.node([0.5])).compile().unwrap();
+    let err = codegen::emit(&compiled, &Options::default()).unwrap_err();
+    assert!(
+        err.to_string().contains("smooth_min") && err.to_string().contains("generated program"),
+        "{err}"
+    );
+}
