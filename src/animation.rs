@@ -284,7 +284,8 @@ fn catmull_rom(
 /// };
 /// assert_eq!(breathe.values(1.0), [("power".to_string(), 10.0)]);
 /// ```
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub enum Motion {
     /// `name` = `center` + `amplitude` · sin(2π t / `period`).
     Oscillate {

@@ -96,6 +96,26 @@ pub enum Error {
         /// What is wrong with it.
         reason: String,
     },
+    /// A scene file cannot be read: a syntax error, an unknown node, field
+    /// or custom shape, an unsupported format version, or a value that
+    /// does not validate.
+    #[error("{}:{line}:{column}: {reason}", file.display())]
+    SceneFile {
+        /// The file, or `<scene>` for text read with
+        /// [`SceneFile::parse`](crate::scene::SceneFile::parse).
+        file: PathBuf,
+        /// The line of the offending text, from 1.
+        line: usize,
+        /// The column (in characters) of the offending text, from 1.
+        column: usize,
+        /// What is wrong, with the node's path in the scene tree where a
+        /// node's value is wrong (`union/b:translate/sphere: ...`).
+        reason: String,
+        /// The validation error, where the file parsed but a value is
+        /// wrong (a scene built in Rust with that value gives this error).
+        #[source]
+        cause: Option<Box<Error>>,
+    },
     /// The scene has no geometry.
     #[error("the scene is empty: add geometry with `Scene::new(node)` or `Scene::add`")]
     EmptyScene,

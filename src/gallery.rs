@@ -16,10 +16,11 @@ use glam::{DVec3, dvec3};
 
 use crate::animation::{CameraPath, Motion};
 use crate::error::Result;
+use crate::quality::{Effects, Glow, Quality};
 use crate::scene::{
-    Axis, Camera, Light, Mandelbulb, Node, QuaternionJulia, Scene, capped_cone, capsule, cuboid,
-    cylinder, ellipsoid, julia, menger, octahedron, param, param3, plane, round_box, sierpinski,
-    sphere, torus,
+    Axis, Camera, Light, Mandelbulb, Node, QuaternionJulia, Scene, SceneFile, capped_cone, capsule,
+    cuboid, cylinder, ellipsoid, julia, menger, octahedron, param, param3, plane, round_box,
+    sierpinski, sphere, torus,
 };
 
 /// Every gallery scene by name.
@@ -67,6 +68,23 @@ pub fn motions(name: &str) -> Vec<Motion> {
         }],
         _ => Vec::new(),
     }
+}
+
+/// The gallery's scene `name` as a scene file: the scene, production
+/// quality with 2×2 supersampling, the default effects with a pale blue
+/// glow, its [`motions`], and for `benchmark` its [`benchmark_path`]. The
+/// crate's `scenes/` folder holds these files (`scenes/NAME.ron`), as
+/// [`SceneFile::to_text`] writes them.
+#[must_use]
+pub fn file(name: &str) -> Option<SceneFile> {
+    let scene = by_name(name)?;
+    Some(SceneFile {
+        scene,
+        quality: Quality::production().supersampling(2),
+        effects: Effects::default().glow(Glow::new(dvec3(0.6, 0.75, 1.0), 0.6)),
+        path: (name == "benchmark").then(|| benchmark_path().expect("a constant path")),
+        motions: motions(name),
+    })
 }
 
 /// The gallery scene called `name`, if there is one.

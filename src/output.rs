@@ -61,7 +61,6 @@ use crate::error::{Error, Result};
 /// with a zero side, which PNG cannot hold.
 pub fn save_png(image: &RgbaImage, path: impl AsRef<Path>) -> Result<()> {
     let target = path.as_ref();
-    let fail = |action: String| move |source| Error::io(target, action, source);
     if image.width() == 0 || image.height() == 0 {
         return Err(Error::Resolution {
             width: image.width(),
@@ -72,9 +71,23 @@ pub fn save_png(image: &RgbaImage, path: impl AsRef<Path>) -> Result<()> {
             ),
         });
     }
+    write_atomic(target, "image", |file| encode(image, file))
+}
+
+/// Writes a file the way [`save_png`] does: into a temporary file beside
+/// `target`, synced, then renamed over it, so that the file is either
+/// whole or absent; through symbolic links; into devices and FIFOs as a
+/// shell redirection would. `what` names the content in errors (`"image"`,
+/// `"scene"`).
+pub(crate) fn write_atomic(
+    target: &Path,
+    what: &str,
+    write: impl Fn(&File) -> io::Result<()>,
+) -> Result<()> {
+    let fail = |action: String| move |source| Error::io(target, action, source);
     match fs::metadata(target) {
         Ok(m) if m.is_dir() => {
-            return Err(fail("cannot replace a directory with an image".into())(
+            return Err(fail(format!("cannot replace a directory with the {what}"))(
                 io::Error::new(io::ErrorKind::IsADirectory, "it is a directory"),
             ));
         }
@@ -84,16 +97,15 @@ pub fn save_png(image: &RgbaImage, path: impl AsRef<Path>) -> Result<()> {
                 .write(true)
                 .open(target)
                 .map_err(fail("cannot open it for writing".into()))?;
-            return encode(image, &file).map_err(fail("cannot write the image".into()));
+            return write(&file).map_err(fail(format!("cannot write the {what}")));
         }
         _ => {}
     }
     let file = resolve_links(target).map_err(fail("cannot follow the symbolic link".into()))?;
     if file.file_name().is_none() {
-        return Err(fail("cannot save an image there".into())(io::Error::new(
-            io::ErrorKind::InvalidInput,
-            "the path names no file",
-        )));
+        return Err(fail(format!("cannot save the {what} there"))(
+            io::Error::new(io::ErrorKind::InvalidInput, "the path names no file"),
+        ));
     }
     let through = if file == target {
         String::new()
@@ -115,14 +127,14 @@ pub fn save_png(image: &RgbaImage, path: impl AsRef<Path>) -> Result<()> {
             at.display()
         ))(e)
     })?;
-    encode(image, &temp.file)
+    write(&temp.file)
         .and_then(|()| temp.file.sync_all())
         .map_err(fail(format!(
-            "cannot write the image (to the temporary file {}){through}",
+            "cannot write the {what} (to the temporary file {}){through}",
             temp.path.display()
         )))?;
     temp.persist(&file).map_err(fail(format!(
-        "cannot replace the file with the new image{through}"
+        "cannot replace the file with the new {what}{through}"
     )))
 }
 

@@ -7,12 +7,13 @@
 //! bounds every scene value, camera, light, knob and effect setting keeps.
 
 use glam::DVec3;
+use serde::{Deserialize, Serialize};
 
 use crate::error::{Error, Result};
 use crate::math::{F32_LIMITS, F64_LIMITS, Limits, Magnitude};
 
 /// Floating-point precision of the generated kernel.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default, Serialize, Deserialize)]
 pub enum Precision {
     /// 32-bit floats: fastest, every device supports them.
     #[default]
@@ -437,7 +438,8 @@ impl Default for Quality {
 }
 
 /// Glow around surfaces, from how closely a ray passed them.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct Glow {
     /// Linear RGB colour of the glow.
     pub color: DVec3,
@@ -454,7 +456,8 @@ impl Glow {
 }
 
 /// Lighting effects. Each one that is off is left out of the kernel.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
 pub struct Effects {
     /// Ambient occlusion (needs [`Quality::ao_samples`] > 0).
     pub ambient_occlusion: bool,
@@ -672,7 +675,7 @@ impl Effects {
 }
 
 /// The named quality presets, in increasing cost.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default, Serialize, Deserialize)]
 pub enum Preset {
     /// [`Quality::draft`].
     Draft,

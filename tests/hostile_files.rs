@@ -237,7 +237,7 @@ fn unwritable_targets_are_errors_naming_the_target() {
     fs::create_dir_all(dir.join("taken.png/inner")).unwrap();
     let target = dir.join("taken.png");
     let err = save_png(&picture(2, 2), &target).unwrap_err();
-    io_error_naming(&err, &target, "cannot replace a directory with an image");
+    io_error_naming(&err, &target, "cannot replace a directory with the image");
     assert!(dir.join("taken.png/inner").is_dir());
     // A file system that takes no new files.
     if Path::new("/proc/self").exists() {

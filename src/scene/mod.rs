@@ -6,17 +6,20 @@
 
 pub mod build;
 mod custom;
+mod file;
 pub(crate) mod names;
 mod node;
 mod param;
 
 use glam::DVec3;
+use serde::{Deserialize, Serialize};
 
 pub use build::{
     capped_cone, capsule, cuboid, cylinder, ellipsoid, julia, mandelbulb, menger, octahedron,
     plane, round_box, sierpinski, sphere, torus,
 };
 pub use custom::{CpuDistance, CustomShape};
+pub use file::{FORMAT_VERSION, MAX_NESTING, SceneFile};
 pub(crate) use node::Mapper;
 pub use node::{
     Axis, CsgOp, Kind, MAX_ESCAPE_ITERATIONS, MAX_FOLD_ITERATIONS, Mandelbulb, Menger, Node,
@@ -28,7 +31,8 @@ use crate::error::{Error, Result, fmt_value};
 use crate::math::{F64_LIMITS, Magnitude, normalize};
 
 /// How the camera projects the scene.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub enum Projection {
     /// Perspective with a vertical field of view in degrees, in (0, 180).
     Perspective {
@@ -43,7 +47,8 @@ pub enum Projection {
 }
 
 /// A look-at camera.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
 pub struct Camera {
     /// Where the camera is.
     pub position: DVec3,
@@ -175,7 +180,8 @@ impl Default for Camera {
 }
 
 /// Where light comes from.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub enum LightSource {
     /// Parallel light, like the sun; `direction` points from the scene
     /// towards the light.
@@ -191,20 +197,42 @@ pub enum LightSource {
 }
 
 /// A light with colour, intensity and shadow softness.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct Light {
     /// Directional or point.
     pub source: LightSource,
     /// Linear RGB colour, each component at least 0.
+    #[serde(default = "white")]
     pub color: DVec3,
     /// Brightness multiplier, at least 0.
+    #[serde(default = "one")]
     pub intensity: f64,
     /// Soft-shadow penumbra width: 0 gives hard shadows, larger values give
     /// wider penumbrae (0.05 is a good start).
+    #[serde(default = "default_softness")]
     pub softness: f64,
 }
 
+/// A light's colour when a scene file leaves it out.
+fn white() -> DVec3 {
+    DVec3::ONE
+}
+
+/// A light's intensity when a scene file leaves it out.
+fn one() -> f64 {
+    1.0
+}
+
+/// A light's softness when a scene file leaves it out, as the builders set.
+fn default_softness() -> f64 {
+    Light::DEFAULT_SOFTNESS
+}
+
 impl Light {
+    /// The penumbra width the builders give a light.
+    pub const DEFAULT_SOFTNESS: f64 = 0.05;
+
     /// A white directional light shining from `direction`.
     #[must_use]
     pub fn directional(direction: impl Into<DVec3>) -> Self {
@@ -214,7 +242,7 @@ impl Light {
             },
             color: DVec3::ONE,
             intensity: 1.0,
-            softness: 0.05,
+            softness: Light::DEFAULT_SOFTNESS,
         }
     }
 
@@ -227,7 +255,7 @@ impl Light {
             },
             color: DVec3::ONE,
             intensity: 1.0,
-            softness: 0.05,
+            softness: Light::DEFAULT_SOFTNESS,
         }
     }
 

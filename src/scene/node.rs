@@ -21,7 +21,7 @@ pub const MAX_ESCAPE_ITERATIONS: u32 = 256;
 pub const MAX_FOLD_ITERATIONS: u32 = 20;
 
 /// A coordinate axis.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize)]
 pub enum Axis {
     /// The x axis.
     X,

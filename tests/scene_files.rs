@@ -1,0 +1,321 @@
+//! Scene files: every gallery scene survives a round trip (the same value,
+//! and the same image on the device), the shipped `scenes/*.ron` are the
+//! gallery as written today, and every kind of bad file is an error that
+//! names the line and column of what is wrong.
+//!
+//! `UPDATE_SCENES=1 cargo test --test scene_files` rewrites `scenes/`.
+
+mod gpu;
+
+use std::path::{Path, PathBuf};
+
+use fractal_sdf::gallery;
+use fractal_sdf::prelude::*;
+use fractal_sdf::scene::{CustomShape, MAX_NESTING, Rule, SceneFile};
+
+fn scenes_dir() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes")
+}
+
+#[test]
+fn every_gallery_scene_round_trips_to_an_equal_value() {
+    for name in gallery::names() {
+        let file = gallery::file(name).unwrap();
+        let text = file.to_text().unwrap();
+        let back = SceneFile::parse(&text).unwrap_or_else(|e| panic!("{name}: {e}\n{text}"));
+        assert_eq!(back, file, "{name}:\n{text}");
+        // Writing is stable: the text of what was read is the same text.
+        assert_eq!(back.to_text().unwrap(), text, "{name}");
+    }
+}
+
+#[test]
+fn the_shipped_scene_files_are_the_gallery() {
+    let update = std::env::var_os("UPDATE_SCENES").is_some();
+    for name in gallery::names() {
+        let path = scenes_dir().join(format!("{name}.ron"));
+        let expected = gallery::file(name).unwrap();
+        if update {
+            expected.save(&path).unwrap();
+        }
+        let loaded = SceneFile::load(&path).unwrap_or_else(|e| {
+            panic!("{e} (run `UPDATE_SCENES=1 cargo test --test scene_files`)")
+        });
+        assert_eq!(loaded, expected, "{} is out of date", path.display());
+    }
+}
+
+/// A file's scene read back renders the identical image: same source, same
+/// buffers, same pixels.
+#[test]
+fn a_round_trip_renders_the_identical_image() {
+    let Some(_device) = gpu::device() else {
+        return;
+    };
+    for name in gallery::names() {
+        let file = gallery::file(name).unwrap();
+        let back = SceneFile::parse(&file.to_text().unwrap()).unwrap();
+        let render = |f: &SceneFile| {
+            let options = fractal_sdf::render::RenderOptions {
+                quality: Quality::draft(),
+                effects: f.effects,
+                ..Default::default()
+            };
+            fractal_sdf::render::Renderer::with_options(&f.scene, &options)
+                .and_then(|mut r| r.render(40, 30))
+                .unwrap_or_else(|e| panic!("{name}: {e}"))
+        };
+        let (a, b) = (render(&file), render(&back));
+        assert!(
+            a.pixels().any(|p| p.0 != a.get_pixel(0, 0).0),
+            "{name} is blank"
+        );
+        assert_eq!(a.as_raw(), b.as_raw(), "{name}: the images differ");
+    }
+}
+
+/// Parses `text` and returns the error's (line, column, message).
+fn error_at(text: &str) -> (usize, usize, String) {
+    match SceneFile::parse(text) {
+        Ok(_) => panic!("accepted:\n{text}"),
+        Err(e @ Error::SceneFile { .. }) => {
+            let Error::SceneFile { line, column, .. } = e else {
+                unreachable!()
+            };
+            (line, column, e.to_string())
+        }
+        Err(other) => panic!("not a scene-file error: {other}"),
+    }
+}
+
+/// The (line, column) where `needle` starts in `text`.
+fn position_of(text: &str, needle: &str) -> (usize, usize) {
+    let at = text.find(needle).expect("the needle is in the text");
+    let line = text[..at].matches('\n').count() + 1;
+    let column = text[..at].rsplit('\n').next().unwrap().chars().count() + 1;
+    (line, column)
+}
+
+#[test]
+fn a_bad_value_is_located_at_its_node_with_its_path() {
+    let text = "(
+    version: 1,
+    geometry: Union([
+        Sphere(radius: 1),
+        Translate(
+            offset: (1, 0, 0),
+            child: Torus(major_radius: 0.5, minor_radius: -0.1),
+        ),
+    ]),
+)";
+    let (line, column, message) = error_at(text);
+    assert_eq!((line, column), position_of(text, "Torus"), "{message}");
+    assert!(
+        message.contains("union/b:translate/torus: parameter `minor_radius` must be >= 0"),
+        "{message}"
+    );
+    assert!(message.starts_with("<scene>:7:20: "), "{message}");
+}
+
+#[test]
+fn each_operand_of_a_long_union_is_located() {
+    let mut text = String::from("(version: 1, geometry: Union([\n");
+    for i in 0..40 {
+        let radius = if i == 27 { "NaN" } else { "0.1" };
+        text.push_str(&format!(
+            "    Translate(offset: ({i}, 0, 0), child: Sphere(radius: {radius})),\n"
+        ));
+    }
+    text.push_str("]))\n");
+    let (line, column, message) = error_at(&text);
+    assert_eq!(
+        (line, column),
+        position_of(&text, "Sphere(radius: NaN"),
+        "{message}"
+    );
+    assert!(message.contains("must be finite"), "{message}");
+}
+
+#[test]
+fn settings_errors_are_located_at_the_setting() {
+    let cases = [
+        (
+            "camera: (position: (0, 0, 3), target: (0, 0, 3))",
+            "(position",
+            "target equals position",
+        ),
+        (
+            "lights: [(source: Directional(direction: (0, 1, 0))), (source: Point(position: (0, 1, 0)), intensity: -2)]",
+            "(source: Point",
+            "light[1]",
+        ),
+        (
+            "quality: (preset: Draft, max_steps: 0)",
+            "(preset",
+            "max_steps",
+        ),
+        ("effects: (gamma: -1)", "(gamma", "gamma"),
+        (
+            "path: [(time: 0, position: (0, 0, 3), target: (0, 0, 0)), (time: 0, position: (1, 0, 3), target: (0, 0, 0))]",
+            "[(time",
+            "camera path",
+        ),
+        (
+            "motions: [Oscillate(name: \"powr\", center: 8, amplitude: 1, period: 2)]",
+            "Oscillate",
+            "no dynamic parameter named `powr`",
+        ),
+    ];
+    for (setting, needle, says) in cases {
+        let text = format!(
+            "(\n    version: 1,\n    geometry: Sphere(radius: param(\"power\", 1)),\n    {setting},\n)"
+        );
+        let (line, column, message) = error_at(&text);
+        assert_eq!((line, column), position_of(&text, needle), "{message}");
+        assert!(message.contains(says), "{setting}: {message}");
+    }
+}
+
+#[test]
+fn syntax_and_vocabulary_errors_say_what_and_where() {
+    let cases = [
+        (
+            "(version: 1, geometry: Sphere(radius: 1)",
+            "1:40: Expected comma",
+        ),
+        (
+            "(version: 1, geometry: Sphere(radius: 1), camra: ())",
+            "camra",
+        ),
+        ("(version: 1, geometry: Spher(radius: 1))", "Spher"),
+        (
+            "(version: 1, geometry: Sphere(radius: 1, height: 2))",
+            "height",
+        ),
+        ("(version: 1, geometry: Sphere(radius: \"big\"))", "big"),
+        ("(version: 1, geometry: Sphere())", "radius"),
+        ("(version: 1, geometry: Union([]))", "at least one operand"),
+        (
+            "(version: 1, geometry: Custom(name: \"gyroid\", args: [0.1]))",
+            "gyroid",
+        ),
+        ("(geometry: Sphere(radius: 1))", "version"),
+        (
+            "(version: 2, geometry: Sphere(radius: 1))",
+            "format version 2",
+        ),
+        (
+            "(version: 1, geometry: Mandelbulb(power: 8, iterations: 0))",
+            "iterations",
+        ),
+    ];
+    for (text, says) in cases {
+        let (line, column, message) = error_at(text);
+        assert!((line, column) >= (1, 1), "{message}");
+        assert!(message.contains(says), "{text}: {message}");
+    }
+    // The file is named in errors from `load`.
+    let dir = std::env::temp_dir().join(format!("fractal-sdf-scene-files-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("bad.ron");
+    std::fs::write(&path, "(version: 1,\ngeometry: Sphere(radius: -1))").unwrap();
+    let message = SceneFile::load(&path).unwrap_err().to_string();
+    assert!(
+        message.starts_with(&format!("{}:2:11: sphere", path.display())),
+        "{message}"
+    );
+}
+
+#[test]
+fn nesting_is_bounded_when_writing_and_reading() {
+    // Deeper than a file may be: refused with a typed error, no overflow.
+    let mut node = sphere(0.5);
+    for _ in 0..(MAX_NESTING + 10) {
+        node = node.translate(dvec3(0.01, 0.0, 0.0));
+    }
+    let err = SceneFile::new(Scene::new(node)).to_text().unwrap_err();
+    assert!(err.to_string().contains("nested"), "{err}");
+
+    let deep = |levels: usize| {
+        let mut text = String::from("(version: 1, geometry: ");
+        for _ in 0..levels {
+            text.push_str("Translate(offset: 0, child: ");
+        }
+        text.push_str("Sphere(radius: 1)");
+        text.push_str(&")".repeat(levels));
+        text.push(')');
+        text
+    };
+    // At the limit it reads (on a test thread's small stack), beyond it is
+    // an error, and far beyond (where recursion would overflow) also.
+    let file = SceneFile::parse(&deep(MAX_NESTING - 1)).unwrap();
+    assert_eq!(file.scene.geometry.unwrap().size_and_depth().1, MAX_NESTING);
+    for levels in [MAX_NESTING + 1, 100_000] {
+        let (_, _, message) = error_at(&deep(levels));
+        assert!(
+            message.contains("nested") || message.contains("recursion"),
+            "{message}"
+        );
+    }
+}
+
+#[test]
+fn a_hundred_thousand_operands_read_and_write() {
+    let mut text = String::from("(version: 1, geometry: Union([\n");
+    for i in 0..100_000 {
+        text.push_str(&format!(
+            "Translate(offset: ({}, 0, {}), child: Sphere(radius: 0.1)),\n",
+            i % 100,
+            i / 100
+        ));
+    }
+    text.push_str("]))");
+    let file = SceneFile::parse(&text).unwrap();
+    assert_eq!(
+        file.scene.geometry.as_ref().unwrap().size_and_depth().0,
+        3 * 100_000 - 1
+    );
+    assert_eq!(SceneFile::parse(&file.to_text().unwrap()).unwrap(), file);
+}
+
+#[test]
+fn custom_shapes_are_named_by_the_caller() {
+    let blob = CustomShape::new(
+        "blob",
+        &[("radius", Rule::Positive)],
+        |p, a| p.length() - a[0],
+        "return length(p) - radius;",
+    )
+    .unwrap();
+    let scene = Scene::new(blob.node([param("r", 0.7)]).translate(dvec3(0.0, 1.0, 0.0)));
+    let text = SceneFile::new(scene.clone()).to_text().unwrap();
+    assert!(
+        text.contains("Custom(name: \"blob\", args: [param(\"r\", 0.7)])"),
+        "{text}"
+    );
+    let back = SceneFile::parse_with(&text, std::slice::from_ref(&blob)).unwrap();
+    assert_eq!(back.scene, scene);
+    let message = SceneFile::parse(&text).unwrap_err().to_string();
+    assert!(
+        message.contains("no custom shape named `blob`"),
+        "{message}"
+    );
+}
+
+#[test]
+fn shorthand_forms_read_as_their_long_forms() {
+    let short = "(version: 1, geometry: Union([
+        Cuboid(half_extents: 0.5),
+        Mandelbulb(power: 8),
+        Translate(offset: param3(\"at\", (1, 2, 3)), child: Sphere(radius: param(name: \"r\", default: 2))),
+    ]), quality: (preset: Draft, supersampling: 3))";
+    let file = SceneFile::parse(short).unwrap();
+    let expected = cuboid(dvec3(0.5, 0.5, 0.5)).union(mandelbulb(8.0)).union(
+        sphere(param("r", 2.0)).translate(fractal_sdf::scene::param3("at", dvec3(1.0, 2.0, 3.0))),
+    );
+    assert_eq!(file.scene.geometry, Some(expected));
+    assert_eq!(file.quality, Quality::draft().supersampling(3));
+    assert_eq!(file.scene.camera, Camera::default());
+    assert_eq!(file.scene.lights, Scene::empty().lights);
+    assert_eq!(file.effects, Effects::default());
+}
