@@ -184,6 +184,7 @@ pub mod quality;
 pub mod render;
 pub mod scene;
 pub mod sequence;
+pub mod settings;
 #[cfg(feature = "proptest")]
 pub mod testing;
 pub mod view;
