@@ -73,6 +73,15 @@ die() {
     exit 1
 }
 
+# Whether process $1 exists and has not exited (a zombie has: the daemons'
+# parent, once this script has exited, may reap them late).
+running() {
+    local stat
+    stat=$(cat "/proc/$1/stat" 2>/dev/null) || return 1
+    stat=${stat##*) }
+    [[ "${stat:0:1}" != Z ]]
+}
+
 # The PID recorded for daemon $1, if that process still runs it with this
 # cluster's files; nothing (status 1) otherwise.
 live_pid() {
@@ -80,7 +89,7 @@ live_pid() {
     [[ -f "$run/$name.pid" ]] || return 1
     pid=$(<"$run/$name.pid")
     [[ "$pid" =~ ^[0-9]+$ ]] || return 1
-    [[ -r "/proc/$pid/cmdline" ]] || return 1
+    running "$pid" || return 1
     cmdline=$(tr '\0' ' ' <"/proc/$pid/cmdline" 2>/dev/null) || return 1
     # The daemon's own name and a path of this cluster's state directory
     # (its config or munge socket): a recycled PID fails one of the two.
@@ -197,7 +206,7 @@ start_munged() {
     local i
     for ((i = 0; i < 100; i++)); do
         [[ -S "$munge_socket" ]] && return
-        kill -0 "$pid" 2>/dev/null || die "munged exited at start"
+        running "$pid" || die "munged exited at start"
         sleep 0.1
     done
     die "munged did not create its socket $munge_socket within 10 s"
@@ -231,8 +240,8 @@ cmd_start() {
     start_daemon slurmd -N localhost
     local s=""
     while ((SECONDS - t0 < start_timeout)); do
-        kill -0 "$(<"$run/slurmctld.pid")" 2>/dev/null || die "slurmctld exited at start"
-        kill -0 "$(<"$run/slurmd.pid")" 2>/dev/null || die "slurmd exited at start"
+        running "$(<"$run/slurmctld.pid")" || die "slurmctld exited at start"
+        running "$(<"$run/slurmd.pid")" || die "slurmd exited at start"
         s=$(node_state || true)
         case "$s" in
         idle | mixed | allocated | completing) break ;;
@@ -274,10 +283,10 @@ stop_one() {
     fi
     kill -TERM "$pid" 2>/dev/null || true
     for ((i = 0; i < 100; i++)); do
-        [[ -e "/proc/$pid" ]] || break
+        running "$pid" || break
         sleep 0.1
     done
-    if [[ -e "/proc/$pid" ]]; then
+    if running "$pid"; then
         err "$name ($pid) still running after 10 s; sending SIGKILL"
         kill -KILL "$pid" 2>/dev/null || true
         sleep 0.2
