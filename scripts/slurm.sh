@@ -4,7 +4,7 @@
 #
 # Usage:
 #   scripts/slurm.sh start    # start munged, slurmctld and slurmd; wait for the node
-#   scripts/slurm.sh status   # the daemons' PIDs and `sinfo`
+#   scripts/slurm.sh status   # the daemons' PIDs, `sinfo`, `squeue`; 0 iff all 3 run
 #   scripts/slurm.sh stop     # cancel the cluster's jobs, stop the daemons it started
 #   scripts/slurm.sh env      # prints `export SLURM_CONF=...` (eval "$(scripts/slurm.sh env)")
 #
@@ -30,9 +30,10 @@
 # (proctrack/linuxproc), tasks are not confined (task/none), and memory is
 # not a scheduled resource.
 #
-# `stop` kills exactly the processes `start` recorded in <state>/run/*.pid,
-# after checking each PID still runs that daemon with this cluster's files;
-# it never kills by name. `start` and `stop` are idempotent: `start` on a
+# `stop` cancels the cluster's jobs, then kills exactly the processes
+# `start` recorded in <state>/run/*.pid (munged, slurmctld, slurmd), after
+# checking each PID still runs that daemon with this cluster's files; it
+# never kills by name. `start` and `stop` are idempotent: `start` on a
 # running cluster only waits for the node, `stop` on a stopped one does
 # nothing.
 set -euo pipefail
@@ -233,7 +234,11 @@ cmd_start() {
     require_tools
     mkdir -p "$state" "$run" "$logs" "$state/ctld" "$state/spool"
     local t0=$SECONDS
-    write_conf
+    # A running daemon keeps the file it started with: rewrite it only when
+    # neither runs (so a changed port applies on the next start).
+    if ! live_pid slurmctld >/dev/null && ! live_pid slurmd >/dev/null; then
+        write_conf
+    fi
     export SLURM_CONF=$conf
     start_munged
     start_daemon slurmctld
