@@ -13,6 +13,9 @@ REQUIRED_PACKAGES=(
     pkg-config
     python3            # scripts/mutate_kernels.py (`make mutants`)
     jq                 # reads `cargo metadata` in scripts/msrv_check.sh
+    # The one-node Slurm cluster of scripts/slurm.sh and scripts/slurm-test.sh:
+    slurm-wlm          # slurmctld, slurmd and the client commands (sbatch, squeue, ...)
+    munge              # munged: the authentication Slurm's daemons and clients use
     # The viewer example's window (feature `viewer`) and its smoke test:
     xvfb               # a virtual X server, so the viewer runs without a display
     xdotool            # sends real key presses to the viewer's window
