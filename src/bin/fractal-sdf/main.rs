@@ -1,0 +1,523 @@
+//! `fractal-sdf`: render scene files and gallery scenes from the command
+//! line. `fractal-sdf --help` lists the subcommands; each has its own
+//! `--help`.
+
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+use std::time::{Duration, Instant};
+
+use clap::{Args, Parser, Subcommand};
+use fractal_sdf::animation::CameraPath;
+use fractal_sdf::codegen::{self, Options};
+use fractal_sdf::gallery;
+use fractal_sdf::output::{save_png, verify_png};
+use fractal_sdf::prelude::*;
+use fractal_sdf::render::{DeviceSelector, RenderOptions, Renderer, devices};
+use fractal_sdf::scene::SceneFile;
+use fractal_sdf::sequence::{Sequence, parse_range};
+use fractal_sdf::settings::{CONFIG_ENV, Settings, parse_preset, parse_size};
+use indicatif::{ProgressBar, ProgressStyle};
+
+/// Render signed-distance scenes and 3D fractals with OpenCL.
+///
+/// SCENE is a scene file (`.ron`, see the crate's `scenes/` folder) or the
+/// name of a gallery scene (`fractal-sdf render mandelbulb -o bulb.png`).
+/// Settings (default preset, size and device) come from the settings
+/// file (`fractal-sdf config` shows where it is); flags override it.
+#[derive(Parser)]
+#[command(name = "fractal-sdf", version, propagate_version = true)]
+struct Cli {
+    /// The settings file to read instead of the default one.
+    #[arg(long, global = true, value_name = "FILE")]
+    config: Option<PathBuf>,
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Render one image to a PNG.
+    Render(RenderArgs),
+    /// Render a camera path to numbered PNG frames (resumable), then a video.
+    Sequence(SequenceArgs),
+    /// Print the generated OpenCL C of a scene.
+    Emit(EmitArgs),
+    /// List the OpenCL platforms and devices.
+    Devices,
+    /// Time frames of a scene: milliseconds and distance evaluations per pixel.
+    Bench(BenchArgs),
+    /// Show the settings file's path and the settings in effect.
+    Config,
+}
+
+/// What every rendering subcommand takes.
+#[derive(Args)]
+struct SceneArgs {
+    /// A scene file (`.ron`) or a gallery scene name.
+    scene: String,
+    /// Quality preset: draft, preview, production or reference (default:
+    /// the settings file's, else the scene file's quality).
+    #[arg(long)]
+    preset: Option<String>,
+    /// Image size, WIDTHxHEIGHT (default: the settings file's, else 640x480).
+    #[arg(long)]
+    size: Option<String>,
+    /// Set a dynamic parameter: NAME=VALUE (repeatable).
+    #[arg(long = "set", value_name = "NAME=VALUE")]
+    set: Vec<String>,
+    /// A substring of the OpenCL device's name (default: the settings
+    /// file's, else automatic).
+    #[arg(long)]
+    device: Option<String>,
+}
+
+#[derive(Args)]
+struct RenderArgs {
+    #[command(flatten)]
+    scene: SceneArgs,
+    /// The PNG to write.
+    #[arg(short, long, value_name = "FILE")]
+    output: PathBuf,
+}
+
+#[derive(Args)]
+struct SequenceArgs {
+    #[command(flatten)]
+    scene: SceneArgs,
+    /// Frames per second.
+    #[arg(long, default_value_t = 24.0)]
+    fps: f64,
+    /// The frames' directory (frame_00000.png, ...).
+    #[arg(long, value_name = "DIR")]
+    out: PathBuf,
+    /// A camera path file in TOML (default: the scene file's path, else one
+    /// orbit around the camera's target).
+    #[arg(long, value_name = "FILE")]
+    path: Option<PathBuf>,
+    /// The orbit's length in seconds, where there is no camera path.
+    #[arg(long, default_value_t = 4.0)]
+    seconds: f64,
+    /// Only these frames: a..b, a..=b, a.., ..b or n.
+    #[arg(long, value_name = "RANGE")]
+    frames: Option<String>,
+    /// Only this share of the frames, I/N: those whose index is I modulo
+    /// N (for job arrays; see deploy/slurm).
+    #[arg(long, value_name = "I/N")]
+    shard: Option<String>,
+    /// Render nothing: check that every frame of the range is a whole PNG
+    /// of the size, and exit 1 listing those that are not.
+    #[arg(long)]
+    verify: bool,
+    /// Do not encode a video once every frame exists.
+    #[arg(long)]
+    no_video: bool,
+    /// The video to encode with ffmpeg (default: DIR.mp4).
+    #[arg(long, value_name = "FILE")]
+    video: Option<PathBuf>,
+}
+
+#[derive(Args)]
+struct EmitArgs {
+    /// A scene file (`.ron`) or a gallery scene name.
+    scene: String,
+    /// Quality preset, which decides precision and loop bounds.
+    #[arg(long)]
+    preset: Option<String>,
+}
+
+#[derive(Args)]
+struct BenchArgs {
+    #[command(flatten)]
+    scene: SceneArgs,
+    /// Frames to time after one warm-up frame.
+    #[arg(long, default_value_t = 10)]
+    frames: u32,
+}
+
+/// A failure and the exit code it gets: 2 for a command line that cannot
+/// be used, 1 for everything else.
+struct Failure {
+    code: u8,
+    message: String,
+}
+
+impl From<Error> for Failure {
+    fn from(e: Error) -> Self {
+        Failure {
+            code: 1,
+            message: e.to_string(),
+        }
+    }
+}
+
+fn usage(message: impl Into<String>) -> Failure {
+    Failure {
+        code: 2,
+        message: message.into(),
+    }
+}
+
+type Outcome<T = ()> = std::result::Result<T, Failure>;
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    match run(cli) {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(f) => {
+            eprintln!("fractal-sdf: {}", f.message);
+            ExitCode::from(f.code)
+        }
+    }
+}
+
+fn run(cli: Cli) -> Outcome {
+    let settings = match &cli.config {
+        Some(path) => Settings::load_from(path)?,
+        None => Settings::load()?,
+    };
+    match cli.command {
+        Command::Render(args) => render(&args, &settings),
+        Command::Sequence(args) => sequence(&args, &settings),
+        Command::Emit(args) => emit(&args, &settings),
+        Command::Devices => list_devices(),
+        Command::Bench(args) => bench(&args, &settings),
+        Command::Config => show_config(cli.config.as_deref(), &settings),
+    }
+}
+
+/// A scene file's path, or a gallery name's file.
+fn load_scene(scene: &str) -> Outcome<SceneFile> {
+    let path = Path::new(scene);
+    if path.is_file() || scene.ends_with(".ron") || scene.contains(std::path::MAIN_SEPARATOR) {
+        return Ok(SceneFile::load(path)?);
+    }
+    gallery::file(scene).ok_or_else(|| {
+        usage(format!(
+            "`{scene}` is neither a scene file nor a gallery scene (one of: {})",
+            gallery::names().join(", ")
+        ))
+    })
+}
+
+/// Everything a rendering subcommand needs, settled from the flags, the
+/// settings file and the scene file.
+struct Job {
+    file: SceneFile,
+    size: (u32, u32),
+    options: RenderOptions,
+    sets: Vec<(String, f64)>,
+}
+
+impl Job {
+    fn new(args: &SceneArgs, settings: &Settings) -> Outcome<Job> {
+        let file = load_scene(&args.scene)?;
+        let preset = match &args.preset {
+            Some(name) => Some(parse_preset(name).map_err(|e| usage(e.to_string()))?),
+            None => settings.preset,
+        };
+        let size = match &args.size {
+            Some(text) => parse_size(text).map_err(|e| usage(e.to_string()))?,
+            None => settings.size.unwrap_or((640, 480)),
+        };
+        let device = args.device.clone().or_else(|| settings.device.clone());
+        let sets = args
+            .set
+            .iter()
+            .map(|pair| {
+                let (name, value) = pair
+                    .split_once('=')
+                    .ok_or_else(|| usage(format!("--set `{pair}`: expected NAME=VALUE")))?;
+                let value: f64 = value
+                    .trim()
+                    .parse()
+                    .map_err(|_| usage(format!("--set `{pair}`: `{value}` is not a number")))?;
+                Ok((name.trim().to_string(), value))
+            })
+            .collect::<Outcome<Vec<_>>>()?;
+        let options = RenderOptions {
+            quality: preset.map_or(file.quality, Preset::quality),
+            effects: file.effects,
+            device: device.map_or_else(DeviceSelector::auto, DeviceSelector::device),
+            ..RenderOptions::default()
+        };
+        Ok(Job {
+            file,
+            size,
+            options,
+            sets,
+        })
+    }
+
+    fn renderer(&self) -> Outcome<Renderer> {
+        let mut renderer = Renderer::with_options(&self.file.scene, &self.options)?;
+        for (name, value) in &self.sets {
+            renderer.set_param(name, *value)?;
+        }
+        Ok(renderer)
+    }
+
+    fn preset_name(&self) -> String {
+        Preset::ALL
+            .into_iter()
+            .find(|p| p.quality() == self.options.quality)
+            .map_or_else(|| "custom".into(), |p| p.name().into())
+    }
+}
+
+fn spinner(message: String) -> ProgressBar {
+    let bar = ProgressBar::new_spinner();
+    bar.set_style(
+        ProgressStyle::with_template("{spinner} {msg} {elapsed}").expect("a valid template"),
+    );
+    bar.set_message(message);
+    bar.enable_steady_tick(Duration::from_millis(120));
+    bar
+}
+
+fn render(args: &RenderArgs, settings: &Settings) -> Outcome {
+    let job = Job::new(&args.scene, settings)?;
+    let (width, height) = job.size;
+    let start = Instant::now();
+    let bar = spinner(format!("rendering {width}x{height}"));
+    let mut renderer = job.renderer()?;
+    let image = renderer.render(width, height);
+    bar.finish_and_clear();
+    save_png(&image?, &args.output)?;
+    println!(
+        "{}: {width}x{height}, {} quality, {:.2} s on {}",
+        args.output.display(),
+        job.preset_name(),
+        start.elapsed().as_secs_f64(),
+        renderer.device().label()
+    );
+    Ok(())
+}
+
+/// `I/N` with `I < N`.
+fn parse_shard(text: &str) -> Outcome<(u32, u32)> {
+    text.split_once('/')
+        .and_then(|(i, n)| Some((i.trim().parse().ok()?, n.trim().parse().ok()?)))
+        .filter(|&(i, n): &(u32, u32)| n > 0 && i < n)
+        .ok_or_else(|| usage(format!("--shard `{text}`: expected I/N with 0 <= I < N")))
+}
+
+fn read_path(file: &Path) -> Outcome<CameraPath> {
+    let text = std::fs::read_to_string(file)
+        .map_err(|source| Error::io(file, "cannot read the camera path", source))?;
+    Ok(CameraPath::from_toml(&text)?)
+}
+
+/// One turn around the camera's target at its distance and height.
+fn orbit(scene: &Scene, seconds: f64) -> Outcome<CameraPath> {
+    let c = &scene.camera;
+    let offset = c.position - c.target;
+    let radius = offset.with_y(0.0).length().max(1e-3);
+    Ok(CameraPath::orbit(c.target, radius, offset.y, seconds, 16)?)
+}
+
+fn sequence(args: &SequenceArgs, settings: &Settings) -> Outcome {
+    let job = Job::new(&args.scene, settings)?;
+    let path = match (&args.path, &job.file.path) {
+        (Some(file), _) => read_path(file)?,
+        (None, Some(path)) => path.clone(),
+        (None, None) => orbit(&job.file.scene, args.seconds)?,
+    };
+    let seq = Sequence::for_duration(&args.out, args.fps, path.duration())?;
+    let range = match &args.frames {
+        Some(text) => parse_range(text, seq.frames())?,
+        None => 0..seq.frames(),
+    };
+    let shard = args.shard.as_deref().map(parse_shard).transpose()?;
+    let mine = |i: &u32| shard.is_none_or(|(k, n)| i % n == k);
+
+    if args.verify {
+        let bad: Vec<String> = range
+            .clone()
+            .filter_map(|i| {
+                verify_png(seq.frame_path(i), job.size)
+                    .err()
+                    .map(|e| format!("  frame {i}: {e}"))
+            })
+            .collect();
+        if bad.is_empty() {
+            println!(
+                "frames {}..{} in {}: all {} present and whole",
+                range.start,
+                range.end,
+                args.out.display(),
+                range.len()
+            );
+            return Ok(());
+        }
+        return Err(Failure {
+            code: 1,
+            message: format!(
+                "{} of frames {}..{} are missing or broken:\n{}",
+                bad.len(),
+                range.start,
+                range.end,
+                bad.join("\n")
+            ),
+        });
+    }
+
+    let todo: Vec<u32> = seq
+        .remaining(range.clone(), job.size)
+        .into_iter()
+        .filter(mine)
+        .collect();
+    let share = range.clone().filter(mine).count();
+    println!(
+        "{}: frames {}..{} of {}{} at {} fps, {}x{}, {} quality -> {}/ ({} of {} on disk already)",
+        args.scene.scene,
+        range.start,
+        range.end,
+        seq.frames(),
+        shard.map_or_else(String::new, |(k, n)| format!(" (share {k}/{n})")),
+        args.fps,
+        job.size.0,
+        job.size.1,
+        job.preset_name(),
+        args.out.display(),
+        share - todo.len(),
+        share,
+    );
+    if !todo.is_empty() {
+        let mut renderer = job.renderer()?;
+        let bar = ProgressBar::new(todo.len() as u64);
+        bar.set_style(
+            ProgressStyle::with_template(
+                "{bar:40} {pos}/{len} frames  {elapsed_precise} elapsed, ETA {eta}  {msg}",
+            )
+            .expect("a valid template"),
+        );
+        seq.render(
+            &mut renderer,
+            &path,
+            &job.file.motions,
+            &todo,
+            job.size,
+            |frame| {
+                if let Some(t) = frame.timing {
+                    bar.set_message(format!("{:.0} ms/frame", t.total.as_secs_f64() * 1e3));
+                }
+                bar.inc(1);
+            },
+        )?;
+        bar.finish();
+    }
+    if !args.no_video && seq.remaining(0..seq.frames(), job.size).is_empty() {
+        let video = args
+            .video
+            .clone()
+            .unwrap_or_else(|| args.out.with_extension("mp4"));
+        encode(&seq, &video);
+    }
+    Ok(())
+}
+
+fn encode(seq: &Sequence, video: &Path) {
+    let args = seq.ffmpeg_args(video);
+    let shown = format!("ffmpeg {}", args.join(" "));
+    match std::process::Command::new("ffmpeg")
+        .args(&args)
+        .stdout(std::process::Stdio::null())
+        .stderr(std::process::Stdio::null())
+        .status()
+    {
+        Ok(status) if status.success() => println!("video -> {}", video.display()),
+        Ok(status) => println!("ffmpeg failed ({status}); the command was:\n  {shown}"),
+        Err(_) => {
+            println!("ffmpeg is not installed; to make a video, install it and run:\n  {shown}")
+        }
+    }
+}
+
+fn emit(args: &EmitArgs, settings: &Settings) -> Outcome {
+    let file = load_scene(&args.scene)?;
+    let quality = match (&args.preset, settings.preset) {
+        (Some(name), _) => parse_preset(name)
+            .map_err(|e| usage(e.to_string()))?
+            .quality(),
+        (None, Some(preset)) => preset.quality(),
+        (None, None) => file.quality,
+    };
+    let options = Options {
+        quality,
+        effects: file.effects,
+        ..Options::default()
+    };
+    let compiled = file.scene.compile()?;
+    let kernel = codegen::emit(&compiled, &options)?;
+    print!("{}", kernel.source);
+    Ok(())
+}
+
+fn list_devices() -> Outcome {
+    let all = devices()?;
+    for (i, d) in all.iter().enumerate() {
+        println!(
+            "{i}: {} / {} ({:?}, {} compute units, {} MiB, fp64: {}, {})",
+            d.platform,
+            d.name,
+            d.kind,
+            d.compute_units,
+            d.global_memory >> 20,
+            if d.fp64 { "yes" } else { "no" },
+            d.opencl_version
+        );
+    }
+    println!(
+        "automatic choice: {}",
+        DeviceSelector::auto().resolve()?.label()
+    );
+    Ok(())
+}
+
+fn bench(args: &BenchArgs, settings: &Settings) -> Outcome {
+    let job = Job::new(&args.scene, settings)?;
+    let (width, height) = job.size;
+    let mut renderer = job.renderer()?;
+    let frame = renderer.render_with_aovs(width, height)?;
+    let pixels = f64::from(width) * f64::from(height);
+    let evaluations: f64 = frame.evaluations.iter().map(|&e| f64::from(e)).sum();
+    let mut times = Vec::new();
+    let bar = ProgressBar::new(u64::from(args.frames));
+    for _ in 0..args.frames {
+        let start = Instant::now();
+        renderer.render(width, height)?;
+        times.push(start.elapsed().as_secs_f64() * 1e3);
+        bar.inc(1);
+    }
+    bar.finish_and_clear();
+    times.sort_by(f64::total_cmp);
+    let median = times.get(times.len() / 2).copied().unwrap_or(f64::NAN);
+    let (low, high) = (
+        times.first().copied().unwrap_or(f64::NAN),
+        times.last().copied().unwrap_or(f64::NAN),
+    );
+    println!(
+        "{}: {width}x{height}, {} quality on {}",
+        args.scene.scene,
+        job.preset_name(),
+        renderer.device().label()
+    );
+    println!(
+        "  {:.1} ms/frame median of {} (min {low:.1}, max {high:.1}); {:.1} distance evaluations per pixel",
+        median,
+        times.len(),
+        evaluations / pixels
+    );
+    Ok(())
+}
+
+fn show_config(given: Option<&Path>, settings: &Settings) -> Outcome {
+    let path = given.map(Path::to_path_buf).or_else(Settings::path);
+    match &path {
+        Some(p) if p.exists() => println!("# settings file: {}", p.display()),
+        Some(p) => println!("# settings file: {} (absent: every default)", p.display()),
+        None => println!("# no configuration directory; set {CONFIG_ENV} to name a file"),
+    }
+    print!("{}", settings.to_toml()?);
+    Ok(())
+}
