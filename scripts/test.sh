@@ -40,6 +40,9 @@ step "$CARGO" test --doc --all-features
 # The features docs.rs documents (`[package.metadata.docs.rs]`: all of them).
 # Its `--cfg docsrs` needs a nightly rustdoc, so it is left out here.
 RUSTDOCFLAGS="-D warnings" step "$CARGO" doc --no-deps --all-features
+# The `fractal-sdf` command renders a sequence as a job array on a one-node
+# Slurm cluster started here (`cargo test` built the binary above).
+step bash scripts/slurm-test.sh target/debug/fractal-sdf
 # The crate as published: built from its package, and the README's program
 # run against that package on the device.
 step bash scripts/package_check.sh

@@ -1,0 +1,284 @@
+//! The `fractal-sdf` command: every subcommand run as a user runs it, and
+//! its errors and exit codes.
+
+mod gpu;
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+use fractal_sdf::output::verify_png;
+use fractal_sdf::sequence::frame_name;
+
+fn scratch(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("fractal-sdf-cli-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+/// Runs the command with a settings file of `settings` (every default
+/// when empty), so the user's own settings never apply.
+fn run(dir: &Path, settings: &str, args: &[&str]) -> Output {
+    let config = dir.join("config.toml");
+    std::fs::write(&config, settings).unwrap();
+    Command::new(env!("CARGO_BIN_EXE_fractal-sdf"))
+        .args(args)
+        .env("FRACTAL_SDF_CONFIG", &config)
+        .output()
+        .expect("the command runs")
+}
+
+fn text(out: &Output) -> String {
+    format!(
+        "status {:?}\nstdout:\n{}\nstderr:\n{}",
+        out.status.code(),
+        String::from_utf8_lossy(&out.stdout),
+        String::from_utf8_lossy(&out.stderr)
+    )
+}
+
+fn scene_path(name: &str) -> String {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("scenes")
+        .join(format!("{name}.ron"))
+        .display()
+        .to_string()
+}
+
+#[test]
+fn render_writes_the_image_of_a_scene_file() {
+    if gpu::device().is_none() {
+        return;
+    }
+    let dir = scratch("render");
+    let png = dir.join("csg.png");
+    let out = run(
+        &dir,
+        "",
+        &[
+            "render",
+            &scene_path("csg"),
+            "-o",
+            png.to_str().unwrap(),
+            "--size",
+            "64x48",
+            "--preset",
+            "draft",
+        ],
+    );
+    assert!(out.status.success(), "{}", text(&out));
+    verify_png(&png, (64, 48)).unwrap();
+    let image = image::open(&png).unwrap().to_rgba8();
+    assert!(image.pixels().any(|p| p != image.get_pixel(0, 0)), "blank");
+
+    // The settings file's size applies where no flag is given, and `--set`
+    // moves a dynamic parameter: a different image.
+    let moved = dir.join("moved.png");
+    let out = run(
+        &dir,
+        "size = \"40x30\"\npreset = \"draft\"\n",
+        &[
+            "render",
+            "benchmark",
+            "-o",
+            moved.to_str().unwrap(),
+            "--set",
+            "orbit.y=1.0",
+        ],
+    );
+    assert!(out.status.success(), "{}", text(&out));
+    verify_png(&moved, (40, 30)).unwrap();
+    let still = dir.join("still.png");
+    let out = run(
+        &dir,
+        "size = \"40x30\"\npreset = \"draft\"\n",
+        &["render", "benchmark", "-o", still.to_str().unwrap()],
+    );
+    assert!(out.status.success(), "{}", text(&out));
+    assert_ne!(
+        std::fs::read(&moved).unwrap(),
+        std::fs::read(&still).unwrap()
+    );
+}
+
+#[test]
+fn sequence_shards_resume_and_verify() {
+    if gpu::device().is_none() {
+        return;
+    }
+    let dir = scratch("sequence");
+    let frames = dir.join("frames");
+    let f = frames.to_str().unwrap();
+    let common = [
+        "sequence",
+        "csg",
+        "--fps",
+        "4",
+        "--seconds",
+        "1",
+        "--size",
+        "32x24",
+        "--preset",
+        "draft",
+        "--out",
+        f,
+        "--no-video",
+    ];
+    let with = |extra: &[&str]| {
+        let mut args = common.to_vec();
+        args.extend_from_slice(extra);
+        run(&dir, "", &args)
+    };
+    let out = with(&["--shard", "1/2"]);
+    assert!(out.status.success(), "{}", text(&out));
+    let on_disk = |i: u32| frames.join(frame_name(i)).exists();
+    assert_eq!(
+        (0..4).map(on_disk).collect::<Vec<_>>(),
+        [false, true, false, true]
+    );
+
+    // Half the frames: verify fails, listing the missing ones.
+    let out = with(&["--verify"]);
+    assert_eq!(out.status.code(), Some(1), "{}", text(&out));
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        stderr.contains("frame 0:") && stderr.contains("frame 2:"),
+        "{stderr}"
+    );
+
+    // The other share renders only what is missing; then all verify.
+    let before = std::fs::metadata(frames.join(frame_name(1)))
+        .unwrap()
+        .modified()
+        .unwrap();
+    let out = with(&[]);
+    assert!(out.status.success(), "{}", text(&out));
+    assert!(String::from_utf8_lossy(&out.stdout).contains("2 of 4 on disk already"));
+    let after = std::fs::metadata(frames.join(frame_name(1)))
+        .unwrap()
+        .modified()
+        .unwrap();
+    assert_eq!(before, after, "a whole frame was rendered again");
+    let out = with(&["--verify"]);
+    assert!(out.status.success(), "{}", text(&out));
+}
+
+#[test]
+fn emit_prints_only_what_the_scene_uses() {
+    let dir = scratch("emit");
+    let out = run(&dir, "", &["emit", "mandelbulb"]);
+    assert!(out.status.success(), "{}", text(&out));
+    let source = String::from_utf8_lossy(&out.stdout);
+    assert!(source.contains("DE("), "{source}");
+    assert!(source.contains("mandelbulb"), "no Mandelbulb");
+    assert!(
+        !source.contains("real menger("),
+        "a Menger sponge in a Mandelbulb scene"
+    );
+    let out = run(&dir, "", &["emit", "mandelbulb", "--preset", "reference"]);
+    assert!(String::from_utf8_lossy(&out.stdout).contains("typedef double real;"));
+}
+
+#[test]
+fn devices_and_bench_report_the_device() {
+    let Some(device) = gpu::device() else {
+        return;
+    };
+    let dir = scratch("devices");
+    let out = run(&dir, "", &["devices"]);
+    assert!(out.status.success(), "{}", text(&out));
+    let listing = String::from_utf8_lossy(&out.stdout);
+    assert!(listing.contains(&device.name), "{listing}");
+    assert!(listing.contains("fp64: "), "{listing}");
+
+    let out = run(
+        &dir,
+        "",
+        &[
+            "bench",
+            "sierpinski",
+            "--size",
+            "32x24",
+            "--preset",
+            "draft",
+            "--frames",
+            "2",
+        ],
+    );
+    assert!(out.status.success(), "{}", text(&out));
+    let report = String::from_utf8_lossy(&out.stdout);
+    assert!(report.contains("ms/frame median of 2"), "{report}");
+    assert!(
+        report.contains("distance evaluations per pixel"),
+        "{report}"
+    );
+}
+
+#[test]
+fn config_shows_the_settings_in_effect() {
+    let dir = scratch("config");
+    let out = run(
+        &dir,
+        "preset = \"reference\"\n[viewer]\nmouse_sensitivity = 0.002\n",
+        &["config"],
+    );
+    assert!(out.status.success(), "{}", text(&out));
+    let shown = String::from_utf8_lossy(&out.stdout);
+    assert!(shown.contains("config.toml"), "{shown}");
+    assert!(shown.contains("preset = \"reference\""), "{shown}");
+    assert!(shown.contains("mouse_sensitivity = 0.002"), "{shown}");
+}
+
+#[test]
+fn bad_input_is_a_clear_error_and_a_nonzero_exit() {
+    let dir = scratch("errors");
+    let bad = dir.join("bad.ron");
+    std::fs::write(&bad, "(version: 1,\n  geometry: Sphere(radius: -2))").unwrap();
+    let png = dir.join("x.png");
+    let o = png.to_str().unwrap();
+    let cases: [(&[&str], &str, i32, &str); 6] = [
+        (
+            &["render", bad.to_str().unwrap(), "-o", o],
+            "",
+            1,
+            "bad.ron:2:13: sphere",
+        ),
+        (
+            &["render", "nosuch", "-o", o],
+            "",
+            2,
+            "neither a scene file nor a gallery scene",
+        ),
+        (
+            &["render", "csg", "-o", o, "--size", "0x5"],
+            "",
+            2,
+            "not a size",
+        ),
+        (
+            &["render", "csg", "-o", o, "--preset", "ultra"],
+            "",
+            2,
+            "unknown preset",
+        ),
+        (
+            &["render", "csg", "-o", o, "--set", "radius"],
+            "",
+            2,
+            "expected NAME=VALUE",
+        ),
+        (
+            &["render", "csg", "-o", o],
+            "presett = 1",
+            1,
+            "config.toml:1:1",
+        ),
+    ];
+    for (args, settings, code, says) in cases {
+        let out = run(&dir, settings, args);
+        assert_eq!(out.status.code(), Some(code), "{args:?}: {}", text(&out));
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert!(stderr.contains(says), "{args:?}: {stderr}");
+    }
+    assert!(!png.exists(), "an image was written despite the errors");
+}
