@@ -119,6 +119,16 @@ impl DeviceSelector {
         }
     }
 
+    /// The device `info` describes: its platform's and its own name (the
+    /// first of two devices with the same names on one platform).
+    #[must_use]
+    pub fn exactly(info: &DeviceInfo) -> Self {
+        DeviceSelector {
+            platform: Some(info.platform.clone()),
+            device: Some(info.name.clone()),
+        }
+    }
+
     /// The first device of the platform whose name contains `name`.
     #[must_use]
     pub fn platform(name: impl Into<String>) -> Self {

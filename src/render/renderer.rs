@@ -107,6 +107,12 @@ pub struct Renderer {
     inputs: Inputs,
     targets: Targets,
     timing: Option<FrameTiming>,
+    /// Renderers on further devices that draw a share of every frame's
+    /// tiles (see [`Renderer::with_devices`]).
+    partners: Vec<Renderer>,
+    /// This renderer's share of the tiles, `(k, n)`: the tiles whose index
+    /// is `k` modulo `n`.
+    share: (usize, usize),
 }
 
 /// Where a renderer's `DE` and `DE_shade` come from.
@@ -231,7 +237,132 @@ impl Renderer {
             inputs,
             targets,
             timing: None,
+            partners: Vec::new(),
+            share: (0, 1),
         })
+    }
+
+    /// A renderer that splits every frame across several devices: the
+    /// image's tiles are dealt out in turn (tile `i` to device `i mod n`),
+    /// each device renders its tiles in its own thread, and the frame is
+    /// put together from them. Every device runs the same program, so the
+    /// image is the one a single device renders where the devices compute
+    /// alike (the same device listed twice gives identical pixels); the
+    /// camera, lights, parameters, quality and effects set on this
+    /// renderer apply to every device. [`Renderer::device`] and
+    /// [`Renderer::last_timing`] describe the first device;
+    /// [`Renderer::render_with_aovs`] renders on the first device alone.
+    /// `options.device` is not used.
+    ///
+    /// ```no_run
+    /// use fractal_sdf::prelude::*;
+    /// use fractal_sdf::render::{DeviceSelector, RenderOptions, Renderer, devices};
+    ///
+    /// let every: Vec<DeviceSelector> = devices()?.iter().map(DeviceSelector::exactly).collect();
+    /// let scene = Scene::new(mandelbulb(8.0));
+    /// let mut renderer = Renderer::with_devices(&scene, &RenderOptions::default(), &every)?;
+    /// let image = renderer.render(640, 480)?;
+    /// # Ok::<(), fractal_sdf::Error>(())
+    /// ```
+    ///
+    /// # Errors
+    /// [`Error::NoDevice`] for an empty list; else as
+    /// [`Renderer::with_options`], for each device.
+    pub fn with_devices(
+        scene: &Scene,
+        options: &RenderOptions,
+        devices: &[DeviceSelector],
+    ) -> Result<Self> {
+        let Some((first, rest)) = devices.split_first() else {
+            return Err(Error::NoDevice {
+                selection: "an empty list of devices".into(),
+                available: device::devices()
+                    .map(|all| {
+                        all.iter()
+                            .map(DeviceInfo::label)
+                            .collect::<Vec<_>>()
+                            .join(", ")
+                    })
+                    .unwrap_or_default(),
+            });
+        };
+        let compiled = scene.compile()?;
+        let on = |device: &DeviceSelector| RenderOptions {
+            device: device.clone(),
+            ..options.clone()
+        };
+        let mut renderer = Self::from_compiled(compiled.clone(), &on(first))?;
+        renderer.partners = rest
+            .iter()
+            .map(|d| Self::from_compiled(compiled.clone(), &on(d)))
+            .collect::<Result<_>>()?;
+        Ok(renderer)
+    }
+
+    /// The devices this renderer splits frames across: its own, then those
+    /// of [`Renderer::with_devices`].
+    #[must_use]
+    pub fn devices(&self) -> Vec<&DeviceInfo> {
+        std::iter::once(self.device())
+            .chain(self.partners.iter().map(Renderer::device))
+            .collect()
+    }
+
+    /// Applies `change` to every partner renderer.
+    fn for_partners(&mut self, change: impl Fn(&mut Renderer) -> Result<()>) -> Result<()> {
+        self.partners.iter_mut().try_for_each(change)
+    }
+
+    /// Renders a frame with the partners: each device its share of the
+    /// tiles, at once, then the partners' tiles copied into this one's.
+    fn render_shared(&mut self, width: u32, height: u32) -> Result<RgbaImage> {
+        let n = self.partners.len() + 1;
+        let mut partners = std::mem::take(&mut self.partners);
+        let (mine, theirs) = std::thread::scope(|s| {
+            let handles: Vec<_> = partners
+                .iter_mut()
+                .enumerate()
+                .map(|(i, p)| s.spawn(move || p.render_share(width, height, (i + 1, n))))
+                .collect();
+            let mine = self.render_share(width, height, (0, n));
+            let theirs: Vec<Result<RgbaImage>> = handles
+                .into_iter()
+                .map(|h| h.join().expect("a device's thread does not panic"))
+                .collect();
+            (mine, theirs)
+        });
+        self.partners = partners;
+        let mut image = mine?;
+        let theirs = theirs.into_iter().collect::<Result<Vec<_>>>()?;
+        let row = |y: u32, x: u32, w: u32| {
+            let start = ((y * width + x) * 4) as usize;
+            start..start + (w * 4) as usize
+        };
+        for (i, tile) in dispatch::tiles(width, height, self.options.tile_size).enumerate() {
+            let Some(from) = (i % n).checked_sub(1).map(|p| &theirs[p]) else {
+                continue;
+            };
+            for y in tile.y..tile.y + tile.height {
+                let span = row(y, tile.x, tile.width);
+                let (dst, src): (&mut [u8], &[u8]) = (&mut image, from);
+                dst[span.clone()].copy_from_slice(&src[span]);
+            }
+        }
+        Ok(image)
+    }
+
+    /// Renders this renderer's `share` of the tiles (the rest of the image
+    /// is left as it was).
+    fn render_share(
+        &mut self,
+        width: u32,
+        height: u32,
+        share: (usize, usize),
+    ) -> Result<RgbaImage> {
+        self.share = share;
+        let image = self.render_alone(width, height);
+        self.share = (0, 1);
+        image
     }
 
     /// Renders a `width` × `height` image.
@@ -247,6 +378,15 @@ impl Renderer {
     /// [`RenderOptions::cancel`] or [`RenderOptions::deadline`] stops the
     /// frame between tiles; [`Error::OpenCl`] if the device fails.
     pub fn render(&mut self, width: u32, height: u32) -> Result<RgbaImage> {
+        if self.partners.is_empty() {
+            self.render_alone(width, height)
+        } else {
+            self.render_shared(width, height)
+        }
+    }
+
+    /// Renders this renderer's share of the tiles on its own device.
+    fn render_alone(&mut self, width: u32, height: u32) -> Result<RgbaImage> {
         let start = Instant::now();
         let kernel = self.run(width, height, false)?;
         let read = Instant::now();
@@ -321,7 +461,8 @@ impl Renderer {
     /// program's precision cannot compute with.
     pub fn set_param(&mut self, name: &str, value: f64) -> Result<()> {
         let limits = self.source.precision.limits();
-        self.values.set_within(name, value, limits)
+        self.values.set_within(name, value, limits)?;
+        self.for_partners(|p| p.set_param(name, value))
     }
 
     /// The current value of a dynamic parameter.
@@ -339,7 +480,8 @@ impl Renderer {
         let view = Viewport::in_frame(&camera, 1, 1, self.source.precision, self.source.origin)?;
         let limits = self.source.precision.limits();
         check_frame_inputs(&view, &[], self.source.origin, limits)?;
-        self.scene.set_camera(camera)
+        self.scene.set_camera(camera)?;
+        self.for_partners(|p| p.set_camera(camera))
     }
 
     /// The camera.
@@ -359,8 +501,9 @@ impl Renderer {
         let lights: Vec<Light> = lights.into_iter().collect();
         check_light_count(&lights)?;
         let mut scene = self.scene.clone();
-        scene.set_lights(lights)?;
+        scene.set_lights(lights.clone())?;
         check_inputs(&scene, &self.values, &self.source)?;
+        self.for_partners(|p| p.set_lights(lights.iter().copied()))?;
         self.scene = scene;
         Ok(())
     }
@@ -387,7 +530,8 @@ impl Renderer {
             quality,
             ..self.options.clone()
         };
-        self.reprogram(options)
+        self.reprogram(options)?;
+        self.for_partners(|p| p.set_quality(quality))
     }
 
     /// Changes the effects: a new program (compiled unless cached).
@@ -399,7 +543,8 @@ impl Renderer {
             effects,
             ..self.options.clone()
         };
-        self.reprogram(options)
+        self.reprogram(options)?;
+        self.for_partners(|p| p.set_effects(effects))
     }
 
     /// The options in use.
@@ -552,8 +697,15 @@ impl Renderer {
         t.bind(k)?;
         let launched = Instant::now();
         let mut events: Vec<Event> = Vec::new();
-        let total = dispatch::tiles(width, height, self.options.tile_size).count();
-        for tile in dispatch::tiles(width, height, self.options.tile_size) {
+        let (share, shares) = self.share;
+        let mine = || {
+            dispatch::tiles(width, height, self.options.tile_size)
+                .enumerate()
+                .filter(move |(i, _)| i % shares == share)
+                .map(|(_, tile)| tile)
+        };
+        let total = mine().count();
+        for tile in mine() {
             if let Some(stop) = self.stop(launched, events.len(), total) {
                 // Let the tiles in flight finish before the buffers are
                 // touched again.

@@ -69,6 +69,10 @@ struct SceneArgs {
     /// file's, else automatic).
     #[arg(long)]
     device: Option<String>,
+    /// Split every frame across devices: `all`, or device name substrings
+    /// separated by commas (a name twice uses that device twice).
+    #[arg(long, value_name = "all|NAME,...", conflicts_with = "device")]
+    devices: Option<String>,
 }
 
 #[derive(Args)]
@@ -203,6 +207,7 @@ fn load_scene(scene: &str) -> Outcome<SceneFile> {
 /// settings file and the scene file.
 struct Job {
     file: SceneFile,
+    devices: Option<Vec<DeviceSelector>>,
     size: (u32, u32),
     options: RenderOptions,
     sets: Vec<(String, f64)>,
@@ -234,6 +239,15 @@ impl Job {
                 Ok((name.trim().to_string(), value))
             })
             .collect::<Outcome<Vec<_>>>()?;
+        let devices = match args.devices.as_deref() {
+            None => None,
+            Some("all") => Some(devices()?.iter().map(DeviceSelector::exactly).collect()),
+            Some(list) => Some(
+                list.split(',')
+                    .map(|name| DeviceSelector::device(name.trim()))
+                    .collect(),
+            ),
+        };
         let options = RenderOptions {
             quality: preset.map_or(file.quality, Preset::quality),
             effects: file.effects,
@@ -242,6 +256,7 @@ impl Job {
         };
         Ok(Job {
             file,
+            devices,
             size,
             options,
             sets,
@@ -249,7 +264,10 @@ impl Job {
     }
 
     fn renderer(&self) -> Outcome<Renderer> {
-        let mut renderer = Renderer::with_options(&self.file.scene, &self.options)?;
+        let mut renderer = match &self.devices {
+            Some(devices) => Renderer::with_devices(&self.file.scene, &self.options, devices)?,
+            None => Renderer::with_options(&self.file.scene, &self.options)?,
+        };
         for (name, value) in &self.sets {
             renderer.set_param(name, *value)?;
         }
@@ -288,9 +306,15 @@ fn render(args: &RenderArgs, settings: &Settings) -> Outcome {
         args.output.display(),
         job.preset_name(),
         start.elapsed().as_secs_f64(),
-        renderer.device().label()
+        on_devices(&renderer)
     );
     Ok(())
+}
+
+/// The renderer's devices, for reports.
+fn on_devices(renderer: &Renderer) -> String {
+    let labels: Vec<String> = renderer.devices().iter().map(|d| d.label()).collect();
+    labels.join(" + ")
 }
 
 /// `I/N` with `I < N`.
@@ -500,7 +524,7 @@ fn bench(args: &BenchArgs, settings: &Settings) -> Outcome {
         "{}: {width}x{height}, {} quality on {}",
         args.scene.scene,
         job.preset_name(),
-        renderer.device().label()
+        on_devices(&renderer)
     );
     println!(
         "  {:.1} ms/frame median of {} (min {low:.1}, max {high:.1}); {:.1} distance evaluations per pixel",
