@@ -319,3 +319,18 @@ fn shorthand_forms_read_as_their_long_forms() {
     assert_eq!(file.scene.lights, Scene::empty().lights);
     assert_eq!(file.effects, Effects::default());
 }
+
+/// The README's complete scene file reads, with every part it shows.
+#[test]
+fn the_readme_example_file_reads() {
+    let readme =
+        std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("README.md")).unwrap();
+    let start = readme.find("```ron\n").expect("a RON block in the README") + 7;
+    let end = start + readme[start..].find("```").unwrap();
+    let file = SceneFile::parse(&readme[start..end]).unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(file.scene.lights.len(), 2);
+    assert_eq!(file.quality, Quality::production().supersampling(2));
+    assert!(file.effects.glow.is_some());
+    assert_eq!(file.motions.len(), 1);
+    assert!(file.scene.compile().unwrap().params().slots().len() == 1);
+}
