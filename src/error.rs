@@ -102,7 +102,7 @@ pub enum Error {
     #[error("{}:{line}:{column}: {reason}", file.display())]
     SceneFile {
         /// The file, or `<scene>` for text read with
-        /// [`SceneFile::parse`](crate::scene::SceneFile::parse).
+        /// [`SceneFile::parse`](crate::SceneFile::parse).
         file: PathBuf,
         /// The line of the offending text, from 1.
         line: usize,

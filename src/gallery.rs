@@ -16,11 +16,12 @@ use glam::{DVec3, dvec3};
 
 use crate::animation::{CameraPath, Motion};
 use crate::error::Result;
+use crate::file::SceneFile;
 use crate::quality::{Effects, Glow, Quality};
 use crate::scene::{
-    Axis, Camera, Light, Mandelbulb, Node, QuaternionJulia, Scene, SceneFile, capped_cone, capsule,
-    cuboid, cylinder, ellipsoid, julia, menger, octahedron, param, param3, plane, round_box,
-    sierpinski, sphere, torus,
+    Axis, Camera, Light, Mandelbulb, Node, QuaternionJulia, Scene, capped_cone, capsule, cuboid,
+    cylinder, ellipsoid, julia, menger, octahedron, param, param3, plane, round_box, sierpinski,
+    sphere, torus,
 };
 
 /// Every gallery scene by name.

@@ -174,6 +174,7 @@ pub mod animation;
 pub mod codegen;
 pub mod cpu;
 pub mod error;
+pub mod file;
 pub mod gallery;
 pub mod ir;
 pub mod math;
@@ -190,6 +191,7 @@ pub mod testing;
 pub mod view;
 
 pub use error::{Error, Result};
+pub use file::SceneFile;
 pub use ir::CompiledScene;
 pub use scene::{Node, Scene};
 

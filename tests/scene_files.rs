@@ -9,9 +9,11 @@ mod gpu;
 
 use std::path::{Path, PathBuf};
 
+use fractal_sdf::SceneFile;
+use fractal_sdf::file::MAX_NESTING;
 use fractal_sdf::gallery;
 use fractal_sdf::prelude::*;
-use fractal_sdf::scene::{CustomShape, MAX_NESTING, Rule, SceneFile};
+use fractal_sdf::scene::{CustomShape, Rule};
 
 fn scenes_dir() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes")

@@ -6,7 +6,6 @@
 
 pub mod build;
 mod custom;
-mod file;
 pub(crate) mod names;
 mod node;
 mod param;
@@ -19,7 +18,6 @@ pub use build::{
     plane, round_box, sierpinski, sphere, torus,
 };
 pub use custom::{CpuDistance, CustomShape};
-pub use file::{FORMAT_VERSION, MAX_NESTING, SceneFile};
 pub(crate) use node::Mapper;
 pub use node::{
     Axis, CsgOp, Kind, MAX_ESCAPE_ITERATIONS, MAX_FOLD_ITERATIONS, Mandelbulb, Menger, Node,

@@ -7,13 +7,13 @@ use std::process::ExitCode;
 use std::time::{Duration, Instant};
 
 use clap::{Args, Parser, Subcommand};
+use fractal_sdf::SceneFile;
 use fractal_sdf::animation::CameraPath;
 use fractal_sdf::codegen::{self, Options};
 use fractal_sdf::gallery;
 use fractal_sdf::output::{save_png, verify_png};
 use fractal_sdf::prelude::*;
 use fractal_sdf::render::{DeviceSelector, RenderOptions, Renderer, devices};
-use fractal_sdf::scene::SceneFile;
 use fractal_sdf::sequence::{Sequence, parse_range};
 use fractal_sdf::settings::{CONFIG_ENV, Settings, parse_preset, parse_size};
 use indicatif::{ProgressBar, ProgressStyle};

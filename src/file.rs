@@ -23,7 +23,7 @@
 //! )
 //! ```
 //!
-//! - **Nodes** are written as in Rust's [`Kind`](super::Kind), with
+//! - **Nodes** are written as in Rust's [`Kind`](crate::scene::Kind), with
 //!   the booleans named: `Union([a, b, ...])` (any number of operands, what
 //!   [`Scene::add`] builds), `Subtract(a: .., b: ..)`, `Intersect(a: ..,
 //!   b: ..)`, `SmoothUnion(k: 0.1, a: .., b: ..)` and the other smooth
@@ -31,7 +31,7 @@
 //!   [`SceneFile::parse_with`]. Fractal settings left out take the
 //!   builders' defaults (Mandelbulb: 12 iterations, bailout 2).
 //! - **Numbers**: a parameter is a number (baked) or `param("name",
-//!   default)` (dynamic, see [`param`](super::param)); a vector is `(x, y,
+//!   default)` (dynamic, see [`param`](crate::scene::param)); a vector is `(x, y,
 //!   z)`, one number for all three, or `param3("name", (x, y, z))`.
 //! - **Everything but `version` and `geometry` may be left out**: the
 //!   camera and lights default as in [`Scene::new`], `quality` to the
@@ -49,7 +49,7 @@
 //!
 //! ```
 //! use fractal_sdf::prelude::*;
-//! use fractal_sdf::scene::SceneFile;
+//! use fractal_sdf::SceneFile;
 //!
 //! let file = SceneFile::parse("(version: 1, geometry: Sphere(radius: 1))")?;
 //! assert_eq!(file.scene.geometry, Some(sphere(1.0)));
@@ -70,15 +70,13 @@ use serde::de::{self, Deserializer, MapAccess, SeqAccess, Visitor};
 use serde::ser::{SerializeTupleVariant, Serializer};
 use serde::{Deserialize, Serialize};
 
-use super::custom::CustomShape;
-use super::node::{
-    Axis, CsgOp, Kind, Mandelbulb, Menger, Node, NodeKind, QuaternionJulia, Sierpinski,
-};
-use super::param::{Param, Param3, param3};
-use super::{Camera, Light, Scene};
 use crate::animation::{CameraPath, Keyframe, Motion};
 use crate::error::{Error, Result};
 use crate::quality::{Effects, Precision, Preset, Quality};
+use crate::scene::{
+    Axis, Camera, CsgOp, CustomShape, Kind, Light, Mandelbulb, Menger, Node, NodeKind, Param,
+    Param3, QuaternionJulia, Scene, Sierpinski, param3,
+};
 
 /// The format version this library reads and writes.
 pub const FORMAT_VERSION: u32 = 1;
