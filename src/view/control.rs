@@ -466,6 +466,9 @@ impl KeyBindings {
 pub struct ViewSettings {
     /// The quality preset.
     pub preset: Preset,
+    /// A quality that is no preset (a scene file's), used instead of
+    /// `preset` until a quality action picks a preset.
+    pub custom_quality: Option<Quality>,
     /// Ambient occlusion on (the draft preset has no AO samples, so it
     /// shows none either way).
     pub ambient_occlusion: bool,
@@ -484,6 +487,7 @@ impl Default for ViewSettings {
     fn default() -> Self {
         ViewSettings {
             preset: Preset::Preview,
+            custom_quality: None,
             ambient_occlusion: true,
             shadows: true,
             glow: false,
@@ -497,10 +501,35 @@ impl Default for ViewSettings {
 }
 
 impl ViewSettings {
-    /// The quality to render with.
+    /// The quality to render with: the custom one if set, else the
+    /// preset's.
     #[must_use]
     pub fn quality(&self) -> Quality {
-        self.preset.quality()
+        self.custom_quality.unwrap_or_else(|| self.preset.quality())
+    }
+
+    /// Renders with `quality` from now on: its preset if it is one, else as
+    /// [`ViewSettings::custom_quality`].
+    pub fn take_quality(&mut self, quality: Quality) {
+        match Preset::ALL.into_iter().find(|p| p.quality() == quality) {
+            Some(preset) => {
+                self.preset = preset;
+                self.custom_quality = None;
+            }
+            None => self.custom_quality = Some(quality),
+        }
+    }
+
+    /// Renders with `effects` from now on: its switches become the
+    /// switches, its glow (if any) the glow style, and the rest the base.
+    pub fn take_effects(&mut self, effects: Effects) {
+        self.ambient_occlusion = effects.ambient_occlusion;
+        self.shadows = effects.shadows;
+        self.glow = effects.glow.is_some();
+        if let Some(glow) = effects.glow {
+            self.glow_style = glow;
+        }
+        self.base = effects;
     }
 
     /// The effects to render with.
@@ -522,16 +551,25 @@ impl ViewSettings {
             Action::ToggleAmbientOcclusion => self.ambient_occlusion ^= true,
             Action::ToggleShadows => self.shadows ^= true,
             Action::ToggleGlow => self.glow ^= true,
-            Action::Quality(p) => self.preset = p,
+            Action::Quality(p) => {
+                self.preset = p;
+                self.custom_quality = None;
+            }
             _ => {}
         }
         *self != before
     }
 
-    /// A short description, such as `preview, AO, shadows, glow`.
+    /// A short description, such as `preview, AO, shadows, glow`
+    /// (`custom` for a custom quality).
     #[must_use]
     pub fn summary(&self) -> String {
-        let mut parts = vec![self.preset.name()];
+        let quality = if self.custom_quality.is_some() {
+            "custom"
+        } else {
+            self.preset.name()
+        };
+        let mut parts = vec![quality];
         for (on, name) in [
             (self.ambient_occlusion, "AO"),
             (self.shadows, "shadows"),
@@ -824,5 +862,42 @@ mod tests {
             .filter(|&&k| Movement::is_movement_key(k))
             .count();
         assert_eq!(moving, Movement::KEYS.len());
+    }
+
+    #[test]
+    fn a_custom_quality_holds_until_a_preset_is_picked() {
+        let mut s = ViewSettings::default();
+        s.take_quality(Quality::draft());
+        assert_eq!((s.preset, s.custom_quality), (Preset::Draft, None));
+        let custom = Quality::production().supersampling(2);
+        s.take_quality(custom);
+        assert_eq!(s.quality(), custom);
+        assert_eq!(s.summary(), "custom, AO, shadows");
+        assert!(s.apply(Action::Quality(Preset::Draft)));
+        assert_eq!(s.quality(), Quality::draft());
+        assert_eq!(s.custom_quality, None);
+        // Picking the preset the custom quality was based on still
+        // changes it.
+        s.take_quality(Quality::draft().supersampling(2));
+        assert!(s.apply(Action::Quality(Preset::Draft)));
+    }
+
+    #[test]
+    fn taken_effects_become_the_switches() {
+        let glow = Glow::new(dvec3(1.0, 0.0, 0.0), 0.3);
+        let effects = Effects::default()
+            .ambient_occlusion(false)
+            .glow(glow)
+            .gamma(1.8);
+        let mut s = ViewSettings::default();
+        s.take_effects(effects);
+        assert_eq!(s.effects(), effects);
+        assert!(s.glow && !s.ambient_occlusion && s.shadows);
+        assert!(s.apply(Action::ToggleGlow));
+        assert_eq!(s.effects().glow, None);
+        assert!(s.apply(Action::ToggleGlow));
+        assert_eq!(s.effects().glow, Some(glow), "the file's glow style");
+        s.take_effects(Effects::default());
+        assert_eq!(s.effects(), Effects::default());
     }
 }
