@@ -457,26 +457,39 @@ fn real_key_presses_reach_the_window() {
     std::fs::remove_dir_all(dir).unwrap();
 }
 
-/// A scene file: `geometry` on one line (the file's third), seen from a
-/// fixed camera, at draft quality.
-fn scene_text(geometry: &str) -> String {
+/// The camera of the scene files.
+const CAMERA: &str = "(position: (0, 0.8, 4), target: (0, -0.2, 0))";
+
+/// A scene file: `geometry` on one line (the file's third), seen from
+/// `camera`, at draft quality.
+fn scene_text_from(geometry: &str, camera: &str) -> String {
     format!(
         "(
     version: 1,
     geometry: {geometry},
-    camera: (position: (0, 0.8, 4), target: (0, -0.2, 0)),
+    camera: {camera},
     quality: (preset: Draft),
 )
 "
     )
 }
 
+/// A scene file: `geometry` seen from [`CAMERA`].
+fn scene_text(geometry: &str) -> String {
+    scene_text_from(geometry, CAMERA)
+}
+
 /// A sphere of dynamic radius `radius` (orange) on a grey floor.
-fn sphere_scene(radius: f64) -> String {
-    scene_text(&format!(
+fn sphere_geometry(radius: f64) -> String {
+    format!(
         "Union([Color(color: (0.95, 0.45, 0.2), child: Sphere(radius: param(\"radius\", {radius}))), \
          Color(color: (0.55, 0.55, 0.6), child: Plane(normal: (0, 1, 0), offset: 1))])"
-    ))
+    )
+}
+
+/// The sphere of [`sphere_geometry`] seen from [`CAMERA`].
+fn sphere_scene(radius: f64) -> String {
+    scene_text(&sphere_geometry(radius))
 }
 
 /// How many times the viewer has reloaded its scene file.
@@ -536,6 +549,18 @@ fn an_edited_scene_file_is_reloaded_and_a_bad_one_reported() {
         "the radius changed {changed} pixels"
     );
 
+    // Another camera: the view moves to it, with the same program.
+    let aside = "(position: (2.5, 2, 2.5), target: (0, -0.2, 0))";
+    replace(&file, &scene_text_from(&sphere_geometry(0.6), aside));
+    viewer.wait_for("the second reload", |r| reloads(r) == 2);
+    assert_eq!(viewer.stdout().matches("(same program in").count(), 2);
+    let moved = shot(&mut viewer, "camera_moved");
+    let changed = differing_pixels(&small, &moved);
+    assert!(
+        changed > 96 * 72 / 20,
+        "the camera changed {changed} pixels"
+    );
+
     // Another shape: another program.
     replace(
         &file,
@@ -544,14 +569,14 @@ fn an_edited_scene_file_is_reloaded_and_a_bad_one_reported() {
              Color(color: (0.55, 0.55, 0.6), child: Plane(normal: (0, 1, 0), offset: 1))])",
         ),
     );
-    viewer.wait_for("the second reload", |r| reloads(r) == 2);
+    viewer.wait_for("the third reload", |r| reloads(r) == 3);
     assert!(
         viewer.stdout().contains("(new program in"),
         "{}",
         viewer.stdout()
     );
     let cube = shot(&mut viewer, "cube");
-    let changed = differing_pixels(&small, &cube);
+    let changed = differing_pixels(&moved, &cube);
     assert!(changed > 96 * 72 / 10, "the cube changed {changed} pixels");
 
     // A syntax error, then a value that does not validate, each on line
@@ -586,11 +611,11 @@ fn an_edited_scene_file_is_reloaded_and_a_bad_one_reported() {
             "a bad file changed {changed} pixels"
         );
     }
-    assert_eq!(reloads(&viewer), 2, "bad files are not reloads");
+    assert_eq!(reloads(&viewer), 3, "bad files are not reloads");
 
     // A good file again: the error is gone and the sphere is back.
     replace(&file, &sphere_scene(1.0));
-    viewer.wait_for("the recovery", |r| reloads(r) == 3);
+    viewer.wait_for("the recovery", |r| reloads(r) == 4);
     viewer.wait_for("the title without the error", |r| {
         let title = r.title();
         title.starts_with("scene.ron | ") && !title.contains("ERROR")
