@@ -1,6 +1,16 @@
-//! An interactive window on any gallery scene.
+//! An interactive window on a gallery scene or a scene file.
 //!
 //! `cargo run --release --features viewer --example viewer -- fractal_mix`
+//! `cargo run --release --features viewer --example viewer -- my_scene.ron`
+//!
+//! A scene file (`.ron`, see `fractal_sdf::scene::SceneFile`) brings its
+//! quality, effects and motions, and is reloaded whenever it changes on
+//! disk (polled: its modification time and size): a good file replaces the
+//! scene (keeping the program when only parameter defaults or the lights
+//! changed, and the view's camera unless the file's changed), a bad one is
+//! reported on stderr and in the title while the last good scene stays.
+//! The user's settings file (`fractal_sdf::settings`) sets the defaults and
+//! the key bindings; command-line options override it.
 //!
 //! The camera, keys, settings and resolution choice live in the library
 //! (`fractal_sdf::view`); this file only connects them to a `winit` window
@@ -9,16 +19,20 @@
 mod common;
 
 use std::num::NonZeroU32;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::rc::Rc;
-use std::time::{Duration, Instant};
+use std::time::{Duration, Instant, SystemTime};
 
 use fractal_sdf::animation::Motion;
+use fractal_sdf::codegen;
+use fractal_sdf::ir::ParamLayout;
 use fractal_sdf::prelude::*;
-use fractal_sdf::render::{RenderOptions, Renderer};
+use fractal_sdf::render::{DeviceSelector, RenderOptions, Renderer};
+use fractal_sdf::scene::SceneFile;
+use fractal_sdf::settings::Settings;
 use fractal_sdf::view::{
-    Action, FlyCamera, Key, KeyScript, Movement, ResolutionScaler, ViewSettings, blit_scaled,
-    reduced_size,
+    Action, FlyCamera, Key, KeyBindings, KeyScript, Movement, ResolutionScaler, ViewSettings,
+    blit_scaled, reduced_size,
 };
 use fractal_sdf::{gallery, output};
 use winit::application::ApplicationHandler;
@@ -29,11 +43,23 @@ use winit::keyboard::{KeyCode, PhysicalKey};
 use winit::window::{Window, WindowId};
 
 const HELP: &str = "\
-fractal-sdf viewer: fly through a gallery scene.
+fractal-sdf viewer: fly through a gallery scene or a scene file.
 
 USAGE: viewer [SCENE] [OPTIONS]
 
-SCENE is a gallery scene name (default mandelbulb); --list prints them.
+SCENE is a gallery scene name (default mandelbulb; --list prints them) or a
+scene file: a path that contains `/`, ends in `.ron` or names a file. A
+scene file brings its quality, effects and motions, and is reloaded when its
+modification time or size changes (checked 4 times a second): the camera,
+quality and effects a new version changes replace the view's, the rest
+stays. A bad version is reported on stderr and in the title (ERROR) while
+the last good scene stays on screen.
+
+SETTINGS: $FRACTAL_SDF_CONFIG or fractal-sdf/config.toml in the user's
+configuration directory: `preset`, `size`, `device`, and under [viewer]
+`mouse_sensitivity` and [viewer.keys] (action name = key name, e.g.
+`toggle_glow = \"l\"`; names below). Options given here override them; a
+scene file's quality overrides `preset`.
 
 OPTIONS:
   --size WxH           window size in pixels (default 640x480)
@@ -41,6 +67,7 @@ OPTIONS:
   --no-ao              start with ambient occlusion off
   --no-shadows         start with shadows off
   --glow               start with glow on
+  --device NAME        the first OpenCL device whose name contains NAME
   --sensitivity F      mouse sensitivity in radians per pixel (default 0.004)
   --speed F            movement speed in units per second (default: a third of
                        the distance to the scene camera's target)
@@ -60,27 +87,44 @@ CONTROLS:
   scroll wheel             change movement speed
 ";
 
+/// How often a scene file's modification time and size are checked.
+const POLL: Duration = Duration::from_millis(250);
+
+/// The longest error message the title shows.
+const TITLE_ERROR_CHARS: usize = 120;
+
+/// The command line; `None` where it leaves the setting to the settings
+/// file or the scene.
 struct Args {
     scene: String,
-    size: (u32, u32),
-    settings: ViewSettings,
-    sensitivity: f64,
+    size: Option<(u32, u32)>,
+    preset: Option<Preset>,
+    no_ao: bool,
+    no_shadows: bool,
+    glow: bool,
+    device: Option<String>,
+    sensitivity: Option<f64>,
     speed: Option<f64>,
     target: Duration,
     max_divisor: u32,
     shots: PathBuf,
     frames: Option<u64>,
     screenshot: Option<PathBuf>,
-    keys: KeyScript,
+    keys: Option<String>,
 }
 
 fn parse_args() -> Result<Option<Args>> {
     let mut a = pico_args::Arguments::from_env();
     if a.contains(["-h", "--help"]) {
         print!("{HELP}");
-        println!("KEYS:");
+        println!("\nKEYS (default key, action name for [viewer.keys]):");
         for action in Action::ALL {
-            println!("  {:<24} {}", action.key(), action.description());
+            println!(
+                "  {:<8} {:<26} {}",
+                action.key(),
+                action.name(),
+                action.description()
+            );
         }
         return Ok(None);
     }
@@ -89,28 +133,22 @@ fn parse_args() -> Result<Option<Args>> {
         return Ok(None);
     }
     let u = common::usage;
-    let mut settings = ViewSettings::default();
-    if let Some(q) = a.opt_value_from_str::<_, String>("--quality").map_err(u)? {
-        settings.preset = common::parse_preset(&q)?;
-    }
-    settings.ambient_occlusion = !a.contains("--no-ao");
-    settings.shadows = !a.contains("--no-shadows");
-    settings.glow = a.contains("--glow");
-    let size = match a.opt_value_from_str::<_, String>("--size").map_err(u)? {
-        Some(s) => common::parse_size(&s)?,
-        None => (640, 480),
+    let preset = match a.opt_value_from_str::<_, String>("--quality").map_err(u)? {
+        Some(q) => Some(common::parse_preset(&q)?),
+        None => None,
     };
-    let keys = match a.opt_value_from_str::<_, String>("--keys").map_err(u)? {
-        Some(s) => KeyScript::parse(&s)?,
-        None => KeyScript::default(),
+    let size = match a.opt_value_from_str::<_, String>("--size").map_err(u)? {
+        Some(s) => Some(common::parse_size(&s)?),
+        None => None,
     };
     let args = Args {
         size,
-        settings,
-        sensitivity: a
-            .opt_value_from_str("--sensitivity")
-            .map_err(u)?
-            .unwrap_or(FlyCamera::DEFAULT_SENSITIVITY),
+        preset,
+        no_ao: a.contains("--no-ao"),
+        no_shadows: a.contains("--no-shadows"),
+        glow: a.contains("--glow"),
+        device: a.opt_value_from_str("--device").map_err(u)?,
+        sensitivity: a.opt_value_from_str("--sensitivity").map_err(u)?,
         speed: a.opt_value_from_str("--speed").map_err(u)?,
         target: Duration::from_secs_f64(
             a.opt_value_from_str::<_, f64>("--target-ms")
@@ -129,7 +167,7 @@ fn parse_args() -> Result<Option<Args>> {
             .unwrap_or_else(|| "out".into()),
         frames: a.opt_value_from_str("--frames").map_err(u)?,
         screenshot: a.opt_value_from_str("--screenshot").map_err(u)?,
-        keys,
+        keys: a.opt_value_from_str("--keys").map_err(u)?,
         scene: a
             .opt_free_from_str()
             .map_err(u)?
@@ -139,17 +177,145 @@ fn parse_args() -> Result<Option<Args>> {
     if !rest.is_empty() {
         return Err(common::usage(format!("unexpected arguments {rest:?}")));
     }
-    if let (Some(last), Some(n)) = (args.keys.last_frame(), args.frames)
-        && last >= n
-    {
-        return Err(common::usage(format!(
-            "--keys presses a key before frame {last}, but --frames renders frames 0..{n}"
-        )));
-    }
     if args.screenshot.is_some() && args.frames.is_none() {
         return Err(common::usage("--screenshot needs --frames"));
     }
+    if let Some(s) = args.sensitivity
+        && !s.is_finite()
+    {
+        return Err(common::usage(format!("--sensitivity {s} is not a number")));
+    }
     Ok(Some(args))
+}
+
+/// Everything that decides how the viewer runs: the command line over the
+/// settings file over the defaults.
+struct Config {
+    args: Args,
+    size: (u32, u32),
+    /// The settings file's preset, for gallery scenes.
+    settings_preset: Option<Preset>,
+    device: DeviceSelector,
+    sensitivity: f64,
+    bindings: KeyBindings,
+    script: KeyScript,
+}
+
+impl Config {
+    fn new(args: Args, settings: Settings) -> Result<Self> {
+        let in_settings = |e: Error| Error::Invalid {
+            what: "settings file",
+            reason: format!(
+                "{}: {e}",
+                Settings::path().map_or_else(String::new, |p| p.display().to_string())
+            ),
+        };
+        let bindings = KeyBindings::from_names(&settings.viewer.keys).map_err(in_settings)?;
+        let sensitivity = match (args.sensitivity, settings.viewer.mouse_sensitivity) {
+            (Some(s), _) => s,
+            (None, Some(s)) if s.is_finite() => s,
+            (None, Some(s)) => {
+                return Err(in_settings(Error::Invalid {
+                    what: "mouse_sensitivity",
+                    reason: format!("{s} is not a number"),
+                }));
+            }
+            (None, None) => FlyCamera::DEFAULT_SENSITIVITY,
+        };
+        let script = match &args.keys {
+            Some(text) => KeyScript::parse_with(text, &bindings)?,
+            None => KeyScript::default(),
+        };
+        if let (Some(last), Some(n)) = (script.last_frame(), args.frames)
+            && last >= n
+        {
+            return Err(common::usage(format!(
+                "--keys presses a key before frame {last}, but --frames renders frames 0..{n}"
+            )));
+        }
+        let device = match args.device.as_ref().or(settings.device.as_ref()) {
+            Some(name) => DeviceSelector::device(name.clone()),
+            None => DeviceSelector::auto(),
+        };
+        Ok(Config {
+            settings_preset: settings.preset,
+            size: args.size.or(settings.size).unwrap_or((640, 480)),
+            args,
+            device,
+            sensitivity,
+            bindings,
+            script,
+        })
+    }
+}
+
+/// Whether the SCENE argument names a scene file rather than a gallery
+/// scene.
+fn is_scene_file(scene: &str) -> bool {
+    scene.contains('/')
+        || scene.contains(std::path::MAIN_SEPARATOR)
+        || scene.ends_with(".ron")
+        || Path::new(scene).is_file()
+}
+
+/// What tells a file's versions apart without reading it.
+type Stamp = (SystemTime, u64);
+
+/// The modification time and size of the file at `path`, if it has one.
+fn stamp(path: &Path) -> Option<Stamp> {
+    let meta = std::fs::metadata(path).ok()?;
+    Some((meta.modified().ok()?, meta.len()))
+}
+
+/// A scene file the viewer shows and watches for changes.
+struct Watched {
+    path: PathBuf,
+    /// The file's stamp when it was last read.
+    stamp: Option<Stamp>,
+    next_check: Instant,
+    /// The last file that loaded and rendered.
+    good: SceneFile,
+    /// The error of the last read, if it failed: for the title.
+    error: Option<String>,
+}
+
+/// The layouts give the same parameters the same slots and rules (their
+/// defaults may differ).
+fn same_slots(a: &ParamLayout, b: &ParamLayout) -> bool {
+    a.constraints() == b.constraints()
+        && a.slots().len() == b.slots().len()
+        && a.slots()
+            .iter()
+            .zip(b.slots())
+            .all(|(x, y)| x.name == y.name && x.rule == y.rule && x.used_at == y.used_at)
+}
+
+/// An error for the title: short, and a scene file's with its file name
+/// instead of its path.
+fn title_error(e: &Error) -> String {
+    let text = match e {
+        Error::SceneFile {
+            file,
+            line,
+            column,
+            reason,
+            ..
+        } => format!(
+            "{}:{line}:{column}: {reason}",
+            file.file_name().map_or_else(
+                || file.display().to_string(),
+                |n| n.to_string_lossy().into_owned()
+            )
+        ),
+        other => other.to_string(),
+    };
+    let text = text.split_whitespace().collect::<Vec<_>>().join(" ");
+    if text.chars().count() > TITLE_ERROR_CHARS {
+        let cut: String = text.chars().take(TITLE_ERROR_CHARS - 3).collect();
+        format!("{cut}...")
+    } else {
+        text
+    }
 }
 
 /// The window and its pixel surface, created once the event loop runs.
@@ -160,8 +326,16 @@ struct Surface {
 
 struct Viewer {
     args: Args,
+    /// The window size asked for.
+    size: (u32, u32),
+    bindings: KeyBindings,
+    script: KeyScript,
+    /// The scene's name in the title: the gallery name or the file name.
+    name: String,
     scene: Scene,
     motions: Vec<Motion>,
+    /// The scene file, when the scene comes from one.
+    watched: Option<Watched>,
     renderer: Renderer,
     fly: FlyCamera,
     keys: Movement,
@@ -172,6 +346,8 @@ struct Viewer {
     image: Option<RgbaImage>,
     /// Whether `image` is full size.
     image_sharp: bool,
+    /// The size of `image`, for the title.
+    image_size: (u32, u32),
     last_tick: Instant,
     /// The last tick found nothing to do, and the loop slept.
     idle: bool,
@@ -190,27 +366,71 @@ struct Viewer {
 }
 
 impl Viewer {
-    fn new(args: Args) -> Result<Self> {
-        let scene = common::gallery_scene(&args.scene)?;
-        let motions = gallery::motions(&args.scene);
-        let settings = args.settings;
+    fn new(config: Config) -> Result<Self> {
+        let Config {
+            args,
+            size,
+            settings_preset,
+            device,
+            sensitivity,
+            bindings,
+            script,
+        } = config;
+        let mut settings = ViewSettings::default();
+        let (name, scene, motions, watched) = if is_scene_file(&args.scene) {
+            let path = PathBuf::from(&args.scene);
+            // The stamp first: a change while the file is read is seen.
+            let stamp = stamp(&path);
+            let file = SceneFile::load(&path)?;
+            settings.take_quality(file.quality);
+            settings.take_effects(file.effects);
+            let name = path
+                .file_name()
+                .map_or_else(|| args.scene.clone(), |n| n.to_string_lossy().into_owned());
+            let watched = Watched {
+                path,
+                stamp,
+                next_check: Instant::now() + POLL,
+                good: file.clone(),
+                error: None,
+            };
+            (name, file.scene, file.motions, Some(watched))
+        } else {
+            let scene = common::gallery_scene(&args.scene)?;
+            if let Some(preset) = settings_preset {
+                settings.preset = preset;
+            }
+            (
+                args.scene.clone(),
+                scene,
+                gallery::motions(&args.scene),
+                None,
+            )
+        };
+        // The command line over the file and the settings.
+        if let Some(preset) = args.preset {
+            settings.apply(Action::Quality(preset));
+        }
+        settings.ambient_occlusion &= !args.no_ao;
+        settings.shadows &= !args.no_shadows;
+        settings.glow |= args.glow;
         let renderer = Renderer::with_options(
             &scene,
             &RenderOptions {
                 quality: settings.quality(),
                 effects: settings.effects(),
+                device,
                 ..RenderOptions::default()
             },
         )?;
         println!(
-            "{}: {} on {} (build {:.0} ms)",
-            args.scene,
+            "{name}: {} on {} (build {:.0} ms)",
             settings.summary(),
             renderer.device().label(),
             renderer.build_info().build_time.as_secs_f64() * 1e3
         );
         let mut fly = FlyCamera::from_camera(&scene.camera);
-        fly.sensitivity = args.sensitivity;
+        fly.sensitivity = sensitivity;
         if let Some(speed) = args.speed {
             fly.speed = speed;
         }
@@ -218,8 +438,13 @@ impl Viewer {
             scaler: ResolutionScaler::new(args.target, args.max_divisor),
             animating: !motions.is_empty(),
             args,
+            size,
+            bindings,
+            script,
+            name,
             scene,
             motions,
+            watched,
             renderer,
             fly,
             keys: Movement::default(),
@@ -227,6 +452,7 @@ impl Viewer {
             surface: None,
             image: None,
             image_sharp: false,
+            image_size: size,
             last_tick: Instant::now(),
             idle: false,
             anim_time: 0.0,
@@ -243,6 +469,19 @@ impl Viewer {
 
     fn headless(&self) -> bool {
         self.args.frames.is_some()
+    }
+
+    /// The fly camera at `camera`, keeping the mouse sensitivity (and the
+    /// speed given on the command line).
+    fn fly_from(&self, camera: &Camera) -> FlyCamera {
+        let mut fly = FlyCamera {
+            sensitivity: self.fly.sensitivity,
+            ..FlyCamera::from_camera(camera)
+        };
+        if let Some(speed) = self.args.speed {
+            fly.speed = speed;
+        }
+        fly
     }
 
     /// Applies a key's action.
@@ -290,6 +529,124 @@ impl Viewer {
         Ok(())
     }
 
+    /// Checks the scene file, at most every [`POLL`], and reloads it when
+    /// its modification time or size changed. A file that fails to load
+    /// is reported and the last good scene stays; the next change retries
+    /// (so a half-written file is reported, then read again once it is
+    /// complete).
+    fn check_file(&mut self) {
+        let Some(watched) = self.watched.as_mut() else {
+            return;
+        };
+        let now = Instant::now();
+        if now < watched.next_check {
+            return;
+        }
+        watched.next_check = now + POLL;
+        let stamp = stamp(&watched.path);
+        if stamp == watched.stamp {
+            return;
+        }
+        watched.stamp = stamp;
+        let t = Instant::now();
+        let outcome = self.reload();
+        let watched = self.watched.as_mut().expect("checked above");
+        match outcome {
+            Ok(how) => {
+                watched.error = None;
+                println!(
+                    "reloaded {}: {} ({how} in {:.0} ms)",
+                    watched.path.display(),
+                    self.settings.summary(),
+                    t.elapsed().as_secs_f64() * 1e3
+                );
+            }
+            Err(e) => {
+                eprintln!("error: {e}");
+                watched.error = Some(title_error(&e));
+            }
+        }
+        self.set_title();
+    }
+
+    /// Reads the scene file again and shows it; returns how the program
+    /// was obtained. On an error nothing the viewer shows has changed.
+    fn reload(&mut self) -> Result<&'static str> {
+        let watched = self.watched.as_ref().expect("a scene file");
+        let file = SceneFile::load(&watched.path)?;
+        let old = &watched.good;
+        // What the file changes replaces what the user chose; the rest
+        // (keys pressed, the camera flown) stays.
+        let mut settings = self.settings;
+        if file.quality != old.quality {
+            settings.take_quality(file.quality);
+        }
+        if file.effects != old.effects {
+            settings.take_effects(file.effects);
+        }
+        let fly = if file.scene.camera == old.scene.camera {
+            self.fly
+        } else {
+            self.fly_from(&file.scene.camera)
+        };
+        let compiled = file.scene.compile()?;
+        let (quality, effects) = (settings.quality(), settings.effects());
+        let source = codegen::emit(
+            &compiled,
+            &codegen::Options {
+                quality,
+                effects,
+                target: codegen::Target::Render,
+            },
+        )?;
+        let same_program = source == *self.renderer.source()
+            && same_slots(self.renderer.scene().params(), compiled.params());
+        let mut fresh = None;
+        let how = if same_program && update_in_place(&mut self.renderer, &compiled).is_ok() {
+            "same program"
+        } else {
+            let options = RenderOptions {
+                quality,
+                effects,
+                ..self.renderer.options().clone()
+            };
+            let r = fresh.insert(Renderer::from_compiled(compiled, &options)?);
+            if r.build_info().cached {
+                "cached program"
+            } else {
+                "new program"
+            }
+        };
+        let renderer = fresh.as_mut().unwrap_or(&mut self.renderer);
+        // Options that leave the program as it is take it from the cache.
+        if renderer.options().quality != quality {
+            renderer.set_quality(quality)?;
+        }
+        if renderer.options().effects != effects {
+            renderer.set_effects(effects)?;
+        }
+        renderer.set_camera(fly.camera(&file.scene.camera))?;
+        for motion in &file.motions {
+            for (name, value) in motion.values(self.anim_time) {
+                renderer.set_param(&name, value)?;
+            }
+        }
+        if let Some(r) = fresh {
+            self.renderer = r;
+            self.scaler.invalidate();
+        }
+        self.settings = settings;
+        self.fly = fly;
+        if self.motions.is_empty() && !file.motions.is_empty() {
+            self.animating = true;
+        }
+        self.motions.clone_from(&file.motions);
+        self.scene = file.scene.clone();
+        self.watched.as_mut().expect("a scene file").good = file;
+        self.changed = true;
+        Ok(how)
+    }
+
     /// One turn of the game loop, after the window's input was delivered:
     /// update the scene, render, present.
     fn tick(&mut self, event_loop: &ActiveEventLoop) -> Result<()> {
@@ -304,12 +661,19 @@ impl Viewer {
             (now - self.last_tick).as_secs_f64().min(0.25)
         };
         self.last_tick = now;
+        if !self.headless() {
+            self.check_file();
+        }
         // Scripted keys for the coming frame, once even if a tick draws
         // nothing.
         if self.scripted != Some(self.frame) {
             self.scripted = Some(self.frame);
-            let script: Vec<Key> = self.args.keys.keys_at(self.frame).collect();
-            for action in script.into_iter().filter_map(Action::for_key) {
+            let script: Vec<Action> = self
+                .script
+                .keys_at(self.frame)
+                .filter_map(|k| self.bindings.action(k))
+                .collect();
+            for action in script {
                 self.act(action, event_loop)?;
             }
         }
@@ -351,9 +715,10 @@ impl Viewer {
             };
             self.image = Some(image);
             self.image_sharp = d == 1;
+            self.image_size = (w, h);
             self.frame += 1;
             self.present()?;
-            self.set_title(w, h);
+            self.set_title();
         }
 
         if self.screenshot_wanted {
@@ -373,21 +738,23 @@ impl Viewer {
         }
         let busy = self.headless() || changing || self.keys.is_moving() || divisor.is_some();
         self.idle = !busy;
-        event_loop.set_control_flow(if busy {
-            ControlFlow::Poll
-        } else {
-            ControlFlow::Wait
+        event_loop.set_control_flow(match &self.watched {
+            _ if busy => ControlFlow::Poll,
+            // Wake up to look at the scene file.
+            Some(watched) => ControlFlow::WaitUntil(watched.next_check),
+            None => ControlFlow::Wait,
         });
         Ok(())
     }
 
     /// Saves the current view at full size (rendering it if the last frame
     /// was reduced).
-    fn save_sharp(&mut self, path: &std::path::Path) -> Result<()> {
+    fn save_sharp(&mut self, path: &Path) -> Result<()> {
         if !self.image_sharp || self.image.is_none() {
             let (w, h) = self.window_size();
             self.image = Some(self.renderer.render(w, h)?);
             self.image_sharp = true;
+            self.image_size = (w, h);
             self.present()?;
         }
         output::save_png(self.image.as_ref().expect("rendered above"), path)
@@ -398,7 +765,7 @@ impl Viewer {
             .as_ref()
             .map(|s| s.window.inner_size())
             .filter(|s| s.width > 0 && s.height > 0)
-            .map_or(self.args.size, |s| (s.width, s.height))
+            .map_or(self.size, |s| (s.width, s.height))
     }
 
     fn present(&mut self) -> Result<()> {
@@ -415,21 +782,29 @@ impl Viewer {
         buffer.present().map_err(display_error)
     }
 
-    fn set_title(&self, w: u32, h: u32) {
-        if let Some(s) = &self.surface {
-            s.window.set_title(&format!(
-                "{} | {:.1} ms/frame | {w}x{h} | {}{} | speed {:.2}",
-                self.args.scene,
-                self.smoothed_ms,
-                self.settings.summary(),
-                if self.animating || self.motions.is_empty() {
-                    ""
-                } else {
-                    ", paused"
-                },
-                self.fly.speed
-            ));
-        }
+    /// The title: the scene, the scene file's error if it has one, and the
+    /// last frame's cost, size and settings.
+    fn set_title(&self) {
+        let Some(s) = &self.surface else { return };
+        let error = self
+            .watched
+            .as_ref()
+            .and_then(|w| w.error.as_ref())
+            .map(|e| format!(" | ERROR {e}"))
+            .unwrap_or_default();
+        let (w, h) = self.image_size;
+        s.window.set_title(&format!(
+            "{}{error} | {:.1} ms/frame | {w}x{h} | {}{} | speed {:.2}",
+            self.name,
+            self.smoothed_ms,
+            self.settings.summary(),
+            if self.animating || self.motions.is_empty() {
+                ""
+            } else {
+                ", paused"
+            },
+            self.fly.speed
+        ));
     }
 
     fn fail(&mut self, event_loop: &ActiveEventLoop, e: Error) {
@@ -438,14 +813,34 @@ impl Viewer {
     }
 }
 
+/// Gives `renderer` the parameter defaults and lights of `compiled`, whose
+/// program is the renderer's; on an error the parameters are put back.
+fn update_in_place(renderer: &mut Renderer, compiled: &CompiledScene) -> Result<()> {
+    let slots = compiled.params().slots();
+    let before: Vec<(&str, f64)> = slots
+        .iter()
+        .filter_map(|s| Some((s.name.as_str(), renderer.param(&s.name)?)))
+        .collect();
+    let result = slots
+        .iter()
+        .try_for_each(|s| renderer.set_param(&s.name, s.default))
+        .and_then(|()| renderer.set_lights(compiled.lights().iter().copied()));
+    if result.is_err() {
+        for (name, value) in before {
+            let _ = renderer.set_param(name, value);
+        }
+    }
+    result
+}
+
 impl ApplicationHandler for Viewer {
     fn resumed(&mut self, event_loop: &ActiveEventLoop) {
         if self.surface.is_some() {
             return;
         }
-        let (w, h) = self.args.size;
+        let (w, h) = self.size;
         let attributes = Window::default_attributes()
-            .with_title(format!("{} | fractal-sdf", self.args.scene))
+            .with_title(format!("{} | fractal-sdf", self.name))
             .with_inner_size(PhysicalSize::new(w, h));
         let made = event_loop
             .create_window(attributes)
@@ -485,7 +880,7 @@ impl ApplicationHandler for Viewer {
                 if self.keys.set(key, pressed) || !pressed || event.repeat {
                     return;
                 }
-                if let Some(action) = Action::for_key(key)
+                if let Some(action) = self.bindings.action(key)
                     && let Err(e) = self.act(action, event_loop)
                 {
                     self.fail(event_loop, e);
@@ -591,7 +986,7 @@ fn key_of(code: KeyCode) -> Option<Key> {
 }
 
 /// `DIR/screenshot_NNN.png` with the first number not yet taken.
-fn next_free(dir: &std::path::Path) -> PathBuf {
+fn next_free(dir: &Path) -> PathBuf {
     (0..)
         .map(|i| dir.join(format!("screenshot_{i:03}.png")))
         .find(|p| !p.exists())
@@ -612,8 +1007,10 @@ fn main() -> std::process::ExitCode {
         let Some(args) = parse_args()? else {
             return Ok(());
         };
+        let config = Config::new(args, Settings::load()?)?;
+        // The scene first: its errors come before the display's.
+        let mut viewer = Viewer::new(config)?;
         let event_loop = EventLoop::new().map_err(display_error)?;
-        let mut viewer = Viewer::new(args)?;
         event_loop.set_control_flow(ControlFlow::Poll);
         event_loop.run_app(&mut viewer).map_err(display_error)?;
         viewer.result

@@ -7,6 +7,7 @@ use std::f64::consts::{FRAC_PI_2, TAU};
 use glam::{DVec3, dvec3};
 
 use super::Key;
+use crate::error::{Error, Result};
 use crate::quality::{Effects, Glow, Preset, Quality};
 use crate::scene::Camera;
 
@@ -164,6 +165,27 @@ impl Movement {
         true
     }
 
+    /// The keys that move the camera: `w`, `a`, `s`, `d`, `e`, `q` and the
+    /// arrows. No [`Action`] may be bound to one.
+    pub const KEYS: [Key; 10] = [
+        Key::W,
+        Key::A,
+        Key::S,
+        Key::D,
+        Key::E,
+        Key::Q,
+        Key::ArrowUp,
+        Key::ArrowDown,
+        Key::ArrowLeft,
+        Key::ArrowRight,
+    ];
+
+    /// Whether `key` moves the camera (one of [`Movement::KEYS`]).
+    #[must_use]
+    pub fn is_movement_key(key: Key) -> bool {
+        Movement::default().set(key, true)
+    }
+
     /// `[right, up, forward]`, each −1, 0 or 1 (opposite keys cancel).
     #[must_use]
     pub fn axes(&self) -> [f64; 3] {
@@ -183,8 +205,9 @@ impl Movement {
 }
 
 /// What a key press asks for, other than movement. Each action has one
-/// key ([`Action::key`]); the keys without one are free for the window's
-/// own use.
+/// default key ([`Action::key`]) and a name ([`Action::name`]) by which a
+/// settings file rebinds it ([`KeyBindings`]); the keys without one are
+/// free for the window's own use.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum Action {
     /// `o`: ambient occlusion on or off.
@@ -239,8 +262,45 @@ impl Action {
         }
     }
 
-    /// The action `key` asks for, if any (movement keys have none: see
-    /// [`Movement::set`]).
+    /// The stable snake_case name of the action, by which settings files
+    /// bind it to a key: `toggle_ambient_occlusion`, `toggle_shadows`,
+    /// `toggle_glow`, `quality_draft`, `quality_preview`,
+    /// `quality_production`, `quality_reference`, `toggle_animation`,
+    /// `reset_camera`, `screenshot` and `quit`.
+    #[must_use]
+    pub fn name(self) -> &'static str {
+        match self {
+            Action::ToggleAmbientOcclusion => "toggle_ambient_occlusion",
+            Action::ToggleShadows => "toggle_shadows",
+            Action::ToggleGlow => "toggle_glow",
+            Action::Quality(Preset::Draft) => "quality_draft",
+            Action::Quality(Preset::Preview) => "quality_preview",
+            Action::Quality(Preset::Production) => "quality_production",
+            Action::Quality(Preset::Reference) => "quality_reference",
+            Action::ToggleAnimation => "toggle_animation",
+            Action::ResetCamera => "reset_camera",
+            Action::Screenshot => "screenshot",
+            Action::Quit => "quit",
+        }
+    }
+
+    /// The action called `name` (see [`Action::name`]; exact, lower case).
+    #[must_use]
+    pub fn from_name(name: &str) -> Option<Action> {
+        Self::ALL.into_iter().find(|a| a.name() == name)
+    }
+
+    /// The action's place in [`Action::ALL`].
+    fn index(self) -> usize {
+        Self::ALL
+            .iter()
+            .position(|&a| a == self)
+            .expect("every action is in Action::ALL")
+    }
+
+    /// The action `key` asks for by default, if any (movement keys have
+    /// none: see [`Movement::set`]); [`KeyBindings::action`] with rebound
+    /// keys.
     #[must_use]
     pub fn for_key(key: Key) -> Option<Action> {
         Self::ALL.into_iter().find(|a| a.key() == key)
@@ -265,11 +325,150 @@ impl Action {
     }
 }
 
+/// Which key asks for each [`Action`]: the defaults ([`Action::key`]) with
+/// some rebound, such as from a settings file's `[viewer.keys]` table
+/// (action name to key name, see [`crate::settings`]).
+///
+/// Every action keeps exactly one key; no two actions share one, and none
+/// is a movement key ([`Movement::KEYS`]).
+///
+/// ```
+/// use fractal_sdf::view::{Action, Key, KeyBindings};
+///
+/// let keys = KeyBindings::from_names([("toggle_glow", "l"), ("screenshot", "p")])?;
+/// assert_eq!(keys.key(Action::ToggleGlow), Key::L);
+/// assert_eq!(keys.action(Key::P), Some(Action::Screenshot));
+/// assert_eq!(keys.action(Key::G), None, "g is free now");
+/// assert_eq!(keys.action(Key::O), Some(Action::ToggleAmbientOcclusion));
+///
+/// let err = KeyBindings::from_names([("quit", "w")]).unwrap_err();
+/// assert!(err.to_string().contains("`w` moves the camera"), "{err}");
+/// # Ok::<(), fractal_sdf::Error>(())
+/// ```
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct KeyBindings {
+    /// The key of each action, in the order of [`Action::ALL`].
+    keys: [Key; Action::ALL.len()],
+}
+
+impl Default for KeyBindings {
+    /// Every action on its [`Action::key`].
+    fn default() -> Self {
+        KeyBindings {
+            keys: Action::ALL.map(Action::key),
+        }
+    }
+}
+
+fn bindings_error(reason: String) -> Error {
+    Error::Invalid {
+        what: "key bindings",
+        reason,
+    }
+}
+
+impl KeyBindings {
+    /// The defaults with each `(action name, key name)` of `names` rebound
+    /// (names as [`Action::name`] and [`Key`] write them; key names ignore
+    /// case). Two actions may swap keys.
+    ///
+    /// # Errors
+    /// [`Error::Invalid`] naming an unknown action or key, an action given
+    /// twice, a movement key, or a key that two actions would share (one of
+    /// them may be an action left on its default key).
+    pub fn from_names<A, K>(names: impl IntoIterator<Item = (A, K)>) -> Result<Self>
+    where
+        A: AsRef<str>,
+        K: AsRef<str>,
+    {
+        let mut bindings = KeyBindings::default();
+        let mut given = [false; Action::ALL.len()];
+        for (action, key) in names {
+            let (action, key) = (action.as_ref(), key.as_ref());
+            let Some(a) = Action::from_name(action) else {
+                let names: Vec<&str> = Action::ALL.iter().map(|a| a.name()).collect();
+                return Err(bindings_error(format!(
+                    "unknown action `{action}` (actions: {})",
+                    names.join(", ")
+                )));
+            };
+            let k = key.parse::<Key>().map_err(|e| match e {
+                Error::Invalid { reason, .. } => bindings_error(format!("`{action}`: {reason}")),
+                other => other,
+            })?;
+            if std::mem::replace(&mut given[a.index()], true) {
+                return Err(bindings_error(format!("`{action}` is bound twice")));
+            }
+            bindings.keys[a.index()] = k;
+        }
+        bindings.check()?;
+        Ok(bindings)
+    }
+
+    /// Binds `action` to `key`.
+    ///
+    /// # Errors
+    /// [`Error::Invalid`] if `key` is a movement key or another action's
+    /// key (the bindings are then unchanged).
+    pub fn bind(&mut self, action: Action, key: Key) -> Result<()> {
+        let mut bound = self.clone();
+        bound.keys[action.index()] = key;
+        bound.check()?;
+        *self = bound;
+        Ok(())
+    }
+
+    /// No movement key, and no key twice.
+    fn check(&self) -> Result<()> {
+        for (i, (&action, &key)) in Action::ALL.iter().zip(&self.keys).enumerate() {
+            if Movement::is_movement_key(key) {
+                let keys: Vec<&str> = Movement::KEYS.iter().map(|k| k.name()).collect();
+                return Err(bindings_error(format!(
+                    "`{}`: `{key}` moves the camera (the movement keys are {})",
+                    action.name(),
+                    keys.join(", ")
+                )));
+            }
+            if let Some(j) = self.keys[..i].iter().position(|&k| k == key) {
+                return Err(bindings_error(format!(
+                    "`{key}` is bound to both `{}` and `{}`",
+                    Action::ALL[j].name(),
+                    action.name()
+                )));
+            }
+        }
+        Ok(())
+    }
+
+    /// The key bound to `action`.
+    #[must_use]
+    pub fn key(&self, action: Action) -> Key {
+        self.keys[action.index()]
+    }
+
+    /// The action bound to `key`, if any.
+    #[must_use]
+    pub fn action(&self, key: Key) -> Option<Action> {
+        self.keys
+            .iter()
+            .position(|&k| k == key)
+            .map(|i| Action::ALL[i])
+    }
+
+    /// Every action with its key, in the order of [`Action::ALL`].
+    pub fn iter(&self) -> impl Iterator<Item = (Action, Key)> + '_ {
+        Action::ALL.into_iter().zip(self.keys.iter().copied())
+    }
+}
+
 /// The quality preset and effect switches of an interactive view.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ViewSettings {
     /// The quality preset.
     pub preset: Preset,
+    /// A quality that is no preset (a scene file's), used instead of
+    /// `preset` until a quality action picks a preset.
+    pub custom_quality: Option<Quality>,
     /// Ambient occlusion on (the draft preset has no AO samples, so it
     /// shows none either way).
     pub ambient_occlusion: bool,
@@ -288,6 +487,7 @@ impl Default for ViewSettings {
     fn default() -> Self {
         ViewSettings {
             preset: Preset::Preview,
+            custom_quality: None,
             ambient_occlusion: true,
             shadows: true,
             glow: false,
@@ -301,10 +501,35 @@ impl Default for ViewSettings {
 }
 
 impl ViewSettings {
-    /// The quality to render with.
+    /// The quality to render with: the custom one if set, else the
+    /// preset's.
     #[must_use]
     pub fn quality(&self) -> Quality {
-        self.preset.quality()
+        self.custom_quality.unwrap_or_else(|| self.preset.quality())
+    }
+
+    /// Renders with `quality` from now on: its preset if it is one, else as
+    /// [`ViewSettings::custom_quality`].
+    pub fn take_quality(&mut self, quality: Quality) {
+        match Preset::ALL.into_iter().find(|p| p.quality() == quality) {
+            Some(preset) => {
+                self.preset = preset;
+                self.custom_quality = None;
+            }
+            None => self.custom_quality = Some(quality),
+        }
+    }
+
+    /// Renders with `effects` from now on: its switches become the
+    /// switches, its glow (if any) the glow style, and the rest the base.
+    pub fn take_effects(&mut self, effects: Effects) {
+        self.ambient_occlusion = effects.ambient_occlusion;
+        self.shadows = effects.shadows;
+        self.glow = effects.glow.is_some();
+        if let Some(glow) = effects.glow {
+            self.glow_style = glow;
+        }
+        self.base = effects;
     }
 
     /// The effects to render with.
@@ -326,16 +551,25 @@ impl ViewSettings {
             Action::ToggleAmbientOcclusion => self.ambient_occlusion ^= true,
             Action::ToggleShadows => self.shadows ^= true,
             Action::ToggleGlow => self.glow ^= true,
-            Action::Quality(p) => self.preset = p,
+            Action::Quality(p) => {
+                self.preset = p;
+                self.custom_quality = None;
+            }
             _ => {}
         }
         *self != before
     }
 
-    /// A short description, such as `preview, AO, shadows, glow`.
+    /// A short description, such as `preview, AO, shadows, glow`
+    /// (`custom` for a custom quality).
     #[must_use]
     pub fn summary(&self) -> String {
-        let mut parts = vec![self.preset.name()];
+        let quality = if self.custom_quality.is_some() {
+            "custom"
+        } else {
+            self.preset.name()
+        };
+        let mut parts = vec![quality];
         for (on, name) in [
             (self.ambient_occlusion, "AO"),
             (self.shadows, "shadows"),
@@ -503,5 +737,167 @@ mod tests {
         for key in [Key::W, Key::ArrowUp, Key::Z, Key::Digit5] {
             assert_eq!(Action::for_key(key), None);
         }
+    }
+
+    #[test]
+    fn action_names_are_unique_snake_case_and_round_trip() {
+        let mut names: Vec<&str> = Action::ALL.iter().map(|a| a.name()).collect();
+        for action in Action::ALL {
+            assert_eq!(Action::from_name(action.name()), Some(action));
+            assert!(
+                action
+                    .name()
+                    .chars()
+                    .all(|c| c.is_ascii_lowercase() || c == '_'),
+                "{}",
+                action.name()
+            );
+        }
+        names.sort_unstable();
+        names.dedup();
+        assert_eq!(names.len(), Action::ALL.len());
+        assert_eq!(
+            Action::ToggleAmbientOcclusion.name(),
+            "toggle_ambient_occlusion"
+        );
+        assert_eq!(
+            Action::Quality(Preset::Reference).name(),
+            "quality_reference"
+        );
+        assert_eq!(Action::from_name("Quit"), None);
+        assert_eq!(Action::from_name("toggle glow"), None);
+    }
+
+    #[test]
+    fn default_bindings_are_the_action_keys() {
+        let keys = KeyBindings::default();
+        for action in Action::ALL {
+            assert_eq!(keys.key(action), action.key());
+            assert_eq!(keys.action(action.key()), Some(action));
+        }
+        for key in Key::ALL.iter().copied() {
+            assert_eq!(keys.action(key), Action::for_key(key), "{key}");
+        }
+        assert_eq!(KeyBindings::from_names::<&str, &str>([]).unwrap(), keys);
+        assert_eq!(keys.iter().count(), Action::ALL.len());
+    }
+
+    #[test]
+    fn rebinding_moves_an_action_and_frees_its_old_key() {
+        let keys = KeyBindings::from_names([("quit", "X"), ("quality_draft", "f1")]).unwrap();
+        assert_eq!(keys.key(Action::Quit), Key::X);
+        assert_eq!(keys.action(Key::X), Some(Action::Quit));
+        assert_eq!(keys.action(Key::Escape), None);
+        assert_eq!(keys.action(Key::F1), Some(Action::Quality(Preset::Draft)));
+        assert_eq!(keys.action(Key::Digit1), None);
+        // Untouched actions keep their keys.
+        assert_eq!(keys.key(Action::ToggleGlow), Key::G);
+        // Two actions may swap keys.
+        let swapped =
+            KeyBindings::from_names([("toggle_glow", "o"), ("toggle_ambient_occlusion", "g")])
+                .unwrap();
+        assert_eq!(swapped.action(Key::O), Some(Action::ToggleGlow));
+        assert_eq!(swapped.action(Key::G), Some(Action::ToggleAmbientOcclusion));
+        // From a settings map.
+        let mut map = std::collections::BTreeMap::new();
+        map.insert("screenshot".to_string(), "p".to_string());
+        let keys = KeyBindings::from_names(&map).unwrap();
+        assert_eq!(keys.action(Key::P), Some(Action::Screenshot));
+    }
+
+    #[test]
+    fn bad_bindings_say_what_is_wrong() {
+        let err = |names: &[(&str, &str)]| {
+            KeyBindings::from_names(names.iter().copied())
+                .unwrap_err()
+                .to_string()
+        };
+        let e = err(&[("toggle_glowing", "l")]);
+        assert!(
+            e.contains("key bindings: unknown action `toggle_glowing`"),
+            "{e}"
+        );
+        assert!(
+            e.contains("toggle_ambient_occlusion, toggle_shadows"),
+            "{e}"
+        );
+        let e = err(&[("toggle_glow", "hyper")]);
+        assert!(e.contains("`toggle_glow`: unknown key `hyper`"), "{e}");
+        // Movement keys, including `q` (down).
+        for key in ["q", "w", "arrowleft", "E"] {
+            let e = err(&[("quit", key)]);
+            assert!(e.contains("moves the camera"), "{key}: {e}");
+            assert!(e.contains("`quit`"), "{key}: {e}");
+        }
+        // A key taken by an action left on its default.
+        let e = err(&[("toggle_glow", "o")]);
+        assert!(
+            e.contains("`o` is bound to both `toggle_ambient_occlusion` and `toggle_glow`"),
+            "{e}"
+        );
+        // Two rebound actions on one key.
+        let e = err(&[("quit", "x"), ("screenshot", "x")]);
+        assert!(
+            e.contains("`x` is bound to both `screenshot` and `quit`"),
+            "{e}"
+        );
+        let e = err(&[("quit", "x"), ("quit", "z")]);
+        assert!(e.contains("`quit` is bound twice"), "{e}");
+    }
+
+    #[test]
+    fn bind_checks_and_leaves_bad_bindings_unchanged() {
+        let mut keys = KeyBindings::default();
+        keys.bind(Action::Screenshot, Key::P).unwrap();
+        assert_eq!(keys.action(Key::P), Some(Action::Screenshot));
+        let before = keys.clone();
+        assert!(keys.bind(Action::Quit, Key::P).is_err());
+        assert!(keys.bind(Action::Quit, Key::ArrowUp).is_err());
+        assert_eq!(keys, before);
+        for key in Movement::KEYS {
+            assert!(Movement::is_movement_key(key), "{key}");
+        }
+        let moving = Key::ALL
+            .iter()
+            .filter(|&&k| Movement::is_movement_key(k))
+            .count();
+        assert_eq!(moving, Movement::KEYS.len());
+    }
+
+    #[test]
+    fn a_custom_quality_holds_until_a_preset_is_picked() {
+        let mut s = ViewSettings::default();
+        s.take_quality(Quality::draft());
+        assert_eq!((s.preset, s.custom_quality), (Preset::Draft, None));
+        let custom = Quality::production().supersampling(2);
+        s.take_quality(custom);
+        assert_eq!(s.quality(), custom);
+        assert_eq!(s.summary(), "custom, AO, shadows");
+        assert!(s.apply(Action::Quality(Preset::Draft)));
+        assert_eq!(s.quality(), Quality::draft());
+        assert_eq!(s.custom_quality, None);
+        // Picking the preset the custom quality was based on still
+        // changes it.
+        s.take_quality(Quality::draft().supersampling(2));
+        assert!(s.apply(Action::Quality(Preset::Draft)));
+    }
+
+    #[test]
+    fn taken_effects_become_the_switches() {
+        let glow = Glow::new(dvec3(1.0, 0.0, 0.0), 0.3);
+        let effects = Effects::default()
+            .ambient_occlusion(false)
+            .glow(glow)
+            .gamma(1.8);
+        let mut s = ViewSettings::default();
+        s.take_effects(effects);
+        assert_eq!(s.effects(), effects);
+        assert!(s.glow && !s.ambient_occlusion && s.shadows);
+        assert!(s.apply(Action::ToggleGlow));
+        assert_eq!(s.effects().glow, None);
+        assert!(s.apply(Action::ToggleGlow));
+        assert_eq!(s.effects().glow, Some(glow), "the file's glow style");
+        s.take_effects(Effects::default());
+        assert_eq!(s.effects(), Effects::default());
     }
 }

@@ -6,8 +6,9 @@
 //! motion into pixel deltas. Each turn of a viewer's loop then
 //!
 //! 1. feeds held keys to [`Movement::set`], pressed keys to
-//!    [`Action::for_key`] and [`ViewSettings::apply`] (a changed setting
-//!    means a new program), and mouse motion to [`FlyCamera::look`];
+//!    [`Action::for_key`] (or [`KeyBindings::action`], with keys rebound)
+//!    and [`ViewSettings::apply`] (a changed setting means a new program),
+//!    and mouse motion to [`FlyCamera::look`];
 //! 2. advances the [`FlyCamera`] and hands its camera to the renderer;
 //! 3. renders at the size that [`ResolutionScaler`] and [`reduced_size`]
 //!    choose — reduced while the view changes, full once it stops — and
@@ -68,7 +69,7 @@ mod script;
 mod timing;
 
 pub use blit::blit_scaled;
-pub use control::{Action, FlyCamera, Movement, ViewSettings};
+pub use control::{Action, FlyCamera, KeyBindings, Movement, ViewSettings};
 pub use key::Key;
 pub use script::KeyScript;
 pub use timing::{FrameStats, FrameTiming, ResolutionScaler, fps, reduced_size};

@@ -3,7 +3,7 @@
 use std::fmt;
 use std::str::FromStr;
 
-use super::{Action, Key};
+use super::{Key, KeyBindings};
 use crate::error::{Error, Result};
 
 /// Key presses scheduled by frame number, for unattended runs.
@@ -12,8 +12,9 @@ use crate::error::{Error, Result};
 /// with keys named as in [`Key`]: `"g,3"` presses `g` before frame 1 and
 /// `3` before frame 2; `"g@5,3@5"` presses both before frame 5. A key
 /// without `@FRAME` comes one frame after the previous key (the first at
-/// frame 1, so frame 0 shows the start). Only keys with an [`Action`] can
-/// be scripted: a movement key is held, not pressed.
+/// frame 1, so frame 0 shows the start). Only keys with an [`Action`](super::Action) can
+/// be scripted (by default, or in the [`KeyBindings`] given to
+/// [`KeyScript::parse_with`]): a movement key is held, not pressed.
 ///
 /// ```
 /// use fractal_sdf::view::{Action, Key, KeyScript};
@@ -47,14 +48,26 @@ impl KeyScript {
     /// A script pressing each `key` before its `frame`.
     ///
     /// # Errors
-    /// [`Error::Invalid`] naming a key that has no [`Action`].
+    /// [`Error::Invalid`] naming a key that has no [`Action`](super::Action).
     pub fn new(presses: impl IntoIterator<Item = (u64, Key)>) -> Result<Self> {
+        Self::new_with(presses, &KeyBindings::default())
+    }
+
+    /// A script pressing each `key` before its `frame`, with keys bound
+    /// as in `bindings`.
+    ///
+    /// # Errors
+    /// [`Error::Invalid`] naming a key that has no action in `bindings`.
+    pub fn new_with(
+        presses: impl IntoIterator<Item = (u64, Key)>,
+        bindings: &KeyBindings,
+    ) -> Result<Self> {
         let mut presses: Vec<(u64, Key)> = presses.into_iter().collect();
         if let Some((_, key)) = presses
             .iter()
-            .find(|(_, key)| Action::for_key(*key).is_none())
+            .find(|(_, key)| bindings.action(*key).is_none())
         {
-            let keys: Vec<String> = Action::ALL.iter().map(|a| a.key().to_string()).collect();
+            let keys: Vec<String> = bindings.iter().map(|(_, k)| k.to_string()).collect();
             return Err(invalid(format!(
                 "`{key}` has no action (scriptable keys: {})",
                 keys.join(", ")
@@ -72,6 +85,14 @@ impl KeyScript {
     /// a bad frame number (frames are `0..=u64::MAX`) or a key that would
     /// come after the last frame.
     pub fn parse(text: &str) -> Result<Self> {
+        Self::parse_with(text, &KeyBindings::default())
+    }
+
+    /// Parses a script whose keys are bound as in `bindings`.
+    ///
+    /// # Errors
+    /// As [`KeyScript::parse`], for a key without an action in `bindings`.
+    pub fn parse_with(text: &str, bindings: &KeyBindings) -> Result<Self> {
         let mut presses = Vec::new();
         // The frame of a key without `@FRAME`; `None` after the last frame.
         let mut next = Some(1u64);
@@ -103,11 +124,11 @@ impl KeyScript {
             presses.push((frame, key));
             next = frame.checked_add(1);
         }
-        Self::new(presses)
+        Self::new_with(presses, bindings)
     }
 
     /// The keys pressed before frame `frame`, in script order. Each has an
-    /// action: `Action::for_key` of it is never `None`.
+    /// action in the bindings the script was made with.
     pub fn keys_at(&self, frame: u64) -> impl Iterator<Item = Key> + '_ {
         self.presses
             .iter()
@@ -155,6 +176,7 @@ impl fmt::Display for KeyScript {
 mod tests {
     use super::*;
     use crate::quality::Preset;
+    use crate::view::Action;
 
     fn actions(script: &KeyScript, frame: u64) -> Vec<Action> {
         script.keys_at(frame).filter_map(Action::for_key).collect()
@@ -214,6 +236,25 @@ mod tests {
             let err = KeyScript::parse(text).unwrap_err().to_string();
             assert!(err.contains("whole number from 0 to"), "{text}: {err}");
         }
+    }
+
+    #[test]
+    fn scripts_follow_rebound_keys() {
+        let keys = KeyBindings::from_names([("toggle_glow", "l")]).unwrap();
+        let s = KeyScript::parse_with("l,o", &keys).unwrap();
+        let scripted: Vec<Option<Action>> = (1..=2)
+            .flat_map(|f| s.keys_at(f).map(|k| keys.action(k)).collect::<Vec<_>>())
+            .collect();
+        assert_eq!(
+            scripted,
+            [
+                Some(Action::ToggleGlow),
+                Some(Action::ToggleAmbientOcclusion)
+            ]
+        );
+        let err = KeyScript::parse_with("g", &keys).unwrap_err().to_string();
+        assert!(err.contains("`g` has no action"), "{err}");
+        assert!(err.contains(", l,"), "the scriptable keys list `l`: {err}");
     }
 
     #[test]
