@@ -3,7 +3,7 @@
 //! `cargo run --release --features viewer --example viewer -- fractal_mix`
 //! `cargo run --release --features viewer --example viewer -- my_scene.ron`
 //!
-//! A scene file (`.ron`, see `fractal_sdf::scene::SceneFile`) brings its
+//! A scene file (`.ron`, see `fractal_sdf::SceneFile`) brings its
 //! quality, effects and motions, and is reloaded whenever it changes on
 //! disk (polled: its modification time and size): a good file replaces the
 //! scene (keeping the program when only parameter defaults or the lights
@@ -23,12 +23,12 @@ use std::path::{Path, PathBuf};
 use std::rc::Rc;
 use std::time::{Duration, Instant, SystemTime};
 
+use fractal_sdf::SceneFile;
 use fractal_sdf::animation::Motion;
 use fractal_sdf::codegen;
 use fractal_sdf::ir::ParamLayout;
 use fractal_sdf::prelude::*;
 use fractal_sdf::render::{DeviceSelector, RenderOptions, Renderer};
-use fractal_sdf::scene::SceneFile;
 use fractal_sdf::settings::Settings;
 use fractal_sdf::view::{
     Action, FlyCamera, Key, KeyBindings, KeyScript, Movement, ResolutionScaler, ViewSettings,
@@ -58,8 +58,8 @@ the last good scene stays on screen.
 SETTINGS: $FRACTAL_SDF_CONFIG or fractal-sdf/config.toml in the user's
 configuration directory: `preset`, `size`, `device`, and under [viewer]
 `mouse_sensitivity` and [viewer.keys] (action name = key name, e.g.
-`toggle_glow = \"l\"`; names below). Options given here override them; a
-scene file's quality overrides `preset`.
+`toggle_glow = \"l\"`; names below). Options given here override them, and
+`preset` overrides a scene file's quality.
 
 OPTIONS:
   --size WxH           window size in pixels (default 640x480)
@@ -193,7 +193,7 @@ fn parse_args() -> Result<Option<Args>> {
 struct Config {
     args: Args,
     size: (u32, u32),
-    /// The settings file's preset, for gallery scenes.
+    /// The settings file's preset, over a scene file's quality.
     settings_preset: Option<Preset>,
     device: DeviceSelector,
     sensitivity: f64,
@@ -397,9 +397,6 @@ impl Viewer {
             (name, file.scene, file.motions, Some(watched))
         } else {
             let scene = common::gallery_scene(&args.scene)?;
-            if let Some(preset) = settings_preset {
-                settings.preset = preset;
-            }
             (
                 args.scene.clone(),
                 scene,
@@ -407,7 +404,12 @@ impl Viewer {
                 None,
             )
         };
-        // The command line over the file and the settings.
+        // The settings file's preset over the scene file's quality (the
+        // user's choice for this machine, as the `fractal-sdf` command
+        // does), and the command line over both.
+        if let Some(preset) = settings_preset {
+            settings.apply(Action::Quality(preset));
+        }
         if let Some(preset) = args.preset {
             settings.apply(Action::Quality(preset));
         }
