@@ -23,7 +23,7 @@
 //! )
 //! ```
 //!
-//! - **Nodes** are written as in Rust's [`Kind`](crate::scene::Kind), with
+//! - **Nodes** are written as in Rust's [`Kind`], with
 //!   the booleans named: `Union([a, b, ...])` (any number of operands, what
 //!   [`Scene::add`] builds), `Subtract(a: .., b: ..)`, `Intersect(a: ..,
 //!   b: ..)`, `SmoothUnion(k: 0.1, a: .., b: ..)` and the other smooth
