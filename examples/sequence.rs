@@ -10,13 +10,12 @@
 mod common;
 
 use std::path::{Path, PathBuf};
-use std::process::Command;
 
 use fractal_sdf::animation::CameraPath;
 use fractal_sdf::gallery;
 use fractal_sdf::prelude::*;
 use fractal_sdf::render::{RenderOptions, Renderer};
-use fractal_sdf::sequence::{Sequence, parse_range};
+use fractal_sdf::sequence::{Encoded, Sequence, parse_range};
 use indicatif::{ProgressBar, ProgressStyle};
 
 const HELP: &str = "\
@@ -60,23 +59,11 @@ fn read_path(file: &Path) -> Result<CameraPath> {
     CameraPath::from_toml(&text)
 }
 
-fn encode(seq: &Sequence, video: &Path) -> Result<()> {
-    let args = seq.ffmpeg_args(video);
-    let shown = format!("ffmpeg {}", args.join(" "));
-    match Command::new("ffmpeg")
-        .args(&args)
-        .stdout(std::process::Stdio::null())
-        .stderr(std::process::Stdio::null())
-        .status()
-    {
-        Ok(status) if status.success() => println!("video -> {}", video.display()),
-        Ok(status) => println!("ffmpeg failed ({status}); the command was:\n  {shown}"),
-        Err(_) => println!(
-            "ffmpeg is not installed; to make a video, install it (Debian: \
-             `sudo apt-get install ffmpeg`) and run:\n  {shown}"
-        ),
+fn encode(seq: &Sequence, video: &Path) {
+    match seq.encode(video) {
+        Encoded::Written => println!("video -> {}", video.display()),
+        other => println!("{other}"),
     }
-    Ok(())
 }
 
 fn main() -> std::process::ExitCode {
@@ -162,7 +149,7 @@ fn main() -> std::process::ExitCode {
             bar.finish();
         }
         if seq.remaining(0..seq.frames(), size).is_empty() {
-            encode(&seq, &video)?;
+            encode(&seq, &video);
         } else {
             println!("some frames are still missing: run again without --frames to finish");
         }

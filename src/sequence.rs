@@ -168,6 +168,30 @@ impl Sequence {
             .collect()
     }
 
+    /// Encodes the frames into an MP4 at `output` with `ffmpeg` from the
+    /// `PATH` (the command [`Sequence::ffmpeg_args`] gives), waiting for
+    /// it. Never fails: the outcome says what happened, with the command
+    /// to run by hand where it did not succeed.
+    #[must_use]
+    pub fn encode(&self, output: &Path) -> Encoded {
+        let args = self.ffmpeg_args(output);
+        let command = format!("ffmpeg {}", args.join(" "));
+        match std::process::Command::new("ffmpeg")
+            .args(&args)
+            .stdin(std::process::Stdio::null())
+            .stdout(std::process::Stdio::null())
+            .stderr(std::process::Stdio::null())
+            .status()
+        {
+            Ok(status) if status.success() => Encoded::Written,
+            Ok(status) => Encoded::Failed {
+                status: status.to_string(),
+                command,
+            },
+            Err(_) => Encoded::NoFfmpeg { command },
+        }
+    }
+
     /// The arguments of the `ffmpeg` command that encodes the frames into
     /// an H.264 MP4 at `output`:
     /// `-y -framerate R -i DIR/frame_%05d.png -pix_fmt yuv420p OUTPUT`.
@@ -183,6 +207,43 @@ impl Sequence {
             "yuv420p".into(),
             output.display().to_string(),
         ]
+    }
+}
+
+/// What [`Sequence::encode`] did.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum Encoded {
+    /// The video was written.
+    Written,
+    /// `ffmpeg` is not on the `PATH`; `command` encodes the video once it
+    /// is installed.
+    NoFfmpeg {
+        /// The `ffmpeg` command line.
+        command: String,
+    },
+    /// `ffmpeg` ran and failed.
+    Failed {
+        /// How it exited.
+        status: String,
+        /// The `ffmpeg` command line, to run by hand and see why.
+        command: String,
+    },
+}
+
+impl std::fmt::Display for Encoded {
+    /// A line for the user: done, or the command to run.
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Encoded::Written => f.write_str("video written"),
+            Encoded::NoFfmpeg { command } => write!(
+                f,
+                "ffmpeg is not installed; to make a video, install it (Debian: \
+                 `sudo apt-get install ffmpeg`) and run:\n  {command}"
+            ),
+            Encoded::Failed { status, command } => {
+                write!(f, "ffmpeg failed ({status}); the command was:\n  {command}")
+            }
+        }
     }
 }
 

@@ -14,7 +14,7 @@ use fractal_sdf::gallery;
 use fractal_sdf::output::{save_png, verify_png};
 use fractal_sdf::prelude::*;
 use fractal_sdf::render::{DeviceSelector, RenderOptions, Renderer, devices};
-use fractal_sdf::sequence::{Sequence, parse_range};
+use fractal_sdf::sequence::{Encoded, Sequence, parse_range};
 use fractal_sdf::settings::{CONFIG_ENV, Settings, parse_preset, parse_size};
 use indicatif::{ProgressBar, ProgressStyle};
 
@@ -441,19 +441,9 @@ fn sequence(args: &SequenceArgs, settings: &Settings) -> Outcome {
 }
 
 fn encode(seq: &Sequence, video: &Path) {
-    let args = seq.ffmpeg_args(video);
-    let shown = format!("ffmpeg {}", args.join(" "));
-    match std::process::Command::new("ffmpeg")
-        .args(&args)
-        .stdout(std::process::Stdio::null())
-        .stderr(std::process::Stdio::null())
-        .status()
-    {
-        Ok(status) if status.success() => println!("video -> {}", video.display()),
-        Ok(status) => println!("ffmpeg failed ({status}); the command was:\n  {shown}"),
-        Err(_) => {
-            println!("ffmpeg is not installed; to make a video, install it and run:\n  {shown}")
-        }
+    match seq.encode(video) {
+        Encoded::Written => println!("video -> {}", video.display()),
+        other => println!("{other}"),
     }
 }
 
