@@ -518,8 +518,8 @@ fn skip_blank(text: &str, line: usize, column: usize) -> (usize, usize) {
     let (mut line, mut column) = (line, column);
     let mut rest = text
         .split_inclusive('\n')
-        .nth(line - 1)
-        .map(|l| l.chars().skip(column - 1).collect::<String>())
+        .nth(line.saturating_sub(1))
+        .map(|l| l.chars().skip(column.saturating_sub(1)).collect::<String>())
         .unwrap_or_default();
     let mut lines = text.split_inclusive('\n').skip(line);
     loop {

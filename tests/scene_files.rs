@@ -336,3 +336,56 @@ fn the_readme_example_file_reads() {
     assert_eq!(file.motions.len(), 1);
     assert!(file.scene.compile().unwrap().params().slots().len() == 1);
 }
+
+mod properties {
+    use fractal_sdf::SceneFile;
+    use fractal_sdf::prelude::*;
+    use fractal_sdf::testing::scene_node;
+    use proptest::prelude::*;
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(128))]
+
+        /// Every node kind, dynamic or baked, any nesting the strategy
+        /// makes: written and read back, the same scene.
+        #[test]
+        fn random_scenes_round_trip(node in scene_node(4)) {
+            let file = SceneFile::new(Scene::new(node));
+            let text = file.to_text().unwrap();
+            let back = SceneFile::parse(&text);
+            prop_assert!(back.is_ok(), "{}\n{text}", back.unwrap_err());
+            prop_assert_eq!(back.unwrap(), file);
+        }
+
+        /// A file cut, or with a character changed, inserted or removed,
+        /// reads or is an error located inside the text: never a panic.
+        #[test]
+        fn mangled_files_are_errors_inside_the_text(
+            name in prop::sample::select(fractal_sdf::gallery::names()),
+            at in any::<prop::sample::Index>(),
+            edit in 0..4u8,
+            c in prop::char::range(' ', '~'),
+        ) {
+            let text = fractal_sdf::gallery::file(name).unwrap().to_text().unwrap();
+            let mut chars: Vec<char> = text.chars().collect();
+            let i = at.index(chars.len());
+            match edit {
+                0 => chars.truncate(i),
+                1 => chars[i] = c,
+                2 => chars.insert(i, c),
+                _ => {
+                    chars.remove(i);
+                }
+            }
+            let mangled: String = chars.into_iter().collect();
+            if let Err(e) = SceneFile::parse(&mangled) {
+                let Error::SceneFile { line, column, .. } = e else {
+                    panic!("not a scene-file error: {e}");
+                };
+                let lines = mangled.lines().count().max(1);
+                prop_assert!(line >= 1 && line <= lines + 1, "line {line} of {lines}: {e}");
+                prop_assert!(column >= 1, "{e}");
+            }
+        }
+    }
+}
