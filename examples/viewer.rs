@@ -58,8 +58,8 @@ the last good scene stays on screen.
 SETTINGS: $FRACTAL_SDF_CONFIG or fractal-sdf/config.toml in the user's
 configuration directory: `preset`, `size`, `device`, and under [viewer]
 `mouse_sensitivity` and [viewer.keys] (action name = key name, e.g.
-`toggle_glow = \"l\"`; names below). Options given here override them, and
-`preset` overrides a scene file's quality.
+`toggle_glow = \"l\"`; names below). Options given here override them; a
+scene file's own quality overrides `preset`.
 
 OPTIONS:
   --size WxH           window size in pixels (default 640x480)
@@ -193,7 +193,8 @@ fn parse_args() -> Result<Option<Args>> {
 struct Config {
     args: Args,
     size: (u32, u32),
-    /// The settings file's preset, over a scene file's quality.
+    /// The settings file's preset, for gallery scenes and scene files
+    /// without a quality.
     settings_preset: Option<Preset>,
     device: DeviceSelector,
     sensitivity: f64,
@@ -382,7 +383,14 @@ impl Viewer {
             // The stamp first: a change while the file is read is seen.
             let stamp = stamp(&path);
             let file = SceneFile::load(&path)?;
-            settings.take_quality(file.quality);
+            match file.quality {
+                Some(quality) => settings.take_quality(quality),
+                None => {
+                    if let Some(preset) = settings_preset {
+                        settings.apply(Action::Quality(preset));
+                    }
+                }
+            }
             settings.take_effects(file.effects);
             let name = path
                 .file_name()
@@ -397,6 +405,9 @@ impl Viewer {
             (name, file.scene, file.motions, Some(watched))
         } else {
             let scene = common::gallery_scene(&args.scene)?;
+            if let Some(preset) = settings_preset {
+                settings.apply(Action::Quality(preset));
+            }
             (
                 args.scene.clone(),
                 scene,
@@ -404,12 +415,7 @@ impl Viewer {
                 None,
             )
         };
-        // The settings file's preset over the scene file's quality (the
-        // user's choice for this machine, as the `fractal-sdf` command
-        // does), and the command line over both.
-        if let Some(preset) = settings_preset {
-            settings.apply(Action::Quality(preset));
-        }
+        // The command line over the scene file and the settings.
         if let Some(preset) = args.preset {
             settings.apply(Action::Quality(preset));
         }
@@ -580,8 +586,10 @@ impl Viewer {
         // What the file changes replaces what the user chose; the rest
         // (keys pressed, the camera flown) stays.
         let mut settings = self.settings;
-        if file.quality != old.quality {
-            settings.take_quality(file.quality);
+        if file.quality != old.quality
+            && let Some(quality) = file.quality
+        {
+            settings.take_quality(quality);
         }
         if file.effects != old.effects {
             settings.take_effects(file.effects);

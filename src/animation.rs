@@ -29,6 +29,7 @@ use crate::scene::Camera;
 
 /// The camera's position and target at a time, in seconds.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct Keyframe {
     /// Time in seconds from the start of the path.
     pub time: f64,

@@ -34,8 +34,9 @@
 //!   default)` (dynamic, see [`param`](crate::scene::param)); a vector is `(x, y,
 //!   z)`, one number for all three, or `param3("name", (x, y, z))`.
 //! - **Everything but `version` and `geometry` may be left out**: the
-//!   camera and lights default as in [`Scene::new`], `quality` to the
-//!   `Production` preset (name a preset and change any of its settings),
+//!   camera and lights default as in [`Scene::new`], `quality` to none
+//!   (the renderer's, or the user's default preset; a quality names a
+//!   preset and changes any of its settings),
 //!   `effects` to [`Effects::default`]. `path` is a camera path (keyframes
 //!   `(time: 0, position: (0, 1, 3), target: (0, 0, 0))`) and `motions` move dynamic
 //!   parameters (see [`Motion`]).
@@ -96,8 +97,10 @@ const TEXT: &str = "<scene>";
 pub struct SceneFile {
     /// Geometry, camera and lights.
     pub scene: Scene,
-    /// How accurately to render it.
-    pub quality: Quality,
+    /// How accurately to render it, or `None` where the file leaves that to
+    /// whoever renders it (the `fractal-sdf` command and the viewer then
+    /// use the user's default preset).
+    pub quality: Option<Quality>,
     /// Lighting effects.
     pub effects: Effects,
     /// A camera path for sequences, if the file has one.
@@ -107,13 +110,13 @@ pub struct SceneFile {
 }
 
 impl SceneFile {
-    /// `scene` with production quality, the default effects, no camera
+    /// `scene` with no quality of its own, the default effects, no camera
     /// path and no motions.
     #[must_use]
     pub fn new(scene: Scene) -> Self {
         SceneFile {
             scene,
-            quality: Quality::default(),
+            quality: None,
             effects: Effects::default(),
             path: None,
             motions: Vec::new(),
@@ -165,7 +168,8 @@ impl SceneFile {
     ///
     /// # Errors
     /// [`Error::Invalid`] if the scene has no geometry or its nodes are
-    /// nested deeper than [`MAX_NESTING`].
+    /// nested deeper than [`MAX_NESTING`]; the quality's or the effects'
+    /// error if they do not validate.
     pub fn to_text(&self) -> Result<String> {
         let invalid = |reason: String| Error::Invalid {
             what: "scene to write",
@@ -176,6 +180,14 @@ impl SceneFile {
             .geometry
             .as_ref()
             .ok_or_else(|| invalid("the scene is empty".into()))?;
+        // What would not read back is not written.
+        match &self.quality {
+            Some(quality) => {
+                quality.validate()?;
+                self.effects.validate_for(quality.precision)?;
+            }
+            None => self.effects.validate()?,
+        }
         let nesting = nesting(geometry);
         if nesting > MAX_NESTING {
             return Err(invalid(format!(
@@ -193,7 +205,10 @@ impl SceneFile {
                 .copied()
                 .map(Located::new)
                 .collect(),
-            quality: Located::new(QualityRepr::from_quality(&self.quality)),
+            quality: self
+                .quality
+                .as_ref()
+                .map(|q| Located::new(QualityRepr::from_quality(q))),
             effects: Located::new(self.effects),
             path: self
                 .path
@@ -386,9 +401,12 @@ fn read(text: &str, file: &Path, shapes: &[CustomShape]) -> Result<SceneFile> {
     // rather than failing on a field this version does not know.
     let version: VersionOnly = options().from_str(text).map_err(syntax)?;
     if version.version != FORMAT_VERSION {
+        let (line, column) = text
+            .find("version")
+            .map_or((1, 1), |i| line_and_column(text, i));
         return Err(at(
-            1,
-            1,
+            line,
+            column,
             format!(
                 "format version {} is not supported: this library reads version {FORMAT_VERSION}",
                 version.version
@@ -398,6 +416,20 @@ fn read(text: &str, file: &Path, shapes: &[CustomShape]) -> Result<SceneFile> {
     }
 
     let repr: FileRepr = Sites::counting(|| options().from_str(text)).map_err(syntax)?;
+    // RON passes a parameter's spelling (`param(..)`) through unread: a
+    // misspelt one is found here.
+    if let Some((offset, name)) = unknown_name(text) {
+        let (line, column) = line_and_column(text, offset);
+        return Err(at(
+            line,
+            column,
+            format!(
+                "`{name}(..)` is not a node, a setting or a parameter form \
+                 (`param(\"name\", default)`, `param3(\"name\", (x, y, z))`)"
+            ),
+            None,
+        ));
+    }
     let located = |site: usize, error: Error| match locate(text, site) {
         Some((line, column)) => at(line, column, error.to_string(), Some(error)),
         None => at(1, 1, error.to_string(), Some(error)),
@@ -419,23 +451,56 @@ fn read(text: &str, file: &Path, shapes: &[CustomShape]) -> Result<SceneFile> {
         located(site, e)
     })?;
 
-    let quality = repr.quality.value.to_quality();
-    quality
-        .validate()
-        .map_err(|e| located(repr.quality.site, e))?;
+    let quality = match &repr.quality {
+        Some(q) => {
+            let quality = q.value.to_quality();
+            quality.validate().map_err(|e| located(q.site, e))?;
+            Some(quality)
+        }
+        None => None,
+    };
+    // Without a quality of its own, a file is held to the limits of `F64`
+    // (which `compile` checked) and its effects to those of any precision.
+    let precision = quality.map_or(Precision::F64, |q| q.precision);
     repr.effects
         .value
-        .validate_for(quality.precision)
+        .validate_for(precision)
         .map_err(|e| located(repr.effects.site, e))?;
     let path = match &repr.path {
         Some(keys) => Some(CameraPath::new(keys.value.clone()).map_err(|e| located(keys.site, e))?),
         None => None,
     };
+    // What a renderer of this precision would refuse: baked values and
+    // dynamic defaults beyond its limits, and every value a motion reaches.
+    let limits = precision.limits();
+    compiled.ir().check_limits(limits).map_err(|e| {
+        let site = sites
+            .site_of(&scene, &repr, &e)
+            .unwrap_or(repr.geometry.site);
+        located(site, e)
+    })?;
+    let defaults = compiled.default_values();
+    for slot in compiled.params().slots() {
+        let value = defaults.get(&slot.name).unwrap_or(f64::NAN);
+        defaults
+            .clone()
+            .set_within(&slot.name, value, limits)
+            .map_err(|e| {
+                let site = sites
+                    .site_of(&scene, &repr, &e)
+                    .unwrap_or(repr.geometry.site);
+                located(site, e)
+            })?;
+    }
     for motion in &repr.motions {
-        for (name, _) in motion.value.values(0.0) {
+        for (name, value) in extremes(&motion.value) {
             if !compiled.params().slots().iter().any(|s| s.name == name) {
                 return Err(located(motion.site, Error::UnknownParam { name }));
             }
+            defaults
+                .clone()
+                .set_within(&name, value, limits)
+                .map_err(|e| located(motion.site, e))?;
         }
     }
     Ok(SceneFile {
@@ -445,6 +510,34 @@ fn read(text: &str, file: &Path, shapes: &[CustomShape]) -> Result<SceneFile> {
         path,
         motions: repr.motions.into_iter().map(|m| m.value).collect(),
     })
+}
+
+/// The values a motion reaches at its extremes, per slot: an oscillation's
+/// `center ± amplitude`, an orbit's centre `± radius` across x and z.
+fn extremes(motion: &Motion) -> Vec<(String, f64)> {
+    match motion {
+        Motion::Oscillate {
+            name,
+            center,
+            amplitude,
+            ..
+        } => vec![
+            (name.clone(), center - amplitude),
+            (name.clone(), center + amplitude),
+        ],
+        Motion::Orbit {
+            name,
+            center,
+            radius,
+            ..
+        } => vec![
+            (format!("{name}.x"), center.x - radius),
+            (format!("{name}.x"), center.x + radius),
+            (format!("{name}.y"), center.y),
+            (format!("{name}.z"), center.z - radius),
+            (format!("{name}.z"), center.z + radius),
+        ],
+    }
 }
 
 /// RON with `Some` optional around values (`supersampling: 2`), and room
@@ -510,6 +603,114 @@ fn locate(text: &str, site: usize) -> Option<(usize, usize)> {
         }
         _ => None,
     }
+}
+
+/// Every name a file may write before `(`: the nodes, the parameter forms,
+/// and the enum variants and structs of the settings.
+const NAMES: &[&str] = &[
+    "Sphere",
+    "Cuboid",
+    "RoundBox",
+    "Torus",
+    "Cylinder",
+    "Capsule",
+    "Plane",
+    "Octahedron",
+    "CappedCone",
+    "Ellipsoid",
+    "Mandelbulb",
+    "Menger",
+    "Julia",
+    "Sierpinski",
+    "Translate",
+    "Rotate",
+    "Scale",
+    "Mirror",
+    "Round",
+    "Onion",
+    "Elongate",
+    "Repeat",
+    "RepeatLimited",
+    "Twist",
+    "Bend",
+    "Color",
+    "Union",
+    "Subtract",
+    "Intersect",
+    "SmoothUnion",
+    "SmoothSubtract",
+    "SmoothIntersect",
+    "Custom",
+    "param",
+    "param3",
+    "Some",
+    "Perspective",
+    "Orthographic",
+    "Directional",
+    "Point",
+    "Oscillate",
+    "Orbit",
+    "Camera",
+    "Light",
+    "Glow",
+    "Effects",
+    "Keyframe",
+];
+
+/// The first name written before `(` that is not one of [`NAMES`] (outside
+/// strings and comments), with its byte offset.
+fn unknown_name(text: &str) -> Option<(usize, &str)> {
+    let bytes = text.as_bytes();
+    let mut i = 0;
+    while i < bytes.len() {
+        match bytes[i] {
+            b'"' => {
+                i += 1;
+                while i < bytes.len() && bytes[i] != b'"' {
+                    i += if bytes[i] == b'\\' { 2 } else { 1 };
+                }
+                i += 1;
+            }
+            b'r' if text[i..].starts_with("r#") || text[i..].starts_with("r\"") => {
+                let hashes = text[i + 1..].bytes().take_while(|&b| b == b'#').count();
+                let close = format!("\"{}", "#".repeat(hashes));
+                let body = i + 2 + hashes;
+                i = text
+                    .get(body..)
+                    .and_then(|rest| rest.find(&close))
+                    .map_or(bytes.len(), |at| body + at + close.len());
+            }
+            b'/' if text[i..].starts_with("//") => {
+                i = text[i..].find('\n').map_or(bytes.len(), |at| i + at);
+            }
+            b'/' if text[i..].starts_with("/*") => {
+                i = text[i + 2..]
+                    .find("*/")
+                    .map_or(bytes.len(), |at| i + 2 + at + 2);
+            }
+            b if b.is_ascii_alphabetic() || b == b'_' => {
+                let start = i;
+                while i < bytes.len() && (bytes[i].is_ascii_alphanumeric() || bytes[i] == b'_') {
+                    i += 1;
+                }
+                let name = &text[start..i];
+                let next = text[i..].trim_start();
+                if next.starts_with('(') && !NAMES.contains(&name) {
+                    return Some((start, name));
+                }
+            }
+            _ => i += 1,
+        }
+    }
+    None
+}
+
+/// The line and column (from 1, in characters) of byte `offset` of `text`.
+fn line_and_column(text: &str, offset: usize) -> (usize, usize) {
+    let before = &text[..offset];
+    let line = before.matches('\n').count() + 1;
+    let column = before.rsplit('\n').next().unwrap_or("").chars().count() + 1;
+    (line, column)
 }
 
 /// The first line and column at or after (`line`, `column`) that is not
@@ -596,11 +797,18 @@ impl SiteMap {
         self.nodes.insert(std::ptr::from_ref(node.kind()), site);
     }
 
+    fn insert_new(&mut self, node: &Node, site: usize) {
+        self.nodes
+            .entry(std::ptr::from_ref(node.kind()))
+            .or_insert(site);
+    }
+
     /// The site of what a validation error names: a node's path, the
     /// camera, or a light.
     fn site_of(&self, scene: &Scene, repr: &FileRepr, e: &Error) -> Option<usize> {
         let node = match e {
             Error::Camera { .. } => return Some(repr.camera.site),
+            Error::CustomShape { name, .. } => return self.custom_site(scene, name),
             Error::NonFinite { node, .. }
             | Error::OutOfRange { node, .. }
             | Error::Precision { node, .. }
@@ -628,6 +836,20 @@ impl SiteMap {
         }
         self.nodes.get(&std::ptr::from_ref(at.kind())).copied()
     }
+
+    /// The site of the first node of the custom shape `name`.
+    fn custom_site(&self, scene: &Scene, name: &str) -> Option<usize> {
+        let mut stack = vec![scene.geometry.as_ref()?];
+        while let Some(node) = stack.pop() {
+            if let Kind::Custom { shape, .. } = node.kind()
+                && shape.name() == name
+            {
+                return self.nodes.get(&std::ptr::from_ref(node.kind())).copied();
+            }
+            stack.extend(node.kind().children().into_iter().rev());
+        }
+        None
+    }
 }
 
 // ---------------------------------------------------------------------------
@@ -643,8 +865,8 @@ struct FileRepr {
     camera: Located<Camera>,
     #[serde(default = "default_lights")]
     lights: Vec<Located<Light>>,
-    #[serde(default)]
-    quality: Located<QualityRepr>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    quality: Option<Located<QualityRepr>>,
     #[serde(default)]
     effects: Located<Effects>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -688,12 +910,6 @@ struct QualityRepr {
     over_relaxation: Option<f64>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     supersampling: Option<u32>,
-}
-
-impl Default for QualityRepr {
-    fn default() -> Self {
-        QualityRepr::from_quality(&Quality::default())
-    }
 }
 
 impl QualityRepr {
@@ -1385,7 +1601,8 @@ impl Located<NodeRepr> {
                 .into()
             }
         };
-        sites.insert(&node, site);
+        // A one-operand union is its operand, which keeps its own site.
+        sites.insert_new(&node, site);
         Ok(node)
     }
 }

@@ -81,7 +81,7 @@ pub fn file(name: &str) -> Option<SceneFile> {
     let scene = by_name(name)?;
     Some(SceneFile {
         scene,
-        quality: Quality::production().supersampling(2),
+        quality: Some(Quality::production().supersampling(2)),
         effects: Effects::default().glow(Glow::new(dvec3(0.6, 0.75, 1.0), 0.6)),
         path: (name == "benchmark").then(|| benchmark_path().expect("a constant path")),
         motions: motions(name),

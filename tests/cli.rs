@@ -137,6 +137,9 @@ fn sequence_shards_resume_and_verify() {
         [false, true, false, true]
     );
 
+    // The share verifies on its own.
+    let out = with(&["--shard", "1/2", "--verify"]);
+    assert!(out.status.success(), "{}", text(&out));
     // Half the frames: verify fails, listing the missing ones.
     let out = with(&["--verify"]);
     assert_eq!(out.status.code(), Some(1), "{}", text(&out));
@@ -177,6 +180,21 @@ fn emit_prints_only_what_the_scene_uses() {
     );
     let out = run(&dir, "", &["emit", "mandelbulb", "--preset", "reference"]);
     assert!(String::from_utf8_lossy(&out.stdout).contains("typedef double real;"));
+
+    // The settings' preset (reference: F64) applies to a file without a
+    // quality of its own, not to one with (the gallery's: F32), and
+    // `--preset` to both.
+    let bare = dir.join("bare.ron");
+    std::fs::write(&bare, "(version: 1, geometry: Sphere(radius: 1))").unwrap();
+    let bare = bare.to_str().unwrap();
+    let f64_source = |args: &[&str]| {
+        let out = run(&dir, "preset = \"reference\"", args);
+        assert!(out.status.success(), "{}", text(&out));
+        String::from_utf8_lossy(&out.stdout).contains("typedef double real;")
+    };
+    assert!(f64_source(&["emit", bare]));
+    assert!(!f64_source(&["emit", "mandelbulb"]));
+    assert!(!f64_source(&["emit", bare, "--preset", "draft"]));
 }
 
 #[test]
@@ -236,7 +254,7 @@ fn bad_input_is_a_clear_error_and_a_nonzero_exit() {
     std::fs::write(&bad, "(version: 1,\n  geometry: Sphere(radius: -2))").unwrap();
     let png = dir.join("x.png");
     let o = png.to_str().unwrap();
-    let cases: [(&[&str], &str, i32, &str); 6] = [
+    let cases: [(&[&str], &str, i32, &str); 9] = [
         (
             &["render", bad.to_str().unwrap(), "-o", o],
             "",
@@ -273,6 +291,19 @@ fn bad_input_is_a_clear_error_and_a_nonzero_exit() {
             1,
             "config.toml:1:1",
         ),
+        (&["config"], "presett = 1", 1, "config.toml:1:1"),
+        (
+            &["render", "csg", "-o", o, "--devices", "pthread,,"],
+            "",
+            2,
+            "an empty device name",
+        ),
+        (
+            &["sequence", "fractal_mix", "--out", o, "--set", "power=4"],
+            "",
+            2,
+            "motions set `power`",
+        ),
     ];
     for (args, settings, code, says) in cases {
         let out = run(&dir, settings, args);
@@ -281,4 +312,9 @@ fn bad_input_is_a_clear_error_and_a_nonzero_exit() {
         assert!(stderr.contains(says), "{args:?}: {stderr}");
     }
     assert!(!png.exists(), "an image was written despite the errors");
+    // A bad settings file does not stop `devices`, which does not read it.
+    if gpu::device().is_some() {
+        let out = run(&dir, "presett = 1", &["devices"]);
+        assert!(out.status.success(), "{}", text(&out));
+    }
 }

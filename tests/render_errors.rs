@@ -103,11 +103,19 @@ fn an_unmatched_device_selector_lists_the_devices() {
         device: DeviceSelector {
             platform: Some(device.platform.to_uppercase()),
             device: Some(device.name.clone()),
+            index: None,
         },
         ..RenderOptions::default()
     };
     let r = Renderer::with_options(&gpu::sphere_box_floor(), &options).unwrap();
     assert_eq!(r.device(), &device);
+    // And by its place in the list, which tells apart devices of one name.
+    let all = fractal_sdf::render::devices().unwrap();
+    let at = all.iter().position(|d| d == &device).unwrap();
+    assert_eq!(DeviceSelector::at(at).resolve().unwrap(), device);
+    let err = DeviceSelector::at(all.len()).resolve().unwrap_err();
+    assert!(matches!(err, Error::NoDevice { .. }), "{err}");
+    assert!(err.to_string().contains("device number"), "{err}");
 }
 
 #[test]

@@ -120,6 +120,57 @@ fn a_bad_value_is_located_at_its_node_with_its_path() {
 }
 
 #[test]
+fn more_errors_are_located_where_they_are() {
+    // The operand of a one-operand union.
+    let text = "(version: 1, geometry: Union([\n    Sphere(radius: -1),\n]))";
+    let (line, column, message) = error_at(text);
+    assert_eq!((line, column), (2, 5), "{message}");
+    // A version, after comments.
+    let text = "// one\n// two\n(\n    version: 7,\n    geometry: Sphere(radius: 1),\n)";
+    let (line, column, message) = error_at(text);
+    assert_eq!((line, column), (4, 5), "{message}");
+    // A value that F64 holds and the file's F32 quality does not.
+    let text = "(\n    version: 1,\n    geometry: Union([\n        Sphere(radius: 1),\n        Sphere(radius: 1e30),\n    ]),\n    quality: (preset: Production),\n)";
+    let (line, column, message) = error_at(text);
+    assert_eq!((line, column), (5, 9), "{message}");
+    assert!(message.contains("F32"), "{message}");
+    // In F64, or with no quality of its own (held to F64's limits), it reads.
+    SceneFile::parse(&text.replace("Production", "Reference")).unwrap();
+    SceneFile::parse(&text.replace("    quality: (preset: Production),\n", "")).unwrap();
+    // A motion that takes a parameter out of its range, at the motion.
+    let text = "(\n    version: 1,\n    geometry: Sphere(radius: param(\"r\", 0.5)),\n    motions: [\n        Oscillate(name: \"r\", center: 0.1, amplitude: 1, period: 1),\n    ],\n)";
+    let (line, column, message) = error_at(text);
+    assert_eq!((line, column), (5, 9), "{message}");
+    assert!(message.contains("must be >= 0, got -0.9"), "{message}");
+}
+
+#[test]
+fn a_custom_shape_error_is_located_at_its_node() {
+    let blob = CustomShape::new(
+        "blob",
+        &[("radius", Rule::Positive)],
+        |p, a| p.length() - a[0],
+        "return length(p) - radius;",
+    )
+    .unwrap();
+    let text = "(\n    version: 1,\n    geometry: Union([\n        Sphere(radius: 1),\n        Custom(name: \"blob\", args: []),\n    ]),\n)";
+    let e = SceneFile::parse_with(text, std::slice::from_ref(&blob)).unwrap_err();
+    assert!(
+        e.to_string()
+            .starts_with("<scene>:5:9: custom shape `blob`"),
+        "{e}"
+    );
+}
+
+#[test]
+fn invalid_settings_are_not_written() {
+    let mut file = SceneFile::new(Scene::new(sphere(1.0)));
+    file.quality = Some(Quality::draft());
+    file.quality.as_mut().unwrap().detail = f64::NAN;
+    assert!(file.to_text().is_err());
+}
+
+#[test]
 fn each_operand_of_a_long_union_is_located() {
     let mut text = String::from("(version: 1, geometry: Union([\n");
     for i in 0..40 {
@@ -316,7 +367,7 @@ fn shorthand_forms_read_as_their_long_forms() {
         sphere(param("r", 2.0)).translate(fractal_sdf::scene::param3("at", dvec3(1.0, 2.0, 3.0))),
     );
     assert_eq!(file.scene.geometry, Some(expected));
-    assert_eq!(file.quality, Quality::draft().supersampling(3));
+    assert_eq!(file.quality, Some(Quality::draft().supersampling(3)));
     assert_eq!(file.scene.camera, Camera::default());
     assert_eq!(file.scene.lights, Scene::empty().lights);
     assert_eq!(file.effects, Effects::default());
@@ -331,7 +382,7 @@ fn the_readme_example_file_reads() {
     let end = start + readme[start..].find("```").unwrap();
     let file = SceneFile::parse(&readme[start..end]).unwrap_or_else(|e| panic!("{e}"));
     assert_eq!(file.scene.lights.len(), 2);
-    assert_eq!(file.quality, Quality::production().supersampling(2));
+    assert_eq!(file.quality, Some(Quality::production().supersampling(2)));
     assert!(file.effects.glow.is_some());
     assert_eq!(file.motions.len(), 1);
     assert!(file.scene.compile().unwrap().params().slots().len() == 1);

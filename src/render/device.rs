@@ -101,6 +101,10 @@ pub struct DeviceSelector {
     pub platform: Option<String>,
     /// A substring of the device's name.
     pub device: Option<String>,
+    /// The device's position in [`devices`] (from 0), which tells apart
+    /// devices of the same name (several identical GPUs). It must also
+    /// match the names given.
+    pub index: Option<usize>,
 }
 
 impl DeviceSelector {
@@ -114,18 +118,29 @@ impl DeviceSelector {
     #[must_use]
     pub fn device(name: impl Into<String>) -> Self {
         DeviceSelector {
-            platform: None,
             device: Some(name.into()),
+            ..Self::default()
         }
     }
 
     /// The device `info` describes: its platform's and its own name (the
-    /// first of two devices with the same names on one platform).
+    /// first of two devices with the same names on one platform; see
+    /// [`DeviceSelector::at`] to tell them apart).
     #[must_use]
     pub fn exactly(info: &DeviceInfo) -> Self {
         DeviceSelector {
             platform: Some(info.platform.clone()),
             device: Some(info.name.clone()),
+            index: None,
+        }
+    }
+
+    /// The device at `index` in [`devices`]' list.
+    #[must_use]
+    pub fn at(index: usize) -> Self {
+        DeviceSelector {
+            index: Some(index),
+            ..Self::default()
         }
     }
 
@@ -134,7 +149,7 @@ impl DeviceSelector {
     pub fn platform(name: impl Into<String>) -> Self {
         DeviceSelector {
             platform: Some(name.into()),
-            device: None,
+            ..Self::default()
         }
     }
 
@@ -148,7 +163,7 @@ impl DeviceSelector {
     }
 
     fn is_auto(&self) -> bool {
-        self.platform.is_none() && self.device.is_none()
+        self.platform.is_none() && self.device.is_none() && self.index.is_none()
     }
 
     fn describe(&self) -> String {
@@ -156,6 +171,7 @@ impl DeviceSelector {
         [
             part("platform", &self.platform),
             part("device", &self.device),
+            self.index.map(|i| format!("device number {i}")),
         ]
         .into_iter()
         .flatten()
@@ -211,10 +227,11 @@ fn choose(devices: &[DeviceInfo], selector: &DeviceSelector, env: Option<&str>) 
         let m = (0..devices.len())
             .filter(|&i| {
                 let d = &devices[i];
-                selector
-                    .platform
-                    .as_ref()
-                    .is_none_or(|p| contains(&d.platform, p))
+                selector.index.is_none_or(|at| at == i)
+                    && selector
+                        .platform
+                        .as_ref()
+                        .is_none_or(|p| contains(&d.platform, p))
                     && selector
                         .device
                         .as_ref()

@@ -13,7 +13,7 @@ use fractal_sdf::codegen::{self, Options};
 use fractal_sdf::gallery;
 use fractal_sdf::output::{save_png, verify_png};
 use fractal_sdf::prelude::*;
-use fractal_sdf::render::{DeviceSelector, RenderOptions, Renderer, devices};
+use fractal_sdf::render::{DeviceKind, DeviceSelector, RenderOptions, Renderer, devices};
 use fractal_sdf::sequence::{Encoded, Sequence, parse_range};
 use fractal_sdf::settings::{CONFIG_ENV, Settings, parse_preset, parse_size};
 use indicatif::{ProgressBar, ProgressStyle};
@@ -56,7 +56,8 @@ struct SceneArgs {
     /// A scene file (`.ron`) or a gallery scene name.
     scene: String,
     /// Quality preset: draft, preview, production or reference (default:
-    /// the settings file's, else the scene file's quality).
+    /// the scene file's quality, else the settings file's preset, else
+    /// production).
     #[arg(long)]
     preset: Option<String>,
     /// Image size, WIDTHxHEIGHT (default: the settings file's, else 640x480).
@@ -69,8 +70,9 @@ struct SceneArgs {
     /// file's, else automatic).
     #[arg(long)]
     device: Option<String>,
-    /// Split every frame across devices: `all`, or device name substrings
-    /// separated by commas (a name twice uses that device twice).
+    /// Split every frame across devices: `all` (every GPU, or every device
+    /// where there is none), or device name substrings separated by commas
+    /// (a name twice uses that device twice).
     #[arg(long, value_name = "all|NAME,...", conflicts_with = "device")]
     devices: Option<String>,
 }
@@ -134,7 +136,7 @@ struct BenchArgs {
     #[command(flatten)]
     scene: SceneArgs,
     /// Frames to time after one warm-up frame.
-    #[arg(long, default_value_t = 10)]
+    #[arg(long, default_value_t = 10, value_parser = clap::value_parser!(u32).range(1..))]
     frames: u32,
 }
 
@@ -175,17 +177,19 @@ fn main() -> ExitCode {
 }
 
 fn run(cli: Cli) -> Outcome {
-    let settings = match &cli.config {
-        Some(path) => Settings::load_from(path)?,
-        None => Settings::load()?,
+    // Read only by the subcommands that use it: `devices` runs whatever the
+    // file holds, and `config` reports what is wrong with it.
+    let settings = || match &cli.config {
+        Some(path) => Settings::load_from(path),
+        None => Settings::load(),
     };
-    match cli.command {
-        Command::Render(args) => render(&args, &settings),
-        Command::Sequence(args) => sequence(&args, &settings),
-        Command::Emit(args) => emit(&args, &settings),
+    match &cli.command {
+        Command::Render(args) => render(args, &settings()?),
+        Command::Sequence(args) => sequence(args, &settings()?),
+        Command::Emit(args) => emit(args, &settings()?),
         Command::Devices => list_devices(),
-        Command::Bench(args) => bench(&args, &settings),
-        Command::Config => show_config(cli.config.as_deref(), &settings),
+        Command::Bench(args) => bench(args, &settings()?),
+        Command::Config => show_config(cli.config.as_deref(), settings()),
     }
 }
 
@@ -218,7 +222,7 @@ impl Job {
         let file = load_scene(&args.scene)?;
         let preset = match &args.preset {
             Some(name) => Some(parse_preset(name).map_err(|e| usage(e.to_string()))?),
-            None => settings.preset,
+            None => None,
         };
         let size = match &args.size {
             Some(text) => parse_size(text).map_err(|e| usage(e.to_string()))?,
@@ -241,15 +245,18 @@ impl Job {
             .collect::<Outcome<Vec<_>>>()?;
         let devices = match args.devices.as_deref() {
             None => None,
-            Some("all") => Some(devices()?.iter().map(DeviceSelector::exactly).collect()),
+            Some("all") => Some(every_device()?),
             Some(list) => Some(
                 list.split(',')
-                    .map(|name| DeviceSelector::device(name.trim()))
-                    .collect(),
+                    .map(|name| match name.trim() {
+                        "" => Err(usage(format!("--devices `{list}`: an empty device name"))),
+                        name => Ok(DeviceSelector::device(name)),
+                    })
+                    .collect::<Outcome<_>>()?,
             ),
         };
         let options = RenderOptions {
-            quality: preset.map_or(file.quality, Preset::quality),
+            quality: quality(preset, &file, settings),
             effects: file.effects,
             device: device.map_or_else(DeviceSelector::auto, DeviceSelector::device),
             ..RenderOptions::default()
@@ -311,6 +318,32 @@ fn render(args: &RenderArgs, settings: &Settings) -> Outcome {
     Ok(())
 }
 
+/// The quality to render with: `--preset`, else the scene file's own, else
+/// the settings file's preset, else production.
+fn quality(flag: Option<Preset>, file: &SceneFile, settings: &Settings) -> Quality {
+    match (flag, file.quality, settings.preset) {
+        (Some(preset), _, _) => preset.quality(),
+        (None, Some(quality), _) => quality,
+        (None, None, Some(preset)) => preset.quality(),
+        (None, None, None) => Quality::production(),
+    }
+}
+
+/// Every GPU of the machine, by its place in the list (identical GPUs are
+/// each used once); every device where there is no GPU.
+fn every_device() -> Outcome<Vec<DeviceSelector>> {
+    let all = devices()?;
+    let gpus: Vec<usize> = (0..all.len())
+        .filter(|&i| all[i].kind == DeviceKind::Gpu)
+        .collect();
+    let chosen = if gpus.is_empty() {
+        (0..all.len()).collect()
+    } else {
+        gpus
+    };
+    Ok(chosen.into_iter().map(DeviceSelector::at).collect())
+}
+
 /// The renderer's devices, for reports.
 fn on_devices(renderer: &Renderer) -> String {
     let labels: Vec<String> = renderer.devices().iter().map(|d| d.label()).collect();
@@ -346,6 +379,18 @@ fn sequence(args: &SequenceArgs, settings: &Settings) -> Outcome {
         (None, Some(path)) => path.clone(),
         (None, None) => orbit(&job.file.scene, args.seconds)?,
     };
+    for (name, _) in &job.sets {
+        let driven = job
+            .file
+            .motions
+            .iter()
+            .any(|m| m.values(0.0).iter().any(|(slot, _)| slot == name));
+        if driven {
+            return Err(usage(format!(
+                "--set {name}: the scene's motions set `{name}` on every frame"
+            )));
+        }
+    }
     let seq = Sequence::for_duration(&args.out, args.fps, path.duration())?;
     let range = match &args.frames {
         Some(text) => parse_range(text, seq.frames())?,
@@ -357,6 +402,7 @@ fn sequence(args: &SequenceArgs, settings: &Settings) -> Outcome {
     if args.verify {
         let bad: Vec<String> = range
             .clone()
+            .filter(mine)
             .filter_map(|i| {
                 verify_png(seq.frame_path(i), job.size)
                     .err()
@@ -365,11 +411,12 @@ fn sequence(args: &SequenceArgs, settings: &Settings) -> Outcome {
             .collect();
         if bad.is_empty() {
             println!(
-                "frames {}..{} in {}: all {} present and whole",
+                "frames {}..{}{} in {}: all {} present and whole",
                 range.start,
                 range.end,
+                shard.map_or_else(String::new, |(k, n)| format!(" (share {k}/{n})")),
                 args.out.display(),
-                range.len()
+                range.clone().filter(mine).count()
             );
             return Ok(());
         }
@@ -431,10 +478,11 @@ fn sequence(args: &SequenceArgs, settings: &Settings) -> Outcome {
         bar.finish();
     }
     if !args.no_video && seq.remaining(0..seq.frames(), job.size).is_empty() {
-        let video = args
-            .video
-            .clone()
-            .unwrap_or_else(|| args.out.with_extension("mp4"));
+        let video = match (&args.video, args.out.file_name()) {
+            (Some(video), _) => video.clone(),
+            (None, Some(_)) => args.out.with_extension("mp4"),
+            (None, None) => args.out.join("sequence.mp4"),
+        };
         encode(&seq, &video);
     }
     Ok(())
@@ -449,15 +497,12 @@ fn encode(seq: &Sequence, video: &Path) {
 
 fn emit(args: &EmitArgs, settings: &Settings) -> Outcome {
     let file = load_scene(&args.scene)?;
-    let quality = match (&args.preset, settings.preset) {
-        (Some(name), _) => parse_preset(name)
-            .map_err(|e| usage(e.to_string()))?
-            .quality(),
-        (None, Some(preset)) => preset.quality(),
-        (None, None) => file.quality,
+    let preset = match &args.preset {
+        Some(name) => Some(parse_preset(name).map_err(|e| usage(e.to_string()))?),
+        None => None,
     };
     let options = Options {
-        quality,
+        quality: quality(preset, &file, settings),
         effects: file.effects,
         ..Options::default()
     };
@@ -525,13 +570,13 @@ fn bench(args: &BenchArgs, settings: &Settings) -> Outcome {
     Ok(())
 }
 
-fn show_config(given: Option<&Path>, settings: &Settings) -> Outcome {
+fn show_config(given: Option<&Path>, settings: fractal_sdf::Result<Settings>) -> Outcome {
     let path = given.map(Path::to_path_buf).or_else(Settings::path);
     match &path {
         Some(p) if p.exists() => println!("# settings file: {}", p.display()),
         Some(p) => println!("# settings file: {} (absent: every default)", p.display()),
         None => println!("# no configuration directory; set {CONFIG_ENV} to name a file"),
     }
-    print!("{}", settings.to_toml()?);
+    print!("{}", settings?.to_toml()?);
     Ok(())
 }
