@@ -389,12 +389,13 @@ fn read(text: &str, file: &Path, shapes: &[CustomShape]) -> Result<SceneFile> {
         cause: cause.map(Box::new),
     };
     let syntax = |e: ron::error::SpannedError| {
-        at(
-            e.span.start.line,
-            e.span.start.col,
-            e.code.to_string(),
-            None,
-        )
+        let reason = match e.code {
+            ron::Error::ExceededRecursionLimit => {
+                format!("nodes are nested more than {MAX_NESTING} deep")
+            }
+            code => code.to_string(),
+        };
+        at(e.span.start.line, e.span.start.col, reason, None)
     };
 
     // The version first, so that a file from a newer format says so
