@@ -144,15 +144,20 @@ fn more_errors_are_located_where_they_are() {
     assert!(message.contains("must be >= 0, got -0.9"), "{message}");
 }
 
-#[test]
-fn a_custom_shape_error_is_located_at_its_node() {
-    let blob = CustomShape::new(
+/// A custom shape: a ball of radius `radius`.
+fn blob() -> CustomShape {
+    CustomShape::new(
         "blob",
         &[("radius", Rule::Positive)],
         |p, a| p.length() - a[0],
         "return length(p) - radius;",
     )
-    .unwrap();
+    .unwrap()
+}
+
+#[test]
+fn a_custom_shape_error_is_located_at_its_node() {
+    let blob = blob();
     let text = "(\n    version: 1,\n    geometry: Union([\n        Sphere(radius: 1),\n        Custom(name: \"blob\", args: []),\n    ]),\n)";
     let e = SceneFile::parse_with(text, std::slice::from_ref(&blob)).unwrap_err();
     assert!(
@@ -330,13 +335,7 @@ fn a_hundred_thousand_operands_read_and_write() {
 
 #[test]
 fn custom_shapes_are_named_by_the_caller() {
-    let blob = CustomShape::new(
-        "blob",
-        &[("radius", Rule::Positive)],
-        |p, a| p.length() - a[0],
-        "return length(p) - radius;",
-    )
-    .unwrap();
+    let blob = blob();
     let scene = Scene::new(blob.node([param("r", 0.7)]).translate(dvec3(0.0, 1.0, 0.0)));
     let text = SceneFile::new(scene.clone()).to_text().unwrap();
     assert!(
