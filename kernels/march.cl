@@ -11,10 +11,12 @@
 //                         real3* color, real* trap)
 //   effects: the code of each effect (ambient occlusion, shadows, glow,
 //           fog) sits in a conditional block named ENABLE_<effect>, with
-//           its constants defined by the header only when it is on. Code
-//           generation resolves these blocks itself and leaves out every
-//           effect that is off, so they are the only preprocessor
-//           conditionals allowed in this file.
+//           its constants defined by the header only when it is on, and so
+//           does the stop at the scene's bounding sphere
+//           (ENABLE_SCENE_BOUND: SCENE_BOUND_CENTRE, SCENE_BOUND_RADIUS,
+//           SCENE_BOUND_SLOPE). Code generation resolves these blocks
+//           itself and leaves out every one that is off, so they are the
+//           only preprocessor conditionals allowed in this file.
 //
 // Everything else arrives at run time, so moving the camera or the lights
 // and changing dynamic parameters never rebuilds the program. The header
@@ -156,6 +158,67 @@ real march_refine(real3 ro, real3 rd, const MarchCamera* cam, real t0, real g0, 
 // 2014); when the unbounding spheres of two consecutive points stop
 // overlapping the long step may have jumped over a surface, so the march
 // returns to the last safe point and continues with plain steps.
+#ifdef ENABLE_SCENE_BOUND
+// How far along the ray a hit can lie at most, for a scene that lies in a
+// sphere (SCENE_BOUND_CENTRE, SCENE_BOUND_RADIUS) outside which its
+// estimate is at least SCENE_BOUND_SLOPE times the distance to the sphere
+// (src/ir/bounds.rs). The drawn surface lies DETAIL footprints out, so
+// the sphere is widened by that at the farthest distance a hit could have,
+// t_max = (|ro - c| + R + DETAIL base / slope) / (1 - DETAIL per_unit /
+// slope): beyond t_max the estimate outgrows the surface's offset, and
+// before it, once the ray has left the widened sphere it never returns.
+// Returns where the ray leaves the widened sphere (negative if it misses
+// it), or MAX_DISTANCE where the footprint grows too fast for the bound.
+real march_bound_exit(real3 ro, real3 rd, const MarchCamera* cam) {
+    real3 oc = ro - SCENE_BOUND_CENTRE;
+    real len = length(oc);
+    real shrink = R(1.0) - DETAIL * cam->footprint_per_unit / SCENE_BOUND_SLOPE;
+    if (shrink <= R(0.0)) {
+        return MAX_DISTANCE;
+    }
+    real t_max = (len + SCENE_BOUND_RADIUS + DETAIL * cam->footprint_base / SCENE_BOUND_SLOPE)
+                 / shrink;
+    real radius = SCENE_BOUND_RADIUS + DETAIL * march_footprint(cam, t_max) / SCENE_BOUND_SLOPE;
+    real b = dot(oc, rd);
+    real disc = b * b - (len - radius) * (len + radius);
+    return disc < R(0.0) ? R(-1.0) : -b + sqrt(disc);
+}
+
+// Whether a ray past the scene's bounding sphere at p, t along it in
+// direction rd, may stop without changing its pixel: always, unless the
+// pixel has a halo of near misses (see below).
+int march_glow_settled(real3 p, real3 rd, real t) {
+#ifdef ENABLE_GLOW
+    // The rest of the ray must keep every d / (t + d) above the angle L
+    // where the glow falls below half a step of an 8-bit pixel
+    // (GLOW_STRENGTH * exp(-falloff * L) times the brightest channel =
+    // 0.5 / 255). Further on, u along the ray, the estimate is at least
+    // G = slope (sqrt(|q|^2 + u^2) - R) with q = p - c (once the ray moves
+    // away from c), and d / (t + d) >= L wherever d >= k (t + u), with
+    // k = L / (1 - L). For any unit (a, b), sqrt(|q|^2 + u^2) >= a |q| + b u;
+    // with b = k / slope the u terms match, so slope (a |q| - R) >= k t
+    // suffices for every u.
+    real3 q = p - SCENE_BOUND_CENTRE;
+    if (dot(q, rd) < R(0.0)) {
+        return 0; // still approaching the sphere, which it misses
+    }
+    real brightest = fmax(GLOW_COLOR.x, fmax(GLOW_COLOR.y, GLOW_COLOR.z)) * GLOW_STRENGTH;
+    real angle = log(fmax(R(510.0) * brightest, R(1.0))) / MARCH_GLOW_FALLOFF;
+    if (angle >= R(1.0)) {
+        return 0;
+    }
+    real k = angle / (R(1.0) - angle);
+    real b = k / SCENE_BOUND_SLOPE;
+    if (b >= R(1.0)) {
+        return 0;
+    }
+    real a = sqrt(R(1.0) - b * b);
+    return SCENE_BOUND_SLOPE * (a * length(q) - SCENE_BOUND_RADIUS) >= k * t;
+#endif
+    return 1;
+}
+#endif
+
 MarchResult march_ray(real3 ro, real3 rd, const MarchCamera* cam,
                       __global const real* params) {
     MarchResult r;
@@ -168,6 +231,11 @@ MarchResult march_ray(real3 ro, real3 rd, const MarchCamera* cam,
     int relaxed = 0; // whether the last step was longer than a plain one
     real prev_t = R(0.0);
     real prev_g = R(0.0);
+#ifdef ENABLE_SCENE_BOUND
+    // A ray that has passed the last place it could hit stops (after a
+    // plain step: a relaxed one may still fall back before it).
+    const real t_exit = march_bound_exit(ro, rd, cam);
+#endif
     for (int i = 0; i < MAX_STEPS; ++i) {
         real d = DE(ro + rd * r.t, params);
         real g = d - DETAIL * march_footprint(cam, r.t);
@@ -198,6 +266,11 @@ MarchResult march_ray(real3 ro, real3 rd, const MarchCamera* cam,
         if (r.t > MAX_DISTANCE) {
             return r;
         }
+#ifdef ENABLE_SCENE_BOUND
+        if (r.t > t_exit && !relaxed && march_glow_settled(ro + rd * r.t, rd, r.t)) {
+            return r;
+        }
+#endif
     }
     return r;
 }

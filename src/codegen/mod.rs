@@ -36,7 +36,7 @@ use std::sync::atomic::{AtomicU64, Ordering};
 use glam::DVec3;
 
 use crate::error::Result;
-use crate::ir::{CompiledScene, Ir};
+use crate::ir::{Bound, CompiledScene, Ir};
 use crate::math::{DEFAULT_COLOR, DERIVATIVE_CAP, MAGNITUDE_CAP, REAL_TINY};
 use crate::quality::{Effects, Precision, Quality};
 
@@ -311,7 +311,7 @@ pub fn emit_ir(ir: &Ir, options: &Options) -> Result<KernelSource> {
     }
     w.line("/* ---- scene ---- */");
     w.raw(&body.finish());
-    let mut kernel = finish(w, options, origin);
+    let mut kernel = finish(w, options, origin, scene_bound(ir, options, origin));
     kernel.custom_regions = custom_regions;
     kernel.constants = constants;
     Ok(kernel)
@@ -332,23 +332,74 @@ pub fn emit_handwritten(scene_functions: &str, options: &Options) -> Result<Kern
     header(&mut w, options);
     w.line("/* ---- scene (hand-written) ---- */");
     w.raw(scene_functions);
-    Ok(finish(w, options, DVec3::ZERO))
+    Ok(finish(w, options, DVec3::ZERO, None))
 }
 
+/// The switch of the march's stop at the scene's bounding sphere.
+const SCENE_BOUND: &str = "ENABLE_SCENE_BOUND";
+
 /// The target kernel for `options`, with the blocks of the effects that are
-/// off removed: what every program for these options ends with.
+/// off removed (and the stop at the scene's bounding sphere, which only
+/// programs for a bounded scene keep): what every program for these
+/// options ends with.
 #[must_use]
 pub fn target_kernel(options: &Options) -> String {
+    kernel_with(options, false)
+}
+
+fn kernel_with(options: &Options, bounded: bool) -> String {
     let kernel = match options.target {
         Target::Render => include_str!("../../kernels/march.cl"),
         Target::Evaluate => include_str!("../../kernels/eval.cl"),
     };
-    select_effects(kernel, &Effect::enabled(options))
+    let mut on: Vec<&str> = Effect::enabled(options)
+        .into_iter()
+        .map(Effect::switch)
+        .collect();
+    if bounded {
+        on.push(SCENE_BOUND);
+    }
+    select_blocks(kernel, &on)
 }
 
-/// Appends the target kernel and hashes the program.
-fn finish(mut w: writer::Writer, options: &Options, origin: DVec3) -> KernelSource {
+/// The sphere a rendering program's rays stop at, in the program's frame:
+/// the bound of the whole scene ([`Ir::bounds`]), where it has one the
+/// precision can compute.
+fn scene_bound(ir: &Ir, options: &Options, origin: DVec3) -> Option<Bound> {
+    if options.target != Target::Render {
+        return None;
+    }
+    let bound = ir.bounds()[ir.root().index()]?;
+    let local = Bound {
+        centre: bound.centre - origin,
+        ..bound
+    };
+    local
+        .fits(options.quality.precision.limits())
+        .then_some(local)
+}
+
+/// Appends the target kernel (with the scene's bounding sphere, if it has
+/// one) and hashes the program.
+fn finish(
+    mut w: writer::Writer,
+    options: &Options,
+    origin: DVec3,
+    bound: Option<Bound>,
+) -> KernelSource {
     EMISSIONS.fetch_add(1, Ordering::Relaxed);
+    if let Some(b) = bound {
+        w.line("/* The sphere around the scene (src/ir/bounds.rs). */");
+        let c = b.centre;
+        w.line(format!(
+            "#define SCENE_BOUND_CENTRE (real3)({}, {}, {})",
+            w.float(c.x),
+            w.float(c.y),
+            w.float(c.z)
+        ));
+        w.line(format!("#define SCENE_BOUND_RADIUS {}", w.float(b.radius)));
+        w.line(format!("#define SCENE_BOUND_SLOPE {}", w.float(b.slope)));
+    }
     w.line(format!(
         "/* ---- kernel: {} ---- */",
         match options.target {
@@ -357,7 +408,7 @@ fn finish(mut w: writer::Writer, options: &Options, origin: DVec3) -> KernelSour
         }
     ));
     let kernel_start = w.len();
-    w.raw(&target_kernel(options));
+    w.raw(&kernel_with(options, bound.is_some()));
     let source = w.finish();
     KernelSource {
         hash: fnv1a(source.as_bytes()),
@@ -437,10 +488,10 @@ fn header(w: &mut writer::Writer, options: &Options) {
 }
 
 /// Resolves the kernels' `#ifdef ENABLE_*` / `#endif` blocks (the kernels
-/// have no `#else`): keeps the lines of features that are on and drops the
-/// rest, so a disabled effect leaves no code at all. Other directives pass
-/// through.
-fn select_effects(kernel: &str, on: &[Effect]) -> String {
+/// have no `#else`): keeps the lines of the switches that are on and drops
+/// the rest, so a disabled effect leaves no code at all. Other directives
+/// pass through.
+fn select_blocks(kernel: &str, on: &[&str]) -> String {
     // One entry per open feature block: whether the text around it was
     // being kept.
     let mut outer: Vec<bool> = Vec::new();
@@ -451,7 +502,7 @@ fn select_effects(kernel: &str, on: &[Effect]) -> String {
         if let Some(name) = directive.strip_prefix("#ifdef ENABLE_") {
             let name = format!("ENABLE_{}", name.trim());
             outer.push(keep);
-            keep = keep && on.iter().any(|e| e.switch() == name);
+            keep = keep && on.contains(&name.as_str());
         } else if directive.starts_with("#endif") && !outer.is_empty() {
             keep = outer.pop().expect("checked non-empty");
         } else if keep {

@@ -22,8 +22,8 @@ use std::fmt::Write as _;
 
 use super::helpers::Helper;
 use super::writer::{INSTANCE_SLOT, Writer};
-use crate::ir::{Ir, IrNode, NodeId, Scalar, Vector};
-use crate::math::{escape_radius, integer_power, mandelbulb_radius, rotation_rows};
+use crate::ir::{Bound, Ir, IrNode, NodeId, SHRINK, Scalar, UnionChain, Vector, union_chain};
+use crate::math::{F32_LIMITS, escape_radius, integer_power, mandelbulb_radius, rotation_rows};
 use crate::quality::Precision;
 use crate::scene::{
     CsgOp, CustomShape, Kind, MAX_ESCAPE_ITERATIONS, MAX_FOLD_ITERATIONS, Mapper, ParamSpec,
@@ -45,6 +45,9 @@ enum Step {
     /// Its children, with their points and whether they need a colour, come
     /// next; the node is finished when it is left.
     Descend(Vec<(NodeId, String, bool)>),
+    /// A tree of hard unions: its operands come next, in the chain's order,
+    /// each folded into the minimum so far (within reach of its bound).
+    Chain(UnionChain),
 }
 
 /// The library function and helper file of each primitive: the table that
@@ -233,6 +236,10 @@ pub(crate) struct SceneEmitter<'a> {
     instance: HashMap<NodeId, IrNode>,
     /// Union trees entered as one, until they are left.
     clusters: HashMap<NodeId, Cluster>,
+    /// Each node's bound, where the kernel's precision can compute it.
+    bounds: Vec<Option<Bound>>,
+    /// Booleans whose second operand's block is open.
+    gated: BTreeSet<NodeId>,
 }
 
 impl<'a> SceneEmitter<'a> {
@@ -256,6 +263,12 @@ impl<'a> SceneEmitter<'a> {
             slots: ir.params().len(),
             instance: HashMap::new(),
             clusters: HashMap::new(),
+            bounds: ir
+                .bounds()
+                .into_iter()
+                .map(|b| b.filter(|b| b.fits(&F32_LIMITS)))
+                .collect(),
+            gated: BTreeSet::new(),
         }
     }
 
@@ -363,6 +376,12 @@ impl<'a> SceneEmitter<'a> {
     fn node(&mut self, root: NodeId, p: &str, needs_color: bool) -> Vars {
         enum Task {
             Enter(NodeId, String, bool),
+            /// Between a pruned boolean's operands: opens the block that
+            /// evaluates the second only within reach of its bound.
+            Gate(NodeId, String, bool, Bound),
+            /// After an operand of a chain: the minimum so far and the
+            /// operand's result, combined under the name of a union node.
+            Fold(NodeId, bool),
             Leave(NodeId, String, bool, usize),
         }
         let mut tasks = vec![Task::Enter(root, p.to_string(), needs_color)];
@@ -371,21 +390,138 @@ impl<'a> SceneEmitter<'a> {
             match task {
                 Task::Enter(id, p, needs_color) => match self.enter(id, &p, needs_color) {
                     Step::Done(v) => results.push(v),
+                    Step::Chain(UnionChain { operands, unions }) => {
+                        let mut run = vec![Task::Enter(operands[0], p.clone(), needs_color)];
+                        for (&operand, &union) in operands[1..].iter().zip(&unions) {
+                            if let Some(bound) = self.bounds[operand.index()] {
+                                run.push(Task::Gate(union, p.clone(), needs_color, bound));
+                            }
+                            run.push(Task::Enter(operand, p.clone(), needs_color));
+                            run.push(Task::Fold(union, needs_color));
+                        }
+                        tasks.extend(run.into_iter().rev());
+                    }
                     Step::Descend(children) => {
-                        tasks.push(Task::Leave(id, p, needs_color, children.len()));
-                        for (child, q, color) in children.into_iter().rev() {
+                        tasks.push(Task::Leave(id, p.clone(), needs_color, children.len()));
+                        let gate = self.prunable(id);
+                        for (i, (child, q, color)) in children.into_iter().enumerate().rev() {
                             tasks.push(Task::Enter(child, q, color));
+                            if let (1, Some(bound)) = (i, gate) {
+                                tasks.push(Task::Gate(id, p.clone(), needs_color, bound));
+                            }
                         }
                     }
                 },
+                Task::Gate(id, p, needs_color, bound) => {
+                    let a = results.last().expect("the first operand has a result");
+                    self.open_gate(id, &p, needs_color, a, bound);
+                }
+                Task::Fold(union, needs_color) => {
+                    let b = results.pop().expect("the operand has a result");
+                    let a = results.pop().expect("the chain has a minimum so far");
+                    let mut v = self.csg(union, CsgOp::Union, None, &a, &b, needs_color);
+                    if self.gated.remove(&union) {
+                        v = self.close_gate(union, &v, needs_color);
+                    }
+                    results.push(v);
+                }
                 Task::Leave(id, p, needs_color, n) => {
                     let children = results.split_off(results.len() - n);
-                    let v = self.leave(id, &p, needs_color, children);
+                    let mut v = self.leave(id, &p, needs_color, children);
+                    if self.gated.remove(&id) {
+                        v = self.close_gate(id, &v, needs_color);
+                    }
                     results.push(v);
                 }
             }
         }
         results.pop().expect("the root has a result")
+    }
+
+    /// The bound of the second operand of a smooth union or a subtraction
+    /// (hard unions are chains), if it has one.
+    fn prunable(&self, id: NodeId) -> Option<Bound> {
+        if !self.instance.is_empty() || self.clusters.contains_key(&id) {
+            return None;
+        }
+        match self.ir.node(id) {
+            Kind::Csg {
+                op: CsgOp::Union | CsgOp::Subtract,
+                b,
+                ..
+            } => self.bounds[b.index()],
+            _ => None,
+        }
+    }
+
+    /// Declares the boolean's result as its first operand's, and opens the
+    /// block that evaluates the second operand only where it can change
+    /// that: where its bound is not beyond the first operand's distance
+    /// (plus the smoothing radius), or not positive. Elsewhere the
+    /// second's estimate is at least its bound, so the (smooth) minimum is
+    /// the first operand's value, colour and trap exactly.
+    fn open_gate(&mut self, id: NodeId, p: &str, needs_color: bool, a: &Vars, bound: Bound) {
+        let Kind::Csg { op, smoothing, .. } = self.ir.node(id) else {
+            unreachable!("only booleans are gated")
+        };
+        let i = id.index();
+        self.w.comment(&format!(
+            "{}: the second operand only within reach of its bound",
+            self.ir.path_tail(id, 2)
+        ));
+        self.w.line(format!("real u{i} = {};", a.d));
+        if self.shade && needs_color {
+            self.w.line(format!("real3 uc{i} = {};", a.c));
+        }
+        if self.shade {
+            self.w.line(format!("real ut{i} = {};", a.t));
+        }
+        let first = match op {
+            CsgOp::Subtract => format!("-u{i}"),
+            _ => format!("u{i}"),
+        };
+        let threshold = match smoothing {
+            Some(k) => format!("{first} + {}", self.w.scalar(*k)),
+            None => first,
+        };
+        let centre = self.w.vector(bound.centre.to_array().map(Scalar::Baked));
+        let mut g = format!(
+            "length({p} - {centre}) * {} - {}",
+            self.w.float(SHRINK),
+            self.w.float(bound.radius)
+        );
+        if bound.slope < 1.0 {
+            g = format!("{} * ({g})", self.w.float(bound.slope));
+        }
+        self.w.line(format!("real g{i} = {g};"));
+        self.w
+            .open(format!("if (!(g{i} > {threshold} && g{i} > R(0.0)))"));
+        self.gated.insert(id);
+    }
+
+    /// Closes a gate: the boolean's value, computed in the block, becomes
+    /// its result.
+    fn close_gate(&mut self, id: NodeId, v: &Vars, needs_color: bool) -> Vars {
+        let i = id.index();
+        self.w.line(format!("u{i} = {};", v.d));
+        let c = if self.shade && needs_color {
+            self.w.line(format!("uc{i} = {};", v.c));
+            format!("uc{i}")
+        } else {
+            "DEFAULT_COLOR".into()
+        };
+        let t = if self.shade {
+            self.w.line(format!("ut{i} = {};", v.t));
+            format!("ut{i}")
+        } else {
+            "R(1.0)".into()
+        };
+        self.w.close();
+        Vars {
+            d: format!("u{i}"),
+            c,
+            t,
+        }
     }
 
     /// Entering a node: a leaf is emitted whole; any other node emits what
@@ -410,9 +546,16 @@ impl<'a> SceneEmitter<'a> {
             smoothing: None,
             ..
         } = node
-            && let Some(step) = self.instanced_union(id, p, needs_color)
         {
-            return step;
+            if let Some(step) = self.instanced_union(id, p, needs_color) {
+                return step;
+            }
+            if self.instance.is_empty()
+                && let Some(chain) = union_chain(ir, id, &self.bounds)
+            {
+                self.label(id);
+                return Step::Chain(chain);
+            }
         }
         if !matches!(
             node,

@@ -14,7 +14,11 @@ pub use crate::math::{Real, V3, v3};
 use sdf::Estimate;
 
 use crate::error::Result;
-use crate::ir::{CompiledScene, Ir, IrNode, NodeId, ParamValues, Scalar};
+use std::collections::HashMap;
+
+use crate::ir::SHRINK;
+use crate::ir::{Bound, CompiledScene, Ir, IrNode, NodeId, ParamValues, Scalar, union_chain};
+use crate::math::F32_LIMITS;
 use crate::scene::{CsgOp, Kind, Node};
 
 /// What the scene is like at one point.
@@ -40,6 +44,13 @@ pub struct Sample<T> {
 pub struct Evaluator {
     ir: Ir,
     values: ParamValues,
+    /// Each node's bound ([`Ir::bounds`]), where the kernels' code can
+    /// evaluate it.
+    bounds: Vec<Option<Bound>>,
+    /// The roots of trees of hard unions, with their operands in the order
+    /// the kernels evaluate them (see `ir::union_chain`).
+    chains: HashMap<usize, Vec<NodeId>>,
+    prune: bool,
 }
 
 impl Evaluator {
@@ -63,7 +74,54 @@ impl Evaluator {
     #[must_use]
     pub fn from_ir(ir: Ir) -> Self {
         let values = ir.default_values();
-        Evaluator { ir, values }
+        let bounds: Vec<Option<Bound>> = ir
+            .bounds()
+            .into_iter()
+            .map(|b| b.filter(|b| b.fits(&F32_LIMITS)))
+            .collect();
+        let chains = (0..ir.nodes().len())
+            .map(NodeId::from_index)
+            .filter(|&id| {
+                ir.parent(id)
+                    .is_none_or(|parent| union_chain(&ir, parent, &bounds).is_none())
+            })
+            .filter_map(|id| Some((id.index(), union_chain(&ir, id, &bounds)?.operands)))
+            .collect();
+        Evaluator {
+            ir,
+            values,
+            bounds,
+            chains,
+            prune: true,
+        }
+    }
+
+    /// Turns the pruning of unions and subtractions off or on (it is on,
+    /// as in the kernels). Pruning skips an operand whose bound is beyond
+    /// the other operand's distance, which changes no value: turning it off
+    /// is how tests check that.
+    #[must_use]
+    pub fn with_pruning(mut self, on: bool) -> Self {
+        self.prune = on;
+        self
+    }
+
+    /// Whether the second operand `b` of a union or subtraction (with
+    /// smoothing `k`), seen at `p`, cannot change the result `a` gives: its
+    /// bound is positive and beyond `a` (by `k`), so its estimate is too.
+    /// The kernels take the same decision (`codegen`).
+    fn skips<T: Real>(&self, op: CsgOp, k: T, a: T, b: NodeId, p: V3<T>) -> bool {
+        let Some(bound) = self.bounds[b.index()].filter(|_| self.prune) else {
+            return false;
+        };
+        let threshold = match op {
+            CsgOp::Union => a + k,
+            CsgOp::Subtract => -a + k,
+            CsgOp::Intersect => return false,
+        };
+        let centre = V3::<f64>::from(bound.centre).cast::<T>();
+        let g = T::of(bound.slope) * ((p - centre).length() * T::of(SHRINK) - T::of(bound.radius));
+        g > threshold && g > T::zero()
     }
 
     /// The lowered scene.
@@ -159,9 +217,25 @@ impl Evaluator {
         let unset = Self::leaf(T::zero());
         let mut samples = vec![unset; nodes.len()];
         for (i, node) in nodes.iter().enumerate() {
-            samples[i] = self.sample_at(node, points[i], &samples);
+            samples[i] = match self.chains.get(&i) {
+                Some(operands) => self.chain_at(operands, points[i], &samples),
+                None => self.sample_at(node, points[i], &samples),
+            };
         }
         samples[self.ir.root().index()]
+    }
+
+    /// A tree of hard unions at `p`, from its operands' samples: their
+    /// minimum, in the kernels' order, skipping the operands whose bound
+    /// is beyond the minimum so far.
+    fn chain_at<T: Real>(&self, operands: &[NodeId], p: V3<T>, done: &[Sample<T>]) -> Sample<T> {
+        let mut acc = done[operands[0].index()];
+        for &o in &operands[1..] {
+            if !self.skips(CsgOp::Union, T::zero(), acc.distance, o, p) {
+                acc = combine(CsgOp::Union, T::zero(), acc, done[o.index()]);
+            }
+        }
+        acc
     }
 
     /// The point a node's children see, for the point `p` it sees.
@@ -295,6 +369,9 @@ impl Evaluator {
                 b,
             } => {
                 let k = smoothing.map_or(T::zero(), s);
+                if self.skips(*op, k, of(a).distance, *b, p) {
+                    return of(a);
+                }
                 combine(*op, k, of(a), of(b))
             }
             Kind::Custom { shape, args } => {

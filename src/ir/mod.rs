@@ -11,6 +11,7 @@
 //! stage receives: the CPU reference ([`crate::cpu`]), code generation
 //! ([`crate::codegen`]) and the renderer read it, never the scene tree.
 
+mod bounds;
 mod compiled;
 mod lower;
 mod params;
@@ -20,6 +21,8 @@ use std::sync::atomic::{AtomicU64, Ordering};
 
 use glam::DVec3;
 
+pub use bounds::{Bound, SHRINK};
+pub(crate) use bounds::{UnionChain, union_chain};
 pub use compiled::CompiledScene;
 pub use params::{Constraint, ParamLayout, ParamSlot, ParamValues, Relation};
 
@@ -32,6 +35,11 @@ use crate::scene::{Kind, Mapper, Node, ParamSpec};
 pub struct NodeId(u32);
 
 impl NodeId {
+    /// The handle of the node at `index` in [`Ir::nodes`].
+    pub(crate) fn from_index(index: usize) -> Self {
+        NodeId(u32::try_from(index).expect("fewer than 2^32 nodes"))
+    }
+
     /// The node's index in [`Ir::nodes`].
     #[must_use]
     pub fn index(self) -> usize {
@@ -116,6 +124,12 @@ impl Ir {
     #[must_use]
     pub fn root(&self) -> NodeId {
         self.root
+    }
+
+    /// The node's parent, `None` for the root.
+    #[must_use]
+    pub fn parent(&self, id: NodeId) -> Option<NodeId> {
+        self.parents[id.index()]
     }
 
     /// The path of a node, as validation errors name it

@@ -1,0 +1,372 @@
+//! Bounding spheres of the nodes of a scene: what lets a union skip an
+//! operand the point cannot be near, and a ray skip the space around the
+//! scene.
+//!
+//! A node's [`Bound`] is a sphere and a slope with one guarantee: wherever
+//! `slope · (|p − centre| − radius)` is positive, the node's distance
+//! estimate at `p` is at least that much. For an exact distance (every
+//! primitive but the plane) any sphere around the shape will do, slope 1;
+//! for an estimate it is a property of the formula, proved for each in
+//! [`Bound`]'s construction below. Because the bound never exceeds the
+//! node's own estimate there, a union whose first operand is nearer than
+//! the second's bound has the first operand's value exactly, and code
+//! generation and the CPU reference skip the second. Pruning changes no
+//! value, only the cost.
+//!
+//! Bounds are computed from baked values. A node whose extent depends on a
+//! dynamic value it cannot bound over the value's whole range (a dynamic
+//! translation, scale or rounding radius) has no bound, and neither does a
+//! plane, an unlimited repetition, a twist, a bend or a custom shape.
+
+use glam::DVec3;
+
+use super::{Ir, IrNode, NodeId, Scalar, baked3};
+use crate::cpu::sdf::{JULIA_FAR_FIELD, JULIA_FAR_FIELD_SLOPE, julia_radius};
+use crate::math::{Limits, mandelbulb_radius, rotation_rows};
+use crate::scene::{CsgOp, Kind};
+
+/// A conservative bounding sphere of a node, in the coordinates the node
+/// sees: wherever `slope · (|p − centre| − radius) > 0`, the node's
+/// distance estimate at `p` is at least that value. Pruning reads it as
+/// [`Bound::distance`], a little lower still.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Bound {
+    /// The sphere's centre.
+    pub centre: DVec3,
+    /// The sphere's radius.
+    pub radius: f64,
+    /// How fast the estimate grows at least, away from the sphere, in
+    /// `(0, 1]`: 1 for exact distances.
+    pub slope: f64,
+}
+
+/// The bound reads `|p − centre|` shortened by this fraction, so that the
+/// rounding of a kernel's precision (a few units in the last place of
+/// `|p|`, where the node's own estimate computes the same length another
+/// way, such as after a rotation) can never put the bound above an
+/// estimate it equals in exact arithmetic (a sphere bounding itself).
+pub const SHRINK: f64 = 1.0 - 1e-4;
+
+/// `√3`: the circumradius of the unit cube and of the Sierpinski
+/// tetrahedron's starting tetrahedron.
+const SQRT_3: f64 = 1.732_050_807_568_877_2;
+
+impl Bound {
+    fn sphere(centre: DVec3, radius: f64) -> Self {
+        Bound {
+            centre,
+            radius,
+            slope: 1.0,
+        }
+    }
+
+    fn with_slope(self, slope: f64) -> Self {
+        Bound {
+            slope: self.slope.min(slope),
+            ..self
+        }
+    }
+
+    /// The value the guarantee is about, as pruning computes it: `slope ·
+    /// (SHRINK |p − centre| − radius)`, a little below `slope · (|p −
+    /// centre| − radius)`.
+    #[must_use]
+    pub fn distance(&self, p: DVec3) -> f64 {
+        self.slope * ((p - self.centre).length() * SHRINK - self.radius)
+    }
+
+    /// Whether code in a precision with `limits` can evaluate the bound
+    /// (its centre and radius within the precision's magnitudes).
+    #[must_use]
+    pub fn fits(&self, limits: &Limits) -> bool {
+        let ok = |v: f64| v.is_finite() && v.abs() <= limits.max;
+        self.centre.to_array().into_iter().all(ok) && ok(self.radius) && self.slope > 0.0
+    }
+
+    /// The sphere grown by `by` along the distance estimate: a node whose
+    /// estimate is its child's less `by` (rounding, a smooth blend).
+    fn grow(self, by: f64) -> Self {
+        Bound {
+            radius: self.radius + by / self.slope,
+            ..self
+        }
+    }
+
+    /// The smallest sphere around both, with the smaller slope.
+    fn around(self, other: Bound) -> Self {
+        let (a, b) = if self.radius >= other.radius {
+            (self, other)
+        } else {
+            (other, self)
+        };
+        let gap = (b.centre - a.centre).length();
+        let slope = a.slope.min(b.slope);
+        if gap + b.radius <= a.radius {
+            return Bound { slope, ..a };
+        }
+        let radius = 0.5 * (gap + a.radius + b.radius);
+        let centre = a.centre + (b.centre - a.centre) * ((radius - a.radius) / gap);
+        Bound {
+            centre,
+            radius,
+            slope,
+        }
+    }
+}
+
+impl Ir {
+    /// Every node's bound, by [`NodeId::index`](super::NodeId::index):
+    /// `None` where a node has none. Computed in one pass over the arena
+    /// (children come before parents).
+    #[must_use]
+    pub fn bounds(&self) -> Vec<Option<Bound>> {
+        let mut out: Vec<Option<Bound>> = Vec::with_capacity(self.nodes().len());
+        for node in self.nodes() {
+            let b = bound(node, &out);
+            out.push(b);
+        }
+        out
+    }
+}
+
+/// The bound of one node from its children's.
+fn bound(node: &IrNode, done: &[Option<Bound>]) -> Option<Bound> {
+    let of = |c: &NodeId| done[c.index()];
+    let baked = Scalar::baked;
+    let origin = DVec3::ZERO;
+    Some(match node {
+        Kind::Sphere { radius } => Bound::sphere(origin, baked(*radius)?),
+        Kind::Cuboid { half_extents } => Bound::sphere(origin, baked3(*half_extents)?.length()),
+        Kind::RoundBox { half_extents, .. } => {
+            // The rounding lies inside the box.
+            Bound::sphere(origin, baked3(*half_extents)?.length())
+        }
+        Kind::Torus {
+            major_radius,
+            minor_radius,
+        } => Bound::sphere(origin, baked(*major_radius)? + baked(*minor_radius)?),
+        Kind::Cylinder {
+            radius,
+            half_height,
+        } => Bound::sphere(origin, baked(*radius)?.hypot(baked(*half_height)?)),
+        Kind::Capsule { a, b, radius } => {
+            let (a, b) = (baked3(*a)?, baked3(*b)?);
+            let centre = 0.5 * (a + b);
+            Bound::sphere(centre, 0.5 * (b - a).length() + baked(*radius)?)
+        }
+        Kind::Octahedron { size } => Bound::sphere(origin, baked(*size)?),
+        Kind::CappedCone {
+            half_height,
+            bottom_radius,
+            top_radius,
+        } => {
+            let r = baked(*bottom_radius)?.max(baked(*top_radius)?);
+            Bound::sphere(origin, r.hypot(baked(*half_height)?))
+        }
+        // The estimate is `(k0 − 1) / |u / r|` with `k0 = |p / r|` and `u`
+        // a unit vector, so it is at least `(k0 − 1) min(r)`, and
+        // `k0 >= |p| / max(r)`: at least `min(r) / max(r) · (|p| − max(r))`,
+        // inside too (there it is `(k0 − 1) min(r)`).
+        Kind::Ellipsoid { radii } => {
+            let r = baked3(*radii)?;
+            Bound::sphere(origin, r.max_element()).with_slope(r.min_element() / r.max_element())
+        }
+        // `max(estimate, |p| − rho)` everywhere (see `cpu::sdf::mandelbulb`),
+        // and `rho` falls with the power: 2 at the smallest power bounds
+        // every dynamic one.
+        Kind::Mandelbulb(f) => {
+            let power = baked(f.power).unwrap_or(2.0);
+            Bound::sphere(origin, mandelbulb_radius(power))
+        }
+        // Both are folds that keep `|z|` (absolute values, permutations,
+        // reflections in planes through the origin) followed by
+        // `z -> s z − v` with `|v| <= √3 (s − 1)`, so after n steps
+        // `|z_n| / s^n >= |p| − √3 (1 − s^−n)`; the last box distance is at
+        // least `|z_n| − √3`, and the tetrahedron's face-plane bound at
+        // least `(|z_n| − √3) / 3`. Divided by `s^n`: `|p| − √3`, for every
+        // scale (at least 1.5) and iteration count.
+        Kind::Menger(_) => Bound::sphere(origin, SQRT_3),
+        Kind::Sierpinski(_) => Bound::sphere(origin, SQRT_3).with_slope(1.0 / 3.0),
+        // Beyond `JULIA_FAR_FIELD · edge` the estimate is exactly
+        // `JULIA_FAR_FIELD_SLOPE (|(p, w)| − edge)`; the bound is that
+        // slope beyond that radius (the largest edge of any constant in
+        // range when `c` or the bailout is dynamic).
+        Kind::Julia(f) => {
+            let edge = match (f.c.map(baked), baked(f.bailout)) {
+                ([Some(x), Some(y), Some(z), Some(w)], Some(bailout)) => {
+                    julia_radius([x, y, z, w]).min(bailout)
+                }
+                _ => julia_radius([8.0, 0.0, 0.0, 0.0]),
+            };
+            Bound::sphere(origin, JULIA_FAR_FIELD * edge).with_slope(JULIA_FAR_FIELD_SLOPE)
+        }
+        Kind::Translate { offset, child } => {
+            let b = of(child)?;
+            Bound {
+                centre: b.centre + baked3(*offset)?,
+                ..b
+            }
+        }
+        Kind::Rotate { axis, angle, child } => {
+            let b = of(child)?;
+            match angle {
+                // The child sees `R(−angle) p`: its centre is at
+                // `R(angle) centre`.
+                Scalar::Baked(a) => {
+                    let rows = rotation_rows(*axis, *a).map(DVec3::from);
+                    let c = b.centre;
+                    Bound {
+                        centre: DVec3::new(rows[0].dot(c), rows[1].dot(c), rows[2].dot(c)),
+                        ..b
+                    }
+                }
+                // Every angle: a sphere around the origin.
+                Scalar::Dynamic(_) => Bound {
+                    centre: origin,
+                    radius: b.radius + b.centre.length(),
+                    ..b
+                },
+            }
+        }
+        Kind::Scale { factor, child } => {
+            let b = of(child)?;
+            let f = baked(*factor)?;
+            Bound {
+                centre: b.centre * f,
+                radius: b.radius * f,
+                ..b
+            }
+        }
+        // The child sees `p` with one coordinate made positive: a sphere
+        // around the child's and its mirror image.
+        Kind::Mirror { axis, child } => {
+            let b = of(child)?;
+            let i = axis.index();
+            let mut centre = b.centre;
+            centre[i] = 0.0;
+            Bound {
+                centre,
+                radius: b.radius + b.centre[i].abs(),
+                ..b
+            }
+        }
+        // The child sees `p` moved by at most `|extents|`.
+        Kind::Elongate { extents, child } => {
+            let b = of(child)?;
+            Bound {
+                radius: b.radius + baked3(*extents)?.length(),
+                ..b
+            }
+        }
+        // Every cell within the limits: the child sees `p` moved by at most
+        // `|period · limit|`.
+        Kind::RepeatLimited {
+            period,
+            limit,
+            child,
+        } => {
+            let b = of(child)?;
+            let period = baked3(*period)?;
+            let reach = (period * DVec3::new(limit[0].into(), limit[1].into(), limit[2].into()))
+                .abs()
+                .length();
+            Bound {
+                centre: origin,
+                radius: b.radius + b.centre.length() + reach,
+                ..b
+            }
+        }
+        Kind::Round { radius, child } => of(child)?.grow(baked(*radius)?),
+        // Where the bound is positive the child's estimate is above the
+        // thickness, so its absolute value is itself.
+        Kind::Onion { thickness, child } => of(child)?.grow(baked(*thickness)?),
+        Kind::Color { child, .. } => of(child)?,
+        Kind::Csg {
+            op,
+            smoothing,
+            a,
+            b,
+        } => {
+            let k = match smoothing {
+                None => 0.0,
+                Some(k) => baked(*k)?,
+            };
+            match op {
+                // The smooth minimum is at most `k / 4` below the minimum.
+                CsgOp::Union => of(a)?.around(of(b)?).grow(0.25 * k),
+                // Both are at least the first operand's estimate (the smooth
+                // forms too: `−smooth_min(−a, b) >= −min(−a, b)`).
+                CsgOp::Subtract => of(a)?,
+                CsgOp::Intersect => match (of(a), of(b)) {
+                    (Some(x), Some(y)) => {
+                        if x.radius <= y.radius {
+                            x
+                        } else {
+                            y
+                        }
+                    }
+                    (x, y) => x.or(y)?,
+                },
+            }
+        }
+        Kind::Plane { .. }
+        | Kind::Repeat { .. }
+        | Kind::Twist { .. }
+        | Kind::Bend { .. }
+        | Kind::Custom { .. } => return None,
+    })
+}
+
+/// A tree of hard unions, flattened: its operands in the order pruning
+/// evaluates them, and its union nodes (which name the partial results).
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) struct UnionChain {
+    /// The operands without a bound first (a plane's distance is a good
+    /// threshold to test the others against, and it has no bound to test),
+    /// then the bounded ones; each group in the tree's order, left to
+    /// right.
+    pub(crate) operands: Vec<NodeId>,
+    /// The tree's union nodes, root first.
+    pub(crate) unions: Vec<NodeId>,
+}
+
+/// The chain of the tree of hard unions rooted at `id`, if `id` is a hard
+/// union. The minimum of the operands in any order is the tree's value
+/// exactly (a hard minimum is associative and commutative); only the colour
+/// on an exact tie between two operands, which goes to the later one, can
+/// differ from the tree's.
+pub(crate) fn union_chain(ir: &Ir, id: NodeId, bounds: &[Option<Bound>]) -> Option<UnionChain> {
+    if !is_hard_union(ir.node(id)) {
+        return None;
+    }
+    let (mut operands, mut unions) = (Vec::new(), Vec::new());
+    let mut stack = vec![id];
+    while let Some(at) = stack.pop() {
+        match ir.node(at) {
+            Kind::Csg { a, b, .. } if is_hard_union(ir.node(at)) => {
+                unions.push(at);
+                stack.push(*b);
+                stack.push(*a);
+            }
+            _ => operands.push(at),
+        }
+    }
+    let (unbounded, bounded): (Vec<NodeId>, Vec<NodeId>) = operands
+        .into_iter()
+        .partition(|o| bounds[o.index()].is_none());
+    Some(UnionChain {
+        operands: unbounded.into_iter().chain(bounded).collect(),
+        unions,
+    })
+}
+
+fn is_hard_union(node: &IrNode) -> bool {
+    matches!(
+        node,
+        Kind::Csg {
+            op: CsgOp::Union,
+            smoothing: None,
+            ..
+        }
+    )
+}
