@@ -59,6 +59,9 @@ typedef struct {
     real half_h;
     real footprint_base;
     real footprint_per_unit;
+    real image_w;     // the image's size in pixels
+    real image_h;
+    real pixel_scale; // image pixels per rendered pixel along each axis
     int orthographic;
 } MarchCamera;
 
@@ -73,6 +76,9 @@ MarchCamera march_load_camera(__global const real* c) {
     cam.forward = vload3(0, c + CAMERA_FORWARD);
     cam.footprint_base = c[CAMERA_FOOTPRINT_BASE];
     cam.footprint_per_unit = c[CAMERA_FOOTPRINT_PER_UNIT];
+    cam.image_w = c[CAMERA_IMAGE_WIDTH];
+    cam.image_h = c[CAMERA_IMAGE_HEIGHT];
+    cam.pixel_scale = c[CAMERA_PIXEL_SCALE];
     return cam;
 }
 
@@ -81,12 +87,11 @@ real march_footprint(const MarchCamera* cam, real t) {
     return cam->footprint_base + cam->footprint_per_unit * t;
 }
 
-// The ray through image position (px, py) in pixels, (0, 0) being the top
-// left corner of the image.
-void march_camera_ray(const MarchCamera* cam, real px, real py, int width, int height,
-                      real3* ro, real3* rd) {
-    real u = (R(2.0) * px / (real)width - R(1.0)) * cam->half_w;
-    real v = (R(1.0) - R(2.0) * py / (real)height) * cam->half_h;
+// The ray through image position (px, py) in image pixels, (0, 0) being
+// the top left corner of the image.
+void march_camera_ray(const MarchCamera* cam, real px, real py, real3* ro, real3* rd) {
+    real u = (R(2.0) * px / cam->image_w - R(1.0)) * cam->half_w;
+    real v = (R(1.0) - R(2.0) * py / cam->image_h) * cam->half_h;
     if (cam->orthographic) {
         *ro = cam->origin + cam->right * u + cam->up * v;
         *rd = cam->forward;
@@ -368,8 +373,8 @@ real3 march_trap_tint(real trap) {
 }
 
 // Background at image row py: SKY_BOTTOM at the bottom, SKY_TOP at the top.
-real3 march_background(real py, int height) {
-    real v = clamp(R(1.0) - py / (real)height, R(0.0), R(1.0));
+real3 march_background(const MarchCamera* cam, real py) {
+    real v = clamp(R(1.0) - py / cam->image_h, R(0.0), R(1.0));
     return mix(SKY_BOTTOM, SKY_TOP, v);
 }
 
@@ -482,16 +487,17 @@ __kernel void render_tile(RENDER_TILE_ARGS) {
             jy = ((real)(s / SUPERSAMPLING) + march_jitter(pixel, (uint)s, 1u))
                  / (real)SUPERSAMPLING;
         }
-        real px = (real)x + jx;
-        real py = (real)y + jy;
+        // Rendered pixel (x, y) covers pixel_scale image pixels each way.
+        real px = ((real)x + jx) * cam.pixel_scale;
+        real py = ((real)y + jy) * cam.pixel_scale;
         real3 ro;
         real3 rd;
-        march_camera_ray(&cam, px, py, width, height, &ro, &rd);
+        march_camera_ray(&cam, px, py, &ro, &rd);
         MarchResult m = march_ray(ro, rd, &cam, params);
         total_steps += (uint)m.steps;
         total_evals += (uint)m.steps;
 
-        real3 background = march_background(py, height);
+        real3 background = march_background(&cam, py);
         real3 color = background;
         real3 n = (real3)(R(0.0));
         if (m.hit) {
@@ -499,7 +505,7 @@ __kernel void render_tile(RENDER_TILE_ARGS) {
             real footprint = march_footprint(&cam, m.t);
             n = march_normal(p, NORMAL_EPSILON * footprint, rd, params);
             total_evals += MARCH_NORMAL_EVALUATIONS;
-            real view_height = footprint * (real)height;
+            real view_height = footprint * cam.image_h;
             if (m.t <= R(0.0)) {
                 // The ray starts inside the surface (a camera within a
                 // solid): shade the nearest point of the surface instead.
@@ -535,7 +541,8 @@ __kernel void render_tile(RENDER_TILE_ARGS) {
             // The colour samples are jittered: trace the pixel centre.
             real3 ro;
             real3 rd;
-            march_camera_ray(&cam, (real)x + R(0.5), (real)y + R(0.5), width, height, &ro, &rd);
+            march_camera_ray(&cam, ((real)x + R(0.5)) * cam.pixel_scale,
+                             ((real)y + R(0.5)) * cam.pixel_scale, &ro, &rd);
             centre = march_ray(ro, rd, &cam, params);
             centre_normal = (real3)(R(0.0));
             if (centre.hit) {

@@ -911,6 +911,10 @@ struct QualityRepr {
     over_relaxation: Option<f64>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     supersampling: Option<u32>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    fast_math: Option<bool>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    resolution_scale: Option<u32>,
 }
 
 impl QualityRepr {
@@ -940,6 +944,9 @@ impl QualityRepr {
                     .map(|()| quality.over_relaxation),
                 supersampling: differs(p.supersampling == quality.supersampling)
                     .map(|()| quality.supersampling),
+                fast_math: differs(p.fast_math == quality.fast_math).map(|()| quality.fast_math),
+                resolution_scale: differs(p.resolution_scale == quality.resolution_scale)
+                    .map(|()| quality.resolution_scale),
             }
         };
         Preset::ALL
@@ -963,6 +970,8 @@ impl QualityRepr {
             self.precision.is_some(),
             self.over_relaxation.is_some(),
             self.supersampling.is_some(),
+            self.fast_math.is_some(),
+            self.resolution_scale.is_some(),
         ]
         .into_iter()
         .filter(|&b| b)
@@ -983,6 +992,8 @@ impl QualityRepr {
             precision: self.precision.unwrap_or(p.precision),
             over_relaxation: self.over_relaxation.unwrap_or(p.over_relaxation),
             supersampling: self.supersampling.unwrap_or(p.supersampling),
+            fast_math: self.fast_math.unwrap_or(p.fast_math),
+            resolution_scale: self.resolution_scale.unwrap_or(p.resolution_scale),
         }
     }
 }

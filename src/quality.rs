@@ -150,6 +150,20 @@ pub struct Quality {
     /// Samples per pixel along each axis (N×N jittered samples; 1: one
     /// sample at the pixel centre).
     pub supersampling: u32,
+    /// Lets the OpenCL compiler trade exactness for speed
+    /// (`-cl-fast-relaxed-math` and `-cl-mad-enable`, and contracted
+    /// multiply-adds): faster on some devices, with results that differ
+    /// from the CPU reference by more than rounding. Off in every preset
+    /// but `draft`; its cost and error are measured in `examples/tradeoff`.
+    pub fast_math: bool,
+    /// Renders one pixel for every `resolution_scale` × `resolution_scale`
+    /// pixels of the image, and scales the result up to the image's size,
+    /// blending neighbours only where their depths say they show the same
+    /// surface (1: every pixel rendered). The surface is the full-size
+    /// image's (thresholds stay in the image's pixels); the image is
+    /// softer. The renderer's [`Frame`](crate::render::Frame) outputs
+    /// come from the nearest rendered pixel.
+    pub resolution_scale: u32,
 }
 
 impl Quality {
@@ -175,6 +189,8 @@ impl Quality {
             precision: Precision::F32,
             over_relaxation: 1.0,
             supersampling: 1,
+            fast_math: false,
+            resolution_scale: 1,
         }
     }
 
@@ -318,6 +334,12 @@ impl Quality {
             f64::from(self.supersampling),
             (1..=8).contains(&self.supersampling),
             "in 1..=8",
+        )?;
+        check(
+            "resolution_scale",
+            f64::from(self.resolution_scale),
+            (1..=8).contains(&self.resolution_scale),
+            "in 1..=8",
         )
     }
 }
@@ -426,6 +448,22 @@ impl Quality {
     #[must_use]
     pub fn supersampling(mut self, n: u32) -> Self {
         self.supersampling = n;
+        self
+    }
+
+    /// Renders one pixel in `k`×`k` and scales the image up (1 to 8; 1:
+    /// every pixel rendered). See [`Quality::resolution_scale`].
+    #[must_use]
+    pub fn resolution_scale(mut self, k: u32) -> Self {
+        self.resolution_scale = k;
+        self
+    }
+
+    /// Builds the program with relaxed, fast math. See
+    /// [`Quality::fast_math`].
+    #[must_use]
+    pub fn fast_math(mut self, on: bool) -> Self {
+        self.fast_math = on;
         self
     }
 }

@@ -37,14 +37,20 @@ fn rays_stop_past_the_scene_bound_with_the_same_hits() {
         let scene = gallery::by_name(name).unwrap();
         let glow = Effects::default().glow(Glow::new(dvec3(0.6, 0.75, 1.0), 0.6));
         for (effects, what) in [(Effects::default(), "no glow"), (glow, "glow")] {
-            let (bounded, source) = render(&scene, effects.clone());
+            let (bounded, source) = render(&scene, effects);
             assert!(source.contains("#define SCENE_BOUND_RADIUS"), "{name}");
             let (full, source) = render(&unbounded(&scene), effects);
             assert!(!source.contains("#define SCENE_BOUND_RADIUS"), "{name}");
-            gpu::save(&format!("bound_{name}_{}", what.replace(' ', "_")), &bounded.image);
+            gpu::save(
+                &format!("bound_{name}_{}", what.replace(' ', "_")),
+                &bounded.image,
+            );
             assert_eq!(bounded.hit, full.hit, "{name}, {what}: hit masks");
             for (i, (a, b)) in bounded.depth.iter().zip(&full.depth).enumerate() {
-                assert!(a.to_bits() == b.to_bits(), "{name}, {what}: depth at {i}: {a} vs {b}");
+                assert!(
+                    a.to_bits() == b.to_bits(),
+                    "{name}, {what}: depth at {i}: {a} vs {b}"
+                );
             }
             let (a, b) = (total_steps(&bounded), total_steps(&full));
             eprintln!("{name}, {what}: {a} steps with the bound, {b} without");
@@ -61,7 +67,10 @@ fn rays_stop_past_the_scene_bound_with_the_same_hits() {
                 .max()
                 .unwrap();
             let allowed = if what == "glow" { 1 } else { 0 };
-            assert!(worst <= allowed, "{name}, {what}: a channel differs by {worst}");
+            assert!(
+                worst <= allowed,
+                "{name}, {what}: a channel differs by {worst}"
+            );
         }
     }
 }

@@ -50,8 +50,16 @@ pub mod camera {
     pub const FOOTPRINT_BASE: Field = field("FOOTPRINT_BASE", 15, 1);
     /// The growth of the pixel footprint per unit along a ray.
     pub const FOOTPRINT_PER_UNIT: Field = field("FOOTPRINT_PER_UNIT", 16, 1);
+    /// The image's width in pixels (the size the camera maps; the kernel's
+    /// `width` is the size it renders, smaller by the resolution scale).
+    pub const IMAGE_WIDTH: Field = field("IMAGE_WIDTH", 17, 1);
+    /// The image's height in pixels.
+    pub const IMAGE_HEIGHT: Field = field("IMAGE_HEIGHT", 18, 1);
+    /// Image pixels per rendered pixel along each axis
+    /// ([`Quality::resolution_scale`](crate::quality::Quality::resolution_scale)).
+    pub const PIXEL_SCALE: Field = field("PIXEL_SCALE", 19, 1);
     /// Every field, in buffer order.
-    pub const FIELDS: [Field; 9] = [
+    pub const FIELDS: [Field; 12] = [
         ORIGIN,
         ORTHOGRAPHIC,
         RIGHT,
@@ -61,9 +69,12 @@ pub mod camera {
         FORWARD,
         FOOTPRINT_BASE,
         FOOTPRINT_PER_UNIT,
+        IMAGE_WIDTH,
+        IMAGE_HEIGHT,
+        PIXEL_SCALE,
     ];
     /// Reals in the buffer.
-    pub const LEN: usize = 17;
+    pub const LEN: usize = 20;
 }
 
 /// One light's entry in the light buffer (`lights` argument of

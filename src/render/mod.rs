@@ -62,6 +62,7 @@ mod memory;
 mod points;
 mod program;
 mod renderer;
+mod upscale;
 mod viewport;
 
 pub use aov::Frame;

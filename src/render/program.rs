@@ -101,13 +101,17 @@ pub(crate) fn context(selected: &Selected) -> Result<Context> {
     Ok(context)
 }
 
-/// Compiler options for a device: OpenCL C 1.2 where the device has it.
-pub(crate) fn build_options(info: &DeviceInfo) -> String {
+/// Compiler options for a device (OpenCL C 1.2 where the device has it)
+/// and a program (relaxed math where it asks for it).
+pub(crate) fn build_options(info: &DeviceInfo, fast_math: bool) -> String {
+    let mut options = Vec::new();
     if info.has_opencl_c_1_2() {
-        "-cl-std=CL1.2".into()
-    } else {
-        String::new()
+        options.push("-cl-std=CL1.2");
     }
+    if fast_math {
+        options.extend(["-cl-fast-relaxed-math", "-cl-mad-enable"]);
+    }
+    options.join(" ")
 }
 
 /// The program for `source` on the selected device, from the cache or
@@ -121,7 +125,7 @@ pub(crate) fn build(
     if source.precision == Precision::F64 {
         selected.info.require_fp64()?;
     }
-    let options = build_options(&selected.info);
+    let options = build_options(&selected.info, source.fast_math);
     let key = ProgramKey {
         device: device_key(selected),
         options: options.clone(),
@@ -296,6 +300,7 @@ mod tests {
             source,
             precision: Precision::F32,
             hash: 0,
+            fast_math: false,
             origin: DVec3::ZERO,
             kernel_start: 0,
             constants: Vec::new(),

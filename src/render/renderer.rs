@@ -15,6 +15,7 @@ use super::device::{self, DeviceInfo, DeviceSelector, Selected, opencl};
 use super::dispatch::{self, DEFAULT_TILE_SIZE, MAX_IMAGE_SIDE};
 use super::memory::{available_host_memory, check_host_memory, frame_host_bytes};
 use super::program::{self, BuildInfo};
+use super::upscale;
 use super::viewport::{Viewport, check_frame_inputs, pack_lights};
 use crate::codegen::interface::{RENDER_TILE, RenderArg, camera};
 use crate::codegen::{self, KernelSource};
@@ -325,44 +326,50 @@ impl Renderer {
                 .map(|(i, p)| s.spawn(move || p.render_share(width, height, (i + 1, n))))
                 .collect();
             let mine = self.render_share(width, height, (0, n));
-            let theirs: Vec<Result<RgbaImage>> = handles
+            let theirs: Vec<Result<Rendered>> = handles
                 .into_iter()
                 .map(|h| h.join().expect("a device's thread does not panic"))
                 .collect();
             (mine, theirs)
         });
         self.partners = partners;
-        let mut image = mine?;
+        let mut low = mine?;
         let theirs = theirs.into_iter().collect::<Result<Vec<_>>>()?;
-        let row = |y: u32, x: u32, w: u32| {
-            let start = ((y * width + x) * 4) as usize;
-            start..start + (w * 4) as usize
+        let (lw, lh) = low.image.dimensions();
+        let span = |y: u32, x: u32, w: u32| {
+            let start = (y * lw + x) as usize;
+            start..start + w as usize
         };
-        for (i, tile) in dispatch::tiles(width, height, self.options.tile_size).enumerate() {
+        for (i, tile) in dispatch::tiles(lw, lh, self.options.tile_size).enumerate() {
             let Some(from) = (i % n).checked_sub(1).map(|p| &theirs[p]) else {
                 continue;
             };
             for y in tile.y..tile.y + tile.height {
-                let span = row(y, tile.x, tile.width);
-                let (dst, src): (&mut [u8], &[u8]) = (&mut image, from);
-                dst[span.clone()].copy_from_slice(&src[span]);
+                let pixels = span(y, tile.x, tile.width);
+                let bytes = 4 * pixels.start..4 * pixels.end;
+                let (dst, src): (&mut [u8], &[u8]) = (&mut low.image, &from.image);
+                dst[bytes.clone()].copy_from_slice(&src[bytes]);
+                if let (Some(dst), Some(src)) = (&mut low.depth, &from.depth) {
+                    dst[pixels.clone()].copy_from_slice(&src[pixels]);
+                }
             }
         }
-        Ok(image)
+        Ok(low.scaled(width, height, self.scale()))
     }
 
     /// Renders this renderer's `share` of the tiles (the rest of the image
-    /// is left as it was).
-    fn render_share(
-        &mut self,
-        width: u32,
-        height: u32,
-        share: (usize, usize),
-    ) -> Result<RgbaImage> {
+    /// is left as it was), at the rendered resolution.
+    fn render_share(&mut self, width: u32, height: u32, share: (usize, usize)) -> Result<Rendered> {
         self.share = share;
-        let image = self.render_alone(width, height);
+        let image = self.render_low(width, height);
         self.share = (0, 1);
         image
+    }
+
+    /// Image pixels per rendered pixel along each axis
+    /// ([`Quality::resolution_scale`]).
+    fn scale(&self) -> u32 {
+        self.options.quality.resolution_scale.max(1)
     }
 
     /// Renders a `width` × `height` image.
@@ -385,15 +392,47 @@ impl Renderer {
         }
     }
 
-    /// Renders this renderer's share of the tiles on its own device.
+    /// Renders the image on this renderer's own device.
     fn render_alone(&mut self, width: u32, height: u32) -> Result<RgbaImage> {
         let start = Instant::now();
-        let kernel = self.run(width, height, false)?;
+        let low = self.render_low(width, height)?;
+        let image = low.scaled(width, height, self.scale());
+        if let Some(t) = &mut self.timing {
+            t.total = start.elapsed();
+        }
+        Ok(image)
+    }
+
+    /// Renders this renderer's share of the tiles on its own device, at the
+    /// rendered resolution (with depth, to scale it up by, when that is
+    /// smaller than the image's).
+    fn render_low(&mut self, width: u32, height: u32) -> Result<Rendered> {
+        let start = Instant::now();
+        let scaled = self.scale() > 1;
+        let kernel = self.run(width, height, scaled)?;
         let read = Instant::now();
-        let mut rgba = host_vec::<u8>(width, height, 4)?;
+        let (lw, lh) = self.rendered_size(width, height);
+        let mut rgba = host_vec::<u8>(lw, lh, 4)?;
         self.targets.rgba.read(&mut rgba).enq().map_err(opencl)?;
+        let depth = if scaled {
+            let mut depth = host_vec::<f32>(lw, lh, 1)?;
+            self.targets.depth.read(&mut depth).enq().map_err(opencl)?;
+            Some(depth)
+        } else {
+            None
+        };
         self.record_timing(start, read, kernel);
-        Ok(RgbaImage::from_raw(width, height, rgba).expect("buffer has width * height * 4 bytes"))
+        Ok(Rendered {
+            image: RgbaImage::from_raw(lw, lh, rgba).expect("buffer has width * height * 4 bytes"),
+            depth,
+        })
+    }
+
+    /// The size the kernel renders for a `width` × `height` image: smaller
+    /// by [`Quality::resolution_scale`], rounded up.
+    fn rendered_size(&self, width: u32, height: u32) -> (u32, u32) {
+        let k = self.scale();
+        (width.div_ceil(k), height.div_ceil(k))
     }
 
     /// Renders a `width` × `height` image with depth, hit mask, normal and
@@ -405,6 +444,8 @@ impl Renderer {
         let start = Instant::now();
         let kernel = self.run(width, height, true)?;
         let read = Instant::now();
+        let (image_w, image_h, scale) = (width, height, self.scale());
+        let (width, height) = self.rendered_size(width, height);
         let t = &self.targets;
         let mut rgba = host_vec::<u8>(width, height, 4)?;
         let mut depth = host_vec::<f32>(width, height, 1)?;
@@ -418,8 +459,7 @@ impl Renderer {
         t.normals.read(&mut normals).enq().map_err(opencl)?;
         t.steps.read(&mut steps).enq().map_err(opencl)?;
         t.evaluations.read(&mut evaluations).enq().map_err(opencl)?;
-        self.record_timing(start, read, kernel);
-        Ok(Frame {
+        let frame = Frame {
             image: RgbaImage::from_raw(width, height, rgba)
                 .expect("buffer has width * height * 4 bytes"),
             depth,
@@ -430,7 +470,14 @@ impl Renderer {
                 .collect(),
             steps,
             evaluations,
-        })
+        };
+        let frame = if scale > 1 {
+            upscale::frame(&frame, image_w, image_h, scale)
+        } else {
+            frame
+        };
+        self.record_timing(start, read, kernel);
+        Ok(frame)
     }
 
     /// What the last frame cost: kernel time (from OpenCL profiling
@@ -657,6 +704,10 @@ impl Renderer {
         self.timing = None;
         check_size(width, height)?;
         let view = self.viewport(width, height)?;
+        // The kernel renders `width` × `height` pixels, each covering
+        // `scale` × `scale` pixels of the image `view` maps.
+        let scale = self.scale();
+        let (width, height) = self.rendered_size(width, height);
         let info = &self.selected.info;
         if self.targets.fits(width, height, aovs) {
             let host = frame_host_bytes(info, width, height, aovs, None);
@@ -680,7 +731,7 @@ impl Renderer {
         self.inputs.upload(
             &self.queue,
             &self.kernel,
-            &view,
+            &view.pack(self.source.origin, scale),
             &self.values,
             self.scene.lights(),
             self.source.origin,
@@ -970,14 +1021,14 @@ impl Inputs {
         &mut self,
         queue: &Queue,
         kernel: &Kernel,
-        view: &Viewport,
+        camera: &[f64; camera::LEN],
         values: &ParamValues,
         lights: &[Light],
         origin: DVec3,
     ) -> Result<()> {
         // The dynamic values only: the constants after them stay.
         self.params.write(values.as_slice())?;
-        self.camera.write(&view.pack(origin))?;
+        self.camera.write(camera)?;
         let packed = pack_lights(lights, origin);
         if packed.len() == self.lights.len() {
             self.lights.write(&packed)?;
@@ -1063,6 +1114,24 @@ fn output<T: ocl::OclPrm>(queue: &Queue, len: usize) -> Result<Buffer<T>> {
         .len(len.max(1))
         .build()
         .map_err(opencl)
+}
+
+/// A frame at the rendered resolution: its colours, and its depth where it
+/// is to be scaled up.
+struct Rendered {
+    image: RgbaImage,
+    depth: Option<Vec<f32>>,
+}
+
+impl Rendered {
+    /// The image at `width` × `height`, scaled up by `scale` (see
+    /// `upscale`).
+    fn scaled(self, width: u32, height: u32, scale: u32) -> RgbaImage {
+        match self.depth {
+            Some(depth) if scale > 1 => upscale::image(&self.image, &depth, width, height, scale),
+            _ => self.image,
+        }
+    }
 }
 
 #[cfg(test)]

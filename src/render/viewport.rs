@@ -188,7 +188,10 @@ impl Viewport {
     /// moved into a frame whose origin is the scene point `origin`. The
     /// subtraction happens here in `f64`, so a camera near a distant origin
     /// reaches an `F32` kernel with small, exact coordinates.
-    pub(crate) fn pack(&self, origin: DVec3) -> [f64; camera::LEN] {
+    ///
+    /// The kernel renders one pixel for every `scale` × `scale` pixels of
+    /// the image ([`Quality::resolution_scale`](crate::quality::Quality::resolution_scale)).
+    pub(crate) fn pack(&self, origin: DVec3, scale: u32) -> [f64; camera::LEN] {
         let mut c = [0.0; camera::LEN];
         put(&mut c, camera::ORIGIN, &(self.origin - origin).to_array());
         put(
@@ -207,6 +210,9 @@ impl Viewport {
             camera::FOOTPRINT_PER_UNIT,
             &[self.footprint_per_unit],
         );
+        put(&mut c, camera::IMAGE_WIDTH, &[f64::from(self.width)]);
+        put(&mut c, camera::IMAGE_HEIGHT, &[f64::from(self.height)]);
+        put(&mut c, camera::PIXEL_SCALE, &[f64::from(scale)]);
         c
     }
 }
@@ -240,7 +246,7 @@ pub(crate) fn check_frame_inputs(
         }
         Ok(())
     };
-    let c = view.pack(origin);
+    let c = view.pack(origin, 1);
     let at = |f: Field| &c[f.offset..f.offset + f.len];
     let (extent, footprint) = if view.orthographic {
         ("orthographic height", "orthographic height per pixel")
@@ -367,7 +373,7 @@ mod tests {
         assert_eq!(a.direction, b.direction);
         assert!(((a.origin - b.origin).length() - 4.0 * 2f64.sqrt()).abs() < 1e-9);
         assert!((view.footprint(123.0) - 0.1).abs() < 1e-15);
-        assert_eq!(view.pack(DVec3::ZERO)[camera::ORTHOGRAPHIC.offset], 1.0);
+        assert_eq!(view.pack(DVec3::ZERO, 1)[camera::ORTHOGRAPHIC.offset], 1.0);
     }
 
     #[test]
