@@ -14,7 +14,9 @@
 //           its constants defined by the header only when it is on, and so
 //           does the stop at the scene's bounding sphere
 //           (ENABLE_SCENE_BOUND: SCENE_BOUND_CENTRE, SCENE_BOUND_RADIUS,
-//           SCENE_BOUND_SLOPE). Code generation resolves these blocks
+//           SCENE_BOUND_SLOPE), and the coarse pass (ENABLE_CONE:
+//           CONE_TILE, the cone_starts kernel and the starts it leaves).
+//           Code generation resolves these blocks
 //           itself and leaves out every one that is off, so they are the
 //           only preprocessor conditionals allowed in this file.
 //
@@ -163,6 +165,22 @@ real march_refine(real3 ro, real3 rd, const MarchCamera* cam, real t0, real g0, 
 // 2014); when the unbounding spheres of two consecutive points stop
 // overlapping the long step may have jumped over a surface, so the march
 // returns to the last safe point and continues with plain steps.
+// The glow of a pixel is set by the smallest d / (t + d) along its ray.
+// Space the march may skip without changing the glow by more than half a
+// step of an 8-bit pixel must keep every d / (t + d) above the angle L
+// where the glow falls below that (its strength times exp(-falloff * L)
+// times its brightest channel = 0.5 / 255), that is d >= k t with
+// k = L / (1 - L). Returns k: 0 without glow, and INFINITY where no angle
+// is small enough.
+real march_glow_slope(void) {
+#ifdef ENABLE_GLOW
+    real brightest = fmax(GLOW_COLOR.x, fmax(GLOW_COLOR.y, GLOW_COLOR.z)) * GLOW_STRENGTH;
+    real angle = log(fmax(R(510.0) * brightest, R(1.0))) / MARCH_GLOW_FALLOFF;
+    return angle < R(1.0) ? angle / (R(1.0) - angle) : (real)INFINITY;
+#endif
+    return R(0.0);
+}
+
 #ifdef ENABLE_SCENE_BOUND
 // How far along the ray a hit can lie at most, for a scene that lies in a
 // sphere (SCENE_BOUND_CENTRE, SCENE_BOUND_RADIUS) outside which its
@@ -191,50 +209,40 @@ real march_bound_exit(real3 ro, real3 rd, const MarchCamera* cam) {
 
 // Whether a ray past the scene's bounding sphere at p, t along it in
 // direction rd, may stop without changing its pixel: always, unless the
-// pixel has a halo of near misses (see below).
+// pixel has a halo of near misses (see march_glow_slope). Further on, u
+// along the ray, the estimate is at least G = slope (sqrt(|q|^2 + u^2) - R)
+// with q = p - c (once the ray moves away from c). For any unit (a, b),
+// sqrt(|q|^2 + u^2) >= a |q| + b u; with b = k / slope the u terms match
+// k (t + u), so slope (a |q| - R) >= k t suffices for every u.
 int march_glow_settled(real3 p, real3 rd, real t) {
-#ifdef ENABLE_GLOW
-    // The rest of the ray must keep every d / (t + d) above the angle L
-    // where the glow falls below half a step of an 8-bit pixel
-    // (GLOW_STRENGTH * exp(-falloff * L) times the brightest channel =
-    // 0.5 / 255). Further on, u along the ray, the estimate is at least
-    // G = slope (sqrt(|q|^2 + u^2) - R) with q = p - c (once the ray moves
-    // away from c), and d / (t + d) >= L wherever d >= k (t + u), with
-    // k = L / (1 - L). For any unit (a, b), sqrt(|q|^2 + u^2) >= a |q| + b u;
-    // with b = k / slope the u terms match, so slope (a |q| - R) >= k t
-    // suffices for every u.
+    real k = march_glow_slope();
+    if (k <= R(0.0)) {
+        return 1;
+    }
     real3 q = p - SCENE_BOUND_CENTRE;
     if (dot(q, rd) < R(0.0)) {
         return 0; // still approaching the sphere, which it misses
     }
-    real brightest = fmax(GLOW_COLOR.x, fmax(GLOW_COLOR.y, GLOW_COLOR.z)) * GLOW_STRENGTH;
-    real angle = log(fmax(R(510.0) * brightest, R(1.0))) / MARCH_GLOW_FALLOFF;
-    if (angle >= R(1.0)) {
-        return 0;
-    }
-    real k = angle / (R(1.0) - angle);
     real b = k / SCENE_BOUND_SLOPE;
     if (b >= R(1.0)) {
         return 0;
     }
     real a = sqrt(R(1.0) - b * b);
     return SCENE_BOUND_SLOPE * (a * length(q) - SCENE_BOUND_RADIUS) >= k * t;
-#endif
-    return 1;
 }
 #endif
 
-MarchResult march_ray(real3 ro, real3 rd, const MarchCamera* cam,
+MarchResult march_ray(real3 ro, real3 rd, real start, const MarchCamera* cam,
                       __global const real* params) {
     MarchResult r;
-    r.t = R(0.0);
+    r.t = start;
     r.closest = R(1.0);
     r.steps = 0;
     r.hit = 0;
     const real lipschitz = R(1.0) + DETAIL * cam->footprint_per_unit;
     real omega = OVER_RELAXATION;
     int relaxed = 0; // whether the last step was longer than a plain one
-    real prev_t = R(0.0);
+    real prev_t = start;
     real prev_g = R(0.0);
 #ifdef ENABLE_SCENE_BOUND
     // A ray that has passed the last place it could hit stops (after a
@@ -471,6 +479,12 @@ __kernel void render_tile(RENDER_TILE_ARGS) {
         return;
     }
     MarchCamera cam = march_load_camera(camera);
+    // Where the pixel's rays start: past the empty space the coarse pass
+    // found in front of its tile.
+    real start = R(0.0);
+#ifdef ENABLE_CONE
+    start = starts[(y / CONE_TILE) * ((width + CONE_TILE - 1) / CONE_TILE) + x / CONE_TILE];
+#endif
 
     real3 sum = (real3)(R(0.0));
     uint total_steps = 0;
@@ -493,7 +507,7 @@ __kernel void render_tile(RENDER_TILE_ARGS) {
         real3 ro;
         real3 rd;
         march_camera_ray(&cam, px, py, &ro, &rd);
-        MarchResult m = march_ray(ro, rd, &cam, params);
+        MarchResult m = march_ray(ro, rd, start, &cam, params);
         total_steps += (uint)m.steps;
         total_evals += (uint)m.steps;
 
@@ -543,7 +557,7 @@ __kernel void render_tile(RENDER_TILE_ARGS) {
             real3 rd;
             march_camera_ray(&cam, ((real)x + R(0.5)) * cam.pixel_scale,
                              ((real)y + R(0.5)) * cam.pixel_scale, &ro, &rd);
-            centre = march_ray(ro, rd, &cam, params);
+            centre = march_ray(ro, rd, start, &cam, params);
             centre_normal = (real3)(R(0.0));
             if (centre.hit) {
                 real h = NORMAL_EPSILON * march_footprint(&cam, centre.t);
@@ -557,3 +571,71 @@ __kernel void render_tile(RENDER_TILE_ARGS) {
         evaluations[idx] = total_evals;
     }
 }
+
+#ifdef ENABLE_CONE
+#define CONE_STEPS 64 // most evaluations of a tile's cone
+
+// The coarse pass: for each tile of CONE_TILE x CONE_TILE rendered pixels,
+// how far every ray of the tile can travel before it could reach the
+// drawn surface. A cone around the ray through the tile's centre holds
+// every ray through the tile: radius rho0 + tau tan(theta) at tau along its
+// axis (rho0 for orthographic cameras, whose rays are parallel; the angle
+// for perspective ones, whose rays share an origin). It is sphere-traced
+// like a ray, stepping from tau only as far as the ball of radius d (the
+// estimate at the axis, less the surface's offset and the glow's margin)
+// still holds the cone's slice: a point of the cone at tau' is within
+// (tau' - tau) + rho0 + tau' tan(theta) of the axis point, so
+// tau' = (d + tau - rho0) / (1 + tan(theta) + k sec(theta)), where k keeps
+// the glow (march_glow_slope) and sec(theta) bounds a ray's length over
+// its axial distance. A ray of the tile is in the cone up to the distance
+// the cone reached, so it starts there.
+__kernel void cone_starts(CONE_STARTS_ARGS) {
+    int cx = (int)get_global_id(0);
+    int cy = (int)get_global_id(1);
+    int columns = (width + CONE_TILE - 1) / CONE_TILE;
+    int rows = (height + CONE_TILE - 1) / CONE_TILE;
+    if (cx >= columns || cy >= rows) {
+        return;
+    }
+    MarchCamera cam = march_load_camera(camera);
+    real x0 = (real)(cx * CONE_TILE) * cam.pixel_scale;
+    real y0 = (real)(cy * CONE_TILE) * cam.pixel_scale;
+    real x1 = (real)min((cx + 1) * CONE_TILE, width) * cam.pixel_scale;
+    real y1 = (real)min((cy + 1) * CONE_TILE, height) * cam.pixel_scale;
+    real3 ro;
+    real3 rd;
+    march_camera_ray(&cam, R(0.5) * (x0 + x1), R(0.5) * (y0 + y1), &ro, &rd);
+    real rho0 = R(0.0);
+    real cos_theta = R(1.0);
+    for (int i = 0; i < 4; ++i) {
+        real3 o;
+        real3 d;
+        march_camera_ray(&cam, (i & 1) ? x1 : x0, (i & 2) ? y1 : y0, &o, &d);
+        rho0 = fmax(rho0, length(o - ro));
+        cos_theta = fmin(cos_theta, dot(d, rd));
+    }
+    // A margin for the rounding of the corner rays.
+    rho0 *= R(1.01);
+    cos_theta = clamp(cos_theta - R(1e-6), R(0.1), R(1.0));
+    real sec_theta = R(1.0) / cos_theta;
+    real tan_theta = sqrt(R(1.0) - cos_theta * cos_theta) * sec_theta;
+    real widen = R(1.0) + tan_theta + march_glow_slope() * sec_theta;
+    real t = R(0.0);
+    for (int i = 0; i < CONE_STEPS; ++i) {
+        real d = DE(ro + rd * t, params);
+        // The surface lies DETAIL footprints out, measured along a ray at
+        // most (t + d) sec(theta) long here (twice that, for margin).
+        real reach = d - DETAIL * march_footprint(&cam, R(2.0) * (t + fabs(d)) * sec_theta);
+        real next = (reach + t - rho0) / widen;
+        if (!(next > t)) {
+            break;
+        }
+        t = next;
+        if (t > MAX_DISTANCE) {
+            break;
+        }
+    }
+    // Rounded down when stored, so no ray starts beyond it.
+    starts[cy * columns + cx] = (float)(t * R(0.999));
+}
+#endif

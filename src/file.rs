@@ -915,6 +915,8 @@ struct QualityRepr {
     fast_math: Option<bool>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     resolution_scale: Option<u32>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    cone_tile: Option<u32>,
 }
 
 impl QualityRepr {
@@ -947,6 +949,7 @@ impl QualityRepr {
                 fast_math: differs(p.fast_math == quality.fast_math).map(|()| quality.fast_math),
                 resolution_scale: differs(p.resolution_scale == quality.resolution_scale)
                     .map(|()| quality.resolution_scale),
+                cone_tile: differs(p.cone_tile == quality.cone_tile).map(|()| quality.cone_tile),
             }
         };
         Preset::ALL
@@ -972,6 +975,7 @@ impl QualityRepr {
             self.supersampling.is_some(),
             self.fast_math.is_some(),
             self.resolution_scale.is_some(),
+            self.cone_tile.is_some(),
         ]
         .into_iter()
         .filter(|&b| b)
@@ -994,6 +998,7 @@ impl QualityRepr {
             supersampling: self.supersampling.unwrap_or(p.supersampling),
             fast_math: self.fast_math.unwrap_or(p.fast_math),
             resolution_scale: self.resolution_scale.unwrap_or(p.resolution_scale),
+            cone_tile: self.cone_tile.unwrap_or(p.cone_tile),
         }
     }
 }

@@ -122,11 +122,12 @@ pub enum RenderArg {
     Normals,
     Steps,
     Evaluations,
+    Starts,
 }
 
 /// `render_tile`'s declarations, in argument order: the one list of its
 /// arguments.
-pub const RENDER_TILE: [(RenderArg, &str); 17] = [
+pub const RENDER_TILE: [(RenderArg, &str); 18] = [
     (RenderArg::Params, "__global const real* params"),
     (RenderArg::Camera, "__global const real* camera"),
     (RenderArg::Lights, "__global const real* lights"),
@@ -144,7 +145,41 @@ pub const RENDER_TILE: [(RenderArg, &str); 17] = [
     (RenderArg::Normals, "__global float* normals"),
     (RenderArg::Steps, "__global uint* steps"),
     (RenderArg::Evaluations, "__global uint* evaluations"),
+    (RenderArg::Starts, "__global const float* starts"),
 ];
+
+/// The arguments of the coarse pass `cone_starts` (see
+/// [`Quality::cone_tile`](crate::quality::Quality::cone_tile)), in order.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[allow(missing_docs)] // Each is described by its declaration in `CONE_STARTS`.
+pub enum ConeArg {
+    Params,
+    Camera,
+    Width,
+    Height,
+    Starts,
+}
+
+/// `cone_starts`' declarations, in argument order.
+pub const CONE_STARTS: [(ConeArg, &str); 5] = [
+    (ConeArg::Params, "__global const real* params"),
+    (ConeArg::Camera, "__global const real* camera"),
+    (ConeArg::Width, "const int width"),
+    (ConeArg::Height, "const int height"),
+    (ConeArg::Starts, "__global float* starts"),
+];
+
+impl ConeArg {
+    /// The argument's position in `cone_starts`.
+    #[must_use]
+    pub fn index(self) -> u32 {
+        let i = CONE_STARTS
+            .iter()
+            .position(|(a, _)| *a == self)
+            .expect("every argument is in CONE_STARTS");
+        u32::try_from(i).expect("few arguments")
+    }
+}
 
 impl RenderArg {
     /// The argument's position in `render_tile`.
@@ -188,6 +223,7 @@ pub(crate) fn defines(target: super::Target) -> String {
     match target {
         super::Target::Render => {
             let _ = writeln!(w, "#define RENDER_TILE_ARGS \\\n    {}", args(&RENDER_TILE));
+            let _ = writeln!(w, "#define CONE_STARTS_ARGS \\\n    {}", args(&CONE_STARTS));
             for f in camera::FIELDS {
                 let _ = writeln!(w, "#define CAMERA_{} {}", f.name, f.offset);
             }

@@ -130,6 +130,10 @@ pub struct KernelSource {
     /// Whether the program is built with relaxed, fast math
     /// ([`Quality::fast_math`]).
     pub fast_math: bool,
+    /// The side of the coarse pass's tiles, in rendered pixels: the
+    /// program has a `cone_starts` kernel when it is not 0
+    /// ([`Quality::cone_tile`]).
+    pub cone_tile: u32,
     /// Where the program's `DE` has its origin in the scene: the scene's
     /// outermost baked translation for [`Target::Render`] (see
     /// [`Ir::local_frame`]), zero otherwise. The renderer moves the camera
@@ -341,6 +345,9 @@ pub fn emit_handwritten(scene_functions: &str, options: &Options) -> Result<Kern
 /// The switch of the march's stop at the scene's bounding sphere.
 const SCENE_BOUND: &str = "ENABLE_SCENE_BOUND";
 
+/// The switch of the coarse pass ([`Quality::cone_tile`]).
+const CONE: &str = "ENABLE_CONE";
+
 /// The target kernel for `options`, with the blocks of the effects that are
 /// off removed (and the stop at the scene's bounding sphere, which only
 /// programs for a bounded scene keep): what every program for these
@@ -361,6 +368,9 @@ fn kernel_with(options: &Options, bounded: bool) -> String {
         .collect();
     if bounded {
         on.push(SCENE_BOUND);
+    }
+    if options.target == Target::Render && options.quality.cone_tile > 0 {
+        on.push(CONE);
     }
     select_blocks(kernel, &on)
 }
@@ -418,6 +428,10 @@ fn finish(
         source,
         precision: options.quality.precision,
         fast_math: options.quality.fast_math,
+        cone_tile: match options.target {
+            Target::Render => options.quality.cone_tile,
+            Target::Evaluate => 0,
+        },
         origin,
         kernel_start,
         custom_regions: Vec::new(),
@@ -484,6 +498,9 @@ fn header(w: &mut writer::Writer, options: &Options) {
     }
     if on.contains(&Effect::Fog) {
         defines.push(("FOG_DENSITY", f(e.fog_density)));
+    }
+    if options.target == Target::Render && q.cone_tile > 0 {
+        defines.push(("CONE_TILE", q.cone_tile.to_string()));
     }
     for (name, value) in defines {
         w.line(format!("#define {name} {value}"));

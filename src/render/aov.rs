@@ -28,6 +28,11 @@ pub struct Frame {
     /// march through the pixel centre that the other outputs need is not
     /// counted.
     pub evaluations: Vec<u32>,
+    /// Where the pixel's rays started along the ray: the distance the
+    /// coarse pass found free in front of its tile
+    /// ([`Quality::cone_tile`](crate::quality::Quality::cone_tile)), 0
+    /// without one.
+    pub start: Vec<f32>,
 }
 
 impl Frame {

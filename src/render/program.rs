@@ -301,6 +301,7 @@ mod tests {
             precision: Precision::F32,
             hash: 0,
             fast_math: false,
+            cone_tile: 0,
             origin: DVec3::ZERO,
             kernel_start: 0,
             constants: Vec::new(),

@@ -17,7 +17,7 @@ use super::memory::{available_host_memory, check_host_memory, frame_host_bytes};
 use super::program::{self, BuildInfo};
 use super::upscale;
 use super::viewport::{Viewport, check_frame_inputs, pack_lights};
-use crate::codegen::interface::{RENDER_TILE, RenderArg, camera};
+use crate::codegen::interface::{CONE_STARTS, ConeArg, RENDER_TILE, RenderArg, camera};
 use crate::codegen::{self, KernelSource};
 use crate::error::{Error, Result};
 use crate::ir::{CompiledScene, ParamValues};
@@ -69,6 +69,7 @@ impl Default for RenderOptions {
 const TILES_IN_FLIGHT: usize = 2;
 
 const KERNEL_NAME: &str = "render_tile";
+const CONE_KERNEL_NAME: &str = "cone_starts";
 
 /// Renders one scene on one OpenCL device.
 ///
@@ -104,6 +105,9 @@ pub struct Renderer {
     build: BuildInfo,
     builds: u64,
     kernel: Kernel,
+    /// The coarse pass, in a program that has one
+    /// ([`Quality::cone_tile`]).
+    cone: Option<Kernel>,
     local: (usize, usize),
     inputs: Inputs,
     targets: Targets,
@@ -221,6 +225,7 @@ impl Renderer {
         let targets = Targets::new(&queue, 1, 1, true)?;
         let (program, build, compiled) = program::build(&selected, &context, &source)?;
         let kernel = make_kernel(&program, &queue, &inputs, &targets)?;
+        let cone = make_cone(&program, &queue, &inputs, &targets, &source)?;
         let local = local_size(&kernel, &selected)?;
         Ok(Renderer {
             selected,
@@ -234,6 +239,7 @@ impl Renderer {
             build,
             builds: u64::from(compiled),
             kernel,
+            cone,
             local,
             inputs,
             targets,
@@ -459,7 +465,9 @@ impl Renderer {
         t.normals.read(&mut normals).enq().map_err(opencl)?;
         t.steps.read(&mut steps).enq().map_err(opencl)?;
         t.evaluations.read(&mut evaluations).enq().map_err(opencl)?;
+        let starts = self.starts(width, height)?;
         let frame = Frame {
+            start: starts,
             image: RgbaImage::from_raw(width, height, rgba)
                 .expect("buffer has width * height * 4 bytes"),
             depth,
@@ -660,6 +668,7 @@ impl Renderer {
             self.inputs = Inputs::new(&self.queue, &source, &self.values, self.scene.lights())?;
         }
         self.kernel = make_kernel(&program, &self.queue, &self.inputs, &self.targets)?;
+        self.cone = make_cone(&program, &self.queue, &self.inputs, &self.targets, &source)?;
         self.local = local_size(&self.kernel, &self.selected)?;
         self.source = source;
         self.build = build;
@@ -675,6 +684,56 @@ impl Renderer {
             total: end - start,
             profiled: kernel.1,
         });
+    }
+
+    /// Each rendered pixel's start distance: its tile's, read back from the
+    /// coarse pass, or 0 without one.
+    fn starts(&self, width: u32, height: u32) -> Result<Vec<f32>> {
+        let side = self.source.cone_tile;
+        let mut out = host_vec::<f32>(width, height, 1)?;
+        if side == 0 {
+            return Ok(out);
+        }
+        let columns = width.div_ceil(side);
+        let mut tiles = vec![0.0f32; cone_tiles(width, height, side)];
+        self.targets.starts.read(&mut tiles).enq().map_err(opencl)?;
+        for y in 0..height {
+            for x in 0..width {
+                out[(y * width + x) as usize] = tiles[((y / side) * columns + x / side) as usize];
+            }
+        }
+        Ok(out)
+    }
+
+    /// Launches the coarse pass over a `width` × `height` rendering: the
+    /// start distance of every tile's rays (see `kernels/march.cl`).
+    fn coarse_pass(&self, cone: &Kernel, width: u32, height: u32) -> Result<Event> {
+        let side = self.source.cone_tile;
+        let set = |a: ConeArg, v: i32| cone.set_arg(a.index(), v).map_err(opencl);
+        #[allow(clippy::cast_possible_wrap)] // sizes are at most MAX_IMAGE_SIDE
+        {
+            set(ConeArg::Width, width as i32)?;
+            set(ConeArg::Height, height as i32)?;
+        }
+        self.inputs.params.set_arg(cone, ConeArg::Params.index())?;
+        self.inputs.camera.set_arg(cone, ConeArg::Camera.index())?;
+        cone.set_arg(ConeArg::Starts.index(), &self.targets.starts)
+            .map_err(opencl)?;
+        let global = (
+            width.div_ceil(side).next_multiple_of(8) as usize,
+            height.div_ceil(side).next_multiple_of(8) as usize,
+        );
+        let mut event = Event::empty();
+        // SAFETY: every buffer argument is alive in `self`, and the kernel
+        // bounds-checks every work item against the grid of tiles.
+        unsafe {
+            cone.cmd()
+                .global_work_size(global)
+                .enew(&mut event)
+                .enq()
+                .map_err(opencl)?;
+        }
+        Ok(event)
     }
 
     /// The error that stops a frame before its next tile, if any: a
@@ -748,6 +807,11 @@ impl Renderer {
         t.bind(k)?;
         let launched = Instant::now();
         let mut events: Vec<Event> = Vec::new();
+        // The queue is in order: every tile starts after the coarse pass.
+        let coarse = match &self.cone {
+            Some(cone) => Some(self.coarse_pass(cone, width, height)?),
+            None => None,
+        };
         let (share, shares) = self.share;
         let mine = || {
             dispatch::tiles(width, height, self.options.tile_size)
@@ -788,6 +852,7 @@ impl Renderer {
             events.push(event);
         }
         self.queue.finish().map_err(opencl)?;
+        events.extend(coarse);
         Ok(match profiled_time(&events) {
             Some(kernel) => (kernel, true),
             None => (launched.elapsed(), false),
@@ -931,6 +996,48 @@ fn host_vec<T: Default + Clone>(width: u32, height: u32, per_pixel: usize) -> Re
     Ok(v)
 }
 
+/// The smallest side of the coarse pass's tiles
+/// ([`Quality::cone_tile`](crate::quality::Quality::cone_tile)): the start
+/// buffer is sized for it.
+const MIN_CONE_TILE: u32 = 2;
+
+/// Tiles of the coarse pass with sides of `side` pixels over a `width` ×
+/// `height` rendering.
+fn cone_tiles(width: u32, height: u32, side: u32) -> usize {
+    width.div_ceil(side) as usize * height.div_ceil(side) as usize
+}
+
+/// The coarse pass's kernel, for a program that has one, with its
+/// buffers bound ([`CONE_STARTS`] lists its arguments).
+fn make_cone(
+    program: &Program,
+    queue: &Queue,
+    inputs: &Inputs,
+    t: &Targets,
+    source: &KernelSource,
+) -> Result<Option<Kernel>> {
+    if source.cone_tile == 0 {
+        return Ok(None);
+    }
+    let mut b = Kernel::builder();
+    b.program(program)
+        .name(CONE_KERNEL_NAME)
+        .queue(queue.clone());
+    for (arg, _) in CONE_STARTS {
+        match arg {
+            ConeArg::Params => inputs.params.push_arg(&mut b),
+            ConeArg::Camera => inputs.camera.push_arg(&mut b),
+            ConeArg::Width | ConeArg::Height => {
+                b.arg(0i32);
+            }
+            ConeArg::Starts => {
+                b.arg(&t.starts);
+            }
+        }
+    }
+    b.build().map(Some).map_err(opencl)
+}
+
 /// The kernel with every argument bound: buffers to the current ones,
 /// scalars to 0 until a frame sets them. Positions come from
 /// [`RENDER_TILE`], the one list of `render_tile`'s arguments.
@@ -959,6 +1066,9 @@ fn make_kernel(program: &Program, queue: &Queue, inputs: &Inputs, t: &Targets) -
             }
             RenderArg::Evaluations => {
                 b.arg(&t.evaluations);
+            }
+            RenderArg::Starts => {
+                b.arg(&t.starts);
             }
             RenderArg::LightCount
             | RenderArg::Width
@@ -1060,6 +1170,9 @@ struct Targets {
     normals: Buffer<f32>,
     steps: Buffer<u32>,
     evaluations: Buffer<u32>,
+    /// The coarse pass's start distances, one per tile of at least 2 × 2
+    /// pixels (see [`cone_tiles`]).
+    starts: Buffer<f32>,
 }
 
 impl Targets {
@@ -1076,6 +1189,12 @@ impl Targets {
             normals: output(queue, aov_pixels * 3)?,
             steps: output(queue, aov_pixels)?,
             evaluations: output(queue, aov_pixels)?,
+            starts: Buffer::builder()
+                .queue(queue.clone())
+                .flags(MemFlags::new().read_write())
+                .len(cone_tiles(width, height, MIN_CONE_TILE).max(1))
+                .build()
+                .map_err(opencl)?,
         })
     }
 
@@ -1083,7 +1202,8 @@ impl Targets {
     fn bytes(width: u32, height: u32, aovs: bool) -> Vec<u64> {
         let pixels = u64::from(width) * u64::from(height);
         let aov = if aovs { pixels } else { 1 };
-        vec![pixels * 4, aov * 4, aov, aov * 12, aov * 4, aov * 4]
+        let starts = cone_tiles(width, height, MIN_CONE_TILE) as u64 * 4;
+        vec![pixels * 4, aov * 4, aov, aov * 12, aov * 4, aov * 4, starts]
     }
 
     /// Binds the output buffers to their arguments.
@@ -1099,6 +1219,8 @@ impl Targets {
         k.set_arg(RenderArg::Steps.index(), &self.steps)
             .map_err(opencl)?;
         k.set_arg(RenderArg::Evaluations.index(), &self.evaluations)
+            .map_err(opencl)?;
+        k.set_arg(RenderArg::Starts.index(), &self.starts)
             .map_err(opencl)
     }
 

@@ -88,6 +88,7 @@ pub(crate) fn frame(low: &Frame, width: u32, height: u32, scale: u32) -> Frame {
         normal: Vec::with_capacity(n),
         steps: vec![0; n],
         evaluations: vec![0; n],
+        start: Vec::with_capacity(n),
     };
     let rgba = low.image.as_raw();
     for y in 0..height {
@@ -109,6 +110,7 @@ pub(crate) fn frame(low: &Frame, width: u32, height: u32, scale: u32) -> Frame {
             out.depth.push(low.depth[i]);
             out.hit.push(low.hit[i]);
             out.normal.push(low.normal[i]);
+            out.start.push(low.start[i]);
         }
     }
     for y in 0..lh {
