@@ -342,11 +342,31 @@ real march_ambient_occlusion(real3 p, real3 n, real view_height,
 // callers pass a fraction of the surface hit threshold so shadows are not
 // fattened by a pixel where objects nearly touch. Adds its DE evaluations
 // to *evals.
+//
+// The ray stops early where the rest cannot change the pixel: once the
+// light it could still let through is below half a step of an 8-bit pixel
+// (`weight` is the most light a fully visible light adds to the pixel in
+// any channel, and the smoothstep below is at most 3 v^2), and, for a
+// hard shadow, once it has passed the scene's bounding sphere (nothing
+// beyond can block it).
 real march_shadow(real3 ro, real3 rd, real max_t, real eps, real start, real softness,
-                  __global const real* params, uint* evals) {
+                  real weight, __global const real* params, uint* evals) {
     real visible = R(1.0);
     real prev_h = R(1e20);
     real t = start;
+    real faint = sqrt(R(0.5) / (R(255.0) * R(3.0) * fmax(weight, REAL_TINY)));
+#ifdef ENABLE_SCENE_BOUND
+    real3 oc = ro - SCENE_BOUND_CENTRE;
+    real b = dot(oc, rd);
+    real widened = SCENE_BOUND_RADIUS + eps / SCENE_BOUND_SLOPE;
+    real disc = b * b - (dot(oc, oc) - widened * widened);
+    // Where the ray leaves the sphere widened until the estimate outside it
+    // exceeds eps (negative: it misses it).
+    real t_exit = disc < R(0.0) ? R(-1.0) : -b + sqrt(disc);
+    if (softness <= R(0.0)) {
+        max_t = fmin(max_t, t_exit);
+    }
+#endif
     for (int i = 0; i < SHADOW_STEPS && t < max_t; ++i) {
         real h = DE(ro + rd * t, params);
         *evals += 1u;
@@ -363,6 +383,9 @@ real march_shadow(real3 ro, real3 rd, real max_t, real eps, real start, real sof
             real side = sqrt(fmax(h * h - y * y, R(0.0)));
             visible = fmin(visible, side / (softness * fmax(t - y, REAL_TINY)));
             prev_h = h;
+            if (visible < faint) {
+                return R(0.0);
+            }
         }
         t += fmax(h, eps);
     }
@@ -429,9 +452,11 @@ real3 march_shade(real3 p, real3 n, real3 rd, real eps, real view_height,
             continue;
         }
 #ifdef ENABLE_SHADOWS
-        real visible =
-            march_shadow(lifted, to_light, light_distance, R(0.25) * eps, eps, l[LIGHT_SOFTNESS],
-                         params, evals);
+        // The most this light adds to the pixel in any channel.
+        real3 most = radiance * ((albedo + MARCH_SPECULAR) * ndl);
+        real visible = march_shadow(lifted, to_light, light_distance, R(0.25) * eps, eps,
+                                    l[LIGHT_SOFTNESS], fmax(most.x, fmax(most.y, most.z)),
+                                    params, evals);
         if (visible <= R(0.0)) {
             continue;
         }

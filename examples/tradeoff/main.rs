@@ -1,6 +1,7 @@
 //! The speed-versus-accuracy trade-off, measured on every fractal of the
-//! gallery: each quality preset and sweeps of `max_steps`, `hit_epsilon`
-//! and `over_relaxation`, timed (median of several renders after a
+//! gallery: each quality preset and sweeps of `max_steps`, `hit_epsilon`,
+//! `over_relaxation`, `cone_tile`, `fast_math` and `resolution_scale`,
+//! timed (median of several renders after a
 //! warm-up) and compared with a `reference` render of the same pixels
 //! (F64, 2048 steps, hits located to a thousandth of a pixel): PSNR,
 //! SSIM, hit-mask mismatch, mean depth error, and PSNR of both images
@@ -9,7 +10,9 @@
 //! ε/10`: a tenth of its `hit_epsilon`). A sweep of `detail`, which
 //! changes the surface drawn rather than the accuracy, shows how much the
 //! look depends on it. Anti-aliasing is measured apart, at half the size,
-//! against a 4×4-sample render. Prints markdown tables, writes
+//! against a 4×4-sample render. A table says whether each preset is on the
+//! measured front (no configuration both faster and more accurate). Prints
+//! markdown tables, writes
 //! `out/tradeoff.csv` and plots time against error in `out/tradeoff.png`.
 //!
 //! ```text
@@ -198,10 +201,72 @@ fn sweeps() -> Vec<(&'static str, Vec<(String, Quality)>)> {
             }),
         ),
         (
+            "cone_tile",
+            sweep("cone_tile", &[4.0, 8.0, 16.0], |q, v| {
+                q.cone_tile = v as u32;
+            }),
+        ),
+        (
+            "fast_math",
+            vec![("fast_math".to_string(), base.fast_math(true))],
+        ),
+        (
+            "resolution_scale",
+            sweep("resolution_scale", &[2.0, 3.0], |q, v| {
+                q.resolution_scale = v as u32;
+            }),
+        ),
+        (
             "detail",
             sweep("detail", &[0.25, 0.4, 0.6, 1.0], |q, v| q.detail = v),
         ),
     ]
+}
+
+/// The groups whose rows are speed-versus-accuracy choices (`detail`
+/// changes the look, `floor` checks the reference).
+const CHOICES: [&str; 7] = [
+    "preset",
+    "max_steps",
+    "hit_epsilon",
+    "over_relaxation",
+    "cone_tile",
+    "fast_math",
+    "resolution_scale",
+];
+
+/// The rows that are both faster and more accurate (PSNR) than a preset
+/// of the same scene: a preset with any is off the measured front.
+fn dominating<'a>(rows: &'a [Row], preset: &Row) -> Vec<&'a Row> {
+    rows.iter()
+        .filter(|r| r.scene == preset.scene && CHOICES.contains(&r.group))
+        .filter(|r| {
+            r.timing.median_ms < preset.timing.median_ms && r.errors.psnr > preset.errors.psnr
+        })
+        .collect()
+}
+
+/// Each preset, and whether a measured configuration beats it on both
+/// time and accuracy.
+fn front(rows: &[Row]) -> String {
+    let mut out = String::from(
+        "| scene | preset | ms/frame | PSNR dB | on the front |\n|---|---|---:|---:|---|\n",
+    );
+    for p in rows.iter().filter(|r| r.group == "preset") {
+        let better = dominating(rows, p);
+        let verdict = if better.is_empty() {
+            "yes".to_string()
+        } else {
+            let names: Vec<&str> = better.iter().map(|r| r.label.as_str()).collect();
+            format!("no: {} faster and more accurate", names.join(", "))
+        };
+        let _ = writeln!(
+            out,
+            "| {} | {} | {:.0} | {:.1} | {verdict} |",
+            p.scene, p.label, p.timing.median_ms, p.errors.psnr
+        );
+    }
+    out
 }
 
 /// The reference at one sample per pixel.
@@ -369,8 +434,20 @@ fn main() -> std::process::ExitCode {
         println!("Sweeps of production quality:\n");
         println!(
             "{}",
-            table(&rows, &["max_steps", "hit_epsilon", "over_relaxation"])
+            table(
+                &rows,
+                &[
+                    "max_steps",
+                    "hit_epsilon",
+                    "over_relaxation",
+                    "cone_tile",
+                    "fast_math",
+                    "resolution_scale"
+                ]
+            )
         );
+        println!("The presets against every other measured configuration:\n");
+        println!("{}", front(&rows));
         println!("The look: `detail` changes the surface drawn (production otherwise):\n");
         println!("{}", table(&rows, &["detail"]));
         if rows.iter().any(|r| r.group == "aa") {

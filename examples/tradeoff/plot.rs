@@ -132,6 +132,21 @@ fn panel(
                     .map(|p| TriangleMarker::new(p, 4, light.stroke_width(1))),
             )
             .expect("draw into memory");
+        // The other knobs, one point each.
+        for group in [
+            "over_relaxation",
+            "cone_tile",
+            "fast_math",
+            "resolution_scale",
+        ] {
+            chart
+                .draw_series(
+                    of(group)
+                        .into_iter()
+                        .map(|p| Circle::new(p, 3, light.stroke_width(1))),
+                )
+                .expect("draw into memory");
+        }
         let presets: Vec<(f64, f64)> = rows
             .iter()
             .filter(|r| r.scene == *scene && r.group == "preset" && r.label != "reference")
