@@ -151,10 +151,14 @@ pub struct Quality {
     /// sample at the pixel centre).
     pub supersampling: u32,
     /// Lets the OpenCL compiler trade exactness for speed
-    /// (`-cl-fast-relaxed-math` and `-cl-mad-enable`, and contracted
-    /// multiply-adds): faster on some devices, with results that differ
-    /// from the CPU reference by more than rounding. Off in every preset
-    /// but `draft`; its cost and error are measured in `examples/tradeoff`.
+    /// (`-cl-unsafe-math-optimizations`: reassociation, multiply-adds,
+    /// reciprocals, and contracted expressions): faster on some devices,
+    /// with results that differ from the CPU reference by more than
+    /// rounding. Not `-cl-fast-relaxed-math`, which also lets the compiler
+    /// assume no value is infinite: the march marks misses and unbounded
+    /// reach with infinities. On in `draft` and `preview`, off in
+    /// `production` and `reference`; its cost and error are measured in
+    /// `examples/tradeoff`.
     pub fast_math: bool,
     /// Renders one pixel for every `resolution_scale` × `resolution_scale`
     /// pixels of the image, and scales the result up to the image's size,
@@ -180,9 +184,12 @@ impl Quality {
     /// The normal step shared by every preset, in pixel footprints.
     pub const NORMAL_EPSILON: f64 = 1.0;
 
-    /// For moving the camera: the cheapest image of the same surface. 128
-    /// steps (rays grazing a floor may run out), hits located to half a
-    /// pixel, no occlusion and no shadows.
+    /// For moving the camera: the cheapest image of the same surface. One
+    /// pixel rendered in 3×3 ([`Quality::resolution_scale`]; 2×2 is
+    /// sharper and about half as fast), 128 steps
+    /// (rays grazing a floor may run out), hits located to half a pixel,
+    /// no occlusion and no shadows, relaxed math, rays started by the
+    /// coarse pass.
     #[must_use]
     pub fn draft() -> Self {
         Quality {
@@ -197,14 +204,15 @@ impl Quality {
             precision: Precision::F32,
             over_relaxation: 1.0,
             supersampling: 1,
-            fast_math: false,
-            resolution_scale: 1,
-            cone_tile: 0,
+            fast_math: true,
+            resolution_scale: 3,
+            cone_tile: 8,
         }
     }
 
-    /// Interactive quality: every effect on, hits located to a seventh of
-    /// a pixel, three occlusion samples and 64-step shadow rays.
+    /// Interactive quality: every pixel, every effect on, hits located to a
+    /// seventh of a pixel, three occlusion samples and 64-step shadow rays,
+    /// relaxed math, rays started by the coarse pass.
     #[must_use]
     pub fn preview() -> Self {
         Quality {
@@ -212,12 +220,14 @@ impl Quality {
             hit_epsilon: 0.15,
             ao_samples: 3,
             shadow_steps: 64,
+            resolution_scale: 1,
             ..Self::draft()
         }
     }
 
     /// Final images: hits located to a twentieth of a pixel, every effect
-    /// converged. Add [`Quality::supersampling`] for anti-aliasing.
+    /// converged, exact math, rays started by the coarse pass. Add
+    /// [`Quality::supersampling`] for anti-aliasing.
     #[must_use]
     pub fn production() -> Self {
         Quality {
@@ -225,13 +235,15 @@ impl Quality {
             hit_epsilon: 0.05,
             ao_samples: 5,
             shadow_steps: 96,
+            fast_math: false,
             ..Self::preview()
         }
     }
 
     /// The accuracy reference the others are measured against: F64, 2048
     /// steps, hits located to a thousandth of a pixel, eight occlusion
-    /// samples, 256 shadow steps. It is converged: halving its relaxation
+    /// samples, 256 shadow steps, exact math, every ray marched from the
+    /// camera (no coarse pass). It is converged: halving its relaxation
     /// factor or dividing its `hit_epsilon` by ten changes its image by
     /// less than the presets differ from it (see the README).
     #[must_use]
@@ -242,6 +254,7 @@ impl Quality {
             ao_samples: 8,
             shadow_steps: 256,
             precision: Precision::F64,
+            cone_tile: 0,
             ..Self::production()
         }
     }

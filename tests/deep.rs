@@ -111,7 +111,7 @@ fn a_deep_scene_renders_as_the_cpu_reference_draws_it() {
     }
     let scene = Scene::new(node).with_camera(Camera::look_at(dvec3(0.0, 0.0, 3.0), DVec3::ZERO));
     let (w, h) = (12, 8);
-    let mut renderer = Renderer::new(&scene, Quality::draft()).unwrap();
+    let mut renderer = Renderer::new(&scene, gpu::plain(Quality::draft())).unwrap();
     let frame = renderer.render_with_aovs(w, h).unwrap();
     let view = renderer.viewport(w, h).unwrap();
     let settings = view.march_settings(&renderer.options().quality);
@@ -162,7 +162,7 @@ fn a_hundred_thousand_added_spheres_render() {
         source.source.len()
     );
     assert_eq!(source.constants.len(), 4 * 100_000);
-    let quality = Quality::draft();
+    let quality = gpu::plain(Quality::draft());
     let options = gpu::options(quality, Effects::none());
     let mut renderer = Renderer::from_compiled(compiled, &options).unwrap();
     let (w, h) = (16, 12);
@@ -226,7 +226,7 @@ fn instanced_spheres_keep_their_table_when_a_parameter_changes() {
         scene = scene.add(sphere(param("r", 0.1)).translate(dvec3(t.cos(), t.sin(), 0.0)));
     }
     let scene = scene.with_camera(Camera::look_at(dvec3(0.0, 0.0, 4.0), DVec3::ZERO));
-    let options = gpu::options(Quality::draft(), Effects::none());
+    let options = gpu::options(gpu::plain(Quality::draft()), Effects::none());
     let mut renderer = Renderer::with_options(&scene, &options).unwrap();
     let (w, h) = (24, 16);
     for r in [0.1, 0.25, 0.05] {

@@ -198,7 +198,7 @@ fn finite_reference(eval: &Evaluator, f32_too: bool) -> Result<(), String> {
 
 fn program(precision: Precision) -> Options {
     Options {
-        quality: Quality::draft().precision(precision),
+        quality: gpu::plain(Quality::draft()).precision(precision),
         ..Options::default()
     }
 }
@@ -474,7 +474,7 @@ fn accepted_frame_input(t: &mut Tally, what: &str, scene: Scene, node: &str, par
     t.accepted += 1;
     let mut precision = Precision::F32;
     if gpu::device().is_some() {
-        let options = gpu::options(Quality::draft(), Effects::none());
+        let options = gpu::options(gpu::plain(Quality::draft()), Effects::none());
         if let Err(e) = Renderer::with_options(&scene, &options) {
             t.f32_refused += 1;
             let text = e.to_string();
@@ -588,7 +588,7 @@ fn setting_cases(t: &mut Tally) {
                 let what = format!("quality {name} = {value:e} {precision:?}");
                 guarded(t, &what, |t| {
                     t.cases += 1;
-                    let q = edit(Quality::draft().precision(precision), value);
+                    let q = edit(gpu::plain(Quality::draft()).precision(precision), value);
                     match q.validate() {
                         Err(e) => t.refused(&what, &e, name, &[name]),
                         Ok(()) => {
@@ -614,7 +614,7 @@ fn setting_cases(t: &mut Tally) {
                         Ok(()) => {
                             t.accepted += 1;
                             let options = Options {
-                                quality: Quality::preview().precision(precision),
+                                quality: gpu::plain(Quality::preview()).precision(precision),
                                 effects: e,
                                 ..Options::default()
                             };
@@ -657,7 +657,10 @@ fn hostile_values_are_refused_by_name_or_computed_finitely() {
             *count += 1;
         }
         for (what, scene, set, precision) in picked {
-            let options = gpu::options(Quality::draft().precision(precision), Effects::none());
+            let options = gpu::options(
+                gpu::plain(Quality::draft()).precision(precision),
+                Effects::none(),
+            );
             let outcome = catch_unwind(AssertUnwindSafe(|| {
                 render_case(&what, &scene, set, &options)
             }));

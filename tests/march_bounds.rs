@@ -19,7 +19,7 @@ fn unbounded(scene: &Scene) -> Scene {
 }
 
 fn render(scene: &Scene, effects: Effects) -> (Frame, String) {
-    let mut quality = Quality::preview();
+    let mut quality = gpu::plain(Quality::preview());
     quality.supersampling = 1;
     let mut renderer = Renderer::with_options(scene, &gpu::options(quality, effects)).unwrap();
     let frame = renderer.render_with_aovs(72, 54).unwrap();
@@ -86,7 +86,7 @@ fn rays_stop_past_the_scene_bound_with_the_same_hits() {
 #[test]
 fn the_coarse_pass_never_starts_a_ray_past_its_surface() {
     let Some(_) = gpu::device() else { return };
-    let mut quality = Quality::preview();
+    let mut quality = gpu::plain(Quality::preview());
     quality.supersampling = 1;
     let (w, h) = (64, 48);
     let mut differ = 0;

@@ -14,7 +14,10 @@ const SAFELY: &str = "cannot be represented safely in";
 
 /// Draft quality in `precision`, no effects: the cheapest image.
 fn options(precision: Precision) -> RenderOptions {
-    gpu::options(Quality::draft().precision(precision), Effects::none())
+    gpu::options(
+        gpu::plain(Quality::draft()).precision(precision),
+        Effects::none(),
+    )
 }
 
 /// Renders `scene` (with dynamic values `sets`) at 16x12, or the error.
@@ -107,7 +110,7 @@ fn values_beyond_f32_are_refused_before_the_build() {
     }
     let plain = scene(sphere(1.0));
     let quality = RenderOptions {
-        quality: Quality::draft().max_distance(big),
+        quality: gpu::plain(Quality::draft()).max_distance(big),
         ..f32_options.clone()
     };
     let fog = RenderOptions {
@@ -143,7 +146,11 @@ fn values_beyond_f32_are_refused_before_the_build() {
     // The same values are fine where they fit.
     let mut renderer = Renderer::with_options(&plain, &options(Precision::F64)).unwrap();
     renderer
-        .set_quality(Quality::draft().precision(Precision::F64).max_distance(big))
+        .set_quality(
+            gpu::plain(Quality::draft())
+                .precision(Precision::F64)
+                .max_distance(big),
+        )
         .unwrap();
 }
 
@@ -325,7 +332,7 @@ fn the_cpu_reference_is_finite_for_every_accepted_value() {
         let eval = Evaluator::from_compiled(&compiled);
         // The f32 reference, for what an F32 program accepts.
         let f32_program = codegen::Options {
-            quality: Quality::draft(),
+            quality: gpu::plain(Quality::draft()),
             ..codegen::Options::default()
         };
         let in_f32 = codegen::emit(&compiled, &f32_program).is_ok();
@@ -351,7 +358,7 @@ fn the_cpu_reference_is_finite_for_every_accepted_value() {
 #[test]
 fn knobs_below_the_resolution_of_the_precision_are_refused() {
     for precision in [Precision::F32, Precision::F64] {
-        let q = Quality::draft().precision(precision);
+        let q = gpu::plain(Quality::draft()).precision(precision);
         for (what, bad) in [
             ("detail", q.detail(1e-300)),
             ("hit_epsilon", q.hit_epsilon(1e-300)),
@@ -439,7 +446,7 @@ fn a_renderer_checks_its_inputs_against_its_precision_as_they_change() {
     renderer.set_param("at.x", 1e30).unwrap();
     // ...but not in the F32 program a quality change asks for.
     let err = renderer
-        .set_quality(Quality::draft().precision(Precision::F32))
+        .set_quality(gpu::plain(Quality::draft()).precision(Precision::F32))
         .unwrap_err();
     assert!(
         matches!(&err, Error::Precision { node, param, precision: "F32", .. }
@@ -448,7 +455,7 @@ fn a_renderer_checks_its_inputs_against_its_precision_as_they_change() {
     );
     renderer.set_param("at.x", 0.0).unwrap();
     renderer
-        .set_quality(Quality::draft().precision(Precision::F32))
+        .set_quality(gpu::plain(Quality::draft()).precision(Precision::F32))
         .unwrap();
     // Now in F32: dynamic values, cameras and lights beyond it are refused
     // and leave the renderer as it was.

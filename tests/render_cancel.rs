@@ -31,7 +31,7 @@ fn options(token: Option<CancelToken>, deadline: Option<Duration>) -> RenderOpti
         tile_size: 4,
         cancel: token,
         deadline,
-        ..gpu::options(Quality::draft(), Effects::none())
+        ..gpu::options(gpu::plain(Quality::draft()), Effects::none())
     }
 }
 

@@ -26,7 +26,7 @@ fn a_resolution_scale_renders_fewer_pixels_of_the_same_image() {
     let scene = gallery::by_name("csg").unwrap();
     // Sizes that the scale divides and sizes it does not.
     for size in [(96, 72), (97, 71)] {
-        let full_quality = Quality::preview();
+        let full_quality = gpu::plain(Quality::preview());
         let (full, _) = render(&scene, full_quality, size);
         let (half, mut renderer) = render(&scene, full_quality.resolution_scale(2), size);
         gpu::save(&format!("scale2_{}x{}", size.0, size.1), &half.image);
@@ -57,22 +57,29 @@ fn a_resolution_scale_renders_fewer_pixels_of_the_same_image() {
     }
 }
 
+/// Switching back from a resolution scale renders every pixel again: the
+/// same image as a renderer that never scaled.
 #[test]
 fn a_scale_of_one_is_the_full_image() {
     let Some(_) = gpu::device() else { return };
     let scene = gallery::by_name("menger").unwrap();
-    let (a, _) = render(&scene, Quality::preview(), (64, 48));
-    let (b, _) = render(&scene, Quality::preview().resolution_scale(1), (64, 48));
-    assert_eq!(a.image, b.image);
+    let full = gpu::plain(Quality::preview());
+    let (a, _) = render(&scene, full, (64, 48));
+    let (b, mut renderer) = render(&scene, full.resolution_scale(4), (64, 48));
+    assert!(a.image != b.image);
+    renderer.set_quality(full).unwrap();
+    let c = renderer.render(64, 48).unwrap();
+    assert!(a.image == c, "switching back to every pixel");
 }
 
 #[test]
 fn fast_math_is_close_and_off_is_exact() {
     let Some(_) = gpu::device() else { return };
     let scene = gallery::by_name("mandelbulb").unwrap();
-    let (exact, r) = render(&scene, Quality::preview(), (80, 60));
+    let exact_quality = gpu::plain(Quality::preview());
+    let (exact, r) = render(&scene, exact_quality, (80, 60));
     assert!(r.source().source.contains("#pragma OPENCL FP_CONTRACT OFF"));
-    let (fast, r) = render(&scene, Quality::preview().fast_math(true), (80, 60));
+    let (fast, r) = render(&scene, exact_quality.fast_math(true), (80, 60));
     assert!(!r.source().source.contains("FP_CONTRACT OFF"));
     assert!(r.source().fast_math);
     gpu::save("fast_math", &fast.image);

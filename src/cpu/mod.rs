@@ -17,7 +17,9 @@ use crate::error::Result;
 use std::collections::HashMap;
 
 use crate::ir::SHRINK;
-use crate::ir::{Bound, CompiledScene, Ir, IrNode, NodeId, ParamValues, Scalar, union_chain};
+use crate::ir::{
+    Bound, CompiledScene, Ir, IrNode, NodeId, ParamValues, Scalar, is_hard_union, union_chain,
+};
 use crate::math::F32_LIMITS;
 use crate::scene::{CsgOp, Kind, Node};
 
@@ -79,11 +81,15 @@ impl Evaluator {
             .into_iter()
             .map(|b| b.filter(|b| b.fits(&F32_LIMITS)))
             .collect();
+        // The roots of trees of hard unions: hard unions whose parent is
+        // not one. Each node is in at most one tree, so this is linear.
         let chains = (0..ir.nodes().len())
             .map(NodeId::from_index)
             .filter(|&id| {
-                ir.parent(id)
-                    .is_none_or(|parent| union_chain(&ir, parent, &bounds).is_none())
+                is_hard_union(ir.node(id))
+                    && ir
+                        .parent(id)
+                        .is_none_or(|parent| !is_hard_union(ir.node(parent)))
             })
             .filter_map(|id| Some((id.index(), union_chain(&ir, id, &bounds)?.operands)))
             .collect();

@@ -7,6 +7,7 @@
 //! (quaternion Julia), White/Nylander and Hart (Mandelbulb) and Knighty's
 //! kaleidoscopic IFS (Menger, Sierpinski).
 
+pub use crate::math::{JULIA_FAR_FIELD, JULIA_FAR_FIELD_SLOPE, julia_radius};
 use crate::math::{Real, V3, escape_radius, mandelbulb_radius, v3};
 
 /// Exact distance to a sphere of radius `r` at the origin.
@@ -339,46 +340,6 @@ pub fn sierpinski<T: Real>(p: V3<T>, iterations: u32, scale: T) -> Estimate<T> {
         trap,
     }
 }
-
-/// The radius `1/2 + sqrt(1/4 + |c|)` of the ball that holds the quaternion
-/// Julia set of `c` (the points whose orbits stay bounded).
-///
-/// Proof. It is the positive root of `r^2 - r - |c|`. For quaternions
-/// `|z^2| = |z|^2`, so if `|z| > r` then `|z^2 + c| >= |z|^2 - |c| > |z|`,
-/// and the excess `|z|^2 - |z| - |c|` grows with `|z|`: the orbit grows
-/// without bound. Hence every bounded orbit stays within the ball, and a
-/// point whose orbit ever leaves it is not in the set.
-///
-/// ```
-/// use fractal_sdf::cpu::sdf::julia_radius;
-/// assert_eq!(julia_radius([-2.0_f64, 0.0, 0.0, 0.0]), 2.0);
-/// assert_eq!(julia_radius([0.0_f64, 0.0, 0.0, 0.0]), 1.0);
-/// ```
-#[must_use]
-pub fn julia_radius<T: Real>(c: [T; 4]) -> T {
-    let half = T::of(0.5);
-    let norm = (c[0] * c[0] + c[1] * c[1] + c[2] * c[2] + c[3] * c[3]).sqrt();
-    half + (half * half + norm).sqrt()
-}
-
-/// Beyond `JULIA_FAR_FIELD` times the radius of its ball (the smaller of
-/// [`julia_radius`] and the bailout) the quaternion Julia estimate is
-/// [`JULIA_FAR_FIELD_SLOPE`] times the distance to that ball. Far from the
-/// set the escape-time estimate grows like `0.5 r ln r`, faster than the
-/// distance: it overestimates from about 2.3 radii, by 1.36 at 10 units
-/// and 6.9 at 1e6 (measured over constants in and near the Mandelbrot
-/// set), and every ray from a camera 10 units from the gallery's set
-/// stepped past it. Up to 1.5 radii it was within 0.97 of the distance.
-pub const JULIA_FAR_FIELD: f64 = 1.5;
-
-/// The far-field estimate is `JULIA_FAR_FIELD_SLOPE` times the ball's
-/// distance. The ball's exact distance grows by exactly the step along a
-/// ray leaving it straight outward, and the soft-shadow penumbra estimate
-/// (`march_shadow`) reads two distance spheres that touch that way as a
-/// surface grazing the ray: shadow rays from the set, which start inside
-/// the ball, came out dark. A slope below 1 keeps them apart (and costs
-/// far-away rays about 8% more steps).
-pub const JULIA_FAR_FIELD_SLOPE: f64 = 0.9;
 
 /// The escape-time estimate is used as is only where the bailout is at
 /// least `JULIA_TRUSTED_BAILOUT` times [`julia_radius`]. With a smaller

@@ -21,8 +21,9 @@
 use glam::DVec3;
 
 use super::{Ir, IrNode, NodeId, Scalar, baked3};
-use crate::cpu::sdf::{JULIA_FAR_FIELD, JULIA_FAR_FIELD_SLOPE, julia_radius};
-use crate::math::{Limits, mandelbulb_radius, rotation_rows};
+use crate::math::{
+    JULIA_FAR_FIELD, JULIA_FAR_FIELD_SLOPE, Limits, julia_radius, mandelbulb_radius, rotation_rows,
+};
 use crate::scene::{CsgOp, Kind};
 
 /// A conservative bounding sphere of a node, in the coordinates the node
@@ -360,7 +361,8 @@ pub(crate) fn union_chain(ir: &Ir, id: NodeId, bounds: &[Option<Bound>]) -> Opti
     })
 }
 
-fn is_hard_union(node: &IrNode) -> bool {
+/// Whether `node` is a union without smoothing.
+pub(crate) fn is_hard_union(node: &IrNode) -> bool {
     matches!(
         node,
         Kind::Csg {

@@ -109,7 +109,7 @@ pub(crate) fn build_options(info: &DeviceInfo, fast_math: bool) -> String {
         options.push("-cl-std=CL1.2");
     }
     if fast_math {
-        options.extend(["-cl-fast-relaxed-math", "-cl-mad-enable"]);
+        options.push("-cl-unsafe-math-optimizations");
     }
     options.join(" ")
 }

@@ -1287,7 +1287,7 @@ mod tests {
         let err = check_device_memory(&device, 3840, 2160, true).unwrap_err();
         assert!(
             err.to_string()
-                .contains("230 MiB but `Small / gpu` has 128 MiB"),
+                .contains("238 MiB but `Small / gpu` has 128 MiB"),
             "{err}"
         );
     }

@@ -15,61 +15,95 @@ use super::Frame;
 
 /// Two hits whose depths differ by less than this fraction of the nearer
 /// show the same surface.
-pub const SAME_SURFACE: f64 = 0.05;
+pub const SAME_SURFACE: f32 = 0.05;
 
-/// Where an image pixel's colour comes from: up to four rendered pixels
-/// and their weights (summing to 1), the nearest first.
-fn taps(
-    x: u32,
-    y: u32,
+/// Weights are fixed-point: `ONE` is a whole rendered pixel along an axis.
+const ONE: u32 = 256;
+
+/// Along one axis: for each image pixel, the two rendered pixels around
+/// its centre and the weight of the second, out of [`ONE`]
+/// (rendered-pixel centres are at integers; the image's edges clamp).
+fn axis(size: u32, rendered: u32, scale: u32) -> Vec<(usize, usize, u32)> {
+    let k = f64::from(scale);
+    (0..size)
+        .map(|i| {
+            let u = (f64::from(i) + 0.5) / k - 0.5;
+            #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss)]
+            let i0 = (u.floor().max(0.0) as u32).min(rendered - 1);
+            let i1 = (i0 + 1).min(rendered - 1);
+            #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss)]
+            let f = ((u - f64::from(i0)).clamp(0.0, 1.0) * f64::from(ONE)).round() as u32;
+            (i0 as usize, i1 as usize, f)
+        })
+        .collect()
+}
+
+/// Calls `each(pixel, taps, weights, nearest)` for every image pixel, row
+/// by row: the four rendered pixels around it, their weights (out of
+/// `ONE²` in all) and which one is the nearest. A tap whose depth says it
+/// shows another surface than the nearest gets no weight.
+fn for_each_tap(
+    (width, height): (u32, u32),
     scale: u32,
     (lw, lh): (u32, u32),
     depth: &[f32],
-) -> ([usize; 4], [f64; 4], usize) {
-    let k = f64::from(scale);
-    // The image pixel's centre in rendered-pixel coordinates (centres at
-    // integers).
-    let u = (f64::from(x) + 0.5) / k - 0.5;
-    let v = (f64::from(y) + 0.5) / k - 0.5;
-    let clampi = |c: f64, n: u32| {
-        #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss)]
-        let i = c.floor().max(0.0) as u32;
-        i.min(n - 1)
-    };
-    let (x0, y0) = (clampi(u, lw), clampi(v, lh));
-    let (x1, y1) = ((x0 + 1).min(lw - 1), (y0 + 1).min(lh - 1));
-    let fx = (u - f64::from(x0)).clamp(0.0, 1.0);
-    let fy = (v - f64::from(y0)).clamp(0.0, 1.0);
-    let at = |x: u32, y: u32| (y * lw + x) as usize;
-    let index = [at(x0, y0), at(x1, y0), at(x0, y1), at(x1, y1)];
-    let mut weight = [
-        (1.0 - fx) * (1.0 - fy),
-        fx * (1.0 - fy),
-        (1.0 - fx) * fy,
-        fx * fy,
-    ];
-    let nearest = (0..4)
-        .max_by(|&a, &b| weight[a].total_cmp(&weight[b]))
-        .expect("four taps");
-    let d0 = f64::from(depth[index[nearest]]);
-    let same = |d: f64| {
-        if d0.is_finite() && d.is_finite() {
-            (d - d0).abs() <= SAME_SURFACE * d.min(d0)
-        } else {
-            d0.is_finite() == d.is_finite()
+    mut each: impl FnMut(usize, [usize; 4], [u32; 4], usize),
+) {
+    let columns = axis(width, lw, scale);
+    let rows = axis(height, lh, scale);
+    let lw = lw as usize;
+    let mut pixel = 0;
+    for &(y0, y1, fy) in &rows {
+        for &(x0, x1, fx) in &columns {
+            let index = [y0 * lw + x0, y0 * lw + x1, y1 * lw + x0, y1 * lw + x1];
+            let mut weight = [
+                (ONE - fx) * (ONE - fy),
+                fx * (ONE - fy),
+                (ONE - fx) * fy,
+                fx * fy,
+            ];
+            let mut nearest = 0;
+            for i in 1..4 {
+                if weight[i] > weight[nearest] {
+                    nearest = i;
+                }
+            }
+            let d0 = depth[index[nearest]];
+            for i in 0..4 {
+                let d = depth[index[i]];
+                let same = if d0.is_finite() && d.is_finite() {
+                    (d - d0).abs() <= SAME_SURFACE * d.min(d0)
+                } else {
+                    d0.is_finite() == d.is_finite()
+                };
+                if !same {
+                    weight[i] = 0;
+                }
+            }
+            each(pixel, index, weight, nearest);
+            pixel += 1;
         }
-    };
-    let mut total = 0.0;
-    for i in 0..4 {
-        if !same(f64::from(depth[index[i]])) {
-            weight[i] = 0.0;
+    }
+}
+
+/// The colour of one image pixel from its taps, rounded to nearest.
+fn blend(rgba: &[u8], index: [usize; 4], weight: [u32; 4], out: &mut [u8]) {
+    let total: u32 = weight.iter().sum();
+    let mut c = [total / 2; 4];
+    for (i, w) in index.into_iter().zip(weight) {
+        if w > 0 {
+            let from = &rgba[4 * i..4 * i + 4];
+            for j in 0..4 {
+                c[j] += w * u32::from(from[j]);
+            }
         }
-        total += weight[i];
     }
-    for w in &mut weight {
-        *w /= total;
+    for j in 0..4 {
+        #[allow(clippy::cast_possible_truncation)]
+        {
+            out[j] = (c[j] / total) as u8;
+        }
     }
-    (index, weight, nearest)
 }
 
 /// Scales a `lw` × `lh` rendering up to `width` × `height` (`lw` is
@@ -80,7 +114,7 @@ fn taps(
 pub(crate) fn frame(low: &Frame, width: u32, height: u32, scale: u32) -> Frame {
     let (lw, lh) = (low.width(), low.height());
     let n = (width as usize) * (height as usize);
-    let mut image = RgbaImage::new(width, height);
+    let mut rgba = vec![0u8; 4 * n];
     let mut out = Frame {
         image: RgbaImage::new(1, 1),
         depth: Vec::with_capacity(n),
@@ -90,29 +124,21 @@ pub(crate) fn frame(low: &Frame, width: u32, height: u32, scale: u32) -> Frame {
         evaluations: vec![0; n],
         start: Vec::with_capacity(n),
     };
-    let rgba = low.image.as_raw();
-    for y in 0..height {
-        for x in 0..width {
-            let (index, weight, nearest) = taps(x, y, scale, (lw, lh), &low.depth);
-            let mut c = [0.0f64; 4];
-            for (&i, &w) in index.iter().zip(&weight) {
-                for (channel, value) in c.iter_mut().zip(&rgba[4 * i..4 * i + 4]) {
-                    *channel += w * f64::from(*value);
-                }
-            }
-            #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss)]
-            image.put_pixel(
-                x,
-                y,
-                image::Rgba(c.map(|v| v.round().clamp(0.0, 255.0) as u8)),
-            );
+    let from = low.image.as_raw();
+    for_each_tap(
+        (width, height),
+        scale,
+        (lw, lh),
+        &low.depth,
+        |p, index, weight, nearest| {
+            blend(from, index, weight, &mut rgba[4 * p..4 * p + 4]);
             let i = index[nearest];
             out.depth.push(low.depth[i]);
             out.hit.push(low.hit[i]);
             out.normal.push(low.normal[i]);
             out.start.push(low.start[i]);
-        }
-    }
+        },
+    );
     for y in 0..lh {
         for x in 0..lw {
             let from = (y * lw + x) as usize;
@@ -121,7 +147,7 @@ pub(crate) fn frame(low: &Frame, width: u32, height: u32, scale: u32) -> Frame {
             out.evaluations[to] = low.evaluations[from];
         }
     }
-    out.image = image;
+    out.image = RgbaImage::from_raw(width, height, rgba).expect("four bytes per pixel");
     out
 }
 
@@ -133,19 +159,18 @@ pub(crate) fn image(
     height: u32,
     scale: u32,
 ) -> RgbaImage {
-    let (lw, lh) = low.dimensions();
-    let rgba = low.as_raw();
-    RgbaImage::from_fn(width, height, |x, y| {
-        let (index, weight, _) = taps(x, y, scale, (lw, lh), depth);
-        let mut c = [0.0f64; 4];
-        for (&i, &w) in index.iter().zip(&weight) {
-            for (channel, value) in c.iter_mut().zip(&rgba[4 * i..4 * i + 4]) {
-                *channel += w * f64::from(*value);
-            }
-        }
-        #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss)]
-        image::Rgba(c.map(|v| v.round().clamp(0.0, 255.0) as u8))
-    })
+    let from = low.as_raw();
+    let mut rgba = vec![0u8; 4 * width as usize * height as usize];
+    for_each_tap(
+        (width, height),
+        scale,
+        low.dimensions(),
+        depth,
+        |p, index, weight, _| {
+            blend(from, index, weight, &mut rgba[4 * p..4 * p + 4]);
+        },
+    );
+    RgbaImage::from_raw(width, height, rgba).expect("four bytes per pixel")
 }
 
 #[cfg(test)]

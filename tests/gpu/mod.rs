@@ -102,14 +102,15 @@ pub fn options(quality: Quality, effects: Effects) -> RenderOptions {
     }
 }
 
-/// A quick quality: production thresholds, fewer shading samples.
+/// A quick quality: production thresholds, fewer steps, and every ray
+/// marched from the camera ([`plain`]).
 pub fn quick() -> Quality {
-    Quality {
+    plain(Quality {
         max_steps: 192,
         ao_samples: 5,
         shadow_steps: 96,
         ..Quality::production()
-    }
+    })
 }
 
 /// Mean luminance (0–255) of the pixels in a square of half side `r`
@@ -170,4 +171,12 @@ pub fn assert_no_nan(frame: &Frame, what: &str) {
             "{what}: pixel {i}"
         );
     }
+}
+
+/// `quality` without the knobs that change pixels for speed (the coarse
+/// pass, the resolution scale, relaxed math): every pixel rendered, every
+/// ray marched from the camera, exact math. For tests that compare pixels
+/// with the CPU reference or count tiles.
+pub fn plain(quality: Quality) -> Quality {
+    quality.cone_tile(0).resolution_scale(1).fast_math(false)
 }

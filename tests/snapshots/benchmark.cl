@@ -22,6 +22,7 @@ typedef float4 real4;
 #define AO_SAMPLES 5
 #define AO_DISTANCE 0.25f
 #define SHADOW_STEPS 96
+#define CONE_TILE 8
 #define ENABLE_AO
 #define ENABLE_SHADOWS
 /* The kernel interface (src/codegen/interface.rs). */
@@ -42,7 +43,14 @@ typedef float4 real4;
     __global uchar* hit_mask, \
     __global float* normals, \
     __global uint* steps, \
-    __global uint* evaluations
+    __global uint* evaluations, \
+    __global const float* starts
+#define CONE_STARTS_ARGS \
+    __global const real* params, \
+    __global const real* camera, \
+    const int width, \
+    const int height, \
+    __global float* starts
 #define CAMERA_ORIGIN 0
 #define CAMERA_ORTHOGRAPHIC 3
 #define CAMERA_RIGHT 4
@@ -52,6 +60,9 @@ typedef float4 real4;
 #define CAMERA_FORWARD 12
 #define CAMERA_FOOTPRINT_BASE 15
 #define CAMERA_FOOTPRINT_PER_UNIT 16
+#define CAMERA_IMAGE_WIDTH 17
+#define CAMERA_IMAGE_HEIGHT 18
+#define CAMERA_PIXEL_SCALE 19
 #define LIGHT_POSITION 0
 #define LIGHT_KIND 3
 #define LIGHT_RADIANCE 4
@@ -187,165 +198,234 @@ real mandelbulb_p8(real3 p, int iterations, real escape, real ball, real* trap) 
 
 /* ---- scene ---- */
 real DE(real3 p0, __global const real* params) {
-    /* .../a:union/a:union/a:translate */
-    real3 p1 = p0 - (real3)(0.0f, 0.05f, 0.0f);
-    /* .../a:translate/color/scale */
-    real3 p2 = p1 / 0.6f;
-    /* .../color/scale/rotate */
-    real3 p3 = (real3)(p2.x, -p2.z, p2.y);
-    /* .../scale/rotate/mandelbulb */
-    real t0;
-    real d0 = mandelbulb_p8(p3, 8, 2.0f, 1.1040895f, &t0);
-    real d2 = d0 * 0.6f;
-    /* .../a:union/a:union/b:translate */
-    real3 p4 = p0 - (real3)(0.0f, (-0.75f), 0.0f);
-    /* .../color/smooth_union/a:cylinder */
-    real d5 = sd_cylinder(p4, 0.35f, 0.2f);
-    /* .../color/smooth_union/b:translate */
-    real3 p5 = p4 - (real3)(0.0f, (-0.2f), 0.0f);
-    /* .../smooth_union/b:translate/cuboid */
-    real d6 = sd_box(p5, (real3)(0.5f, 0.05f, 0.5f));
-    /* .../b:translate/color/smooth_union */
-    real x8 = d5;
-    real y8 = d6;
-    real2 m8 = smooth_min(x8, y8, 0.05f);
-    real d8 = m8.x;
-    /* .../a:union/a:union/a:union */
-    real x11 = d2;
-    real y11 = d8;
-    real d11 = fmin(x11, y11);
-    /* .../a:union/a:union/b:translate */
-    real3 p6 = p0 - (real3)((-1.5f), (-0.55f), (-0.3f));
-    /* .../b:translate/color/rotate */
-    real3 p7 = (real3)(0.921061f * p6.x + (-0.38941833f) * p6.z, p6.y, 0.38941833f * p6.x + 0.921061f * p6.z);
-    /* .../color/rotate/scale */
-    real3 p8 = p7 / 0.4f;
-    /* .../rotate/scale/menger */
-    real t12;
-    real d12 = menger(p8, 3, 3.0f, &t12);
-    real d13 = d12 * 0.4f;
-    /* .../a:union/a:union/a:union */
-    real x17 = d11;
-    real y17 = d13;
-    real d17 = fmin(x17, y17);
-    /* .../a:union/a:union/b:translate */
-    real3 p9 = p0 - (real3)(1.5f, (-0.5f), (-0.2f));
-    /* .../b:translate/color/rotate */
-    real3 p10 = (real3)(p9.x, 0.36235777f * p9.y + 0.9320391f * p9.z, (-0.9320391f) * p9.y + 0.36235777f * p9.z);
-    /* .../color/rotate/torus */
-    real d18 = sd_torus(p10, 0.35f, 0.1f);
-    /* union/a:union/a:union */
-    real x22 = d17;
-    real y22 = d18;
-    real d22 = fmin(x22, y22);
+    /* union */
     /* union/a:union/b:translate */
-    real3 p11 = p0 - (real3)(params[0] /* orbit.x */, params[1] /* orbit.y */, params[2] /* orbit.z */);
+    real3 p1 = p0 - (real3)(params[0] /* orbit.x */, params[1] /* orbit.y */, params[2] /* orbit.z */);
     /* .../b:translate/color/sphere */
-    real d23 = sd_sphere(p11, 0.18f);
-    /* union/a:union */
-    real x26 = d22;
-    real y26 = d23;
-    real d26 = fmin(x26, y26);
+    real d23 = sd_sphere(p1, 0.18f);
     /* union/b:color/plane */
     real d27 = sd_plane(p0, (real3)(0.0f, 1.0f, 0.0f), 0.95f);
-    /* union */
-    real x29 = d26;
+    real x29 = d23;
     real y29 = d27;
     real d29 = fmin(x29, y29);
-    return d29;
+    /* union/a:union: the second operand only within reach of its bound */
+    real u26 = d29;
+    real g26 = length(p0 - (real3)(0.0f, 0.05f, 0.0f)) * 0.9999f - 0.6624537f;
+    if (!(g26 > u26 && g26 > R(0.0))) {
+        /* .../a:union/a:union/a:translate */
+        real3 p2 = p0 - (real3)(0.0f, 0.05f, 0.0f);
+        /* .../a:translate/color/scale */
+        real3 p3 = p2 / 0.6f;
+        /* .../color/scale/rotate */
+        real3 p4 = (real3)(p3.x, -p3.z, p3.y);
+        /* .../scale/rotate/mandelbulb */
+        real t0;
+        real d0 = mandelbulb_p8(p4, 8, 2.0f, 1.1040895f, &t0);
+        real d2 = d0 * 0.6f;
+        real x26 = d29;
+        real y26 = d2;
+        real d26 = fmin(x26, y26);
+        u26 = d26;
+    }
+    /* .../a:union/a:union: the second operand only within reach of its bound */
+    real u22 = u26;
+    real g22 = length(p0 - (real3)(0.0f, (-0.95f), 0.0f)) * 0.9999f - 0.72137237f;
+    if (!(g22 > u22 && g22 > R(0.0))) {
+        /* .../a:union/a:union/b:translate */
+        real3 p5 = p0 - (real3)(0.0f, (-0.75f), 0.0f);
+        /* .../color/smooth_union/a:cylinder */
+        real d5 = sd_cylinder(p5, 0.35f, 0.2f);
+        /* .../color/smooth_union: the second operand only within reach of its bound */
+        real u8 = d5;
+        real g8 = length(p5 - (real3)(0.0f, (-0.2f), 0.0f)) * 0.9999f - 0.7088723f;
+        if (!(g8 > u8 + 0.05f && g8 > R(0.0))) {
+            /* .../color/smooth_union/b:translate */
+            real3 p6 = p5 - (real3)(0.0f, (-0.2f), 0.0f);
+            /* .../smooth_union/b:translate/cuboid */
+            real d6 = sd_box(p6, (real3)(0.5f, 0.05f, 0.5f));
+            /* .../b:translate/color/smooth_union */
+            real x8 = d5;
+            real y8 = d6;
+            real2 m8 = smooth_min(x8, y8, 0.05f);
+            real d8 = m8.x;
+            u8 = d8;
+        }
+        real x22 = u26;
+        real y22 = u8;
+        real d22 = fmin(x22, y22);
+        u22 = d22;
+    }
+    /* .../a:union/a:union: the second operand only within reach of its bound */
+    real u17 = u22;
+    real g17 = length(p0 - (real3)((-1.5f), (-0.55f), (-0.3f))) * 0.9999f - 0.6928203f;
+    if (!(g17 > u17 && g17 > R(0.0))) {
+        /* .../a:union/a:union/b:translate */
+        real3 p7 = p0 - (real3)((-1.5f), (-0.55f), (-0.3f));
+        /* .../b:translate/color/rotate */
+        real3 p8 = (real3)(0.921061f * p7.x + (-0.38941833f) * p7.z, p7.y, 0.38941833f * p7.x + 0.921061f * p7.z);
+        /* .../color/rotate/scale */
+        real3 p9 = p8 / 0.4f;
+        /* .../rotate/scale/menger */
+        real t12;
+        real d12 = menger(p9, 3, 3.0f, &t12);
+        real d13 = d12 * 0.4f;
+        real x17 = u22;
+        real y17 = d13;
+        real d17 = fmin(x17, y17);
+        u17 = d17;
+    }
+    /* .../a:union/a:union: the second operand only within reach of its bound */
+    real u11 = u17;
+    real g11 = length(p0 - (real3)(1.5f, (-0.5f), (-0.2f))) * 0.9999f - 0.45f;
+    if (!(g11 > u11 && g11 > R(0.0))) {
+        /* .../a:union/a:union/b:translate */
+        real3 p10 = p0 - (real3)(1.5f, (-0.5f), (-0.2f));
+        /* .../b:translate/color/rotate */
+        real3 p11 = (real3)(p10.x, 0.36235777f * p10.y + 0.9320391f * p10.z, (-0.9320391f) * p10.y + 0.36235777f * p10.z);
+        /* .../color/rotate/torus */
+        real d18 = sd_torus(p11, 0.35f, 0.1f);
+        real x11 = u17;
+        real y11 = d18;
+        real d11 = fmin(x11, y11);
+        u11 = d11;
+    }
+    return u11;
 }
 
 real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
-    /* .../a:union/a:union/a:translate */
-    real3 p1 = p0 - (real3)(0.0f, 0.05f, 0.0f);
-    /* .../a:translate/color/scale */
-    real3 p2 = p1 / 0.6f;
-    /* .../color/scale/rotate */
-    real3 p3 = (real3)(p2.x, -p2.z, p2.y);
-    /* .../scale/rotate/mandelbulb */
-    real t0;
-    real d0 = mandelbulb_p8(p3, 8, 2.0f, 1.1040895f, &t0);
-    real d2 = d0 * 0.6f;
-    /* .../a:union/a:translate/color */
-    real3 c3 = (real3)(0.9f, 0.6f, 0.35f);
-    /* .../a:union/a:union/b:translate */
-    real3 p4 = p0 - (real3)(0.0f, (-0.75f), 0.0f);
-    /* .../color/smooth_union/a:cylinder */
-    real d5 = sd_cylinder(p4, 0.35f, 0.2f);
-    /* .../color/smooth_union/b:translate */
-    real3 p5 = p4 - (real3)(0.0f, (-0.2f), 0.0f);
-    /* .../smooth_union/b:translate/cuboid */
-    real d6 = sd_box(p5, (real3)(0.5f, 0.05f, 0.5f));
-    /* .../b:translate/color/smooth_union */
-    real x8 = d5;
-    real y8 = d6;
-    real2 m8 = smooth_min(x8, y8, 0.05f);
-    real d8 = m8.x;
-    /* .../a:union/b:translate/color */
-    real3 c9 = (real3)(0.5f, 0.5f, 0.55f);
-    /* .../a:union/a:union/a:union */
-    real x11 = d2;
-    real y11 = d8;
-    real d11 = fmin(x11, y11);
-    real3 c11 = x11 < y11 ? c3 : c9;
-    real t11 = x11 < y11 ? t0 : R(1.0);
-    /* .../a:union/a:union/b:translate */
-    real3 p6 = p0 - (real3)((-1.5f), (-0.55f), (-0.3f));
-    /* .../b:translate/color/rotate */
-    real3 p7 = (real3)(0.921061f * p6.x + (-0.38941833f) * p6.z, p6.y, 0.38941833f * p6.x + 0.921061f * p6.z);
-    /* .../color/rotate/scale */
-    real3 p8 = p7 / 0.4f;
-    /* .../rotate/scale/menger */
-    real t12;
-    real d12 = menger(p8, 3, 3.0f, &t12);
-    real d13 = d12 * 0.4f;
-    /* .../a:union/b:translate/color */
-    real3 c15 = (real3)(0.85f, 0.85f, 0.8f);
-    /* .../a:union/a:union/a:union */
-    real x17 = d11;
-    real y17 = d13;
-    real d17 = fmin(x17, y17);
-    real3 c17 = x17 < y17 ? c11 : c15;
-    real t17 = x17 < y17 ? t11 : t12;
-    /* .../a:union/a:union/b:translate */
-    real3 p9 = p0 - (real3)(1.5f, (-0.5f), (-0.2f));
-    /* .../b:translate/color/rotate */
-    real3 p10 = (real3)(p9.x, 0.36235777f * p9.y + 0.9320391f * p9.z, (-0.9320391f) * p9.y + 0.36235777f * p9.z);
-    /* .../color/rotate/torus */
-    real d18 = sd_torus(p10, 0.35f, 0.1f);
-    /* .../a:union/b:translate/color */
-    real3 c20 = (real3)(0.4f, 0.75f, 0.95f);
-    /* union/a:union/a:union */
-    real x22 = d17;
-    real y22 = d18;
-    real d22 = fmin(x22, y22);
-    real3 c22 = x22 < y22 ? c17 : c20;
-    real t22 = x22 < y22 ? t17 : R(1.0);
+    /* union */
     /* union/a:union/b:translate */
-    real3 p11 = p0 - (real3)(params[0] /* orbit.x */, params[1] /* orbit.y */, params[2] /* orbit.z */);
+    real3 p1 = p0 - (real3)(params[0] /* orbit.x */, params[1] /* orbit.y */, params[2] /* orbit.z */);
     /* .../b:translate/color/sphere */
-    real d23 = sd_sphere(p11, 0.18f);
+    real d23 = sd_sphere(p1, 0.18f);
     /* .../a:union/b:translate/color */
     real3 c24 = (real3)(0.95f, 0.4f, 0.3f);
-    /* union/a:union */
-    real x26 = d22;
-    real y26 = d23;
-    real d26 = fmin(x26, y26);
-    real3 c26 = x26 < y26 ? c22 : c24;
-    real t26 = x26 < y26 ? t22 : R(1.0);
     /* union/b:color/plane */
     real d27 = sd_plane(p0, (real3)(0.0f, 1.0f, 0.0f), 0.95f);
     /* union/b:color */
     real3 c28 = (real3)(0.55f, 0.55f, 0.6f);
-    /* union */
-    real x29 = d26;
+    real x29 = d23;
     real y29 = d27;
     real d29 = fmin(x29, y29);
-    real3 c29 = x29 < y29 ? c26 : c28;
-    real t29 = x29 < y29 ? t26 : R(1.0);
-    *color = c29;
-    *trap = t29;
-    return d29;
+    real3 c29 = x29 < y29 ? c24 : c28;
+    /* union/a:union: the second operand only within reach of its bound */
+    real u26 = d29;
+    real3 uc26 = c29;
+    real ut26 = R(1.0);
+    real g26 = length(p0 - (real3)(0.0f, 0.05f, 0.0f)) * 0.9999f - 0.6624537f;
+    if (!(g26 > u26 && g26 > R(0.0))) {
+        /* .../a:union/a:union/a:translate */
+        real3 p2 = p0 - (real3)(0.0f, 0.05f, 0.0f);
+        /* .../a:translate/color/scale */
+        real3 p3 = p2 / 0.6f;
+        /* .../color/scale/rotate */
+        real3 p4 = (real3)(p3.x, -p3.z, p3.y);
+        /* .../scale/rotate/mandelbulb */
+        real t0;
+        real d0 = mandelbulb_p8(p4, 8, 2.0f, 1.1040895f, &t0);
+        real d2 = d0 * 0.6f;
+        /* .../a:union/a:translate/color */
+        real3 c3 = (real3)(0.9f, 0.6f, 0.35f);
+        real x26 = d29;
+        real y26 = d2;
+        real d26 = fmin(x26, y26);
+        real3 c26 = x26 < y26 ? c29 : c3;
+        real t26 = x26 < y26 ? R(1.0) : t0;
+        u26 = d26;
+        uc26 = c26;
+        ut26 = t26;
+    }
+    /* .../a:union/a:union: the second operand only within reach of its bound */
+    real u22 = u26;
+    real3 uc22 = uc26;
+    real ut22 = ut26;
+    real g22 = length(p0 - (real3)(0.0f, (-0.95f), 0.0f)) * 0.9999f - 0.72137237f;
+    if (!(g22 > u22 && g22 > R(0.0))) {
+        /* .../a:union/a:union/b:translate */
+        real3 p5 = p0 - (real3)(0.0f, (-0.75f), 0.0f);
+        /* .../color/smooth_union/a:cylinder */
+        real d5 = sd_cylinder(p5, 0.35f, 0.2f);
+        /* .../color/smooth_union: the second operand only within reach of its bound */
+        real u8 = d5;
+        real ut8 = R(1.0);
+        real g8 = length(p5 - (real3)(0.0f, (-0.2f), 0.0f)) * 0.9999f - 0.7088723f;
+        if (!(g8 > u8 + 0.05f && g8 > R(0.0))) {
+            /* .../color/smooth_union/b:translate */
+            real3 p6 = p5 - (real3)(0.0f, (-0.2f), 0.0f);
+            /* .../smooth_union/b:translate/cuboid */
+            real d6 = sd_box(p6, (real3)(0.5f, 0.05f, 0.5f));
+            /* .../b:translate/color/smooth_union */
+            real x8 = d5;
+            real y8 = d6;
+            real2 m8 = smooth_min(x8, y8, 0.05f);
+            real d8 = m8.x;
+            u8 = d8;
+            ut8 = R(1.0);
+        }
+        /* .../a:union/b:translate/color */
+        real3 c9 = (real3)(0.5f, 0.5f, 0.55f);
+        real x22 = u26;
+        real y22 = u8;
+        real d22 = fmin(x22, y22);
+        real3 c22 = x22 < y22 ? uc26 : c9;
+        real t22 = x22 < y22 ? ut26 : ut8;
+        u22 = d22;
+        uc22 = c22;
+        ut22 = t22;
+    }
+    /* .../a:union/a:union: the second operand only within reach of its bound */
+    real u17 = u22;
+    real3 uc17 = uc22;
+    real ut17 = ut22;
+    real g17 = length(p0 - (real3)((-1.5f), (-0.55f), (-0.3f))) * 0.9999f - 0.6928203f;
+    if (!(g17 > u17 && g17 > R(0.0))) {
+        /* .../a:union/a:union/b:translate */
+        real3 p7 = p0 - (real3)((-1.5f), (-0.55f), (-0.3f));
+        /* .../b:translate/color/rotate */
+        real3 p8 = (real3)(0.921061f * p7.x + (-0.38941833f) * p7.z, p7.y, 0.38941833f * p7.x + 0.921061f * p7.z);
+        /* .../color/rotate/scale */
+        real3 p9 = p8 / 0.4f;
+        /* .../rotate/scale/menger */
+        real t12;
+        real d12 = menger(p9, 3, 3.0f, &t12);
+        real d13 = d12 * 0.4f;
+        /* .../a:union/b:translate/color */
+        real3 c15 = (real3)(0.85f, 0.85f, 0.8f);
+        real x17 = u22;
+        real y17 = d13;
+        real d17 = fmin(x17, y17);
+        real3 c17 = x17 < y17 ? uc22 : c15;
+        real t17 = x17 < y17 ? ut22 : t12;
+        u17 = d17;
+        uc17 = c17;
+        ut17 = t17;
+    }
+    /* .../a:union/a:union: the second operand only within reach of its bound */
+    real u11 = u17;
+    real3 uc11 = uc17;
+    real ut11 = ut17;
+    real g11 = length(p0 - (real3)(1.5f, (-0.5f), (-0.2f))) * 0.9999f - 0.45f;
+    if (!(g11 > u11 && g11 > R(0.0))) {
+        /* .../a:union/a:union/b:translate */
+        real3 p10 = p0 - (real3)(1.5f, (-0.5f), (-0.2f));
+        /* .../b:translate/color/rotate */
+        real3 p11 = (real3)(p10.x, 0.36235777f * p10.y + 0.9320391f * p10.z, (-0.9320391f) * p10.y + 0.36235777f * p10.z);
+        /* .../color/rotate/torus */
+        real d18 = sd_torus(p11, 0.35f, 0.1f);
+        /* .../a:union/b:translate/color */
+        real3 c20 = (real3)(0.4f, 0.75f, 0.95f);
+        real x11 = u17;
+        real y11 = d18;
+        real d11 = fmin(x11, y11);
+        real3 c11 = x11 < y11 ? uc17 : c20;
+        real t11 = x11 < y11 ? ut17 : R(1.0);
+        u11 = d11;
+        uc11 = c11;
+        ut11 = t11;
+    }
+    *color = uc11;
+    *trap = ut11;
+    return u11;
 }
 
 /* ---- kernel: march.cl ---- */

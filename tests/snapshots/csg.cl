@@ -22,6 +22,7 @@ typedef float4 real4;
 #define AO_SAMPLES 5
 #define AO_DISTANCE 0.25f
 #define SHADOW_STEPS 96
+#define CONE_TILE 8
 #define ENABLE_AO
 #define ENABLE_SHADOWS
 /* The kernel interface (src/codegen/interface.rs). */
@@ -42,7 +43,14 @@ typedef float4 real4;
     __global uchar* hit_mask, \
     __global float* normals, \
     __global uint* steps, \
-    __global uint* evaluations
+    __global uint* evaluations, \
+    __global const float* starts
+#define CONE_STARTS_ARGS \
+    __global const real* params, \
+    __global const real* camera, \
+    const int width, \
+    const int height, \
+    __global float* starts
 #define CAMERA_ORIGIN 0
 #define CAMERA_ORTHOGRAPHIC 3
 #define CAMERA_RIGHT 4
@@ -52,6 +60,9 @@ typedef float4 real4;
 #define CAMERA_FORWARD 12
 #define CAMERA_FOOTPRINT_BASE 15
 #define CAMERA_FOOTPRINT_PER_UNIT 16
+#define CAMERA_IMAGE_WIDTH 17
+#define CAMERA_IMAGE_HEIGHT 18
+#define CAMERA_PIXEL_SCALE 19
 #define LIGHT_POSITION 0
 #define LIGHT_KIND 3
 #define LIGHT_RADIANCE 4
@@ -101,134 +112,209 @@ real2 smooth_min(real a, real b, real k) {
 
 /* ---- scene ---- */
 real DE(real3 p0, __global const real* params) {
-    /* .../a:union/a:union/a:translate */
-    real3 p1 = p0 - (real3)((-1.3f), 0.0f, 0.0f);
-    /* .../color/smooth_union/a:sphere */
-    real d0 = sd_sphere(p1, 0.55f);
-    /* .../color/smooth_union/b:translate */
-    real3 p2 = p1 - (real3)(0.45f, 0.0f, 0.0f);
-    /* .../smooth_union/b:translate/cuboid */
-    real d1 = sd_box(p2, (real3)(0.35f));
-    /* .../a:translate/color/smooth_union */
-    real x3 = d0;
-    real y3 = d1;
-    real2 m3 = smooth_min(x3, y3, 0.25f);
-    real d3 = m3.x;
-    /* .../a:union/a:union/b:rotate */
-    real3 p3 = (real3)(0.8253356f * p0.x + (-0.5646425f) * p0.z, p0.y, 0.5646425f * p0.x + 0.8253356f * p0.z);
-    /* .../color/smooth_subtract/a:round_box */
-    real d6 = sd_round_box(p3, (real3)(0.5f), 0.08f);
-    /* .../color/smooth_subtract/b:sphere */
-    real d7 = sd_sphere(p3, 0.62f);
-    /* .../b:rotate/color/smooth_subtract */
-    real x8 = -d6;
-    real y8 = d7;
-    real2 m8 = smooth_min(x8, y8, 0.08f);
-    real d8 = -m8.x;
-    /* union/a:union/a:union */
-    real x11 = d3;
-    real y11 = d8;
-    real d11 = fmin(x11, y11);
-    /* union/a:union/b:translate */
-    real3 p4 = p0 - (real3)(1.3f, 0.0f, 0.0f);
-    /* .../a:union/b:translate/rotate */
-    real3 p5 = (real3)(p4.x, 0.62161f * p4.y + 0.7833269f * p4.z, (-0.7833269f) * p4.y + 0.62161f * p4.z);
-    /* .../color/smooth_intersect/a:translate */
-    real3 p6 = p5 - (real3)(0.0f, 0.0f, 0.3f);
-    /* .../smooth_intersect/a:translate/sphere */
-    real d12 = sd_sphere(p6, 0.6f);
-    /* .../color/smooth_intersect/b:translate */
-    real3 p7 = p5 - (real3)(0.0f, 0.0f, (-0.3f));
-    /* .../smooth_intersect/b:translate/sphere */
-    real d14 = sd_sphere(p7, 0.6f);
-    /* .../rotate/color/smooth_intersect */
-    real x16 = -d12;
-    real y16 = -d14;
-    real2 m16 = smooth_min(x16, y16, 0.1f);
-    real d16 = -m16.x;
-    /* union/a:union */
-    real x20 = d11;
-    real y20 = d16;
-    real d20 = fmin(x20, y20);
+    /* union */
     /* union/b:color/plane */
     real d21 = sd_plane(p0, (real3)(0.0f, 1.0f, 0.0f), 0.6f);
-    /* union */
-    real x23 = d20;
-    real y23 = d21;
-    real d23 = fmin(x23, y23);
-    return d23;
+    /* union: the second operand only within reach of its bound */
+    real u23 = d21;
+    real g23 = length(p0 - (real3)((-1.0468911f), 0.0f, 0.0f)) * 0.9999f - 0.8656089f;
+    if (!(g23 > u23 && g23 > R(0.0))) {
+        /* .../a:union/a:union/a:translate */
+        real3 p1 = p0 - (real3)((-1.3f), 0.0f, 0.0f);
+        /* .../color/smooth_union/a:sphere */
+        real d0 = sd_sphere(p1, 0.55f);
+        /* .../color/smooth_union: the second operand only within reach of its bound */
+        real u3 = d0;
+        real g3 = length(p1 - (real3)(0.45f, 0.0f, 0.0f)) * 0.9999f - 0.6062178f;
+        if (!(g3 > u3 + 0.25f && g3 > R(0.0))) {
+            /* .../color/smooth_union/b:translate */
+            real3 p2 = p1 - (real3)(0.45f, 0.0f, 0.0f);
+            /* .../smooth_union/b:translate/cuboid */
+            real d1 = sd_box(p2, (real3)(0.35f));
+            /* .../a:translate/color/smooth_union */
+            real x3 = d0;
+            real y3 = d1;
+            real2 m3 = smooth_min(x3, y3, 0.25f);
+            real d3 = m3.x;
+            u3 = d3;
+        }
+        real x23 = d21;
+        real y23 = u3;
+        real d23 = fmin(x23, y23);
+        u23 = d23;
+    }
+    /* union/a:union: the second operand only within reach of its bound */
+    real u20 = u23;
+    real g20 = length(p0 - (real3)(0.0f)) * 0.9999f - 0.8660254f;
+    if (!(g20 > u20 && g20 > R(0.0))) {
+        /* .../a:union/a:union/b:rotate */
+        real3 p3 = (real3)(0.8253356f * p0.x + (-0.5646425f) * p0.z, p0.y, 0.5646425f * p0.x + 0.8253356f * p0.z);
+        /* .../color/smooth_subtract/a:round_box */
+        real d6 = sd_round_box(p3, (real3)(0.5f), 0.08f);
+        /* .../color/smooth_subtract: the second operand only within reach of its bound */
+        real u8 = d6;
+        real g8 = length(p3 - (real3)(0.0f)) * 0.9999f - 0.62f;
+        if (!(g8 > -u8 + 0.08f && g8 > R(0.0))) {
+            /* .../color/smooth_subtract/b:sphere */
+            real d7 = sd_sphere(p3, 0.62f);
+            /* .../b:rotate/color/smooth_subtract */
+            real x8 = -d6;
+            real y8 = d7;
+            real2 m8 = smooth_min(x8, y8, 0.08f);
+            real d8 = -m8.x;
+            u8 = d8;
+        }
+        real x20 = u23;
+        real y20 = u8;
+        real d20 = fmin(x20, y20);
+        u20 = d20;
+    }
+    /* .../a:union/a:union: the second operand only within reach of its bound */
+    real u11 = u20;
+    real g11 = length(p0 - (real3)(1.3f, (-0.23499808f), 0.186483f)) * 0.9999f - 0.6f;
+    if (!(g11 > u11 && g11 > R(0.0))) {
+        /* union/a:union/b:translate */
+        real3 p4 = p0 - (real3)(1.3f, 0.0f, 0.0f);
+        /* .../a:union/b:translate/rotate */
+        real3 p5 = (real3)(p4.x, 0.62161f * p4.y + 0.7833269f * p4.z, (-0.7833269f) * p4.y + 0.62161f * p4.z);
+        /* .../color/smooth_intersect/a:translate */
+        real3 p6 = p5 - (real3)(0.0f, 0.0f, 0.3f);
+        /* .../smooth_intersect/a:translate/sphere */
+        real d12 = sd_sphere(p6, 0.6f);
+        /* .../color/smooth_intersect/b:translate */
+        real3 p7 = p5 - (real3)(0.0f, 0.0f, (-0.3f));
+        /* .../smooth_intersect/b:translate/sphere */
+        real d14 = sd_sphere(p7, 0.6f);
+        /* .../rotate/color/smooth_intersect */
+        real x16 = -d12;
+        real y16 = -d14;
+        real2 m16 = smooth_min(x16, y16, 0.1f);
+        real d16 = -m16.x;
+        real x11 = u20;
+        real y11 = d16;
+        real d11 = fmin(x11, y11);
+        u11 = d11;
+    }
+    return u11;
 }
 
 real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
-    /* .../a:union/a:union/a:translate */
-    real3 p1 = p0 - (real3)((-1.3f), 0.0f, 0.0f);
-    /* .../color/smooth_union/a:sphere */
-    real d0 = sd_sphere(p1, 0.55f);
-    /* .../color/smooth_union/b:translate */
-    real3 p2 = p1 - (real3)(0.45f, 0.0f, 0.0f);
-    /* .../smooth_union/b:translate/cuboid */
-    real d1 = sd_box(p2, (real3)(0.35f));
-    /* .../a:translate/color/smooth_union */
-    real x3 = d0;
-    real y3 = d1;
-    real2 m3 = smooth_min(x3, y3, 0.25f);
-    real d3 = m3.x;
-    /* .../a:union/a:translate/color */
-    real3 c4 = (real3)(0.95f, 0.45f, 0.2f);
-    /* .../a:union/a:union/b:rotate */
-    real3 p3 = (real3)(0.8253356f * p0.x + (-0.5646425f) * p0.z, p0.y, 0.5646425f * p0.x + 0.8253356f * p0.z);
-    /* .../color/smooth_subtract/a:round_box */
-    real d6 = sd_round_box(p3, (real3)(0.5f), 0.08f);
-    /* .../color/smooth_subtract/b:sphere */
-    real d7 = sd_sphere(p3, 0.62f);
-    /* .../b:rotate/color/smooth_subtract */
-    real x8 = -d6;
-    real y8 = d7;
-    real2 m8 = smooth_min(x8, y8, 0.08f);
-    real d8 = -m8.x;
-    /* .../a:union/b:rotate/color */
-    real3 c9 = (real3)(0.3f, 0.65f, 0.95f);
-    /* union/a:union/a:union */
-    real x11 = d3;
-    real y11 = d8;
-    real d11 = fmin(x11, y11);
-    real3 c11 = x11 < y11 ? c4 : c9;
-    /* union/a:union/b:translate */
-    real3 p4 = p0 - (real3)(1.3f, 0.0f, 0.0f);
-    /* .../a:union/b:translate/rotate */
-    real3 p5 = (real3)(p4.x, 0.62161f * p4.y + 0.7833269f * p4.z, (-0.7833269f) * p4.y + 0.62161f * p4.z);
-    /* .../color/smooth_intersect/a:translate */
-    real3 p6 = p5 - (real3)(0.0f, 0.0f, 0.3f);
-    /* .../smooth_intersect/a:translate/sphere */
-    real d12 = sd_sphere(p6, 0.6f);
-    /* .../color/smooth_intersect/b:translate */
-    real3 p7 = p5 - (real3)(0.0f, 0.0f, (-0.3f));
-    /* .../smooth_intersect/b:translate/sphere */
-    real d14 = sd_sphere(p7, 0.6f);
-    /* .../rotate/color/smooth_intersect */
-    real x16 = -d12;
-    real y16 = -d14;
-    real2 m16 = smooth_min(x16, y16, 0.1f);
-    real d16 = -m16.x;
-    /* .../b:translate/rotate/color */
-    real3 c17 = (real3)(0.4f, 0.85f, 0.45f);
-    /* union/a:union */
-    real x20 = d11;
-    real y20 = d16;
-    real d20 = fmin(x20, y20);
-    real3 c20 = x20 < y20 ? c11 : c17;
+    /* union */
     /* union/b:color/plane */
     real d21 = sd_plane(p0, (real3)(0.0f, 1.0f, 0.0f), 0.6f);
     /* union/b:color */
     real3 c22 = (real3)(0.55f, 0.55f, 0.6f);
-    /* union */
-    real x23 = d20;
-    real y23 = d21;
-    real d23 = fmin(x23, y23);
-    real3 c23 = x23 < y23 ? c20 : c22;
-    *color = c23;
-    *trap = R(1.0);
-    return d23;
+    /* union: the second operand only within reach of its bound */
+    real u23 = d21;
+    real3 uc23 = c22;
+    real ut23 = R(1.0);
+    real g23 = length(p0 - (real3)((-1.0468911f), 0.0f, 0.0f)) * 0.9999f - 0.8656089f;
+    if (!(g23 > u23 && g23 > R(0.0))) {
+        /* .../a:union/a:union/a:translate */
+        real3 p1 = p0 - (real3)((-1.3f), 0.0f, 0.0f);
+        /* .../color/smooth_union/a:sphere */
+        real d0 = sd_sphere(p1, 0.55f);
+        /* .../color/smooth_union: the second operand only within reach of its bound */
+        real u3 = d0;
+        real ut3 = R(1.0);
+        real g3 = length(p1 - (real3)(0.45f, 0.0f, 0.0f)) * 0.9999f - 0.6062178f;
+        if (!(g3 > u3 + 0.25f && g3 > R(0.0))) {
+            /* .../color/smooth_union/b:translate */
+            real3 p2 = p1 - (real3)(0.45f, 0.0f, 0.0f);
+            /* .../smooth_union/b:translate/cuboid */
+            real d1 = sd_box(p2, (real3)(0.35f));
+            /* .../a:translate/color/smooth_union */
+            real x3 = d0;
+            real y3 = d1;
+            real2 m3 = smooth_min(x3, y3, 0.25f);
+            real d3 = m3.x;
+            u3 = d3;
+            ut3 = R(1.0);
+        }
+        /* .../a:union/a:translate/color */
+        real3 c4 = (real3)(0.95f, 0.45f, 0.2f);
+        real x23 = d21;
+        real y23 = u3;
+        real d23 = fmin(x23, y23);
+        real3 c23 = x23 < y23 ? c22 : c4;
+        real t23 = x23 < y23 ? R(1.0) : ut3;
+        u23 = d23;
+        uc23 = c23;
+        ut23 = t23;
+    }
+    /* union/a:union: the second operand only within reach of its bound */
+    real u20 = u23;
+    real3 uc20 = uc23;
+    real ut20 = ut23;
+    real g20 = length(p0 - (real3)(0.0f)) * 0.9999f - 0.8660254f;
+    if (!(g20 > u20 && g20 > R(0.0))) {
+        /* .../a:union/a:union/b:rotate */
+        real3 p3 = (real3)(0.8253356f * p0.x + (-0.5646425f) * p0.z, p0.y, 0.5646425f * p0.x + 0.8253356f * p0.z);
+        /* .../color/smooth_subtract/a:round_box */
+        real d6 = sd_round_box(p3, (real3)(0.5f), 0.08f);
+        /* .../color/smooth_subtract: the second operand only within reach of its bound */
+        real u8 = d6;
+        real ut8 = R(1.0);
+        real g8 = length(p3 - (real3)(0.0f)) * 0.9999f - 0.62f;
+        if (!(g8 > -u8 + 0.08f && g8 > R(0.0))) {
+            /* .../color/smooth_subtract/b:sphere */
+            real d7 = sd_sphere(p3, 0.62f);
+            /* .../b:rotate/color/smooth_subtract */
+            real x8 = -d6;
+            real y8 = d7;
+            real2 m8 = smooth_min(x8, y8, 0.08f);
+            real d8 = -m8.x;
+            u8 = d8;
+            ut8 = R(1.0);
+        }
+        /* .../a:union/b:rotate/color */
+        real3 c9 = (real3)(0.3f, 0.65f, 0.95f);
+        real x20 = u23;
+        real y20 = u8;
+        real d20 = fmin(x20, y20);
+        real3 c20 = x20 < y20 ? uc23 : c9;
+        real t20 = x20 < y20 ? ut23 : ut8;
+        u20 = d20;
+        uc20 = c20;
+        ut20 = t20;
+    }
+    /* .../a:union/a:union: the second operand only within reach of its bound */
+    real u11 = u20;
+    real3 uc11 = uc20;
+    real ut11 = ut20;
+    real g11 = length(p0 - (real3)(1.3f, (-0.23499808f), 0.186483f)) * 0.9999f - 0.6f;
+    if (!(g11 > u11 && g11 > R(0.0))) {
+        /* union/a:union/b:translate */
+        real3 p4 = p0 - (real3)(1.3f, 0.0f, 0.0f);
+        /* .../a:union/b:translate/rotate */
+        real3 p5 = (real3)(p4.x, 0.62161f * p4.y + 0.7833269f * p4.z, (-0.7833269f) * p4.y + 0.62161f * p4.z);
+        /* .../color/smooth_intersect/a:translate */
+        real3 p6 = p5 - (real3)(0.0f, 0.0f, 0.3f);
+        /* .../smooth_intersect/a:translate/sphere */
+        real d12 = sd_sphere(p6, 0.6f);
+        /* .../color/smooth_intersect/b:translate */
+        real3 p7 = p5 - (real3)(0.0f, 0.0f, (-0.3f));
+        /* .../smooth_intersect/b:translate/sphere */
+        real d14 = sd_sphere(p7, 0.6f);
+        /* .../rotate/color/smooth_intersect */
+        real x16 = -d12;
+        real y16 = -d14;
+        real2 m16 = smooth_min(x16, y16, 0.1f);
+        real d16 = -m16.x;
+        /* .../b:translate/rotate/color */
+        real3 c17 = (real3)(0.4f, 0.85f, 0.45f);
+        real x11 = u20;
+        real y11 = d16;
+        real d11 = fmin(x11, y11);
+        real3 c11 = x11 < y11 ? uc20 : c17;
+        real t11 = x11 < y11 ? ut20 : R(1.0);
+        u11 = d11;
+        uc11 = c11;
+        ut11 = t11;
+    }
+    *color = uc11;
+    *trap = ut11;
+    return u11;
 }
 
 /* ---- kernel: march.cl ---- */

@@ -22,6 +22,7 @@ typedef float4 real4;
 #define AO_SAMPLES 5
 #define AO_DISTANCE 0.25f
 #define SHADOW_STEPS 96
+#define CONE_TILE 8
 #define ENABLE_AO
 #define ENABLE_SHADOWS
 /* The kernel interface (src/codegen/interface.rs). */
@@ -42,7 +43,14 @@ typedef float4 real4;
     __global uchar* hit_mask, \
     __global float* normals, \
     __global uint* steps, \
-    __global uint* evaluations
+    __global uint* evaluations, \
+    __global const float* starts
+#define CONE_STARTS_ARGS \
+    __global const real* params, \
+    __global const real* camera, \
+    const int width, \
+    const int height, \
+    __global float* starts
 #define CAMERA_ORIGIN 0
 #define CAMERA_ORTHOGRAPHIC 3
 #define CAMERA_RIGHT 4
@@ -52,6 +60,9 @@ typedef float4 real4;
 #define CAMERA_FORWARD 12
 #define CAMERA_FOOTPRINT_BASE 15
 #define CAMERA_FOOTPRINT_PER_UNIT 16
+#define CAMERA_IMAGE_WIDTH 17
+#define CAMERA_IMAGE_HEIGHT 18
+#define CAMERA_PIXEL_SCALE 19
 #define LIGHT_POSITION 0
 #define LIGHT_KIND 3
 #define LIGHT_RADIANCE 4
@@ -119,208 +130,298 @@ real bend_bound(real d, real k, real rho) {
 
 /* ---- scene ---- */
 real DE(real3 p0, __global const real* params) {
-    /* .../a:union/a:union/a:translate */
-    real3 p1 = p0 - (real3)((-1.5f), 0.0f, 0.0f);
-    /* .../color/intersect/a:twist */
-    real s1 = sin(2.0f * p1.y);
-    real k1 = cos(2.0f * p1.y);
-    real3 p2 = (real3)(k1 * p1.x - s1 * p1.z, p1.y, s1 * p1.x + k1 * p1.z);
-    /* .../intersect/a:twist/cuboid */
-    real d0 = sd_box(p2, (real3)(0.25f, 0.6f, 0.25f));
-    real d1 = twist_bound(d0, 2.0f, hypot(p1.x, p1.z));
-    /* .../color/intersect/b:cylinder */
-    real d2 = sd_cylinder(p1, 0.36f, 0.6f);
-    /* .../a:translate/color/intersect */
-    real x3 = -d1;
-    real y3 = -d2;
-    real d3 = -fmin(x3, y3);
-    /* .../a:union/a:union/b:translate */
-    real3 p3 = p0 - (real3)((-0.4f), 0.0f, 0.0f);
-    /* .../color/intersect/a:bend */
-    real s7 = sin(0.8f * p3.x);
-    real k7 = cos(0.8f * p3.x);
-    real3 p4 = (real3)(k7 * p3.x - s7 * p3.y, s7 * p3.x + k7 * p3.y, p3.z);
-    /* .../intersect/a:bend/cuboid */
-    real d6 = sd_box(p4, (real3)(0.6f, 0.1f, 0.2f));
-    real d7 = bend_bound(d6, 0.8f, hypot(p3.x, p3.y));
-    /* .../color/intersect/b:sphere */
-    real d8 = sd_sphere(p3, 0.65f);
-    /* .../b:translate/color/intersect */
-    real x9 = -d7;
-    real y9 = -d8;
-    real d9 = -fmin(x9, y9);
-    /* .../a:union/a:union/a:union */
-    real x12 = d3;
-    real y12 = d9;
-    real d12 = fmin(x12, y12);
-    /* .../a:union/a:union/b:translate */
-    real3 p5 = p0 - (real3)(0.65f, 0.0f, 0.0f);
-    /* .../subtract/a:onion/sphere */
-    real d13 = sd_sphere(p5, 0.45f);
-    /* .../color/subtract/a:onion */
-    real d14 = fabs(d13) - 0.04f;
-    /* .../color/subtract/b:translate */
-    real3 p6 = p5 - (real3)(0.0f, 1.2f, 0.0f);
-    /* .../subtract/b:translate/cuboid */
-    real d15 = sd_box(p6, (real3)(1.0f));
-    /* .../b:translate/color/subtract */
-    real x17 = -d14;
-    real y17 = d15;
-    real d17 = -fmin(x17, y17);
-    /* .../a:union/a:union/a:union */
-    real x20 = d12;
-    real y20 = d17;
-    real d20 = fmin(x20, y20);
-    /* .../a:union/a:union/b:translate */
-    real3 p7 = p0 - (real3)(1.6f, (-0.25f), 0.0f);
-    /* .../b:translate/color/repeat_limited */
-    real3 p8 = p7;
-    p8.x = p7.x - 0.35f * clamp(round(p7.x / 0.35f), -1.0f, 1.0f);
-    p8.z = p7.z - 0.35f * clamp(round(p7.z / 0.35f), -1.0f, 1.0f);
-    /* .../color/repeat_limited/elongate */
-    real3 p9 = p8 - clamp(p8, -(real3)(0.0f, 0.15f, 0.0f), (real3)(0.0f, 0.15f, 0.0f));
-    /* .../repeat_limited/elongate/sphere */
-    real d21 = sd_sphere(p9, 0.12f);
-    /* union/a:union/a:union */
-    real x26 = d20;
-    real y26 = d21;
-    real d26 = fmin(x26, y26);
-    /* union/a:union/b:translate */
-    real3 p10 = p0 - (real3)(0.0f, 0.85f, (-0.8f));
-    /* .../color/round/mirror */
-    real3 p11 = p10;
-    p11.x = fabs(p11.x);
-    /* .../round/mirror/translate */
-    real3 p12 = p11 - (real3)(0.5f, 0.0f, 0.0f);
-    /* .../mirror/translate/rotate */
-    real3 p13 = (real3)(p12.x, p12.z, -p12.y);
-    /* .../translate/rotate/torus */
-    real d27 = sd_torus(p13, 0.2f, 0.06f);
-    /* .../b:translate/color/round */
-    real d31 = d27 - 0.01f;
-    /* union/a:union */
-    real x34 = d26;
-    real y34 = d31;
-    real d34 = fmin(x34, y34);
+    /* union */
     /* union/b:color/plane */
     real d35 = sd_plane(p0, (real3)(0.0f, 1.0f, 0.0f), 0.6f);
-    /* union */
-    real x37 = d34;
-    real y37 = d35;
-    real d37 = fmin(x37, y37);
-    return d37;
+    /* union: the second operand only within reach of its bound */
+    real u37 = d35;
+    real g37 = length(p0 - (real3)((-1.5f), 0.0f, 0.0f)) * 0.9999f - 0.69971424f;
+    if (!(g37 > u37 && g37 > R(0.0))) {
+        /* .../a:union/a:union/a:translate */
+        real3 p1 = p0 - (real3)((-1.5f), 0.0f, 0.0f);
+        /* .../color/intersect/a:twist */
+        real s1 = sin(2.0f * p1.y);
+        real k1 = cos(2.0f * p1.y);
+        real3 p2 = (real3)(k1 * p1.x - s1 * p1.z, p1.y, s1 * p1.x + k1 * p1.z);
+        /* .../intersect/a:twist/cuboid */
+        real d0 = sd_box(p2, (real3)(0.25f, 0.6f, 0.25f));
+        real d1 = twist_bound(d0, 2.0f, hypot(p1.x, p1.z));
+        /* .../color/intersect/b:cylinder */
+        real d2 = sd_cylinder(p1, 0.36f, 0.6f);
+        /* .../a:translate/color/intersect */
+        real x3 = -d1;
+        real y3 = -d2;
+        real d3 = -fmin(x3, y3);
+        real x37 = d35;
+        real y37 = d3;
+        real d37 = fmin(x37, y37);
+        u37 = d37;
+    }
+    /* union/a:union: the second operand only within reach of its bound */
+    real u34 = u37;
+    real g34 = length(p0 - (real3)((-0.4f), 0.0f, 0.0f)) * 0.9999f - 0.65f;
+    if (!(g34 > u34 && g34 > R(0.0))) {
+        /* .../a:union/a:union/b:translate */
+        real3 p3 = p0 - (real3)((-0.4f), 0.0f, 0.0f);
+        /* .../color/intersect/a:bend */
+        real s7 = sin(0.8f * p3.x);
+        real k7 = cos(0.8f * p3.x);
+        real3 p4 = (real3)(k7 * p3.x - s7 * p3.y, s7 * p3.x + k7 * p3.y, p3.z);
+        /* .../intersect/a:bend/cuboid */
+        real d6 = sd_box(p4, (real3)(0.6f, 0.1f, 0.2f));
+        real d7 = bend_bound(d6, 0.8f, hypot(p3.x, p3.y));
+        /* .../color/intersect/b:sphere */
+        real d8 = sd_sphere(p3, 0.65f);
+        /* .../b:translate/color/intersect */
+        real x9 = -d7;
+        real y9 = -d8;
+        real d9 = -fmin(x9, y9);
+        real x34 = u37;
+        real y34 = d9;
+        real d34 = fmin(x34, y34);
+        u34 = d34;
+    }
+    /* .../a:union/a:union: the second operand only within reach of its bound */
+    real u26 = u34;
+    real g26 = length(p0 - (real3)(0.65f, 0.0f, 0.0f)) * 0.9999f - 0.49f;
+    if (!(g26 > u26 && g26 > R(0.0))) {
+        /* .../a:union/a:union/b:translate */
+        real3 p5 = p0 - (real3)(0.65f, 0.0f, 0.0f);
+        /* .../subtract/a:onion/sphere */
+        real d13 = sd_sphere(p5, 0.45f);
+        /* .../color/subtract/a:onion */
+        real d14 = fabs(d13) - 0.04f;
+        /* .../color/subtract: the second operand only within reach of its bound */
+        real u17 = d14;
+        real g17 = length(p5 - (real3)(0.0f, 1.2f, 0.0f)) * 0.9999f - 1.7320508f;
+        if (!(g17 > -u17 && g17 > R(0.0))) {
+            /* .../color/subtract/b:translate */
+            real3 p6 = p5 - (real3)(0.0f, 1.2f, 0.0f);
+            /* .../subtract/b:translate/cuboid */
+            real d15 = sd_box(p6, (real3)(1.0f));
+            /* .../b:translate/color/subtract */
+            real x17 = -d14;
+            real y17 = d15;
+            real d17 = -fmin(x17, y17);
+            u17 = d17;
+        }
+        real x26 = u34;
+        real y26 = u17;
+        real d26 = fmin(x26, y26);
+        u26 = d26;
+    }
+    /* .../a:union/a:union: the second operand only within reach of its bound */
+    real u20 = u26;
+    real g20 = length(p0 - (real3)(1.6f, (-0.25f), 0.0f)) * 0.9999f - 0.7649748f;
+    if (!(g20 > u20 && g20 > R(0.0))) {
+        /* .../a:union/a:union/b:translate */
+        real3 p7 = p0 - (real3)(1.6f, (-0.25f), 0.0f);
+        /* .../b:translate/color/repeat_limited */
+        real3 p8 = p7;
+        p8.x = p7.x - 0.35f * clamp(round(p7.x / 0.35f), -1.0f, 1.0f);
+        p8.z = p7.z - 0.35f * clamp(round(p7.z / 0.35f), -1.0f, 1.0f);
+        /* .../color/repeat_limited/elongate */
+        real3 p9 = p8 - clamp(p8, -(real3)(0.0f, 0.15f, 0.0f), (real3)(0.0f, 0.15f, 0.0f));
+        /* .../repeat_limited/elongate/sphere */
+        real d21 = sd_sphere(p9, 0.12f);
+        real x20 = u26;
+        real y20 = d21;
+        real d20 = fmin(x20, y20);
+        u20 = d20;
+    }
+    /* .../a:union/a:union: the second operand only within reach of its bound */
+    real u12 = u20;
+    real g12 = length(p0 - (real3)(0.0f, 0.85f, (-0.8f))) * 0.9999f - 0.77f;
+    if (!(g12 > u12 && g12 > R(0.0))) {
+        /* union/a:union/b:translate */
+        real3 p10 = p0 - (real3)(0.0f, 0.85f, (-0.8f));
+        /* .../color/round/mirror */
+        real3 p11 = p10;
+        p11.x = fabs(p11.x);
+        /* .../round/mirror/translate */
+        real3 p12 = p11 - (real3)(0.5f, 0.0f, 0.0f);
+        /* .../mirror/translate/rotate */
+        real3 p13 = (real3)(p12.x, p12.z, -p12.y);
+        /* .../translate/rotate/torus */
+        real d27 = sd_torus(p13, 0.2f, 0.06f);
+        /* .../b:translate/color/round */
+        real d31 = d27 - 0.01f;
+        real x12 = u20;
+        real y12 = d31;
+        real d12 = fmin(x12, y12);
+        u12 = d12;
+    }
+    return u12;
 }
 
 real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
-    /* .../a:union/a:union/a:translate */
-    real3 p1 = p0 - (real3)((-1.5f), 0.0f, 0.0f);
-    /* .../color/intersect/a:twist */
-    real s1 = sin(2.0f * p1.y);
-    real k1 = cos(2.0f * p1.y);
-    real3 p2 = (real3)(k1 * p1.x - s1 * p1.z, p1.y, s1 * p1.x + k1 * p1.z);
-    /* .../intersect/a:twist/cuboid */
-    real d0 = sd_box(p2, (real3)(0.25f, 0.6f, 0.25f));
-    real d1 = twist_bound(d0, 2.0f, hypot(p1.x, p1.z));
-    /* .../color/intersect/b:cylinder */
-    real d2 = sd_cylinder(p1, 0.36f, 0.6f);
-    /* .../a:translate/color/intersect */
-    real x3 = -d1;
-    real y3 = -d2;
-    real d3 = -fmin(x3, y3);
-    /* .../a:union/a:translate/color */
-    real3 c4 = (real3)(0.9f, 0.4f, 0.4f);
-    /* .../a:union/a:union/b:translate */
-    real3 p3 = p0 - (real3)((-0.4f), 0.0f, 0.0f);
-    /* .../color/intersect/a:bend */
-    real s7 = sin(0.8f * p3.x);
-    real k7 = cos(0.8f * p3.x);
-    real3 p4 = (real3)(k7 * p3.x - s7 * p3.y, s7 * p3.x + k7 * p3.y, p3.z);
-    /* .../intersect/a:bend/cuboid */
-    real d6 = sd_box(p4, (real3)(0.6f, 0.1f, 0.2f));
-    real d7 = bend_bound(d6, 0.8f, hypot(p3.x, p3.y));
-    /* .../color/intersect/b:sphere */
-    real d8 = sd_sphere(p3, 0.65f);
-    /* .../b:translate/color/intersect */
-    real x9 = -d7;
-    real y9 = -d8;
-    real d9 = -fmin(x9, y9);
-    /* .../a:union/b:translate/color */
-    real3 c10 = (real3)(0.4f, 0.9f, 0.5f);
-    /* .../a:union/a:union/a:union */
-    real x12 = d3;
-    real y12 = d9;
-    real d12 = fmin(x12, y12);
-    real3 c12 = x12 < y12 ? c4 : c10;
-    /* .../a:union/a:union/b:translate */
-    real3 p5 = p0 - (real3)(0.65f, 0.0f, 0.0f);
-    /* .../subtract/a:onion/sphere */
-    real d13 = sd_sphere(p5, 0.45f);
-    /* .../color/subtract/a:onion */
-    real d14 = fabs(d13) - 0.04f;
-    /* .../color/subtract/b:translate */
-    real3 p6 = p5 - (real3)(0.0f, 1.2f, 0.0f);
-    /* .../subtract/b:translate/cuboid */
-    real d15 = sd_box(p6, (real3)(1.0f));
-    /* .../b:translate/color/subtract */
-    real x17 = -d14;
-    real y17 = d15;
-    real d17 = -fmin(x17, y17);
-    /* .../a:union/b:translate/color */
-    real3 c18 = (real3)(0.4f, 0.6f, 0.95f);
-    /* .../a:union/a:union/a:union */
-    real x20 = d12;
-    real y20 = d17;
-    real d20 = fmin(x20, y20);
-    real3 c20 = x20 < y20 ? c12 : c18;
-    /* .../a:union/a:union/b:translate */
-    real3 p7 = p0 - (real3)(1.6f, (-0.25f), 0.0f);
-    /* .../b:translate/color/repeat_limited */
-    real3 p8 = p7;
-    p8.x = p7.x - 0.35f * clamp(round(p7.x / 0.35f), -1.0f, 1.0f);
-    p8.z = p7.z - 0.35f * clamp(round(p7.z / 0.35f), -1.0f, 1.0f);
-    /* .../color/repeat_limited/elongate */
-    real3 p9 = p8 - clamp(p8, -(real3)(0.0f, 0.15f, 0.0f), (real3)(0.0f, 0.15f, 0.0f));
-    /* .../repeat_limited/elongate/sphere */
-    real d21 = sd_sphere(p9, 0.12f);
-    /* .../a:union/b:translate/color */
-    real3 c24 = (real3)(0.95f, 0.8f, 0.3f);
-    /* union/a:union/a:union */
-    real x26 = d20;
-    real y26 = d21;
-    real d26 = fmin(x26, y26);
-    real3 c26 = x26 < y26 ? c20 : c24;
-    /* union/a:union/b:translate */
-    real3 p10 = p0 - (real3)(0.0f, 0.85f, (-0.8f));
-    /* .../color/round/mirror */
-    real3 p11 = p10;
-    p11.x = fabs(p11.x);
-    /* .../round/mirror/translate */
-    real3 p12 = p11 - (real3)(0.5f, 0.0f, 0.0f);
-    /* .../mirror/translate/rotate */
-    real3 p13 = (real3)(p12.x, p12.z, -p12.y);
-    /* .../translate/rotate/torus */
-    real d27 = sd_torus(p13, 0.2f, 0.06f);
-    /* .../b:translate/color/round */
-    real d31 = d27 - 0.01f;
-    /* .../a:union/b:translate/color */
-    real3 c32 = (real3)(0.8f, 0.5f, 0.9f);
-    /* union/a:union */
-    real x34 = d26;
-    real y34 = d31;
-    real d34 = fmin(x34, y34);
-    real3 c34 = x34 < y34 ? c26 : c32;
+    /* union */
     /* union/b:color/plane */
     real d35 = sd_plane(p0, (real3)(0.0f, 1.0f, 0.0f), 0.6f);
     /* union/b:color */
     real3 c36 = (real3)(0.55f, 0.55f, 0.6f);
-    /* union */
-    real x37 = d34;
-    real y37 = d35;
-    real d37 = fmin(x37, y37);
-    real3 c37 = x37 < y37 ? c34 : c36;
-    *color = c37;
-    *trap = R(1.0);
-    return d37;
+    /* union: the second operand only within reach of its bound */
+    real u37 = d35;
+    real3 uc37 = c36;
+    real ut37 = R(1.0);
+    real g37 = length(p0 - (real3)((-1.5f), 0.0f, 0.0f)) * 0.9999f - 0.69971424f;
+    if (!(g37 > u37 && g37 > R(0.0))) {
+        /* .../a:union/a:union/a:translate */
+        real3 p1 = p0 - (real3)((-1.5f), 0.0f, 0.0f);
+        /* .../color/intersect/a:twist */
+        real s1 = sin(2.0f * p1.y);
+        real k1 = cos(2.0f * p1.y);
+        real3 p2 = (real3)(k1 * p1.x - s1 * p1.z, p1.y, s1 * p1.x + k1 * p1.z);
+        /* .../intersect/a:twist/cuboid */
+        real d0 = sd_box(p2, (real3)(0.25f, 0.6f, 0.25f));
+        real d1 = twist_bound(d0, 2.0f, hypot(p1.x, p1.z));
+        /* .../color/intersect/b:cylinder */
+        real d2 = sd_cylinder(p1, 0.36f, 0.6f);
+        /* .../a:translate/color/intersect */
+        real x3 = -d1;
+        real y3 = -d2;
+        real d3 = -fmin(x3, y3);
+        /* .../a:union/a:translate/color */
+        real3 c4 = (real3)(0.9f, 0.4f, 0.4f);
+        real x37 = d35;
+        real y37 = d3;
+        real d37 = fmin(x37, y37);
+        real3 c37 = x37 < y37 ? c36 : c4;
+        u37 = d37;
+        uc37 = c37;
+        ut37 = R(1.0);
+    }
+    /* union/a:union: the second operand only within reach of its bound */
+    real u34 = u37;
+    real3 uc34 = uc37;
+    real ut34 = ut37;
+    real g34 = length(p0 - (real3)((-0.4f), 0.0f, 0.0f)) * 0.9999f - 0.65f;
+    if (!(g34 > u34 && g34 > R(0.0))) {
+        /* .../a:union/a:union/b:translate */
+        real3 p3 = p0 - (real3)((-0.4f), 0.0f, 0.0f);
+        /* .../color/intersect/a:bend */
+        real s7 = sin(0.8f * p3.x);
+        real k7 = cos(0.8f * p3.x);
+        real3 p4 = (real3)(k7 * p3.x - s7 * p3.y, s7 * p3.x + k7 * p3.y, p3.z);
+        /* .../intersect/a:bend/cuboid */
+        real d6 = sd_box(p4, (real3)(0.6f, 0.1f, 0.2f));
+        real d7 = bend_bound(d6, 0.8f, hypot(p3.x, p3.y));
+        /* .../color/intersect/b:sphere */
+        real d8 = sd_sphere(p3, 0.65f);
+        /* .../b:translate/color/intersect */
+        real x9 = -d7;
+        real y9 = -d8;
+        real d9 = -fmin(x9, y9);
+        /* .../a:union/b:translate/color */
+        real3 c10 = (real3)(0.4f, 0.9f, 0.5f);
+        real x34 = u37;
+        real y34 = d9;
+        real d34 = fmin(x34, y34);
+        real3 c34 = x34 < y34 ? uc37 : c10;
+        real t34 = x34 < y34 ? ut37 : R(1.0);
+        u34 = d34;
+        uc34 = c34;
+        ut34 = t34;
+    }
+    /* .../a:union/a:union: the second operand only within reach of its bound */
+    real u26 = u34;
+    real3 uc26 = uc34;
+    real ut26 = ut34;
+    real g26 = length(p0 - (real3)(0.65f, 0.0f, 0.0f)) * 0.9999f - 0.49f;
+    if (!(g26 > u26 && g26 > R(0.0))) {
+        /* .../a:union/a:union/b:translate */
+        real3 p5 = p0 - (real3)(0.65f, 0.0f, 0.0f);
+        /* .../subtract/a:onion/sphere */
+        real d13 = sd_sphere(p5, 0.45f);
+        /* .../color/subtract/a:onion */
+        real d14 = fabs(d13) - 0.04f;
+        /* .../color/subtract: the second operand only within reach of its bound */
+        real u17 = d14;
+        real ut17 = R(1.0);
+        real g17 = length(p5 - (real3)(0.0f, 1.2f, 0.0f)) * 0.9999f - 1.7320508f;
+        if (!(g17 > -u17 && g17 > R(0.0))) {
+            /* .../color/subtract/b:translate */
+            real3 p6 = p5 - (real3)(0.0f, 1.2f, 0.0f);
+            /* .../subtract/b:translate/cuboid */
+            real d15 = sd_box(p6, (real3)(1.0f));
+            /* .../b:translate/color/subtract */
+            real x17 = -d14;
+            real y17 = d15;
+            real d17 = -fmin(x17, y17);
+            u17 = d17;
+            ut17 = R(1.0);
+        }
+        /* .../a:union/b:translate/color */
+        real3 c18 = (real3)(0.4f, 0.6f, 0.95f);
+        real x26 = u34;
+        real y26 = u17;
+        real d26 = fmin(x26, y26);
+        real3 c26 = x26 < y26 ? uc34 : c18;
+        real t26 = x26 < y26 ? ut34 : ut17;
+        u26 = d26;
+        uc26 = c26;
+        ut26 = t26;
+    }
+    /* .../a:union/a:union: the second operand only within reach of its bound */
+    real u20 = u26;
+    real3 uc20 = uc26;
+    real ut20 = ut26;
+    real g20 = length(p0 - (real3)(1.6f, (-0.25f), 0.0f)) * 0.9999f - 0.7649748f;
+    if (!(g20 > u20 && g20 > R(0.0))) {
+        /* .../a:union/a:union/b:translate */
+        real3 p7 = p0 - (real3)(1.6f, (-0.25f), 0.0f);
+        /* .../b:translate/color/repeat_limited */
+        real3 p8 = p7;
+        p8.x = p7.x - 0.35f * clamp(round(p7.x / 0.35f), -1.0f, 1.0f);
+        p8.z = p7.z - 0.35f * clamp(round(p7.z / 0.35f), -1.0f, 1.0f);
+        /* .../color/repeat_limited/elongate */
+        real3 p9 = p8 - clamp(p8, -(real3)(0.0f, 0.15f, 0.0f), (real3)(0.0f, 0.15f, 0.0f));
+        /* .../repeat_limited/elongate/sphere */
+        real d21 = sd_sphere(p9, 0.12f);
+        /* .../a:union/b:translate/color */
+        real3 c24 = (real3)(0.95f, 0.8f, 0.3f);
+        real x20 = u26;
+        real y20 = d21;
+        real d20 = fmin(x20, y20);
+        real3 c20 = x20 < y20 ? uc26 : c24;
+        real t20 = x20 < y20 ? ut26 : R(1.0);
+        u20 = d20;
+        uc20 = c20;
+        ut20 = t20;
+    }
+    /* .../a:union/a:union: the second operand only within reach of its bound */
+    real u12 = u20;
+    real3 uc12 = uc20;
+    real ut12 = ut20;
+    real g12 = length(p0 - (real3)(0.0f, 0.85f, (-0.8f))) * 0.9999f - 0.77f;
+    if (!(g12 > u12 && g12 > R(0.0))) {
+        /* union/a:union/b:translate */
+        real3 p10 = p0 - (real3)(0.0f, 0.85f, (-0.8f));
+        /* .../color/round/mirror */
+        real3 p11 = p10;
+        p11.x = fabs(p11.x);
+        /* .../round/mirror/translate */
+        real3 p12 = p11 - (real3)(0.5f, 0.0f, 0.0f);
+        /* .../mirror/translate/rotate */
+        real3 p13 = (real3)(p12.x, p12.z, -p12.y);
+        /* .../translate/rotate/torus */
+        real d27 = sd_torus(p13, 0.2f, 0.06f);
+        /* .../b:translate/color/round */
+        real d31 = d27 - 0.01f;
+        /* .../a:union/b:translate/color */
+        real3 c32 = (real3)(0.8f, 0.5f, 0.9f);
+        real x12 = u20;
+        real y12 = d31;
+        real d12 = fmin(x12, y12);
+        real3 c12 = x12 < y12 ? uc20 : c32;
+        real t12 = x12 < y12 ? ut20 : R(1.0);
+        u12 = d12;
+        uc12 = c12;
+        ut12 = t12;
+    }
+    *color = uc12;
+    *trap = ut12;
+    return u12;
 }
 
 /* ---- kernel: march.cl ---- */

@@ -22,6 +22,7 @@ typedef float4 real4;
 #define AO_SAMPLES 5
 #define AO_DISTANCE 0.25f
 #define SHADOW_STEPS 96
+#define CONE_TILE 8
 #define ENABLE_AO
 #define ENABLE_SHADOWS
 /* The kernel interface (src/codegen/interface.rs). */
@@ -42,7 +43,14 @@ typedef float4 real4;
     __global uchar* hit_mask, \
     __global float* normals, \
     __global uint* steps, \
-    __global uint* evaluations
+    __global uint* evaluations, \
+    __global const float* starts
+#define CONE_STARTS_ARGS \
+    __global const real* params, \
+    __global const real* camera, \
+    const int width, \
+    const int height, \
+    __global float* starts
 #define CAMERA_ORIGIN 0
 #define CAMERA_ORTHOGRAPHIC 3
 #define CAMERA_RIGHT 4
@@ -52,6 +60,9 @@ typedef float4 real4;
 #define CAMERA_FORWARD 12
 #define CAMERA_FOOTPRINT_BASE 15
 #define CAMERA_FOOTPRINT_PER_UNIT 16
+#define CAMERA_IMAGE_WIDTH 17
+#define CAMERA_IMAGE_HEIGHT 18
+#define CAMERA_PIXEL_SCALE 19
 #define LIGHT_POSITION 0
 #define LIGHT_KIND 3
 #define LIGHT_RADIANCE 4
@@ -277,156 +288,234 @@ real2 smooth_min(real a, real b, real k) {
 
 /* ---- scene ---- */
 real DE(real3 p0, __global const real* params) {
-    /* .../a:smooth_union/a:smooth_union/a:translate */
-    real3 p1 = p0 - (real3)((-1.1f), 0.0f, 0.0f);
-    /* .../a:translate/color/scale */
-    real3 p2 = p1 / 0.5f;
-    /* .../color/scale/rotate */
-    real3 p3 = (real3)(p2.x, -p2.z, p2.y);
-    /* .../scale/rotate/mandelbulb */
-    real t0;
-    real d0 = mandelbulb(p3, params[0] /* power */, 8, fmin(2.0f, pow(MAGNITUDE_CAP, R(1.0) / params[0] /* power */)), pow(R(2.0), R(1.0) / (params[0] /* power */ - R(1.0))), &t0);
-    real d2 = d0 * 0.5f;
-    /* .../a:smooth_union/a:smooth_union/b:translate */
-    real3 p4 = p0 - (real3)(0.0f, 0.0f, (-0.6f));
-    /* .../color/smooth_subtract/a:scale */
-    real3 p5 = p4 / 0.45f;
-    /* .../smooth_subtract/a:scale/menger */
-    real t5;
-    real d5 = menger(p5, 3, 3.0f, &t5);
-    real d6 = d5 * 0.45f;
-    /* .../color/smooth_subtract/b:sphere */
-    real d7 = sd_sphere(p4, 0.55f);
-    /* .../b:translate/color/smooth_subtract */
-    real x8 = -d6;
-    real y8 = d7;
-    real2 m8 = smooth_min(x8, y8, 0.05f);
-    real d8 = -m8.x;
-    /* .../a:smooth_union/a:smooth_union/a:smooth_union */
-    real x11 = d2;
-    real y11 = d8;
-    real2 m11 = smooth_min(x11, y11, 0.1f);
-    real d11 = m11.x;
-    /* .../a:smooth_union/a:smooth_union/b:translate */
-    real3 p6 = p0 - (real3)(1.1f, 0.0f, 0.0f);
-    /* .../b:translate/color/scale */
-    real3 p7 = p6 / 0.5f;
-    /* .../color/scale/julia */
-    real t12;
-    real d12 = julia(p7, (real4)((-0.2f), 0.6f, 0.2f, 0.2f), 0.0f, 12, 4.0f, &t12);
-    real d13 = d12 * 0.5f;
-    /* union/a:smooth_union/a:smooth_union */
-    real x16 = d11;
-    real y16 = d13;
-    real2 m16 = smooth_min(x16, y16, 0.1f);
-    real d16 = m16.x;
-    /* union/a:smooth_union/b:translate */
-    real3 p8 = p0 - (real3)(0.0f, 0.0f, 0.7f);
-    /* .../b:translate/color/scale */
-    real3 p9 = p8 / 0.35f;
-    /* .../color/scale/sierpinski */
-    real t17;
-    real d17 = sierpinski(p9, 5, 2.0f, &t17);
-    real d18 = d17 * 0.35f;
-    /* union/a:smooth_union */
-    real x21 = d16;
-    real y21 = d18;
-    real2 m21 = smooth_min(x21, y21, 0.1f);
-    real d21 = m21.x;
+    /* union */
     /* union/b:color/plane */
     real d22 = sd_plane(p0, (real3)(0.0f, 1.0f, 0.0f), 0.55f);
-    /* union */
-    real x24 = d21;
-    real y24 = d22;
-    real d24 = fmin(x24, y24);
-    return d24;
+    /* union: the second operand only within reach of its bound */
+    real u24 = d22;
+    real g24 = 0.33333334f * (length(p0 - (real3)(0.00976538f, 0.0f, (-0.15427618f))) * 0.9999f - 2.307116f);
+    if (!(g24 > u24 && g24 > R(0.0))) {
+        /* .../a:smooth_union/a:smooth_union/a:translate */
+        real3 p1 = p0 - (real3)((-1.1f), 0.0f, 0.0f);
+        /* .../a:translate/color/scale */
+        real3 p2 = p1 / 0.5f;
+        /* .../color/scale/rotate */
+        real3 p3 = (real3)(p2.x, -p2.z, p2.y);
+        /* .../scale/rotate/mandelbulb */
+        real t0;
+        real d0 = mandelbulb(p3, params[0] /* power */, 8, fmin(2.0f, pow(MAGNITUDE_CAP, R(1.0) / params[0] /* power */)), pow(R(2.0), R(1.0) / (params[0] /* power */ - R(1.0))), &t0);
+        real d2 = d0 * 0.5f;
+        /* .../a:smooth_union/a:smooth_union: the second operand only within reach of its bound */
+        real u11 = d2;
+        real g11 = length(p0 - (real3)(0.0f, 0.0f, (-0.6f))) * 0.9999f - 0.7794229f;
+        if (!(g11 > u11 + 0.1f && g11 > R(0.0))) {
+            /* .../a:smooth_union/a:smooth_union/b:translate */
+            real3 p4 = p0 - (real3)(0.0f, 0.0f, (-0.6f));
+            /* .../color/smooth_subtract/a:scale */
+            real3 p5 = p4 / 0.45f;
+            /* .../smooth_subtract/a:scale/menger */
+            real t5;
+            real d5 = menger(p5, 3, 3.0f, &t5);
+            real d6 = d5 * 0.45f;
+            /* .../color/smooth_subtract: the second operand only within reach of its bound */
+            real u8 = d6;
+            real g8 = length(p4 - (real3)(0.0f)) * 0.9999f - 0.55f;
+            if (!(g8 > -u8 + 0.05f && g8 > R(0.0))) {
+                /* .../color/smooth_subtract/b:sphere */
+                real d7 = sd_sphere(p4, 0.55f);
+                /* .../b:translate/color/smooth_subtract */
+                real x8 = -d6;
+                real y8 = d7;
+                real2 m8 = smooth_min(x8, y8, 0.05f);
+                real d8 = -m8.x;
+                u8 = d8;
+            }
+            /* .../a:smooth_union/a:smooth_union/a:smooth_union */
+            real x11 = d2;
+            real y11 = u8;
+            real2 m11 = smooth_min(x11, y11, 0.1f);
+            real d11 = m11.x;
+            u11 = d11;
+        }
+        /* .../a:smooth_union/a:smooth_union: the second operand only within reach of its bound */
+        real u16 = u11;
+        real g16 = 0.9f * (length(p0 - (real3)(1.1f, 0.0f, 0.0f)) * 0.9999f - 1.103242f);
+        if (!(g16 > u16 + 0.1f && g16 > R(0.0))) {
+            /* .../a:smooth_union/a:smooth_union/b:translate */
+            real3 p6 = p0 - (real3)(1.1f, 0.0f, 0.0f);
+            /* .../b:translate/color/scale */
+            real3 p7 = p6 / 0.5f;
+            /* .../color/scale/julia */
+            real t12;
+            real d12 = julia(p7, (real4)((-0.2f), 0.6f, 0.2f, 0.2f), 0.0f, 12, 4.0f, &t12);
+            real d13 = d12 * 0.5f;
+            /* union/a:smooth_union/a:smooth_union */
+            real x16 = u11;
+            real y16 = d13;
+            real2 m16 = smooth_min(x16, y16, 0.1f);
+            real d16 = m16.x;
+            u16 = d16;
+        }
+        /* union/a:smooth_union: the second operand only within reach of its bound */
+        real u21 = u16;
+        real g21 = 0.33333334f * (length(p0 - (real3)(0.0f, 0.0f, 0.7f)) * 0.9999f - 0.6062178f);
+        if (!(g21 > u21 + 0.1f && g21 > R(0.0))) {
+            /* union/a:smooth_union/b:translate */
+            real3 p8 = p0 - (real3)(0.0f, 0.0f, 0.7f);
+            /* .../b:translate/color/scale */
+            real3 p9 = p8 / 0.35f;
+            /* .../color/scale/sierpinski */
+            real t17;
+            real d17 = sierpinski(p9, 5, 2.0f, &t17);
+            real d18 = d17 * 0.35f;
+            /* union/a:smooth_union */
+            real x21 = u16;
+            real y21 = d18;
+            real2 m21 = smooth_min(x21, y21, 0.1f);
+            real d21 = m21.x;
+            u21 = d21;
+        }
+        real x24 = d22;
+        real y24 = u21;
+        real d24 = fmin(x24, y24);
+        u24 = d24;
+    }
+    return u24;
 }
 
 real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
-    /* .../a:smooth_union/a:smooth_union/a:translate */
-    real3 p1 = p0 - (real3)((-1.1f), 0.0f, 0.0f);
-    /* .../a:translate/color/scale */
-    real3 p2 = p1 / 0.5f;
-    /* .../color/scale/rotate */
-    real3 p3 = (real3)(p2.x, -p2.z, p2.y);
-    /* .../scale/rotate/mandelbulb */
-    real t0;
-    real d0 = mandelbulb(p3, params[0] /* power */, 8, fmin(2.0f, pow(MAGNITUDE_CAP, R(1.0) / params[0] /* power */)), pow(R(2.0), R(1.0) / (params[0] /* power */ - R(1.0))), &t0);
-    real d2 = d0 * 0.5f;
-    /* .../a:smooth_union/a:translate/color */
-    real3 c3 = (real3)(0.9f, 0.55f, 0.3f);
-    /* .../a:smooth_union/a:smooth_union/b:translate */
-    real3 p4 = p0 - (real3)(0.0f, 0.0f, (-0.6f));
-    /* .../color/smooth_subtract/a:scale */
-    real3 p5 = p4 / 0.45f;
-    /* .../smooth_subtract/a:scale/menger */
-    real t5;
-    real d5 = menger(p5, 3, 3.0f, &t5);
-    real d6 = d5 * 0.45f;
-    /* .../color/smooth_subtract/b:sphere */
-    real d7 = sd_sphere(p4, 0.55f);
-    /* .../b:translate/color/smooth_subtract */
-    real x8 = -d6;
-    real y8 = d7;
-    real2 m8 = smooth_min(x8, y8, 0.05f);
-    real d8 = -m8.x;
-    real t8 = x8 < y8 ? mix(t5, R(1.0), m8.y) : mix(R(1.0), t5, m8.y);
-    /* .../a:smooth_union/b:translate/color */
-    real3 c9 = (real3)(0.8f, 0.8f, 0.75f);
-    /* .../a:smooth_union/a:smooth_union/a:smooth_union */
-    real x11 = d2;
-    real y11 = d8;
-    real2 m11 = smooth_min(x11, y11, 0.1f);
-    real d11 = m11.x;
-    real3 c11 = x11 < y11 ? mix(c3, c9, m11.y) : mix(c9, c3, m11.y);
-    real t11 = x11 < y11 ? mix(t0, t8, m11.y) : mix(t8, t0, m11.y);
-    /* .../a:smooth_union/a:smooth_union/b:translate */
-    real3 p6 = p0 - (real3)(1.1f, 0.0f, 0.0f);
-    /* .../b:translate/color/scale */
-    real3 p7 = p6 / 0.5f;
-    /* .../color/scale/julia */
-    real t12;
-    real d12 = julia(p7, (real4)((-0.2f), 0.6f, 0.2f, 0.2f), 0.0f, 12, 4.0f, &t12);
-    real d13 = d12 * 0.5f;
-    /* .../a:smooth_union/b:translate/color */
-    real3 c14 = (real3)(0.4f, 0.7f, 0.95f);
-    /* union/a:smooth_union/a:smooth_union */
-    real x16 = d11;
-    real y16 = d13;
-    real2 m16 = smooth_min(x16, y16, 0.1f);
-    real d16 = m16.x;
-    real3 c16 = x16 < y16 ? mix(c11, c14, m16.y) : mix(c14, c11, m16.y);
-    real t16 = x16 < y16 ? mix(t11, t12, m16.y) : mix(t12, t11, m16.y);
-    /* union/a:smooth_union/b:translate */
-    real3 p8 = p0 - (real3)(0.0f, 0.0f, 0.7f);
-    /* .../b:translate/color/scale */
-    real3 p9 = p8 / 0.35f;
-    /* .../color/scale/sierpinski */
-    real t17;
-    real d17 = sierpinski(p9, 5, 2.0f, &t17);
-    real d18 = d17 * 0.35f;
-    /* .../a:smooth_union/b:translate/color */
-    real3 c19 = (real3)(0.95f, 0.8f, 0.4f);
-    /* union/a:smooth_union */
-    real x21 = d16;
-    real y21 = d18;
-    real2 m21 = smooth_min(x21, y21, 0.1f);
-    real d21 = m21.x;
-    real3 c21 = x21 < y21 ? mix(c16, c19, m21.y) : mix(c19, c16, m21.y);
-    real t21 = x21 < y21 ? mix(t16, t17, m21.y) : mix(t17, t16, m21.y);
+    /* union */
     /* union/b:color/plane */
     real d22 = sd_plane(p0, (real3)(0.0f, 1.0f, 0.0f), 0.55f);
     /* union/b:color */
     real3 c23 = (real3)(0.55f, 0.55f, 0.6f);
-    /* union */
-    real x24 = d21;
-    real y24 = d22;
-    real d24 = fmin(x24, y24);
-    real3 c24 = x24 < y24 ? c21 : c23;
-    real t24 = x24 < y24 ? t21 : R(1.0);
-    *color = c24;
-    *trap = t24;
-    return d24;
+    /* union: the second operand only within reach of its bound */
+    real u24 = d22;
+    real3 uc24 = c23;
+    real ut24 = R(1.0);
+    real g24 = 0.33333334f * (length(p0 - (real3)(0.00976538f, 0.0f, (-0.15427618f))) * 0.9999f - 2.307116f);
+    if (!(g24 > u24 && g24 > R(0.0))) {
+        /* .../a:smooth_union/a:smooth_union/a:translate */
+        real3 p1 = p0 - (real3)((-1.1f), 0.0f, 0.0f);
+        /* .../a:translate/color/scale */
+        real3 p2 = p1 / 0.5f;
+        /* .../color/scale/rotate */
+        real3 p3 = (real3)(p2.x, -p2.z, p2.y);
+        /* .../scale/rotate/mandelbulb */
+        real t0;
+        real d0 = mandelbulb(p3, params[0] /* power */, 8, fmin(2.0f, pow(MAGNITUDE_CAP, R(1.0) / params[0] /* power */)), pow(R(2.0), R(1.0) / (params[0] /* power */ - R(1.0))), &t0);
+        real d2 = d0 * 0.5f;
+        /* .../a:smooth_union/a:translate/color */
+        real3 c3 = (real3)(0.9f, 0.55f, 0.3f);
+        /* .../a:smooth_union/a:smooth_union: the second operand only within reach of its bound */
+        real u11 = d2;
+        real3 uc11 = c3;
+        real ut11 = t0;
+        real g11 = length(p0 - (real3)(0.0f, 0.0f, (-0.6f))) * 0.9999f - 0.7794229f;
+        if (!(g11 > u11 + 0.1f && g11 > R(0.0))) {
+            /* .../a:smooth_union/a:smooth_union/b:translate */
+            real3 p4 = p0 - (real3)(0.0f, 0.0f, (-0.6f));
+            /* .../color/smooth_subtract/a:scale */
+            real3 p5 = p4 / 0.45f;
+            /* .../smooth_subtract/a:scale/menger */
+            real t5;
+            real d5 = menger(p5, 3, 3.0f, &t5);
+            real d6 = d5 * 0.45f;
+            /* .../color/smooth_subtract: the second operand only within reach of its bound */
+            real u8 = d6;
+            real ut8 = t5;
+            real g8 = length(p4 - (real3)(0.0f)) * 0.9999f - 0.55f;
+            if (!(g8 > -u8 + 0.05f && g8 > R(0.0))) {
+                /* .../color/smooth_subtract/b:sphere */
+                real d7 = sd_sphere(p4, 0.55f);
+                /* .../b:translate/color/smooth_subtract */
+                real x8 = -d6;
+                real y8 = d7;
+                real2 m8 = smooth_min(x8, y8, 0.05f);
+                real d8 = -m8.x;
+                real t8 = x8 < y8 ? mix(t5, R(1.0), m8.y) : mix(R(1.0), t5, m8.y);
+                u8 = d8;
+                ut8 = t8;
+            }
+            /* .../a:smooth_union/b:translate/color */
+            real3 c9 = (real3)(0.8f, 0.8f, 0.75f);
+            /* .../a:smooth_union/a:smooth_union/a:smooth_union */
+            real x11 = d2;
+            real y11 = u8;
+            real2 m11 = smooth_min(x11, y11, 0.1f);
+            real d11 = m11.x;
+            real3 c11 = x11 < y11 ? mix(c3, c9, m11.y) : mix(c9, c3, m11.y);
+            real t11 = x11 < y11 ? mix(t0, ut8, m11.y) : mix(ut8, t0, m11.y);
+            u11 = d11;
+            uc11 = c11;
+            ut11 = t11;
+        }
+        /* .../a:smooth_union/a:smooth_union: the second operand only within reach of its bound */
+        real u16 = u11;
+        real3 uc16 = uc11;
+        real ut16 = ut11;
+        real g16 = 0.9f * (length(p0 - (real3)(1.1f, 0.0f, 0.0f)) * 0.9999f - 1.103242f);
+        if (!(g16 > u16 + 0.1f && g16 > R(0.0))) {
+            /* .../a:smooth_union/a:smooth_union/b:translate */
+            real3 p6 = p0 - (real3)(1.1f, 0.0f, 0.0f);
+            /* .../b:translate/color/scale */
+            real3 p7 = p6 / 0.5f;
+            /* .../color/scale/julia */
+            real t12;
+            real d12 = julia(p7, (real4)((-0.2f), 0.6f, 0.2f, 0.2f), 0.0f, 12, 4.0f, &t12);
+            real d13 = d12 * 0.5f;
+            /* .../a:smooth_union/b:translate/color */
+            real3 c14 = (real3)(0.4f, 0.7f, 0.95f);
+            /* union/a:smooth_union/a:smooth_union */
+            real x16 = u11;
+            real y16 = d13;
+            real2 m16 = smooth_min(x16, y16, 0.1f);
+            real d16 = m16.x;
+            real3 c16 = x16 < y16 ? mix(uc11, c14, m16.y) : mix(c14, uc11, m16.y);
+            real t16 = x16 < y16 ? mix(ut11, t12, m16.y) : mix(t12, ut11, m16.y);
+            u16 = d16;
+            uc16 = c16;
+            ut16 = t16;
+        }
+        /* union/a:smooth_union: the second operand only within reach of its bound */
+        real u21 = u16;
+        real3 uc21 = uc16;
+        real ut21 = ut16;
+        real g21 = 0.33333334f * (length(p0 - (real3)(0.0f, 0.0f, 0.7f)) * 0.9999f - 0.6062178f);
+        if (!(g21 > u21 + 0.1f && g21 > R(0.0))) {
+            /* union/a:smooth_union/b:translate */
+            real3 p8 = p0 - (real3)(0.0f, 0.0f, 0.7f);
+            /* .../b:translate/color/scale */
+            real3 p9 = p8 / 0.35f;
+            /* .../color/scale/sierpinski */
+            real t17;
+            real d17 = sierpinski(p9, 5, 2.0f, &t17);
+            real d18 = d17 * 0.35f;
+            /* .../a:smooth_union/b:translate/color */
+            real3 c19 = (real3)(0.95f, 0.8f, 0.4f);
+            /* union/a:smooth_union */
+            real x21 = u16;
+            real y21 = d18;
+            real2 m21 = smooth_min(x21, y21, 0.1f);
+            real d21 = m21.x;
+            real3 c21 = x21 < y21 ? mix(uc16, c19, m21.y) : mix(c19, uc16, m21.y);
+            real t21 = x21 < y21 ? mix(ut16, t17, m21.y) : mix(t17, ut16, m21.y);
+            u21 = d21;
+            uc21 = c21;
+            ut21 = t21;
+        }
+        real x24 = d22;
+        real y24 = u21;
+        real d24 = fmin(x24, y24);
+        real3 c24 = x24 < y24 ? c23 : uc21;
+        real t24 = x24 < y24 ? R(1.0) : ut21;
+        u24 = d24;
+        uc24 = c24;
+        ut24 = t24;
+    }
+    *color = uc24;
+    *trap = ut24;
+    return u24;
 }
 
 /* ---- kernel: march.cl ---- */

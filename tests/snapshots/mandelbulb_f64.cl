@@ -43,7 +43,14 @@ typedef double4 real4;
     __global uchar* hit_mask, \
     __global float* normals, \
     __global uint* steps, \
-    __global uint* evaluations
+    __global uint* evaluations, \
+    __global const float* starts
+#define CONE_STARTS_ARGS \
+    __global const real* params, \
+    __global const real* camera, \
+    const int width, \
+    const int height, \
+    __global float* starts
 #define CAMERA_ORIGIN 0
 #define CAMERA_ORTHOGRAPHIC 3
 #define CAMERA_RIGHT 4
@@ -53,6 +60,9 @@ typedef double4 real4;
 #define CAMERA_FORWARD 12
 #define CAMERA_FOOTPRINT_BASE 15
 #define CAMERA_FOOTPRINT_PER_UNIT 16
+#define CAMERA_IMAGE_WIDTH 17
+#define CAMERA_IMAGE_HEIGHT 18
+#define CAMERA_PIXEL_SCALE 19
 #define LIGHT_POSITION 0
 #define LIGHT_KIND 3
 #define LIGHT_RADIANCE 4
@@ -140,4 +150,8 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     return d0;
 }
 
+/* The sphere around the scene (src/ir/bounds.rs). */
+#define SCENE_BOUND_CENTRE (real3)(0.0, 0.0, 0.0)
+#define SCENE_BOUND_RADIUS 1.1040895136738123
+#define SCENE_BOUND_SLOPE 1.0
 /* ---- kernel: march.cl ---- */

@@ -22,6 +22,7 @@ typedef float4 real4;
 #define AO_SAMPLES 5
 #define AO_DISTANCE 0.25f
 #define SHADOW_STEPS 96
+#define CONE_TILE 8
 #define ENABLE_AO
 #define ENABLE_SHADOWS
 /* The kernel interface (src/codegen/interface.rs). */
@@ -42,7 +43,14 @@ typedef float4 real4;
     __global uchar* hit_mask, \
     __global float* normals, \
     __global uint* steps, \
-    __global uint* evaluations
+    __global uint* evaluations, \
+    __global const float* starts
+#define CONE_STARTS_ARGS \
+    __global const real* params, \
+    __global const real* camera, \
+    const int width, \
+    const int height, \
+    __global float* starts
 #define CAMERA_ORIGIN 0
 #define CAMERA_ORTHOGRAPHIC 3
 #define CAMERA_RIGHT 4
@@ -52,6 +60,9 @@ typedef float4 real4;
 #define CAMERA_FORWARD 12
 #define CAMERA_FOOTPRINT_BASE 15
 #define CAMERA_FOOTPRINT_PER_UNIT 16
+#define CAMERA_IMAGE_WIDTH 17
+#define CAMERA_IMAGE_HEIGHT 18
+#define CAMERA_PIXEL_SCALE 19
 #define LIGHT_POSITION 0
 #define LIGHT_KIND 3
 #define LIGHT_RADIANCE 4
@@ -99,41 +110,57 @@ real menger(real3 p, int iterations, real scale, real* trap) {
 
 /* ---- scene ---- */
 real DE(real3 p0, __global const real* params) {
-    /* union/a:color/rotate */
-    real3 p1 = (real3)(0.87758255f * p0.x + (-0.47942555f) * p0.z, p0.y, 0.47942555f * p0.x + 0.87758255f * p0.z);
-    /* .../a:color/rotate/menger */
-    real t0;
-    real d0 = menger(p1, 4, 3.0f, &t0);
+    /* union */
     /* union/b:color/plane */
     real d3 = sd_plane(p0, (real3)(0.0f, 1.0f, 0.0f), 1.0f);
-    /* union */
-    real x5 = d0;
-    real y5 = d3;
-    real d5 = fmin(x5, y5);
-    return d5;
+    /* union: the second operand only within reach of its bound */
+    real u5 = d3;
+    real g5 = length(p0 - (real3)(0.0f)) * 0.9999f - 1.7320508f;
+    if (!(g5 > u5 && g5 > R(0.0))) {
+        /* union/a:color/rotate */
+        real3 p1 = (real3)(0.87758255f * p0.x + (-0.47942555f) * p0.z, p0.y, 0.47942555f * p0.x + 0.87758255f * p0.z);
+        /* .../a:color/rotate/menger */
+        real t0;
+        real d0 = menger(p1, 4, 3.0f, &t0);
+        real x5 = d3;
+        real y5 = d0;
+        real d5 = fmin(x5, y5);
+        u5 = d5;
+    }
+    return u5;
 }
 
 real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
-    /* union/a:color/rotate */
-    real3 p1 = (real3)(0.87758255f * p0.x + (-0.47942555f) * p0.z, p0.y, 0.47942555f * p0.x + 0.87758255f * p0.z);
-    /* .../a:color/rotate/menger */
-    real t0;
-    real d0 = menger(p1, 4, 3.0f, &t0);
-    /* union/a:color */
-    real3 c2 = (real3)(0.85f, 0.85f, 0.8f);
+    /* union */
     /* union/b:color/plane */
     real d3 = sd_plane(p0, (real3)(0.0f, 1.0f, 0.0f), 1.0f);
     /* union/b:color */
     real3 c4 = (real3)(0.55f, 0.55f, 0.6f);
-    /* union */
-    real x5 = d0;
-    real y5 = d3;
-    real d5 = fmin(x5, y5);
-    real3 c5 = x5 < y5 ? c2 : c4;
-    real t5 = x5 < y5 ? t0 : R(1.0);
-    *color = c5;
-    *trap = t5;
-    return d5;
+    /* union: the second operand only within reach of its bound */
+    real u5 = d3;
+    real3 uc5 = c4;
+    real ut5 = R(1.0);
+    real g5 = length(p0 - (real3)(0.0f)) * 0.9999f - 1.7320508f;
+    if (!(g5 > u5 && g5 > R(0.0))) {
+        /* union/a:color/rotate */
+        real3 p1 = (real3)(0.87758255f * p0.x + (-0.47942555f) * p0.z, p0.y, 0.47942555f * p0.x + 0.87758255f * p0.z);
+        /* .../a:color/rotate/menger */
+        real t0;
+        real d0 = menger(p1, 4, 3.0f, &t0);
+        /* union/a:color */
+        real3 c2 = (real3)(0.85f, 0.85f, 0.8f);
+        real x5 = d3;
+        real y5 = d0;
+        real d5 = fmin(x5, y5);
+        real3 c5 = x5 < y5 ? c4 : c2;
+        real t5 = x5 < y5 ? R(1.0) : t0;
+        u5 = d5;
+        uc5 = c5;
+        ut5 = t5;
+    }
+    *color = uc5;
+    *trap = ut5;
+    return u5;
 }
 
 /* ---- kernel: march.cl ---- */

@@ -22,6 +22,7 @@ typedef float4 real4;
 #define AO_SAMPLES 5
 #define AO_DISTANCE 0.25f
 #define SHADOW_STEPS 96
+#define CONE_TILE 8
 #define ENABLE_AO
 #define ENABLE_SHADOWS
 /* The kernel interface (src/codegen/interface.rs). */
@@ -42,7 +43,14 @@ typedef float4 real4;
     __global uchar* hit_mask, \
     __global float* normals, \
     __global uint* steps, \
-    __global uint* evaluations
+    __global uint* evaluations, \
+    __global const float* starts
+#define CONE_STARTS_ARGS \
+    __global const real* params, \
+    __global const real* camera, \
+    const int width, \
+    const int height, \
+    __global float* starts
 #define CAMERA_ORIGIN 0
 #define CAMERA_ORTHOGRAPHIC 3
 #define CAMERA_RIGHT 4
@@ -52,6 +60,9 @@ typedef float4 real4;
 #define CAMERA_FORWARD 12
 #define CAMERA_FOOTPRINT_BASE 15
 #define CAMERA_FOOTPRINT_PER_UNIT 16
+#define CAMERA_IMAGE_WIDTH 17
+#define CAMERA_IMAGE_HEIGHT 18
+#define CAMERA_PIXEL_SCALE 19
 #define LIGHT_POSITION 0
 #define LIGHT_KIND 3
 #define LIGHT_RADIANCE 4
@@ -167,190 +178,326 @@ real sd_ellipsoid(real3 p, real3 r) {
 
 /* ---- scene ---- */
 real DE(real3 p0, __global const real* params) {
-    /* .../a:union/a:union/a:translate */
-    real3 p1 = p0 - (real3)((-1.9f), 0.0f, (-0.6f));
-    /* .../a:translate/color/sphere */
-    real d0 = sd_sphere(p1, 0.35f);
-    /* .../a:union/a:union/b:translate */
-    real3 p2 = p0 - (real3)((-0.95f), 0.0f, (-0.6f));
-    /* .../b:translate/color/cuboid */
-    real d3 = sd_box(p2, (real3)(0.3f));
-    /* .../a:union/a:union/a:union */
-    real x6 = d0;
-    real y6 = d3;
-    real d6 = fmin(x6, y6);
-    /* .../a:union/a:union/b:translate */
-    real3 p3 = p0 - (real3)(0.0f, 0.0f, (-0.6f));
-    /* .../b:translate/color/round_box */
-    real d7 = sd_round_box(p3, (real3)(0.3f), 0.08f);
-    /* .../a:union/a:union/a:union */
-    real x10 = d6;
-    real y10 = d7;
-    real d10 = fmin(x10, y10);
-    /* .../a:union/a:union/b:translate */
-    real3 p4 = p0 - (real3)(0.95f, 0.0f, (-0.6f));
-    /* .../b:translate/color/torus */
-    real d11 = sd_torus(p4, 0.28f, 0.1f);
-    /* .../a:union/a:union/a:union */
-    real x14 = d10;
-    real y14 = d11;
-    real d14 = fmin(x14, y14);
-    /* .../a:union/a:union/b:translate */
-    real3 p5 = p0 - (real3)(1.9f, 0.0f, (-0.6f));
-    /* .../b:translate/color/cylinder */
-    real d15 = sd_cylinder(p5, 0.25f, 0.35f);
-    /* .../a:union/a:union/a:union */
-    real x18 = d14;
-    real y18 = d15;
-    real d18 = fmin(x18, y18);
-    /* .../a:union/a:union/b:translate */
-    real3 p6 = p0 - (real3)((-1.425f), 0.0f, 0.6f);
-    /* .../b:translate/color/capsule */
-    real d19 = sd_capsule(p6, (real3)(0.0f, (-0.2f), 0.0f), (real3)(0.0f, 0.2f, 0.0f), 0.18f);
-    /* .../a:union/a:union/a:union */
-    real x22 = d18;
-    real y22 = d19;
-    real d22 = fmin(x22, y22);
-    /* .../a:union/a:union/b:translate */
-    real3 p7 = p0 - (real3)((-0.475f), 0.0f, 0.6f);
-    /* .../b:translate/color/octahedron */
-    real d23 = sd_octahedron(p7, 0.4f);
-    /* .../a:union/a:union/a:union */
-    real x26 = d22;
-    real y26 = d23;
-    real d26 = fmin(x26, y26);
-    /* .../a:union/a:union/b:translate */
-    real3 p8 = p0 - (real3)(0.475f, 0.0f, 0.6f);
-    /* .../b:translate/color/capped_cone */
-    real d27 = sd_capped_cone(p8, 0.35f, 0.3f, 0.1f);
-    /* union/a:union/a:union */
-    real x30 = d26;
-    real y30 = d27;
-    real d30 = fmin(x30, y30);
-    /* union/a:union/b:translate */
-    real3 p9 = p0 - (real3)(1.425f, 0.0f, 0.6f);
-    /* .../b:translate/color/ellipsoid */
-    real d31 = sd_ellipsoid(p9, (real3)(0.35f, 0.2f, 0.25f));
-    /* union/a:union */
-    real x34 = d30;
-    real y34 = d31;
-    real d34 = fmin(x34, y34);
+    /* union */
     /* union/b:color/plane */
     real d35 = sd_plane(p0, (real3)(0.0f, 1.0f, 0.0f), 0.4f);
-    /* union */
-    real x37 = d34;
-    real y37 = d35;
-    real d37 = fmin(x37, y37);
-    return d37;
+    /* union: the second operand only within reach of its bound */
+    real u37 = d35;
+    real g37 = length(p0 - (real3)((-1.9f), 0.0f, (-0.6f))) * 0.9999f - 0.35f;
+    if (!(g37 > u37 && g37 > R(0.0))) {
+        /* .../a:union/a:union/a:translate */
+        real3 p1 = p0 - (real3)((-1.9f), 0.0f, (-0.6f));
+        /* .../a:translate/color/sphere */
+        real d0 = sd_sphere(p1, 0.35f);
+        real x37 = d35;
+        real y37 = d0;
+        real d37 = fmin(x37, y37);
+        u37 = d37;
+    }
+    /* union/a:union: the second operand only within reach of its bound */
+    real u34 = u37;
+    real g34 = length(p0 - (real3)((-0.95f), 0.0f, (-0.6f))) * 0.9999f - 0.51961523f;
+    if (!(g34 > u34 && g34 > R(0.0))) {
+        /* .../a:union/a:union/b:translate */
+        real3 p2 = p0 - (real3)((-0.95f), 0.0f, (-0.6f));
+        /* .../b:translate/color/cuboid */
+        real d3 = sd_box(p2, (real3)(0.3f));
+        real x34 = u37;
+        real y34 = d3;
+        real d34 = fmin(x34, y34);
+        u34 = d34;
+    }
+    /* .../a:union/a:union: the second operand only within reach of its bound */
+    real u30 = u34;
+    real g30 = length(p0 - (real3)(0.0f, 0.0f, (-0.6f))) * 0.9999f - 0.51961523f;
+    if (!(g30 > u30 && g30 > R(0.0))) {
+        /* .../a:union/a:union/b:translate */
+        real3 p3 = p0 - (real3)(0.0f, 0.0f, (-0.6f));
+        /* .../b:translate/color/round_box */
+        real d7 = sd_round_box(p3, (real3)(0.3f), 0.08f);
+        real x30 = u34;
+        real y30 = d7;
+        real d30 = fmin(x30, y30);
+        u30 = d30;
+    }
+    /* .../a:union/a:union: the second operand only within reach of its bound */
+    real u26 = u30;
+    real g26 = length(p0 - (real3)(0.95f, 0.0f, (-0.6f))) * 0.9999f - 0.38f;
+    if (!(g26 > u26 && g26 > R(0.0))) {
+        /* .../a:union/a:union/b:translate */
+        real3 p4 = p0 - (real3)(0.95f, 0.0f, (-0.6f));
+        /* .../b:translate/color/torus */
+        real d11 = sd_torus(p4, 0.28f, 0.1f);
+        real x26 = u30;
+        real y26 = d11;
+        real d26 = fmin(x26, y26);
+        u26 = d26;
+    }
+    /* .../a:union/a:union: the second operand only within reach of its bound */
+    real u22 = u26;
+    real g22 = length(p0 - (real3)(1.9f, 0.0f, (-0.6f))) * 0.9999f - 0.43011627f;
+    if (!(g22 > u22 && g22 > R(0.0))) {
+        /* .../a:union/a:union/b:translate */
+        real3 p5 = p0 - (real3)(1.9f, 0.0f, (-0.6f));
+        /* .../b:translate/color/cylinder */
+        real d15 = sd_cylinder(p5, 0.25f, 0.35f);
+        real x22 = u26;
+        real y22 = d15;
+        real d22 = fmin(x22, y22);
+        u22 = d22;
+    }
+    /* .../a:union/a:union: the second operand only within reach of its bound */
+    real u18 = u22;
+    real g18 = length(p0 - (real3)((-1.425f), 0.0f, 0.6f)) * 0.9999f - 0.38f;
+    if (!(g18 > u18 && g18 > R(0.0))) {
+        /* .../a:union/a:union/b:translate */
+        real3 p6 = p0 - (real3)((-1.425f), 0.0f, 0.6f);
+        /* .../b:translate/color/capsule */
+        real d19 = sd_capsule(p6, (real3)(0.0f, (-0.2f), 0.0f), (real3)(0.0f, 0.2f, 0.0f), 0.18f);
+        real x18 = u22;
+        real y18 = d19;
+        real d18 = fmin(x18, y18);
+        u18 = d18;
+    }
+    /* .../a:union/a:union: the second operand only within reach of its bound */
+    real u14 = u18;
+    real g14 = length(p0 - (real3)((-0.475f), 0.0f, 0.6f)) * 0.9999f - 0.4f;
+    if (!(g14 > u14 && g14 > R(0.0))) {
+        /* .../a:union/a:union/b:translate */
+        real3 p7 = p0 - (real3)((-0.475f), 0.0f, 0.6f);
+        /* .../b:translate/color/octahedron */
+        real d23 = sd_octahedron(p7, 0.4f);
+        real x14 = u18;
+        real y14 = d23;
+        real d14 = fmin(x14, y14);
+        u14 = d14;
+    }
+    /* .../a:union/a:union: the second operand only within reach of its bound */
+    real u10 = u14;
+    real g10 = length(p0 - (real3)(0.475f, 0.0f, 0.6f)) * 0.9999f - 0.46097723f;
+    if (!(g10 > u10 && g10 > R(0.0))) {
+        /* .../a:union/a:union/b:translate */
+        real3 p8 = p0 - (real3)(0.475f, 0.0f, 0.6f);
+        /* .../b:translate/color/capped_cone */
+        real d27 = sd_capped_cone(p8, 0.35f, 0.3f, 0.1f);
+        real x10 = u14;
+        real y10 = d27;
+        real d10 = fmin(x10, y10);
+        u10 = d10;
+    }
+    /* .../a:union/a:union: the second operand only within reach of its bound */
+    real u6 = u10;
+    real g6 = 0.5714286f * (length(p0 - (real3)(1.425f, 0.0f, 0.6f)) * 0.9999f - 0.35f);
+    if (!(g6 > u6 && g6 > R(0.0))) {
+        /* union/a:union/b:translate */
+        real3 p9 = p0 - (real3)(1.425f, 0.0f, 0.6f);
+        /* .../b:translate/color/ellipsoid */
+        real d31 = sd_ellipsoid(p9, (real3)(0.35f, 0.2f, 0.25f));
+        real x6 = u10;
+        real y6 = d31;
+        real d6 = fmin(x6, y6);
+        u6 = d6;
+    }
+    return u6;
 }
 
 real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
-    /* .../a:union/a:union/a:translate */
-    real3 p1 = p0 - (real3)((-1.9f), 0.0f, (-0.6f));
-    /* .../a:translate/color/sphere */
-    real d0 = sd_sphere(p1, 0.35f);
-    /* .../a:union/a:translate/color */
-    real3 c1 = (real3)(0.9f, 0.45f, 0.3f);
-    /* .../a:union/a:union/b:translate */
-    real3 p2 = p0 - (real3)((-0.95f), 0.0f, (-0.6f));
-    /* .../b:translate/color/cuboid */
-    real d3 = sd_box(p2, (real3)(0.3f));
-    /* .../a:union/b:translate/color */
-    real3 c4 = (real3)(0.825f, 0.5375f, 0.375f);
-    /* .../a:union/a:union/a:union */
-    real x6 = d0;
-    real y6 = d3;
-    real d6 = fmin(x6, y6);
-    real3 c6 = x6 < y6 ? c1 : c4;
-    /* .../a:union/a:union/b:translate */
-    real3 p3 = p0 - (real3)(0.0f, 0.0f, (-0.6f));
-    /* .../b:translate/color/round_box */
-    real d7 = sd_round_box(p3, (real3)(0.3f), 0.08f);
-    /* .../a:union/b:translate/color */
-    real3 c8 = (real3)(0.75f, 0.625f, 0.45f);
-    /* .../a:union/a:union/a:union */
-    real x10 = d6;
-    real y10 = d7;
-    real d10 = fmin(x10, y10);
-    real3 c10 = x10 < y10 ? c6 : c8;
-    /* .../a:union/a:union/b:translate */
-    real3 p4 = p0 - (real3)(0.95f, 0.0f, (-0.6f));
-    /* .../b:translate/color/torus */
-    real d11 = sd_torus(p4, 0.28f, 0.1f);
-    /* .../a:union/b:translate/color */
-    real3 c12 = (real3)(0.675f, 0.7125f, 0.525f);
-    /* .../a:union/a:union/a:union */
-    real x14 = d10;
-    real y14 = d11;
-    real d14 = fmin(x14, y14);
-    real3 c14 = x14 < y14 ? c10 : c12;
-    /* .../a:union/a:union/b:translate */
-    real3 p5 = p0 - (real3)(1.9f, 0.0f, (-0.6f));
-    /* .../b:translate/color/cylinder */
-    real d15 = sd_cylinder(p5, 0.25f, 0.35f);
-    /* .../a:union/b:translate/color */
-    real3 c16 = (real3)(0.6f, 0.8f, 0.6f);
-    /* .../a:union/a:union/a:union */
-    real x18 = d14;
-    real y18 = d15;
-    real d18 = fmin(x18, y18);
-    real3 c18 = x18 < y18 ? c14 : c16;
-    /* .../a:union/a:union/b:translate */
-    real3 p6 = p0 - (real3)((-1.425f), 0.0f, 0.6f);
-    /* .../b:translate/color/capsule */
-    real d19 = sd_capsule(p6, (real3)(0.0f, (-0.2f), 0.0f), (real3)(0.0f, 0.2f, 0.0f), 0.18f);
-    /* .../a:union/b:translate/color */
-    real3 c20 = (real3)(0.525f, 0.7125f, 0.675f);
-    /* .../a:union/a:union/a:union */
-    real x22 = d18;
-    real y22 = d19;
-    real d22 = fmin(x22, y22);
-    real3 c22 = x22 < y22 ? c18 : c20;
-    /* .../a:union/a:union/b:translate */
-    real3 p7 = p0 - (real3)((-0.475f), 0.0f, 0.6f);
-    /* .../b:translate/color/octahedron */
-    real d23 = sd_octahedron(p7, 0.4f);
-    /* .../a:union/b:translate/color */
-    real3 c24 = (real3)(0.45f, 0.625f, 0.75f);
-    /* .../a:union/a:union/a:union */
-    real x26 = d22;
-    real y26 = d23;
-    real d26 = fmin(x26, y26);
-    real3 c26 = x26 < y26 ? c22 : c24;
-    /* .../a:union/a:union/b:translate */
-    real3 p8 = p0 - (real3)(0.475f, 0.0f, 0.6f);
-    /* .../b:translate/color/capped_cone */
-    real d27 = sd_capped_cone(p8, 0.35f, 0.3f, 0.1f);
-    /* .../a:union/b:translate/color */
-    real3 c28 = (real3)(0.375f, 0.5375f, 0.825f);
-    /* union/a:union/a:union */
-    real x30 = d26;
-    real y30 = d27;
-    real d30 = fmin(x30, y30);
-    real3 c30 = x30 < y30 ? c26 : c28;
-    /* union/a:union/b:translate */
-    real3 p9 = p0 - (real3)(1.425f, 0.0f, 0.6f);
-    /* .../b:translate/color/ellipsoid */
-    real d31 = sd_ellipsoid(p9, (real3)(0.35f, 0.2f, 0.25f));
-    /* .../a:union/b:translate/color */
-    real3 c32 = (real3)(0.3f, 0.45f, 0.9f);
-    /* union/a:union */
-    real x34 = d30;
-    real y34 = d31;
-    real d34 = fmin(x34, y34);
-    real3 c34 = x34 < y34 ? c30 : c32;
+    /* union */
     /* union/b:color/plane */
     real d35 = sd_plane(p0, (real3)(0.0f, 1.0f, 0.0f), 0.4f);
     /* union/b:color */
     real3 c36 = (real3)(0.55f, 0.55f, 0.6f);
-    /* union */
-    real x37 = d34;
-    real y37 = d35;
-    real d37 = fmin(x37, y37);
-    real3 c37 = x37 < y37 ? c34 : c36;
-    *color = c37;
-    *trap = R(1.0);
-    return d37;
+    /* union: the second operand only within reach of its bound */
+    real u37 = d35;
+    real3 uc37 = c36;
+    real ut37 = R(1.0);
+    real g37 = length(p0 - (real3)((-1.9f), 0.0f, (-0.6f))) * 0.9999f - 0.35f;
+    if (!(g37 > u37 && g37 > R(0.0))) {
+        /* .../a:union/a:union/a:translate */
+        real3 p1 = p0 - (real3)((-1.9f), 0.0f, (-0.6f));
+        /* .../a:translate/color/sphere */
+        real d0 = sd_sphere(p1, 0.35f);
+        /* .../a:union/a:translate/color */
+        real3 c1 = (real3)(0.9f, 0.45f, 0.3f);
+        real x37 = d35;
+        real y37 = d0;
+        real d37 = fmin(x37, y37);
+        real3 c37 = x37 < y37 ? c36 : c1;
+        u37 = d37;
+        uc37 = c37;
+        ut37 = R(1.0);
+    }
+    /* union/a:union: the second operand only within reach of its bound */
+    real u34 = u37;
+    real3 uc34 = uc37;
+    real ut34 = ut37;
+    real g34 = length(p0 - (real3)((-0.95f), 0.0f, (-0.6f))) * 0.9999f - 0.51961523f;
+    if (!(g34 > u34 && g34 > R(0.0))) {
+        /* .../a:union/a:union/b:translate */
+        real3 p2 = p0 - (real3)((-0.95f), 0.0f, (-0.6f));
+        /* .../b:translate/color/cuboid */
+        real d3 = sd_box(p2, (real3)(0.3f));
+        /* .../a:union/b:translate/color */
+        real3 c4 = (real3)(0.825f, 0.5375f, 0.375f);
+        real x34 = u37;
+        real y34 = d3;
+        real d34 = fmin(x34, y34);
+        real3 c34 = x34 < y34 ? uc37 : c4;
+        real t34 = x34 < y34 ? ut37 : R(1.0);
+        u34 = d34;
+        uc34 = c34;
+        ut34 = t34;
+    }
+    /* .../a:union/a:union: the second operand only within reach of its bound */
+    real u30 = u34;
+    real3 uc30 = uc34;
+    real ut30 = ut34;
+    real g30 = length(p0 - (real3)(0.0f, 0.0f, (-0.6f))) * 0.9999f - 0.51961523f;
+    if (!(g30 > u30 && g30 > R(0.0))) {
+        /* .../a:union/a:union/b:translate */
+        real3 p3 = p0 - (real3)(0.0f, 0.0f, (-0.6f));
+        /* .../b:translate/color/round_box */
+        real d7 = sd_round_box(p3, (real3)(0.3f), 0.08f);
+        /* .../a:union/b:translate/color */
+        real3 c8 = (real3)(0.75f, 0.625f, 0.45f);
+        real x30 = u34;
+        real y30 = d7;
+        real d30 = fmin(x30, y30);
+        real3 c30 = x30 < y30 ? uc34 : c8;
+        real t30 = x30 < y30 ? ut34 : R(1.0);
+        u30 = d30;
+        uc30 = c30;
+        ut30 = t30;
+    }
+    /* .../a:union/a:union: the second operand only within reach of its bound */
+    real u26 = u30;
+    real3 uc26 = uc30;
+    real ut26 = ut30;
+    real g26 = length(p0 - (real3)(0.95f, 0.0f, (-0.6f))) * 0.9999f - 0.38f;
+    if (!(g26 > u26 && g26 > R(0.0))) {
+        /* .../a:union/a:union/b:translate */
+        real3 p4 = p0 - (real3)(0.95f, 0.0f, (-0.6f));
+        /* .../b:translate/color/torus */
+        real d11 = sd_torus(p4, 0.28f, 0.1f);
+        /* .../a:union/b:translate/color */
+        real3 c12 = (real3)(0.675f, 0.7125f, 0.525f);
+        real x26 = u30;
+        real y26 = d11;
+        real d26 = fmin(x26, y26);
+        real3 c26 = x26 < y26 ? uc30 : c12;
+        real t26 = x26 < y26 ? ut30 : R(1.0);
+        u26 = d26;
+        uc26 = c26;
+        ut26 = t26;
+    }
+    /* .../a:union/a:union: the second operand only within reach of its bound */
+    real u22 = u26;
+    real3 uc22 = uc26;
+    real ut22 = ut26;
+    real g22 = length(p0 - (real3)(1.9f, 0.0f, (-0.6f))) * 0.9999f - 0.43011627f;
+    if (!(g22 > u22 && g22 > R(0.0))) {
+        /* .../a:union/a:union/b:translate */
+        real3 p5 = p0 - (real3)(1.9f, 0.0f, (-0.6f));
+        /* .../b:translate/color/cylinder */
+        real d15 = sd_cylinder(p5, 0.25f, 0.35f);
+        /* .../a:union/b:translate/color */
+        real3 c16 = (real3)(0.6f, 0.8f, 0.6f);
+        real x22 = u26;
+        real y22 = d15;
+        real d22 = fmin(x22, y22);
+        real3 c22 = x22 < y22 ? uc26 : c16;
+        real t22 = x22 < y22 ? ut26 : R(1.0);
+        u22 = d22;
+        uc22 = c22;
+        ut22 = t22;
+    }
+    /* .../a:union/a:union: the second operand only within reach of its bound */
+    real u18 = u22;
+    real3 uc18 = uc22;
+    real ut18 = ut22;
+    real g18 = length(p0 - (real3)((-1.425f), 0.0f, 0.6f)) * 0.9999f - 0.38f;
+    if (!(g18 > u18 && g18 > R(0.0))) {
+        /* .../a:union/a:union/b:translate */
+        real3 p6 = p0 - (real3)((-1.425f), 0.0f, 0.6f);
+        /* .../b:translate/color/capsule */
+        real d19 = sd_capsule(p6, (real3)(0.0f, (-0.2f), 0.0f), (real3)(0.0f, 0.2f, 0.0f), 0.18f);
+        /* .../a:union/b:translate/color */
+        real3 c20 = (real3)(0.525f, 0.7125f, 0.675f);
+        real x18 = u22;
+        real y18 = d19;
+        real d18 = fmin(x18, y18);
+        real3 c18 = x18 < y18 ? uc22 : c20;
+        real t18 = x18 < y18 ? ut22 : R(1.0);
+        u18 = d18;
+        uc18 = c18;
+        ut18 = t18;
+    }
+    /* .../a:union/a:union: the second operand only within reach of its bound */
+    real u14 = u18;
+    real3 uc14 = uc18;
+    real ut14 = ut18;
+    real g14 = length(p0 - (real3)((-0.475f), 0.0f, 0.6f)) * 0.9999f - 0.4f;
+    if (!(g14 > u14 && g14 > R(0.0))) {
+        /* .../a:union/a:union/b:translate */
+        real3 p7 = p0 - (real3)((-0.475f), 0.0f, 0.6f);
+        /* .../b:translate/color/octahedron */
+        real d23 = sd_octahedron(p7, 0.4f);
+        /* .../a:union/b:translate/color */
+        real3 c24 = (real3)(0.45f, 0.625f, 0.75f);
+        real x14 = u18;
+        real y14 = d23;
+        real d14 = fmin(x14, y14);
+        real3 c14 = x14 < y14 ? uc18 : c24;
+        real t14 = x14 < y14 ? ut18 : R(1.0);
+        u14 = d14;
+        uc14 = c14;
+        ut14 = t14;
+    }
+    /* .../a:union/a:union: the second operand only within reach of its bound */
+    real u10 = u14;
+    real3 uc10 = uc14;
+    real ut10 = ut14;
+    real g10 = length(p0 - (real3)(0.475f, 0.0f, 0.6f)) * 0.9999f - 0.46097723f;
+    if (!(g10 > u10 && g10 > R(0.0))) {
+        /* .../a:union/a:union/b:translate */
+        real3 p8 = p0 - (real3)(0.475f, 0.0f, 0.6f);
+        /* .../b:translate/color/capped_cone */
+        real d27 = sd_capped_cone(p8, 0.35f, 0.3f, 0.1f);
+        /* .../a:union/b:translate/color */
+        real3 c28 = (real3)(0.375f, 0.5375f, 0.825f);
+        real x10 = u14;
+        real y10 = d27;
+        real d10 = fmin(x10, y10);
+        real3 c10 = x10 < y10 ? uc14 : c28;
+        real t10 = x10 < y10 ? ut14 : R(1.0);
+        u10 = d10;
+        uc10 = c10;
+        ut10 = t10;
+    }
+    /* .../a:union/a:union: the second operand only within reach of its bound */
+    real u6 = u10;
+    real3 uc6 = uc10;
+    real ut6 = ut10;
+    real g6 = 0.5714286f * (length(p0 - (real3)(1.425f, 0.0f, 0.6f)) * 0.9999f - 0.35f);
+    if (!(g6 > u6 && g6 > R(0.0))) {
+        /* union/a:union/b:translate */
+        real3 p9 = p0 - (real3)(1.425f, 0.0f, 0.6f);
+        /* .../b:translate/color/ellipsoid */
+        real d31 = sd_ellipsoid(p9, (real3)(0.35f, 0.2f, 0.25f));
+        /* .../a:union/b:translate/color */
+        real3 c32 = (real3)(0.3f, 0.45f, 0.9f);
+        real x6 = u10;
+        real y6 = d31;
+        real d6 = fmin(x6, y6);
+        real3 c6 = x6 < y6 ? uc10 : c32;
+        real t6 = x6 < y6 ? ut10 : R(1.0);
+        u6 = d6;
+        uc6 = c6;
+        ut6 = t6;
+    }
+    *color = uc6;
+    *trap = ut6;
+    return u6;
 }
 
 /* ---- kernel: march.cl ---- */

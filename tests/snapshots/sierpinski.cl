@@ -22,6 +22,7 @@ typedef float4 real4;
 #define AO_SAMPLES 5
 #define AO_DISTANCE 0.25f
 #define SHADOW_STEPS 96
+#define CONE_TILE 8
 #define ENABLE_AO
 #define ENABLE_SHADOWS
 /* The kernel interface (src/codegen/interface.rs). */
@@ -42,7 +43,14 @@ typedef float4 real4;
     __global uchar* hit_mask, \
     __global float* normals, \
     __global uint* steps, \
-    __global uint* evaluations
+    __global uint* evaluations, \
+    __global const float* starts
+#define CONE_STARTS_ARGS \
+    __global const real* params, \
+    __global const real* camera, \
+    const int width, \
+    const int height, \
+    __global float* starts
 #define CAMERA_ORIGIN 0
 #define CAMERA_ORTHOGRAPHIC 3
 #define CAMERA_RIGHT 4
@@ -52,6 +60,9 @@ typedef float4 real4;
 #define CAMERA_FORWARD 12
 #define CAMERA_FOOTPRINT_BASE 15
 #define CAMERA_FOOTPRINT_PER_UNIT 16
+#define CAMERA_IMAGE_WIDTH 17
+#define CAMERA_IMAGE_HEIGHT 18
+#define CAMERA_PIXEL_SCALE 19
 #define LIGHT_POSITION 0
 #define LIGHT_KIND 3
 #define LIGHT_RADIANCE 4
@@ -98,37 +109,53 @@ real sierpinski(real3 p, int iterations, real scale, real* trap) {
 
 /* ---- scene ---- */
 real DE(real3 p0, __global const real* params) {
-    /* union/a:color/sierpinski */
-    real t0;
-    real d0 = sierpinski(p0, 7, 2.0f, &t0);
+    /* union */
     /* union/b:color/plane */
     real d2 = sd_plane(p0, (real3)(0.0f, 1.0f, 0.0f), 1.0f);
-    /* union */
-    real x4 = d0;
-    real y4 = d2;
-    real d4 = fmin(x4, y4);
-    return d4;
+    /* union: the second operand only within reach of its bound */
+    real u4 = d2;
+    real g4 = 0.33333334f * (length(p0 - (real3)(0.0f)) * 0.9999f - 1.7320508f);
+    if (!(g4 > u4 && g4 > R(0.0))) {
+        /* union/a:color/sierpinski */
+        real t0;
+        real d0 = sierpinski(p0, 7, 2.0f, &t0);
+        real x4 = d2;
+        real y4 = d0;
+        real d4 = fmin(x4, y4);
+        u4 = d4;
+    }
+    return u4;
 }
 
 real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
-    /* union/a:color/sierpinski */
-    real t0;
-    real d0 = sierpinski(p0, 7, 2.0f, &t0);
-    /* union/a:color */
-    real3 c1 = (real3)(0.95f, 0.75f, 0.45f);
+    /* union */
     /* union/b:color/plane */
     real d2 = sd_plane(p0, (real3)(0.0f, 1.0f, 0.0f), 1.0f);
     /* union/b:color */
     real3 c3 = (real3)(0.55f, 0.55f, 0.6f);
-    /* union */
-    real x4 = d0;
-    real y4 = d2;
-    real d4 = fmin(x4, y4);
-    real3 c4 = x4 < y4 ? c1 : c3;
-    real t4 = x4 < y4 ? t0 : R(1.0);
-    *color = c4;
-    *trap = t4;
-    return d4;
+    /* union: the second operand only within reach of its bound */
+    real u4 = d2;
+    real3 uc4 = c3;
+    real ut4 = R(1.0);
+    real g4 = 0.33333334f * (length(p0 - (real3)(0.0f)) * 0.9999f - 1.7320508f);
+    if (!(g4 > u4 && g4 > R(0.0))) {
+        /* union/a:color/sierpinski */
+        real t0;
+        real d0 = sierpinski(p0, 7, 2.0f, &t0);
+        /* union/a:color */
+        real3 c1 = (real3)(0.95f, 0.75f, 0.45f);
+        real x4 = d2;
+        real y4 = d0;
+        real d4 = fmin(x4, y4);
+        real3 c4 = x4 < y4 ? c3 : c1;
+        real t4 = x4 < y4 ? R(1.0) : t0;
+        u4 = d4;
+        uc4 = c4;
+        ut4 = t4;
+    }
+    *color = uc4;
+    *trap = ut4;
+    return u4;
 }
 
 /* ---- kernel: march.cl ---- */

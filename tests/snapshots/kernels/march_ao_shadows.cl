@@ -11,10 +11,14 @@
 //                         real3* color, real* trap)
 //   effects: the code of each effect (ambient occlusion, shadows, glow,
 //           fog) sits in a conditional block named ENABLE_<effect>, with
-//           its constants defined by the header only when it is on. Code
-//           generation resolves these blocks itself and leaves out every
-//           effect that is off, so they are the only preprocessor
-//           conditionals allowed in this file.
+//           its constants defined by the header only when it is on, and so
+//           does the stop at the scene's bounding sphere
+//           (ENABLE_SCENE_BOUND: SCENE_BOUND_CENTRE, SCENE_BOUND_RADIUS,
+//           SCENE_BOUND_SLOPE), and the coarse pass (ENABLE_CONE:
+//           CONE_TILE, the cone_starts kernel and the starts it leaves).
+//           Code generation resolves these blocks
+//           itself and leaves out every one that is off, so they are the
+//           only preprocessor conditionals allowed in this file.
 //
 // Everything else arrives at run time, so moving the camera or the lights
 // and changing dynamic parameters never rebuilds the program. The header
@@ -54,6 +58,9 @@ typedef struct {
     real half_h;
     real footprint_base;
     real footprint_per_unit;
+    real image_w;     // the image's size in pixels
+    real image_h;
+    real pixel_scale; // image pixels per rendered pixel along each axis
     int orthographic;
 } MarchCamera;
 
@@ -68,6 +75,9 @@ MarchCamera march_load_camera(__global const real* c) {
     cam.forward = vload3(0, c + CAMERA_FORWARD);
     cam.footprint_base = c[CAMERA_FOOTPRINT_BASE];
     cam.footprint_per_unit = c[CAMERA_FOOTPRINT_PER_UNIT];
+    cam.image_w = c[CAMERA_IMAGE_WIDTH];
+    cam.image_h = c[CAMERA_IMAGE_HEIGHT];
+    cam.pixel_scale = c[CAMERA_PIXEL_SCALE];
     return cam;
 }
 
@@ -76,12 +86,11 @@ real march_footprint(const MarchCamera* cam, real t) {
     return cam->footprint_base + cam->footprint_per_unit * t;
 }
 
-// The ray through image position (px, py) in pixels, (0, 0) being the top
-// left corner of the image.
-void march_camera_ray(const MarchCamera* cam, real px, real py, int width, int height,
-                      real3* ro, real3* rd) {
-    real u = (R(2.0) * px / (real)width - R(1.0)) * cam->half_w;
-    real v = (R(1.0) - R(2.0) * py / (real)height) * cam->half_h;
+// The ray through image position (px, py) in image pixels, (0, 0) being
+// the top left corner of the image.
+void march_camera_ray(const MarchCamera* cam, real px, real py, real3* ro, real3* rd) {
+    real u = (R(2.0) * px / cam->image_w - R(1.0)) * cam->half_w;
+    real v = (R(1.0) - R(2.0) * py / cam->image_h) * cam->half_h;
     if (cam->orthographic) {
         *ro = cam->origin + cam->right * u + cam->up * v;
         *rd = cam->forward;
@@ -153,18 +162,81 @@ real march_refine(real3 ro, real3 rd, const MarchCamera* cam, real t0, real g0, 
 // 2014); when the unbounding spheres of two consecutive points stop
 // overlapping the long step may have jumped over a surface, so the march
 // returns to the last safe point and continues with plain steps.
-MarchResult march_ray(real3 ro, real3 rd, const MarchCamera* cam,
+// The glow of a pixel is set by the smallest d / (t + d) along its ray.
+// Space the march may skip without changing the glow by more than half a
+// step of an 8-bit pixel must keep every d / (t + d) above the angle L
+// where the glow falls below that (its strength times exp(-falloff * L)
+// times its brightest channel = 0.5 / 255), that is d >= k t with
+// k = L / (1 - L). Returns k: 0 without glow, and INFINITY where no angle
+// is small enough.
+real march_glow_slope(void) {
+    return R(0.0);
+}
+
+// How far along the ray a hit can lie at most, for a scene that lies in a
+// sphere (SCENE_BOUND_CENTRE, SCENE_BOUND_RADIUS) outside which its
+// estimate is at least SCENE_BOUND_SLOPE times the distance to the sphere
+// (src/ir/bounds.rs). The drawn surface lies DETAIL footprints out, so
+// the sphere is widened by that at the farthest distance a hit could have,
+// t_max = (|ro - c| + R + DETAIL base / slope) / (1 - DETAIL per_unit /
+// slope): beyond t_max the estimate outgrows the surface's offset, and
+// before it, once the ray has left the widened sphere it never returns.
+// Returns where the ray leaves the widened sphere (negative if it misses
+// it), or MAX_DISTANCE where the footprint grows too fast for the bound.
+real march_bound_exit(real3 ro, real3 rd, const MarchCamera* cam) {
+    real3 oc = ro - SCENE_BOUND_CENTRE;
+    real len = length(oc);
+    real shrink = R(1.0) - DETAIL * cam->footprint_per_unit / SCENE_BOUND_SLOPE;
+    if (shrink <= R(0.0)) {
+        return MAX_DISTANCE;
+    }
+    real t_max = (len + SCENE_BOUND_RADIUS + DETAIL * cam->footprint_base / SCENE_BOUND_SLOPE)
+                 / shrink;
+    real radius = SCENE_BOUND_RADIUS + DETAIL * march_footprint(cam, t_max) / SCENE_BOUND_SLOPE;
+    real b = dot(oc, rd);
+    real disc = b * b - (len - radius) * (len + radius);
+    return disc < R(0.0) ? R(-1.0) : -b + sqrt(disc);
+}
+
+// Whether a ray past the scene's bounding sphere at p, t along it in
+// direction rd, may stop without changing its pixel: always, unless the
+// pixel has a halo of near misses (see march_glow_slope). Further on, u
+// along the ray, the estimate is at least G = slope (sqrt(|q|^2 + u^2) - R)
+// with q = p - c (once the ray moves away from c). For any unit (a, b),
+// sqrt(|q|^2 + u^2) >= a |q| + b u; with b = k / slope the u terms match
+// k (t + u), so slope (a |q| - R) >= k t suffices for every u.
+int march_glow_settled(real3 p, real3 rd, real t) {
+    real k = march_glow_slope();
+    if (k <= R(0.0)) {
+        return 1;
+    }
+    real3 q = p - SCENE_BOUND_CENTRE;
+    if (dot(q, rd) < R(0.0)) {
+        return 0; // still approaching the sphere, which it misses
+    }
+    real b = k / SCENE_BOUND_SLOPE;
+    if (b >= R(1.0)) {
+        return 0;
+    }
+    real a = sqrt(R(1.0) - b * b);
+    return SCENE_BOUND_SLOPE * (a * length(q) - SCENE_BOUND_RADIUS) >= k * t;
+}
+
+MarchResult march_ray(real3 ro, real3 rd, real start, const MarchCamera* cam,
                       __global const real* params) {
     MarchResult r;
-    r.t = R(0.0);
+    r.t = start;
     r.closest = R(1.0);
     r.steps = 0;
     r.hit = 0;
     const real lipschitz = R(1.0) + DETAIL * cam->footprint_per_unit;
     real omega = OVER_RELAXATION;
     int relaxed = 0; // whether the last step was longer than a plain one
-    real prev_t = R(0.0);
+    real prev_t = start;
     real prev_g = R(0.0);
+    // A ray that has passed the last place it could hit stops (after a
+    // plain step: a relaxed one may still fall back before it).
+    const real t_exit = march_bound_exit(ro, rd, cam);
     for (int i = 0; i < MAX_STEPS; ++i) {
         real d = DE(ro + rd * r.t, params);
         real g = d - DETAIL * march_footprint(cam, r.t);
@@ -193,6 +265,9 @@ MarchResult march_ray(real3 ro, real3 rd, const MarchCamera* cam,
         prev_g = g;
         r.t += fmax(omega * plain, shortest);
         if (r.t > MAX_DISTANCE) {
+            return r;
+        }
+        if (r.t > t_exit && !relaxed && march_glow_settled(ro + rd * r.t, rd, r.t)) {
             return r;
         }
     }
@@ -250,11 +325,29 @@ real march_ambient_occlusion(real3 p, real3 n, real view_height,
 // callers pass a fraction of the surface hit threshold so shadows are not
 // fattened by a pixel where objects nearly touch. Adds its DE evaluations
 // to *evals.
+//
+// The ray stops early where the rest cannot change the pixel: once the
+// light it could still let through is below half a step of an 8-bit pixel
+// (`weight` is the most light a fully visible light adds to the pixel in
+// any channel, and the smoothstep below is at most 3 v^2), and, for a
+// hard shadow, once it has passed the scene's bounding sphere (nothing
+// beyond can block it).
 real march_shadow(real3 ro, real3 rd, real max_t, real eps, real start, real softness,
-                  __global const real* params, uint* evals) {
+                  real weight, __global const real* params, uint* evals) {
     real visible = R(1.0);
     real prev_h = R(1e20);
     real t = start;
+    real faint = sqrt(R(0.5) / (R(255.0) * R(3.0) * fmax(weight, REAL_TINY)));
+    real3 oc = ro - SCENE_BOUND_CENTRE;
+    real b = dot(oc, rd);
+    real widened = SCENE_BOUND_RADIUS + eps / SCENE_BOUND_SLOPE;
+    real disc = b * b - (dot(oc, oc) - widened * widened);
+    // Where the ray leaves the sphere widened until the estimate outside it
+    // exceeds eps (negative: it misses it).
+    real t_exit = disc < R(0.0) ? R(-1.0) : -b + sqrt(disc);
+    if (softness <= R(0.0)) {
+        max_t = fmin(max_t, t_exit);
+    }
     for (int i = 0; i < SHADOW_STEPS && t < max_t; ++i) {
         real h = DE(ro + rd * t, params);
         *evals += 1u;
@@ -271,6 +364,9 @@ real march_shadow(real3 ro, real3 rd, real max_t, real eps, real start, real sof
             real side = sqrt(fmax(h * h - y * y, R(0.0)));
             visible = fmin(visible, side / (softness * fmax(t - y, REAL_TINY)));
             prev_h = h;
+            if (visible < faint) {
+                return R(0.0);
+            }
         }
         t += fmax(h, eps);
     }
@@ -288,8 +384,8 @@ real3 march_trap_tint(real trap) {
 }
 
 // Background at image row py: SKY_BOTTOM at the bottom, SKY_TOP at the top.
-real3 march_background(real py, int height) {
-    real v = clamp(R(1.0) - py / (real)height, R(0.0), R(1.0));
+real3 march_background(const MarchCamera* cam, real py) {
+    real v = clamp(R(1.0) - py / cam->image_h, R(0.0), R(1.0));
     return mix(SKY_BOTTOM, SKY_TOP, v);
 }
 
@@ -331,9 +427,11 @@ real3 march_shade(real3 p, real3 n, real3 rd, real eps, real view_height,
         if (ndl <= R(0.0)) {
             continue;
         }
-        real visible =
-            march_shadow(lifted, to_light, light_distance, R(0.25) * eps, eps, l[LIGHT_SOFTNESS],
-                         params, evals);
+        // The most this light adds to the pixel in any channel.
+        real3 most = radiance * ((albedo + MARCH_SPECULAR) * ndl);
+        real visible = march_shadow(lifted, to_light, light_distance, R(0.25) * eps, eps,
+                                    l[LIGHT_SOFTNESS], fmax(most.x, fmax(most.y, most.z)),
+                                    params, evals);
         if (visible <= R(0.0)) {
             continue;
         }
@@ -380,6 +478,9 @@ __kernel void render_tile(RENDER_TILE_ARGS) {
         return;
     }
     MarchCamera cam = march_load_camera(camera);
+    // Where the pixel's rays start: past the empty space the coarse pass
+    // found in front of its tile.
+    real start = R(0.0);
 
     real3 sum = (real3)(R(0.0));
     uint total_steps = 0;
@@ -396,16 +497,17 @@ __kernel void render_tile(RENDER_TILE_ARGS) {
             jy = ((real)(s / SUPERSAMPLING) + march_jitter(pixel, (uint)s, 1u))
                  / (real)SUPERSAMPLING;
         }
-        real px = (real)x + jx;
-        real py = (real)y + jy;
+        // Rendered pixel (x, y) covers pixel_scale image pixels each way.
+        real px = ((real)x + jx) * cam.pixel_scale;
+        real py = ((real)y + jy) * cam.pixel_scale;
         real3 ro;
         real3 rd;
-        march_camera_ray(&cam, px, py, width, height, &ro, &rd);
-        MarchResult m = march_ray(ro, rd, &cam, params);
+        march_camera_ray(&cam, px, py, &ro, &rd);
+        MarchResult m = march_ray(ro, rd, start, &cam, params);
         total_steps += (uint)m.steps;
         total_evals += (uint)m.steps;
 
-        real3 background = march_background(py, height);
+        real3 background = march_background(&cam, py);
         real3 color = background;
         real3 n = (real3)(R(0.0));
         if (m.hit) {
@@ -413,7 +515,7 @@ __kernel void render_tile(RENDER_TILE_ARGS) {
             real footprint = march_footprint(&cam, m.t);
             n = march_normal(p, NORMAL_EPSILON * footprint, rd, params);
             total_evals += MARCH_NORMAL_EVALUATIONS;
-            real view_height = footprint * (real)height;
+            real view_height = footprint * cam.image_h;
             if (m.t <= R(0.0)) {
                 // The ray starts inside the surface (a camera within a
                 // solid): shade the nearest point of the surface instead.
@@ -441,8 +543,9 @@ __kernel void render_tile(RENDER_TILE_ARGS) {
             // The colour samples are jittered: trace the pixel centre.
             real3 ro;
             real3 rd;
-            march_camera_ray(&cam, (real)x + R(0.5), (real)y + R(0.5), width, height, &ro, &rd);
-            centre = march_ray(ro, rd, &cam, params);
+            march_camera_ray(&cam, ((real)x + R(0.5)) * cam.pixel_scale,
+                             ((real)y + R(0.5)) * cam.pixel_scale, &ro, &rd);
+            centre = march_ray(ro, rd, start, &cam, params);
             centre_normal = (real3)(R(0.0));
             if (centre.hit) {
                 real h = NORMAL_EPSILON * march_footprint(&cam, centre.t);
@@ -456,3 +559,4 @@ __kernel void render_tile(RENDER_TILE_ARGS) {
         evaluations[idx] = total_evals;
     }
 }
+
