@@ -173,23 +173,24 @@ impl ConeArg {
     /// The argument's position in `cone_starts`.
     #[must_use]
     pub fn index(self) -> u32 {
-        let i = CONE_STARTS
-            .iter()
-            .position(|(a, _)| *a == self)
-            .expect("every argument is in CONE_STARTS");
-        u32::try_from(i).expect("few arguments")
+        position(&CONE_STARTS, &self)
     }
+}
+
+/// The position of `arg` in a kernel's list of declarations.
+fn position<A: PartialEq>(list: &[(A, &str)], arg: &A) -> u32 {
+    let i = list
+        .iter()
+        .position(|(a, _)| a == arg)
+        .expect("every argument is in its kernel's list");
+    u32::try_from(i).expect("few arguments")
 }
 
 impl RenderArg {
     /// The argument's position in `render_tile`.
     #[must_use]
     pub fn index(self) -> u32 {
-        let i = RENDER_TILE
-            .iter()
-            .position(|(a, _)| *a == self)
-            .expect("every argument is in RENDER_TILE");
-        u32::try_from(i).expect("few arguments")
+        position(&RENDER_TILE, &self)
     }
 }
 
