@@ -178,6 +178,7 @@ pub mod file;
 pub mod gallery;
 pub mod ir;
 pub mod math;
+pub mod mesh;
 pub mod metrics;
 pub mod output;
 pub mod quality;

@@ -24,6 +24,12 @@ const STAGES: &[(&str, &[&str])] = &[
             "error", "scene", "ir", "math", "quality", "cpu", "codegen", "view",
         ],
     ),
+    (
+        "mesh",
+        &[
+            "error", "scene", "ir", "math", "quality", "cpu", "render", "output",
+        ],
+    ),
 ];
 
 fn sources(at: &Path, out: &mut Vec<PathBuf>) {

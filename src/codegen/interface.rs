@@ -216,6 +216,33 @@ pub const EVAL_POINTS: [(EvalArg, &str); 4] = [
 /// `(colour, 0)`.
 pub const EVAL_OUT_STRIDE: usize = 8;
 
+/// The arguments of the grid-evaluation kernel `eval_grid`, in order: `DE`
+/// at every sample of cubic blocks of a regular grid (meshes, volumes).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[allow(missing_docs)] // Each is described by its declaration in `EVAL_GRID`.
+pub enum GridArg {
+    Blocks,
+    Grid,
+    Side,
+    Params,
+    Out,
+    Count,
+}
+
+/// `eval_grid`'s declarations, in argument order. `blocks` holds each
+/// block's first sample as grid indices; `grid` the grid's origin and
+/// spacing `(x, y, z, spacing)`; `side` the samples along a block's edge.
+/// Sample `s` of block `b` is written to `out[b·side³ + s]`, `s = x + side
+/// (y + side z)`.
+pub const EVAL_GRID: [(GridArg, &str); 6] = [
+    (GridArg::Blocks, "__global const int4* blocks"),
+    (GridArg::Grid, "__global const real* grid"),
+    (GridArg::Side, "const uint side"),
+    (GridArg::Params, "__global const real* params"),
+    (GridArg::Out, "__global real* out"),
+    (GridArg::Count, "const uint count"),
+];
+
 /// The header's `#define`s of the interface of `target`'s kernel: its
 /// argument list and the layouts of its buffers.
 pub(crate) fn defines(target: super::Target) -> String {
@@ -236,6 +263,7 @@ pub(crate) fn defines(target: super::Target) -> String {
         super::Target::Evaluate => {
             let _ = writeln!(w, "#define EVAL_POINTS_ARGS \\\n    {}", args(&EVAL_POINTS));
             let _ = writeln!(w, "#define EVAL_OUT_STRIDE {EVAL_OUT_STRIDE}");
+            let _ = writeln!(w, "#define EVAL_GRID_ARGS \\\n    {}", args(&EVAL_GRID));
         }
     }
     out

@@ -1,0 +1,336 @@
+//! Triangle meshes by Naive Surface Nets over the blocks the octree keeps,
+//! welded into one watertight mesh.
+
+use std::collections::HashMap;
+
+use fast_surface_nets::ndshape::{ConstShape, ConstShape3u32};
+use fast_surface_nets::{SurfaceNetsBuffer, surface_nets};
+use glam::{DVec3, Vec3};
+
+use super::grid::{Grid, Progress, Stage, occupied, plan};
+use super::sharpen::{Crossings, sharpen};
+use super::{GridOptions, Sampling};
+use crate::error::Result;
+use crate::ir::CompiledScene;
+
+/// Cells along a block's edge: the unit the octree drops or keeps.
+pub const CHUNK: u32 = 16;
+
+/// Samples along a sampled block's edge: the block's `CHUNK + 1` corners
+/// and one more, shared with the next block, which Surface Nets needs to
+/// connect blocks without seams.
+const SIDE: u32 = CHUNK + 2;
+
+type BlockShape = ConstShape3u32<SIDE, SIDE, SIDE>;
+
+/// Blocks sampled per call to the sampler.
+const BATCH: usize = 256;
+
+/// Vertices coloured per call to the sampler.
+const SHADE_BATCH: usize = 1 << 18;
+
+/// Display gamma of vertex colours (the renderer's default).
+const GAMMA: f64 = 2.2;
+
+/// A triangle mesh in the scene's coordinates.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct Mesh {
+    /// Vertex positions.
+    pub positions: Vec<Vec3>,
+    /// Unit vertex normals, pointing out of the shape (the distance
+    /// field's gradient).
+    pub normals: Vec<Vec3>,
+    /// Vertex colours (8-bit, gamma-encoded as the renderer's images):
+    /// the scene's colour at each vertex, from `DE_shade`.
+    pub colors: Vec<[u8; 3]>,
+    /// Triangles as vertex indices, counter-clockwise seen from outside.
+    pub triangles: Vec<[u32; 3]>,
+    /// The grid's cell size.
+    pub voxel_size: f64,
+    /// What the extraction cost.
+    pub stats: MeshStats,
+}
+
+/// What an extraction cost.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct MeshStats {
+    /// Cells along each axis of the grid.
+    pub cells: [u32; 3],
+    /// Blocks of [`CHUNK`]³ cells in the grid.
+    pub blocks: u64,
+    /// Blocks the octree kept and sampled.
+    pub blocks_sampled: u64,
+    /// Distance evaluations in all (octree centres, block samples, vertex
+    /// colours).
+    pub evaluations: u64,
+}
+
+/// How a mesh's edges are shared: a closed 2-manifold surface shares
+/// every edge between exactly two triangles that traverse it in opposite
+/// directions.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct Topology {
+    /// Distinct edges.
+    pub edges: usize,
+    /// Edges of only one triangle: holes.
+    pub boundary_edges: usize,
+    /// Edges of more than two triangles.
+    pub non_manifold_edges: usize,
+    /// Edges two triangles traverse in the same direction: flipped
+    /// orientation.
+    pub misoriented_edges: usize,
+}
+
+impl Topology {
+    /// Whether every edge joins exactly two consistently oriented
+    /// triangles.
+    #[must_use]
+    pub fn is_closed_manifold(&self) -> bool {
+        self.boundary_edges == 0 && self.non_manifold_edges == 0 && self.misoriented_edges == 0
+    }
+}
+
+impl Mesh {
+    /// How the mesh's edges are shared.
+    #[must_use]
+    pub fn topology(&self) -> Topology {
+        // Per undirected edge: (triangles, this direction minus the other).
+        let mut edges: HashMap<(u32, u32), (u32, i32)> = HashMap::new();
+        for t in &self.triangles {
+            for (a, b) in [(t[0], t[1]), (t[1], t[2]), (t[2], t[0])] {
+                let e = edges.entry((a.min(b), a.max(b))).or_default();
+                e.0 += 1;
+                e.1 += if a < b { 1 } else { -1 };
+            }
+        }
+        let mut out = Topology {
+            edges: edges.len(),
+            ..Topology::default()
+        };
+        for (count, balance) in edges.values() {
+            match count {
+                1 => out.boundary_edges += 1,
+                2 if *balance != 0 => out.misoriented_edges += 1,
+                2 => {}
+                _ => out.non_manifold_edges += 1,
+            }
+        }
+        out
+    }
+
+    /// The enclosed volume (the divergence theorem over the triangles):
+    /// positive for a closed mesh oriented outwards.
+    #[must_use]
+    pub fn volume(&self) -> f64 {
+        self.triangles
+            .iter()
+            .map(|t| {
+                let [a, b, c] = t.map(|i| self.positions[i as usize].as_dvec3());
+                a.dot(b.cross(c)) / 6.0
+            })
+            .sum()
+    }
+
+    /// The total area of the triangles.
+    #[must_use]
+    pub fn area(&self) -> f64 {
+        self.triangles
+            .iter()
+            .map(|t| {
+                let [a, b, c] = t.map(|i| self.positions[i as usize].as_dvec3());
+                0.5 * (b - a).cross(c - a).length()
+            })
+            .sum()
+    }
+}
+
+/// The mesh of `scene`'s surface over the grid `options` describe.
+///
+/// # Errors
+/// [`Error::Invalid`](crate::Error::Invalid) for a resolution outside
+/// `1..=MAX_RESOLUTION`, a box that is not finite with `min < max`, or a
+/// scene without a bound and no box; the sampler's errors (no OpenCL
+/// platform, a build failure, ...).
+pub fn extract(scene: &CompiledScene, options: &GridOptions) -> Result<Mesh> {
+    extract_with_progress(scene, options, &mut |_| {})
+}
+
+/// [`extract`], reporting progress as it goes.
+///
+/// # Errors
+/// As [`extract`].
+pub fn extract_with_progress(
+    scene: &CompiledScene,
+    options: &GridOptions,
+    progress: &mut dyn FnMut(Progress),
+) -> Result<Mesh> {
+    let (grid, sampling) = plan(scene, options, progress)?;
+    let count = grid.cells.map(|c| c.div_ceil(CHUNK));
+    let (blocks, octree) = occupied(&sampling, &grid, CHUNK, 1, count, Stage::Culling, progress)?;
+    let mut welder = Welder::new(grid);
+    let total = blocks.len() as u64;
+    let mut buffer = SurfaceNetsBuffer::default();
+    for (n, batch) in blocks.chunks(BATCH).enumerate() {
+        let starts: Vec<[i32; 3]> = batch
+            .iter()
+            .map(|b| b.map(|i| i32::try_from(i * CHUNK).expect("grids are small")))
+            .collect();
+        let mut values = sampling.blocks(grid.origin, grid.spacing, SIDE, &starts)?;
+        let per = BlockShape::SIZE as usize;
+        for (start, sdf) in starts.iter().zip(values.chunks_exact_mut(per)) {
+            close_at_the_border(&grid, *start, sdf);
+            surface_nets(sdf, &BlockShape {}, [0; 3], [SIDE - 1; 3], &mut buffer);
+            welder.add(*start, sdf, &buffer);
+        }
+        progress(Progress {
+            stage: Stage::Sampling,
+            done: ((n + 1) * BATCH).min(blocks.len()) as u64,
+            total,
+        });
+    }
+    let (mut mesh, crossings) = welder.finish();
+    let mut sharpening = 0;
+    if options.sharp {
+        progress(Progress {
+            stage: Stage::Sharpening,
+            done: 0,
+            total: mesh.positions.len() as u64,
+        });
+        sharpening = sharpen(
+            &sampling,
+            &grid,
+            &crossings,
+            &mut mesh.positions,
+            &mut mesh.normals,
+        )?;
+    }
+    mesh.colors = shade(&sampling, &mesh.positions, progress)?;
+    mesh.stats = MeshStats {
+        cells: grid.cells,
+        blocks: count.iter().map(|&c| u64::from(c)).product(),
+        blocks_sampled: total,
+        evaluations: octree
+            + sharpening
+            + total * u64::from(BlockShape::SIZE)
+            + mesh.positions.len() as u64,
+    };
+    Ok(mesh)
+}
+
+/// Makes the grid's outer layer (and anything past it) outside, so that
+/// the mesh is closed where the box cuts the scene.
+fn close_at_the_border(grid: &Grid, start: [i32; 3], sdf: &mut [f32]) {
+    let cells = grid.cells.map(i64::from);
+    let inside = |a: usize, at: i64| at > 0 && at < cells[a];
+    let all_inside = (0..3).all(|a| {
+        inside(a, i64::from(start[a])) && inside(a, i64::from(start[a]) + i64::from(SIDE) - 1)
+    });
+    if all_inside {
+        return;
+    }
+    #[allow(clippy::cast_possible_truncation)] // A positive f32 is enough.
+    let outside = grid.spacing as f32;
+    for (i, d) in sdf.iter_mut().enumerate() {
+        let [x, y, z] = BlockShape::delinearize(u32::try_from(i).expect("a block is small"));
+        let at = [x, y, z];
+        if !(0..3).all(|a| inside(a, i64::from(start[a]) + i64::from(at[a]))) {
+            *d = outside;
+        }
+    }
+}
+
+/// Joins blocks' meshes into one: a vertex belongs to a grid cell, and the
+/// cells blocks share give the same vertex in both.
+struct Welder {
+    grid: Grid,
+    cells: HashMap<u64, u32>,
+    mesh: Mesh,
+    local: Vec<u32>,
+    crossings: Crossings,
+}
+
+impl Welder {
+    fn new(grid: Grid) -> Self {
+        Welder {
+            grid,
+            cells: HashMap::new(),
+            mesh: Mesh {
+                voxel_size: grid.spacing,
+                ..Mesh::default()
+            },
+            local: Vec::new(),
+            crossings: Crossings::default(),
+        }
+    }
+
+    fn add(&mut self, start: [i32; 3], sdf: &[f32], block: &SurfaceNetsBuffer) {
+        let stride = u64::from(self.grid.cells[0]) + 2;
+        let layer = stride * (u64::from(self.grid.cells[1]) + 2);
+        self.local.clear();
+        for ((cell, position), normal) in block
+            .surface_points
+            .iter()
+            .zip(&block.positions)
+            .zip(&block.normals)
+        {
+            let g = [0, 1, 2]
+                .map(|a| u64::try_from(start[a]).expect("blocks start at 0") + u64::from(cell[a]));
+            let key = g[0] + stride * g[1] + layer * g[2];
+            let next = u32::try_from(self.mesh.positions.len()).expect("fewer than 2³² vertices");
+            let index = *self.cells.entry(key).or_insert(next);
+            if index == next {
+                let local = DVec3::new(
+                    f64::from(start[0]) + f64::from(position[0]),
+                    f64::from(start[1]) + f64::from(position[1]),
+                    f64::from(start[2]) + f64::from(position[2]),
+                );
+                let p = self.grid.origin + self.grid.spacing * local;
+                self.mesh.positions.push(p.as_vec3());
+                let n = Vec3::from_array(*normal).normalize_or_zero();
+                self.mesh.normals.push(n);
+                let corners: [f32; 8] = std::array::from_fn(|i| {
+                    let offset =
+                        [i & 1, i >> 1 & 1, i >> 2].map(|o| u32::try_from(o).expect("0 or 1"));
+                    let at = [0, 1, 2].map(|a| cell[a] + offset[a]);
+                    sdf[BlockShape::linearize(at) as usize]
+                });
+                let global = g.map(|c| u32::try_from(c).expect("grids are small"));
+                self.crossings.push(global, corners);
+            }
+            self.local.push(index);
+        }
+        for t in block.indices.chunks_exact(3) {
+            let [a, b, c] = [t[0], t[1], t[2]].map(|i| self.local[i as usize]);
+            self.mesh.triangles.push([a, b, c]);
+        }
+    }
+
+    fn finish(self) -> (Mesh, Crossings) {
+        (self.mesh, self.crossings)
+    }
+}
+
+/// Gamma-encoded 8-bit colours of the scene at `points`.
+fn shade(
+    sampling: &Sampling,
+    points: &[Vec3],
+    progress: &mut dyn FnMut(Progress),
+) -> Result<Vec<[u8; 3]>> {
+    let mut out = Vec::with_capacity(points.len());
+    for batch in points.chunks(SHADE_BATCH) {
+        let at: Vec<DVec3> = batch.iter().map(|p| p.as_dvec3()).collect();
+        for c in sampling.colors(&at)? {
+            out.push(c.to_array().map(|v| {
+                #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss)] // In 0..=255.
+                let byte = (v.clamp(0.0, 1.0).powf(1.0 / GAMMA) * 255.0).round() as u8;
+                byte
+            }));
+        }
+        progress(Progress {
+            stage: Stage::Shading,
+            done: out.len() as u64,
+            total: points.len() as u64,
+        });
+    }
+    Ok(out)
+}

@@ -1,0 +1,50 @@
+//! Meshes and volumes out of any scene: watertight triangle meshes for 3D
+//! printers and modelling tools (binary STL, PLY with colours, OBJ), and
+//! voxel grids of signed distances (NRRD) or slice stacks (one PNG per z)
+//! for volume tools.
+//!
+//! Both start from the same regular grid over a box, sampled in bulk: on
+//! an OpenCL device through the generated `DE` (feature `opencl`, the
+//! default) or on the CPU through the reference evaluator. A mesh samples
+//! only the parts of the grid that can hold surface: an octree over blocks
+//! of 16³ cells asks the distance at each node's centre and drops every
+//! node farther from the scene than its own half-diagonal (a distance
+//! estimate never overestimates, so no surface is lost), which makes the
+//! cost grow with the surface's area, not the box's volume. Each block
+//! left is meshed by Naive Surface Nets (the `fast-surface-nets` crate),
+//! and the blocks' meshes are welded into one by grid cell, so the result
+//! is watertight: the grid's outer layer counts as outside, which closes
+//! any surface the box cuts.
+//!
+//! ```
+//! use fractal_sdf::mesh::{self, GridOptions, Sampler};
+//! use fractal_sdf::prelude::*;
+//!
+//! let scene = Scene::new(sphere(1.0)).compile()?;
+//! let options = GridOptions::default().resolution(32).sampler(Sampler::Cpu);
+//! let mesh = mesh::extract(&scene, &options)?;
+//! assert!(mesh.topology().is_closed_manifold());
+//! let volume = mesh.volume();
+//! assert!((volume - 4.0 / 3.0 * std::f64::consts::PI).abs() < 0.05 * volume);
+//! # Ok::<(), fractal_sdf::Error>(())
+//! ```
+//!
+//! The default box is the scene's bound (see [`Ir::bounds`]), tightened by
+//! a coarse pass to where the surface is, plus two voxels; a scene without
+//! a bound (a plane, an infinite repetition) needs [`GridOptions::bounds`].
+//!
+//! [`Ir::bounds`]: crate::ir::Ir::bounds
+
+mod extract;
+mod grid;
+use sample::Sampling;
+mod sample;
+mod sharpen;
+mod volume;
+mod write;
+
+pub use extract::{CHUNK, Mesh, MeshStats, Topology, extract, extract_with_progress};
+pub use grid::{Aabb, GridOptions, MAX_RESOLUTION, Progress, Stage};
+pub use sample::Sampler;
+pub use volume::{MAX_VOLUME_SAMPLES, Volume, sample_volume, sample_volume_with_progress};
+pub use write::MeshFormat;

@@ -1,0 +1,150 @@
+//! Where distances come from: an OpenCL device running the generated `DE`
+//! (only distances travel back), or the CPU reference on every core.
+
+use glam::DVec3;
+
+use crate::cpu::Evaluator;
+use crate::error::Result;
+use crate::ir::CompiledScene;
+use crate::quality::Precision;
+#[cfg(feature = "opencl")]
+use crate::render::{DeviceSelector, PointEvaluator};
+
+/// Where a mesh's or a volume's distances are computed.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Sampler {
+    /// The generated `DE` on an OpenCL device (the default with the
+    /// `opencl` feature, on the automatically chosen device).
+    #[cfg(feature = "opencl")]
+    Device(DeviceSelector),
+    /// The CPU reference evaluator, on every core (the default without
+    /// `opencl`).
+    Cpu,
+}
+
+impl Default for Sampler {
+    fn default() -> Self {
+        #[cfg(feature = "opencl")]
+        return Sampler::Device(DeviceSelector::auto());
+        #[cfg(not(feature = "opencl"))]
+        return Sampler::Cpu;
+    }
+}
+
+/// A built sampler.
+pub(crate) enum Sampling {
+    Cpu {
+        eval: Evaluator,
+        precision: Precision,
+    },
+    #[cfg(feature = "opencl")]
+    Device(Box<PointEvaluator>),
+}
+
+impl Sampling {
+    pub fn new(scene: &CompiledScene, sampler: &Sampler, precision: Precision) -> Result<Self> {
+        Ok(match sampler {
+            Sampler::Cpu => Sampling::Cpu {
+                eval: Evaluator::from_compiled(scene),
+                precision,
+            },
+            #[cfg(feature = "opencl")]
+            Sampler::Device(selector) => Sampling::Device(Box::new(PointEvaluator::from_compiled(
+                scene, precision, selector,
+            )?)),
+        })
+    }
+
+    /// The distance at every point.
+    pub fn distances(&self, points: &[DVec3]) -> Result<Vec<f64>> {
+        match self {
+            Sampling::Cpu { eval, precision } => Ok(on_cores(points.len(), |i| {
+                distance(eval, *precision, points[i])
+            })),
+            #[cfg(feature = "opencl")]
+            Sampling::Device(device) => Ok(device
+                .eval(points)?
+                .into_iter()
+                .map(|s| s.distance)
+                .collect()),
+        }
+    }
+
+    /// The colour (linear RGB) `DE_shade` gives at every point.
+    pub fn colors(&self, points: &[DVec3]) -> Result<Vec<DVec3>> {
+        match self {
+            Sampling::Cpu { eval, .. } => Ok(on_cores(points.len(), |i| {
+                eval.sample::<f64>(points[i].into()).color.into()
+            })),
+            #[cfg(feature = "opencl")]
+            Sampling::Device(device) => {
+                Ok(device.eval(points)?.into_iter().map(|s| s.color).collect())
+            }
+        }
+    }
+
+    /// `DE` at every sample of cubic blocks of `side³` samples of the grid
+    /// at `origin` with `spacing`, block after block, `x` fastest (as
+    /// [`PointEvaluator::eval_grid`]).
+    pub fn blocks(
+        &self,
+        origin: DVec3,
+        spacing: f64,
+        side: u32,
+        blocks: &[[i32; 3]],
+    ) -> Result<Vec<f32>> {
+        let per = (side as usize).pow(3);
+        match self {
+            Sampling::Cpu { eval, precision } => Ok(on_cores(per * blocks.len(), |i| {
+                let b = blocks[i / per];
+                let s = u32::try_from(i % per).expect("a block is small");
+                let at = [s % side, (s / side) % side, s / (side * side)];
+                let p = origin
+                    + spacing
+                        * DVec3::new(
+                            f64::from(b[0]) + f64::from(at[0]),
+                            f64::from(b[1]) + f64::from(at[1]),
+                            f64::from(b[2]) + f64::from(at[2]),
+                        );
+                #[allow(clippy::cast_possible_truncation)] // Grids hold f32.
+                let d = distance(eval, *precision, p) as f32;
+                d
+            })),
+            #[cfg(feature = "opencl")]
+            Sampling::Device(device) => {
+                #[allow(clippy::cast_possible_truncation)] // Grids hold f32.
+                let out = device
+                    .eval_grid(origin, spacing, side, blocks)?
+                    .into_iter()
+                    .map(|d| d as f32)
+                    .collect();
+                Ok(out)
+            }
+        }
+    }
+}
+
+fn distance(eval: &Evaluator, precision: Precision, p: DVec3) -> f64 {
+    match precision {
+        Precision::F32 => f64::from(eval.distance_f32(p.as_vec3())),
+        Precision::F64 => eval.distance(p),
+    }
+}
+
+/// `f(i)` for every `i < len`, split over the machine's cores.
+fn on_cores<T: Send + Default + Clone>(len: usize, f: impl Fn(usize) -> T + Sync) -> Vec<T> {
+    let mut out = vec![T::default(); len];
+    let cores = std::thread::available_parallelism().map_or(1, std::num::NonZero::get);
+    let per = len.div_ceil(cores).max(1024);
+    std::thread::scope(|s| {
+        for (k, part) in out.chunks_mut(per).enumerate() {
+            let f = &f;
+            s.spawn(move || {
+                for (j, v) in part.iter_mut().enumerate() {
+                    *v = f(k * per + j);
+                }
+            });
+        }
+    });
+    out
+}

@@ -1,0 +1,148 @@
+//! Dual contouring's vertex placement on Surface Nets' topology: each
+//! vertex moves to the point that best fits the tangent planes where the
+//! surface crosses its cell's edges (a quadratic error function over the
+//! exact gradients there), so box edges and corners, and the creases of
+//! CSG, stay sharp instead of being rounded off by averaging.
+
+use glam::{DMat3, DVec3, Vec3};
+
+use super::Sampling;
+use super::grid::Grid;
+use crate::error::Result;
+
+/// Pull towards the crossings' mean, in voxel units: it settles the
+/// directions the planes leave free (along a flat face, along an edge)
+/// and keeps nearly parallel planes from throwing a vertex far away.
+const REGULARISATION: f64 = 0.05;
+
+/// The step of the gradient's differences, in voxels.
+const GRADIENT_STEP: f64 = 1e-2;
+
+/// Points whose distances are asked for at once.
+const BATCH: usize = 1 << 20;
+
+/// The corners of a tetrahedron around a point: the differences along them
+/// give the gradient with four evaluations.
+const TETRAHEDRON: [DVec3; 4] = [
+    DVec3::new(1.0, -1.0, -1.0),
+    DVec3::new(-1.0, -1.0, 1.0),
+    DVec3::new(-1.0, 1.0, -1.0),
+    DVec3::new(1.0, 1.0, 1.0),
+];
+
+/// Where the surface crosses each cell's edges, per vertex: crossings in
+/// grid (voxel) coordinates, and each vertex's cell.
+#[derive(Default)]
+pub(crate) struct Crossings {
+    pub points: Vec<Vec3>,
+    /// Vertex `v`'s crossings are `points[starts[v]..starts[v + 1]]`.
+    pub starts: Vec<u32>,
+    pub cells: Vec<[u32; 3]>,
+}
+
+impl Crossings {
+    /// Records the crossings of the cell whose corner distances are
+    /// `corners` (corner `i` at offset `(i & 1, i >> 1 & 1, i >> 2)`).
+    pub fn push(&mut self, cell: [u32; 3], corners: [f32; 8]) {
+        if self.starts.is_empty() {
+            self.starts.push(0);
+        }
+        let base = Vec3::from_array(cell.map(|c| {
+            #[allow(clippy::cast_precision_loss)] // Grid indices are small.
+            let c = c as f32;
+            c
+        }));
+        let corner = |i: usize| {
+            #[allow(clippy::cast_precision_loss)] // 0 or 1.
+            let v = Vec3::new((i & 1) as f32, (i >> 1 & 1) as f32, (i >> 2) as f32);
+            v
+        };
+        for a in 0..8 {
+            for bit in [1, 2, 4] {
+                let b = a | bit;
+                if b == a {
+                    continue;
+                }
+                let (da, db) = (corners[a], corners[b]);
+                if (da < 0.0) != (db < 0.0) {
+                    let t = da / (da - db);
+                    self.points.push(base + corner(a).lerp(corner(b), t));
+                }
+            }
+        }
+        self.starts
+            .push(u32::try_from(self.points.len()).expect("fewer than 2³² crossings"));
+        self.cells.push(cell);
+    }
+}
+
+/// Moves every vertex to its cell's best fit of the crossings' tangent
+/// planes, and gives it the distance field's gradient there as its
+/// normal. Returns the distance evaluations it took.
+pub(crate) fn sharpen(
+    sampling: &Sampling,
+    grid: &Grid,
+    crossings: &Crossings,
+    positions: &mut [Vec3],
+    normals: &mut [Vec3],
+) -> Result<u64> {
+    let world = |v: DVec3| grid.origin + grid.spacing * v;
+    let at: Vec<DVec3> = crossings
+        .points
+        .iter()
+        .map(|p| world(p.as_dvec3()))
+        .collect();
+    let planes = gradients(sampling, grid.spacing, &at)?;
+    for (v, position) in positions.iter_mut().enumerate() {
+        let range = crossings.starts[v] as usize..crossings.starts[v + 1] as usize;
+        let points = &crossings.points[range.clone()];
+        let planes = &planes[range];
+        #[allow(clippy::cast_precision_loss)] // At most 12.
+        let mean = points.iter().map(|p| p.as_dvec3()).sum::<DVec3>() / points.len() as f64;
+        let mut a = DMat3::from_diagonal(DVec3::splat(REGULARISATION));
+        let mut b = DVec3::ZERO;
+        for (p, n) in points.iter().zip(planes) {
+            a += outer(*n);
+            b += *n * n.dot(p.as_dvec3() - mean);
+        }
+        let fit = mean + a.inverse() * b;
+        let cell = DVec3::from_array(crossings.cells[v].map(f64::from));
+        let placed = fit.clamp(cell, cell + DVec3::ONE);
+        if placed.is_finite() {
+            *position = world(placed).as_vec3();
+        }
+    }
+    let at: Vec<DVec3> = positions.iter().map(|p| p.as_dvec3()).collect();
+    for (n, g) in normals
+        .iter_mut()
+        .zip(gradients(sampling, grid.spacing, &at)?)
+    {
+        if g != DVec3::ZERO {
+            *n = g.as_vec3();
+        }
+    }
+    Ok(5 * (at.len() + crossings.points.len()) as u64)
+}
+
+fn outer(n: DVec3) -> DMat3 {
+    DMat3::from_cols(n * n.x, n * n.y, n * n.z)
+}
+
+/// The unit gradient of the distance at every point (zero where it
+/// vanishes).
+fn gradients(sampling: &Sampling, spacing: f64, points: &[DVec3]) -> Result<Vec<DVec3>> {
+    let step = GRADIENT_STEP * spacing;
+    let mut out = Vec::with_capacity(points.len());
+    for batch in points.chunks(BATCH / TETRAHEDRON.len()) {
+        let around: Vec<DVec3> = batch
+            .iter()
+            .flat_map(|p| TETRAHEDRON.map(|k| *p + step * k))
+            .collect();
+        let d = sampling.distances(&around)?;
+        for q in d.chunks_exact(TETRAHEDRON.len()) {
+            let g: DVec3 = TETRAHEDRON.iter().zip(q).map(|(k, d)| *k * *d).sum();
+            out.push(g.normalize_or_zero());
+        }
+    }
+    Ok(out)
+}

@@ -1,0 +1,396 @@
+//! Meshes and volumes: closed, accurate surfaces on the device and the
+//! CPU; sharp box edges; files that independent readers read back; voxel
+//! grids whose signs are the CPU reference's; clear errors for bad grids.
+
+mod gpu;
+
+use std::f64::consts::PI;
+use std::path::PathBuf;
+
+use fractal_sdf::mesh::{self, Aabb, GridOptions, Mesh, Sampler, Volume};
+use fractal_sdf::prelude::*;
+use fractal_sdf::render::DeviceSelector;
+
+fn scratch(name: &str) -> PathBuf {
+    let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR"))
+        .join("mesh")
+        .join(name);
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+fn compiled(node: Node) -> CompiledScene {
+    Scene::new(node).compile().unwrap()
+}
+
+/// The device sampler, or `None` where no OpenCL platform is installed
+/// and none is required (the skip is recorded).
+fn device() -> Option<Sampler> {
+    gpu::device().map(|_| Sampler::Device(DeviceSelector::auto()))
+}
+
+/// The largest `|f(vertex)|` in voxels.
+fn worst(mesh: &Mesh, f: impl Fn(DVec3) -> f64) -> f64 {
+    mesh.positions
+        .iter()
+        .map(|p| f(p.as_dvec3()).abs() / mesh.voxel_size)
+        .fold(0.0, f64::max)
+}
+
+#[test]
+fn a_sphere_at_128_is_closed_on_the_surface_and_holds_its_volume() {
+    let Some(sampler) = device() else { return };
+    let scene = compiled(sphere(1.0));
+    let mesh = mesh::extract(&scene, &GridOptions::default().sampler(sampler)).unwrap();
+    assert_eq!(mesh.stats.cells, [128, 128, 128]);
+    let topology = mesh.topology();
+    assert!(topology.is_closed_manifold(), "{topology:?}");
+    assert!(
+        mesh.triangles.len() > 100_000,
+        "{} triangles",
+        mesh.triangles.len()
+    );
+    let off = worst(&mesh, |p| p.length() - 1.0);
+    assert!(off < 0.5, "a vertex lies {off} voxels off the sphere");
+    let exact = 4.0 / 3.0 * PI;
+    let error = (mesh.volume() - exact).abs() / exact;
+    assert!(
+        error < 0.01,
+        "volume {} is {error:.4} off {exact}",
+        mesh.volume()
+    );
+    // Normals point out, along the radius.
+    for (p, n) in mesh.positions.iter().zip(&mesh.normals) {
+        assert!(n.dot(p.normalize()) > 0.99, "normal {n} at {p}");
+    }
+    // The octree samples only blocks near the surface.
+    assert!(
+        mesh.stats.blocks_sampled < mesh.stats.blocks,
+        "{:?}",
+        mesh.stats
+    );
+}
+
+#[test]
+fn a_box_keeps_its_edges_and_corners() {
+    let half = dvec3(0.5, 0.7, 0.9);
+    let scene = compiled(cuboid(half));
+    for sharp in [true, false] {
+        let options = GridOptions::default()
+            .resolution(48)
+            .sampler(Sampler::Cpu)
+            .sharp(sharp);
+        let mesh = mesh::extract(&scene, &options).unwrap();
+        assert!(mesh.topology().is_closed_manifold());
+        let box_distance = |p: DVec3| {
+            let q = p.abs() - half;
+            q.max(DVec3::ZERO).length() + q.max_element().min(0.0)
+        };
+        let off = worst(&mesh, box_distance);
+        let nearest_corner = [-1.0, 1.0]
+            .into_iter()
+            .flat_map(|x| [-1.0, 1.0].map(|y| (x, y)))
+            .flat_map(|(x, y)| [-1.0, 1.0].map(|z| dvec3(x, y, z) * half))
+            .map(|c| {
+                mesh.positions
+                    .iter()
+                    .map(|p| (p.as_dvec3() - c).length() / mesh.voxel_size)
+                    .fold(f64::INFINITY, f64::min)
+            })
+            .fold(0.0, f64::max);
+        if sharp {
+            // The fit puts vertices on the faces, the edges and the corners.
+            assert!(off < 0.1, "a vertex lies {off} voxels off the box");
+            assert!(
+                nearest_corner < 0.25,
+                "a corner is {nearest_corner} voxels from any vertex"
+            );
+        } else {
+            // Surface Nets' averages cut corners: what the fit is for.
+            assert!(off > 0.2 && nearest_corner > 0.3, "{off} {nearest_corner}");
+        }
+    }
+}
+
+#[test]
+fn the_device_and_the_cpu_give_the_same_mesh() {
+    let Some(sampler) = device() else { return };
+    let node = sphere(0.6)
+        .smooth_union(
+            cuboid(dvec3(0.4, 0.3, 0.5)).translate(dvec3(0.5, 0.0, 0.0)),
+            0.1,
+        )
+        .union(torus(0.5, 0.15).translate(dvec3(-0.6, 0.2, 0.0)));
+    let scene = compiled(node);
+    let options = GridOptions::default().resolution(64);
+    let on_device = mesh::extract(&scene, &options.clone().sampler(sampler)).unwrap();
+    let on_cpu = mesh::extract(&scene, &options.sampler(Sampler::Cpu)).unwrap();
+    // Both round to f32, in different orders: a sample within rounding
+    // of the surface may take the other sign, and nothing more.
+    let near = |a: f64, b: f64, tolerance: f64| (a - b).abs() <= tolerance * b.abs();
+    #[allow(clippy::cast_precision_loss)]
+    let count = |m: &Mesh| m.triangles.len() as f64;
+    assert!(
+        near(count(&on_device), count(&on_cpu), 2e-3),
+        "{} vs {}",
+        count(&on_device),
+        count(&on_cpu)
+    );
+    assert!(near(on_device.volume(), on_cpu.volume(), 1e-4));
+    assert!(near(on_device.area(), on_cpu.area(), 1e-3));
+    assert!(on_device.topology().is_closed_manifold());
+    assert!(on_cpu.topology().is_closed_manifold());
+}
+
+#[test]
+fn fractals_mesh_closed_and_coloured() {
+    let Some(sampler) = device() else { return };
+    for node in [menger(3).color(dvec3(0.9, 0.3, 0.1)), mandelbulb(8.0)] {
+        let scene = compiled(node);
+        let options = GridOptions::default()
+            .resolution(48)
+            .sampler(sampler.clone());
+        let mesh = mesh::extract(&scene, &options).unwrap();
+        let topology = mesh.topology();
+        assert_eq!(topology.boundary_edges, 0, "{topology:?}");
+        assert_eq!(topology.misoriented_edges, 0, "{topology:?}");
+        assert!(mesh.volume() > 0.0);
+        assert_eq!(mesh.colors.len(), mesh.positions.len());
+        let eval = cpu::Evaluator::from_compiled(&scene);
+        let expected = eval
+            .sample::<f64>(mesh.positions[0].as_dvec3().into())
+            .color;
+        let expected = DVec3::from(expected)
+            .to_array()
+            .map(|c| (c.powf(1.0 / 2.2) * 255.0).round());
+        let got = mesh.colors[0].map(f64::from);
+        for (g, e) in got.iter().zip(expected) {
+            assert!(
+                (g - e).abs() <= 1.0,
+                "colour {got:?}, expected {expected:?}"
+            );
+        }
+    }
+}
+
+#[test]
+fn a_box_that_cuts_the_scene_closes_the_mesh() {
+    // A floor has no bound: the box is required, and the cut is capped.
+    let scene = compiled(plane(DVec3::Y, 0.0).union(sphere(0.5).translate(dvec3(0.0, 0.5, 0.0))));
+    let err = mesh::extract(&scene, &GridOptions::default().sampler(Sampler::Cpu)).unwrap_err();
+    assert!(err.to_string().contains("no bound"), "{err}");
+    let bounds = Aabb::new(dvec3(-1.0, -0.5, -1.0), dvec3(1.0, 1.5, 1.0));
+    let options = GridOptions::default()
+        .bounds(bounds)
+        .resolution(32)
+        .sampler(Sampler::Cpu);
+    let mesh = mesh::extract(&scene, &options).unwrap();
+    assert!(
+        mesh.topology().is_closed_manifold(),
+        "{:?}",
+        mesh.topology()
+    );
+    // A slab of 2 × 0.5 × 2 under the floor, less a voxel at the cut, and
+    // most of the sphere above it.
+    let slab = 2.0 * 0.5 * 2.0;
+    assert!(
+        mesh.volume() > 0.8 * slab && mesh.volume() < slab + 0.6,
+        "{}",
+        mesh.volume()
+    );
+}
+
+#[test]
+fn bad_grids_say_what_is_wrong() {
+    let scene = compiled(sphere(1.0));
+    let cpu = GridOptions::default().sampler(Sampler::Cpu);
+    let cases = [
+        (cpu.clone().resolution(0), "grid resolution"),
+        (cpu.clone().resolution(1 << 20), "1..=4096"),
+        (
+            cpu.clone().bounds(Aabb::new(DVec3::ONE, DVec3::ZERO)),
+            "min < max",
+        ),
+        (
+            cpu.clone()
+                .bounds(Aabb::new(DVec3::ZERO, dvec3(1.0, f64::NAN, 1.0))),
+            "finite",
+        ),
+    ];
+    for (options, says) in cases {
+        let err = mesh::extract(&scene, &options).unwrap_err();
+        assert!(matches!(err, Error::Invalid { .. }), "{err:?}");
+        assert!(err.to_string().contains(says), "{err} should say {says}");
+        let err = mesh::sample_volume(&scene, &options).unwrap_err();
+        assert!(err.to_string().contains(says), "{err} should say {says}");
+    }
+    let mesh = mesh::extract(&scene, &cpu.clone().resolution(8)).unwrap();
+    let err = mesh.write(scratch("bad").join("out.gltf")).unwrap_err();
+    assert!(err.to_string().contains(".stl, .ply or .obj"), "{err}");
+    let err = mesh::sample_volume(&scene, &cpu.resolution(4096)).unwrap_err();
+    assert!(err.to_string().contains("lower the resolution"), "{err}");
+}
+
+#[test]
+fn stl_ply_and_obj_read_back_with_independent_readers() {
+    let scene = compiled(
+        sphere(0.5)
+            .color(dvec3(0.2, 0.6, 1.0))
+            .union(cuboid(dvec3(0.3, 0.3, 0.3)).translate(dvec3(0.6, 0.0, 0.0))),
+    );
+    let options = GridOptions::default().resolution(24).sampler(Sampler::Cpu);
+    let mesh = mesh::extract(&scene, &options).unwrap();
+    let dir = scratch("files");
+
+    // STL: a triangle soup; the reader welds equal corners again.
+    mesh.write(dir.join("mesh.stl")).unwrap();
+    let mut file = std::fs::File::open(dir.join("mesh.stl")).unwrap();
+    let stl = stl_io::read_stl(&mut file).unwrap();
+    assert_eq!(stl.faces.len(), mesh.triangles.len());
+    assert_eq!(stl.vertices.len(), mesh.positions.len());
+    for (face, t) in stl.faces.iter().zip(&mesh.triangles) {
+        for (i, v) in face.vertices.iter().zip(t) {
+            let read = stl.vertices[*i];
+            let p = mesh.positions[*v as usize];
+            assert_eq!([read[0], read[1], read[2]], p.to_array());
+        }
+    }
+
+    // PLY: positions, normals and colours.
+    mesh.write(dir.join("mesh.ply")).unwrap();
+    let mut file = std::fs::File::open(dir.join("mesh.ply")).unwrap();
+    let parser = ply_rs::parser::Parser::<ply_rs::ply::DefaultElement>::new();
+    let ply = parser.read_ply(&mut file).unwrap();
+    let vertices = &ply.payload["vertex"];
+    let faces = &ply.payload["face"];
+    assert_eq!(vertices.len(), mesh.positions.len());
+    assert_eq!(faces.len(), mesh.triangles.len());
+    use ply_rs::ply::Property;
+    let float = |e: &ply_rs::ply::DefaultElement, k: &str| match e[k] {
+        Property::Float(v) => v,
+        ref other => panic!("{k} is {other:?}"),
+    };
+    let byte = |e: &ply_rs::ply::DefaultElement, k: &str| match e[k] {
+        Property::UChar(v) => v,
+        ref other => panic!("{k} is {other:?}"),
+    };
+    for (i, v) in vertices.iter().enumerate() {
+        assert_eq!(
+            [float(v, "x"), float(v, "y"), float(v, "z")],
+            mesh.positions[i].to_array()
+        );
+        assert_eq!(
+            [float(v, "nx"), float(v, "ny"), float(v, "nz")],
+            mesh.normals[i].to_array()
+        );
+        assert_eq!(
+            [byte(v, "red"), byte(v, "green"), byte(v, "blue")],
+            mesh.colors[i]
+        );
+    }
+    for (f, t) in faces.iter().zip(&mesh.triangles) {
+        match &f["vertex_indices"] {
+            Property::ListInt(list) => {
+                assert_eq!(list, &t.map(|i| i32::try_from(i).unwrap()).to_vec());
+            }
+            other => panic!("vertex_indices is {other:?}"),
+        }
+    }
+    // The blue sphere's colour reached its vertices.
+    assert!(mesh.colors.iter().any(|c| c[2] > 200 && c[0] < 150));
+
+    // OBJ: positions, colours and normals, indices from 1.
+    mesh.write(dir.join("mesh.obj")).unwrap();
+    // The reader numbers vertices in the order faces first use them.
+    let (models, _) = tobj::load_obj(dir.join("mesh.obj"), &tobj::LoadOptions::default()).unwrap();
+    let obj = &models[0].mesh;
+    assert_eq!(obj.positions.len(), 3 * mesh.positions.len());
+    assert_eq!(obj.indices.len(), 3 * mesh.triangles.len());
+    assert_eq!(obj.vertex_color.len(), 3 * mesh.positions.len());
+    let at = |list: &[f32], i: u32| [0, 1, 2].map(|k| list[3 * i as usize + k]);
+    for (read, t) in obj.indices.chunks(3).zip(&mesh.triangles) {
+        for (r, v) in read.iter().zip(t) {
+            assert_eq!(
+                at(&obj.positions, *r),
+                mesh.positions[*v as usize].to_array()
+            );
+            let color = at(&obj.vertex_color, *r).map(|c| (c * 255.0).round());
+            assert_eq!(color, mesh.colors[*v as usize].map(f32::from));
+        }
+    }
+    // No temporary file is left beside them.
+    let names: Vec<_> = std::fs::read_dir(&dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name())
+        .collect();
+    assert_eq!(names.len(), 3, "{names:?}");
+}
+
+/// Reads an NRRD file as `write_nrrd` writes it: the header's fields, then
+/// raw little-endian `f32`.
+fn read_nrrd(path: &std::path::Path) -> (Vec<u32>, Vec<f32>) {
+    let bytes = std::fs::read(path).unwrap();
+    let end = bytes.windows(2).position(|w| w == b"\n\n").unwrap() + 2;
+    let header = std::str::from_utf8(&bytes[..end]).unwrap();
+    assert!(header.starts_with("NRRD0004\n"));
+    assert!(header.contains("type: float\n") && header.contains("encoding: raw\n"));
+    assert!(header.contains("endian: little\n"));
+    let sizes: Vec<u32> = header
+        .lines()
+        .find_map(|l| l.strip_prefix("sizes: "))
+        .unwrap()
+        .split(' ')
+        .map(|s| s.parse().unwrap())
+        .collect();
+    let values = bytes[end..]
+        .chunks_exact(4)
+        .map(|c| f32::from_le_bytes([c[0], c[1], c[2], c[3]]))
+        .collect();
+    (sizes, values)
+}
+
+#[test]
+fn a_volume_has_the_cpu_references_signs_and_reads_back() {
+    let Some(device) = gpu::device() else { return };
+    if !gpu::fp64(&device) {
+        return;
+    }
+    let node = mandelbulb(8.0).union(sphere(0.3).translate(dvec3(1.2, 0.0, 0.0)));
+    let scene = compiled(node);
+    let options = GridOptions::default()
+        .resolution(40)
+        .precision(Precision::F64)
+        .sampler(Sampler::Device(DeviceSelector::auto()));
+    let volume: Volume = mesh::sample_volume(&scene, &options).unwrap();
+    let eval = cpu::Evaluator::from_compiled(&scene);
+    let [nx, ny, nz] = volume.dims;
+    assert!(nx > 40 && ny > 20 && nz > 20, "{:?}", volume.dims);
+    let mut inside = 0;
+    for k in 0..nz {
+        for j in 0..ny {
+            for i in 0..nx {
+                let d = eval.distance(volume.point([i, j, k]));
+                let got = volume.distance([i, j, k]);
+                assert_eq!(got < 0.0, d < 0.0, "sign at ({i}, {j}, {k}): {got} vs {d}");
+                inside += usize::from(d < 0.0);
+            }
+        }
+    }
+    assert!(inside > 1000, "only {inside} samples inside");
+
+    let dir = scratch("volume");
+    volume.write_nrrd(dir.join("bulb.nrrd")).unwrap();
+    let (sizes, values) = read_nrrd(&dir.join("bulb.nrrd"));
+    assert_eq!(sizes, volume.dims.to_vec());
+    assert_eq!(values, volume.distances);
+
+    let slices = volume.write_slices(dir.join("slices")).unwrap();
+    assert_eq!(slices.len(), nz as usize);
+    let middle = image::open(&slices[nz as usize / 2]).unwrap().to_luma8();
+    assert_eq!(middle.dimensions(), (nx, ny));
+    for (i, j, pixel) in middle.enumerate_pixels() {
+        let inside = volume.distance([i, j, nz / 2]) < 0.0;
+        assert_eq!(pixel.0[0], if inside { 255 } else { 0 });
+    }
+}
