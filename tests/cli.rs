@@ -318,3 +318,119 @@ fn bad_input_is_a_clear_error_and_a_nonzero_exit() {
         assert!(out.status.success(), "{}", text(&out));
     }
 }
+
+#[test]
+fn mesh_and_volume_write_files_and_refuse_bad_grids() {
+    if gpu::device().is_none() {
+        return;
+    }
+    let dir = scratch("mesh");
+    let stl = dir.join("julia.stl");
+    let out = run(
+        &dir,
+        "",
+        &[
+            "mesh",
+            "julia",
+            "-o",
+            stl.to_str().unwrap(),
+            "--resolution",
+            "32",
+        ],
+    );
+    assert!(out.status.success(), "{}", text(&out));
+    let said = String::from_utf8_lossy(&out.stdout);
+    assert!(said.contains("triangles") && said.contains("32x"), "{said}");
+    let mut file = std::fs::File::open(&stl).unwrap();
+    let mesh = stl_io::read_stl(&mut file).unwrap();
+    assert!(mesh.faces.len() > 1000, "{} faces", mesh.faces.len());
+
+    // A floor has no bound: the error names the box of the rest, and that
+    // box works.
+    let ply = dir.join("menger.ply");
+    let ply_arg = ply.to_str().unwrap();
+    let out = run(
+        &dir,
+        "",
+        &["mesh", "menger", "-o", ply_arg, "--resolution", "24"],
+    );
+    assert_eq!(out.status.code(), Some(1), "{}", text(&out));
+    let said = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        said.contains("no bound") && said.contains("-1.732"),
+        "{said}"
+    );
+    let bounds = "--bounds=-1.8,-0.99,-1.8,1.8,1.8,1.8";
+    let out = run(
+        &dir,
+        "",
+        &[
+            "mesh",
+            "menger",
+            "-o",
+            ply_arg,
+            "--resolution",
+            "24",
+            bounds,
+            "--cpu",
+        ],
+    );
+    assert!(out.status.success(), "{}", text(&out));
+    assert!(
+        std::fs::read(&ply)
+            .unwrap()
+            .starts_with(b"ply\nformat binary_little_endian")
+    );
+
+    let nrrd = dir.join("bulb.nrrd");
+    let slices = dir.join("slices");
+    let out = run(
+        &dir,
+        "",
+        &[
+            "volume",
+            "mandelbulb",
+            "-o",
+            nrrd.to_str().unwrap(),
+            "--slices",
+            slices.to_str().unwrap(),
+            "--resolution",
+            "20",
+        ],
+    );
+    assert!(out.status.success(), "{}", text(&out));
+    assert!(std::fs::read(&nrrd).unwrap().starts_with(b"NRRD0004\n"));
+    assert_eq!(std::fs::read_dir(&slices).unwrap().count(), 21);
+
+    for (args, code, says) in [
+        (
+            vec!["mesh", "julia", "-o", "x.gltf"],
+            1,
+            ".stl, .ply or .obj",
+        ),
+        (
+            vec!["mesh", "julia", "-o", "x.stl", "--resolution", "0"],
+            1,
+            "grid resolution",
+        ),
+        (
+            vec!["mesh", "julia", "-o", "x.stl", "--bounds", "1,2,3"],
+            2,
+            "six numbers",
+        ),
+        (
+            vec!["mesh", "julia", "-o", "x.stl", "--bounds=0,0,0,-1,1,1"],
+            1,
+            "min < max",
+        ),
+        (vec!["volume", "julia"], 2, "--output"),
+    ] {
+        let out = run(&dir, "", &args);
+        assert_eq!(out.status.code(), Some(code), "{args:?}: {}", text(&out));
+        assert!(
+            String::from_utf8_lossy(&out.stderr).contains(says),
+            "{args:?}: {}",
+            text(&out)
+        );
+    }
+}

@@ -1,27 +1,19 @@
-//! Triangle meshes by Naive Surface Nets over the blocks the octree keeps,
-//! welded into one watertight mesh.
+//! Triangle meshes of the blocks the octree keeps, welded into one
+//! watertight mesh, with vertices fitted to the surface and coloured.
 
 use std::collections::HashMap;
 
-use fast_surface_nets::ndshape::{ConstShape, ConstShape3u32};
-use fast_surface_nets::{SurfaceNetsBuffer, surface_nets};
 use glam::{DVec3, Vec3};
 
+use super::dual::{Mesher, SIDE};
 use super::grid::{Grid, Progress, Stage, occupied, plan};
-use super::sharpen::{Crossings, sharpen};
+use super::sharpen::sharpen;
 use super::{GridOptions, Sampling};
 use crate::error::Result;
 use crate::ir::CompiledScene;
 
 /// Cells along a block's edge: the unit the octree drops or keeps.
 pub const CHUNK: u32 = 16;
-
-/// Samples along a sampled block's edge: the block's `CHUNK + 1` corners
-/// and one more, shared with the next block, which Surface Nets needs to
-/// connect blocks without seams.
-const SIDE: u32 = CHUNK + 2;
-
-type BlockShape = ConstShape3u32<SIDE, SIDE, SIDE>;
 
 /// Blocks sampled per call to the sampler.
 const BATCH: usize = 256;
@@ -167,20 +159,19 @@ pub fn extract_with_progress(
     let (grid, sampling) = plan(scene, options, progress)?;
     let count = grid.cells.map(|c| c.div_ceil(CHUNK));
     let (blocks, octree) = occupied(&sampling, &grid, CHUNK, 1, count, Stage::Culling, progress)?;
-    let mut welder = Welder::new(grid);
+    let mut mesher = Mesher::new(grid);
     let total = blocks.len() as u64;
-    let mut buffer = SurfaceNetsBuffer::default();
+    let per = (SIDE as usize).pow(3);
     for (n, batch) in blocks.chunks(BATCH).enumerate() {
         let starts: Vec<[i32; 3]> = batch
             .iter()
             .map(|b| b.map(|i| i32::try_from(i * CHUNK).expect("grids are small")))
             .collect();
         let mut values = sampling.blocks(grid.origin, grid.spacing, SIDE, &starts)?;
-        let per = BlockShape::SIZE as usize;
-        for (start, sdf) in starts.iter().zip(values.chunks_exact_mut(per)) {
-            close_at_the_border(&grid, *start, sdf);
-            surface_nets(sdf, &BlockShape {}, [0; 3], [SIDE - 1; 3], &mut buffer);
-            welder.add(*start, sdf, &buffer);
+        for (block, sdf) in batch.iter().zip(values.chunks_exact_mut(per)) {
+            let start = block.map(|i| i * CHUNK);
+            close_at_the_border(&grid, start, sdf);
+            mesher.add(start, sdf);
         }
         progress(Progress {
             stage: Stage::Sampling,
@@ -188,7 +179,7 @@ pub fn extract_with_progress(
             total,
         });
     }
-    let (mut mesh, crossings) = welder.finish();
+    let (mut mesh, crossings) = mesher.finish();
     let mut sharpening = 0;
     if options.sharp {
         progress(Progress {
@@ -209,104 +200,27 @@ pub fn extract_with_progress(
         cells: grid.cells,
         blocks: count.iter().map(|&c| u64::from(c)).product(),
         blocks_sampled: total,
-        evaluations: octree
-            + sharpening
-            + total * u64::from(BlockShape::SIZE)
-            + mesh.positions.len() as u64,
+        evaluations: octree + sharpening + total * per as u64 + mesh.positions.len() as u64,
     };
     Ok(mesh)
 }
 
 /// Makes the grid's outer layer (and anything past it) outside, so that
 /// the mesh is closed where the box cuts the scene.
-fn close_at_the_border(grid: &Grid, start: [i32; 3], sdf: &mut [f32]) {
-    let cells = grid.cells.map(i64::from);
-    let inside = |a: usize, at: i64| at > 0 && at < cells[a];
-    let all_inside = (0..3).all(|a| {
-        inside(a, i64::from(start[a])) && inside(a, i64::from(start[a]) + i64::from(SIDE) - 1)
-    });
-    if all_inside {
+fn close_at_the_border(grid: &Grid, start: [u32; 3], sdf: &mut [f32]) {
+    let inside = |a: usize, at: u32| at > 0 && at < grid.cells[a];
+    if (0..3).all(|a| inside(a, start[a]) && inside(a, start[a] + SIDE - 1)) {
         return;
     }
     #[allow(clippy::cast_possible_truncation)] // A positive f32 is enough.
     let outside = grid.spacing as f32;
+    let side = SIDE as usize;
     for (i, d) in sdf.iter_mut().enumerate() {
-        let [x, y, z] = BlockShape::delinearize(u32::try_from(i).expect("a block is small"));
-        let at = [x, y, z];
-        if !(0..3).all(|a| inside(a, i64::from(start[a]) + i64::from(at[a]))) {
+        let at = [i % side, (i / side) % side, i / (side * side)]
+            .map(|c| u32::try_from(c).expect("a block is small"));
+        if !(0..3).all(|a| inside(a, start[a] + at[a])) {
             *d = outside;
         }
-    }
-}
-
-/// Joins blocks' meshes into one: a vertex belongs to a grid cell, and the
-/// cells blocks share give the same vertex in both.
-struct Welder {
-    grid: Grid,
-    cells: HashMap<u64, u32>,
-    mesh: Mesh,
-    local: Vec<u32>,
-    crossings: Crossings,
-}
-
-impl Welder {
-    fn new(grid: Grid) -> Self {
-        Welder {
-            grid,
-            cells: HashMap::new(),
-            mesh: Mesh {
-                voxel_size: grid.spacing,
-                ..Mesh::default()
-            },
-            local: Vec::new(),
-            crossings: Crossings::default(),
-        }
-    }
-
-    fn add(&mut self, start: [i32; 3], sdf: &[f32], block: &SurfaceNetsBuffer) {
-        let stride = u64::from(self.grid.cells[0]) + 2;
-        let layer = stride * (u64::from(self.grid.cells[1]) + 2);
-        self.local.clear();
-        for ((cell, position), normal) in block
-            .surface_points
-            .iter()
-            .zip(&block.positions)
-            .zip(&block.normals)
-        {
-            let g = [0, 1, 2]
-                .map(|a| u64::try_from(start[a]).expect("blocks start at 0") + u64::from(cell[a]));
-            let key = g[0] + stride * g[1] + layer * g[2];
-            let next = u32::try_from(self.mesh.positions.len()).expect("fewer than 2³² vertices");
-            let index = *self.cells.entry(key).or_insert(next);
-            if index == next {
-                let local = DVec3::new(
-                    f64::from(start[0]) + f64::from(position[0]),
-                    f64::from(start[1]) + f64::from(position[1]),
-                    f64::from(start[2]) + f64::from(position[2]),
-                );
-                let p = self.grid.origin + self.grid.spacing * local;
-                self.mesh.positions.push(p.as_vec3());
-                let n = Vec3::from_array(*normal).normalize_or_zero();
-                self.mesh.normals.push(n);
-                let corners: [f32; 8] = std::array::from_fn(|i| {
-                    let offset =
-                        [i & 1, i >> 1 & 1, i >> 2].map(|o| u32::try_from(o).expect("0 or 1"));
-                    let at = [0, 1, 2].map(|a| cell[a] + offset[a]);
-                    sdf[BlockShape::linearize(at) as usize]
-                });
-                let global = g.map(|c| u32::try_from(c).expect("grids are small"));
-                self.crossings.push(global, corners);
-            }
-            self.local.push(index);
-        }
-        for t in block.indices.chunks_exact(3) {
-            let [a, b, c] = [t[0], t[1], t[2]].map(|i| self.local[i as usize]);
-            self.mesh.triangles.push([a, b, c]);
-        }
-    }
-
-    fn finish(self) -> (Mesh, Crossings) {
-        (self.mesh, self.crossings)
     }
 }
 

@@ -5,7 +5,7 @@ use glam::DVec3;
 
 use super::sample::{Sampler, Sampling};
 use crate::error::{Error, Result};
-use crate::ir::CompiledScene;
+use crate::ir::{Bound, CompiledScene, union_chain};
 use crate::quality::Precision;
 
 /// The most cells along a grid's longest side.
@@ -88,6 +88,9 @@ pub struct GridOptions {
     /// from the gradient at the vertex; `false`: Surface Nets' mean of the
     /// crossings and the grid's gradient. Default `true`.
     pub sharp: bool,
+    /// Dynamic parameters to set before sampling, by name (the rest keep
+    /// their defaults).
+    pub params: Vec<(String, f64)>,
 }
 
 impl Default for GridOptions {
@@ -98,6 +101,7 @@ impl Default for GridOptions {
             sampler: Sampler::default(),
             precision: Precision::F32,
             sharp: true,
+            params: Vec::new(),
         }
     }
 }
@@ -128,6 +132,13 @@ impl GridOptions {
     #[must_use]
     pub fn precision(mut self, precision: Precision) -> Self {
         self.precision = precision;
+        self
+    }
+
+    /// Sets a dynamic parameter before sampling.
+    #[must_use]
+    pub fn param(mut self, name: impl Into<String>, value: f64) -> Self {
+        self.params.push((name.into(), value));
         self
     }
 
@@ -226,7 +237,10 @@ pub(crate) fn plan(
     progress: &mut dyn FnMut(Progress),
 ) -> Result<(Grid, Sampling)> {
     options.validate()?;
-    let sampling = Sampling::new(scene, &options.sampler, options.precision)?;
+    let mut sampling = Sampling::new(scene, &options.sampler, options.precision)?;
+    for (name, value) in &options.params {
+        sampling.set_param(name, *value)?;
+    }
     let bounds = match options.bounds {
         Some(b) => b,
         None => {
@@ -245,16 +259,35 @@ pub(crate) fn plan(
 /// The box around the scene's bounding sphere.
 fn scene_box(scene: &CompiledScene) -> Result<Aabb> {
     let ir = scene.ir();
-    let bound = ir.bounds()[ir.root().index()].ok_or_else(|| Error::Invalid {
+    let bounds = ir.bounds();
+    let around = |b: Bound| Aabb::cube(b.centre, b.radius.max(f64::MIN_POSITIVE));
+    if let Some(b) = bounds[ir.root().index()] {
+        return Ok(around(b));
+    }
+    // A union with a floor: name the box of the parts that have a bound.
+    let parts = union_chain(ir, ir.root(), &bounds).map(|chain| {
+        chain
+            .operands
+            .iter()
+            .filter_map(|id| bounds[id.index()])
+            .map(around)
+            .reduce(|a, b| Aabb::new(a.min.min(b.min), a.max.max(b.max)))
+    });
+    let hint = match parts.flatten() {
+        Some(b) => format!(
+            "; its bounded parts lie within {:.3},{:.3},{:.3},{:.3},{:.3},{:.3} \
+             (MINX,MINY,MINZ,MAXX,MAXY,MAXZ)",
+            b.min.x, b.min.y, b.min.z, b.max.x, b.max.y, b.max.z
+        ),
+        None => String::new(),
+    };
+    Err(Error::Invalid {
         what: "grid bounds",
-        reason: "the scene has no bound (it holds a plane or an unlimited repetition, or a \
-                 custom shape): give the box to sample"
-            .into(),
-    })?;
-    Ok(Aabb::cube(
-        bound.centre,
-        bound.radius.max(f64::MIN_POSITIVE),
-    ))
+        reason: format!(
+            "the scene has no bound (it holds a plane, an unlimited repetition, a custom \
+             shape or a dynamic size): give the box to sample{hint}"
+        ),
+    })
 }
 
 /// `found` shrunk to the cells of a coarse grid that can hold surface.

@@ -35,6 +35,8 @@
 //!
 //! [`Ir::bounds`]: crate::ir::Ir::bounds
 
+mod cases;
+mod dual;
 mod extract;
 mod grid;
 use sample::Sampling;

@@ -55,6 +55,18 @@ impl Sampling {
         })
     }
 
+    /// Sets a dynamic parameter.
+    pub fn set_param(&mut self, name: &str, value: f64) -> Result<()> {
+        match self {
+            Sampling::Cpu { eval, precision } => {
+                eval.set_param(name, value)?;
+                eval.values().check_within(precision.limits())
+            }
+            #[cfg(feature = "opencl")]
+            Sampling::Device(device) => device.set_param(name, value),
+        }
+    }
+
     /// The distance at every point.
     pub fn distances(&self, points: &[DVec3]) -> Result<Vec<f64>> {
         match self {

@@ -41,35 +41,13 @@ pub(crate) struct Crossings {
 }
 
 impl Crossings {
-    /// Records the crossings of the cell whose corner distances are
-    /// `corners` (corner `i` at offset `(i & 1, i >> 1 & 1, i >> 2)`).
-    pub fn push(&mut self, cell: [u32; 3], corners: [f32; 8]) {
+    /// Records the crossings (grid coordinates) of the next vertex, which
+    /// lies in `cell`.
+    pub fn push(&mut self, cell: [u32; 3], points: &[Vec3]) {
         if self.starts.is_empty() {
             self.starts.push(0);
         }
-        let base = Vec3::from_array(cell.map(|c| {
-            #[allow(clippy::cast_precision_loss)] // Grid indices are small.
-            let c = c as f32;
-            c
-        }));
-        let corner = |i: usize| {
-            #[allow(clippy::cast_precision_loss)] // 0 or 1.
-            let v = Vec3::new((i & 1) as f32, (i >> 1 & 1) as f32, (i >> 2) as f32);
-            v
-        };
-        for a in 0..8 {
-            for bit in [1, 2, 4] {
-                let b = a | bit;
-                if b == a {
-                    continue;
-                }
-                let (da, db) = (corners[a], corners[b]);
-                if (da < 0.0) != (db < 0.0) {
-                    let t = da / (da - db);
-                    self.points.push(base + corner(a).lerp(corner(b), t));
-                }
-            }
-        }
+        self.points.extend_from_slice(points);
         self.starts
             .push(u32::try_from(self.points.len()).expect("fewer than 2³² crossings"));
         self.cells.push(cell);

@@ -2,6 +2,8 @@
 //! line. `fractal-sdf --help` lists the subcommands; each has its own
 //! `--help`.
 
+mod mesh;
+
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::time::{Duration, Instant};
@@ -50,6 +52,10 @@ enum Command {
     Config,
     /// Compare two images of the same size: PSNR, SSIM and differing pixels.
     Compare(CompareArgs),
+    /// Extract a watertight mesh of a scene's surface: STL, PLY or OBJ.
+    Mesh(mesh::MeshArgs),
+    /// Sample a scene's signed distances on a grid: an NRRD volume, PNG slices.
+    Volume(mesh::VolumeArgs),
 }
 
 #[derive(Args)]
@@ -201,6 +207,8 @@ fn run(cli: Cli) -> Outcome {
         Command::Bench(args) => bench(args, &settings()?),
         Command::Config => show_config(cli.config.as_deref(), settings()),
         Command::Compare(args) => compare(args),
+        Command::Mesh(args) => mesh::mesh(args),
+        Command::Volume(args) => mesh::volume(args),
     }
 }
 
@@ -216,6 +224,23 @@ fn load_scene(scene: &str) -> Outcome<SceneFile> {
             gallery::names().join(", ")
         ))
     })
+}
+
+/// `--set NAME=VALUE` flags.
+fn parse_sets(flags: &[String]) -> Outcome<Vec<(String, f64)>> {
+    flags
+        .iter()
+        .map(|pair| {
+            let (name, value) = pair
+                .split_once('=')
+                .ok_or_else(|| usage(format!("--set `{pair}`: expected NAME=VALUE")))?;
+            let value: f64 = value
+                .trim()
+                .parse()
+                .map_err(|_| usage(format!("--set `{pair}`: `{value}` is not a number")))?;
+            Ok((name.trim().to_string(), value))
+        })
+        .collect()
 }
 
 /// Everything a rendering subcommand needs, settled from the flags, the
@@ -240,20 +265,7 @@ impl Job {
             None => settings.size.unwrap_or((640, 480)),
         };
         let device = args.device.clone().or_else(|| settings.device.clone());
-        let sets = args
-            .set
-            .iter()
-            .map(|pair| {
-                let (name, value) = pair
-                    .split_once('=')
-                    .ok_or_else(|| usage(format!("--set `{pair}`: expected NAME=VALUE")))?;
-                let value: f64 = value
-                    .trim()
-                    .parse()
-                    .map_err(|_| usage(format!("--set `{pair}`: `{value}` is not a number")))?;
-                Ok((name.trim().to_string(), value))
-            })
-            .collect::<Outcome<Vec<_>>>()?;
+        let sets = parse_sets(&args.set)?;
         let devices = match args.devices.as_deref() {
             None => None,
             Some("all") => Some(every_device()?),
