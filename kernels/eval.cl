@@ -1,6 +1,7 @@
 /* Point evaluator: DE and DE_shade at each point, for checking the OpenCL
    formulas against the CPU reference and for shading mesh vertices. The
-   header defines the argument lists (EVAL_POINTS_ARGS, EVAL_GRID_ARGS). Per point, EVAL_OUT_STRIDE reals:
+   header defines the argument lists (EVAL_POINTS_ARGS,
+   EVAL_DISTANCES_ARGS, EVAL_GRID_ARGS). Per point, EVAL_OUT_STRIDE reals:
    out[2i] = (DE, DE_shade, trap, 0), out[2i + 1] = (colour, 0). */
 __kernel void eval_points(EVAL_POINTS_ARGS) {
     uint i = get_global_id(0);
@@ -14,6 +15,16 @@ __kernel void eval_points(EVAL_POINTS_ARGS) {
     real shaded = DE_shade(p, params, &color, &trap);
     out[2 * i] = (real4)(d, shaded, trap, R(0.0));
     out[2 * i + 1] = (real4)(color, R(0.0));
+}
+
+/* Distances only: DE at each point, one real per point (fitting mesh
+   vertices, culling). */
+__kernel void eval_distances(EVAL_DISTANCES_ARGS) {
+    uint i = get_global_id(0);
+    if (i >= count) {
+        return;
+    }
+    out[i] = DE(points[i].xyz, params);
 }
 
 /* Grid evaluator: DE at every sample of cubic blocks of a regular grid, for

@@ -20,6 +20,9 @@
 //!    device choice, program build and cache, tiled ray marching into an
 //!    image with depth, hit, normal and step outputs.
 //! 5. [`output`]: saving images (atomic PNG writes).
+//! 6. [`mesh`]: geometry instead of pixels: watertight meshes (STL, PLY,
+//!    OBJ) and volumes of signed distances (NRRD, PNG slices), sampled on
+//!    the device or the CPU.
 //!
 //! Around the pipeline:
 //!

@@ -394,3 +394,44 @@ fn a_volume_has_the_cpu_references_signs_and_reads_back() {
         assert_eq!(pixel.0[0], if inside { 255 } else { 0 });
     }
 }
+
+#[test]
+fn the_distance_kernels_agree_with_the_point_kernel() {
+    use fractal_sdf::render::PointEvaluator;
+    if gpu::device().is_none() {
+        return;
+    }
+    let scene =
+        compiled(mandelbulb(8.0).smooth_union(sphere(0.4).translate(dvec3(1.0, 0.2, 0.0)), 0.1));
+    let device =
+        PointEvaluator::from_compiled(&scene, Precision::F32, &DeviceSelector::auto()).unwrap();
+    let (origin, spacing, side) = (dvec3(-1.3, -1.1, -1.2), 0.07, 5);
+    let blocks = [[0, 0, 0], [5, 0, 0], [3, 7, 11], [-2, 4, 1]];
+    let grid = device.eval_grid(origin, spacing, side, &blocks).unwrap();
+    let mut points = Vec::new();
+    for b in blocks {
+        for z in 0..side {
+            for y in 0..side {
+                for x in 0..side {
+                    let at = [x, y, z].map(|c| i32::try_from(c).unwrap());
+                    let index = DVec3::from_array([0, 1, 2].map(|a| f64::from(b[a] + at[a])));
+                    points.push(origin + spacing * index);
+                }
+            }
+        }
+    }
+    assert_eq!(grid.len(), points.len());
+    let full = device.eval(&points).unwrap();
+    let distances = device.distances(&points).unwrap();
+    let eval = cpu::Evaluator::from_compiled(&scene);
+    for (i, p) in points.iter().enumerate() {
+        assert_eq!(distances[i], full[i].distance, "at {p}");
+        // The grid kernel computes the point itself, rounding differently.
+        let cpu = f64::from(eval.distance_f32(p.as_vec3()));
+        assert!(
+            (grid[i] - cpu).abs() < 1e-4,
+            "at {p}: grid {} vs CPU {cpu}",
+            grid[i]
+        );
+    }
+}

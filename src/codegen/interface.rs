@@ -212,6 +212,15 @@ pub const EVAL_POINTS: [(EvalArg, &str); 4] = [
     (EvalArg::Count, "const uint count"),
 ];
 
+/// `eval_distances`' declarations, in argument order: the arguments of
+/// `eval_points`, but only `DE` is written, one real per point.
+pub const EVAL_DISTANCES: [(EvalArg, &str); 4] = [
+    (EvalArg::Points, "__global const real4* points"),
+    (EvalArg::Params, "__global const real* params"),
+    (EvalArg::Out, "__global real* out"),
+    (EvalArg::Count, "const uint count"),
+];
+
 /// Reals `eval_points` writes per point: `(DE, DE_shade, trap, 0)` then
 /// `(colour, 0)`.
 pub const EVAL_OUT_STRIDE: usize = 8;
@@ -263,6 +272,11 @@ pub(crate) fn defines(target: super::Target) -> String {
         super::Target::Evaluate => {
             let _ = writeln!(w, "#define EVAL_POINTS_ARGS \\\n    {}", args(&EVAL_POINTS));
             let _ = writeln!(w, "#define EVAL_OUT_STRIDE {EVAL_OUT_STRIDE}");
+            let _ = writeln!(
+                w,
+                "#define EVAL_DISTANCES_ARGS \\\n    {}",
+                args(&EVAL_DISTANCES)
+            );
             let _ = writeln!(w, "#define EVAL_GRID_ARGS \\\n    {}", args(&EVAL_GRID));
         }
     }

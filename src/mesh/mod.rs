@@ -10,11 +10,19 @@
 //! of 16³ cells asks the distance at each node's centre and drops every
 //! node farther from the scene than its own half-diagonal (a distance
 //! estimate never overestimates, so no surface is lost), which makes the
-//! cost grow with the surface's area, not the box's volume. Each block
-//! left is meshed by Naive Surface Nets (the `fast-surface-nets` crate),
-//! and the blocks' meshes are welded into one by grid cell, so the result
-//! is watertight: the grid's outer layer counts as outside, which closes
-//! any surface the box cuts.
+//! cost grow with the surface's area, not the box's volume.
+//!
+//! Each block left is meshed dually, as Surface Nets and dual contouring
+//! do: a vertex in every cell the surface crosses and a quad around every
+//! grid edge it crosses. A cell gets one vertex per separate piece of
+//! surface in it (marching cubes' reading of its corners), so two sheets
+//! passing through one cell do not share an edge; the blocks are welded
+//! by cell, and the grid's outer layer counts as outside, which closes any
+//! surface the box cuts: the mesh is watertight. Each vertex is then moved
+//! to where the tangent planes at its cell's edge crossings meet (dual
+//! contouring's fit, on the exact gradient), which keeps box edges,
+//! corners and CSG creases sharp ([`GridOptions::sharp`]), and gets the
+//! gradient there as its normal and the scene's colour from `DE_shade`.
 //!
 //! ```
 //! use fractal_sdf::mesh::{self, GridOptions, Sampler};

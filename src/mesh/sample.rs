@@ -74,11 +74,7 @@ impl Sampling {
                 distance(eval, *precision, points[i])
             })),
             #[cfg(feature = "opencl")]
-            Sampling::Device(device) => Ok(device
-                .eval(points)?
-                .into_iter()
-                .map(|s| s.distance)
-                .collect()),
+            Sampling::Device(device) => device.distances(points),
         }
     }
 

@@ -9,7 +9,9 @@ use ocl::{Kernel, Queue};
 use super::buffer::RealBuffer;
 use super::device::{self, DeviceInfo, DeviceSelector, Selected, opencl};
 use super::program;
-use crate::codegen::interface::{EVAL_GRID, EVAL_OUT_STRIDE, EVAL_POINTS, EvalArg, GridArg};
+use crate::codegen::interface::{
+    EVAL_DISTANCES, EVAL_GRID, EVAL_OUT_STRIDE, EVAL_POINTS, EvalArg, GridArg,
+};
 use crate::codegen::{self, Options, Target};
 use crate::error::Result;
 use crate::ir::{CompiledScene, Ir, ParamValues};
@@ -134,6 +136,36 @@ impl PointEvaluator {
     /// [`Error::OpenCl`](crate::Error::OpenCl) if a buffer or the launch
     /// fails.
     pub fn eval(&self, points: &[DVec3]) -> Result<Vec<PointSample>> {
+        let out = self.launch(points, "eval_points", &EVAL_POINTS, EVAL_OUT_STRIDE)?;
+        Ok(out
+            .chunks_exact(EVAL_OUT_STRIDE)
+            .map(|c| PointSample {
+                distance: c[0],
+                shade_distance: c[1],
+                trap: c[2],
+                color: DVec3::new(c[4], c[5], c[6]),
+            })
+            .collect())
+    }
+
+    /// `DE` at every point, and nothing else: half the work of
+    /// [`PointEvaluator::eval`], which also runs `DE_shade`.
+    ///
+    /// # Errors
+    /// As [`PointEvaluator::eval`].
+    pub fn distances(&self, points: &[DVec3]) -> Result<Vec<f64>> {
+        self.launch(points, "eval_distances", &EVAL_DISTANCES, 1)
+    }
+
+    /// Runs the point kernel `name` (whose arguments are `list`) on
+    /// `points`, reading back `stride` reals per point.
+    fn launch(
+        &self,
+        points: &[DVec3],
+        name: &str,
+        list: &[(EvalArg, &str)],
+        stride: usize,
+    ) -> Result<Vec<f64>> {
         if points.is_empty() {
             return Ok(Vec::new());
         }
@@ -145,15 +177,15 @@ impl PointEvaluator {
             self.precision,
             &self.source.param_buffer(self.values.as_slice()),
         )?;
-        let output = RealBuffer::output(q, self.precision, points.len() * EVAL_OUT_STRIDE)?;
+        let output = RealBuffer::output(q, self.precision, points.len() * stride)?;
         let count = u32::try_from(points.len()).map_err(opencl)?;
         let mut builder = Kernel::builder();
         builder
             .program(&self.program)
-            .name("eval_points")
+            .name(name)
             .queue(q.clone())
             .global_work_size(points.len());
-        for (arg, _) in EVAL_POINTS {
+        for (arg, _) in list {
             match arg {
                 EvalArg::Points => input.push_arg(&mut builder),
                 EvalArg::Params => params.push_arg(&mut builder),
@@ -164,20 +196,10 @@ impl PointEvaluator {
             }
         }
         let kernel = builder.build().map_err(opencl)?;
-        // SAFETY: the kernel reads `count` points and writes
-        // EVAL_OUT_STRIDE reals per point, exactly the sizes of the buffers
-        // bound above.
+        // SAFETY: the kernel reads `count` points and writes `stride` reals
+        // per point, exactly the sizes of the buffers bound above.
         unsafe { kernel.enq().map_err(opencl)? };
-        let out = output.read()?;
-        Ok(out
-            .chunks_exact(EVAL_OUT_STRIDE)
-            .map(|c| PointSample {
-                distance: c[0],
-                shade_distance: c[1],
-                trap: c[2],
-                color: DVec3::new(c[4], c[5], c[6]),
-            })
-            .collect())
+        output.read()
     }
 
     /// `DE` at every sample of cubic blocks of a regular grid whose sample
