@@ -15,8 +15,15 @@ use crate::error::Result;
 /// and keeps nearly parallel planes from throwing a vertex far away.
 const REGULARISATION: f64 = 0.05;
 
-/// The step of the gradient's differences, in voxels.
-const GRADIENT_STEP: f64 = 1e-2;
+/// The step of the differences that give the tangent planes at edge
+/// crossings, in voxels: small, so that a plane near a crease is the
+/// plane of its own side.
+const PLANE_STEP: f64 = 1e-2;
+
+/// The step of the differences that give vertex normals, in voxels: the
+/// mesh's own scale, so that detail far below a voxel (which the mesh
+/// cannot show) does not make its shading noisy.
+const NORMAL_STEP: f64 = 0.5;
 
 /// Points whose distances are asked for at once.
 const BATCH: usize = 1 << 20;
@@ -70,7 +77,7 @@ pub(crate) fn sharpen(
         .iter()
         .map(|p| world(p.as_dvec3()))
         .collect();
-    let planes = gradients(sampling, grid.spacing, &at)?;
+    let planes = gradients(sampling, PLANE_STEP * grid.spacing, &at)?;
     for (v, position) in positions.iter_mut().enumerate() {
         let range = crossings.starts[v] as usize..crossings.starts[v + 1] as usize;
         let points = &crossings.points[range.clone()];
@@ -106,10 +113,9 @@ fn outer(n: DVec3) -> DMat3 {
     DMat3::from_cols(n * n.x, n * n.y, n * n.z)
 }
 
-/// The unit gradient of the distance at every point (zero where it
-/// vanishes).
-fn gradients(sampling: &Sampling, spacing: f64, points: &[DVec3]) -> Result<Vec<DVec3>> {
-    let step = GRADIENT_STEP * spacing;
+/// The unit gradient of the distance at every point, by differences over
+/// `step` (zero where it vanishes).
+fn gradients(sampling: &Sampling, step: f64, points: &[DVec3]) -> Result<Vec<DVec3>> {
     let mut out = Vec::with_capacity(points.len());
     for batch in points.chunks(BATCH / TETRAHEDRON.len()) {
         let around: Vec<DVec3> = batch
