@@ -23,7 +23,7 @@ const PLANE_STEP: f64 = 1e-2;
 /// The step of the differences that give vertex normals, in voxels: the
 /// mesh's own scale, so that detail far below a voxel (which the mesh
 /// cannot show) does not make its shading noisy.
-const NORMAL_STEP: f64 = 0.5;
+const NORMAL_STEP: f64 = 1.0;
 
 /// Points whose distances are asked for at once.
 const BATCH: usize = 1 << 20;
@@ -100,7 +100,7 @@ pub(crate) fn sharpen(
     let at: Vec<DVec3> = positions.iter().map(|p| p.as_dvec3()).collect();
     for (n, g) in normals
         .iter_mut()
-        .zip(gradients(sampling, grid.spacing, &at)?)
+        .zip(gradients(sampling, NORMAL_STEP * grid.spacing, &at)?)
     {
         if g != DVec3::ZERO {
             *n = g.as_vec3();
