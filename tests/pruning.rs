@@ -143,3 +143,49 @@ fn bounds_follow_the_tree() {
     assert!((1.0..1.001).contains(&b.radius));
     assert!(bound(sphere(1.0).union(plane(DVec3::Y, 0.0))).is_none());
 }
+
+/// A smooth union evaluates its dearer operand second, behind a gate, and
+/// a gate tests each part of a union tree rather than the sphere around
+/// them all; the values stay the unpruned ones.
+#[test]
+fn smooth_unions_evaluate_the_dearer_operand_second() {
+    let far = dvec3(3.0, 0.0, 0.0);
+    let node = mandelbulb(8.0)
+        .smooth_union(sphere(0.5).translate(far), 0.1)
+        .smooth_union(torus(0.4, 0.1).translate(-far), 0.1);
+    let scene = Scene::new(node.clone()).compile().expect("valid");
+    let source = fractal_sdf::codegen::emit(&scene, &fractal_sdf::codegen::Options::default())
+        .expect("valid")
+        .source;
+    let de = &source[source.find("real DE(").expect("DE")..];
+    let de = &de[..de.find("\n}").expect("DE ends")];
+    let at = |what: &str| de.find(what).unwrap_or_else(|| panic!("{what} in\n{de}"));
+    // The torus, then the sphere, then the bulb: the dearest last, and
+    // each behind a gate.
+    assert!(at("sd_torus(") < at("sd_sphere("), "{de}");
+    assert!(at("sd_sphere(") < at("mandelbulb"), "{de}");
+    let gates = de.matches("if (!(g").count();
+    assert_eq!(gates, 2, "{de}");
+    // The first gate tests the bulb's and the sphere's spheres apart,
+    // each lowered by the smoothing above it.
+    let first_gate = &de[at("real g")..];
+    let first_gate = &first_gate[..first_gate.find('\n').expect("a line")];
+    assert!(
+        first_gate.starts_with("real g") && first_gate.contains("fmin("),
+        "{first_gate}"
+    );
+    assert_eq!(first_gate.matches("length(").count(), 2, "{first_gate}");
+
+    let pruned = Evaluator::new(&node).expect("valid");
+    let full = pruned.clone().with_pruning(false);
+    for i in 0..200 {
+        let x = -4.0 + 0.04 * f64::from(i);
+        for y in [0.0, 0.3, 1.0] {
+            let p = dvec3(x, y, 0.05);
+            let (a, b) = (pruned.sample::<f64>(p.into()), full.sample::<f64>(p.into()));
+            assert_eq!(a.distance.to_bits(), b.distance.to_bits(), "{p}");
+            assert_eq!(a.color, b.color, "{p}");
+            assert_eq!(a.trap.to_bits(), b.trap.to_bits(), "{p}");
+        }
+    }
+}

@@ -22,7 +22,10 @@ use std::fmt::Write as _;
 
 use super::helpers::Helper;
 use super::writer::{INSTANCE_SLOT, Writer};
-use crate::ir::{Bound, Ir, IrNode, NodeId, SHRINK, Scalar, UnionChain, Vector, union_chain};
+use crate::ir::{
+    Bound, Ir, IrNode, NodeId, Reach, SHRINK, Scalar, UnionChain, Vector, costs, reach, swaps,
+    union_chain,
+};
 use crate::math::{F32_LIMITS, escape_radius, integer_power, mandelbulb_radius, rotation_rows};
 use crate::quality::Precision;
 use crate::scene::{
@@ -238,6 +241,9 @@ pub(crate) struct SceneEmitter<'a> {
     clusters: HashMap<NodeId, Cluster>,
     /// Each node's bound, where the kernel's precision can compute it.
     bounds: Vec<Option<Bound>>,
+    /// Each node's rough cost (`ir::costs`): which operand of a smooth
+    /// union goes first.
+    costs: Vec<f64>,
     /// Booleans whose second operand's block is open.
     gated: BTreeSet<NodeId>,
 }
@@ -268,6 +274,7 @@ impl<'a> SceneEmitter<'a> {
                 .into_iter()
                 .map(|b| b.filter(|b| b.fits(&F32_LIMITS)))
                 .collect(),
+            costs: costs(ir),
             gated: BTreeSet::new(),
         }
     }
@@ -378,7 +385,7 @@ impl<'a> SceneEmitter<'a> {
             Enter(NodeId, String, bool),
             /// Between a pruned boolean's operands: opens the block that
             /// evaluates the second only within reach of its bound.
-            Gate(NodeId, String, bool, Bound),
+            Gate(NodeId, String, bool, Reach),
             /// After an operand of a chain: the minimum so far and the
             /// operand's result, combined under the name of a union node.
             Fold(NodeId, bool),
@@ -393,8 +400,8 @@ impl<'a> SceneEmitter<'a> {
                     Step::Chain(UnionChain { operands, unions }) => {
                         let mut run = vec![Task::Enter(operands[0], p.clone(), needs_color)];
                         for (&operand, &union) in operands[1..].iter().zip(&unions) {
-                            if let Some(bound) = self.bounds[operand.index()] {
-                                run.push(Task::Gate(union, p.clone(), needs_color, bound));
+                            if let Some(reach) = reach(self.ir, operand, &self.bounds) {
+                                run.push(Task::Gate(union, p.clone(), needs_color, reach));
                             }
                             run.push(Task::Enter(operand, p.clone(), needs_color));
                             run.push(Task::Fold(union, needs_color));
@@ -406,15 +413,15 @@ impl<'a> SceneEmitter<'a> {
                         let gate = self.prunable(id);
                         for (i, (child, q, color)) in children.into_iter().enumerate().rev() {
                             tasks.push(Task::Enter(child, q, color));
-                            if let (1, Some(bound)) = (i, gate) {
-                                tasks.push(Task::Gate(id, p.clone(), needs_color, bound));
+                            if let (1, Some(reach)) = (i, &gate) {
+                                tasks.push(Task::Gate(id, p.clone(), needs_color, reach.clone()));
                             }
                         }
                     }
                 },
-                Task::Gate(id, p, needs_color, bound) => {
+                Task::Gate(id, p, needs_color, reach) => {
                     let a = results.last().expect("the first operand has a result");
-                    self.open_gate(id, &p, needs_color, a, bound);
+                    self.open_gate(id, &p, needs_color, a, &reach);
                 }
                 Task::Fold(union, needs_color) => {
                     let b = results.pop().expect("the operand has a result");
@@ -438,20 +445,31 @@ impl<'a> SceneEmitter<'a> {
         results.pop().expect("the root has a result")
     }
 
-    /// The bound of the second operand of a smooth union or a subtraction
-    /// (hard unions are chains), if it has one.
-    fn prunable(&self, id: NodeId) -> Option<Bound> {
+    /// The reach of the operand of a smooth union or a subtraction (hard
+    /// unions are chains) that is evaluated second, if it has one.
+    fn prunable(&self, id: NodeId) -> Option<Reach> {
         if !self.instance.is_empty() || self.clusters.contains_key(&id) {
             return None;
         }
         match self.ir.node(id) {
             Kind::Csg {
                 op: CsgOp::Union | CsgOp::Subtract,
+                a,
                 b,
                 ..
-            } => self.bounds[b.index()],
+            } => {
+                let second = if self.swapped(id) { a } else { b };
+                reach(self.ir, *second, &self.bounds)
+            }
             _ => None,
         }
+    }
+
+    /// Whether the smooth union `id` evaluates its second operand first
+    /// (see `ir::swaps`): never inside an instanced loop, whose body is
+    /// emitted once for operands whose costs are alike.
+    fn swapped(&self, id: NodeId) -> bool {
+        self.instance.is_empty() && swaps(self.ir, id, &self.bounds, &self.costs)
     }
 
     /// Declares the boolean's result as its first operand's, and opens the
@@ -460,7 +478,7 @@ impl<'a> SceneEmitter<'a> {
     /// (plus the smoothing radius), or not positive. Elsewhere the
     /// second's estimate is at least its bound, so the (smooth) minimum is
     /// the first operand's value, colour and trap exactly.
-    fn open_gate(&mut self, id: NodeId, p: &str, needs_color: bool, a: &Vars, bound: Bound) {
+    fn open_gate(&mut self, id: NodeId, p: &str, needs_color: bool, a: &Vars, reach: &Reach) {
         let Kind::Csg { op, smoothing, .. } = self.ir.node(id) else {
             unreachable!("only booleans are gated")
         };
@@ -484,19 +502,38 @@ impl<'a> SceneEmitter<'a> {
             Some(k) => format!("{first} + {}", self.w.scalar(*k)),
             None => first,
         };
+        let g = reach
+            .parts
+            .iter()
+            .map(|(bound, offset)| {
+                let g = self.bound_distance(p, bound);
+                if *offset > 0.0 {
+                    format!("{g} - {}", self.w.float(*offset))
+                } else {
+                    g
+                }
+            })
+            .reduce(|a, b| format!("fmin({a}, {b})"))
+            .expect("a reach has parts");
+        self.w.line(format!("real g{i} = {g};"));
+        self.w
+            .open(format!("if (!(g{i} > {threshold} && g{i} > R(0.0)))"));
+        self.gated.insert(id);
+    }
+
+    /// `Bound::distance` at `p`, as the kernel computes it.
+    fn bound_distance(&self, p: &str, bound: &Bound) -> String {
         let centre = self.w.vector(bound.centre.to_array().map(Scalar::Baked));
-        let mut g = format!(
+        let g = format!(
             "length({p} - {centre}) * {} - {}",
             self.w.float(SHRINK),
             self.w.float(bound.radius)
         );
         if bound.slope < 1.0 {
-            g = format!("{} * ({g})", self.w.float(bound.slope));
+            format!("{} * ({g})", self.w.float(bound.slope))
+        } else {
+            g
         }
-        self.w.line(format!("real g{i} = {g};"));
-        self.w
-            .open(format!("if (!(g{i} > {threshold} && g{i} > R(0.0)))"));
-        self.gated.insert(id);
     }
 
     /// Closes a gate: the boolean's value, computed in the block, becomes
@@ -697,10 +734,13 @@ impl<'a> SceneEmitter<'a> {
                 ));
                 Step::Descend(vec![(*child, q, needs_color)])
             }
-            Kind::Csg { a, b, .. } => Step::Descend(vec![
-                (*a, p.to_string(), needs_color),
-                (*b, p.to_string(), needs_color),
-            ]),
+            Kind::Csg { a, b, .. } => {
+                let (a, b) = if self.swapped(id) { (b, a) } else { (a, b) };
+                Step::Descend(vec![
+                    (*a, p.to_string(), needs_color),
+                    (*b, p.to_string(), needs_color),
+                ])
+            }
             Kind::Custom { shape, .. } => {
                 self.customs.insert(shape.name().to_string(), shape.clone());
                 let args = self.arguments(node);

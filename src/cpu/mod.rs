@@ -18,7 +18,8 @@ use std::collections::HashMap;
 
 use crate::ir::SHRINK;
 use crate::ir::{
-    Bound, CompiledScene, Ir, IrNode, NodeId, ParamValues, Scalar, is_hard_union, union_chain,
+    Bound, CompiledScene, Ir, IrNode, NodeId, ParamValues, Reach, Scalar, costs, is_hard_union,
+    reach, swaps, union_chain,
 };
 use crate::math::F32_LIMITS;
 use crate::scene::{CsgOp, Kind, Node};
@@ -52,6 +53,12 @@ pub struct Evaluator {
     /// The roots of trees of hard unions, with their operands in the order
     /// the kernels evaluate them (see `ir::union_chain`).
     chains: HashMap<usize, Vec<NodeId>>,
+    /// The reach (`ir::reach`) of each operand that pruning tests, where it
+    /// is more than the operand's own bound.
+    reaches: HashMap<usize, Reach>,
+    /// The smooth unions that evaluate their second operand first
+    /// (`ir::swaps`).
+    swapped: Vec<bool>,
     prune: bool,
 }
 
@@ -92,20 +99,42 @@ impl Evaluator {
                         .is_none_or(|parent| !is_hard_union(ir.node(parent)))
             })
             .filter_map(|id| Some((id.index(), union_chain(&ir, id, &bounds)?.operands)))
+            .collect::<HashMap<_, _>>();
+        let costs = costs(&ir);
+        let swapped: Vec<bool> = (0..ir.nodes().len())
+            .map(|i| swaps(&ir, NodeId::from_index(i), &bounds, &costs))
+            .collect();
+        // The operands pruning tests: every chain operand after the first,
+        // and the second operand a union or subtraction evaluates.
+        let mut tested: Vec<NodeId> = chains.values().flat_map(|o| o[1..].to_vec()).collect();
+        for (i, node) in ir.nodes().iter().enumerate() {
+            if let Kind::Csg { a, b, .. } = node {
+                tested.push(if swapped[i] { *a } else { *b });
+            }
+        }
+        let reaches = tested
+            .into_iter()
+            .filter_map(|o| {
+                let r = reach(&ir, o, &bounds)?;
+                (r.parts.len() > 1 || r.parts[0].1 != 0.0).then_some((o.index(), r))
+            })
             .collect();
         Evaluator {
             ir,
             values,
             bounds,
             chains,
+            reaches,
+            swapped,
             prune: true,
         }
     }
 
     /// Turns the pruning of unions and subtractions off or on (it is on,
     /// as in the kernels). Pruning skips an operand whose bound is beyond
-    /// the other operand's distance, which changes no value: turning it off
-    /// is how tests check that.
+    /// the other operand's distance, and evaluates the dearer operand of a
+    /// smooth union second, which changes no value: turning it off is how
+    /// tests check that.
     #[must_use]
     pub fn with_pruning(mut self, on: bool) -> Self {
         self.prune = on;
@@ -125,8 +154,18 @@ impl Evaluator {
             CsgOp::Subtract => -a + k,
             CsgOp::Intersect => return false,
         };
-        let centre = V3::<f64>::from(bound.centre).cast::<T>();
-        let g = T::of(bound.slope) * ((p - centre).length() * T::of(SHRINK) - T::of(bound.radius));
+        let g = match self.reaches.get(&b.index()) {
+            Some(reach) => reach
+                .parts
+                .iter()
+                .map(|(bound, offset)| {
+                    let g = bound_distance(bound, p);
+                    if *offset > 0.0 { g - T::of(*offset) } else { g }
+                })
+                .reduce(|x, y| x.min(y))
+                .expect("a reach has parts"),
+            None => bound_distance(&bound, p),
+        };
         g > threshold && g > T::zero()
     }
 
@@ -225,7 +264,7 @@ impl Evaluator {
         for (i, node) in nodes.iter().enumerate() {
             samples[i] = match self.chains.get(&i) {
                 Some(operands) => self.chain_at(operands, points[i], &samples),
-                None => self.sample_at(node, points[i], &samples),
+                None => self.sample_at(i, node, points[i], &samples),
             };
         }
         samples[self.ir.root().index()]
@@ -288,7 +327,13 @@ impl Evaluator {
     /// A node's sample at the point `p` it sees, from its children's
     /// samples (already in `done`).
     #[allow(clippy::too_many_lines)]
-    fn sample_at<T: Real>(&self, node: &IrNode, p: V3<T>, done: &[Sample<T>]) -> Sample<T> {
+    fn sample_at<T: Real>(
+        &self,
+        id: usize,
+        node: &IrNode,
+        p: V3<T>,
+        done: &[Sample<T>],
+    ) -> Sample<T> {
         let s = |x: Scalar| self.scalar::<T>(x);
         let v = |x: [Scalar; 3]| self.vector::<T>(x);
         let of = |c: &NodeId| done[c.index()];
@@ -375,6 +420,11 @@ impl Evaluator {
                 b,
             } => {
                 let k = smoothing.map_or(T::zero(), s);
+                let (a, b) = if self.prune && self.swapped[id] {
+                    (b, a)
+                } else {
+                    (a, b)
+                };
                 if self.skips(*op, k, of(a).distance, *b, p) {
                     return of(a);
                 }
@@ -429,6 +479,12 @@ fn repeat<T: Real>(p: V3<T>, c: V3<T>, limit: Option<[u32; 3]>) -> V3<T> {
         }
     }
     q
+}
+
+/// `Bound::distance` at `p` in `T`, as the kernels compute it.
+fn bound_distance<T: Real>(bound: &Bound, p: V3<T>) -> T {
+    let centre = V3::<f64>::from(bound.centre).cast::<T>();
+    T::of(bound.slope) * ((p - centre).length() * T::of(SHRINK) - T::of(bound.radius))
 }
 
 /// Hard or smooth CSG of two samples. Every operation is a (smooth) minimum

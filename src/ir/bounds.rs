@@ -372,3 +372,111 @@ pub(crate) fn is_hard_union(node: &IrNode) -> bool {
         }
     )
 }
+
+/// The most spheres a [`Reach`] holds; a tree with more is bounded by its
+/// own sphere.
+const MAX_REACH_PARTS: usize = 8;
+
+/// A lower bound of a node's estimate made of its union tree's parts:
+/// wherever `min_i (g_i(p) − offset_i)` is positive, with `g_i` the
+/// [`Bound::distance`] of part `i`, the node's estimate is at least that.
+/// A hard union's estimate is the minimum of its operands', and a smooth
+/// union's at most `k / 4` below it, so the parts of a union tree (through
+/// colour nodes, which change no distance) are its operands' bounds, each
+/// lowered by the smoothing radii above it. Tighter than the sphere around
+/// them all: a point between two far-apart fractals is far from both.
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) struct Reach {
+    pub(crate) parts: Vec<(Bound, f64)>,
+}
+
+/// The reach of `id`, where it has a bound: at most [`MAX_REACH_PARTS`]
+/// parts, found by walking down at most that many union nodes.
+pub(crate) fn reach(ir: &Ir, id: NodeId, bounds: &[Option<Bound>]) -> Option<Reach> {
+    let own = bounds[id.index()]?;
+    let fallback = Reach {
+        parts: vec![(own, 0.0)],
+    };
+    let mut parts = Vec::new();
+    let mut stack = vec![(id, 0.0)];
+    while let Some((at, offset)) = stack.pop() {
+        let k = match ir.node(at) {
+            Kind::Csg {
+                op: CsgOp::Union,
+                smoothing: None,
+                ..
+            } => Some(0.0),
+            Kind::Csg {
+                op: CsgOp::Union,
+                smoothing: Some(k),
+                ..
+            } => k.baked().map(|k| 0.25 * k),
+            _ => None,
+        };
+        match (ir.node(at), k) {
+            (Kind::Csg { a, b, .. }, Some(k)) => {
+                stack.push((*b, offset + k));
+                stack.push((*a, offset + k));
+            }
+            (Kind::Color { child, .. }, _) => stack.push((*child, offset)),
+            _ => match bounds[at.index()] {
+                Some(b) => parts.push((b, offset)),
+                None => return Some(fallback),
+            },
+        }
+        if parts.len() + stack.len() > MAX_REACH_PARTS {
+            return Some(fallback);
+        }
+    }
+    Some(Reach { parts })
+}
+
+/// A rough cost of evaluating each node's estimate (children come before
+/// parents), to choose which operand of a smooth union is evaluated first:
+/// the other is skipped where it cannot change the result, so the dearer
+/// one goes second.
+pub(crate) fn costs(ir: &Ir) -> Vec<f64> {
+    let mut out: Vec<f64> = Vec::with_capacity(ir.nodes().len());
+    for node in ir.nodes() {
+        let own = match node {
+            Kind::Mandelbulb(f) => {
+                let per = match f.power.baked() {
+                    Some(p) if p.fract() == 0.0 => 8.0,
+                    Some(_) => 20.0,
+                    None => 30.0,
+                };
+                per * f64::from(f.iterations)
+            }
+            Kind::Julia(f) => 6.0 * f64::from(f.iterations),
+            Kind::Menger(f) => 4.0 * f64::from(f.iterations),
+            Kind::Sierpinski(f) => 3.0 * f64::from(f.iterations),
+            Kind::Custom { .. } => 10.0,
+            _ => 1.0,
+        };
+        let children: f64 = node.children().iter().map(|c| out[c.index()]).sum();
+        out.push(own + children);
+    }
+    out
+}
+
+/// Whether the smooth union `id` evaluates its second operand first: where
+/// only the second has a bound (the first is then the threshold, as in a
+/// chain), or both have one and the first costs more. A smooth minimum is
+/// symmetric, so the order changes no distance; only the colour of an exact
+/// tie between the operands can go to the other one.
+pub(crate) fn swaps(ir: &Ir, id: NodeId, bounds: &[Option<Bound>], costs: &[f64]) -> bool {
+    let Kind::Csg {
+        op: CsgOp::Union,
+        smoothing: Some(_),
+        a,
+        b,
+    } = ir.node(id)
+    else {
+        return false;
+    };
+    match (bounds[a.index()], bounds[b.index()]) {
+        (Some(_), None) => true,
+        (Some(_), Some(_)) => costs[a.index()] > costs[b.index()],
+        _ => false,
+    }
+}

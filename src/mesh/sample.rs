@@ -34,7 +34,7 @@ impl Default for Sampler {
 /// A built sampler.
 pub(crate) enum Sampling {
     Cpu {
-        eval: Evaluator,
+        eval: Box<Evaluator>,
         precision: Precision,
     },
     #[cfg(feature = "opencl")]
@@ -45,7 +45,7 @@ impl Sampling {
     pub fn new(scene: &CompiledScene, sampler: &Sampler, precision: Precision) -> Result<Self> {
         Ok(match sampler {
             Sampler::Cpu => Sampling::Cpu {
-                eval: Evaluator::from_compiled(scene),
+                eval: Box::new(Evaluator::from_compiled(scene)),
                 precision,
             },
             #[cfg(feature = "opencl")]

@@ -293,84 +293,84 @@ real DE(real3 p0, __global const real* params) {
     real d22 = sd_plane(p0, (real3)(0.0f, 1.0f, 0.0f), 0.55f);
     /* union: the second operand only within reach of its bound */
     real u24 = d22;
-    real g24 = 0.33333334f * (length(p0 - (real3)(0.00976538f, 0.0f, (-0.15427618f))) * 0.9999f - 2.307116f);
+    real g24 = fmin(fmin(fmin(length(p0 - (real3)((-1.1f), 0.0f, 0.0f)) * 0.9999f - 1.0f - 0.075f, length(p0 - (real3)(0.0f, 0.0f, (-0.6f))) * 0.9999f - 0.7794229f - 0.075f), 0.9f * (length(p0 - (real3)(1.1f, 0.0f, 0.0f)) * 0.9999f - 1.103242f) - 0.05f), 0.33333334f * (length(p0 - (real3)(0.0f, 0.0f, 0.7f)) * 0.9999f - 0.6062178f) - 0.025f);
     if (!(g24 > u24 && g24 > R(0.0))) {
-        /* .../a:smooth_union/a:smooth_union/a:translate */
-        real3 p1 = p0 - (real3)((-1.1f), 0.0f, 0.0f);
-        /* .../a:translate/color/scale */
-        real3 p2 = p1 / 0.5f;
-        /* .../color/scale/rotate */
-        real3 p3 = (real3)(p2.x, -p2.z, p2.y);
-        /* .../scale/rotate/mandelbulb */
-        real t0;
-        real d0 = mandelbulb(p3, params[0] /* power */, 8, fmin(2.0f, pow(MAGNITUDE_CAP, R(1.0) / params[0] /* power */)), pow(R(2.0), R(1.0) / (params[0] /* power */ - R(1.0))), &t0);
-        real d2 = d0 * 0.5f;
-        /* .../a:smooth_union/a:smooth_union: the second operand only within reach of its bound */
-        real u11 = d2;
-        real g11 = length(p0 - (real3)(0.0f, 0.0f, (-0.6f))) * 0.9999f - 0.7794229f;
-        if (!(g11 > u11 + 0.1f && g11 > R(0.0))) {
+        /* union/a:smooth_union/b:translate */
+        real3 p1 = p0 - (real3)(0.0f, 0.0f, 0.7f);
+        /* .../b:translate/color/scale */
+        real3 p2 = p1 / 0.35f;
+        /* .../color/scale/sierpinski */
+        real t17;
+        real d17 = sierpinski(p2, 5, 2.0f, &t17);
+        real d18 = d17 * 0.35f;
+        /* union/a:smooth_union: the second operand only within reach of its bound */
+        real u21 = d18;
+        real g21 = fmin(fmin(length(p0 - (real3)((-1.1f), 0.0f, 0.0f)) * 0.9999f - 1.0f - 0.05f, length(p0 - (real3)(0.0f, 0.0f, (-0.6f))) * 0.9999f - 0.7794229f - 0.05f), 0.9f * (length(p0 - (real3)(1.1f, 0.0f, 0.0f)) * 0.9999f - 1.103242f) - 0.025f);
+        if (!(g21 > u21 + 0.1f && g21 > R(0.0))) {
             /* .../a:smooth_union/a:smooth_union/b:translate */
-            real3 p4 = p0 - (real3)(0.0f, 0.0f, (-0.6f));
-            /* .../color/smooth_subtract/a:scale */
-            real3 p5 = p4 / 0.45f;
-            /* .../smooth_subtract/a:scale/menger */
-            real t5;
-            real d5 = menger(p5, 3, 3.0f, &t5);
-            real d6 = d5 * 0.45f;
-            /* .../color/smooth_subtract: the second operand only within reach of its bound */
-            real u8 = d6;
-            real g8 = length(p4 - (real3)(0.0f)) * 0.9999f - 0.55f;
-            if (!(g8 > -u8 + 0.05f && g8 > R(0.0))) {
-                /* .../color/smooth_subtract/b:sphere */
-                real d7 = sd_sphere(p4, 0.55f);
-                /* .../b:translate/color/smooth_subtract */
-                real x8 = -d6;
-                real y8 = d7;
-                real2 m8 = smooth_min(x8, y8, 0.05f);
-                real d8 = -m8.x;
-                u8 = d8;
-            }
-            /* .../a:smooth_union/a:smooth_union/a:smooth_union */
-            real x11 = d2;
-            real y11 = u8;
-            real2 m11 = smooth_min(x11, y11, 0.1f);
-            real d11 = m11.x;
-            u11 = d11;
-        }
-        /* .../a:smooth_union/a:smooth_union: the second operand only within reach of its bound */
-        real u16 = u11;
-        real g16 = 0.9f * (length(p0 - (real3)(1.1f, 0.0f, 0.0f)) * 0.9999f - 1.103242f);
-        if (!(g16 > u16 + 0.1f && g16 > R(0.0))) {
-            /* .../a:smooth_union/a:smooth_union/b:translate */
-            real3 p6 = p0 - (real3)(1.1f, 0.0f, 0.0f);
+            real3 p3 = p0 - (real3)(1.1f, 0.0f, 0.0f);
             /* .../b:translate/color/scale */
-            real3 p7 = p6 / 0.5f;
+            real3 p4 = p3 / 0.5f;
             /* .../color/scale/julia */
             real t12;
-            real d12 = julia(p7, (real4)((-0.2f), 0.6f, 0.2f, 0.2f), 0.0f, 12, 4.0f, &t12);
+            real d12 = julia(p4, (real4)((-0.2f), 0.6f, 0.2f, 0.2f), 0.0f, 12, 4.0f, &t12);
             real d13 = d12 * 0.5f;
-            /* union/a:smooth_union/a:smooth_union */
-            real x16 = u11;
-            real y16 = d13;
-            real2 m16 = smooth_min(x16, y16, 0.1f);
-            real d16 = m16.x;
-            u16 = d16;
-        }
-        /* union/a:smooth_union: the second operand only within reach of its bound */
-        real u21 = u16;
-        real g21 = 0.33333334f * (length(p0 - (real3)(0.0f, 0.0f, 0.7f)) * 0.9999f - 0.6062178f);
-        if (!(g21 > u21 + 0.1f && g21 > R(0.0))) {
-            /* union/a:smooth_union/b:translate */
-            real3 p8 = p0 - (real3)(0.0f, 0.0f, 0.7f);
-            /* .../b:translate/color/scale */
-            real3 p9 = p8 / 0.35f;
-            /* .../color/scale/sierpinski */
-            real t17;
-            real d17 = sierpinski(p9, 5, 2.0f, &t17);
-            real d18 = d17 * 0.35f;
+            /* .../a:smooth_union/a:smooth_union: the second operand only within reach of its bound */
+            real u16 = d13;
+            real g16 = fmin(length(p0 - (real3)((-1.1f), 0.0f, 0.0f)) * 0.9999f - 1.0f - 0.025f, length(p0 - (real3)(0.0f, 0.0f, (-0.6f))) * 0.9999f - 0.7794229f - 0.025f);
+            if (!(g16 > u16 + 0.1f && g16 > R(0.0))) {
+                /* .../a:smooth_union/a:smooth_union/b:translate */
+                real3 p5 = p0 - (real3)(0.0f, 0.0f, (-0.6f));
+                /* .../color/smooth_subtract/a:scale */
+                real3 p6 = p5 / 0.45f;
+                /* .../smooth_subtract/a:scale/menger */
+                real t5;
+                real d5 = menger(p6, 3, 3.0f, &t5);
+                real d6 = d5 * 0.45f;
+                /* .../color/smooth_subtract: the second operand only within reach of its bound */
+                real u8 = d6;
+                real g8 = length(p5 - (real3)(0.0f)) * 0.9999f - 0.55f;
+                if (!(g8 > -u8 + 0.05f && g8 > R(0.0))) {
+                    /* .../color/smooth_subtract/b:sphere */
+                    real d7 = sd_sphere(p5, 0.55f);
+                    /* .../b:translate/color/smooth_subtract */
+                    real x8 = -d6;
+                    real y8 = d7;
+                    real2 m8 = smooth_min(x8, y8, 0.05f);
+                    real d8 = -m8.x;
+                    u8 = d8;
+                }
+                /* .../a:smooth_union/a:smooth_union: the second operand only within reach of its bound */
+                real u11 = u8;
+                real g11 = length(p0 - (real3)((-1.1f), 0.0f, 0.0f)) * 0.9999f - 1.0f;
+                if (!(g11 > u11 + 0.1f && g11 > R(0.0))) {
+                    /* .../a:smooth_union/a:smooth_union/a:translate */
+                    real3 p7 = p0 - (real3)((-1.1f), 0.0f, 0.0f);
+                    /* .../a:translate/color/scale */
+                    real3 p8 = p7 / 0.5f;
+                    /* .../color/scale/rotate */
+                    real3 p9 = (real3)(p8.x, -p8.z, p8.y);
+                    /* .../scale/rotate/mandelbulb */
+                    real t0;
+                    real d0 = mandelbulb(p9, params[0] /* power */, 8, fmin(2.0f, pow(MAGNITUDE_CAP, R(1.0) / params[0] /* power */)), pow(R(2.0), R(1.0) / (params[0] /* power */ - R(1.0))), &t0);
+                    real d2 = d0 * 0.5f;
+                    /* .../a:smooth_union/a:smooth_union/a:smooth_union */
+                    real x11 = u8;
+                    real y11 = d2;
+                    real2 m11 = smooth_min(x11, y11, 0.1f);
+                    real d11 = m11.x;
+                    u11 = d11;
+                }
+                /* union/a:smooth_union/a:smooth_union */
+                real x16 = d13;
+                real y16 = u11;
+                real2 m16 = smooth_min(x16, y16, 0.1f);
+                real d16 = m16.x;
+                u16 = d16;
+            }
             /* union/a:smooth_union */
-            real x21 = u16;
-            real y21 = d18;
+            real x21 = d18;
+            real y21 = u16;
             real2 m21 = smooth_min(x21, y21, 0.1f);
             real d21 = m21.x;
             u21 = d21;
@@ -393,113 +393,113 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     real u24 = d22;
     real3 uc24 = c23;
     real ut24 = R(1.0);
-    real g24 = 0.33333334f * (length(p0 - (real3)(0.00976538f, 0.0f, (-0.15427618f))) * 0.9999f - 2.307116f);
+    real g24 = fmin(fmin(fmin(length(p0 - (real3)((-1.1f), 0.0f, 0.0f)) * 0.9999f - 1.0f - 0.075f, length(p0 - (real3)(0.0f, 0.0f, (-0.6f))) * 0.9999f - 0.7794229f - 0.075f), 0.9f * (length(p0 - (real3)(1.1f, 0.0f, 0.0f)) * 0.9999f - 1.103242f) - 0.05f), 0.33333334f * (length(p0 - (real3)(0.0f, 0.0f, 0.7f)) * 0.9999f - 0.6062178f) - 0.025f);
     if (!(g24 > u24 && g24 > R(0.0))) {
-        /* .../a:smooth_union/a:smooth_union/a:translate */
-        real3 p1 = p0 - (real3)((-1.1f), 0.0f, 0.0f);
-        /* .../a:translate/color/scale */
-        real3 p2 = p1 / 0.5f;
-        /* .../color/scale/rotate */
-        real3 p3 = (real3)(p2.x, -p2.z, p2.y);
-        /* .../scale/rotate/mandelbulb */
-        real t0;
-        real d0 = mandelbulb(p3, params[0] /* power */, 8, fmin(2.0f, pow(MAGNITUDE_CAP, R(1.0) / params[0] /* power */)), pow(R(2.0), R(1.0) / (params[0] /* power */ - R(1.0))), &t0);
-        real d2 = d0 * 0.5f;
-        /* .../a:smooth_union/a:translate/color */
-        real3 c3 = (real3)(0.9f, 0.55f, 0.3f);
-        /* .../a:smooth_union/a:smooth_union: the second operand only within reach of its bound */
-        real u11 = d2;
-        real3 uc11 = c3;
-        real ut11 = t0;
-        real g11 = length(p0 - (real3)(0.0f, 0.0f, (-0.6f))) * 0.9999f - 0.7794229f;
-        if (!(g11 > u11 + 0.1f && g11 > R(0.0))) {
+        /* union/a:smooth_union/b:translate */
+        real3 p1 = p0 - (real3)(0.0f, 0.0f, 0.7f);
+        /* .../b:translate/color/scale */
+        real3 p2 = p1 / 0.35f;
+        /* .../color/scale/sierpinski */
+        real t17;
+        real d17 = sierpinski(p2, 5, 2.0f, &t17);
+        real d18 = d17 * 0.35f;
+        /* .../a:smooth_union/b:translate/color */
+        real3 c19 = (real3)(0.95f, 0.8f, 0.4f);
+        /* union/a:smooth_union: the second operand only within reach of its bound */
+        real u21 = d18;
+        real3 uc21 = c19;
+        real ut21 = t17;
+        real g21 = fmin(fmin(length(p0 - (real3)((-1.1f), 0.0f, 0.0f)) * 0.9999f - 1.0f - 0.05f, length(p0 - (real3)(0.0f, 0.0f, (-0.6f))) * 0.9999f - 0.7794229f - 0.05f), 0.9f * (length(p0 - (real3)(1.1f, 0.0f, 0.0f)) * 0.9999f - 1.103242f) - 0.025f);
+        if (!(g21 > u21 + 0.1f && g21 > R(0.0))) {
             /* .../a:smooth_union/a:smooth_union/b:translate */
-            real3 p4 = p0 - (real3)(0.0f, 0.0f, (-0.6f));
-            /* .../color/smooth_subtract/a:scale */
-            real3 p5 = p4 / 0.45f;
-            /* .../smooth_subtract/a:scale/menger */
-            real t5;
-            real d5 = menger(p5, 3, 3.0f, &t5);
-            real d6 = d5 * 0.45f;
-            /* .../color/smooth_subtract: the second operand only within reach of its bound */
-            real u8 = d6;
-            real ut8 = t5;
-            real g8 = length(p4 - (real3)(0.0f)) * 0.9999f - 0.55f;
-            if (!(g8 > -u8 + 0.05f && g8 > R(0.0))) {
-                /* .../color/smooth_subtract/b:sphere */
-                real d7 = sd_sphere(p4, 0.55f);
-                /* .../b:translate/color/smooth_subtract */
-                real x8 = -d6;
-                real y8 = d7;
-                real2 m8 = smooth_min(x8, y8, 0.05f);
-                real d8 = -m8.x;
-                real t8 = x8 < y8 ? mix(t5, R(1.0), m8.y) : mix(R(1.0), t5, m8.y);
-                u8 = d8;
-                ut8 = t8;
-            }
-            /* .../a:smooth_union/b:translate/color */
-            real3 c9 = (real3)(0.8f, 0.8f, 0.75f);
-            /* .../a:smooth_union/a:smooth_union/a:smooth_union */
-            real x11 = d2;
-            real y11 = u8;
-            real2 m11 = smooth_min(x11, y11, 0.1f);
-            real d11 = m11.x;
-            real3 c11 = x11 < y11 ? mix(c3, c9, m11.y) : mix(c9, c3, m11.y);
-            real t11 = x11 < y11 ? mix(t0, ut8, m11.y) : mix(ut8, t0, m11.y);
-            u11 = d11;
-            uc11 = c11;
-            ut11 = t11;
-        }
-        /* .../a:smooth_union/a:smooth_union: the second operand only within reach of its bound */
-        real u16 = u11;
-        real3 uc16 = uc11;
-        real ut16 = ut11;
-        real g16 = 0.9f * (length(p0 - (real3)(1.1f, 0.0f, 0.0f)) * 0.9999f - 1.103242f);
-        if (!(g16 > u16 + 0.1f && g16 > R(0.0))) {
-            /* .../a:smooth_union/a:smooth_union/b:translate */
-            real3 p6 = p0 - (real3)(1.1f, 0.0f, 0.0f);
+            real3 p3 = p0 - (real3)(1.1f, 0.0f, 0.0f);
             /* .../b:translate/color/scale */
-            real3 p7 = p6 / 0.5f;
+            real3 p4 = p3 / 0.5f;
             /* .../color/scale/julia */
             real t12;
-            real d12 = julia(p7, (real4)((-0.2f), 0.6f, 0.2f, 0.2f), 0.0f, 12, 4.0f, &t12);
+            real d12 = julia(p4, (real4)((-0.2f), 0.6f, 0.2f, 0.2f), 0.0f, 12, 4.0f, &t12);
             real d13 = d12 * 0.5f;
             /* .../a:smooth_union/b:translate/color */
             real3 c14 = (real3)(0.4f, 0.7f, 0.95f);
-            /* union/a:smooth_union/a:smooth_union */
-            real x16 = u11;
-            real y16 = d13;
-            real2 m16 = smooth_min(x16, y16, 0.1f);
-            real d16 = m16.x;
-            real3 c16 = x16 < y16 ? mix(uc11, c14, m16.y) : mix(c14, uc11, m16.y);
-            real t16 = x16 < y16 ? mix(ut11, t12, m16.y) : mix(t12, ut11, m16.y);
-            u16 = d16;
-            uc16 = c16;
-            ut16 = t16;
-        }
-        /* union/a:smooth_union: the second operand only within reach of its bound */
-        real u21 = u16;
-        real3 uc21 = uc16;
-        real ut21 = ut16;
-        real g21 = 0.33333334f * (length(p0 - (real3)(0.0f, 0.0f, 0.7f)) * 0.9999f - 0.6062178f);
-        if (!(g21 > u21 + 0.1f && g21 > R(0.0))) {
-            /* union/a:smooth_union/b:translate */
-            real3 p8 = p0 - (real3)(0.0f, 0.0f, 0.7f);
-            /* .../b:translate/color/scale */
-            real3 p9 = p8 / 0.35f;
-            /* .../color/scale/sierpinski */
-            real t17;
-            real d17 = sierpinski(p9, 5, 2.0f, &t17);
-            real d18 = d17 * 0.35f;
-            /* .../a:smooth_union/b:translate/color */
-            real3 c19 = (real3)(0.95f, 0.8f, 0.4f);
+            /* .../a:smooth_union/a:smooth_union: the second operand only within reach of its bound */
+            real u16 = d13;
+            real3 uc16 = c14;
+            real ut16 = t12;
+            real g16 = fmin(length(p0 - (real3)((-1.1f), 0.0f, 0.0f)) * 0.9999f - 1.0f - 0.025f, length(p0 - (real3)(0.0f, 0.0f, (-0.6f))) * 0.9999f - 0.7794229f - 0.025f);
+            if (!(g16 > u16 + 0.1f && g16 > R(0.0))) {
+                /* .../a:smooth_union/a:smooth_union/b:translate */
+                real3 p5 = p0 - (real3)(0.0f, 0.0f, (-0.6f));
+                /* .../color/smooth_subtract/a:scale */
+                real3 p6 = p5 / 0.45f;
+                /* .../smooth_subtract/a:scale/menger */
+                real t5;
+                real d5 = menger(p6, 3, 3.0f, &t5);
+                real d6 = d5 * 0.45f;
+                /* .../color/smooth_subtract: the second operand only within reach of its bound */
+                real u8 = d6;
+                real ut8 = t5;
+                real g8 = length(p5 - (real3)(0.0f)) * 0.9999f - 0.55f;
+                if (!(g8 > -u8 + 0.05f && g8 > R(0.0))) {
+                    /* .../color/smooth_subtract/b:sphere */
+                    real d7 = sd_sphere(p5, 0.55f);
+                    /* .../b:translate/color/smooth_subtract */
+                    real x8 = -d6;
+                    real y8 = d7;
+                    real2 m8 = smooth_min(x8, y8, 0.05f);
+                    real d8 = -m8.x;
+                    real t8 = x8 < y8 ? mix(t5, R(1.0), m8.y) : mix(R(1.0), t5, m8.y);
+                    u8 = d8;
+                    ut8 = t8;
+                }
+                /* .../a:smooth_union/b:translate/color */
+                real3 c9 = (real3)(0.8f, 0.8f, 0.75f);
+                /* .../a:smooth_union/a:smooth_union: the second operand only within reach of its bound */
+                real u11 = u8;
+                real3 uc11 = c9;
+                real ut11 = ut8;
+                real g11 = length(p0 - (real3)((-1.1f), 0.0f, 0.0f)) * 0.9999f - 1.0f;
+                if (!(g11 > u11 + 0.1f && g11 > R(0.0))) {
+                    /* .../a:smooth_union/a:smooth_union/a:translate */
+                    real3 p7 = p0 - (real3)((-1.1f), 0.0f, 0.0f);
+                    /* .../a:translate/color/scale */
+                    real3 p8 = p7 / 0.5f;
+                    /* .../color/scale/rotate */
+                    real3 p9 = (real3)(p8.x, -p8.z, p8.y);
+                    /* .../scale/rotate/mandelbulb */
+                    real t0;
+                    real d0 = mandelbulb(p9, params[0] /* power */, 8, fmin(2.0f, pow(MAGNITUDE_CAP, R(1.0) / params[0] /* power */)), pow(R(2.0), R(1.0) / (params[0] /* power */ - R(1.0))), &t0);
+                    real d2 = d0 * 0.5f;
+                    /* .../a:smooth_union/a:translate/color */
+                    real3 c3 = (real3)(0.9f, 0.55f, 0.3f);
+                    /* .../a:smooth_union/a:smooth_union/a:smooth_union */
+                    real x11 = u8;
+                    real y11 = d2;
+                    real2 m11 = smooth_min(x11, y11, 0.1f);
+                    real d11 = m11.x;
+                    real3 c11 = x11 < y11 ? mix(c9, c3, m11.y) : mix(c3, c9, m11.y);
+                    real t11 = x11 < y11 ? mix(ut8, t0, m11.y) : mix(t0, ut8, m11.y);
+                    u11 = d11;
+                    uc11 = c11;
+                    ut11 = t11;
+                }
+                /* union/a:smooth_union/a:smooth_union */
+                real x16 = d13;
+                real y16 = u11;
+                real2 m16 = smooth_min(x16, y16, 0.1f);
+                real d16 = m16.x;
+                real3 c16 = x16 < y16 ? mix(c14, uc11, m16.y) : mix(uc11, c14, m16.y);
+                real t16 = x16 < y16 ? mix(t12, ut11, m16.y) : mix(ut11, t12, m16.y);
+                u16 = d16;
+                uc16 = c16;
+                ut16 = t16;
+            }
             /* union/a:smooth_union */
-            real x21 = u16;
-            real y21 = d18;
+            real x21 = d18;
+            real y21 = u16;
             real2 m21 = smooth_min(x21, y21, 0.1f);
             real d21 = m21.x;
-            real3 c21 = x21 < y21 ? mix(uc16, c19, m21.y) : mix(c19, uc16, m21.y);
-            real t21 = x21 < y21 ? mix(ut16, t17, m21.y) : mix(t17, ut16, m21.y);
+            real3 c21 = x21 < y21 ? mix(c19, uc16, m21.y) : mix(uc16, c19, m21.y);
+            real t21 = x21 < y21 ? mix(t17, ut16, m21.y) : mix(ut16, t17, m21.y);
             u21 = d21;
             uc21 = c21;
             ut21 = t21;
