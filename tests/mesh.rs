@@ -191,6 +191,17 @@ fn a_box_that_cuts_the_scene_closes_the_mesh() {
         "{:?}",
         mesh.topology()
     );
+    // The cap under the slab faces down: its vertices keep the closed
+    // field's normal, not the floor's.
+    let h = mesh.voxel_size as f32;
+    let mut capped = 0;
+    for (p, n) in mesh.positions.iter().zip(&mesh.normals) {
+        if p.y < -0.5 + 1.5 * h && p.x.abs() < 0.8 && p.z.abs() < 0.8 {
+            assert!(n.y < -0.9, "normal {n} at {p} on the cap");
+            capped += 1;
+        }
+    }
+    assert!(capped > 100, "{capped} cap vertices");
     // A slab of 2 × 0.5 × 2 under the floor, less a voxel at the cut, and
     // most of the sphere above it.
     let slab = 2.0 * 0.5 * 2.0;
@@ -215,6 +226,11 @@ fn bad_grids_say_what_is_wrong() {
         (
             cpu.clone()
                 .bounds(Aabb::new(DVec3::ZERO, dvec3(1.0, f64::NAN, 1.0))),
+            "finite",
+        ),
+        (
+            cpu.clone()
+                .bounds(Aabb::new(DVec3::splat(-1e308), DVec3::splat(1e308))),
             "finite",
         ),
     ];
@@ -319,6 +335,14 @@ fn stl_ply_and_obj_read_back_with_independent_readers() {
             assert_eq!(color, mesh.colors[*v as usize].map(f32::from));
         }
     }
+    // Without normals, OBJ faces name positions only.
+    let mut bare = mesh.clone();
+    bare.normals.clear();
+    bare.write(dir.join("bare.obj")).unwrap();
+    let (models, _) = tobj::load_obj(dir.join("bare.obj"), &tobj::LoadOptions::default()).unwrap();
+    assert_eq!(models[0].mesh.indices.len(), 3 * mesh.triangles.len());
+    assert!(models[0].mesh.normals.is_empty());
+    std::fs::remove_file(dir.join("bare.obj")).unwrap();
     // No temporary file is left beside them.
     let names: Vec<_> = std::fs::read_dir(&dir)
         .unwrap()

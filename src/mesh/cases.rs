@@ -6,9 +6,11 @@
 //! two crossing edges the two join; on a face with four (inside corners on
 //! one diagonal, outside on the other) each inside corner is cut off by
 //! its own segment, so the outside stays connected across the face. Both
-//! cells that share a face read it the same way, so giving each loop its
-//! own vertex yields a surface in which every edge joins exactly two
-//! faces, even where two sheets pass through one cell.
+//! cells that share a face read it the same way. Giving each loop its own
+//! vertex keeps two sheets that pass through one cell from sharing an
+//! edge; an edge still joins four faces where one piece on each side of a
+//! face touches it along two separate segments, which no dual mesh can
+//! represent (rare, and only in features smaller than a cell).
 
 use std::sync::OnceLock;
 

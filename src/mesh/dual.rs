@@ -40,6 +40,8 @@ pub(crate) struct Mesher {
     /// This block's cells' cases and their pieces' vertices.
     masks: Vec<u8>,
     slots: Vec<u32>,
+    /// Set when the mesh outgrows 32-bit indices.
+    overflow: bool,
 }
 
 impl Mesher {
@@ -54,7 +56,14 @@ impl Mesher {
             crossings: Crossings::default(),
             masks: vec![0; CELLS.pow(3)],
             slots: vec![u32::MAX; 4 * CELLS.pow(3)],
+            overflow: false,
         }
+    }
+
+    /// Whether the mesh has outgrown 32-bit vertex indices (what STL, PLY
+    /// and OBJ readers take): vertices or edge crossings past 2³² − 1.
+    pub fn overflowed(&self) -> bool {
+        self.overflow || self.crossings.overflowed()
     }
 
     /// Meshes the block whose first sample is grid sample `start`, from
@@ -119,7 +128,10 @@ impl Mesher {
         let key =
             u64::from(global[0]) + stride * u64::from(global[1]) + layer * u64::from(global[2]);
         for piece in 0..case.pieces {
-            let next = u32::try_from(self.mesh.positions.len()).expect("fewer than 2³² vertices");
+            let Ok(next) = u32::try_from(self.mesh.positions.len()) else {
+                self.overflow = true;
+                return;
+            };
             let index = *self
                 .vertices
                 .entry(4 * key + u64::from(piece))

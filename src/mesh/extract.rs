@@ -9,7 +9,7 @@ use super::dual::{Mesher, SIDE};
 use super::grid::{Grid, Progress, Stage, occupied, plan};
 use super::sharpen::sharpen;
 use super::{GridOptions, Sampling};
-use crate::error::Result;
+use crate::error::{Error, Result};
 use crate::ir::CompiledScene;
 
 /// Cells along a block's edge: the unit the octree drops or keeps.
@@ -173,6 +173,16 @@ pub fn extract_with_progress(
             close_at_the_border(&grid, start, sdf);
             mesher.add(start, sdf);
         }
+        if mesher.overflowed() {
+            return Err(Error::Invalid {
+                what: "mesh size",
+                reason: format!(
+                    "more than 2³² − 1 vertices or edge crossings at {} cells across: lower \
+                     the resolution or sample a smaller box",
+                    options.resolution
+                ),
+            });
+        }
         progress(Progress {
             stage: Stage::Sampling,
             done: ((n + 1) * BATCH).min(blocks.len()) as u64,
@@ -207,13 +217,19 @@ pub fn extract_with_progress(
 
 /// Makes the grid's outer layer (and anything past it) outside, so that
 /// the mesh is closed where the box cuts the scene.
+///
+/// A sample that is not a number (no estimate gives one, but a custom
+/// shape might) counts as outside too, so no vertex is placed from it.
 fn close_at_the_border(grid: &Grid, start: [u32; 3], sdf: &mut [f32]) {
+    #[allow(clippy::cast_possible_truncation)] // A positive f32 is enough.
+    let outside = grid.spacing as f32;
+    for d in sdf.iter_mut().filter(|d| d.is_nan()) {
+        *d = outside;
+    }
     let inside = |a: usize, at: u32| at > 0 && at < grid.cells[a];
     if (0..3).all(|a| inside(a, start[a]) && inside(a, start[a] + SIDE - 1)) {
         return;
     }
-    #[allow(clippy::cast_possible_truncation)] // A positive f32 is enough.
-    let outside = grid.spacing as f32;
     let side = SIDE as usize;
     for (i, d) in sdf.iter_mut().enumerate() {
         let at = [i % side, (i / side) % side, i / (side * side)]

@@ -53,7 +53,8 @@ impl Aabb {
     }
 
     fn validate(&self) -> Result<()> {
-        let finite = self.min.is_finite() && self.max.is_finite();
+        let finite =
+            self.min.is_finite() && self.max.is_finite() && (self.max - self.min).is_finite();
         if !finite || !self.min.cmplt(self.max).all() {
             return Err(Error::Invalid {
                 what: "grid bounds",
@@ -83,7 +84,7 @@ pub struct GridOptions {
     pub precision: Precision,
     /// Meshes only: place each vertex where the tangent planes at its
     /// cell's edge crossings meet (dual contouring's fit, on exact
-    /// gradients: five more evaluations per crossing and per vertex), so
+    /// gradients: four more evaluations per crossing and per vertex), so
     /// box edges, corners and CSG creases stay sharp, and take normals
     /// from the gradient at the vertex; `false`: Surface Nets' mean of the
     /// crossings and the grid's gradient. Default `true`.

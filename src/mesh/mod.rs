@@ -10,7 +10,9 @@
 //! of 16³ cells asks the distance at each node's centre and drops every
 //! node farther from the scene than its own half-diagonal (a distance
 //! estimate never overestimates, so no surface is lost), which makes the
-//! cost grow with the surface's area, not the box's volume.
+//! cost grow with the surface's area and the shape's volume, not the
+//! box's (only nodes outside the shape are dropped: inside a fractal the
+//! estimate is no distance).
 //!
 //! Each block left is meshed dually, as Surface Nets and dual contouring
 //! do: a vertex in every cell the surface crosses and a quad around every

@@ -56,14 +56,20 @@ impl Crossings {
         }
         self.points.extend_from_slice(points);
         self.starts
-            .push(u32::try_from(self.points.len()).expect("fewer than 2³² crossings"));
+            .push(u32::try_from(self.points.len()).unwrap_or(u32::MAX));
         self.cells.push(cell);
+    }
+
+    /// Whether there are more crossings than 32-bit offsets reach.
+    pub fn overflowed(&self) -> bool {
+        u32::try_from(self.points.len()).is_err()
     }
 }
 
 /// Moves every vertex to its cell's best fit of the crossings' tangent
 /// planes, and gives it the distance field's gradient there as its
-/// normal. Returns the distance evaluations it took.
+/// normal, except in the grid's outer layer of cells, where a box may cut
+/// the scene. Returns the distance evaluations it took.
 pub(crate) fn sharpen(
     sampling: &Sampling,
     grid: &Grid,
@@ -78,7 +84,14 @@ pub(crate) fn sharpen(
         .map(|p| world(p.as_dvec3()))
         .collect();
     let planes = gradients(sampling, PLANE_STEP * grid.spacing, &at)?;
+    // Cells on the grid's outer layer meet the cap where the box cuts the
+    // scene: their crossings' planes are the box's, not the scene's, so
+    // they keep Surface Nets' mean and the closed field's normal.
+    let on_border = |cell: [u32; 3]| (0..3).any(|a| cell[a] == 0 || cell[a] + 1 >= grid.cells[a]);
     for (v, position) in positions.iter_mut().enumerate() {
+        if on_border(crossings.cells[v]) {
+            continue;
+        }
         let range = crossings.starts[v] as usize..crossings.starts[v + 1] as usize;
         let points = &crossings.points[range.clone()];
         let planes = &planes[range];
@@ -98,15 +111,16 @@ pub(crate) fn sharpen(
         }
     }
     let at: Vec<DVec3> = positions.iter().map(|p| p.as_dvec3()).collect();
-    for (n, g) in normals
+    let fitted = normals
         .iter_mut()
         .zip(gradients(sampling, NORMAL_STEP * grid.spacing, &at)?)
-    {
-        if g != DVec3::ZERO {
+        .zip(&crossings.cells);
+    for ((n, g), cell) in fitted {
+        if g != DVec3::ZERO && !on_border(*cell) {
             *n = g.as_vec3();
         }
     }
-    Ok(5 * (at.len() + crossings.points.len()) as u64)
+    Ok((TETRAHEDRON.len() * (at.len() + crossings.points.len())) as u64)
 }
 
 fn outer(n: DVec3) -> DMat3 {

@@ -136,12 +136,19 @@ impl Mesh {
             let c = |v: u8| f32::from(v) / 255.0;
             writeln!(out, "v {} {} {} {} {} {}", p.x, p.y, p.z, c(r), c(g), c(b))?;
         }
-        for n in &self.normals {
-            writeln!(out, "vn {} {} {}", n.x, n.y, n.z)?;
+        if self.normals.len() == self.positions.len() {
+            for n in &self.normals {
+                writeln!(out, "vn {} {} {}", n.x, n.y, n.z)?;
+            }
         }
+        let with_normals = self.normals.len() == self.positions.len();
         for t in &self.triangles {
             let [a, b, c] = t.map(|i| u64::from(i) + 1);
-            writeln!(out, "f {a}//{a} {b}//{b} {c}//{c}")?;
+            if with_normals {
+                writeln!(out, "f {a}//{a} {b}//{b} {c}//{c}")?;
+            } else {
+                writeln!(out, "f {a} {b} {c}")?;
+            }
         }
         Ok(())
     }

@@ -178,7 +178,7 @@ impl PointEvaluator {
             &self.source.param_buffer(self.values.as_slice()),
         )?;
         let output = RealBuffer::output(q, self.precision, points.len() * stride)?;
-        let count = u32::try_from(points.len()).map_err(opencl)?;
+        let count = u32::try_from(points.len()).map_err(|_| too_many(points.len() as u64))?;
         let mut builder = Kernel::builder();
         builder
             .program(&self.program)
@@ -210,7 +210,8 @@ impl PointEvaluator {
     ///
     /// # Errors
     /// [`Error::OpenCl`](crate::Error::OpenCl) if a buffer or the launch
-    /// fails, or if the samples number more than `u32::MAX`.
+    /// fails; [`Error::Invalid`](crate::Error::Invalid) if the samples
+    /// number more than `u32::MAX`.
     pub fn eval_grid(
         &self,
         origin: DVec3,
@@ -223,7 +224,7 @@ impl PointEvaluator {
         if total == 0 {
             return Ok(Vec::new());
         }
-        let count = u32::try_from(total).map_err(opencl)?;
+        let count = u32::try_from(total).map_err(|_| too_many(total))?;
         let q = &self.queue;
         let packed: Vec<ocl::prm::Int4> = blocks
             .iter()
@@ -270,5 +271,16 @@ impl PointEvaluator {
         // sizes of the buffers bound above.
         unsafe { kernel.enq().map_err(opencl)? };
         output.read()
+    }
+}
+
+/// The error for a launch of more than `u32::MAX` points or samples.
+fn too_many(count: u64) -> crate::Error {
+    crate::Error::Invalid {
+        what: "point count",
+        reason: format!(
+            "{count} points in one call; at most {} (split them into several calls)",
+            u32::MAX
+        ),
     }
 }
