@@ -13,7 +13,7 @@ use crate::codegen::interface::{
     EVAL_DISTANCES, EVAL_GRID, EVAL_OUT_STRIDE, EVAL_POINTS, EvalArg, GridArg,
 };
 use crate::codegen::{self, Options, Target};
-use crate::error::Result;
+use crate::error::{Error, Result};
 use crate::ir::{CompiledScene, Ir, ParamValues};
 use crate::quality::{Precision, Quality};
 use crate::scene::Node;
@@ -275,8 +275,8 @@ impl PointEvaluator {
 }
 
 /// The error for a launch of more than `u32::MAX` points or samples.
-fn too_many(count: u64) -> crate::Error {
-    crate::Error::Invalid {
+fn too_many(count: u64) -> Error {
+    Error::Invalid {
         what: "point count",
         reason: format!(
             "{count} points in one call; at most {} (split them into several calls)",
