@@ -29,6 +29,7 @@ use fractal_sdf::codegen;
 use fractal_sdf::ir::ParamLayout;
 use fractal_sdf::prelude::*;
 use fractal_sdf::render::{DeviceSelector, RenderOptions, Renderer};
+use fractal_sdf::scene::{Stereo, StereoLayout};
 use fractal_sdf::settings::Settings;
 use fractal_sdf::view::{
     Action, FlyCamera, Key, KeyBindings, KeyScript, Movement, ResolutionScaler, ViewSettings,
@@ -85,7 +86,15 @@ CONTROLS:
   W/S A/D E/Q (or arrows)  move forward/back, left/right, up/down
   drag with left button    look around
   scroll wheel             change movement speed
+
+A still view is refined by progressive passes, up to 64 samples per pixel:
+edges smooth out, and a camera with a lens (a scene file's `aperture`)
+shows its depth of field.
 ";
+
+/// The progressive passes a still view is refined by (see
+/// `Renderer::render_progressive`).
+const REFINE_PASSES: u32 = 64;
 
 /// How often a scene file's modification time and size are checked.
 const POLL: Duration = Duration::from_millis(250);
@@ -700,19 +709,24 @@ impl Viewer {
         }
         let changing = moved || self.changed || (self.animating && !self.motions.is_empty());
         self.changed = false;
-        self.renderer
-            .set_camera(self.fly.camera(&self.scene.camera))?;
+        // A camera set again restarts the progressive passes: only a new
+        // one is handed over.
+        let camera = self.fly.camera(&self.scene.camera);
+        if self.renderer.camera() != &camera {
+            self.renderer.set_camera(camera)?;
+        }
 
-        // Render at the chosen resolution (always full size unattended).
+        // Render at the chosen resolution (always full size unattended),
+        // then, while the view stays still, refine it pass by pass.
         let divisor = if self.headless() {
             Some(1)
         } else {
-            self.scaler.next(changing)
+            self.scaler.next(changing).or(self.refining().then_some(1))
         };
         let (width, height) = self.window_size();
         if let Some(d) = divisor {
             let (w, h) = reduced_size(width, height, d);
-            let image = self.renderer.render(w, h)?;
+            let image = self.draw(w, h, d == 1)?;
             let took = self
                 .renderer
                 .last_timing()
@@ -746,7 +760,11 @@ impl Viewer {
             }
             event_loop.exit();
         }
-        let busy = self.headless() || changing || self.keys.is_moving() || divisor.is_some();
+        let busy = self.headless()
+            || changing
+            || self.keys.is_moving()
+            || divisor.is_some()
+            || self.refining();
         self.idle = !busy;
         event_loop.set_control_flow(match &self.watched {
             _ if busy => ControlFlow::Poll,
@@ -757,16 +775,48 @@ impl Viewer {
         Ok(())
     }
 
+    /// Whether the still view has more progressive passes to add: the
+    /// full-size image is up, in one eye, short of [`REFINE_PASSES`].
+    fn refining(&self) -> bool {
+        !self.headless()
+            && self.image_sharp
+            && self.settings.stereo.is_none()
+            && self.renderer.progressive_passes() < REFINE_PASSES
+    }
+
+    /// Renders a `w` × `h` view: both eyes laid out in it with stereo on,
+    /// else the next progressive pass of a full-size (`sharp`) view in an
+    /// interactive window, else a frame of its own.
+    fn draw(&mut self, w: u32, h: u32, sharp: bool) -> Result<RgbaImage> {
+        match self.settings.stereo {
+            Some(layout) => {
+                let (ew, eh) = match layout {
+                    StereoLayout::Anaglyph => (w, h),
+                    StereoLayout::SideBySide => ((w / 2).max(1), h),
+                    StereoLayout::OverUnder => (w, (h / 2).max(1)),
+                };
+                self.renderer.render_stereo(ew, eh, &Stereo::new(layout))
+            }
+            None if sharp && !self.headless() => self.renderer.render_progressive(w, h),
+            None => self.renderer.render(w, h),
+        }
+    }
+
     /// Saves the current view at full size (rendering it if the last frame
-    /// was reduced).
+    /// was reduced) and, in a window, with every progressive pass.
     fn save_sharp(&mut self, path: &Path) -> Result<()> {
+        let (w, h) = self.window_size();
         if !self.image_sharp || self.image.is_none() {
-            let (w, h) = self.window_size();
-            self.image = Some(self.renderer.render(w, h)?);
+            self.image = Some(self.draw(w, h, true)?);
             self.image_sharp = true;
             self.image_size = (w, h);
             self.present()?;
         }
+        // The view refined to the end, whenever the key came.
+        while self.refining() {
+            self.image = Some(self.draw(w, h, true)?);
+        }
+        self.present()?;
         output::save_png(self.image.as_ref().expect("rendered above"), path)
     }
 

@@ -64,6 +64,9 @@ typedef struct {
     real image_w;     // the image's size in pixels
     real image_h;
     real pixel_scale; // image pixels per rendered pixel along each axis
+    real2 shift;      // the image window's offset, in units of half_h
+    real aperture;    // the thin lens's radius (0: a pinhole)
+    real focus;       // the distance along forward that is in focus
     int orthographic;
 } MarchCamera;
 
@@ -81,6 +84,9 @@ MarchCamera march_load_camera(__global const real* c) {
     cam.image_w = c[CAMERA_IMAGE_WIDTH];
     cam.image_h = c[CAMERA_IMAGE_HEIGHT];
     cam.pixel_scale = c[CAMERA_PIXEL_SCALE];
+    cam.shift = vload2(0, c + CAMERA_SHIFT);
+    cam.aperture = c[CAMERA_APERTURE];
+    cam.focus = c[CAMERA_FOCUS_DISTANCE];
     return cam;
 }
 
@@ -90,16 +96,30 @@ real march_footprint(const MarchCamera* cam, real t) {
 }
 
 // The ray through image position (px, py) in image pixels, (0, 0) being
-// the top left corner of the image.
+// the top left corner of the image, through the centre of the lens.
 void march_camera_ray(const MarchCamera* cam, real px, real py, real3* ro, real3* rd) {
-    real u = (R(2.0) * px / cam->image_w - R(1.0)) * cam->half_w;
-    real v = (R(1.0) - R(2.0) * py / cam->image_h) * cam->half_h;
+    real u = (R(2.0) * px / cam->image_w - R(1.0)) * cam->half_w + cam->shift.x * cam->half_h;
+    real v = (R(1.0) - R(2.0) * py / cam->image_h + cam->shift.y) * cam->half_h;
     if (cam->orthographic) {
         *ro = cam->origin + cam->right * u + cam->up * v;
         *rd = cam->forward;
     } else {
         *ro = cam->origin;
         *rd = normalize(cam->forward + cam->right * u + cam->up * v);
+    }
+}
+
+// The ray through image position (px, py) and the point (lx, ly) of the
+// unit disc scaled to the lens: it leaves the lens there and meets the
+// ray through the lens's centre on the plane in focus, FOCUS_DISTANCE
+// along forward. A pinhole camera (aperture 0) keeps the centre's ray.
+void march_lens_ray(const MarchCamera* cam, real px, real py, real2 lens, real3* ro,
+                    real3* rd) {
+    march_camera_ray(cam, px, py, ro, rd);
+    if (cam->aperture > R(0.0)) {
+        real3 focus = *ro + *rd * (cam->focus / dot(*rd, cam->forward));
+        *ro += (cam->right * lens.x + cam->up * lens.y) * cam->aperture;
+        *rd = normalize(focus - *ro);
     }
 }
 
@@ -484,17 +504,71 @@ real march_jitter(uint x, uint y, uint sample) {
     return (real)(h >> 8) * R(5.9604644775390625e-8); // 2^-24
 }
 
+// Point j of the R2 sequence (Roberts 2018), rotated by a per-pixel offset
+// drawn from the hash's dimensions (dim, dim + 1): well spread in the unit
+// square for every count of points, so progressive passes converge
+// faster than independent random points would.
+real2 march_sequence(uint pixel, uint j, uint dim) {
+    real2 offset = (real2)(march_jitter(pixel, 0u, dim), march_jitter(pixel, 0u, dim + 1u));
+    real2 step = (real2)(R(0.75487766624669276), R(0.56984029099805327));
+    real2 q = offset + step * (real)j;
+    return q - floor(q);
+}
+
+// The unit square onto the unit disc, keeping areas and neighbourhoods
+// (Shirley and Chiu's concentric map).
+real2 march_disc(real2 q) {
+    real a = R(2.0) * q.x - R(1.0);
+    real b = R(2.0) * q.y - R(1.0);
+    if (a == R(0.0) && b == R(0.0)) {
+        return (real2)(R(0.0));
+    }
+    const real quarter = R(0.78539816339744831);
+    if (fabs(a) > fabs(b)) {
+        return a * (real2)(cos(quarter * b / a), sin(quarter * b / a));
+    }
+    return b * (real2)(sin(quarter * a / b), cos(quarter * a / b));
+}
+
+// Where sample j of a pixel (j = pass * SUPERSAMPLING^2 + s) lies in it,
+// (jx, jy) in [0, 1)^2, and on the lens, in the unit disc. With
+// supersampling, sample s is jittered in cell s of an N x N grid over the
+// pixel; without, sample 0 is the pixel's centre and the rest follow the
+// R2 sequence. The lens always follows the R2 sequence, apart from the
+// pixel's.
+void march_sample_point(uint pixel, uint j, int s, real* jx, real* jy, real2* lens) {
+    if (SUPERSAMPLING > 1) {
+        *jx = ((real)(s % SUPERSAMPLING) + march_jitter(pixel, j, 0u)) / (real)SUPERSAMPLING;
+        *jy = ((real)(s / SUPERSAMPLING) + march_jitter(pixel, j, 1u)) / (real)SUPERSAMPLING;
+    } else if (j == 0u) {
+        *jx = R(0.5);
+        *jy = R(0.5);
+    } else {
+        real2 q = march_sequence(pixel, j, 0u);
+        *jx = q.x;
+        *jy = q.y;
+    }
+    *lens = march_disc(march_sequence(pixel, j, 2u));
+}
+
 // One launch shades the tile [x0, x0 + tile_w) x [y0, y0 + tile_h) of a
 // width x height image. The global size may be rounded up past the tile.
 //
-// AOVs describe the ray through the pixel centre: depth (distance along
-// the ray, +INFINITY on a miss), hit (0/1), world-space normal (0 on a
-// miss); and the cost of the pixel's colour: steps, the primary-march
-// distance evaluations of all its samples, and evaluations, every distance
-// evaluation of all its samples (primary march, normal, DE_shade, occlusion
-// and shadow rays, and the step onto the surface of a ray that starts
-// inside it). The extra march through
-// the pixel centre that AOVs need with supersampling is not counted.
+// A frame of its own (pass < 0) takes SUPERSAMPLING^2 samples per pixel.
+// Progressive pass k >= 0 takes the next SUPERSAMPLING^2 (samples
+// k N^2 to (k + 1) N^2 - 1), adds their linear colours to the pixel's sum
+// in accumulation (pass 0 starts it) and writes the mean of every sample
+// so far: pass 0 is the frame of its own, and later passes converge on
+// the mean of ever more samples.
+//
+// AOVs describe the ray through the pixel centre and the lens's centre:
+// depth (distance along the ray, +INFINITY on a miss), hit (0/1),
+// world-space normal (0 on a miss); and the cost of the pixel's colour:
+// steps, the primary-march distance evaluations of this launch's samples,
+// and evaluations, every distance evaluation of them (primary march,
+// normal, DE_shade, occlusion and shadow rays, and the step onto the
+// surface of a ray that starts inside it). The extra march through the
+// pixel centre that AOVs need with supersampling or a lens is not counted.
 __kernel void render_tile(RENDER_TILE_ARGS) {
     int lx = (int)get_global_id(0);
     int ly = (int)get_global_id(1);
@@ -511,27 +585,25 @@ __kernel void render_tile(RENDER_TILE_ARGS) {
     start = starts[(y / CONE_TILE) * ((width + CONE_TILE - 1) / CONE_TILE) + x / CONE_TILE];
 #endif
 
+    const int per_pass = SUPERSAMPLING * SUPERSAMPLING;
+    const uint first = pass > 0 ? (uint)pass * (uint)per_pass : 0u;
+    const uint pixel = (uint)y * (uint)width + (uint)x;
     real3 sum = (real3)(R(0.0));
     uint total_steps = 0;
     uint total_evals = 0;
     MarchResult centre = {R(0.0), R(1.0), 0, 0};
     real3 centre_normal = (real3)(R(0.0));
-    for (int s = 0; s < SUPERSAMPLING * SUPERSAMPLING; ++s) {
-        real jx = R(0.5);
-        real jy = R(0.5);
-        if (SUPERSAMPLING > 1) {
-            uint pixel = (uint)y * (uint)width + (uint)x;
-            jx = ((real)(s % SUPERSAMPLING) + march_jitter(pixel, (uint)s, 0u))
-                 / (real)SUPERSAMPLING;
-            jy = ((real)(s / SUPERSAMPLING) + march_jitter(pixel, (uint)s, 1u))
-                 / (real)SUPERSAMPLING;
-        }
+    for (int s = 0; s < per_pass; ++s) {
+        real jx;
+        real jy;
+        real2 lens;
+        march_sample_point(pixel, first + (uint)s, s, &jx, &jy, &lens);
         // Rendered pixel (x, y) covers pixel_scale image pixels each way.
         real px = ((real)x + jx) * cam.pixel_scale;
         real py = ((real)y + jy) * cam.pixel_scale;
         real3 ro;
         real3 rd;
-        march_camera_ray(&cam, px, py, &ro, &rd);
+        march_lens_ray(&cam, px, py, lens, &ro, &rd);
         MarchResult m = march_ray(ro, rd, start, &cam, params);
         total_steps += (uint)m.steps;
         total_evals += (uint)m.steps;
@@ -570,13 +642,19 @@ __kernel void render_tile(RENDER_TILE_ARGS) {
             centre_normal = n;
         }
     }
-    real3 color = sum / (real)(SUPERSAMPLING * SUPERSAMPLING);
-    real3 out = pow(clamp(color, R(0.0), R(1.0)), (real3)(R(1.0) / GAMMA));
     int idx = y * width + x;
+    real3 color = sum / (real)per_pass;
+    if (pass >= 0) {
+        float4 total = pass == 0 ? (float4)(0.0f) : accumulation[idx];
+        total += (float4)(convert_float3(sum), 0.0f);
+        accumulation[idx] = total;
+        color = (real3)(total.x, total.y, total.z) / ((real)(pass + 1) * (real)per_pass);
+    }
+    real3 out = pow(clamp(color, R(0.0), R(1.0)), (real3)(R(1.0) / GAMMA));
     rgba[idx] = (uchar4)(convert_uchar3_sat_rte(convert_float3(out) * 255.0f), (uchar)255);
 
     if (write_aovs) {
-        if (SUPERSAMPLING > 1) {
+        if (SUPERSAMPLING > 1 || pass > 0 || cam.aperture > R(0.0)) {
             // The colour samples are jittered: trace the pixel centre.
             real3 ro;
             real3 rd;
@@ -642,8 +720,16 @@ __kernel void cone_starts(CONE_STARTS_ARGS) {
     // A margin for the rounding of the corner rays.
     rho0 *= R(1.01);
     cos_theta = clamp(cos_theta - R(1e-6), R(0.1), R(1.0));
-    real sec_theta = R(1.0) / cos_theta;
-    real tan_theta = sqrt(R(1.0) - cos_theta * cos_theta) * sec_theta;
+    real tan_theta = sqrt(R(1.0) - cos_theta * cos_theta) / cos_theta;
+    // A lens of radius a moves each ray off its pinhole ray by
+    // a |1 - tau / focus| <= a + tau a / focus at tau along the axis (the
+    // lens ray and the pinhole ray meet on the plane in focus): the cone
+    // widens by a at its apex and by a / focus in slope.
+    if (cam.aperture > R(0.0)) {
+        rho0 += cam.aperture;
+        tan_theta += cam.aperture / cam.focus;
+    }
+    real sec_theta = sqrt(R(1.0) + tan_theta * tan_theta);
     real widen = R(1.0) + tan_theta + march_glow_slope() * sec_theta;
     real t = R(0.0);
     for (int i = 0; i < CONE_STEPS; ++i) {

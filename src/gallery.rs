@@ -37,6 +37,7 @@ pub fn all() -> Vec<(&'static str, Scene)> {
         ("domain_ops", domain_ops()),
         ("fractal_mix", fractal_mix()),
         ("benchmark", benchmark()),
+        ("depth_of_field", depth_of_field()),
     ]
 }
 
@@ -72,16 +73,18 @@ pub fn motions(name: &str) -> Vec<Motion> {
 }
 
 /// The gallery's scene `name` as a scene file: the scene, production
-/// quality with 2×2 supersampling, the default effects with a pale blue
+/// quality with 2×2 supersampling (4×4 for a camera with a lens, whose
+/// blur needs more samples), the default effects with a pale blue
 /// glow, its [`motions`], and for `benchmark` its [`benchmark_path`]. The
 /// crate's `scenes/` folder holds these files (`scenes/NAME.ron`), as
 /// [`SceneFile::to_text`] writes them.
 #[must_use]
 pub fn file(name: &str) -> Option<SceneFile> {
     let scene = by_name(name)?;
+    let samples = if scene.camera.aperture > 0.0 { 4 } else { 2 };
     Some(SceneFile {
         scene,
-        quality: Some(Quality::production().supersampling(2)),
+        quality: Some(Quality::production().supersampling(samples)),
         effects: Effects::default().glow(Glow::new(dvec3(0.6, 0.75, 1.0), 0.6)),
         path: (name == "benchmark").then(|| benchmark_path().expect("a constant path")),
         motions: motions(name),
@@ -155,6 +158,37 @@ pub fn sierpinski_tetrahedron() -> Scene {
     let tet = sierpinski(7).color(dvec3(0.95, 0.75, 0.45));
     Scene::new(tet.union(floor(1.0)))
         .with_camera(Camera::look_at(dvec3(2.4, 1.4, 3.0), dvec3(0.0, -0.1, 0.0)).fov(45.0))
+        .with_lights(key_and_fill())
+}
+
+/// Five Menger sponges in a row, seen through a lens focused on the
+/// middle one: the nearer and farther ones blur, more with distance from
+/// the plane in focus (render with supersampling or progressive passes).
+#[must_use]
+pub fn depth_of_field() -> Scene {
+    let colors = [
+        dvec3(0.35, 0.6, 0.95),
+        dvec3(0.5, 0.7, 0.9),
+        dvec3(0.85, 0.85, 0.8),
+        dvec3(0.95, 0.75, 0.5),
+        dvec3(0.95, 0.55, 0.35),
+    ];
+    let row = (-2..=2)
+        .zip(colors)
+        .map(|(i, color)| {
+            let t = f64::from(i);
+            menger(3)
+                .rotate(DVec3::Y, 0.35 * t)
+                .scale(0.36)
+                .color(color)
+                .translate(dvec3(0.62 * t, 0.0, -0.95 * t))
+        })
+        .reduce(Node::union)
+        .expect("five sponges");
+    let camera = Camera::look_at(dvec3(-0.6, 1.0, 4.3), dvec3(0.0, -0.15, 0.0)).fov(38.0);
+    let in_focus = (camera.target - camera.position).length();
+    Scene::new(row.union(floor(0.36)))
+        .with_camera(camera.lens(0.1).focus(in_focus))
         .with_lights(key_and_fill())
 }
 

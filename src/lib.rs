@@ -214,6 +214,6 @@ pub mod prelude {
         Scene, Sierpinski, capped_cone, capsule, cuboid, cylinder, ellipsoid, julia, mandelbulb,
         menger, octahedron, param, param3, plane, round_box, sierpinski, sphere, torus,
     };
-    pub use glam::{DQuat, DVec3, EulerRot, Vec3, dvec3, vec3};
+    pub use glam::{DQuat, DVec2, DVec3, EulerRot, Vec3, dvec2, dvec3, vec3};
     pub use image::RgbaImage;
 }

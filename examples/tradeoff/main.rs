@@ -10,7 +10,8 @@
 //! ε/10`: a tenth of its `hit_epsilon`). A sweep of `detail`, which
 //! changes the surface drawn rather than the accuracy, shows how much the
 //! look depends on it. Anti-aliasing is measured apart, at half the size,
-//! against a 4×4-sample render. A table says whether each preset is on the
+//! against a 4×4-sample render, and so are progressive passes, against an
+//! 8×8-sample render. A table says whether each preset is on the
 //! measured front (no configuration both faster, by more than 10%, and
 //! more accurate, by more than 0.5 dB). Prints
 //! markdown tables, writes
@@ -80,6 +81,50 @@ impl Study {
     fn frame(&self, scene: &Scene, quality: Quality) -> Result<Frame> {
         self.renderer(scene, quality)?
             .render_with_aovs(self.size.0, self.size.1)
+    }
+
+    /// Progressive rendering: 1, 4, 16 and 64 passes of production
+    /// quality, timed once each (the program built beforehand), against
+    /// production with 8×8 samples, the mean of as many samples as the
+    /// last row has. Depth and hit mask are the pixel centres'.
+    fn progressive(&self, name: &str, scene: &Scene) -> Result<Vec<Row>> {
+        let (w, h) = self.size;
+        let best = self.frame(scene, Quality::production().supersampling(8))?;
+        let mut renderer = self.renderer(scene, Quality::production())?;
+        let centre = renderer.render_with_aovs(w, h)?;
+        let mut rows: Vec<Row> = Vec::new();
+        for passes in [1u32, 4, 16, 64] {
+            renderer.restart_progressive();
+            let start = std::time::Instant::now();
+            let mut image = renderer.render_progressive(w, h)?;
+            for _ in 1..passes {
+                image = renderer.render_progressive(w, h)?;
+            }
+            let ms = start.elapsed().as_secs_f64() * 1e3;
+            let frame = Frame {
+                image,
+                ..centre.clone()
+            };
+            let row = Row {
+                scene: name.to_string(),
+                group: "progressive",
+                label: format!("{passes} passes"),
+                timing: Timing {
+                    median_ms: ms,
+                    runs: 1,
+                },
+                speedup: rows.first().map_or(1.0, |one| one.timing.median_ms / ms),
+                evaluations: centre.mean_evaluations() * f64::from(passes),
+                errors: compare(&frame, &best),
+                size: self.size,
+            };
+            eprintln!(
+                "  {:<20} {:>9.1} ms  {:>6.1} evals/px  {:>6.2} dB",
+                row.label, ms, row.evaluations, row.errors.psnr
+            );
+            rows.push(row);
+        }
+        Ok(rows)
     }
 
     fn renderer(&self, scene: &Scene, quality: Quality) -> Result<Renderer> {
@@ -433,6 +478,7 @@ fn main() -> std::process::ExitCode {
                     r.speedup = one / r.timing.median_ms;
                 }
                 rows.extend(aa_rows);
+                rows.extend(aa.progressive(name, &scene)?);
             }
         }
         println!(
@@ -467,6 +513,12 @@ fn main() -> std::process::ExitCode {
                 size.1 / 2
             );
             println!("{}", table(&rows, &["aa"]));
+            println!(
+                "Progressive passes at {}x{} (production, one sample per pass; speed-up: against one pass; error: against production with 8x8 samples):\n",
+                size.0 / 2,
+                size.1 / 2
+            );
+            println!("{}", table(&rows, &["progressive"]));
         }
         let csv_path = "out/tradeoff.csv";
         std::fs::write(csv_path, csv(&rows, &device))

@@ -58,8 +58,15 @@ pub mod camera {
     /// Image pixels per rendered pixel along each axis
     /// ([`Quality::resolution_scale`](crate::quality::Quality::resolution_scale)).
     pub const PIXEL_SCALE: Field = field("PIXEL_SCALE", 19, 1);
+    /// The lens shift: how far the image window is moved along `RIGHT` and
+    /// `UP`, in units of `HALF_HEIGHT` (off-axis stereo eyes).
+    pub const SHIFT: Field = field("SHIFT", 20, 2);
+    /// The thin lens's radius in scene units (0: a pinhole).
+    pub const APERTURE: Field = field("APERTURE", 22, 1);
+    /// The distance along `FORWARD` at which the thin lens is in focus.
+    pub const FOCUS_DISTANCE: Field = field("FOCUS_DISTANCE", 23, 1);
     /// Every field, in buffer order.
-    pub const FIELDS: [Field; 12] = [
+    pub const FIELDS: [Field; 15] = [
         ORIGIN,
         ORTHOGRAPHIC,
         RIGHT,
@@ -72,9 +79,12 @@ pub mod camera {
         IMAGE_WIDTH,
         IMAGE_HEIGHT,
         PIXEL_SCALE,
+        SHIFT,
+        APERTURE,
+        FOCUS_DISTANCE,
     ];
     /// Reals in the buffer.
-    pub const LEN: usize = 20;
+    pub const LEN: usize = 24;
 }
 
 /// One light's entry in the light buffer (`lights` argument of
@@ -123,11 +133,15 @@ pub enum RenderArg {
     Steps,
     Evaluations,
     Starts,
+    Pass,
+    Accumulation,
 }
 
 /// `render_tile`'s declarations, in argument order: the one list of its
-/// arguments.
-pub const RENDER_TILE: [(RenderArg, &str); 18] = [
+/// arguments. `pass` is -1 for a frame of its own; from 0 up it is the
+/// index of a progressive pass, which adds its samples to `accumulation`
+/// (linear colour sums, reset by pass 0) and writes their mean to `rgba`.
+pub const RENDER_TILE: [(RenderArg, &str); 20] = [
     (RenderArg::Params, "__global const real* params"),
     (RenderArg::Camera, "__global const real* camera"),
     (RenderArg::Lights, "__global const real* lights"),
@@ -146,6 +160,8 @@ pub const RENDER_TILE: [(RenderArg, &str); 18] = [
     (RenderArg::Steps, "__global uint* steps"),
     (RenderArg::Evaluations, "__global uint* evaluations"),
     (RenderArg::Starts, "__global const float* starts"),
+    (RenderArg::Pass, "const int pass"),
+    (RenderArg::Accumulation, "__global float4* accumulation"),
 ];
 
 /// The arguments of the coarse pass `cone_starts` (see

@@ -62,6 +62,8 @@ mod memory;
 mod points;
 mod program;
 mod renderer;
+mod sampling;
+mod stereo;
 mod upscale;
 mod viewport;
 
@@ -72,6 +74,8 @@ pub use dispatch::{DEFAULT_TILE_SIZE, MAX_IMAGE_SIDE};
 pub use points::{PointEvaluator, PointSample};
 pub use program::{BuildInfo, PROGRAM_CACHE_CAPACITY, program_builds};
 pub use renderer::{RenderOptions, Renderer};
+pub use sampling::{SamplePoint, sample_point};
+pub use stereo::compose;
 pub use viewport::Viewport;
 
 pub use crate::view::FrameTiming;

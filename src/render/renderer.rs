@@ -118,6 +118,22 @@ pub struct Renderer {
     /// This renderer's share of the tiles, `(k, n)`: the tiles whose index
     /// is `k` modulo `n`.
     share: (usize, usize),
+    /// The progressive pass the next launch is, or -1 for a frame of its
+    /// own (the kernel's `pass`).
+    pass: i32,
+    /// The progressive passes accumulated so far, and the image size they
+    /// are for; `None` once anything that changes the image has changed.
+    progress: Option<Progress>,
+}
+
+/// Progressive rendering's state: the passes in the accumulation buffers.
+#[derive(Debug, Clone)]
+struct Progress {
+    width: u32,
+    height: u32,
+    passes: u32,
+    /// The image once the passes reach the most samples per pixel.
+    converged: Option<RgbaImage>,
 }
 
 /// Where a renderer's `DE` and `DE_shade` come from.
@@ -222,7 +238,7 @@ impl Renderer {
         let context = program::context(&selected)?;
         let queue = profiling_queue(&context, &selected)?;
         let inputs = Inputs::new(&queue, &source, &values, scene.lights())?;
-        let targets = Targets::new(&queue, 1, 1, true)?;
+        let targets = Targets::new(&queue, 1, 1, true, false)?;
         let (program, build, compiled) = program::build(&selected, &context, &source)?;
         let kernel = make_kernel(&program, &queue, &inputs, &targets)?;
         let cone = make_cone(&program, &queue, &inputs, &targets, &source)?;
@@ -246,6 +262,8 @@ impl Renderer {
             timing: None,
             partners: Vec::new(),
             share: (0, 1),
+            pass: -1,
+            progress: None,
         })
     }
 
@@ -398,6 +416,102 @@ impl Renderer {
         }
     }
 
+    /// Renders one more progressive pass of a `width` × `height` image and
+    /// returns the mean of every pass so far.
+    ///
+    /// The first pass is the frame [`Renderer::render`] draws. Each later
+    /// pass adds [`Quality::supersampling`]² new samples to every pixel,
+    /// each at its own point in the pixel and on the lens
+    /// ([`Camera::aperture`]), and the image converges on the mean over
+    /// the pixel and the lens: edges smooth out and depth of field
+    /// becomes a soft blur. The sums are kept on the device, so a pass
+    /// costs one frame's samples whatever the count.
+    ///
+    /// Changing the camera, lights, a parameter, the quality, the effects
+    /// or the size starts again from the first pass; so does
+    /// [`Renderer::restart_progressive`]. Past
+    /// [`Renderer::MAX_PROGRESSIVE_SAMPLES`] samples per pixel the image
+    /// has converged, and a further call renders no more passes but
+    /// returns it again.
+    ///
+    /// ```no_run
+    /// use fractal_sdf::prelude::*;
+    /// use fractal_sdf::render::Renderer;
+    ///
+    /// let camera = Camera::look_at(dvec3(0.0, 0.5, 3.0), DVec3::ZERO).lens(0.08);
+    /// let scene = Scene::new(mandelbulb(8.0)).with_camera(camera);
+    /// let mut renderer = Renderer::new(&scene, Quality::preview())?;
+    /// let mut image = renderer.render_progressive(320, 240)?;
+    /// while renderer.progressive_passes() < 16 {
+    ///     image = renderer.render_progressive(320, 240)?;
+    /// }
+    /// # let _ = image;
+    /// # Ok::<(), fractal_sdf::Error>(())
+    /// ```
+    ///
+    /// # Errors
+    /// As [`Renderer::render`]; after a failed pass the next call starts
+    /// again from the first.
+    pub fn render_progressive(&mut self, width: u32, height: u32) -> Result<RgbaImage> {
+        let per_pass = self.options.quality.supersampling.max(1).pow(2);
+        let last = (Self::MAX_PROGRESSIVE_SAMPLES / per_pass).max(1);
+        let done = match &self.progress {
+            Some(p) if (p.width, p.height) == (width, height) => {
+                if let Some(image) = &p.converged {
+                    return Ok(image.clone());
+                }
+                p.passes
+            }
+            _ => 0,
+        };
+        // Sums lost with buffers made anew (for another size) start again.
+        let (lw, lh) = self.rendered_size(width, height);
+        let done = if self.targets.fits(lw, lh, false, true) {
+            done
+        } else {
+            0
+        };
+        self.progress = None;
+        self.set_pass(i32::try_from(done).expect("passes are at most 4096"));
+        let image = self.render(width, height);
+        self.set_pass(-1);
+        let image = image?;
+        let passes = done + 1;
+        self.progress = Some(Progress {
+            width,
+            height,
+            passes,
+            converged: (passes == last).then(|| image.clone()),
+        });
+        Ok(image)
+    }
+
+    /// The progressive passes in the last image of
+    /// [`Renderer::render_progressive`]: 0 before the first, or after
+    /// anything that restarts it.
+    #[must_use]
+    pub fn progressive_passes(&self) -> u32 {
+        self.progress.as_ref().map_or(0, |p| p.passes)
+    }
+
+    /// Makes the next [`Renderer::render_progressive`] start from its
+    /// first pass.
+    pub fn restart_progressive(&mut self) {
+        self.progress = None;
+    }
+
+    /// The most samples per pixel progressive rendering takes: past it the
+    /// sums, kept in `f32`, would round away what a further sample adds.
+    pub const MAX_PROGRESSIVE_SAMPLES: u32 = 4096;
+
+    /// Sets the kernel's `pass` here and on the partners.
+    fn set_pass(&mut self, pass: i32) {
+        self.pass = pass;
+        for p in &mut self.partners {
+            p.set_pass(pass);
+        }
+    }
+
     /// Renders the image on this renderer's own device.
     fn render_alone(&mut self, width: u32, height: u32) -> Result<RgbaImage> {
         let start = Instant::now();
@@ -517,6 +631,7 @@ impl Renderer {
     pub fn set_param(&mut self, name: &str, value: f64) -> Result<()> {
         let limits = self.source.precision.limits();
         self.values.set_within(name, value, limits)?;
+        self.progress = None;
         self.for_partners(|p| p.set_param(name, value))
     }
 
@@ -536,6 +651,7 @@ impl Renderer {
         let limits = self.source.precision.limits();
         check_frame_inputs(&view, &[], self.source.origin, limits)?;
         self.scene.set_camera(camera)?;
+        self.progress = None;
         self.for_partners(|p| p.set_camera(camera))
     }
 
@@ -560,6 +676,7 @@ impl Renderer {
         check_inputs(&scene, &self.values, &self.source)?;
         self.for_partners(|p| p.set_lights(lights.iter().copied()))?;
         self.scene = scene;
+        self.progress = None;
         Ok(())
     }
 
@@ -655,6 +772,7 @@ impl Renderer {
         check_inputs(&self.scene, &self.values, &source)?;
         self.load(source)?;
         self.options = options;
+        self.progress = None;
         Ok(())
     }
 
@@ -768,17 +886,20 @@ impl Renderer {
         let scale = self.scale();
         let (width, height) = self.rendered_size(width, height);
         let info = &self.selected.info;
-        if self.targets.fits(width, height, aovs) {
+        let progressive = self.pass >= 0;
+        if self.targets.fits(width, height, aovs, progressive) {
             let host = frame_host_bytes(info, width, height, aovs, None);
             check_host_memory(width, height, host, available_host_memory())?;
         } else {
             // Free the old buffers first so their memory can be reused.
-            self.targets = Targets::new(&self.queue, 1, 1, false)?;
-            check_device_memory(info, width, height, aovs)?;
-            let device = Targets::bytes(width, height, aovs).iter().sum();
+            self.targets = Targets::new(&self.queue, 1, 1, false, false)?;
+            check_device_memory(info, width, height, aovs, progressive)?;
+            let device = Targets::bytes(width, height, aovs, progressive)
+                .iter()
+                .sum();
             let host = frame_host_bytes(info, width, height, aovs, Some(device));
             check_host_memory(width, height, host, available_host_memory())?;
-            self.targets = Targets::new(&self.queue, width, height, aovs)
+            self.targets = Targets::new(&self.queue, width, height, aovs, progressive)
                 .map_err(|e| too_large(width, height, &format!("{e}")))?;
         }
         check_frame_inputs(
@@ -804,6 +925,7 @@ impl Renderer {
             set(RenderArg::Height, height as i32)?;
         }
         set(RenderArg::WriteAovs, i32::from(aovs))?;
+        set(RenderArg::Pass, self.pass)?;
         t.bind(k)?;
         let launched = Instant::now();
         let mut events: Vec<Event> = Vec::new();
@@ -886,8 +1008,14 @@ fn profiled_time(events: &[Event]) -> Option<Duration> {
 
 /// A clear error, before anything is allocated, for an image whose output
 /// buffers the device cannot hold.
-fn check_device_memory(info: &DeviceInfo, width: u32, height: u32, aovs: bool) -> Result<()> {
-    let wanted = Targets::bytes(width, height, aovs);
+fn check_device_memory(
+    info: &DeviceInfo,
+    width: u32,
+    height: u32,
+    aovs: bool,
+    progressive: bool,
+) -> Result<()> {
+    let wanted = Targets::bytes(width, height, aovs, progressive);
     let largest = wanted.iter().copied().max().unwrap_or(0);
     let total: u64 = wanted.iter().sum();
     let mib = |b: u64| b.div_ceil(1 << 20);
@@ -1070,6 +1198,12 @@ fn make_kernel(program: &Program, queue: &Queue, inputs: &Inputs, t: &Targets) -
             RenderArg::Starts => {
                 b.arg(&t.starts);
             }
+            RenderArg::Accumulation => {
+                b.arg(&t.accumulation);
+            }
+            RenderArg::Pass => {
+                b.arg(-1i32);
+            }
             RenderArg::LightCount
             | RenderArg::Width
             | RenderArg::Height
@@ -1158,12 +1292,14 @@ impl Inputs {
 }
 
 /// The per-pixel outputs on the device. Without AOVs, the AOV buffers hold
-/// one element each (the kernel does not write them).
+/// one element each (the kernel does not write them); so does the
+/// accumulation buffer outside progressive rendering.
 #[derive(Debug)]
 struct Targets {
     width: u32,
     height: u32,
     aovs: bool,
+    progressive: bool,
     rgba: Buffer<u8>,
     depth: Buffer<f32>,
     hit: Buffer<u8>,
@@ -1173,16 +1309,21 @@ struct Targets {
     /// The coarse pass's start distances, one per tile of at least 2 × 2
     /// pixels (see [`cone_tiles`]).
     starts: Buffer<f32>,
+    /// Progressive rendering's sums of linear colours, an RGB and a spare
+    /// `f32` per pixel.
+    accumulation: Buffer<f32>,
 }
 
 impl Targets {
-    fn new(queue: &Queue, width: u32, height: u32, aovs: bool) -> Result<Self> {
+    fn new(queue: &Queue, width: u32, height: u32, aovs: bool, progressive: bool) -> Result<Self> {
         let pixels = width as usize * height as usize;
         let aov_pixels = if aovs { pixels } else { 1 };
+        let summed_pixels = if progressive { pixels } else { 1 };
         Ok(Targets {
             width,
             height,
             aovs,
+            progressive,
             rgba: output(queue, pixels * 4)?,
             depth: output(queue, aov_pixels)?,
             hit: output(queue, aov_pixels)?,
@@ -1195,15 +1336,31 @@ impl Targets {
                 .len(cone_tiles(width, height, MIN_CONE_TILE).max(1))
                 .build()
                 .map_err(opencl)?,
+            accumulation: Buffer::builder()
+                .queue(queue.clone())
+                .flags(MemFlags::new().read_write())
+                .len(summed_pixels * 4)
+                .build()
+                .map_err(opencl)?,
         })
     }
 
     /// Bytes of each output buffer for an image.
-    fn bytes(width: u32, height: u32, aovs: bool) -> Vec<u64> {
+    fn bytes(width: u32, height: u32, aovs: bool, progressive: bool) -> Vec<u64> {
         let pixels = u64::from(width) * u64::from(height);
         let aov = if aovs { pixels } else { 1 };
+        let summed = if progressive { pixels } else { 1 };
         let starts = cone_tiles(width, height, MIN_CONE_TILE) as u64 * 4;
-        vec![pixels * 4, aov * 4, aov, aov * 12, aov * 4, aov * 4, starts]
+        vec![
+            pixels * 4,
+            aov * 4,
+            aov,
+            aov * 12,
+            aov * 4,
+            aov * 4,
+            starts,
+            summed * 16,
+        ]
     }
 
     /// Binds the output buffers to their arguments.
@@ -1221,11 +1378,16 @@ impl Targets {
         k.set_arg(RenderArg::Evaluations.index(), &self.evaluations)
             .map_err(opencl)?;
         k.set_arg(RenderArg::Starts.index(), &self.starts)
+            .map_err(opencl)?;
+        k.set_arg(RenderArg::Accumulation.index(), &self.accumulation)
             .map_err(opencl)
     }
 
-    fn fits(&self, width: u32, height: u32, aovs: bool) -> bool {
-        self.width == width && self.height == height && (self.aovs || !aovs)
+    fn fits(&self, width: u32, height: u32, aovs: bool, progressive: bool) -> bool {
+        self.width == width
+            && self.height == height
+            && (self.aovs || !aovs)
+            && (self.progressive || !progressive)
     }
 }
 
@@ -1268,9 +1430,9 @@ mod tests {
         device.max_allocation = 64 << 20;
         device.global_memory = 128 << 20;
         // 4K colour: 32 MiB in one buffer.
-        check_device_memory(&device, 3840, 2160, false).unwrap();
+        check_device_memory(&device, 3840, 2160, false, false).unwrap();
         // 8K colour: 127 MiB in one buffer.
-        let err = check_device_memory(&device, 7680, 4320, false).unwrap_err();
+        let err = check_device_memory(&device, 7680, 4320, false, false).unwrap_err();
         let text = err.to_string();
         assert!(
             matches!(err, Error::Resolution { width: 7680, .. }),
@@ -1281,10 +1443,10 @@ mod tests {
             "{text}"
         );
         // 4K with AOVs: 95 MiB of normals.
-        let err = check_device_memory(&device, 3840, 2160, true).unwrap_err();
+        let err = check_device_memory(&device, 3840, 2160, true, false).unwrap_err();
         assert!(err.to_string().contains("95 MiB"), "{err}");
         device.max_allocation = 1 << 30;
-        let err = check_device_memory(&device, 3840, 2160, true).unwrap_err();
+        let err = check_device_memory(&device, 3840, 2160, true, false).unwrap_err();
         assert!(
             err.to_string()
                 .contains("238 MiB but `Small / gpu` has 128 MiB"),

@@ -5,7 +5,7 @@
 //! [`codegen::interface`](crate::codegen::interface), which the kernel
 //! reads through the header's `#define`s.
 
-use glam::DVec3;
+use glam::{DVec2, DVec3};
 
 use crate::codegen::interface::{Field, camera, light, put};
 use crate::cpu::{MarchSettings, Ray};
@@ -44,6 +44,9 @@ pub struct Viewport {
     footprint_per_unit: f64,
     width: u32,
     height: u32,
+    shift: DVec2,
+    aperture: f64,
+    focus: f64,
 }
 
 impl Viewport {
@@ -117,6 +120,9 @@ impl Viewport {
             footprint_per_unit,
             width,
             height,
+            shift: camera.shift,
+            aperture: camera.aperture,
+            focus: camera.focus_distance(),
         })
     }
 
@@ -139,10 +145,12 @@ impl Viewport {
 
     /// The ray through image position `(x, y)` in pixels, `(0, 0)` being the
     /// top-left corner: the centre of pixel `(i, j)` is `(i + 0.5, j + 0.5)`.
+    /// It passes through the centre of the lens, so it is the same with or
+    /// without one.
     #[must_use]
     pub fn ray(&self, x: f64, y: f64) -> Ray {
-        let u = (2.0 * x / f64::from(self.width) - 1.0) * self.half_w;
-        let v = (1.0 - 2.0 * y / f64::from(self.height)) * self.half_h;
+        let u = (2.0 * x / f64::from(self.width) - 1.0) * self.half_w + self.shift.x * self.half_h;
+        let v = (1.0 - 2.0 * y / f64::from(self.height) + self.shift.y) * self.half_h;
         if self.orthographic {
             Ray {
                 origin: self.origin + self.right * u + self.up * v,
@@ -154,6 +162,25 @@ impl Viewport {
                 direction: normalize(self.forward + self.right * u + self.up * v)
                     .unwrap_or(self.forward),
             }
+        }
+    }
+
+    /// The ray through image position `(x, y)` that leaves the lens at
+    /// `lens`, a point of the unit disc scaled to the aperture: it meets
+    /// [`Viewport::ray`] on the plane in focus. Without a lens (aperture
+    /// 0) it is [`Viewport::ray`].
+    #[must_use]
+    pub fn lens_ray(&self, x: f64, y: f64, lens: DVec2) -> Ray {
+        let centre = self.ray(x, y);
+        if self.aperture <= 0.0 {
+            return centre;
+        }
+        let focus =
+            centre.origin + centre.direction * (self.focus / centre.direction.dot(self.forward));
+        let origin = centre.origin + (self.right * lens.x + self.up * lens.y) * self.aperture;
+        Ray {
+            origin,
+            direction: normalize(focus - origin).unwrap_or(centre.direction),
         }
     }
 
@@ -213,6 +240,9 @@ impl Viewport {
         put(&mut c, camera::IMAGE_WIDTH, &[f64::from(self.width)]);
         put(&mut c, camera::IMAGE_HEIGHT, &[f64::from(self.height)]);
         put(&mut c, camera::PIXEL_SCALE, &[f64::from(scale)]);
+        put(&mut c, camera::SHIFT, &self.shift.to_array());
+        put(&mut c, camera::APERTURE, &[self.aperture]);
+        put(&mut c, camera::FOCUS_DISTANCE, &[self.focus]);
         c
     }
 }
@@ -271,6 +301,14 @@ pub(crate) fn check_frame_inputs(
         "camera",
         "field of view per pixel",
         at(camera::FOOTPRINT_PER_UNIT),
+        Magnitude::Size,
+    )?;
+    check("camera", "lens shift", at(camera::SHIFT), Magnitude::Size)?;
+    check("camera", "aperture", at(camera::APERTURE), Magnitude::Size)?;
+    check(
+        "camera",
+        "focus distance",
+        at(camera::FOCUS_DISTANCE),
         Magnitude::Size,
     )?;
     let packed = pack_lights(lights, origin);

@@ -9,8 +9,9 @@ mod custom;
 pub(crate) mod names;
 mod node;
 mod param;
+mod stereo;
 
-use glam::DVec3;
+use glam::{DVec2, DVec3};
 use serde::{Deserialize, Serialize};
 
 pub use build::{
@@ -24,6 +25,7 @@ pub use node::{
     NodeKind, ParamSpec, QuaternionJulia, Rule, Sierpinski,
 };
 pub use param::{Param, Param3, param, param3};
+pub use stereo::{Stereo, StereoLayout};
 
 use crate::error::{Error, Result, fmt_value};
 use crate::math::{F64_LIMITS, Magnitude, normalize};
@@ -56,6 +58,20 @@ pub struct Camera {
     pub up: DVec3,
     /// Perspective or orthographic.
     pub projection: Projection,
+    /// The radius of a thin lens, in scene units: points off the plane in
+    /// focus blur into discs that grow with it (depth of field). 0, the
+    /// default, is a pinhole: everything is sharp, and the image is the
+    /// same as without a lens. The blur is sampled by supersampling or
+    /// progressive passes.
+    pub aperture: f64,
+    /// The distance along the view at which the lens is in focus; `None`
+    /// (the default) focuses on the target.
+    pub focus_distance: Option<f64>,
+    /// Lens shift: the image window moved sideways and up without turning
+    /// the camera, in units of half the image's height (`(0, 1)` moves it
+    /// up by half the image). Off-axis stereo eyes use it
+    /// ([`Camera::eyes`]); 0 by default.
+    pub shift: DVec2,
 }
 
 impl Camera {
@@ -70,6 +86,9 @@ impl Camera {
             projection: Projection::Perspective {
                 fov_y_degrees: 45.0,
             },
+            aperture: 0.0,
+            focus_distance: None,
+            shift: DVec2::ZERO,
         }
     }
 
@@ -94,6 +113,96 @@ impl Camera {
         self
     }
 
+    /// Gives the camera a thin lens of radius `aperture` (scene units),
+    /// in focus at the target unless [`Camera::focus`] says otherwise.
+    ///
+    /// ```
+    /// use fractal_sdf::prelude::*;
+    /// let camera = Camera::look_at(dvec3(0.0, 0.0, 4.0), DVec3::ZERO).lens(0.05).focus(3.0);
+    /// assert_eq!(camera.focus_distance(), 3.0);
+    /// ```
+    #[must_use]
+    pub fn lens(mut self, aperture: f64) -> Self {
+        self.aperture = aperture;
+        self
+    }
+
+    /// Sets the distance along the view that is in focus.
+    #[must_use]
+    pub fn focus(mut self, distance: f64) -> Self {
+        self.focus_distance = Some(distance);
+        self
+    }
+
+    /// Sets the lens shift ([`Camera::shift`]).
+    #[must_use]
+    pub fn shifted(mut self, shift: impl Into<DVec2>) -> Self {
+        self.shift = shift.into();
+        self
+    }
+
+    /// The distance along the view that is in focus:
+    /// [`Camera::focus_distance`], or the target's distance.
+    #[must_use]
+    pub fn focus_distance(&self) -> f64 {
+        self.focus_distance
+            .unwrap_or_else(|| (self.target - self.position).length())
+    }
+
+    /// The left and right eyes of a stereo pair around this camera, with
+    /// off-axis (asymmetric) frusta rather than turned-in ones: each eye
+    /// moves `separation / 2` sideways and looks the same way, and its
+    /// image window shifts back towards the centre so that the two windows
+    /// coincide `convergence` along the view. Points at that distance
+    /// appear at the same place in both images; nearer points are seen
+    /// further right by the left eye than by the right (crossed
+    /// disparity), farther points further left.
+    ///
+    /// # Errors
+    /// [`Error::Camera`] for an orthographic camera (parallel rays see no
+    /// depth), a separation that is negative or not finite, or a
+    /// convergence distance that is not above 0; any error of
+    /// [`Camera::validate`].
+    ///
+    /// ```
+    /// use fractal_sdf::prelude::*;
+    /// let [left, right] = Camera::default().eyes(0.1, 3.5)?;
+    /// assert!(left.position.x < right.position.x);
+    /// # Ok::<(), fractal_sdf::Error>(())
+    /// ```
+    pub fn eyes(&self, separation: f64, convergence: f64) -> Result<[Camera; 2]> {
+        let (right, _, _) = self.basis()?;
+        let bad = |reason: String| Err(Error::Camera { reason });
+        let Projection::Perspective { fov_y_degrees } = self.projection else {
+            return bad("stereo needs a perspective camera".into());
+        };
+        if !(separation >= 0.0 && separation.is_finite()) {
+            return bad(format!(
+                "eye separation must be finite and >= 0, got {}",
+                fmt_value(separation)
+            ));
+        }
+        if !(convergence > 0.0 && convergence.is_finite()) {
+            return bad(format!(
+                "convergence distance must be finite and > 0, got {}",
+                fmt_value(convergence)
+            ));
+        }
+        // Half the window's height at unit distance: the shift's unit.
+        let half_h = (fov_y_degrees.to_radians() * 0.5).tan();
+        let eye = |side: f64| {
+            let offset = right * (side * separation * 0.5);
+            Camera {
+                position: self.position + offset,
+                target: self.target + offset,
+                shift: self.shift
+                    + DVec2::new(-side * separation * 0.5 / (convergence * half_h), 0.0),
+                ..*self
+            }
+        };
+        Ok([eye(-1.0), eye(1.0)])
+    }
+
     /// The orthonormal camera basis `(right, up, forward)`, normalised
     /// robustly ([`math::normalize`](crate::math::normalize)): an `up` or a
     /// view of any finite length gives the same basis.
@@ -112,7 +221,7 @@ impl Camera {
     /// Checks that the camera can form an image: finite vectors, target
     /// different from position, up not zero nor parallel to the view (its
     /// length does not matter), field of view in (0°, 180°), orthographic
-    /// height > 0; and that position, target and height are within the
+    /// height > 0, aperture >= 0, focus distance > 0, finite shift; and that position, target and height are within the
     /// magnitudes the CPU reference and an `F64` kernel compute with
     /// ([`Precision::limits`](crate::quality::Precision::limits)). A
     /// renderer also checks them against its own precision.
@@ -165,6 +274,28 @@ impl Camera {
                 }
                 within_scalar("camera", "orthographic height", height, Magnitude::Size)?;
             }
+        }
+        if !(self.aperture >= 0.0 && self.aperture.is_finite()) {
+            return bad(&format!(
+                "aperture must be finite and >= 0, got {}",
+                fmt_value(self.aperture)
+            ));
+        }
+        within_scalar("camera", "aperture", self.aperture, Magnitude::Size)?;
+        if let Some(focus) = self.focus_distance {
+            if !(focus > 0.0 && focus.is_finite()) {
+                return bad(&format!(
+                    "focus distance must be finite and > 0, got {}",
+                    fmt_value(focus)
+                ));
+            }
+            within_scalar("camera", "focus distance", focus, Magnitude::Size)?;
+        }
+        if !self.shift.is_finite() {
+            return bad("lens shift must be finite");
+        }
+        for (value, axis) in self.shift.to_array().into_iter().zip(["x", "y"]) {
+            within_scalar("camera", &format!("shift.{axis}"), value, Magnitude::Size)?;
         }
         Ok(())
     }

@@ -9,7 +9,7 @@ use glam::{DVec3, dvec3};
 use super::Key;
 use crate::error::{Error, Result};
 use crate::quality::{Effects, Glow, Preset, Quality};
-use crate::scene::Camera;
+use crate::scene::{Camera, StereoLayout};
 
 /// A first-person camera: a position, a heading (`yaw`) and an elevation
 /// (`pitch`), moved by keys at `speed` units per second and turned by mouse
@@ -216,6 +216,8 @@ pub enum Action {
     ToggleShadows,
     /// `g`: glow on or off.
     ToggleGlow,
+    /// `v`: stereo off, then each [`StereoLayout`] in turn.
+    CycleStereo,
     /// `1`–`4`: draft, preview, production, reference quality.
     Quality(Preset),
     /// `space`: pause or resume the animated parameters.
@@ -230,10 +232,11 @@ pub enum Action {
 
 impl Action {
     /// Every action, in the order a help text lists them.
-    pub const ALL: [Action; 11] = [
+    pub const ALL: [Action; 12] = [
         Action::ToggleAmbientOcclusion,
         Action::ToggleShadows,
         Action::ToggleGlow,
+        Action::CycleStereo,
         Action::Quality(Preset::Draft),
         Action::Quality(Preset::Preview),
         Action::Quality(Preset::Production),
@@ -251,6 +254,7 @@ impl Action {
             Action::ToggleAmbientOcclusion => Key::O,
             Action::ToggleShadows => Key::H,
             Action::ToggleGlow => Key::G,
+            Action::CycleStereo => Key::V,
             Action::Quality(Preset::Draft) => Key::Digit1,
             Action::Quality(Preset::Preview) => Key::Digit2,
             Action::Quality(Preset::Production) => Key::Digit3,
@@ -264,7 +268,7 @@ impl Action {
 
     /// The stable snake_case name of the action, by which settings files
     /// bind it to a key: `toggle_ambient_occlusion`, `toggle_shadows`,
-    /// `toggle_glow`, `quality_draft`, `quality_preview`,
+    /// `toggle_glow`, `cycle_stereo`, `quality_draft`, `quality_preview`,
     /// `quality_production`, `quality_reference`, `toggle_animation`,
     /// `reset_camera`, `screenshot` and `quit`.
     #[must_use]
@@ -273,6 +277,7 @@ impl Action {
             Action::ToggleAmbientOcclusion => "toggle_ambient_occlusion",
             Action::ToggleShadows => "toggle_shadows",
             Action::ToggleGlow => "toggle_glow",
+            Action::CycleStereo => "cycle_stereo",
             Action::Quality(Preset::Draft) => "quality_draft",
             Action::Quality(Preset::Preview) => "quality_preview",
             Action::Quality(Preset::Production) => "quality_production",
@@ -313,6 +318,7 @@ impl Action {
             Action::ToggleAmbientOcclusion => "toggle ambient occlusion",
             Action::ToggleShadows => "toggle shadows",
             Action::ToggleGlow => "toggle glow",
+            Action::CycleStereo => "stereo: off, anaglyph, side by side, over-under",
             Action::Quality(Preset::Draft) => "draft quality",
             Action::Quality(Preset::Preview) => "preview quality",
             Action::Quality(Preset::Production) => "production quality",
@@ -480,6 +486,8 @@ pub struct ViewSettings {
     pub glow_style: Glow,
     /// Everything else about the effects (background, fog, gamma).
     pub base: Effects,
+    /// The stereo layout, or `None` for one eye.
+    pub stereo: Option<StereoLayout>,
 }
 
 impl Default for ViewSettings {
@@ -496,6 +504,7 @@ impl Default for ViewSettings {
                 strength: 0.8,
             },
             base: Effects::default(),
+            stereo: None,
         }
     }
 }
@@ -543,14 +552,24 @@ impl ViewSettings {
         }
     }
 
-    /// Applies an action; returns whether the quality or effects changed
-    /// (which means a new program).
+    /// Applies an action; returns whether the settings changed (a new
+    /// quality or new effects mean a new program; stereo does not).
     pub fn apply(&mut self, action: Action) -> bool {
         let before = *self;
         match action {
             Action::ToggleAmbientOcclusion => self.ambient_occlusion ^= true,
             Action::ToggleShadows => self.shadows ^= true,
             Action::ToggleGlow => self.glow ^= true,
+            Action::CycleStereo => {
+                let all = StereoLayout::ALL;
+                self.stereo = match self.stereo {
+                    None => Some(all[0]),
+                    Some(layout) => {
+                        let i = all.iter().position(|&l| l == layout).expect("a layout");
+                        all.get(i + 1).copied()
+                    }
+                };
+            }
             Action::Quality(p) => {
                 self.preset = p;
                 self.custom_quality = None;
@@ -560,8 +579,8 @@ impl ViewSettings {
         *self != before
     }
 
-    /// A short description, such as `preview, AO, shadows, glow`
-    /// (`custom` for a custom quality).
+    /// A short description, such as `preview, AO, shadows, glow,
+    /// anaglyph` (`custom` for a custom quality).
     #[must_use]
     pub fn summary(&self) -> String {
         let quality = if self.custom_quality.is_some() {
@@ -579,6 +598,7 @@ impl ViewSettings {
                 parts.push(name);
             }
         }
+        parts.extend(self.stereo.map(StereoLayout::name));
         parts.join(", ")
     }
 }
@@ -716,6 +736,13 @@ mod tests {
         assert!(!s.apply(Action::Quality(Preset::Production)), "no change");
         assert!(!s.apply(Action::Screenshot));
         assert_eq!(s.summary(), "production, glow");
+        // Stereo cycles through every layout and back to one eye.
+        for layout in ["anaglyph", "side-by-side", "over-under"] {
+            assert!(s.apply(Action::CycleStereo));
+            assert_eq!(s.summary(), format!("production, glow, {layout}"));
+        }
+        assert!(s.apply(Action::CycleStereo));
+        assert_eq!(s.stereo, None);
     }
 
     #[test]

@@ -44,7 +44,9 @@ typedef float4 real4;
     __global float* normals, \
     __global uint* steps, \
     __global uint* evaluations, \
-    __global const float* starts
+    __global const float* starts, \
+    const int pass, \
+    __global float4* accumulation
 #define CONE_STARTS_ARGS \
     __global const real* params, \
     __global const real* camera, \
@@ -63,6 +65,9 @@ typedef float4 real4;
 #define CAMERA_IMAGE_WIDTH 17
 #define CAMERA_IMAGE_HEIGHT 18
 #define CAMERA_PIXEL_SCALE 19
+#define CAMERA_SHIFT 20
+#define CAMERA_APERTURE 22
+#define CAMERA_FOCUS_DISTANCE 23
 #define LIGHT_POSITION 0
 #define LIGHT_KIND 3
 #define LIGHT_RADIANCE 4

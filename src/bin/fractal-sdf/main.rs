@@ -16,6 +16,7 @@ use fractal_sdf::gallery;
 use fractal_sdf::output::{save_png, verify_png};
 use fractal_sdf::prelude::*;
 use fractal_sdf::render::{DeviceKind, DeviceSelector, RenderOptions, Renderer, devices};
+use fractal_sdf::scene::{Stereo, StereoLayout};
 use fractal_sdf::sequence::{Encoded, Sequence, parse_range};
 use fractal_sdf::settings::{CONFIG_ENV, Settings, parse_preset, parse_size};
 use indicatif::{ProgressBar, ProgressStyle};
@@ -100,6 +101,49 @@ struct RenderArgs {
     /// The PNG to write.
     #[arg(short, long, value_name = "FILE")]
     output: PathBuf,
+    /// Progressive passes: the image is the mean of N passes of the
+    /// preset's samples, each at new points in the pixel and on the lens.
+    #[arg(long, default_value_t = 1, value_name = "N",
+          value_parser = clap::value_parser!(u32).range(1..=4096))]
+    passes: u32,
+    /// The lens's radius in scene units, for depth of field (0: a pinhole).
+    #[arg(long, value_name = "RADIUS")]
+    aperture: Option<f64>,
+    /// The distance in focus (default: the scene camera's, else its target's).
+    #[arg(long, value_name = "DISTANCE")]
+    focus: Option<f64>,
+    /// A stereo pair: anaglyph, side-by-side or over-under (each eye at
+    /// --size).
+    #[arg(long, value_name = "LAYOUT", conflicts_with = "passes")]
+    stereo: Option<String>,
+    /// The distance between the eyes (default: a thirtieth of the
+    /// convergence distance).
+    #[arg(long, value_name = "DISTANCE", requires = "stereo")]
+    eye_separation: Option<f64>,
+    /// Where the eyes' images coincide (default: the distance in focus).
+    #[arg(long, value_name = "DISTANCE", requires = "stereo")]
+    convergence: Option<f64>,
+}
+
+impl RenderArgs {
+    /// The stereo view asked for, if any.
+    fn stereo(&self) -> Outcome<Option<Stereo>> {
+        let Some(name) = &self.stereo else {
+            return Ok(None);
+        };
+        let layout = StereoLayout::from_name(name).ok_or_else(|| {
+            let names: Vec<&str> = StereoLayout::ALL.iter().map(|l| l.name()).collect();
+            usage(format!(
+                "--stereo `{name}`: expected one of {}",
+                names.join(", ")
+            ))
+        })?;
+        Ok(Some(Stereo {
+            layout,
+            eye_separation: self.eye_separation,
+            convergence: self.convergence,
+        }))
+    }
 }
 
 #[derive(Args)]
@@ -323,12 +367,24 @@ fn spinner(message: String) -> ProgressBar {
 }
 
 fn render(args: &RenderArgs, settings: &Settings) -> Outcome {
-    let job = Job::new(&args.scene, settings)?;
+    let stereo = args.stereo()?;
+    let mut job = Job::new(&args.scene, settings)?;
+    let camera = &mut job.file.scene.camera;
+    if let Some(aperture) = args.aperture {
+        camera.aperture = aperture;
+    }
+    if let Some(focus) = args.focus {
+        camera.focus_distance = Some(focus);
+    }
     let (width, height) = job.size;
     let start = Instant::now();
     let bar = spinner(format!("rendering {width}x{height}"));
     let mut renderer = job.renderer()?;
-    let image = renderer.render(width, height);
+    let image = match stereo {
+        Some(stereo) => renderer.render_stereo(width, height, &stereo),
+        None if args.passes > 1 => progressive(&mut renderer, width, height, args.passes),
+        None => renderer.render(width, height),
+    };
     bar.finish_and_clear();
     save_png(&image?, &args.output)?;
     println!(
@@ -339,6 +395,21 @@ fn render(args: &RenderArgs, settings: &Settings) -> Outcome {
         on_devices(&renderer)
     );
     Ok(())
+}
+
+/// The mean of `passes` progressive passes (fewer past the renderer's
+/// sample limit, where the image has converged).
+fn progressive(
+    renderer: &mut Renderer,
+    width: u32,
+    height: u32,
+    passes: u32,
+) -> fractal_sdf::Result<image::RgbaImage> {
+    let mut image = renderer.render_progressive(width, height)?;
+    for _ in 1..passes {
+        image = renderer.render_progressive(width, height)?;
+    }
+    Ok(image)
 }
 
 /// The quality to render with: `--preset`, else the scene file's own, else

@@ -1,0 +1,146 @@
+//! Where each sample of a pixel lies, in the pixel and on the lens: the
+//! CPU twin of `march_sample_point` in `kernels/march.cl`, so a test can
+//! trace the rays the kernel traces.
+
+use glam::DVec2;
+
+/// Sample `j` of a pixel: its position in the pixel and on the lens.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SamplePoint {
+    /// The position in the pixel, each coordinate in `[0, 1)`; add the
+    /// pixel's corner to get an image position for
+    /// [`Viewport::lens_ray`](super::Viewport::lens_ray).
+    pub offset: DVec2,
+    /// The point of the unit disc where the ray leaves the lens.
+    pub lens: DVec2,
+}
+
+/// Sample `j` of rendered pixel `(x, y)` of an image `width` pixels wide,
+/// with `supersampling` × `supersampling` samples per pass: sample
+/// `j = pass · N² + s`. With supersampling, sample `s` is jittered in cell
+/// `s` of an N × N grid over the pixel; without, sample 0 is the pixel's
+/// centre and later ones follow the R2 sequence (Roberts 2018) rotated by
+/// a per-pixel offset. The lens follows the R2 sequence with an offset of
+/// its own, mapped to the disc by Shirley and Chiu's concentric map.
+///
+/// ```
+/// use fractal_sdf::render::sample_point;
+/// let first = sample_point(64, 3, 5, 0, 1);
+/// assert_eq!(first.offset.to_array(), [0.5, 0.5]);
+/// assert!(first.lens.length() <= 1.0);
+/// ```
+#[must_use]
+pub fn sample_point(width: u32, x: u32, y: u32, j: u32, supersampling: u32) -> SamplePoint {
+    let pixel = y.wrapping_mul(width).wrapping_add(x);
+    let n = supersampling.max(1);
+    let offset = if n > 1 {
+        let s = j % (n * n);
+        DVec2::new(
+            (f64::from(s % n) + jitter(pixel, j, 0)) / f64::from(n),
+            (f64::from(s / n) + jitter(pixel, j, 1)) / f64::from(n),
+        )
+    } else if j == 0 {
+        DVec2::splat(0.5)
+    } else {
+        sequence(pixel, j, 0)
+    };
+    SamplePoint {
+        offset,
+        lens: disc(sequence(pixel, j, 2)),
+    }
+}
+
+/// The kernel's `march_hash`.
+fn hash(mut x: u32) -> u32 {
+    x ^= x >> 16;
+    x = x.wrapping_mul(0x7feb_352d);
+    x ^= x >> 15;
+    x = x.wrapping_mul(0x846c_a68b);
+    x ^= x >> 16;
+    x
+}
+
+/// The kernel's `march_jitter`: a number in `[0, 1)` with 24 bits.
+fn jitter(x: u32, y: u32, sample: u32) -> f64 {
+    f64::from(hash(x ^ hash(y ^ hash(sample))) >> 8) * 2f64.powi(-24)
+}
+
+/// The kernel's `march_sequence`: point `j` of the R2 sequence, rotated
+/// by the pixel's offset in dimensions `dim` and `dim + 1`.
+fn sequence(pixel: u32, j: u32, dim: u32) -> DVec2 {
+    let offset = DVec2::new(jitter(pixel, 0, dim), jitter(pixel, 0, dim + 1));
+    let step = DVec2::new(0.754_877_666_246_692_8, 0.569_840_290_998_053_3);
+    let q = offset + step * f64::from(j);
+    q - q.floor()
+}
+
+/// The kernel's `march_disc`: the unit square onto the unit disc.
+fn disc(q: DVec2) -> DVec2 {
+    let (a, b) = (2.0 * q.x - 1.0, 2.0 * q.y - 1.0);
+    if a == 0.0 && b == 0.0 {
+        return DVec2::ZERO;
+    }
+    let quarter = std::f64::consts::FRAC_PI_4;
+    if a.abs() > b.abs() {
+        a * DVec2::new((quarter * b / a).cos(), (quarter * b / a).sin())
+    } else {
+        b * DVec2::new((quarter * a / b).sin(), (quarter * a / b).cos())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn supersampled_points_fill_their_cells() {
+        for j in 0..32 {
+            let p = sample_point(100, 7, 9, j, 4);
+            let s = j % 16;
+            let cell = DVec2::new(f64::from(s % 4), f64::from(s / 4)) / 4.0;
+            let inside = p.offset - cell;
+            assert!(
+                inside.min_element() >= 0.0 && inside.max_element() < 0.25,
+                "{j}: {p:?}"
+            );
+        }
+    }
+
+    #[test]
+    fn lens_points_cover_the_disc_evenly() {
+        // 4096 points: each quarter of the disc, and the inner disc of half
+        // the radius (a quarter of the area), gets close to a quarter.
+        let points: Vec<DVec2> = (0..4096)
+            .map(|j| sample_point(64, 3, 2, j, 1).lens)
+            .collect();
+        assert!(points.iter().all(|p| p.length() <= 1.0 + 1e-12));
+        let share = |f: &dyn Fn(&DVec2) -> bool| {
+            points.iter().filter(|p| f(p)).count() as f64 / points.len() as f64
+        };
+        for quadrant in [
+            share(&|p| p.x > 0.0 && p.y > 0.0),
+            share(&|p| p.x < 0.0 && p.y > 0.0),
+            share(&|p| p.x < 0.0 && p.y < 0.0),
+            share(&|p| p.x > 0.0 && p.y < 0.0),
+            share(&|p| p.length() < 0.5),
+        ] {
+            assert!((quadrant - 0.25).abs() < 0.01, "{quadrant}");
+        }
+    }
+
+    #[test]
+    fn pixel_points_after_the_first_spread_over_the_pixel() {
+        let points: Vec<DVec2> = (1..1025)
+            .map(|j| sample_point(64, 3, 2, j, 1).offset)
+            .collect();
+        let mean = points.iter().copied().sum::<DVec2>() / points.len() as f64;
+        assert!((mean - DVec2::splat(0.5)).length() < 0.01, "{mean}");
+        // Every cell of an 8 × 8 grid gets 16 ± 4 of them: the R2
+        // sequence is far more even than independent random points.
+        let mut cells = [0u32; 64];
+        for p in &points {
+            cells[(p.y * 8.0) as usize * 8 + (p.x * 8.0) as usize] += 1;
+        }
+        assert!(cells.iter().all(|&c| (12..=20).contains(&c)), "{cells:?}");
+    }
+}

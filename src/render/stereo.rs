@@ -1,0 +1,72 @@
+//! Stereo pairs: two off-axis eyes
+//! ([`Camera::eyes`](crate::scene::Camera::eyes)) rendered and laid out in
+//! one picture.
+
+use image::{Rgba, RgbaImage};
+
+use super::renderer::Renderer;
+use crate::error::Result;
+use crate::scene::{Stereo, StereoLayout};
+
+impl Renderer {
+    /// Renders both eyes of `stereo` around the current camera, each
+    /// `width` × `height`, and lays them out in one picture
+    /// ([`StereoLayout::size`]). The camera is left as it was.
+    ///
+    /// # Errors
+    /// As [`Stereo::eyes`] and [`Renderer::render`] (each eye's size is
+    /// checked as a frame's).
+    pub fn render_stereo(&mut self, width: u32, height: u32, stereo: &Stereo) -> Result<RgbaImage> {
+        let centre = *self.camera();
+        let eyes = stereo.eyes(&centre)?;
+        let mut images = Vec::with_capacity(2);
+        for eye in eyes {
+            let image = self
+                .set_camera(eye)
+                .and_then(|()| self.render(width, height));
+            let failed = image.is_err();
+            images.push(image);
+            if failed {
+                break;
+            }
+        }
+        // The centre camera was valid, so it is taken back.
+        self.set_camera(centre)?;
+        let mut images = images.into_iter();
+        let left = images.next().expect("one eye at least")?;
+        let right = images.next().expect("two eyes when the first rendered")?;
+        Ok(compose(&left, &right, stereo.layout))
+    }
+}
+
+/// Lays out two eyes' images of the same size.
+///
+/// # Panics
+/// If the images differ in size.
+#[must_use]
+pub fn compose(left: &RgbaImage, right: &RgbaImage, layout: StereoLayout) -> RgbaImage {
+    assert_eq!(left.dimensions(), right.dimensions(), "eyes of one size");
+    let (width, height) = left.dimensions();
+    let (w, h) = layout.size(width, height);
+    match layout {
+        StereoLayout::Anaglyph => RgbaImage::from_fn(w, h, |x, y| {
+            let l = left.get_pixel(x, y).0;
+            let r = right.get_pixel(x, y).0;
+            let luma = 0.299 * f64::from(l[0]) + 0.587 * f64::from(l[1]) + 0.114 * f64::from(l[2]);
+            #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss)]
+            let red = luma.round().clamp(0.0, 255.0) as u8;
+            Rgba([red, r[1], r[2], 255])
+        }),
+        StereoLayout::SideBySide | StereoLayout::OverUnder => {
+            let mut out = RgbaImage::new(w, h);
+            let (dx, dy) = if layout == StereoLayout::SideBySide {
+                (width, 0)
+            } else {
+                (0, height)
+            };
+            image::imageops::replace(&mut out, left, 0, 0);
+            image::imageops::replace(&mut out, right, i64::from(dx), i64::from(dy));
+            out
+        }
+    }
+}
