@@ -641,6 +641,8 @@ const NAMES: &[&str] = &[
     "SmoothUnion",
     "SmoothSubtract",
     "SmoothIntersect",
+    "Cut",
+    "SmoothCut",
     "Custom",
     "param",
     "param3",
@@ -1163,6 +1165,15 @@ enum NodeRepr {
         a: Child,
         b: Child,
     },
+    Cut {
+        a: Child,
+        b: Child,
+    },
+    SmoothCut {
+        k: Param,
+        a: Child,
+        b: Child,
+    },
     Custom {
         name: String,
         args: Vec<Param>,
@@ -1364,6 +1375,8 @@ impl NodeRepr {
                     (CsgOp::Union, Some(k)) => NodeRepr::SmoothUnion { k, a, b },
                     (CsgOp::Subtract, Some(k)) => NodeRepr::SmoothSubtract { k, a, b },
                     (CsgOp::Intersect, Some(k)) => NodeRepr::SmoothIntersect { k, a, b },
+                    (CsgOp::Cut, None) => NodeRepr::Cut { a, b },
+                    (CsgOp::Cut, Some(k)) => NodeRepr::SmoothCut { k, a, b },
                 }
             }
             Kind::Custom { shape, args } => NodeRepr::Custom {
@@ -1596,6 +1609,8 @@ impl Located<NodeRepr> {
             NodeRepr::SmoothIntersect { k, a, b } => {
                 csg(CsgOp::Intersect, Some(k), child(a)?, child(b)?)
             }
+            NodeRepr::Cut { a, b } => csg(CsgOp::Cut, None, child(a)?, child(b)?),
+            NodeRepr::SmoothCut { k, a, b } => csg(CsgOp::Cut, Some(k), child(a)?, child(b)?),
             NodeRepr::Custom { name, args } => {
                 let shape = shapes.iter().find(|s| s.name() == name).ok_or_else(|| {
                     let known: Vec<&str> = shapes.iter().map(CustomShape::name).collect();

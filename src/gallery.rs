@@ -38,12 +38,14 @@ pub fn all() -> Vec<(&'static str, Scene)> {
         ("fractal_mix", fractal_mix()),
         ("benchmark", benchmark()),
         ("depth_of_field", depth_of_field()),
+        ("cross_section", cross_section()),
     ]
 }
 
 /// The animated dynamic parameters of the gallery scene `name` (empty for
-/// a still scene): `fractal_mix`'s Mandelbulb breathes (its `power`), and
-/// `benchmark`'s sphere orbits the fractals (its `orbit`).
+/// a still scene): `fractal_mix`'s Mandelbulb breathes (its `power`),
+/// `benchmark`'s sphere orbits the fractals (its `orbit`), and
+/// `cross_section`'s cut sweeps through its Mandelbulb (its `cut`).
 ///
 /// ```
 /// use fractal_sdf::gallery;
@@ -61,6 +63,12 @@ pub fn motions(name: &str) -> Vec<Motion> {
             center: 8.0,
             amplitude: 2.0,
             period: 6.0,
+        }],
+        "cross_section" => vec![Motion::Oscillate {
+            name: "cut".into(),
+            center: 0.0,
+            amplitude: 0.5,
+            period: 8.0,
         }],
         "benchmark" => vec![Motion::Orbit {
             name: "orbit".into(),
@@ -189,6 +197,21 @@ pub fn depth_of_field() -> Scene {
     let in_focus = (camera.target - camera.position).length();
     Scene::new(row.union(floor(0.36)))
         .with_camera(camera.lens(0.1).focus(in_focus))
+        .with_lights(key_and_fill())
+}
+
+/// A power-8 Mandelbulb cut open by a plane facing the camera: the cut
+/// face shows the inside coloured by its orbit traps. The plane's offset
+/// is the dynamic parameter `cut` (0: through the centre), so it moves
+/// without a new program.
+#[must_use]
+pub fn cross_section() -> Scene {
+    let bulb = Node::from(Mandelbulb::new(8.0).iterations(10))
+        .rotate(DVec3::X, -FRAC_PI_2)
+        .color(dvec3(0.95, 0.7, 0.45))
+        .cut_plane(dvec3(0.0, 0.3, 1.0), param("cut", 0.0));
+    Scene::new(bulb.union(floor(1.15)))
+        .with_camera(Camera::look_at(dvec3(2.5, 1.7, 2.9), dvec3(0.0, -0.2, 0.0)).fov(40.0))
         .with_lights(key_and_fill())
 }
 

@@ -108,7 +108,11 @@ impl Study {
             let row = Row {
                 scene: name.to_string(),
                 group: "progressive",
-                label: format!("{passes} passes"),
+                label: if passes == 1 {
+                    "1 pass".into()
+                } else {
+                    format!("{passes} passes")
+                },
                 timing: Timing {
                     median_ms: ms,
                     runs: 1,

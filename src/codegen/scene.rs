@@ -1027,7 +1027,7 @@ impl<'a> SceneEmitter<'a> {
         let (x, y) = match op {
             CsgOp::Union => (a.d.clone(), b.d.clone()),
             CsgOp::Subtract => (format!("-{}", a.d), b.d.clone()),
-            CsgOp::Intersect => (format!("-{}", a.d), format!("-{}", b.d)),
+            CsgOp::Intersect | CsgOp::Cut => (format!("-{}", a.d), format!("-{}", b.d)),
         };
         let sign = if op == CsgOp::Union { "" } else { "-" };
         let v = vars(id);
@@ -1050,6 +1050,14 @@ impl<'a> SceneEmitter<'a> {
         };
         if !self.shade {
             return v;
+        }
+        if op == CsgOp::Cut {
+            // A cut shows its first operand's colour and trap everywhere.
+            return Vars {
+                d: v.d,
+                c: a.c.clone(),
+                t: a.t.clone(),
+            };
         }
         let near = format!("x{i} < y{i}");
         let c = if needs_color {

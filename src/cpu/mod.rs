@@ -152,7 +152,7 @@ impl Evaluator {
         let threshold = match op {
             CsgOp::Union => a + k,
             CsgOp::Subtract => -a + k,
-            CsgOp::Intersect => return false,
+            CsgOp::Intersect | CsgOp::Cut => return false,
         };
         let g = match self.reaches.get(&b.index()) {
             Some(reach) => reach
@@ -489,13 +489,20 @@ fn bound_distance<T: Real>(bound: &Bound, p: V3<T>) -> T {
 
 /// Hard or smooth CSG of two samples. Every operation is a (smooth) minimum
 /// of signed operands: union `min(a, b)`, subtraction `-min(-a, b)`,
-/// intersection `-min(-a, -b)`.
+/// intersection and cut `-min(-a, -b)`. A cut keeps `a`'s colour and trap.
 fn combine<T: Real>(op: CsgOp, k: T, a: Sample<T>, b: Sample<T>) -> Sample<T> {
     let (sa, sb) = match op {
         CsgOp::Union => (T::one(), T::one()),
         CsgOp::Subtract => (-T::one(), T::one()),
-        CsgOp::Intersect => (-T::one(), -T::one()),
+        CsgOp::Intersect | CsgOp::Cut => (-T::one(), -T::one()),
     };
+    if op == CsgOp::Cut {
+        let (x, y) = (sa * a.distance, sb * b.distance);
+        return Sample {
+            distance: -sdf::smooth_min(x, y, k).0,
+            ..a
+        };
+    }
     let (x, y) = (sa * a.distance, sb * b.distance);
     let (m, blend) = sdf::smooth_min(x, y, k);
     let (near, far) = if x < y { (a, b) } else { (b, a) };

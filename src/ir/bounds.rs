@@ -298,7 +298,7 @@ fn bound(node: &IrNode, done: &[Option<Bound>]) -> Option<Bound> {
                 // Both are at least the first operand's estimate (the smooth
                 // forms too: `−smooth_min(−a, b) >= −min(−a, b)`).
                 CsgOp::Subtract => of(a)?,
-                CsgOp::Intersect => match (of(a), of(b)) {
+                CsgOp::Intersect | CsgOp::Cut => match (of(a), of(b)) {
                     (Some(x), Some(y)) => {
                         if x.radius <= y.radius {
                             x

@@ -422,6 +422,40 @@ impl Node {
         self.csg(CsgOp::Intersect, None, other)
     }
 
+    /// `self` cut by `cutter`: only what is in both, like
+    /// [`Node::intersect`], but the face the cutter makes shows `self`'s
+    /// colour and orbit trap at that point, so a fractal cut open shows its
+    /// inside coloured by how its orbits behave there. The cutter is any
+    /// shape: a half-space for a cross-section ([`Node::cut_plane`]), a box
+    /// for a cut-away corner. Its parameters can be dynamic, so a cut moves
+    /// through a scene without a new program.
+    ///
+    /// ```
+    /// use fractal_sdf::prelude::*;
+    /// // A sphere cut open along x = 0: only its x < 0 half is left.
+    /// let half = sphere(1.0).color(dvec3(1.0, 0.2, 0.1)).cut_plane(dvec3(1.0, 0.0, 0.0), 0.0);
+    /// let eval = fractal_sdf::cpu::Evaluator::new(&half)?;
+    /// assert!(eval.distance(dvec3(-0.5, 0.0, 0.0)) < 0.0);
+    /// assert!(eval.distance(dvec3(0.5, 0.0, 0.0)) > 0.0);
+    /// // The cut face keeps the sphere's colour.
+    /// let face = eval.sample::<f64>(dvec3(0.0, 0.3, 0.0).into());
+    /// assert_eq!(DVec3::from(face.color), dvec3(1.0, 0.2, 0.1));
+    /// # Ok::<(), fractal_sdf::Error>(())
+    /// ```
+    #[must_use]
+    pub fn cut(self, cutter: impl Into<Node>) -> Node {
+        self.csg(CsgOp::Cut, None, cutter)
+    }
+
+    /// `self` cut by the plane `dot(p, normal) + offset = 0`: the side the
+    /// normal points to is removed ([`Node::cut`] with a [`plane`]). Give
+    /// `normal` and `offset` as dynamic parameters to move the cut
+    /// without a new program.
+    #[must_use]
+    pub fn cut_plane(self, normal: impl Into<Param3>, offset: impl Into<Param>) -> Node {
+        self.cut(plane(normal, offset))
+    }
+
     /// Union with a smooth blend of radius `k` (`k = 0` is the hard union).
     #[must_use]
     pub fn smooth_union(self, other: impl Into<Node>, k: impl Into<Param>) -> Node {

@@ -48,6 +48,10 @@ pub enum CsgOp {
     Subtract,
     /// Only what is in both: `max(a, b)`.
     Intersect,
+    /// `a` cut by `b`: only what is in both, as [`CsgOp::Intersect`], but
+    /// showing `a`'s colour and orbit trap everywhere, the face `b` cuts
+    /// included: a cross-section (see [`Node::cut`]).
+    Cut,
 }
 
 /// The Mandelbulb: the escape-time fractal of the "triplex" power map
@@ -499,6 +503,8 @@ impl<S, V, C> Kind<S, V, C> {
                 (CsgOp::Union, true) => "smooth_union",
                 (CsgOp::Subtract, true) => "smooth_subtract",
                 (CsgOp::Intersect, true) => "smooth_intersect",
+                (CsgOp::Cut, false) => "cut",
+                (CsgOp::Cut, true) => "smooth_cut",
             },
             Kind::Custom { .. } => "custom",
             Kind::Color { .. } => "color",

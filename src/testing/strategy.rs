@@ -9,9 +9,9 @@ use proptest::prelude::*;
 
 use crate::cpu::Ray;
 use crate::scene::{
-    Axis, MAX_ESCAPE_ITERATIONS, MAX_FOLD_ITERATIONS, Mandelbulb, Menger, Node, Param, Param3,
-    QuaternionJulia, Sierpinski, capped_cone, capsule, cuboid, cylinder, ellipsoid, octahedron,
-    param, plane, round_box, sphere, torus,
+    Axis, CsgOp, Kind, MAX_ESCAPE_ITERATIONS, MAX_FOLD_ITERATIONS, Mandelbulb, Menger, Node, Param,
+    Param3, QuaternionJulia, Sierpinski, capped_cone, capsule, cuboid, cylinder, ellipsoid,
+    octahedron, param, plane, round_box, sphere, torus,
 };
 
 /// The largest size (radius, half extent, height) the primitive strategies
@@ -291,16 +291,23 @@ fn color() -> impl Strategy<Value = DVec3> + Clone {
     vector(0.0..=1.0f64)
 }
 
-/// A boolean of two nodes: one of the three operations, hard or smooth
+/// A boolean of two nodes: one of the four operations, hard or smooth
 /// with `k` in `[0, 1]` (sometimes exactly 0).
 fn csg(a: Node, b: Node, op: u8, smoothing: Option<f64>) -> Node {
-    match (op % 3, smoothing) {
+    match (op % 4, smoothing) {
         (0, None) => a.union(b),
         (1, None) => a.subtract(b),
-        (_, None) => a.intersect(b),
+        (2, None) => a.intersect(b),
+        (_, None) => a.cut(b),
         (0, Some(k)) => a.smooth_union(b, k),
         (1, Some(k)) => a.smooth_subtract(b, k),
-        (_, Some(k)) => a.smooth_intersect(b, k),
+        (2, Some(k)) => a.smooth_intersect(b, k),
+        (_, Some(k)) => Node::from(Kind::Csg {
+            op: CsgOp::Cut,
+            smoothing: Some(k.into()),
+            a,
+            b,
+        }),
     }
 }
 
