@@ -102,6 +102,79 @@ fn render_writes_the_image_of_a_scene_file() {
 }
 
 #[test]
+fn render_takes_passes_a_lens_and_stereo() {
+    if gpu::device().is_none() {
+        return;
+    }
+    let dir = scratch("optics");
+    let render = |name: &str, extra: &[&str]| {
+        let png = dir.join(name);
+        let mut args = vec!["render", "csg", "-o", png.to_str().unwrap()];
+        args.extend(["--size", "40x30", "--preset", "preview"]);
+        args.extend(extra);
+        let out = run(&dir, "", &args);
+        assert!(out.status.success(), "{extra:?}: {}", text(&out));
+        png
+    };
+    let plain = render("plain.png", &[]);
+    let passes = render("passes.png", &["--passes", "4"]);
+    let lens = render(
+        "lens.png",
+        &["--aperture", "0.2", "--focus", "1", "--passes", "2"],
+    );
+    let bytes = |p: &Path| std::fs::read(p).unwrap();
+    assert_ne!(
+        bytes(&plain),
+        bytes(&passes),
+        "four passes smooth the edges"
+    );
+    assert_ne!(bytes(&passes), bytes(&lens), "a lens blurs");
+    verify_png(&lens, (40, 30)).unwrap();
+    let pair = render(
+        "pair.png",
+        &["--stereo", "side-by-side", "--eye-separation", "0.2"],
+    );
+    verify_png(&pair, (80, 30)).unwrap();
+    let over = render(
+        "over.png",
+        &["--stereo", "over-under", "--convergence", "3"],
+    );
+    verify_png(&over, (40, 60)).unwrap();
+    let anaglyph = render("anaglyph.png", &["--stereo", "anaglyph"]);
+    verify_png(&anaglyph, (40, 30)).unwrap();
+    // Bad values: a clear error and no image.
+    let o = dir.join("x.png");
+    let o = o.to_str().unwrap();
+    let cases: [(&[&str], i32, &str); 4] = [
+        (
+            &["--stereo", "crossed"],
+            2,
+            "--stereo `crossed`: expected one of anaglyph",
+        ),
+        (
+            &["--aperture=-1"],
+            1,
+            "aperture must be finite and >= 0, got -1",
+        ),
+        (&["--passes", "0"], 2, "--passes"),
+        (
+            &["--stereo", "anaglyph", "--eye-separation=-1"],
+            1,
+            "eye separation",
+        ),
+    ];
+    for (extra, code, says) in cases {
+        let mut args = vec!["render", "csg", "-o", o, "--size", "8x8"];
+        args.extend(extra);
+        let out = run(&dir, "", &args);
+        assert_eq!(out.status.code(), Some(code), "{extra:?}: {}", text(&out));
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert!(stderr.contains(says), "{extra:?}: {stderr}");
+    }
+    assert!(!Path::new(o).exists());
+}
+
+#[test]
 fn sequence_shards_resume_and_verify() {
     if gpu::device().is_none() {
         return;

@@ -45,7 +45,16 @@ pub fn render_to_png(
     let mut renderer = Renderer::with_options(scene, options)?;
     let build = renderer.build_info().clone();
     let t = Instant::now();
-    let image = renderer.render(size.0, size.1)?;
+    // A lens's blur needs more samples than edges do: four passes.
+    let image = if scene.camera.aperture > 0.0 {
+        let mut image = renderer.render_progressive(size.0, size.1)?;
+        for _ in 1..4 {
+            image = renderer.render_progressive(size.0, size.1)?;
+        }
+        image
+    } else {
+        renderer.render(size.0, size.1)?
+    };
     let render_time = t.elapsed();
     let path = format!("out/{name}.png");
     fractal_sdf::output::save_png(&image, &path)?;

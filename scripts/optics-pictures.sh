@@ -1,0 +1,31 @@
+#!/usr/bin/env bash
+# Renders the README's pictures of the camera's optics and of cuts with
+# `fractal-sdf render`:
+#
+#   docs/depth-of-field.png       the depth_of_field scene, 32 progressive passes
+#   docs/progressive-1.png        the same at 320x200 after 1 pass,
+#   docs/progressive-64.png       and after 64
+#   docs/stereo-anaglyph.png      the Mandelbulb as a red-cyan anaglyph
+#   docs/stereo-side-by-side.png  the Menger sponge as a side-by-side pair
+#   docs/cross-section-N.png      the cross_section scene with its cut at
+#                                 -0.35, 0 and 0.3
+#
+#   scripts/optics-pictures.sh
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+cargo build --release --features cli --bin fractal-sdf
+bin=target/release/fractal-sdf
+mkdir -p docs
+render() { "$bin" render --preset production "$@"; }
+
+render depth_of_field --size 640x400 --passes 32 -o docs/depth-of-field.png
+render depth_of_field --size 320x200 -o docs/progressive-1.png
+render depth_of_field --size 320x200 --passes 64 -o docs/progressive-64.png
+render mandelbulb --size 480x360 --stereo anaglyph -o docs/stereo-anaglyph.png
+render menger --size 320x240 --stereo side-by-side -o docs/stereo-side-by-side.png
+n=0
+for cut in -0.35 0 0.3; do
+    n=$((n + 1))
+    render cross_section --size 320x240 --set "cut=$cut" -o "docs/cross-section-$n.png"
+done
