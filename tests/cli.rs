@@ -142,10 +142,13 @@ fn render_takes_passes_a_lens_and_stereo() {
     verify_png(&over, (40, 60)).unwrap();
     let anaglyph = render("anaglyph.png", &["--stereo", "anaglyph"]);
     verify_png(&anaglyph, (40, 30)).unwrap();
+    let adaptive = render("adaptive.png", &["--adaptive", "4"]);
+    assert_ne!(bytes(&plain), bytes(&adaptive), "edges refined");
+    assert_ne!(bytes(&passes), bytes(&adaptive), "the rest left alone");
     // Bad values: a clear error and no image.
     let o = dir.join("x.png");
     let o = o.to_str().unwrap();
-    let cases: [(&[&str], i32, &str); 4] = [
+    let cases: [(&[&str], i32, &str); 5] = [
         (
             &["--stereo", "crossed"],
             2,
@@ -157,6 +160,11 @@ fn render_takes_passes_a_lens_and_stereo() {
             "aperture must be finite and >= 0, got -1",
         ),
         (&["--passes", "0"], 2, "--passes"),
+        (
+            &["--adaptive", "4", "--passes", "2"],
+            2,
+            "cannot be used with",
+        ),
         (
             &["--stereo", "anaglyph", "--eye-separation=-1"],
             1,

@@ -7,7 +7,7 @@ mod gpu;
 
 use fractal_sdf::cpu::{self, Evaluator};
 use fractal_sdf::prelude::*;
-use fractal_sdf::render::{Renderer, Viewport, compose, sample_point};
+use fractal_sdf::render::{EdgeThresholds, Renderer, Viewport, compose, sample_point};
 use fractal_sdf::scene::{Stereo, StereoLayout};
 use image::RgbaImage;
 
@@ -398,4 +398,74 @@ fn bad_optics_are_refused_clearly() {
     // A scene whose camera has a bad lens does not compile.
     let scene = Scene::new(sphere(1.0)).with_camera(camera.lens(-1.0));
     assert!(matches!(scene.compile(), Err(Error::Camera { .. })));
+}
+
+#[test]
+fn adaptive_supersampling_refines_the_edges_as_uniform_passes_do() {
+    let Some(_) = gpu::device() else { return };
+    let scene = gpu::sphere_box_floor().with_lights([gpu::sun(0.05)]);
+    let (w, h) = (128, 96);
+    let quality = gpu::quick();
+    let mut r = Renderer::new(&scene, quality).unwrap();
+    let frame = r
+        .render_adaptive(w, h, 8, &EdgeThresholds::default())
+        .unwrap();
+    gpu::save("adaptive", &frame.image);
+    let mask = RgbaImage::from_fn(w, h, |x, y| {
+        let on = frame.refined[(y * w + x) as usize];
+        image::Rgba(if on { [255, 0, 0, 255] } else { [0, 0, 0, 255] })
+    });
+    gpu::save("adaptive_mask", &mask);
+    let uniform = {
+        let mut u = Renderer::new(&scene, quality).unwrap();
+        let mut image = u.render_progressive(w, h).unwrap();
+        while u.progressive_passes() < 8 {
+            image = u.render_progressive(w, h).unwrap();
+        }
+        image
+    };
+    let plain = Renderer::new(&scene, quality)
+        .unwrap()
+        .render(w, h)
+        .unwrap();
+    assert_eq!(
+        frame.first.image, plain,
+        "the first pass is the plain frame"
+    );
+    // A refined pixel is the uniform passes' pixel, byte for byte; the
+    // rest keep their first sample.
+    for (i, &refined) in frame.refined.iter().enumerate() {
+        let (x, y) = (i as u32 % w, i as u32 / w);
+        let expected = if refined { &uniform } else { &plain };
+        assert_eq!(
+            frame.image.get_pixel(x, y),
+            expected.get_pixel(x, y),
+            "({x}, {y})"
+        );
+    }
+    // The silhouettes are refined and the open floor is not: a few
+    // pixels in ten.
+    let share = frame.refined_fraction();
+    eprintln!("{:.1}% of the pixels refined", 100.0 * share);
+    assert!(share > 0.05 && share < 0.4, "{share}");
+    let view = r.viewport(w, h).unwrap();
+    let (ox, oy) = gpu::project(&view, dvec3(0.0, 0.0, 1.0));
+    assert!(!frame.refined[(oy * w + ox) as usize], "the open floor");
+    for i in 0..frame.refined.len() - 1 {
+        if frame.first.hit[i] != frame.first.hit[i + 1] && (i + 1) % w as usize != 0 {
+            assert!(
+                frame.refined[i] && frame.refined[i + 1],
+                "a silhouette at {i}"
+            );
+        }
+    }
+    // Closer to 8 uniform passes than the plain frame is, for a fraction
+    // of the cost.
+    assert!(psnr(&frame.image, &uniform) > psnr(&plain, &uniform) + 6.0);
+    assert!(frame.mean_evaluations() < 0.6 * 8.0 * frame.first.mean_evaluations());
+    // Bad pass counts are refused.
+    let err = r
+        .render_adaptive(w, h, 0, &EdgeThresholds::default())
+        .unwrap_err();
+    assert!(err.to_string().contains("adaptive passes"), "{err}");
 }

@@ -10,8 +10,8 @@
 //! ε/10`: a tenth of its `hit_epsilon`). A sweep of `detail`, which
 //! changes the surface drawn rather than the accuracy, shows how much the
 //! look depends on it. Anti-aliasing is measured apart, at half the size,
-//! against a 4×4-sample render, and so are progressive passes, against an
-//! 8×8-sample render. A table says whether each preset is on the
+//! against a 4×4-sample render, and so are progressive passes, everywhere
+//! and at the edges alone (adaptive), against an 8×8-sample render. A table says whether each preset is on the
 //! measured front (no configuration both faster, by more than 10%, and
 //! more accurate, by more than 0.5 dB). Prints
 //! markdown tables, writes
@@ -33,7 +33,7 @@ use std::fmt::Write as _;
 
 use common::measure::{self, Errors, Runs, Timing, compare};
 use fractal_sdf::prelude::*;
-use fractal_sdf::render::{Frame, RenderOptions, Renderer};
+use fractal_sdf::render::{EdgeThresholds, Frame, RenderOptions, Renderer};
 
 /// The fractal scenes of the gallery.
 const SCENES: [&str; 4] = ["mandelbulb", "menger", "julia", "sierpinski"];
@@ -119,6 +119,38 @@ impl Study {
                 },
                 speedup: rows.first().map_or(1.0, |one| one.timing.median_ms / ms),
                 evaluations: centre.mean_evaluations() * f64::from(passes),
+                errors: compare(&frame, &best),
+                size: self.size,
+            };
+            eprintln!(
+                "  {:<20} {:>9.1} ms  {:>6.1} evals/px  {:>6.2} dB",
+                row.label, ms, row.evaluations, row.errors.psnr
+            );
+            rows.push(row);
+            if passes == 1 {
+                continue;
+            }
+            // The same passes at the edges alone.
+            let start = std::time::Instant::now();
+            let adaptive = renderer.render_adaptive(w, h, passes, &EdgeThresholds::default())?;
+            let ms = start.elapsed().as_secs_f64() * 1e3;
+            let frame = Frame {
+                image: adaptive.image.clone(),
+                ..centre.clone()
+            };
+            let row = Row {
+                scene: name.to_string(),
+                group: "progressive",
+                label: format!(
+                    "adaptive, {passes} at {:.0}%",
+                    100.0 * adaptive.refined_fraction()
+                ),
+                timing: Timing {
+                    median_ms: ms,
+                    runs: 1,
+                },
+                speedup: rows[0].timing.median_ms / ms,
+                evaluations: adaptive.mean_evaluations(),
                 errors: compare(&frame, &best),
                 size: self.size,
             };
@@ -518,7 +550,7 @@ fn main() -> std::process::ExitCode {
             );
             println!("{}", table(&rows, &["aa"]));
             println!(
-                "Progressive passes at {}x{} (production, one sample per pass; speed-up: against one pass; error: against production with 8x8 samples):\n",
+                "Progressive and adaptive passes at {}x{} (production, one sample per pass; adaptive: N passes at the refined share of the pixels, one elsewhere; speed-up: against one pass; error: against production with 8x8 samples):\n",
                 size.0 / 2,
                 size.1 / 2
             );

@@ -135,13 +135,17 @@ pub enum RenderArg {
     Starts,
     Pass,
     Accumulation,
+    RefineOnly,
+    Refine,
 }
 
 /// `render_tile`'s declarations, in argument order: the one list of its
 /// arguments. `pass` is -1 for a frame of its own; from 0 up it is the
 /// index of a progressive pass, which adds its samples to `accumulation`
 /// (linear colour sums, reset by pass 0) and writes their mean to `rgba`.
-pub const RENDER_TILE: [(RenderArg, &str); 20] = [
+/// With `refine_only` set, only the pixels `refine` marks are rendered
+/// (adaptive supersampling's further passes).
+pub const RENDER_TILE: [(RenderArg, &str); 22] = [
     (RenderArg::Params, "__global const real* params"),
     (RenderArg::Camera, "__global const real* camera"),
     (RenderArg::Lights, "__global const real* lights"),
@@ -162,6 +166,8 @@ pub const RENDER_TILE: [(RenderArg, &str); 20] = [
     (RenderArg::Starts, "__global const float* starts"),
     (RenderArg::Pass, "const int pass"),
     (RenderArg::Accumulation, "__global float4* accumulation"),
+    (RenderArg::RefineOnly, "const int refine_only"),
+    (RenderArg::Refine, "__global const uchar* refine"),
 ];
 
 /// The arguments of the coarse pass `cone_starts` (see

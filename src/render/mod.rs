@@ -52,6 +52,7 @@
 //! in `[0, 1]` (1 for non-fractal surfaces). Camera, lights and the light
 //! count are kernel arguments, so none of them is in the source.
 
+mod adaptive;
 mod aov;
 mod buffer;
 mod cache;
@@ -67,6 +68,7 @@ mod stereo;
 mod upscale;
 mod viewport;
 
+pub use adaptive::{AdaptiveFrame, EdgeThresholds, edges};
 pub use aov::Frame;
 pub use cancel::CancelToken;
 pub use device::{DEVICE_ENV, DeviceInfo, DeviceKind, DeviceSelector, devices};

@@ -8,6 +8,7 @@ use image::RgbaImage;
 use ocl::enums::ProfilingInfo;
 use ocl::{Buffer, Context, Event, Kernel, MemFlags, Program, Queue};
 
+use super::adaptive::{self, AdaptiveFrame, EdgeThresholds};
 use super::aov::Frame;
 use super::buffer::RealBuffer;
 use super::cancel::CancelToken;
@@ -124,6 +125,9 @@ pub struct Renderer {
     /// The progressive passes accumulated so far, and the image size they
     /// are for; `None` once anything that changes the image has changed.
     progress: Option<Progress>,
+    /// Whether launches render only the pixels of the refine buffer
+    /// (the kernel's `refine_only`).
+    refine_only: bool,
 }
 
 /// Progressive rendering's state: the passes in the accumulation buffers.
@@ -264,6 +268,7 @@ impl Renderer {
             share: (0, 1),
             pass: -1,
             progress: None,
+            refine_only: false,
         })
     }
 
@@ -503,6 +508,89 @@ impl Renderer {
     /// The most samples per pixel progressive rendering takes: past it the
     /// sums, kept in `f32`, would round away what a further sample adds.
     pub const MAX_PROGRESSIVE_SAMPLES: u32 = 4096;
+
+    /// Renders a `width` × `height` image with adaptive supersampling: a
+    /// first pass with its outputs everywhere, then `passes - 1` further
+    /// progressive passes only at the pixels that differ from a neighbour
+    /// by more than `thresholds` ([`adaptive::edges`]: a silhouette, a
+    /// crease, a depth step, a colour edge such as a shadow's). A refined
+    /// pixel is the mean of every pass's samples, exactly the pixel
+    /// [`Renderer::render_progressive`] gives after as many passes; the
+    /// rest keep their first sample. It renders on the first device alone,
+    /// as [`Renderer::render_with_aovs`] does, and starts the progressive
+    /// passes again.
+    ///
+    /// ```no_run
+    /// use fractal_sdf::prelude::*;
+    /// use fractal_sdf::render::{EdgeThresholds, Renderer};
+    ///
+    /// let mut renderer = Renderer::new(&fractal_sdf::gallery::csg(), Quality::production())?;
+    /// let frame = renderer.render_adaptive(640, 480, 16, &EdgeThresholds::default())?;
+    /// println!("{:.0}% of the pixels refined", 100.0 * frame.refined_fraction());
+    /// # Ok::<(), fractal_sdf::Error>(())
+    /// ```
+    ///
+    /// # Errors
+    /// [`Error::Quality`] for `passes` of 0 or past
+    /// [`Renderer::MAX_PROGRESSIVE_SAMPLES`] samples per pixel; else as
+    /// [`Renderer::render`].
+    pub fn render_adaptive(
+        &mut self,
+        width: u32,
+        height: u32,
+        passes: u32,
+        thresholds: &EdgeThresholds,
+    ) -> Result<AdaptiveFrame> {
+        let per_pass = self.options.quality.supersampling.max(1).pow(2);
+        let most = (Self::MAX_PROGRESSIVE_SAMPLES / per_pass).max(1);
+        if passes == 0 || passes > most {
+            return Err(Error::Quality {
+                setting: "adaptive passes",
+                value: f64::from(passes),
+                expected: format!("in 1..={most} at this supersampling"),
+            });
+        }
+        self.progress = None;
+        let frame = self.refine_adaptively(width, height, passes, thresholds);
+        self.pass = -1;
+        self.refine_only = false;
+        frame
+    }
+
+    fn refine_adaptively(
+        &mut self,
+        width: u32,
+        height: u32,
+        passes: u32,
+        thresholds: &EdgeThresholds,
+    ) -> Result<AdaptiveFrame> {
+        self.pass = 0;
+        let first = self.render_with_aovs(width, height)?;
+        let marked = adaptive::edges(&first, thresholds);
+        // The rendered pixels: one for every `scale` × `scale` of the
+        // image, refined if any of them is marked.
+        let scale = self.scale();
+        let (lw, lh) = self.rendered_size(width, height);
+        let mut refined = vec![false; lw as usize * lh as usize];
+        for (i, _) in marked.iter().enumerate().filter(|(_, m)| **m) {
+            let (x, y) = (i as u32 % width / scale, i as u32 / width / scale);
+            refined[(y * lw + x) as usize] = true;
+        }
+        let bytes: Vec<u8> = refined.iter().map(|&r| u8::from(r)).collect();
+        self.targets.refine.write(&bytes).enq().map_err(opencl)?;
+        self.refine_only = true;
+        let mut image = first.image.clone();
+        for pass in 1..passes {
+            self.pass = i32::try_from(pass).expect("passes are at most 4096");
+            image = self.render_low(width, height)?.scaled(width, height, scale);
+        }
+        Ok(AdaptiveFrame {
+            image,
+            first,
+            refined,
+            passes,
+        })
+    }
 
     /// Sets the kernel's `pass` here and on the partners.
     fn set_pass(&mut self, pass: i32) {
@@ -926,6 +1014,7 @@ impl Renderer {
         }
         set(RenderArg::WriteAovs, i32::from(aovs))?;
         set(RenderArg::Pass, self.pass)?;
+        set(RenderArg::RefineOnly, i32::from(self.refine_only))?;
         t.bind(k)?;
         let launched = Instant::now();
         let mut events: Vec<Event> = Vec::new();
@@ -1204,6 +1293,9 @@ fn make_kernel(program: &Program, queue: &Queue, inputs: &Inputs, t: &Targets) -
             RenderArg::Pass => {
                 b.arg(-1i32);
             }
+            RenderArg::Refine => {
+                b.arg(&t.refine);
+            }
             RenderArg::LightCount
             | RenderArg::Width
             | RenderArg::Height
@@ -1211,7 +1303,8 @@ fn make_kernel(program: &Program, queue: &Queue, inputs: &Inputs, t: &Targets) -
             | RenderArg::Y0
             | RenderArg::TileWidth
             | RenderArg::TileHeight
-            | RenderArg::WriteAovs => {
+            | RenderArg::WriteAovs
+            | RenderArg::RefineOnly => {
                 b.arg(0i32);
             }
         }
@@ -1312,6 +1405,8 @@ struct Targets {
     /// Progressive rendering's sums of linear colours, an RGB and a spare
     /// `f32` per pixel.
     accumulation: Buffer<f32>,
+    /// The pixels adaptive supersampling refines, a byte per pixel.
+    refine: Buffer<u8>,
 }
 
 impl Targets {
@@ -1342,6 +1437,12 @@ impl Targets {
                 .len(summed_pixels * 4)
                 .build()
                 .map_err(opencl)?,
+            refine: Buffer::builder()
+                .queue(queue.clone())
+                .flags(MemFlags::new().read_only())
+                .len(summed_pixels)
+                .build()
+                .map_err(opencl)?,
         })
     }
 
@@ -1360,6 +1461,7 @@ impl Targets {
             aov * 4,
             starts,
             summed * 16,
+            summed,
         ]
     }
 
@@ -1380,6 +1482,8 @@ impl Targets {
         k.set_arg(RenderArg::Starts.index(), &self.starts)
             .map_err(opencl)?;
         k.set_arg(RenderArg::Accumulation.index(), &self.accumulation)
+            .map_err(opencl)?;
+        k.set_arg(RenderArg::Refine.index(), &self.refine)
             .map_err(opencl)
     }
 

@@ -46,7 +46,9 @@ typedef float4 real4;
     __global uint* evaluations, \
     __global const float* starts, \
     const int pass, \
-    __global float4* accumulation
+    __global float4* accumulation, \
+    const int refine_only, \
+    __global const uchar* refine
 #define CONE_STARTS_ARGS \
     __global const real* params, \
     __global const real* camera, \

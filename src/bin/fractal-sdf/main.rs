@@ -15,7 +15,9 @@ use fractal_sdf::codegen::{self, Options};
 use fractal_sdf::gallery;
 use fractal_sdf::output::{save_png, verify_png};
 use fractal_sdf::prelude::*;
-use fractal_sdf::render::{DeviceKind, DeviceSelector, RenderOptions, Renderer, devices};
+use fractal_sdf::render::{
+    DeviceKind, DeviceSelector, EdgeThresholds, RenderOptions, Renderer, devices,
+};
 use fractal_sdf::scene::{Stereo, StereoLayout};
 use fractal_sdf::sequence::{Encoded, Sequence, parse_range};
 use fractal_sdf::settings::{CONFIG_ENV, Settings, parse_preset, parse_size};
@@ -106,6 +108,11 @@ struct RenderArgs {
     #[arg(long, default_value_t = 1, value_name = "N",
           value_parser = clap::value_parser!(u32).range(1..=4096))]
     passes: u32,
+    /// Adaptive supersampling: N passes at the pixels that differ from a
+    /// neighbour (edges, creases, shadow borders), one elsewhere.
+    #[arg(long, value_name = "N", conflicts_with_all = ["passes", "stereo"],
+          value_parser = clap::value_parser!(u32).range(1..=4096))]
+    adaptive: Option<u32>,
     /// The lens's radius in scene units, for depth of field (0: a pinhole).
     #[arg(long, value_name = "RADIUS")]
     aperture: Option<f64>,
@@ -380,13 +387,26 @@ fn render(args: &RenderArgs, settings: &Settings) -> Outcome {
     let start = Instant::now();
     let bar = spinner(format!("rendering {width}x{height}"));
     let mut renderer = job.renderer()?;
-    let image = match stereo {
-        Some(stereo) => renderer.render_stereo(width, height, &stereo),
-        None if args.passes > 1 => progressive(&mut renderer, width, height, args.passes),
-        None => renderer.render(width, height),
+    let mut refined = None;
+    let image = match (stereo, args.adaptive) {
+        (Some(stereo), _) => renderer.render_stereo(width, height, &stereo),
+        (None, Some(passes)) => renderer
+            .render_adaptive(width, height, passes, &EdgeThresholds::default())
+            .map(|frame| {
+                refined = Some(format!(
+                    "{:.1}% of the pixels refined by {passes} passes",
+                    100.0 * frame.refined_fraction()
+                ));
+                frame.image
+            }),
+        (None, None) if args.passes > 1 => progressive(&mut renderer, width, height, args.passes),
+        (None, None) => renderer.render(width, height),
     };
     bar.finish_and_clear();
     save_png(&image?, &args.output)?;
+    if let Some(refined) = refined {
+        println!("{refined}");
+    }
     println!(
         "{}: {width}x{height}, {} quality, {:.2} s on {}",
         args.output.display(),

@@ -533,7 +533,8 @@ void march_sample_point(uint pixel, uint j, int s, real* jx, real* jy, real2* le
 // k N^2 to (k + 1) N^2 - 1), adds their linear colours to the pixel's sum
 // in accumulation (pass 0 starts it) and writes the mean of every sample
 // so far: pass 0 is the frame of its own, and later passes converge on
-// the mean of ever more samples.
+// the mean of ever more samples. With refine_only, only the pixels refine
+// marks take the pass: adaptive supersampling refines edges alone.
 //
 // AOVs describe the ray through the pixel centre and the lens's centre:
 // depth (distance along the ray, +INFINITY on a miss), hit (0/1),
@@ -549,6 +550,9 @@ __kernel void render_tile(RENDER_TILE_ARGS) {
     int x = x0 + lx;
     int y = y0 + ly;
     if (lx >= tile_w || ly >= tile_h || x >= width || y >= height) {
+        return;
+    }
+    if (refine_only && !refine[y * width + x]) {
         return;
     }
     MarchCamera cam = march_load_camera(camera);
