@@ -93,6 +93,32 @@ impl Study {
         let mut renderer = self.renderer(scene, Quality::production())?;
         let centre = renderer.render_with_aovs(w, h)?;
         let mut rows: Vec<Row> = Vec::new();
+        let mut add = |label: String, ms: f64, evaluations: f64, image: RgbaImage| {
+            let row = Row {
+                scene: name.to_string(),
+                group: "progressive",
+                label,
+                timing: Timing {
+                    median_ms: ms,
+                    runs: 1,
+                },
+                speedup: rows.first().map_or(1.0, |one| one.timing.median_ms / ms),
+                evaluations,
+                errors: compare(
+                    &Frame {
+                        image,
+                        ..centre.clone()
+                    },
+                    &best,
+                ),
+                size: self.size,
+            };
+            eprintln!(
+                "  {:<20} {:>9.1} ms  {:>6.1} evals/px  {:>6.2} dB",
+                row.label, ms, row.evaluations, row.errors.psnr
+            );
+            rows.push(row);
+        };
         for passes in [1u32, 4, 16, 64] {
             renderer.restart_progressive();
             let start = std::time::Instant::now();
@@ -101,32 +127,17 @@ impl Study {
                 image = renderer.render_progressive(w, h)?;
             }
             let ms = start.elapsed().as_secs_f64() * 1e3;
-            let frame = Frame {
+            let label = if passes == 1 {
+                "1 pass".into()
+            } else {
+                format!("{passes} passes")
+            };
+            add(
+                label,
+                ms,
+                centre.mean_evaluations() * f64::from(passes),
                 image,
-                ..centre.clone()
-            };
-            let row = Row {
-                scene: name.to_string(),
-                group: "progressive",
-                label: if passes == 1 {
-                    "1 pass".into()
-                } else {
-                    format!("{passes} passes")
-                },
-                timing: Timing {
-                    median_ms: ms,
-                    runs: 1,
-                },
-                speedup: rows.first().map_or(1.0, |one| one.timing.median_ms / ms),
-                evaluations: centre.mean_evaluations() * f64::from(passes),
-                errors: compare(&frame, &best),
-                size: self.size,
-            };
-            eprintln!(
-                "  {:<20} {:>9.1} ms  {:>6.1} evals/px  {:>6.2} dB",
-                row.label, ms, row.evaluations, row.errors.psnr
             );
-            rows.push(row);
             if passes == 1 {
                 continue;
             }
@@ -134,31 +145,11 @@ impl Study {
             let start = std::time::Instant::now();
             let adaptive = renderer.render_adaptive(w, h, passes, &EdgeThresholds::default())?;
             let ms = start.elapsed().as_secs_f64() * 1e3;
-            let frame = Frame {
-                image: adaptive.image.clone(),
-                ..centre.clone()
-            };
-            let row = Row {
-                scene: name.to_string(),
-                group: "progressive",
-                label: format!(
-                    "adaptive, {passes} at {:.0}%",
-                    100.0 * adaptive.refined_fraction()
-                ),
-                timing: Timing {
-                    median_ms: ms,
-                    runs: 1,
-                },
-                speedup: rows[0].timing.median_ms / ms,
-                evaluations: adaptive.mean_evaluations(),
-                errors: compare(&frame, &best),
-                size: self.size,
-            };
-            eprintln!(
-                "  {:<20} {:>9.1} ms  {:>6.1} evals/px  {:>6.2} dB",
-                row.label, ms, row.evaluations, row.errors.psnr
+            let label = format!(
+                "adaptive, {passes} at {:.0}%",
+                100.0 * adaptive.refined_fraction()
             );
-            rows.push(row);
+            add(label, ms, adaptive.mean_evaluations(), adaptive.image);
         }
         Ok(rows)
     }

@@ -458,8 +458,7 @@ impl Renderer {
     /// As [`Renderer::render`]; after a failed pass the next call starts
     /// again from the first.
     pub fn render_progressive(&mut self, width: u32, height: u32) -> Result<RgbaImage> {
-        let per_pass = self.options.quality.supersampling.max(1).pow(2);
-        let last = (Self::MAX_PROGRESSIVE_SAMPLES / per_pass).max(1);
+        let last = self.most_passes();
         let done = match &self.progress {
             Some(p) if (p.width, p.height) == (width, height) => {
                 if let Some(image) = &p.converged {
@@ -541,8 +540,7 @@ impl Renderer {
         passes: u32,
         thresholds: &EdgeThresholds,
     ) -> Result<AdaptiveFrame> {
-        let per_pass = self.options.quality.supersampling.max(1).pow(2);
-        let most = (Self::MAX_PROGRESSIVE_SAMPLES / per_pass).max(1);
+        let most = self.most_passes();
         if passes == 0 || passes > most {
             return Err(Error::Quality {
                 setting: "adaptive passes",
@@ -590,6 +588,13 @@ impl Renderer {
             refined,
             passes,
         })
+    }
+
+    /// The most progressive passes at the quality's supersampling: as many
+    /// as make [`Renderer::MAX_PROGRESSIVE_SAMPLES`], one at least.
+    fn most_passes(&self) -> u32 {
+        let per_pass = self.options.quality.supersampling.max(1).pow(2);
+        (Self::MAX_PROGRESSIVE_SAMPLES / per_pass).max(1)
     }
 
     /// Sets the kernel's `pass` here and on the partners.
