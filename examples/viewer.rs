@@ -87,7 +87,8 @@ CONTROLS:
   drag with left button    look around
   scroll wheel             change movement speed
 
-A still view is refined by progressive passes, up to 64 samples per pixel:
+A still view is refined by 64 progressive passes (64 samples per pixel
+times the preset's supersampling):
 edges smooth out, and a camera with a lens (a scene file's `aperture`)
 shows its depth of field.
 ";
@@ -778,10 +779,12 @@ impl Viewer {
     /// Whether the still view has more progressive passes to add: the
     /// full-size image is up, in one eye, short of [`REFINE_PASSES`].
     fn refining(&self) -> bool {
+        let supersampling = self.renderer.options().quality.supersampling.max(1);
+        let most = (Renderer::MAX_PROGRESSIVE_SAMPLES / supersampling.pow(2)).max(1);
         !self.headless()
             && self.image_sharp
             && self.settings.stereo.is_none()
-            && self.renderer.progressive_passes() < REFINE_PASSES
+            && self.renderer.progressive_passes() < REFINE_PASSES.min(most)
     }
 
     /// Renders a `w` × `h` view: both eyes laid out in it with stereo on,

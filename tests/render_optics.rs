@@ -7,7 +7,9 @@ mod gpu;
 
 use fractal_sdf::cpu::{self, Evaluator};
 use fractal_sdf::prelude::*;
-use fractal_sdf::render::{EdgeThresholds, Renderer, Viewport, compose, sample_point};
+use fractal_sdf::render::{
+    DeviceSelector, EdgeThresholds, Renderer, Viewport, compose, sample_point,
+};
 use fractal_sdf::scene::{Stereo, StereoLayout};
 use image::RgbaImage;
 
@@ -146,9 +148,15 @@ fn lens_rays_are_the_cpu_twins() {
                             "pass {pass}, ({x}, {y}): no hit, {p:?} against the sky's {sky:?}"
                         );
                     } else {
+                        // The mean of the samples' linear colours: the
+                        // sky's green times the share that misses.
+                        let sky_linear = (f64::from(sky.0[1]) / 255.0).powf(2.2);
+                        let missed = f64::from(all - hits) / f64::from(all);
+                        let expected = 255.0 * (missed * sky_linear).powf(1.0 / 2.2);
                         assert!(
-                            green > 0 && green < sky.0[1],
-                            "pass {pass}, ({x}, {y}): {hits} of {all} hit"
+                            (f64::from(green) - expected).abs() <= 4.0,
+                            "pass {pass}, ({x}, {y}): {hits} of {all} hit, green {green}, \
+                             expected {expected:.1}"
                         );
                     }
                 }
@@ -260,8 +268,56 @@ fn progressive_passes_converge_on_the_supersampled_image() {
     assert_eq!(first, r.render(w, h).unwrap());
     // So does another size.
     r.render_progressive(w, h).unwrap();
-    r.render_progressive(w / 2, h / 2).unwrap();
+    let small = r.render_progressive(w / 2, h / 2).unwrap();
     assert_eq!(r.progressive_passes(), 1);
+    assert_eq!(small, r.render(w / 2, h / 2).unwrap());
+    // And sums lost to buffers made anew at the same size (a frame with
+    // outputs needs buffers that progressive ones do not have).
+    r.render_progressive(w, h).unwrap();
+    r.render_progressive(w, h).unwrap();
+    r.render_with_aovs(w, h).unwrap();
+    let again = r.render_progressive(w, h).unwrap();
+    assert_eq!(r.progressive_passes(), 1);
+    assert_eq!(again, r.render(w, h).unwrap());
+}
+
+#[test]
+fn progressive_passes_agree_across_devices_scales_and_precisions() {
+    let Some(device) = gpu::device() else { return };
+    let scene = gpu::sphere_box_floor().with_lights([gpu::sun(0.05)]);
+    let (w, h) = (48, 36);
+    let passes = |r: &mut Renderer| {
+        let first = r.render_progressive(w, h).unwrap();
+        let mut last = first.clone();
+        for _ in 1..3 {
+            last = r.render_progressive(w, h).unwrap();
+        }
+        (first, last)
+    };
+    // The same device twice splits every pass's tiles: the same image.
+    let quality = gpu::quick();
+    let (_, alone) = passes(&mut Renderer::new(&scene, quality).unwrap());
+    let twice = [
+        DeviceSelector::exactly(&device),
+        DeviceSelector::exactly(&device),
+    ];
+    let options = gpu::options(quality, Effects::default());
+    let mut shared = Renderer::with_devices(&scene, &options, &twice).unwrap();
+    assert_eq!(passes(&mut shared).1, alone);
+    // A resolution scale and F64: the first pass is still the frame of
+    // its own, and the passes refine it.
+    let mut qualities = vec![quality.resolution_scale(2)];
+    if gpu::fp64(&device) {
+        qualities.push(quality.precision(Precision::F64));
+    }
+    for quality in qualities {
+        let mut r = Renderer::new(&scene, quality).unwrap();
+        let plain = r.render(w, h).unwrap();
+        let (first, last) = passes(&mut r);
+        assert_eq!(first, plain, "{quality:?}");
+        assert_ne!(last, plain, "{quality:?}");
+        assert_eq!(last.dimensions(), (w, h));
+    }
 }
 
 #[test]
@@ -468,4 +524,19 @@ fn adaptive_supersampling_refines_the_edges_as_uniform_passes_do() {
         .render_adaptive(w, h, 0, &EdgeThresholds::default())
         .unwrap_err();
     assert!(err.to_string().contains("adaptive passes"), "{err}");
+    // Afterwards a frame is a frame of its own again.
+    assert_eq!(r.render(w, h).unwrap(), plain);
+    // With a resolution scale of 2 the mask is at the rendered size, and
+    // the image at the asked one.
+    let mut scaled = Renderer::new(&scene, quality.resolution_scale(2)).unwrap();
+    let plain = scaled.render(w, h).unwrap();
+    let frame = scaled
+        .render_adaptive(w, h, 4, &EdgeThresholds::default())
+        .unwrap();
+    assert_eq!(frame.refined.len(), (w as usize / 2) * (h as usize / 2));
+    assert_eq!(frame.first.image, plain);
+    assert_eq!(frame.image.dimensions(), (w, h));
+    assert_ne!(frame.image, plain);
+    let share = frame.refined_fraction();
+    assert!(share > 0.05 && share < 0.6, "{share}");
 }

@@ -17,11 +17,13 @@ pub struct SamplePoint {
 
 /// Sample `j` of rendered pixel `(x, y)` of an image `width` pixels wide,
 /// with `supersampling` × `supersampling` samples per pass: sample
-/// `j = pass · N² + s`. With supersampling, sample `s` is jittered in cell
-/// `s` of an N × N grid over the pixel; without, sample 0 is the pixel's
-/// centre and later ones follow the R2 sequence (Roberts 2018) rotated by
-/// a per-pixel offset. The lens follows the R2 sequence with an offset of
-/// its own, mapped to the disc by Shirley and Chiu's concentric map.
+/// `j = pass · N² + s`. Every sample has point `j` of the four-dimensional
+/// R sequence (Roberts 2018), rotated by a per-pixel offset: its first two
+/// coordinates place it in the pixel, its last two on the lens (through
+/// Shirley and Chiu's concentric map), so no point in the pixel is tied to
+/// one on the lens. With supersampling, sample `s` is instead jittered in
+/// cell `s` of an N × N grid over the pixel; without, sample 0 is the
+/// pixel's centre.
 ///
 /// ```
 /// use fractal_sdf::render::sample_point;
@@ -33,6 +35,7 @@ pub struct SamplePoint {
 pub fn sample_point(width: u32, x: u32, y: u32, j: u32, supersampling: u32) -> SamplePoint {
     let pixel = y.wrapping_mul(width).wrapping_add(x);
     let n = supersampling.max(1);
+    let q = sequence(pixel, j);
     let offset = if n > 1 {
         let s = j % (n * n);
         DVec2::new(
@@ -42,11 +45,11 @@ pub fn sample_point(width: u32, x: u32, y: u32, j: u32, supersampling: u32) -> S
     } else if j == 0 {
         DVec2::splat(0.5)
     } else {
-        sequence(pixel, j, 0)
+        DVec2::new(q[0], q[1])
     };
     SamplePoint {
         offset,
-        lens: disc(sequence(pixel, j, 2)),
+        lens: disc(DVec2::new(q[2], q[3])),
     }
 }
 
@@ -65,13 +68,16 @@ fn jitter(x: u32, y: u32, sample: u32) -> f64 {
     f64::from(hash(x ^ hash(y ^ hash(sample))) >> 8) * 2f64.powi(-24)
 }
 
-/// The kernel's `march_sequence`: point `j` of the R2 sequence, rotated
-/// by the pixel's offset in dimensions `dim` and `dim + 1`.
-fn sequence(pixel: u32, j: u32, dim: u32) -> DVec2 {
-    let offset = DVec2::new(jitter(pixel, 0, dim), jitter(pixel, 0, dim + 1));
-    let step = DVec2::new(0.754_877_666_246_692_8, 0.569_840_290_998_053_3);
-    let q = offset + step * f64::from(j);
-    q - q.floor()
+/// The kernel's `march_sequence`: point `j` of the four-dimensional R
+/// sequence, its steps `1 / g^k` (`g` the root of `x^5 = x + 1`) as 32-bit
+/// fractions, rotated by the pixel's offset.
+fn sequence(pixel: u32, j: u32) -> [f64; 4] {
+    const STEPS: [u32; 4] = [0xdb4f_0b91, 0xbbe0_5633, 0xa0f2_ec76, 0x89e1_8285];
+    std::array::from_fn(|k| {
+        let step = f64::from(STEPS[k].wrapping_mul(j) >> 8) * 2f64.powi(-24);
+        let q = jitter(pixel, 0, k as u32) + step;
+        q - q.floor()
+    })
 }
 
 /// The kernel's `march_disc`: the unit square onto the unit disc.
@@ -125,6 +131,26 @@ mod tests {
             share(&|p| p.length() < 0.5),
         ] {
             assert!((quadrant - 0.25).abs() < 0.01, "{quadrant}");
+        }
+    }
+
+    #[test]
+    fn lens_points_are_not_tied_to_pixel_points() {
+        // The samples in one quarter of the pixel land on every quarter of
+        // the lens alike: a lens point drawn from the pixel point (the same
+        // sequence shifted) would crowd one of them.
+        let mut quarters = [0u32; 4];
+        for j in 1..4097 {
+            let p = sample_point(64, 3, 2, j, 1);
+            if p.offset.x < 0.5 && p.offset.y < 0.5 {
+                quarters[usize::from(p.lens.x > 0.0) + 2 * usize::from(p.lens.y > 0.0)] += 1;
+            }
+        }
+        let total: u32 = quarters.iter().sum();
+        assert!(total > 900, "{total}");
+        for q in quarters {
+            let share = f64::from(q) / f64::from(total);
+            assert!((share - 0.25).abs() < 0.03, "{quarters:?}");
         }
     }
 

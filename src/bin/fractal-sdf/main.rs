@@ -403,10 +403,12 @@ fn render(args: &RenderArgs, settings: &Settings) -> Outcome {
         (None, None) => renderer.render(width, height),
     };
     bar.finish_and_clear();
-    save_png(&image?, &args.output)?;
+    let image = image?;
+    save_png(&image, &args.output)?;
     if let Some(refined) = refined {
         println!("{refined}");
     }
+    let (width, height) = image.dimensions();
     println!(
         "{}: {width}x{height}, {} quality, {:.2} s on {}",
         args.output.display(),

@@ -478,14 +478,19 @@ real march_jitter(uint x, uint y, uint sample) {
     return (real)(h >> 8) * R(5.9604644775390625e-8); // 2^-24
 }
 
-// Point j of the R2 sequence (Roberts 2018), rotated by a per-pixel offset
-// drawn from the hash's dimensions (dim, dim + 1): well spread in the unit
-// square for every count of points, so progressive passes converge
-// faster than independent random points would.
-real2 march_sequence(uint pixel, uint j, uint dim) {
-    real2 offset = (real2)(march_jitter(pixel, 0u, dim), march_jitter(pixel, 0u, dim + 1u));
-    real2 step = (real2)(R(0.75487766624669276), R(0.56984029099805327));
-    real2 q = offset + step * (real)j;
+// Point j of the four-dimensional R sequence (Roberts 2018), rotated by a
+// per-pixel offset from the hash: x and y place a sample in the pixel, z
+// and w on the lens. The four together are well spread for every count of
+// points, so progressive passes converge faster than independent random
+// points would, and no point in the pixel is tied to one on the lens. The
+// steps are 1 / g^k for g the root of x^5 = x + 1, as 32-bit fractions:
+// j times a step wraps to its fractional part exactly, in any precision.
+real4 march_sequence(uint pixel, uint j) {
+    uint4 steps = ((uint4)(0xdb4f0b91u, 0xbbe05633u, 0xa0f2ec76u, 0x89e18285u) * j) >> 8;
+    real4 q = (real4)(march_jitter(pixel, 0u, 0u), march_jitter(pixel, 0u, 1u),
+                      march_jitter(pixel, 0u, 2u), march_jitter(pixel, 0u, 3u))
+              + (real4)((real)steps.x, (real)steps.y, (real)steps.z, (real)steps.w)
+                    * R(5.9604644775390625e-8); // 2^-24
     return q - floor(q);
 }
 
@@ -508,9 +513,9 @@ real2 march_disc(real2 q) {
 // (jx, jy) in [0, 1)^2, and on the lens, in the unit disc. With
 // supersampling, sample s is jittered in cell s of an N x N grid over the
 // pixel; without, sample 0 is the pixel's centre and the rest follow the
-// R2 sequence. The lens always follows the R2 sequence, apart from the
-// pixel's.
+// sequence's x and y. The lens follows its z and w.
 void march_sample_point(uint pixel, uint j, int s, real* jx, real* jy, real2* lens) {
+    real4 q = march_sequence(pixel, j);
     if (SUPERSAMPLING > 1) {
         *jx = ((real)(s % SUPERSAMPLING) + march_jitter(pixel, j, 0u)) / (real)SUPERSAMPLING;
         *jy = ((real)(s / SUPERSAMPLING) + march_jitter(pixel, j, 1u)) / (real)SUPERSAMPLING;
@@ -518,11 +523,10 @@ void march_sample_point(uint pixel, uint j, int s, real* jx, real* jy, real2* le
         *jx = R(0.5);
         *jy = R(0.5);
     } else {
-        real2 q = march_sequence(pixel, j, 0u);
         *jx = q.x;
         *jy = q.y;
     }
-    *lens = march_disc(march_sequence(pixel, j, 2u));
+    *lens = march_disc(q.zw);
 }
 
 // One launch shades the tile [x0, x0 + tile_w) x [y0, y0 + tile_h) of a
@@ -615,13 +619,16 @@ __kernel void render_tile(RENDER_TILE_ARGS) {
         float4 total = pass == 0 ? (float4)(0.0f) : accumulation[idx];
         total += (float4)(convert_float3(sum), 0.0f);
         accumulation[idx] = total;
-        color = (real3)(total.x, total.y, total.z) / ((real)(pass + 1) * (real)per_pass);
+        if (pass > 0) {
+            color = (real3)(total.x, total.y, total.z) / ((real)(pass + 1) * (real)per_pass);
+        }
     }
     real3 out = pow(clamp(color, R(0.0), R(1.0)), (real3)(R(1.0) / GAMMA));
     rgba[idx] = (uchar4)(convert_uchar3_sat_rte(convert_float3(out) * 255.0f), (uchar)255);
 
-    if (write_aovs) {
-        if (SUPERSAMPLING > 1 || pass > 0 || cam.aperture > R(0.0)) {
+    // Later passes leave the outputs of the first: the same rays.
+    if (write_aovs && pass <= 0) {
+        if (SUPERSAMPLING > 1 || cam.aperture > R(0.0)) {
             // The colour samples are jittered: trace the pixel centre.
             real3 ro;
             real3 rd;
