@@ -504,19 +504,39 @@ real march_jitter(uint x, uint y, uint sample) {
     return (real)(h >> 8) * R(5.9604644775390625e-8); // 2^-24
 }
 
-// Point j of the four-dimensional R sequence (Roberts 2018), rotated by a
-// per-pixel offset from the hash: x and y place a sample in the pixel, z
-// and w on the lens. The four together are well spread for every count of
+// Point j of the R2 sequence (Roberts 2018), rotated by a per-pixel
+// offset from the hash: well spread in the pixel for every count of
 // points, so progressive passes converge faster than independent random
-// points would, and no point in the pixel is tied to one on the lens. The
-// steps are 1 / g^k for g the root of x^5 = x + 1, as 32-bit fractions:
-// j times a step wraps to its fractional part exactly, in any precision.
-real4 march_sequence(uint pixel, uint j) {
-    uint4 steps = ((uint4)(0xdb4f0b91u, 0xbbe05633u, 0xa0f2ec76u, 0x89e18285u) * j) >> 8;
-    real4 q = (real4)(march_jitter(pixel, 0u, 0u), march_jitter(pixel, 0u, 1u),
-                      march_jitter(pixel, 0u, 2u), march_jitter(pixel, 0u, 3u))
-              + (real4)((real)steps.x, (real)steps.y, (real)steps.z, (real)steps.w)
-                    * R(5.9604644775390625e-8); // 2^-24
+// points would. The steps are 1 / g and 1 / g^2 for g the root of
+// x^3 = x + 1, as 32-bit fractions: j times a step wraps to its
+// fractional part exactly, in any precision.
+real2 march_pixel_point(uint pixel, uint j) {
+    uint2 steps = ((uint2)(0xc13fa9a9u, 0x91e10da6u) * j) >> 8;
+    real2 q = (real2)(march_jitter(pixel, 0u, 0u), march_jitter(pixel, 0u, 1u))
+              + (real2)((real)steps.x, (real)steps.y) * R(5.9604644775390625e-8); // 2^-24
+    return q - floor(q);
+}
+
+// The radical inverse of j in base b: its digits mirrored about the point.
+real march_radical_inverse(uint j, uint b) {
+    real step = R(1.0) / (real)b;
+    real scale = step;
+    real r = R(0.0);
+    for (; j > 0u; j /= b) {
+        r += scale * (real)(j % b);
+        scale *= step;
+    }
+    return r;
+}
+
+// Point j of the Halton sequence in bases 2 and 3, rotated by a per-pixel
+// offset from the hash: where sample j leaves the lens, in the unit
+// square. A different kind of sequence from the pixel's, so no point in
+// the pixel is tied to one on the lens, and pixel and lens together are
+// well spread too.
+real2 march_lens_point(uint pixel, uint j) {
+    real2 q = (real2)(march_jitter(pixel, 0u, 2u), march_jitter(pixel, 0u, 3u))
+              + (real2)(march_radical_inverse(j, 2u), march_radical_inverse(j, 3u));
     return q - floor(q);
 }
 
@@ -539,9 +559,8 @@ real2 march_disc(real2 q) {
 // (jx, jy) in [0, 1)^2, and on the lens, in the unit disc. With
 // supersampling, sample s is jittered in cell s of an N x N grid over the
 // pixel; without, sample 0 is the pixel's centre and the rest follow the
-// sequence's x and y. The lens follows its z and w.
+// R2 sequence. The lens follows the Halton sequence.
 void march_sample_point(uint pixel, uint j, int s, real* jx, real* jy, real2* lens) {
-    real4 q = march_sequence(pixel, j);
     if (SUPERSAMPLING > 1) {
         *jx = ((real)(s % SUPERSAMPLING) + march_jitter(pixel, j, 0u)) / (real)SUPERSAMPLING;
         *jy = ((real)(s / SUPERSAMPLING) + march_jitter(pixel, j, 1u)) / (real)SUPERSAMPLING;
@@ -549,10 +568,11 @@ void march_sample_point(uint pixel, uint j, int s, real* jx, real* jy, real2* le
         *jx = R(0.5);
         *jy = R(0.5);
     } else {
+        real2 q = march_pixel_point(pixel, j);
         *jx = q.x;
         *jy = q.y;
     }
-    *lens = march_disc(q.zw);
+    *lens = march_disc(march_lens_point(pixel, j));
 }
 
 // One launch shades the tile [x0, x0 + tile_w) x [y0, y0 + tile_h) of a

@@ -17,13 +17,13 @@ pub struct SamplePoint {
 
 /// Sample `j` of rendered pixel `(x, y)` of an image `width` pixels wide,
 /// with `supersampling` × `supersampling` samples per pass: sample
-/// `j = pass · N² + s`. Every sample has point `j` of the four-dimensional
-/// R sequence (Roberts 2018), rotated by a per-pixel offset: its first two
-/// coordinates place it in the pixel, its last two on the lens (through
-/// Shirley and Chiu's concentric map), so no point in the pixel is tied to
-/// one on the lens. With supersampling, sample `s` is instead jittered in
-/// cell `s` of an N × N grid over the pixel; without, sample 0 is the
-/// pixel's centre.
+/// `j = pass · N² + s`. With supersampling, sample `s` is jittered in cell
+/// `s` of an N × N grid over the pixel; without, sample 0 is the pixel's
+/// centre and later ones follow the R2 sequence (Roberts 2018) rotated by a
+/// per-pixel offset. The lens follows the Halton sequence in bases 2 and 3,
+/// with an offset of its own, mapped to the disc by Shirley and Chiu's
+/// concentric map: a different kind of sequence from the pixel's, so no
+/// point in the pixel is tied to one on the lens.
 ///
 /// ```
 /// use fractal_sdf::render::sample_point;
@@ -35,7 +35,6 @@ pub struct SamplePoint {
 pub fn sample_point(width: u32, x: u32, y: u32, j: u32, supersampling: u32) -> SamplePoint {
     let pixel = y.wrapping_mul(width).wrapping_add(x);
     let n = supersampling.max(1);
-    let q = sequence(pixel, j);
     let offset = if n > 1 {
         let s = j % (n * n);
         DVec2::new(
@@ -45,11 +44,11 @@ pub fn sample_point(width: u32, x: u32, y: u32, j: u32, supersampling: u32) -> S
     } else if j == 0 {
         DVec2::splat(0.5)
     } else {
-        DVec2::new(q[0], q[1])
+        pixel_point(pixel, j)
     };
     SamplePoint {
         offset,
-        lens: disc(DVec2::new(q[2], q[3])),
+        lens: disc(lens_point(pixel, j)),
     }
 }
 
@@ -68,16 +67,37 @@ fn jitter(x: u32, y: u32, sample: u32) -> f64 {
     f64::from(hash(x ^ hash(y ^ hash(sample))) >> 8) * 2f64.powi(-24)
 }
 
-/// The kernel's `march_sequence`: point `j` of the four-dimensional R
-/// sequence, its steps `1 / g^k` (`g` the root of `x^5 = x + 1`) as 32-bit
-/// fractions, rotated by the pixel's offset.
-fn sequence(pixel: u32, j: u32) -> [f64; 4] {
-    const STEPS: [u32; 4] = [0xdb4f_0b91, 0xbbe0_5633, 0xa0f2_ec76, 0x89e1_8285];
-    std::array::from_fn(|k| {
+/// The kernel's `march_pixel_point`: point `j` of the R2 sequence, its
+/// steps as 32-bit fractions, rotated by the pixel's offset.
+fn pixel_point(pixel: u32, j: u32) -> DVec2 {
+    const STEPS: [u32; 2] = [0xc13f_a9a9, 0x91e1_0da6];
+    let at = |k: usize| {
         let step = f64::from(STEPS[k].wrapping_mul(j) >> 8) * 2f64.powi(-24);
         let q = jitter(pixel, 0, k as u32) + step;
         q - q.floor()
-    })
+    };
+    DVec2::new(at(0), at(1))
+}
+
+/// The kernel's `march_radical_inverse`: `j`'s digits in base `b`
+/// mirrored about the point.
+fn radical_inverse(mut j: u32, b: u32) -> f64 {
+    let step = 1.0 / f64::from(b);
+    let (mut scale, mut r) = (step, 0.0);
+    while j > 0 {
+        r += scale * f64::from(j % b);
+        scale *= step;
+        j /= b;
+    }
+    r
+}
+
+/// The kernel's `march_lens_point`: point `j` of the Halton sequence in
+/// bases 2 and 3, rotated by the pixel's offset.
+fn lens_point(pixel: u32, j: u32) -> DVec2 {
+    let q = DVec2::new(jitter(pixel, 0, 2), jitter(pixel, 0, 3))
+        + DVec2::new(radical_inverse(j, 2), radical_inverse(j, 3));
+    q - q.floor()
 }
 
 /// The kernel's `march_disc`: the unit square onto the unit disc.
@@ -137,8 +157,8 @@ mod tests {
     #[test]
     fn lens_points_are_not_tied_to_pixel_points() {
         // The samples in one quarter of the pixel land on every quarter of
-        // the lens alike: a lens point drawn from the pixel point (the same
-        // sequence shifted) would crowd one of them.
+        // the lens alike: a lens point drawn from the pixel point (the
+        // pixel's sequence shifted, say) would crowd one of them.
         let mut quarters = [0u32; 4];
         for j in 1..4097 {
             let p = sample_point(64, 3, 2, j, 1);
