@@ -530,11 +530,11 @@ real2 march_disc(real2 q) {
 }
 
 // Where sample j of a pixel (j = pass * SUPERSAMPLING^2 + s) lies in it,
-// (jx, jy) in [0, 1)^2, and on the lens, in the unit disc. With
-// supersampling, sample s is jittered in cell s of an N x N grid over the
-// pixel; without, sample 0 is the pixel's centre and the rest follow the
-// R2 sequence. The lens follows the Halton sequence.
-void march_sample_point(uint pixel, uint j, int s, real* jx, real* jy, real2* lens) {
+// (jx, jy) in [0, 1)^2. With supersampling, sample s is jittered in cell s
+// of an N x N grid over the pixel; without, sample 0 is the pixel's centre
+// and the rest follow the R2 sequence. (On the lens, the sample lies at
+// march_disc(march_lens_point(pixel, j)).)
+void march_sample_point(uint pixel, uint j, int s, real* jx, real* jy) {
     if (SUPERSAMPLING > 1) {
         *jx = ((real)(s % SUPERSAMPLING) + march_jitter(pixel, j, 0u)) / (real)SUPERSAMPLING;
         *jy = ((real)(s / SUPERSAMPLING) + march_jitter(pixel, j, 1u)) / (real)SUPERSAMPLING;
@@ -546,7 +546,6 @@ void march_sample_point(uint pixel, uint j, int s, real* jx, real* jy, real2* le
         *jx = q.x;
         *jy = q.y;
     }
-    *lens = march_disc(march_lens_point(pixel, j));
 }
 
 // One launch shades the tile [x0, x0 + tile_w) x [y0, y0 + tile_h) of a
@@ -595,8 +594,12 @@ __kernel void render_tile(RENDER_TILE_ARGS) {
     for (int s = 0; s < per_pass; ++s) {
         real jx;
         real jy;
-        real2 lens;
-        march_sample_point(pixel, first + (uint)s, s, &jx, &jy, &lens);
+        march_sample_point(pixel, first + (uint)s, s, &jx, &jy);
+        // A pinhole needs no lens point.
+        real2 lens = (real2)(R(0.0));
+        if (cam.aperture > R(0.0)) {
+            lens = march_disc(march_lens_point(pixel, first + (uint)s));
+        }
         // Rendered pixel (x, y) covers pixel_scale image pixels each way.
         real px = ((real)x + jx) * cam.pixel_scale;
         real py = ((real)y + jy) * cam.pixel_scale;
