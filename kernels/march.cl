@@ -124,10 +124,12 @@ void march_lens_ray(const MarchCamera* cam, real px, real py, real2 lens, real3*
 }
 
 // The drawn surface: where the distance estimate falls to DETAIL pixel
-// footprints. g(t) is how far the point at t along the ray lies outside it.
-real march_level(real3 ro, real3 rd, const MarchCamera* cam, real t,
+// footprints. g(t) is how far the point at t along the ray lies outside it
+// (side 1), or inside it (side -1: a ray travelling inside a transparent
+// shape, looking for the way out).
+real march_level(real3 ro, real3 rd, const MarchCamera* cam, real t, real side,
                  __global const real* params) {
-    return DE(ro + rd * t, params) - DETAIL * march_footprint(cam, t);
+    return side * (DE(ro + rd * t, params) - DETAIL * march_footprint(cam, t));
 }
 
 // Locates the crossing of the surface between t0 (outside, g0 > 0) and t1
@@ -137,14 +139,14 @@ real march_level(real3 ro, real3 rd, const MarchCamera* cam, real t,
 // superlinear elsewhere. Returns the inside end of the final bracket and
 // adds its evaluations to *steps.
 real march_refine(real3 ro, real3 rd, const MarchCamera* cam, real t0, real g0, real t1,
-                  real g1, __global const real* params, int* steps) {
+                  real g1, real side, __global const real* params, int* steps) {
     int kept = 0; // which end the last step moved: -1 outside, 1 inside
     for (int i = 0; i < MARCH_REFINE_LIMIT; ++i) {
         if (t1 - t0 <= HIT_EPSILON * march_footprint(cam, t1)) {
             break;
         }
         real t = clamp(t0 + (t1 - t0) * (g0 / (g0 - g1)), t0, t1);
-        real g = march_level(ro, rd, cam, t, params);
+        real g = march_level(ro, rd, cam, t, side, params);
         *steps += 1;
         if (g > R(0.0)) {
             t0 = t;
@@ -252,7 +254,10 @@ int march_glow_settled(real3 p, real3 rd, real t) {
 }
 #endif
 
-MarchResult march_ray(real3 ro, real3 rd, real start, const MarchCamera* cam,
+// Side 1 marches towards the surface from outside, side -1 towards the
+// way out from inside it (g and its Lipschitz bound are the same up to
+// sign).
+MarchResult march_ray(real3 ro, real3 rd, real start, const MarchCamera* cam, real side,
                       __global const real* params) {
     MarchResult r;
     r.t = start;
@@ -271,7 +276,7 @@ MarchResult march_ray(real3 ro, real3 rd, real start, const MarchCamera* cam,
 #endif
     for (int i = 0; i < MAX_STEPS; ++i) {
         real d = DE(ro + rd * r.t, params);
-        real g = d - DETAIL * march_footprint(cam, r.t);
+        real g = side * (d - DETAIL * march_footprint(cam, r.t));
         r.steps += 1;
         if (relaxed && (g < R(0.0) || prev_g + g < lipschitz * (r.t - prev_t))) {
             r.t = prev_t + prev_g / lipschitz;
@@ -286,7 +291,7 @@ MarchResult march_ray(real3 ro, real3 rd, real start, const MarchCamera* cam,
             r.hit = 1;
             r.closest = R(0.0);
             if (i > 0) {
-                r.t = march_refine(ro, rd, cam, prev_t, prev_g, r.t, g, params, &r.steps);
+                r.t = march_refine(ro, rd, cam, prev_t, prev_g, r.t, g, side, params, &r.steps);
             }
             return r;
         }
@@ -429,9 +434,64 @@ real3 march_background(const MarchCamera* cam, real py) {
     return mix(SKY_BOTTOM, SKY_TOP, v);
 }
 
+#ifdef ENABLE_MATERIALS
+#define MARCH_SCATTER_SAMPLES 4 // DE calls of march_thinness
+
+// Oren-Nayar's qualitative model: the diffuse light of a surface of
+// microfacets whose slopes spread by sigma radians, relative to Lambert's
+// (so 1 at sigma 0), for unit normal n, light direction l and view
+// direction v, with ndl = n.l > 0:
+//   A + B max(0, cos(phi_l - phi_v)) sin(alpha) tan(beta),
+//   A = 1 - sigma^2 / (2 (sigma^2 + 0.33)),  B = 0.45 sigma^2 / (sigma^2 + 0.09),
+// alpha and beta the larger and smaller of the angles of l and v from n.
+real march_oren_nayar(real sigma, real3 n, real3 l, real3 v, real ndl) {
+    if (sigma <= R(0.0)) {
+        return R(1.0);
+    }
+    real s2 = sigma * sigma;
+    real a = R(1.0) - R(0.5) * s2 / (s2 + R(0.33));
+    real b = R(0.45) * s2 / (s2 + R(0.09));
+    // The view can sit just behind a normal taken by differences.
+    real ndv = clamp(dot(n, v), R(1e-4), R(1.0));
+    real3 lt = l - n * ndl;
+    real3 vt = v - n * ndv;
+    real norms = length(lt) * length(vt);
+    real cos_phi = norms > REAL_TINY ? fmax(dot(lt, vt) / norms, R(0.0)) : R(0.0);
+    real cos_alpha = fmin(ndl, ndv);
+    real cos_beta = fmax(ndl, ndv);
+    real sin_alpha = sqrt(fmax(R(1.0) - cos_alpha * cos_alpha, R(0.0)));
+    real tan_beta = sqrt(fmax(R(1.0) - cos_beta * cos_beta, R(0.0))) / cos_beta;
+    return a + b * cos_phi * sin_alpha * tan_beta;
+}
+
+// How thin the shape is below p, with outward normal n, down to depth:
+// 0 where it is solid that deep, towards 1 where it ends sooner. Samples
+// MARCH_SCATTER_SAMPLES points along the inward normal; at h below a
+// solid face the distance is -h, so each sample adds how far its depth
+// inside falls short of h.
+real march_thinness(real3 p, real3 n, real depth, __global const real* params, uint* evals) {
+    real solid = R(0.0);
+    for (int i = 1; i <= MARCH_SCATTER_SAMPLES; ++i) {
+        real h = depth * (real)i / (real)MARCH_SCATTER_SAMPLES;
+        solid += clamp(-DE(p - n * h, params) / h, R(0.0), R(1.0));
+    }
+    *evals += (uint)MARCH_SCATTER_SAMPLES;
+    return R(1.0) - solid / (real)MARCH_SCATTER_SAMPLES;
+}
+#endif
+
 // Lit colour of the surface point p with normal n, seen along rd; the
 // image is view_height scene units high at p's distance. Adds its distance
-// evaluations (DE_shade, occlusion, shadow rays) to *evals.
+// evaluations (DE_shade, DE_material, occlusion, shadow rays, thickness)
+// to *evals.
+//
+// Every light adds albedo * diffuse * n.l plus the Blinn-Phong highlight
+// specular * (n.h)^shininess * n.l, the diffuse term being Lambert's (1)
+// or, with a material's roughness, Oren-Nayar's. With a material's
+// subsurface strength s, a light behind the surface (n.l < 0) adds
+// albedo * s * thinness * -n.l: it shows through thin parts, unshadowed
+// (the shape itself stands between). Without materials the highlight is
+// MARCH_SPECULAR and MARCH_SHININESS, the default material's.
 real3 march_shade(real3 p, real3 n, real3 rd, real eps, real view_height,
                   __global const real* params, __global const real* lights, int light_count,
                   uint* evals) {
@@ -440,6 +500,19 @@ real3 march_shade(real3 p, real3 n, real3 rd, real eps, real view_height,
     DE_shade(p, params, &albedo, &trap);
     *evals += 1u;
     albedo *= march_trap_tint(trap);
+    real specular_strength = MARCH_SPECULAR;
+    real shininess = MARCH_SHININESS;
+#ifdef ENABLE_MATERIALS
+    real8 material;
+    DE_material(p, params, &material);
+    *evals += 1u;
+    specular_strength = material.s1;
+    shininess = material.s2;
+    real through = R(0.0);
+    if (material.s3 > R(0.0) && material.s4 > R(0.0)) {
+        through = material.s3 * march_thinness(p, n, material.s4, params, evals);
+    }
+#endif
 
     real occlusion = R(1.0);
 #ifdef ENABLE_AO
@@ -468,12 +541,21 @@ real3 march_shade(real3 p, real3 n, real3 rd, real eps, real view_height,
             radiance /= dist2;
         }
         real ndl = dot(n, to_light);
+#ifdef ENABLE_MATERIALS
+        if (ndl < R(0.0)) {
+            color += radiance * albedo * (through * -ndl);
+        }
+#endif
         if (ndl <= R(0.0)) {
             continue;
         }
+        real diffuse = R(1.0);
+#ifdef ENABLE_MATERIALS
+        diffuse = march_oren_nayar(material.s0, n, to_light, -rd, ndl);
+#endif
 #ifdef ENABLE_SHADOWS
         // The most this light adds to the pixel in any channel.
-        real3 most = radiance * ((albedo + MARCH_SPECULAR) * ndl);
+        real3 most = radiance * ((albedo * diffuse + specular_strength) * ndl);
         real visible = march_shadow(lifted, to_light, light_distance, R(0.25) * eps, eps,
                                     l[LIGHT_SOFTNESS], fmax(most.x, fmax(most.y, most.z)),
                                     params, evals);
@@ -483,11 +565,166 @@ real3 march_shade(real3 p, real3 n, real3 rd, real eps, real view_height,
         radiance *= visible;
 #endif
         real3 half_vector = normalize(to_light - rd);
-        real specular = MARCH_SPECULAR * pow(fmax(dot(n, half_vector), R(0.0)), MARCH_SHININESS);
-        color += radiance * (albedo * ndl + specular * ndl);
+        real specular = specular_strength * pow(fmax(dot(n, half_vector), R(0.0)), shininess);
+        color += radiance * (albedo * (diffuse * ndl) + specular * ndl);
     }
     return color;
 }
+
+#ifdef ENABLE_MATERIALS
+// A branch carrying less than this share of a pixel cannot change its
+// 8-bit value: it is not traced.
+#define MARCH_FAINT R(0.001953125) // 2^-9
+
+// A reflected or refracted ray still to trace.
+typedef struct {
+    real3 ro;
+    real3 rd;
+    real3 weight;    // the share of the pixel's colour it brings
+    real travelled;  // the path's length before ro: sets the footprint
+    int depth;       // bounces so far, this one included
+    int inside;      // whether it travels inside a transparent shape
+} MarchBranch;
+
+// The sky seen along rd, where a path leaves the scene or is cut off.
+real3 march_sky(real3 rd) {
+    return mix(SKY_BOTTOM, SKY_TOP, clamp(R(0.5) + R(0.5) * rd.y, R(0.0), R(1.0)));
+}
+
+// The share of light a clear surface reflects, arriving from index 1 at
+// an angle with cosine cos_i onto index ior: Fresnel's equations for
+// unpolarised light (0 for ior 1, 1 on total internal reflection).
+real march_fresnel(real cos_i, real ior) {
+    real sin_t2 = (R(1.0) - cos_i * cos_i) / (ior * ior);
+    if (sin_t2 >= R(1.0)) {
+        return R(1.0);
+    }
+    real cos_t = sqrt(R(1.0) - sin_t2);
+    real rs = (cos_i - ior * cos_t) / (cos_i + ior * cos_t);
+    real rp = (cos_t - ior * cos_i) / (cos_t + ior * cos_i);
+    return R(0.5) * (rs * rs + rp * rp);
+}
+
+// rd refracted through a surface with unit normal n facing it, going from
+// index 1 to index 1 / eta; 0 on total internal reflection.
+real3 march_refract(real3 rd, real3 n, real eta) {
+    real cos_i = -dot(n, rd);
+    real k = R(1.0) - eta * eta * (R(1.0) - cos_i * cos_i);
+    return k < R(0.0) ? (real3)(R(0.0)) : eta * rd + (eta * cos_i - sqrt(k)) * n;
+}
+
+// Adds a branch of `weight` to the stack, or, a bounce too deep, returns
+// the sky's share it brings instead (the cut-off). Branches too faint to
+// show are dropped.
+real3 march_branch(MarchBranch b, MarchBranch* stack, int* top) {
+    if (fmax(b.weight.x, fmax(b.weight.y, b.weight.z)) < MARCH_FAINT) {
+        return (real3)(R(0.0));
+    }
+    if (b.depth > BOUNCES || *top >= BOUNCES + 2) {
+        return b.weight * march_sky(b.rd);
+    }
+    stack[(*top)++] = b;
+    return (real3)(R(0.0));
+}
+
+// Splits the path that reaches surface point p (outward normal n, eps its
+// hit threshold) along rd, t from the camera, carrying weight, after depth
+// bounces: the material's reflectivity r and transparency tau, with the
+// Fresnel reflectance F for index ior (march_fresnel), share it among
+//   the surface's own colour, own: (1 - r)(1 - tau),
+//   a reflected ray: r + (1 - r) tau F,
+//   a refracted ray: (1 - r) tau (1 - F) (reflected too, on total
+//   internal reflection).
+// Returns the colour it adds now; the rays go on the stack.
+real3 march_split(real3 p, real3 n, real3 rd, real eps, real t, real3 weight, int depth,
+                  real3 own, __global const real* params, MarchBranch* stack, int* top,
+                  uint* evals) {
+    real8 material;
+    DE_material(p, params, &material);
+    *evals += 1u;
+    real r = material.s5;
+    real tau = material.s6;
+    real ior = material.s7;
+    real3 color = weight * ((R(1.0) - r) * (R(1.0) - tau)) * own;
+    real reflected = r;
+    if (tau > R(0.0)) {
+        real fresnel = march_fresnel(clamp(-dot(n, rd), R(0.0), R(1.0)), ior);
+        real3 bent = march_refract(rd, n, R(1.0) / ior);
+        real passed = (R(1.0) - r) * tau * (R(1.0) - fresnel);
+        if (dot(bent, bent) > R(0.0)) {
+            MarchBranch b = {p - n * (R(2.0) * eps), normalize(bent), weight * passed, t,
+                             depth + 1, 1};
+            color += march_branch(b, stack, top);
+        } else {
+            reflected += passed;
+        }
+        reflected += (R(1.0) - r) * tau * fresnel;
+    }
+    if (reflected > R(0.0)) {
+        MarchBranch b = {p + n * (R(2.0) * eps), rd - R(2.0) * dot(rd, n) * n,
+                         weight * reflected, t, depth + 1, 0};
+        color += march_branch(b, stack, top);
+    }
+    return color;
+}
+
+// The colour of a pixel's path that first meets the surface at p (normal
+// n, hit threshold eps) t along rd, whose own lit colour is own: own
+// weighted by the surface's share, plus what its reflected and refracted
+// rays bring, each marched like a primary ray (its footprint grows with
+// the whole path's length) and lit with the same occlusion and shadows,
+// depth first, at most BOUNCES deep. A ray inside a transparent shape
+// marches to where it leaves (side -1) and refracts out, or reflects back
+// in on total internal reflection; the inside is clear. Adds every
+// evaluation to *evals.
+real3 march_paths(real3 p, real3 n, real3 rd, real eps, real t, const MarchCamera* cam,
+                  real3 own, __global const real* params, __global const real* lights,
+                  int light_count, uint* evals) {
+    MarchBranch stack[BOUNCES + 2];
+    int top = 0;
+    real3 color = march_split(p, n, rd, eps, t, (real3)(R(1.0)), 0, own, params, stack, &top,
+                              evals);
+    while (top > 0) {
+        MarchBranch b = stack[--top];
+        // The footprint goes on growing along the path.
+        MarchCamera along = *cam;
+        along.footprint_base = march_footprint(cam, b.travelled);
+        MarchResult m = march_ray(b.ro, b.rd, R(0.0), &along, b.inside ? R(-1.0) : R(1.0),
+                                  params);
+        *evals += (uint)m.steps;
+        if (!m.hit) {
+            color += b.weight * march_sky(b.rd);
+            continue;
+        }
+        real3 q = b.ro + b.rd * m.t;
+        real footprint = march_footprint(&along, m.t);
+        real3 nq = march_normal(q, NORMAL_EPSILON * footprint, b.rd, params);
+        *evals += MARCH_NORMAL_EVALUATIONS;
+        real eq = DETAIL * footprint;
+        real travelled = b.travelled + m.t;
+        if (b.inside) {
+            real8 material;
+            DE_material(q, params, &material);
+            *evals += 1u;
+            real3 out = march_refract(b.rd, -nq, material.s7);
+            MarchBranch next = {q + nq * (R(2.0) * eq), normalize(out), b.weight, travelled,
+                                b.depth + 1, 0};
+            if (dot(out, out) <= R(0.0)) {
+                next.ro = q - nq * (R(2.0) * eq);
+                next.rd = b.rd - R(2.0) * dot(b.rd, nq) * nq;
+                next.inside = 1;
+            }
+            color += march_branch(next, stack, &top);
+            continue;
+        }
+        real3 lit = march_shade(q, nq, b.rd, eq, footprint * cam->image_h, params, lights,
+                                light_count, evals);
+        color += march_split(q, nq, b.rd, eq, travelled, b.weight, b.depth, lit, params, stack,
+                             &top, evals);
+    }
+    return color;
+}
+#endif
 
 // Deterministic per-sample jitter in [0, 1): the same image every run.
 uint march_hash(uint x) {
@@ -635,7 +872,7 @@ __kernel void render_tile(RENDER_TILE_ARGS) {
         real3 ro;
         real3 rd;
         march_lens_ray(&cam, px, py, lens, &ro, &rd);
-        MarchResult m = march_ray(ro, rd, start, &cam, params);
+        MarchResult m = march_ray(ro, rd, start, &cam, R(1.0), params);
         total_steps += (uint)m.steps;
         total_evals += (uint)m.steps;
 
@@ -658,6 +895,10 @@ __kernel void render_tile(RENDER_TILE_ARGS) {
             }
             color = march_shade(p, n, rd, DETAIL * footprint, view_height, params, lights,
                                 light_count, &total_evals);
+#ifdef ENABLE_MATERIALS
+            color = march_paths(p, n, rd, DETAIL * footprint, m.t, &cam, color, params, lights,
+                                light_count, &total_evals);
+#endif
 #ifdef ENABLE_FOG
             color = mix(background, color, exp(-FOG_DENSITY * m.t));
 #endif
@@ -694,7 +935,7 @@ __kernel void render_tile(RENDER_TILE_ARGS) {
             real3 rd;
             march_camera_ray(&cam, ((real)x + R(0.5)) * cam.pixel_scale,
                              ((real)y + R(0.5)) * cam.pixel_scale, &ro, &rd);
-            centre = march_ray(ro, rd, start, &cam, params);
+            centre = march_ray(ro, rd, start, &cam, R(1.0), params);
             centre_normal = (real3)(R(0.0));
             if (centre.hit) {
                 real h = NORMAL_EPSILON * march_footprint(&cam, centre.t);

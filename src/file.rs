@@ -75,8 +75,8 @@ use crate::animation::{CameraPath, Keyframe, Motion};
 use crate::error::{Error, Result};
 use crate::quality::{Effects, Precision, Preset, Quality};
 use crate::scene::{
-    Axis, Camera, CsgOp, CustomShape, Kind, Light, Mandelbulb, Menger, Node, NodeKind, Param,
-    Param3, QuaternionJulia, Scene, Sierpinski, param3,
+    Axis, Camera, CsgOp, CustomShape, Kind, Light, Mandelbulb, Material, Menger, Node, NodeKind,
+    Param, Param3, QuaternionJulia, Scene, Sierpinski, param3,
 };
 
 /// The format version this library reads and writes.
@@ -635,6 +635,7 @@ const NAMES: &[&str] = &[
     "Twist",
     "Bend",
     "Color",
+    "Material",
     "Union",
     "Subtract",
     "Intersect",
@@ -919,6 +920,8 @@ struct QualityRepr {
     resolution_scale: Option<u32>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     cone_tile: Option<u32>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    bounces: Option<u32>,
 }
 
 impl QualityRepr {
@@ -952,6 +955,7 @@ impl QualityRepr {
                 resolution_scale: differs(p.resolution_scale == quality.resolution_scale)
                     .map(|()| quality.resolution_scale),
                 cone_tile: differs(p.cone_tile == quality.cone_tile).map(|()| quality.cone_tile),
+                bounces: differs(p.bounces == quality.bounces).map(|()| quality.bounces),
             }
         };
         Preset::ALL
@@ -978,6 +982,7 @@ impl QualityRepr {
             self.fast_math.is_some(),
             self.resolution_scale.is_some(),
             self.cone_tile.is_some(),
+            self.bounces.is_some(),
         ]
         .into_iter()
         .filter(|&b| b)
@@ -1001,6 +1006,7 @@ impl QualityRepr {
             fast_math: self.fast_math.unwrap_or(p.fast_math),
             resolution_scale: self.resolution_scale.unwrap_or(p.resolution_scale),
             cone_tile: self.cone_tile.unwrap_or(p.cone_tile),
+            bounces: self.bounces.unwrap_or(p.bounces),
         }
     }
 }
@@ -1021,6 +1027,68 @@ fn four() -> Param {
 }
 fn zero() -> Param {
     Param::Value(0.0)
+}
+
+/// A material as written in a file: only the values that differ from
+/// [`Material::default`] need be named.
+#[derive(Serialize, Deserialize, Default)]
+#[serde(default, deny_unknown_fields)]
+struct MaterialRepr {
+    #[serde(skip_serializing_if = "Option::is_none")]
+    roughness: Option<Param>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    specular: Option<Param>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    shininess: Option<Param>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    subsurface: Option<Param>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    scatter_depth: Option<Param>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    reflectivity: Option<Param>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    transparency: Option<Param>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    ior: Option<Param>,
+}
+
+impl MaterialRepr {
+    fn from_material(m: &Material) -> Self {
+        let defaults = Material::default();
+        let [a, b, c, d, e, f, g, h] = std::array::from_fn(|i| {
+            let (value, default) = (m.values()[i], defaults.values()[i]);
+            (value != default).then(|| value.clone())
+        });
+        MaterialRepr {
+            roughness: a,
+            specular: b,
+            shininess: c,
+            subsurface: d,
+            scatter_depth: e,
+            reflectivity: f,
+            transparency: g,
+            ior: h,
+        }
+    }
+
+    fn to_material(&self) -> Material {
+        let defaults = Material::default();
+        let given = [
+            &self.roughness,
+            &self.specular,
+            &self.shininess,
+            &self.subsurface,
+            &self.scatter_depth,
+            &self.reflectivity,
+            &self.transparency,
+            &self.ior,
+        ];
+        Material::from_values(std::array::from_fn(|i| {
+            given[i]
+                .clone()
+                .unwrap_or_else(|| defaults.values()[i].clone())
+        }))
+    }
 }
 
 /// A node as written in a file.
@@ -1139,6 +1207,10 @@ enum NodeRepr {
     },
     Color {
         color: Param3,
+        child: Child,
+    },
+    Material {
+        material: MaterialRepr,
         child: Child,
     },
     Union(Vec<Located<NodeRepr>>),
@@ -1359,6 +1431,10 @@ impl NodeRepr {
             },
             Kind::Color { color, child: c } => NodeRepr::Color {
                 color,
+                child: child(&c),
+            },
+            Kind::Material { material, child: c } => NodeRepr::Material {
+                material: MaterialRepr::from_material(&material),
                 child: child(&c),
             },
             Kind::Csg {
@@ -1583,6 +1659,11 @@ impl Located<NodeRepr> {
             .into(),
             NodeRepr::Color { color, child: c } => Kind::Color {
                 color: color.clone(),
+                child: child(c)?,
+            }
+            .into(),
+            NodeRepr::Material { material, child: c } => Kind::Material {
+                material: material.to_material(),
                 child: child(c)?,
             }
             .into(),

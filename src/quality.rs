@@ -176,7 +176,19 @@ pub struct Quality {
     /// march finds it in fewer steps (or, where the cone skips only
     /// empty space a few steps long, costs a little more).
     pub cone_tile: u32,
+    /// How many times a path may bounce off mirrors or pass through glass
+    /// (0 to 8): the most secondary rays, reflected or refracted, between
+    /// the camera and the last surface a pixel's path reaches. A path that
+    /// would bounce once more takes the sky's colour in that direction
+    /// instead. Only scenes with a reflective or transparent
+    /// [`Material`](crate::scene::Material) use it; each bounce at most
+    /// doubles the rays of a pixel, so the cost stays within `2^(bounces
+    /// + 1)` times a frame without them.
+    pub bounces: u32,
 }
+
+/// The most bounces [`Quality::bounces`] allows.
+pub const MAX_BOUNCES: u32 = 8;
 
 impl Quality {
     /// The detail level shared by every preset, in pixel footprints.
@@ -207,6 +219,7 @@ impl Quality {
             fast_math: true,
             resolution_scale: 3,
             cone_tile: 8,
+            bounces: 1,
         }
     }
 
@@ -221,6 +234,7 @@ impl Quality {
             ao_samples: 3,
             shadow_steps: 64,
             resolution_scale: 1,
+            bounces: 2,
             ..Self::draft()
         }
     }
@@ -236,6 +250,7 @@ impl Quality {
             ao_samples: 5,
             shadow_steps: 96,
             fast_math: false,
+            bounces: 4,
             ..Self::preview()
         }
     }
@@ -255,6 +270,7 @@ impl Quality {
             shadow_steps: 256,
             precision: Precision::F64,
             cone_tile: 0,
+            bounces: 8,
             ..Self::production()
         }
     }
@@ -368,6 +384,12 @@ impl Quality {
             f64::from(self.cone_tile),
             self.cone_tile == 0 || (2..=64).contains(&self.cone_tile),
             "0 (off) or in 2..=64",
+        )?;
+        check(
+            "bounces",
+            f64::from(self.bounces),
+            self.bounces <= MAX_BOUNCES,
+            "<= 8",
         )
     }
 }
@@ -492,6 +514,14 @@ impl Quality {
     #[must_use]
     pub fn cone_tile(mut self, side: u32) -> Self {
         self.cone_tile = side;
+        self
+    }
+
+    /// Lets paths bounce off mirrors or pass through glass up to `bounces`
+    /// times (0 to 8). See [`Quality::bounces`].
+    #[must_use]
+    pub fn bounces(mut self, bounces: u32) -> Self {
+        self.bounces = bounces;
         self
     }
 

@@ -65,7 +65,7 @@ pub(crate) fn program_names() -> &'static BTreeSet<String> {
 }
 
 /// Every text a generated program is assembled from: the header for each
-/// precision and target with every effect on, the helper library, a
+/// precision and target with every effect and materials on, the helper library, a
 /// specialised Mandelbulb and both kernels with all their effect blocks.
 fn library_texts() -> Vec<String> {
     let mut texts = Vec::new();
@@ -88,7 +88,7 @@ fn library_texts() -> Vec<String> {
                 target,
             };
             let mut w = Writer::new(precision);
-            header(&mut w, &options);
+            header(&mut w, &options, true);
             texts.push(w.finish());
         }
     }

@@ -188,6 +188,7 @@ fn instance(ir: &Ir, root: NodeId) -> Option<Instance> {
             Kind::Translate { .. }
                 | Kind::Scale { .. }
                 | Kind::Color { .. }
+                | Kind::Material { .. }
                 | Kind::Round { .. }
                 | Kind::Onion { .. }
                 | Kind::Elongate { .. }
@@ -222,7 +223,12 @@ pub(crate) struct SceneEmitter<'a> {
     /// leaves out (see `Ir::local_frame`).
     frame: Option<NodeId>,
     w: &'a mut Writer,
+    /// Whether the function being written carries a surface (`DE_shade`,
+    /// `DE_material`) beside the distance.
     shade: bool,
+    /// Whether the surface it carries is the material (`DE_material`:
+    /// materials in place of colours, no traps) rather than the colour.
+    material: bool,
     points: usize,
     iteration_override: Option<u32>,
     /// The helper files the emitted code calls.
@@ -260,6 +266,7 @@ impl<'a> SceneEmitter<'a> {
             frame,
             w,
             shade: false,
+            material: false,
             points: 0,
             iteration_override,
             used: BTreeSet::new(),
@@ -279,23 +286,28 @@ impl<'a> SceneEmitter<'a> {
         }
     }
 
-    /// Writes `DE` and `DE_shade`.
-    pub(crate) fn emit(&mut self) {
-        for shade in [false, true] {
+    /// Writes `DE` and `DE_shade`, and `DE_material` with `materials`.
+    pub(crate) fn emit(&mut self, materials: bool) {
+        let functions = [(false, false), (true, false), (true, true)];
+        for (shade, material) in functions.into_iter().take(if materials { 3 } else { 2 }) {
             self.shade = shade;
+            self.material = material;
             self.points = 0;
-            // Both functions lay out the same tables.
+            // Every function lays out the same tables.
             self.constants.clear();
-            if shade {
-                self.w.open(
-                    "real DE_shade(real3 p0, __global const real* params, real3* color, real* trap)",
-                );
-            } else {
-                self.w
-                    .open("real DE(real3 p0, __global const real* params)");
-            }
+            self.w.open(match (shade, material) {
+                (false, _) => "real DE(real3 p0, __global const real* params)",
+                (true, false) => {
+                    "real DE_shade(real3 p0, __global const real* params, real3* color, real* trap)"
+                }
+                (true, true) => {
+                    "real DE_material(real3 p0, __global const real* params, real8* material)"
+                }
+            });
             let out = self.node(self.ir.root(), "p0", true);
-            if shade {
+            if material {
+                self.w.line(format!("*material = {};", out.c));
+            } else if shade {
                 self.w.line(format!("*color = {};", out.c));
                 self.w.line(format!("*trap = {};", out.t));
             }
@@ -303,6 +315,26 @@ impl<'a> SceneEmitter<'a> {
             self.w.close();
             self.w.line("");
         }
+    }
+
+    /// Whether the function being written computes orbit traps.
+    fn traps(&self) -> bool {
+        self.shade && !self.material
+    }
+
+    /// The surface value of a node that sets none: the default colour, or
+    /// the default material.
+    fn default_surface(&self) -> String {
+        if self.material {
+            "DEFAULT_MATERIAL".into()
+        } else {
+            "DEFAULT_COLOR".into()
+        }
+    }
+
+    /// The type of the surface values: a colour or a material.
+    fn surface_type(&self) -> &'static str {
+        if self.material { "real8" } else { "real3" }
     }
 
     fn point(&mut self, expr: String) -> String {
@@ -343,7 +375,7 @@ impl<'a> SceneEmitter<'a> {
         self.w.line(format!("real {d} = {expr};"));
         Vars {
             d,
-            c: "DEFAULT_COLOR".into(),
+            c: self.default_surface(),
             t: "R(1.0)".into(),
         }
     }
@@ -361,8 +393,9 @@ impl<'a> SceneEmitter<'a> {
         self.w
             .line(format!("real {} = {function}({args}, &{});", v.d, v.t));
         Vars {
-            c: "DEFAULT_COLOR".into(),
-            ..v
+            c: self.default_surface(),
+            t: if self.traps() { v.t } else { "R(1.0)".into() },
+            d: v.d,
         }
     }
 
@@ -489,9 +522,10 @@ impl<'a> SceneEmitter<'a> {
         ));
         self.w.line(format!("real u{i} = {};", a.d));
         if self.shade && needs_color {
-            self.w.line(format!("real3 uc{i} = {};", a.c));
+            let ty = self.surface_type();
+            self.w.line(format!("{ty} uc{i} = {};", a.c));
         }
-        if self.shade {
+        if self.traps() {
             self.w.line(format!("real ut{i} = {};", a.t));
         }
         let first = match op {
@@ -545,9 +579,9 @@ impl<'a> SceneEmitter<'a> {
             self.w.line(format!("uc{i} = {};", v.c));
             format!("uc{i}")
         } else {
-            "DEFAULT_COLOR".into()
+            self.default_surface()
         };
-        let t = if self.shade {
+        let t = if self.traps() {
             self.w.line(format!("ut{i} = {};", v.t));
             format!("ut{i}")
         } else {
@@ -596,7 +630,11 @@ impl<'a> SceneEmitter<'a> {
         }
         if !matches!(
             node,
-            Kind::Csg { .. } | Kind::Color { .. } | Kind::Round { .. } | Kind::Onion { .. }
+            Kind::Csg { .. }
+                | Kind::Color { .. }
+                | Kind::Material { .. }
+                | Kind::Round { .. }
+                | Kind::Onion { .. }
         ) {
             self.label(id);
         }
@@ -747,7 +785,16 @@ impl<'a> SceneEmitter<'a> {
                 let comma = if args.is_empty() { "" } else { ", " };
                 Step::Done(self.leaf(id, format!("{}({p}{comma}{args})", shape.function_name())))
             }
-            Kind::Color { child, .. } => Step::Descend(vec![(*child, p.to_string(), false)]),
+            // Below a colour no colour is needed, below a material no
+            // material: each paints over what its child computes.
+            Kind::Color { child, .. } => {
+                let needs = self.material && needs_color;
+                Step::Descend(vec![(*child, p.to_string(), needs)])
+            }
+            Kind::Material { child, .. } => {
+                let needs = !self.material && needs_color;
+                Step::Descend(vec![(*child, p.to_string(), needs)])
+            }
             _ => unreachable!("leaves are emitted from the table above"),
         }
     }
@@ -811,13 +858,24 @@ impl<'a> SceneEmitter<'a> {
             }
             Kind::Color { color, .. } => {
                 let c = child();
-                if !self.shade || !needs_color {
+                if !self.shade || self.material || !needs_color {
                     return c;
                 }
                 self.label(id);
                 let v = vars(id);
                 let rgb = self.w.vector(*color);
                 self.w.line(format!("real3 {} = {rgb};", v.c));
+                Vars { c: v.c, ..c }
+            }
+            Kind::Material { material, .. } => {
+                let c = child();
+                if !self.material || !needs_color {
+                    return c;
+                }
+                self.label(id);
+                let v = vars(id);
+                let values = material.values().map(|s| self.w.scalar(*s)).join(", ");
+                self.w.line(format!("real8 {} = (real8)({values});", v.c));
                 Vars { c: v.c, ..c }
             }
             // Nodes that only move the point pass their child's result on.
@@ -916,9 +974,10 @@ impl<'a> SceneEmitter<'a> {
         ));
         self.w.line(format!("real {d} = INFINITY;"));
         if colour {
-            self.w.line(format!("real3 {c} = DEFAULT_COLOR;"));
+            let (ty, default) = (self.surface_type(), self.default_surface());
+            self.w.line(format!("{ty} {c} = {default};"));
         }
-        if self.shade {
+        if self.traps() {
             self.w.line(format!("real {t} = R(1.0);"));
         }
         self.w
@@ -935,7 +994,9 @@ impl<'a> SceneEmitter<'a> {
             if colour {
                 self.w.line(format!("{c} = {};", v.c));
             }
-            self.w.line(format!("{t} = {};", v.t));
+            if self.traps() {
+                self.w.line(format!("{t} = {};", v.t));
+            }
             self.w.close();
         } else {
             self.w.line(format!("{d} = fmin({d}, {});", v.d));
@@ -943,8 +1004,8 @@ impl<'a> SceneEmitter<'a> {
         self.w.close();
         Vars {
             d,
-            c: if colour { c } else { "DEFAULT_COLOR".into() },
-            t: if self.shade { t } else { "R(1.0)".into() },
+            c: if colour { c } else { self.default_surface() },
+            t: if self.traps() { t } else { "R(1.0)".into() },
         }
     }
 
@@ -1052,7 +1113,7 @@ impl<'a> SceneEmitter<'a> {
             return v;
         }
         if op == CsgOp::Cut {
-            // A cut shows its first operand's colour and trap everywhere.
+            // A cut shows its first operand's surface and trap everywhere.
             return Vars {
                 d: v.d,
                 c: a.c.clone(),
@@ -1061,11 +1122,16 @@ impl<'a> SceneEmitter<'a> {
         }
         let near = format!("x{i} < y{i}");
         let c = if needs_color {
-            self.choose("real3", &v.c, &near, (&a.c, &b.c), blend.as_deref())
+            let ty = self.surface_type();
+            self.choose(ty, &v.c, &near, (&a.c, &b.c), blend.as_deref())
         } else {
             v.c
         };
-        let t = self.choose("real", &v.t, &near, (&a.t, &b.t), blend.as_deref());
+        let t = if self.traps() {
+            self.choose("real", &v.t, &near, (&a.t, &b.t), blend.as_deref())
+        } else {
+            "R(1.0)".into()
+        };
         Vars { d: v.d, c, t }
     }
 

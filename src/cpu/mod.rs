@@ -6,6 +6,7 @@
 //! speed.
 
 pub mod sdf;
+pub mod shade;
 
 use glam::DVec3;
 
@@ -22,7 +23,7 @@ use crate::ir::{
     reach, swaps, union_chain,
 };
 use crate::math::F32_LIMITS;
-use crate::scene::{CsgOp, Kind, Node};
+use crate::scene::{CsgOp, DEFAULT_MATERIAL, Kind, MATERIAL_LEN, Node};
 
 /// What the scene is like at one point.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -33,6 +34,9 @@ pub struct Sample<T> {
     pub color: V3<T>,
     /// Orbit trap in `[0, 1]` (1 for non-fractal surfaces).
     pub trap: T,
+    /// The nearest surface's material, in
+    /// [`Material::values`](crate::scene::Material::values) order.
+    pub material: [T; MATERIAL_LEN],
 }
 
 /// Evaluates one scene's geometry on the CPU.
@@ -236,6 +240,7 @@ impl Evaluator {
             distance,
             color: V3::splat(T::of(DEFAULT_COLOR[0])),
             trap: T::one(),
+            material: DEFAULT_MATERIAL.map(T::of),
         }
     }
 
@@ -439,6 +444,10 @@ impl Evaluator {
                 color: v(*color),
                 ..of(child)
             },
+            Kind::Material { material, child } => Sample {
+                material: material.values().map(|x| s(*x)),
+                ..of(child)
+            },
         }
     }
 }
@@ -489,7 +498,8 @@ fn bound_distance<T: Real>(bound: &Bound, p: V3<T>) -> T {
 
 /// Hard or smooth CSG of two samples. Every operation is a (smooth) minimum
 /// of signed operands: union `min(a, b)`, subtraction `-min(-a, b)`,
-/// intersection and cut `-min(-a, -b)`. A cut keeps `a`'s colour and trap.
+/// intersection and cut `-min(-a, -b)`. A cut keeps `a`'s colour, trap and
+/// material.
 fn combine<T: Real>(op: CsgOp, k: T, a: Sample<T>, b: Sample<T>) -> Sample<T> {
     let (sa, sb) = match op {
         CsgOp::Union => (T::one(), T::one()),
@@ -511,6 +521,7 @@ fn combine<T: Real>(op: CsgOp, k: T, a: Sample<T>, b: Sample<T>) -> Sample<T> {
         distance: if op == CsgOp::Union { m } else { -m },
         color: near.color.zip(far.color, mix),
         trap: mix(near.trap, far.trap),
+        material: std::array::from_fn(|i| mix(near.material[i], far.material[i])),
     }
 }
 

@@ -281,7 +281,7 @@ fn bound(node: &IrNode, done: &[Option<Bound>]) -> Option<Bound> {
         // Where the bound is positive the child's estimate is above the
         // thickness, so its absolute value is itself.
         Kind::Onion { thickness, child } => of(child)?.grow(baked(*thickness)?),
-        Kind::Color { child, .. } => of(child)?,
+        Kind::Color { child, .. } | Kind::Material { child, .. } => of(child)?,
         Kind::Csg {
             op,
             smoothing,
@@ -418,7 +418,9 @@ pub(crate) fn reach(ir: &Ir, id: NodeId, bounds: &[Option<Bound>]) -> Option<Rea
                 stack.push((*b, offset + k));
                 stack.push((*a, offset + k));
             }
-            (Kind::Color { child, .. }, _) => stack.push((*child, offset)),
+            (Kind::Color { child, .. } | Kind::Material { child, .. }, _) => {
+                stack.push((*child, offset));
+            }
             _ => match bounds[at.index()] {
                 Some(b) => parts.push((b, offset)),
                 None => return Some(fallback),

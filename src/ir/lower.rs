@@ -238,7 +238,8 @@ impl Lowering {
             Kind::Translate { child, .. }
             | Kind::Rotate { child, .. }
             | Kind::Scale { child, .. }
-            | Kind::Color { child, .. } => Some(*child),
+            | Kind::Color { child, .. }
+            | Kind::Material { child, .. } => Some(*child),
             _ => None,
         };
         let Some(child) = child_of(&node) else {
@@ -283,6 +284,16 @@ impl Lowering {
                 },
             ) => Some(Kind::Color {
                 color: *color,
+                child: *grandchild,
+            }),
+            // So does the outer material.
+            (
+                Kind::Material { material, .. },
+                Kind::Material {
+                    child: grandchild, ..
+                },
+            ) => Some(Kind::Material {
+                material: material.clone(),
                 child: *grandchild,
             }),
             (

@@ -158,7 +158,7 @@ impl Ir {
     }
 
     /// The scene's outermost baked translation, reached from the root
-    /// through colours only (they move nothing), with its node. Programs
+    /// through colours and materials only (they move nothing), with its node. Programs
     /// for rendering leave that translation out and work in coordinates
     /// relative to it, and the host moves the camera and the lights into
     /// those coordinates in `f64`: a scene placed far from the origin then
@@ -168,7 +168,7 @@ impl Ir {
         let mut id = self.root;
         loop {
             match self.node(id) {
-                Kind::Color { child, .. } => id = *child,
+                Kind::Color { child, .. } | Kind::Material { child, .. } => id = *child,
                 Kind::Translate { offset, .. } => return baked3(*offset).map(|o| (o, id)),
                 _ => return None,
             }

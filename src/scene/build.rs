@@ -9,6 +9,7 @@
 
 use glam::{DQuat, DVec3, DVec4, EulerRot};
 
+use super::material::Material;
 use super::node::{Axis, CsgOp, Kind, Mandelbulb, Menger, Node, QuaternionJulia, Sierpinski};
 use super::param::{Param, Param3};
 
@@ -389,6 +390,18 @@ impl Node {
     pub fn color(self, rgb: impl Into<Param3>) -> Node {
         Kind::Color {
             color: rgb.into(),
+            child: self,
+        }
+        .into()
+    }
+
+    /// Gives the node a material: how its surfaces answer light (see
+    /// [`Material`]). An outer material replaces an inner one, as an outer
+    /// colour does.
+    #[must_use]
+    pub fn material(self, material: Material) -> Node {
+        Kind::Material {
+            material,
             child: self,
         }
         .into()

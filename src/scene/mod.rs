@@ -6,6 +6,7 @@
 
 pub mod build;
 mod custom;
+mod material;
 pub(crate) mod names;
 mod node;
 mod param;
@@ -19,6 +20,7 @@ pub use build::{
     plane, round_box, sierpinski, sphere, torus,
 };
 pub use custom::{CpuDistance, CustomShape};
+pub use material::{DEFAULT_MATERIAL, MATERIAL_LEN, Material};
 pub(crate) use node::Mapper;
 pub use node::{
     Axis, CsgOp, Kind, MAX_ESCAPE_ITERATIONS, MAX_FOLD_ITERATIONS, Mandelbulb, Menger, Node,

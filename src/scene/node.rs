@@ -8,6 +8,7 @@ use std::sync::{Arc, OnceLock};
 use glam::DVec3;
 
 use super::custom::CustomShape;
+use super::material::Material;
 use super::param::{Param, Param3};
 use crate::math::Magnitude;
 
@@ -367,6 +368,14 @@ pub enum Kind<S, V, C> {
         /// The painted node.
         child: C,
     },
+    /// Gives the child (every surface below this node) a material: how it
+    /// answers light (see [`Material`]).
+    Material {
+        /// The material's values.
+        material: Material<S>,
+        /// The node it covers.
+        child: C,
+    },
 }
 
 /// What a parameter must satisfy. Every rule also requires a finite value,
@@ -508,6 +517,7 @@ impl<S, V, C> Kind<S, V, C> {
             },
             Kind::Custom { .. } => "custom",
             Kind::Color { .. } => "color",
+            Kind::Material { .. } => "material",
         }
     }
 
@@ -525,7 +535,8 @@ impl<S, V, C> Kind<S, V, C> {
             | Kind::RepeatLimited { child, .. }
             | Kind::Twist { child, .. }
             | Kind::Bend { child, .. }
-            | Kind::Color { child, .. } => vec![child],
+            | Kind::Color { child, .. }
+            | Kind::Material { child, .. } => vec![child],
             Kind::Csg { a, b, .. } => vec![a, b],
             _ => vec![],
         }
@@ -561,7 +572,8 @@ impl<S, V, C> Kind<S, V, C> {
             | Kind::RepeatLimited { child, .. }
             | Kind::Twist { child, .. }
             | Kind::Bend { child, .. }
-            | Kind::Color { child, .. } => vec![child],
+            | Kind::Color { child, .. }
+            | Kind::Material { child, .. } => vec![child],
             Kind::Csg { a, b, .. } => vec![a, b],
         }
     }
@@ -755,6 +767,10 @@ impl<S, V, C> Kind<S, V, C> {
             },
             Kind::Color { color, child } => Kind::Color {
                 color: m.vector(color, spec("color", NonNegative))?,
+                child: m.child(child)?,
+            },
+            Kind::Material { material, child } => Kind::Material {
+                material: material.try_map(|s, spec| m.scalar(s, spec))?,
                 child: m.child(child)?,
             },
         })

@@ -121,10 +121,12 @@ void march_lens_ray(const MarchCamera* cam, real px, real py, real2 lens, real3*
 }
 
 // The drawn surface: where the distance estimate falls to DETAIL pixel
-// footprints. g(t) is how far the point at t along the ray lies outside it.
-real march_level(real3 ro, real3 rd, const MarchCamera* cam, real t,
+// footprints. g(t) is how far the point at t along the ray lies outside it
+// (side 1), or inside it (side -1: a ray travelling inside a transparent
+// shape, looking for the way out).
+real march_level(real3 ro, real3 rd, const MarchCamera* cam, real t, real side,
                  __global const real* params) {
-    return DE(ro + rd * t, params) - DETAIL * march_footprint(cam, t);
+    return side * (DE(ro + rd * t, params) - DETAIL * march_footprint(cam, t));
 }
 
 // Locates the crossing of the surface between t0 (outside, g0 > 0) and t1
@@ -134,14 +136,14 @@ real march_level(real3 ro, real3 rd, const MarchCamera* cam, real t,
 // superlinear elsewhere. Returns the inside end of the final bracket and
 // adds its evaluations to *steps.
 real march_refine(real3 ro, real3 rd, const MarchCamera* cam, real t0, real g0, real t1,
-                  real g1, __global const real* params, int* steps) {
+                  real g1, real side, __global const real* params, int* steps) {
     int kept = 0; // which end the last step moved: -1 outside, 1 inside
     for (int i = 0; i < MARCH_REFINE_LIMIT; ++i) {
         if (t1 - t0 <= HIT_EPSILON * march_footprint(cam, t1)) {
             break;
         }
         real t = clamp(t0 + (t1 - t0) * (g0 / (g0 - g1)), t0, t1);
-        real g = march_level(ro, rd, cam, t, params);
+        real g = march_level(ro, rd, cam, t, side, params);
         *steps += 1;
         if (g > R(0.0)) {
             t0 = t;
@@ -242,7 +244,10 @@ int march_glow_settled(real3 p, real3 rd, real t) {
     return SCENE_BOUND_SLOPE * (a * length(q) - SCENE_BOUND_RADIUS) >= k * t;
 }
 
-MarchResult march_ray(real3 ro, real3 rd, real start, const MarchCamera* cam,
+// Side 1 marches towards the surface from outside, side -1 towards the
+// way out from inside it (g and its Lipschitz bound are the same up to
+// sign).
+MarchResult march_ray(real3 ro, real3 rd, real start, const MarchCamera* cam, real side,
                       __global const real* params) {
     MarchResult r;
     r.t = start;
@@ -259,7 +264,7 @@ MarchResult march_ray(real3 ro, real3 rd, real start, const MarchCamera* cam,
     const real t_exit = march_bound_exit(ro, rd, cam);
     for (int i = 0; i < MAX_STEPS; ++i) {
         real d = DE(ro + rd * r.t, params);
-        real g = d - DETAIL * march_footprint(cam, r.t);
+        real g = side * (d - DETAIL * march_footprint(cam, r.t));
         r.steps += 1;
         if (relaxed && (g < R(0.0) || prev_g + g < lipschitz * (r.t - prev_t))) {
             r.t = prev_t + prev_g / lipschitz;
@@ -274,7 +279,7 @@ MarchResult march_ray(real3 ro, real3 rd, real start, const MarchCamera* cam,
             r.hit = 1;
             r.closest = R(0.0);
             if (i > 0) {
-                r.t = march_refine(ro, rd, cam, prev_t, prev_g, r.t, g, params, &r.steps);
+                r.t = march_refine(ro, rd, cam, prev_t, prev_g, r.t, g, side, params, &r.steps);
             }
             return r;
         }
@@ -409,9 +414,19 @@ real3 march_background(const MarchCamera* cam, real py) {
     return mix(SKY_BOTTOM, SKY_TOP, v);
 }
 
+
 // Lit colour of the surface point p with normal n, seen along rd; the
 // image is view_height scene units high at p's distance. Adds its distance
-// evaluations (DE_shade, occlusion, shadow rays) to *evals.
+// evaluations (DE_shade, DE_material, occlusion, shadow rays, thickness)
+// to *evals.
+//
+// Every light adds albedo * diffuse * n.l plus the Blinn-Phong highlight
+// specular * (n.h)^shininess * n.l, the diffuse term being Lambert's (1)
+// or, with a material's roughness, Oren-Nayar's. With a material's
+// subsurface strength s, a light behind the surface (n.l < 0) adds
+// albedo * s * thinness * -n.l: it shows through thin parts, unshadowed
+// (the shape itself stands between). Without materials the highlight is
+// MARCH_SPECULAR and MARCH_SHININESS, the default material's.
 real3 march_shade(real3 p, real3 n, real3 rd, real eps, real view_height,
                   __global const real* params, __global const real* lights, int light_count,
                   uint* evals) {
@@ -420,6 +435,8 @@ real3 march_shade(real3 p, real3 n, real3 rd, real eps, real view_height,
     DE_shade(p, params, &albedo, &trap);
     *evals += 1u;
     albedo *= march_trap_tint(trap);
+    real specular_strength = MARCH_SPECULAR;
+    real shininess = MARCH_SHININESS;
 
     real occlusion = R(1.0);
     occlusion = march_ambient_occlusion(p, n, view_height, params);
@@ -447,8 +464,9 @@ real3 march_shade(real3 p, real3 n, real3 rd, real eps, real view_height,
         if (ndl <= R(0.0)) {
             continue;
         }
+        real diffuse = R(1.0);
         // The most this light adds to the pixel in any channel.
-        real3 most = radiance * ((albedo + MARCH_SPECULAR) * ndl);
+        real3 most = radiance * ((albedo * diffuse + specular_strength) * ndl);
         real visible = march_shadow(lifted, to_light, light_distance, R(0.25) * eps, eps,
                                     l[LIGHT_SOFTNESS], fmax(most.x, fmax(most.y, most.z)),
                                     params, evals);
@@ -457,11 +475,12 @@ real3 march_shade(real3 p, real3 n, real3 rd, real eps, real view_height,
         }
         radiance *= visible;
         real3 half_vector = normalize(to_light - rd);
-        real specular = MARCH_SPECULAR * pow(fmax(dot(n, half_vector), R(0.0)), MARCH_SHININESS);
-        color += radiance * (albedo * ndl + specular * ndl);
+        real specular = specular_strength * pow(fmax(dot(n, half_vector), R(0.0)), shininess);
+        color += radiance * (albedo * (diffuse * ndl) + specular * ndl);
     }
     return color;
 }
+
 
 // Deterministic per-sample jitter in [0, 1): the same image every run.
 uint march_hash(uint x) {
@@ -606,7 +625,7 @@ __kernel void render_tile(RENDER_TILE_ARGS) {
         real3 ro;
         real3 rd;
         march_lens_ray(&cam, px, py, lens, &ro, &rd);
-        MarchResult m = march_ray(ro, rd, start, &cam, params);
+        MarchResult m = march_ray(ro, rd, start, &cam, R(1.0), params);
         total_steps += (uint)m.steps;
         total_evals += (uint)m.steps;
 
@@ -657,7 +676,7 @@ __kernel void render_tile(RENDER_TILE_ARGS) {
             real3 rd;
             march_camera_ray(&cam, ((real)x + R(0.5)) * cam.pixel_scale,
                              ((real)y + R(0.5)) * cam.pixel_scale, &ro, &rd);
-            centre = march_ray(ro, rd, start, &cam, params);
+            centre = march_ray(ro, rd, start, &cam, R(1.0), params);
             centre_normal = (real3)(R(0.0));
             if (centre.hit) {
                 real h = NORMAL_EPSILON * march_footprint(&cam, centre.t);
