@@ -19,9 +19,9 @@ use crate::error::Result;
 use crate::file::SceneFile;
 use crate::quality::{Effects, Glow, Quality};
 use crate::scene::{
-    Axis, Camera, Light, Mandelbulb, Node, QuaternionJulia, Scene, capped_cone, capsule, cuboid,
-    cylinder, ellipsoid, julia, menger, octahedron, param, param3, plane, round_box, sierpinski,
-    sphere, torus,
+    Axis, Camera, Light, Mandelbulb, Material, Node, QuaternionJulia, Scene, capped_cone, capsule,
+    cuboid, cylinder, ellipsoid, julia, menger, octahedron, param, param3, plane, round_box,
+    sierpinski, sphere, torus,
 };
 
 /// Every gallery scene by name.
@@ -39,6 +39,7 @@ pub fn all() -> Vec<(&'static str, Scene)> {
         ("benchmark", benchmark()),
         ("depth_of_field", depth_of_field()),
         ("cross_section", cross_section()),
+        ("materials", materials()),
     ]
 }
 
@@ -213,6 +214,56 @@ pub fn cross_section() -> Scene {
     Scene::new(bulb.union(floor(1.15)))
         .with_camera(Camera::look_at(dvec3(2.5, 1.7, 2.9), dvec3(0.0, -0.2, 0.0)).fov(40.0))
         .with_lights(key_and_fill())
+}
+
+/// The shading models and the secondary rays, side by side on a polished
+/// floor that mirrors them: from the left, a rough clay sphere
+/// (Oren–Nayar), a glossy one (Blinn–Phong), a waxy lens whose thin rim
+/// glows with the light behind it (subsurface), a glass sphere whose
+/// index is the dynamic parameter `ior` (1.5) and a mirror sphere; a
+/// Mandelbulb behind them shows in the glass and the mirror.
+#[must_use]
+pub fn materials() -> Scene {
+    let at = |x: f64, z: f64| dvec3(x, 0.0, z);
+    let clay = sphere(0.42)
+        .color(dvec3(0.8, 0.45, 0.3))
+        .material(Material::oren_nayar(0.9))
+        .translate(at(-1.9, 0.2));
+    let glossy = sphere(0.42)
+        .color(dvec3(0.25, 0.45, 0.9))
+        .material(Material::blinn_phong(0.9, 80.0))
+        .translate(at(-0.95, 0.2));
+    let wax = ellipsoid(dvec3(0.45, 0.45, 0.16))
+        .color(dvec3(0.95, 0.8, 0.5))
+        .material(Material::subsurface(1.0, 0.3))
+        .rotate(DVec3::Y, -0.5)
+        .translate(at(0.0, 0.2));
+    let glass = sphere(0.42)
+        .material(Material::glass(param("ior", 1.5)))
+        .translate(at(0.95, 0.35));
+    let mirror = sphere(0.42)
+        .material(Material::mirror())
+        .translate(at(1.9, 0.2));
+    let bulb = Node::from(Mandelbulb::new(8.0).iterations(8))
+        .rotate(DVec3::X, -FRAC_PI_2)
+        .scale(0.7)
+        .color(dvec3(0.95, 0.7, 0.45))
+        .translate(dvec3(0.5, 0.25, -1.3));
+    let polished = floor(0.45).material(Material::default().reflectivity(0.25));
+    let shapes = [clay, glossy, wax, glass, mirror, bulb]
+        .into_iter()
+        .reduce(Node::union)
+        .expect("six shapes");
+    Scene::new(shapes.union(polished))
+        .with_camera(Camera::look_at(dvec3(0.0, 1.1, 4.4), dvec3(0.0, -0.05, -0.2)).fov(42.0))
+        .with_lights(vec![
+            Light::directional(dvec3(0.5, 0.8, 0.6))
+                .color(dvec3(1.0, 0.95, 0.85))
+                .softness(0.06),
+            Light::directional(dvec3(-0.3, 0.35, -0.9))
+                .color(dvec3(1.0, 0.85, 0.7))
+                .intensity(0.8),
+        ])
 }
 
 /// Smooth union, subtraction and intersection of transformed primitives.
