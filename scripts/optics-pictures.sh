@@ -9,6 +9,9 @@
 #   docs/stereo-side-by-side.png  the Menger sponge as a side-by-side pair
 #   docs/cross-section-N.png      the cross_section scene with its cut at
 #                                 -0.35, 0 and 0.3
+#   docs/materials.png            the materials scene, 4 progressive passes
+#   docs/materials-bounces-N.png  its glass and mirror after 0, 1 and 4
+#                                 bounces
 #
 #   scripts/optics-pictures.sh
 set -euo pipefail
@@ -28,4 +31,8 @@ n=0
 for cut in -0.35 0 0.3; do
     n=$((n + 1))
     render cross_section --size 320x240 --set "cut=$cut" -o "docs/cross-section-$n.png"
+done
+render materials --size 640x400 --passes 4 -o docs/materials.png
+for n in 0 1 4; do
+    render materials --size 320x200 --bounces "$n" -o "docs/materials-bounces-$n.png"
 done

@@ -155,10 +155,24 @@ fn render_takes_passes_a_lens_and_stereo() {
         refined += usize::from(a == q && p != q);
     }
     assert!(kept > 0 && refined > 0, "{kept} kept, {refined} refined");
+    // Bounces: the gallery's mirror and glass show the sky without any.
+    let bounce = |n: &str| {
+        let png = dir.join(format!("bounces-{n}.png"));
+        let args = ["render", "materials", "-o", png.to_str().unwrap()];
+        let out = run(
+            &dir,
+            "",
+            &[&args[..], &["--size", "40x30", "--bounces", n]].concat(),
+        );
+        assert!(out.status.success(), "--bounces {n}: {}", text(&out));
+        read(&png)
+    };
+    assert_ne!(bounce("0"), bounce("2"), "bounces show reflections");
     // Bad values: a clear error and no image.
     let o = dir.join("x.png");
     let o = o.to_str().unwrap();
-    let cases: [(&[&str], i32, &str); 5] = [
+    let cases: [(&[&str], i32, &str); 6] = [
+        (&["--bounces", "9"], 1, "bounces"),
         (
             &["--stereo", "crossed"],
             2,

@@ -11,7 +11,9 @@
 //! changes the surface drawn rather than the accuracy, shows how much the
 //! look depends on it. Anti-aliasing is measured apart, at half the size,
 //! against a 4×4-sample render, and so are progressive passes, everywhere
-//! and at the edges alone (adaptive), against an 8×8-sample render. A table says whether each preset is on the
+//! and at the edges alone (adaptive), against an 8×8-sample render; and
+//! `bounces` on the gallery's `materials` scene, against eight bounces.
+//! A table says whether each preset is on the
 //! measured front (no configuration both faster, by more than 10%, and
 //! more accurate, by more than 0.5 dB). Prints
 //! markdown tables, writes
@@ -19,10 +21,11 @@
 //!
 //! ```text
 //! cargo run --release --example tradeoff [-- --quick | --size 640x480]
-//!     [--scenes mandelbulb,menger] [--no-aa]
+//!     [--scenes mandelbulb,menger] [--no-aa] [--no-bounces]
 //! ```
 //!
-//! `--quick` renders 320×240 with fewer timed runs. Timings depend on the
+//! `--quick` renders 320×240 with fewer timed runs; `--scenes ''` measures
+//! only the bounces. Timings depend on the
 //! device and on whatever else the machine is doing.
 
 #[path = "../common/mod.rs"]
@@ -448,7 +451,12 @@ fn main() -> std::process::ExitCode {
         };
         let scenes: Vec<String> = measure::value("--scenes").map_or_else(
             || SCENES.iter().map(ToString::to_string).collect(),
-            |s| s.split(',').map(str::to_string).collect(),
+            |s| {
+                s.split(',')
+                    .filter(|n| !n.is_empty())
+                    .map(str::to_string)
+                    .collect()
+            },
         );
         let study = Study {
             size,
@@ -508,31 +516,46 @@ fn main() -> std::process::ExitCode {
                 rows.extend(aa.progressive(name, &scene)?);
             }
         }
+        if !measure::flag("--no-bounces") {
+            // Secondary rays, on the gallery's mirrors and glass, against
+            // paths eight bounces deep.
+            let scene = fractal_sdf::gallery::materials();
+            eprintln!("materials: bounces");
+            let deepest = Quality::production().bounces(fractal_sdf::quality::MAX_BOUNCES);
+            let (timing, best) = study.measure(&scene, deepest)?;
+            let configs = (0..=4)
+                .map(|n| (format!("bounces={n}"), Quality::production().bounces(n)))
+                .collect();
+            let against = (timing.median_ms, &best);
+            rows.extend(study.group("materials", &scene, "bounces", configs, against)?);
+        }
         println!(
             "Measured by `cargo run --release --example tradeoff` at {}x{} on {device}.\n",
             size.0, size.1
         );
-        println!("March accuracy (1 sample per pixel; error against `reference`):\n");
-        println!("{}", table(&rows, &["preset", "floor"]));
-        println!("Sweeps of production quality:\n");
-        println!(
-            "{}",
-            table(
-                &rows,
-                &[
-                    "max_steps",
-                    "hit_epsilon",
-                    "over_relaxation",
-                    "cone_tile",
-                    "fast_math",
-                    "resolution_scale"
-                ]
-            )
-        );
-        println!("The presets against every other measured configuration:\n");
-        println!("{}", front(&rows));
-        println!("The look: `detail` changes the surface drawn (production otherwise):\n");
-        println!("{}", table(&rows, &["detail"]));
+        if rows.iter().any(|r| r.group == "preset") {
+            println!("March accuracy (1 sample per pixel; error against `reference`):\n");
+            println!("{}", table(&rows, &["preset", "floor"]));
+            println!("Sweeps of production quality:\n");
+            println!(
+                "{}",
+                table(
+                    &rows,
+                    &[
+                        "max_steps",
+                        "hit_epsilon",
+                        "over_relaxation",
+                        "cone_tile",
+                        "fast_math",
+                        "resolution_scale"
+                    ]
+                )
+            );
+            println!("The presets against every other measured configuration:\n");
+            println!("{}", front(&rows));
+            println!("The look: `detail` changes the surface drawn (production otherwise):\n");
+            println!("{}", table(&rows, &["detail"]));
+        }
         if rows.iter().any(|r| r.group == "aa") {
             println!(
                 "Anti-aliasing at {}x{} (speed-up: against 1x1; error: against production with 4x4 samples):\n",
@@ -546,6 +569,12 @@ fn main() -> std::process::ExitCode {
                 size.1 / 2
             );
             println!("{}", table(&rows, &["progressive"]));
+        }
+        if rows.iter().any(|r| r.group == "bounces") {
+            println!(
+                "Reflections and refraction: `bounces` on the `materials` scene (speed-up and error: against 8 bounces):\n"
+            );
+            println!("{}", table(&rows, &["bounces"]));
         }
         let csv_path = "out/tradeoff.csv";
         std::fs::write(csv_path, csv(&rows, &device))

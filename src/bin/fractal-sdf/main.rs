@@ -130,6 +130,10 @@ struct RenderArgs {
     /// Where the eyes' images coincide (default: the distance in focus).
     #[arg(long, value_name = "DISTANCE", requires = "stereo")]
     convergence: Option<f64>,
+    /// How many times a path may bounce off mirrors or pass through glass
+    /// (0 to 8; default: the quality's).
+    #[arg(long, value_name = "N")]
+    bounces: Option<u32>,
 }
 
 impl RenderArgs {
@@ -382,6 +386,9 @@ fn render(args: &RenderArgs, settings: &Settings) -> Outcome {
     }
     if let Some(focus) = args.focus {
         camera.focus_distance = Some(focus);
+    }
+    if let Some(bounces) = args.bounces {
+        job.options.quality.bounces = bounces;
     }
     let (width, height) = job.size;
     let start = Instant::now();
