@@ -82,6 +82,10 @@ fn each_shading_model_matches_its_cpu_reference() {
     ];
     let quality = gpu::quick();
     let effects = Effects::none();
+    let sky = shade::Sky {
+        bottom: effects.sky_bottom,
+        top: effects.sky_top,
+    };
     let mut images = Vec::new();
     for (name, node) in models {
         let scene = lit(node.clone());
@@ -96,7 +100,7 @@ fn each_shading_model_matches_its_cpu_reference() {
             let p = ray.origin + ray.direction * f64::from(frame.depth[i]);
             let n = DVec3::from(frame.normal[i].map(f64::from));
             let expected = encode(
-                shade::shade(&eval, p, n, ray.direction, &scene.lights, &effects),
+                shade::shade(&eval, p, n, ray.direction, &scene.lights, sky),
                 effects.gamma,
             );
             let got = frame.image.get_pixel(x, y).0;
@@ -104,6 +108,10 @@ fn each_shading_model_matches_its_cpu_reference() {
                 worst = worst.max((f64::from(got[c]) - expected[c]).abs());
             }
         }
+        eprintln!(
+            "{name}: {} pixels, at most {worst} levels off",
+            pixels.len()
+        );
         assert!(worst <= 2.0, "{name}: off its reference by {worst} levels");
         images.push((name, frame.image));
     }
@@ -199,6 +207,7 @@ fn a_mirror_shows_what_its_reflected_rays_must_hit() {
         "{red} of {total} see the wall"
     );
     let share = agree as f64 / total as f64;
+    eprintln!("mirror: {agree} of {total} pixels as predicted, {red} see the wall");
     assert!(share > 0.97, "{agree} of {total} pixels as predicted");
 }
 
@@ -294,6 +303,7 @@ fn glass_bends_rays_as_snell_says() {
             }
         }
         let share = agree as f64 / total as f64;
+        eprintln!("glass {ior}: {agree} of {total} as predicted, {moved} moved");
         assert!(total > 400, "ior {ior}: {total} pixels");
         assert!(share > 0.95, "ior {ior}: {agree} of {total} as predicted");
         if ior > 1.0 {
@@ -321,7 +331,8 @@ fn glass_of_index_one_is_invisible() {
         .count();
     // Only pixels at the wall's seam, seen through the ball's rim, may
     // differ: the rays are moved off the surface by a pixel or so.
-    assert!(off < 40, "{off} pixels differ");
+    eprintln!("glass of index 1: {off} pixels differ");
+    assert!(off < 10, "{off} pixels differ");
 }
 
 #[test]

@@ -9,8 +9,18 @@
 use glam::DVec3;
 
 use super::Evaluator;
-use crate::quality::Effects;
 use crate::scene::{Light, LightSource, Material};
+
+/// The sky's colours, whose hemisphere lights every surface
+/// ([`Effects::sky_bottom`](crate::quality::Effects::sky_bottom) and
+/// [`Effects::sky_top`](crate::quality::Effects::sky_top)).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Sky {
+    /// Linear RGB below the horizon.
+    pub bottom: DVec3,
+    /// Linear RGB overhead.
+    pub top: DVec3,
+}
 
 /// The kernels' strength of the sky's hemisphere light
 /// (`MARCH_AMBIENT`).
@@ -22,7 +32,7 @@ pub const SCATTER_SAMPLES: u32 = 4;
 
 /// The lit linear colour of the surface point `p` of `eval`'s scene with
 /// unit outward normal `n`, seen along the unit direction `rd`, under
-/// `lights` and the sky of `effects`; occlusion 1 and no shadows. `p`,
+/// `lights` and `sky`; occlusion 1 and no shadows. `p`,
 /// `n` and `rd` are in the scene's coordinates, as the renderer's AOVs
 /// give them.
 ///
@@ -33,24 +43,19 @@ pub const SCATTER_SAMPLES: u32 = 4;
 /// let eval = cpu::Evaluator::new(&sphere(1.0).material(Material::oren_nayar(0.5)))?;
 /// let lights = [Light::directional(dvec3(0.0, 0.0, 1.0))];
 /// let p = dvec3(0.0, 0.0, 1.0);
-/// let lit = shade::shade(&eval, p, p, -p, &lights, &Effects::default());
+/// let effects = Effects::default();
+/// let sky = shade::Sky { bottom: effects.sky_bottom, top: effects.sky_top };
+/// let lit = shade::shade(&eval, p, p, -p, &lights, sky);
 /// assert!(lit.x > 0.5);
 /// # Ok::<(), fractal_sdf::Error>(())
 /// ```
 #[must_use]
-pub fn shade(
-    eval: &Evaluator,
-    p: DVec3,
-    n: DVec3,
-    rd: DVec3,
-    lights: &[Light],
-    effects: &Effects,
-) -> DVec3 {
+pub fn shade(eval: &Evaluator, p: DVec3, n: DVec3, rd: DVec3, lights: &[Light], sky: Sky) -> DVec3 {
     let sample = eval.sample::<f64>(p.into());
     let albedo = DVec3::from(sample.color) * trap_tint(sample.trap);
     let m: Material<f64> = Material::from_values(sample.material);
-    let sky = effects.sky_bottom.lerp(effects.sky_top, 0.5 + 0.5 * n.y);
-    let mut color = albedo * sky * AMBIENT;
+    let ambient = sky.bottom.lerp(sky.top, 0.5 + 0.5 * n.y);
+    let mut color = albedo * ambient * AMBIENT;
     let through = if m.subsurface > 0.0 && m.scatter_depth > 0.0 {
         m.subsurface * thinness(eval, p, n, m.scatter_depth)
     } else {

@@ -166,26 +166,7 @@ impl Material {
 
 impl Default for Material {
     fn default() -> Self {
-        let [
-            roughness,
-            specular,
-            shininess,
-            subsurface,
-            scatter_depth,
-            reflectivity,
-            transparency,
-            ior,
-        ] = DEFAULT_MATERIAL.map(Param::from);
-        Material {
-            roughness,
-            specular,
-            shininess,
-            subsurface,
-            scatter_depth,
-            reflectivity,
-            transparency,
-            ior,
-        }
+        Material::from_values(DEFAULT_MATERIAL.map(Param::from))
     }
 }
 
