@@ -34,7 +34,10 @@
 use super::node::{ParamSpec, Rule};
 use super::param::Param;
 
-/// How a surface answers light; see the [module](self) for the formula.
+/// How a surface answers light: the values that the renderer's one
+/// shading formula reads (Oren–Nayar diffuse, a Blinn–Phong highlight,
+/// subsurface light through thin parts, reflections and refraction; see
+/// [`Node::material`](super::Node::material) and the README).
 ///
 /// `Material::default()` is the look of every surface without a material:
 /// Lambert diffuse with a Blinn–Phong highlight of strength 0.25 and
