@@ -68,6 +68,7 @@ typedef struct {
     real aperture;    // the thin lens's radius (0: a pinhole)
     real focus;       // the distance along forward that is in focus
     int orthographic;
+    real phase;       // where a ray's brute-force steps start, in [0, 1) of a step
 } MarchCamera;
 
 MarchCamera march_load_camera(__global const real* c) {
@@ -87,6 +88,7 @@ MarchCamera march_load_camera(__global const real* c) {
     cam.shift = vload2(0, c + CAMERA_SHIFT);
     cam.aperture = c[CAMERA_APERTURE];
     cam.focus = c[CAMERA_FOCUS_DISTANCE];
+    cam.phase = R(0.5);
     return cam;
 }
 
@@ -146,6 +148,12 @@ real march_refine(real3 ro, real3 rd, const MarchCamera* cam, real t0, real g0, 
             break;
         }
         real t = clamp(t0 + (t1 - t0) * (g0 / (g0 - g1)), t0, t1);
+#ifdef ENABLE_BRUTE
+        // An inside shape's value has a sign and no size: halve the bracket.
+        if (fmax(fabs(g0), fabs(g1)) >= R(0.5) * INSIDE_HUGE) {
+            t = R(0.5) * (t0 + t1);
+        }
+#endif
         real g = march_level(ro, rd, cam, t, side, params);
         *steps += 1;
         if (g > R(0.0)) {
@@ -254,6 +262,49 @@ int march_glow_settled(real3 p, real3 rd, real t) {
 }
 #endif
 
+#ifdef ENABLE_BRUTE
+// Where the ray ro + t rd (rd of unit length) is within the sphere the
+// inside shapes lie in (BRUTE_CENTRE, BRUTE_RADIUS): (enter, exit), with
+// enter > exit where it misses the sphere.
+real2 march_brute_span(real3 ro, real3 rd) {
+    real3 oc = ro - BRUTE_CENTRE;
+    real b = dot(oc, rd);
+    real disc = b * b - (dot(oc, oc) - BRUTE_RADIUS * BRUTE_RADIUS);
+    if (disc < R(0.0)) {
+        return (real2)(R(1.0), R(-1.0));
+    }
+    real root = sqrt(disc);
+    return (real2)(-b - root, -b + root);
+}
+
+// Brute-force marching. Inside shapes have no distance (their value is
+// +-INSIDE_HUGE), so within their sphere a ray samples points at most h
+// apart and asks only for the sign. The samples form a lattice that
+// starts phase * h past where the ray enters the sphere (or past t, where
+// it starts within it) and continues h apart; a sphere-tracing step
+// shorter than the way to the next sample (near a distance-estimated
+// surface) is taken as it is, and the lattice resumes from the sample it
+// did not reach. Returns the step from t, at most `step`, and keeps the
+// next sample in *next (negative before the first).
+real march_brute_step(real t, real step, real2 span, real h, real phase, real* next) {
+    if (t + step <= span.x || t >= span.y) {
+        return step;
+    }
+    if (*next < R(0.0)) {
+        *next = fmax(t, span.x) + phase * h;
+    }
+    if (*next <= t) {
+        *next = t + h;
+    }
+    real to_next = *next - t;
+    if (to_next > step) {
+        return step;
+    }
+    *next += h;
+    return to_next;
+}
+#endif
+
 // Side 1 marches towards the surface from outside, side -1 towards the
 // way out from inside it (g and its Lipschitz bound are the same up to
 // sign).
@@ -273,6 +324,11 @@ MarchResult march_ray(real3 ro, real3 rd, real start, const MarchCamera* cam, re
     // A ray that has passed the last place it could hit stops (after a
     // plain step: a relaxed one may still fall back before it).
     const real t_exit = march_bound_exit(ro, rd, cam);
+#endif
+#ifdef ENABLE_BRUTE
+    const real2 span = march_brute_span(ro, rd);
+    real next_sample = R(-1.0);
+    int brute_steps = 0;
 #endif
     for (int i = 0; i < MAX_STEPS; ++i) {
         real d = DE(ro + rd * r.t, params);
@@ -298,9 +354,24 @@ MarchResult march_ray(real3 ro, real3 rd, real start, const MarchCamera* cam, re
         real plain = g / lipschitz;
         real shortest = HIT_EPSILON * march_footprint(cam, r.t);
         relaxed = omega > R(1.0) && omega * plain > fmax(plain, shortest);
+        real step = fmax(omega * plain, shortest);
+#ifdef ENABLE_BRUTE
+        real h = BRUTE_STEP * march_footprint(cam, fmax(r.t, span.x));
+        real brute = march_brute_step(r.t, step, span, h, cam->phase, &next_sample);
+        if (brute < step) {
+            // A brute-force step: never relaxed, and not one of the
+            // MAX_STEPS the sphere tracing may take (BRUTE_MAX_STEPS more).
+            step = brute;
+            relaxed = 0;
+            if (brute_steps < BRUTE_MAX_STEPS) {
+                brute_steps += 1;
+                i -= 1;
+            }
+        }
+#endif
         prev_t = r.t;
         prev_g = g;
-        r.t += fmax(omega * plain, shortest);
+        r.t += step;
         if (r.t > MAX_DISTANCE) {
             return r;
         }
@@ -392,12 +463,31 @@ real march_shadow(real3 ro, real3 rd, real max_t, real eps, real start, real sof
         max_t = fmin(max_t, t_exit);
     }
 #endif
+#ifdef ENABLE_BRUTE
+    // Inside shapes block the ray where a sample lands in them: samples
+    // BRUTE_STEP times 4 of the shaded pixel's footprints apart (start is
+    // DETAIL footprints), beyond SHADOW_STEPS. They begin two samples out:
+    // a set's surface is rough at the scale of a step, and the sub-pixel
+    // dust next to a hit would otherwise shadow every point of it.
+    const real lattice = R(4.0) * BRUTE_STEP * start / DETAIL;
+    real2 span = march_brute_span(ro, rd);
+    span.x = fmax(span.x, R(2.0) * lattice);
+    real next_sample = R(-1.0);
+    int brute_steps = 0;
+#endif
     for (int i = 0; i < SHADOW_STEPS && t < max_t; ++i) {
         real h = DE(ro + rd * t, params);
         *evals += 1u;
+#ifdef ENABLE_BRUTE
+        if (h <= R(-0.5) * INSIDE_HUGE && t < span.x) {
+            // The dust next to the start: no information.
+            h = INSIDE_HUGE;
+        }
+#endif
         if (h < eps) {
             return R(0.0);
         }
+
         if (softness > R(0.0)) {
             // The closest point to the surface between this sample and the
             // previous one, estimated from the two distance spheres. They
@@ -412,7 +502,18 @@ real march_shadow(real3 ro, real3 rd, real max_t, real eps, real start, real sof
                 return R(0.0);
             }
         }
-        t += fmax(h, eps);
+        real step = fmax(h, eps);
+#ifdef ENABLE_BRUTE
+        real brute = march_brute_step(t, step, span, lattice, R(0.5), &next_sample);
+        if (brute < step) {
+            step = brute;
+            if (brute_steps < BRUTE_MAX_STEPS) {
+                brute_steps += 1;
+                i -= 1;
+            }
+        }
+#endif
+        t += step;
     }
     visible = clamp(visible, R(0.0), R(1.0));
     return visible * visible * (R(3.0) - R(2.0) * visible);
@@ -480,10 +581,22 @@ real march_thinness(real3 p, real3 n, real depth, __global const real* params, u
 }
 #endif
 
-// Lit colour of the surface point p with normal n, seen along rd; the
-// image is view_height scene units high at p's distance. Adds its distance
-// evaluations (DE_shade, DE_material, occlusion, shadow rays, thickness)
-// to *evals.
+// Ambient occlusion at p from the distance estimate (see
+// march_ambient_occlusion), or 1 without it; the image is view_height
+// scene units high at p's distance. Adds its evaluations to *evals.
+real march_occlusion(real3 p, real3 n, real view_height, __global const real* params,
+                     uint* evals) {
+    real occlusion = R(1.0);
+#ifdef ENABLE_AO
+    occlusion = march_ambient_occlusion(p, n, view_height, params);
+    *evals += (uint)AO_SAMPLES;
+#endif
+    return occlusion;
+}
+
+// Lit colour of the surface point p with normal n, seen along rd, with the
+// sky's light scaled by occlusion (1: open). Adds its distance evaluations
+// (DE_shade, DE_material, shadow rays, thickness) to *evals.
 //
 // Every light adds albedo * diffuse * n.l plus the Blinn-Phong highlight
 // specular * (n.h)^shininess * n.l, the diffuse term being Lambert's (1)
@@ -492,7 +605,7 @@ real march_thinness(real3 p, real3 n, real depth, __global const real* params, u
 // albedo * s * thinness * -n.l: it shows through thin parts, unshadowed
 // (the shape itself stands between). Without materials the highlight is
 // MARCH_SPECULAR and MARCH_SHININESS, the default material's.
-real3 march_shade(real3 p, real3 n, real3 rd, real eps, real view_height,
+real3 march_shade(real3 p, real3 n, real3 rd, real eps, real occlusion,
                   __global const real* params, __global const real* lights, int light_count,
                   uint* evals) {
     real3 albedo;
@@ -514,11 +627,6 @@ real3 march_shade(real3 p, real3 n, real3 rd, real eps, real view_height,
     }
 #endif
 
-    real occlusion = R(1.0);
-#ifdef ENABLE_AO
-    occlusion = march_ambient_occlusion(p, n, view_height, params);
-    *evals += (uint)AO_SAMPLES;
-#endif
     real3 sky = mix(SKY_BOTTOM, SKY_TOP, R(0.5) + R(0.5) * n.y);
     real3 color = albedo * sky * (MARCH_AMBIENT * occlusion);
 
@@ -717,8 +825,8 @@ real3 march_paths(real3 p, real3 n, real3 rd, real eps, real t, const MarchCamer
             color += march_branch(next, stack, &top);
             continue;
         }
-        real3 lit = march_shade(q, nq, b.rd, eq, footprint * cam->image_h, params, lights,
-                                light_count, evals);
+        real occlusion = march_occlusion(q, nq, footprint * cam->image_h, params, evals);
+        real3 lit = march_shade(q, nq, b.rd, eq, occlusion, params, lights, light_count, evals);
         color += march_split(q, nq, b.rd, eq, travelled, b.weight, b.depth, lit, params, stack,
                              &top, evals);
     }
@@ -811,6 +919,196 @@ void march_sample_point(uint pixel, uint j, int s, real* jx, real* jy) {
     }
 }
 
+// The ray of sample j (the s-th of its pass) of rendered pixel (x, y),
+// whose index is pixel: its image row *py, origin and direction.
+void march_sample_ray(const MarchCamera* cam, int x, int y, uint pixel, uint j, int s, real* py,
+                      real3* ro, real3* rd) {
+    real jx;
+    real jy;
+    march_sample_point(pixel, j, s, &jx, &jy);
+    // A pinhole needs no lens point.
+    real2 lens = (real2)(R(0.0));
+    if (cam->aperture > R(0.0)) {
+        lens = march_disc(march_lens_point(pixel, j));
+    }
+    // Rendered pixel (x, y) covers pixel_scale image pixels each way.
+    real px = ((real)x + jx) * cam->pixel_scale;
+    *py = ((real)y + jy) * cam->pixel_scale;
+    march_lens_ray(cam, px, *py, lens, ro, rd);
+}
+
+#ifdef ENABLE_BRUTE
+// Where a pixel's brute-force steps start on its sample j, in [0, 1) of a
+// step: an offset of its own, advanced by the golden ratio's fraction from
+// one sample to the next, so successive passes spread their lattices
+// evenly over the step and their mean converges on the set's surface.
+real march_brute_phase(uint pixel, uint j) {
+    real u = march_jitter(pixel, 0u, 2u) + R(0.61803398874989485) * (real)j;
+    return u - floor(u);
+}
+
+// The brute-force pass: marches sample s of this pass at every pixel and
+// leaves its depth (+INFINITY on a miss) and evaluations at
+// (s * height + y) * width + x, for render_tile to shade: the normal and
+// occlusion of a point of an inside shape need its neighbours' hits.
+__kernel void brute_depths(BRUTE_DEPTHS_ARGS) {
+    int x = (int)get_global_id(0);
+    int y = (int)get_global_id(1);
+    if (x >= width || y >= height) {
+        return;
+    }
+    MarchCamera cam = march_load_camera(camera);
+    const int per_pass = SUPERSAMPLING * SUPERSAMPLING;
+    const uint first = pass > 0 ? (uint)pass * (uint)per_pass : 0u;
+    const uint pixel = (uint)y * (uint)width + (uint)x;
+    for (int s = 0; s < per_pass; ++s) {
+        uint j = first + (uint)s;
+        real py;
+        real3 ro;
+        real3 rd;
+        march_sample_ray(&cam, x, y, pixel, j, s, &py, &ro, &rd);
+        cam.phase = march_brute_phase(pixel, j);
+        MarchResult m = march_ray(ro, rd, R(0.0), &cam, R(1.0), params);
+        int at = (s * height + y) * width + x;
+        depths[at] = m.hit ? (float)m.t : INFINITY;
+        steps[at] = (uint)m.steps;
+    }
+}
+
+// The hit point of sample s (sample j of the image) at rendered pixel
+// (x, y), from the depths brute_depths left. Returns 0 where the pixel is
+// outside the image or its ray missed.
+int march_stored_point(const MarchCamera* cam, __global const float* depths, int x, int y, int s,
+                       int width, int height, uint j, real3* p) {
+    if (x < 0 || y < 0 || x >= width || y >= height) {
+        return 0;
+    }
+    float t = depths[(s * height + y) * width + x];
+    if (isinf(t)) {
+        return 0;
+    }
+    real py;
+    real3 ro;
+    real3 rd;
+    march_sample_ray(cam, x, y, (uint)y * (uint)width + (uint)x, j, s, &py, &ro, &rd);
+    *p = ro + rd * (real)t;
+    return 1;
+}
+
+// Neighbours whose hit points lie within this many brute-force steps (and
+// at least this many footprints) of a pixel's are on its surface.
+#define MARCH_SCREEN_REACH R(6.0)
+
+// The normal at p, the hit of sample s at pixel (x, y) along rd, from its
+// eight neighbours' hits on the same surface (see MARCH_SCREEN_REACH).
+// SCREEN_NORMALS 0: the cross product of the central differences across
+// the pixel, one-sided where a neighbour is elsewhere. 1: Englund's least
+// squares: the plane through the hits, p's among them, that best predicts
+// their depth along the view from their offsets across it (the jittered
+// steps put their noise in depth); the differences where the hits do not
+// span a plane. Faces the viewer; -rd where no plane can be found.
+real3 march_screen_normal(const MarchCamera* cam, __global const float* depths, int x, int y,
+                          int s, int width, int height, uint j, real3 p, real3 rd,
+                          real footprint) {
+    real reach = MARCH_SCREEN_REACH * fmax(BRUTE_STEP, R(1.0)) * footprint;
+    real3 q[9];
+    int ok[9];
+    for (int k = 0; k < 9; ++k) {
+        q[k] = p;
+        ok[k] = k == 4;
+        real3 at;
+        if (k != 4 &&
+            march_stored_point(cam, depths, x + k % 3 - 1, y + k / 3 - 1, s, width, height, j,
+                               &at) &&
+            length(at - p) <= reach) {
+            q[k] = at;
+            ok[k] = 1;
+        }
+    }
+    // Central differences, or one-sided ones (q[k] is p where not ok).
+    real3 du = q[5] - q[3];
+    real3 dv = q[7] - q[1];
+    real3 n = (ok[3] || ok[5]) && (ok[1] || ok[7]) ? cross(du, dv) : (real3)(R(0.0));
+    if (SCREEN_NORMALS == 1) {
+        real3 mean = (real3)(R(0.0));
+        real count = R(0.0);
+        for (int k = 0; k < 9; ++k) {
+            if (ok[k]) {
+                mean += q[k];
+                count += R(1.0);
+            }
+        }
+        mean /= count;
+        real suu = R(0.0);
+        real suv = R(0.0);
+        real svv = R(0.0);
+        real suw = R(0.0);
+        real svw = R(0.0);
+        for (int k = 0; k < 9; ++k) {
+            if (ok[k]) {
+                real3 d = q[k] - mean;
+                real u = dot(d, cam->right);
+                real v = dot(d, cam->up);
+                real w = dot(d, cam->forward);
+                suu += u * u;
+                suv += u * v;
+                svv += v * v;
+                suw += u * w;
+                svw += v * w;
+            }
+        }
+        real det = suu * svv - suv * suv;
+        if (count >= R(3.0) && det > R(1e-3) * suu * svv) {
+            // w = a u + b v: the surface's gradient is (-a, -b, 1).
+            real a = (suw * svv - svw * suv) / det;
+            real b = (svw * suu - suw * suv) / det;
+            n = a * cam->right + b * cam->up - cam->forward;
+        }
+    }
+    real len = length(n);
+    if (!(len > REAL_TINY)) {
+        return -rd;
+    }
+    n /= len;
+    return dot(n, rd) > R(0.0) ? -n : n;
+}
+
+#ifdef ENABLE_AO
+#define MARCH_SSAO_SAMPLES 16
+// Screen-space ambient occlusion at p, the hit of sample s at pixel
+// (x, y), with normal n: MARCH_SSAO_SAMPLES neighbours on a golden-angle
+// spiral out to the pixels the occlusion's reach covers (the reach of
+// march_ambient_occlusion), each occluding by how far above p's tangent
+// plane its hit lies (the cosine of its elevation, less a small bias
+// against flat surfaces occluding themselves), fading to nothing at twice
+// the reach. 1 on an open face, towards 0 in a crease.
+real march_screen_occlusion(const MarchCamera* cam, __global const float* depths, int x, int y,
+                            int s, int width, int height, uint j, real3 p, real3 n,
+                            real footprint, real view_height) {
+    real reach = fmin(AO_DISTANCE, AO_VIEW_FRACTION * view_height);
+    real radius = clamp(reach / footprint, R(2.0), R(32.0));
+    real turn = R(6.28318530717958648) * march_jitter((uint)y * (uint)width + (uint)x, j, 3u);
+    real hidden = R(0.0);
+    for (int k = 0; k < MARCH_SSAO_SAMPLES; ++k) {
+        real angle = turn + R(2.39996322972865332) * (real)k;
+        real r = radius * sqrt(((real)k + R(0.5)) / (real)MARCH_SSAO_SAMPLES);
+        int qx = x + (int)rint(r * cos(angle));
+        int qy = y + (int)rint(r * sin(angle));
+        real3 q;
+        if (march_stored_point(cam, depths, qx, qy, s, width, height, j, &q)) {
+            real3 v = q - p;
+            real d = length(v);
+            if (d > REAL_TINY) {
+                real rise = fmax(dot(n, v) / d - R(0.1), R(0.0));
+                hidden += rise * clamp(R(1.0) - d / (R(2.0) * reach), R(0.0), R(1.0));
+            }
+        }
+    }
+    return clamp(R(1.0) - R(2.0) * hidden / (real)MARCH_SSAO_SAMPLES, R(0.0), R(1.0));
+}
+#endif
+#endif
+
 // One launch shades the tile [x0, x0 + tile_w) x [y0, y0 + tile_h) of a
 // width x height image. The global size may be rounded up past the tile.
 //
@@ -857,22 +1155,29 @@ __kernel void render_tile(RENDER_TILE_ARGS) {
     uint total_evals = 0;
     MarchResult centre = {R(0.0), R(1.0), 0, 0};
     real3 centre_normal = (real3)(R(0.0));
+    // Whether the rays come marched by brute_depths.
+    int stored = 0;
     for (int s = 0; s < per_pass; ++s) {
-        real jx;
-        real jy;
-        march_sample_point(pixel, first + (uint)s, s, &jx, &jy);
-        // A pinhole needs no lens point.
-        real2 lens = (real2)(R(0.0));
-        if (cam.aperture > R(0.0)) {
-            lens = march_disc(march_lens_point(pixel, first + (uint)s));
-        }
-        // Rendered pixel (x, y) covers pixel_scale image pixels each way.
-        real px = ((real)x + jx) * cam.pixel_scale;
-        real py = ((real)y + jy) * cam.pixel_scale;
+        const uint j = first + (uint)s;
+        real py;
         real3 ro;
         real3 rd;
-        march_lens_ray(&cam, px, py, lens, &ro, &rd);
-        MarchResult m = march_ray(ro, rd, start, &cam, R(1.0), params);
+        march_sample_ray(&cam, x, y, pixel, j, s, &py, &ro, &rd);
+        MarchResult m;
+#ifdef ENABLE_BRUTE
+        stored = 1;
+        {
+            int at = (s * height + y) * width + x;
+            float t = brute_depths[at];
+            m.hit = !isinf(t);
+            m.t = m.hit ? (real)t : R(0.0);
+            m.closest = R(1.0);
+            m.steps = (int)brute_steps[at];
+        }
+#endif
+        if (!stored) {
+            m = march_ray(ro, rd, start, &cam, R(1.0), params);
+        }
         total_steps += (uint)m.steps;
         total_evals += (uint)m.steps;
 
@@ -882,18 +1187,44 @@ __kernel void render_tile(RENDER_TILE_ARGS) {
         if (m.hit) {
             real3 p = ro + rd * m.t;
             real footprint = march_footprint(&cam, m.t);
-            n = march_normal(p, NORMAL_EPSILON * footprint, rd, params);
-            total_evals += MARCH_NORMAL_EVALUATIONS;
             real view_height = footprint * cam.image_h;
-            if (m.t <= R(0.0)) {
-                // The ray starts inside the surface (a camera within a
-                // solid): shade the nearest point of the surface instead.
-                // No view to scale occlusion to: it keeps AO_DISTANCE.
-                p -= n * DE(p, params);
-                total_evals += 1u;
-                view_height = (real)INFINITY;
+            // Whether p lies in an inside shape, which has no distance to
+            // take a normal or occlusion from.
+            int in_set = 0;
+#ifdef ENABLE_BRUTE
+            in_set = DE(p, params) <= R(-0.5) * INSIDE_HUGE;
+            total_evals += 1u;
+            if (in_set) {
+                n = march_screen_normal(&cam, brute_depths, x, y, s, width, height, j, p, rd,
+                                        footprint);
             }
-            color = march_shade(p, n, rd, DETAIL * footprint, view_height, params, lights,
+#endif
+            if (!in_set) {
+                n = march_normal(p, NORMAL_EPSILON * footprint, rd, params);
+                total_evals += MARCH_NORMAL_EVALUATIONS;
+                if (m.t <= R(0.0)) {
+                    // The ray starts inside the surface (a camera within a
+                    // solid): shade the nearest point of the surface
+                    // instead. No view to scale occlusion to: it keeps
+                    // AO_DISTANCE.
+                    p -= n * DE(p, params);
+                    total_evals += 1u;
+                    view_height = (real)INFINITY;
+                }
+            }
+            real occlusion = R(1.0);
+#ifdef ENABLE_BRUTE
+#ifdef ENABLE_AO
+            // Inside shapes occlude what the distance cannot see: every
+            // hit takes its occlusion from the screen.
+            occlusion = march_screen_occlusion(&cam, brute_depths, x, y, s, width, height, j, p,
+                                               n, footprint, view_height);
+#endif
+#endif
+            if (!stored) {
+                occlusion = march_occlusion(p, n, view_height, params, &total_evals);
+            }
+            color = march_shade(p, n, rd, DETAIL * footprint, occlusion, params, lights,
                                 light_count, &total_evals);
 #ifdef ENABLE_MATERIALS
             color = march_paths(p, n, rd, DETAIL * footprint, m.t, &cam, color, params, lights,
@@ -929,7 +1260,9 @@ __kernel void render_tile(RENDER_TILE_ARGS) {
 
     // Later passes leave the outputs of the first: the same rays.
     if (write_aovs && pass <= 0) {
-        if (SUPERSAMPLING > 1 || cam.aperture > R(0.0)) {
+        // Brute-forced rays report their first sample's: its normal needs
+        // the neighbours' samples.
+        if (!stored && (SUPERSAMPLING > 1 || cam.aperture > R(0.0))) {
             // The colour samples are jittered: trace the pixel centre.
             real3 ro;
             real3 rd;

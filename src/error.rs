@@ -81,6 +81,17 @@ pub enum Error {
         /// What is wrong.
         reason: String,
     },
+    /// An inside shape (see [`InsideShape`](crate::scene::InsideShape))
+    /// is used where a distance is needed, or its scene cannot be marched.
+    #[error("inside shape `{name}` at {node}: {reason}")]
+    InsideShape {
+        /// The shape's name.
+        name: String,
+        /// Path of the node that uses it in the scene.
+        node: String,
+        /// What is wrong, and what is allowed instead.
+        reason: String,
+    },
     /// A camera path is invalid.
     #[error("camera path: {reason}")]
     Animation {

@@ -73,7 +73,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::animation::{CameraPath, Keyframe, Motion};
 use crate::error::{Error, Result};
-use crate::quality::{Effects, Precision, Preset, Quality};
+use crate::quality::{Effects, Precision, Preset, Quality, ScreenNormals};
 use crate::scene::{
     Axis, Camera, CsgOp, CustomShape, Kind, Light, Mandelbulb, Material, Menger, Node, NodeKind,
     Param, Param3, QuaternionJulia, Scene, Sierpinski, param3,
@@ -922,6 +922,10 @@ struct QualityRepr {
     cone_tile: Option<u32>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     bounces: Option<u32>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    brute_step: Option<f64>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    screen_normals: Option<ScreenNormals>,
 }
 
 impl QualityRepr {
@@ -956,6 +960,10 @@ impl QualityRepr {
                     .map(|()| quality.resolution_scale),
                 cone_tile: differs(p.cone_tile == quality.cone_tile).map(|()| quality.cone_tile),
                 bounces: differs(p.bounces == quality.bounces).map(|()| quality.bounces),
+                brute_step: differs(p.brute_step == quality.brute_step)
+                    .map(|()| quality.brute_step),
+                screen_normals: differs(p.screen_normals == quality.screen_normals)
+                    .map(|()| quality.screen_normals),
             }
         };
         Preset::ALL
@@ -983,6 +991,8 @@ impl QualityRepr {
             self.resolution_scale.is_some(),
             self.cone_tile.is_some(),
             self.bounces.is_some(),
+            self.brute_step.is_some(),
+            self.screen_normals.is_some(),
         ]
         .into_iter()
         .filter(|&b| b)
@@ -1007,6 +1017,8 @@ impl QualityRepr {
             resolution_scale: self.resolution_scale.unwrap_or(p.resolution_scale),
             cone_tile: self.cone_tile.unwrap_or(p.cone_tile),
             bounces: self.bounces.unwrap_or(p.bounces),
+            brute_step: self.brute_step.unwrap_or(p.brute_step),
+            screen_normals: self.screen_normals.unwrap_or(p.screen_normals),
         }
     }
 }

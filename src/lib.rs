@@ -208,12 +208,12 @@ pub mod prelude {
     pub use crate::cpu;
     pub use crate::error::{Error, Result};
     pub use crate::ir::CompiledScene;
-    pub use crate::quality::{Effects, Glow, Precision, Preset, Quality};
+    pub use crate::quality::{Effects, Glow, Precision, Preset, Quality, ScreenNormals};
     pub use crate::scene::{
-        Axis, Camera, Light, Mandelbulb, Material, Menger, Node, Param, Param3, Projection,
-        QuaternionJulia, Scene, Sierpinski, capped_cone, capsule, cuboid, cylinder, ellipsoid,
-        julia, mandelbulb, menger, octahedron, param, param3, plane, round_box, sierpinski, sphere,
-        torus,
+        Axis, Camera, InsideBounds, InsideShape, Light, Mandelbulb, Material, Menger, Node, Param,
+        Param3, Projection, QuaternionJulia, Scene, Sierpinski, capped_cone, capsule, cuboid,
+        cylinder, ellipsoid, julia, mandelbulb, menger, octahedron, param, param3, plane,
+        round_box, sierpinski, sphere, torus,
     };
     pub use glam::{DQuat, DVec2, DVec3, EulerRot, Vec3, dvec2, dvec3, vec3};
     pub use image::RgbaImage;

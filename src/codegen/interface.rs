@@ -137,6 +137,8 @@ pub enum RenderArg {
     Accumulation,
     RefineOnly,
     Refine,
+    BruteDepths,
+    BruteSteps,
 }
 
 /// `render_tile`'s declarations, in argument order: the one list of its
@@ -144,8 +146,10 @@ pub enum RenderArg {
 /// index of a progressive pass, which adds its samples to `accumulation`
 /// (linear colour sums, reset by pass 0) and writes their mean to `rgba`.
 /// With `refine_only` set, only the pixels `refine` marks are rendered
-/// (adaptive supersampling's further passes).
-pub const RENDER_TILE: [(RenderArg, &str); 22] = [
+/// (adaptive supersampling's further passes). `brute_depths` and
+/// `brute_steps` are what `brute_depths` left for this pass (read only by
+/// programs that march inside shapes by brute force).
+pub const RENDER_TILE: [(RenderArg, &str); 24] = [
     (RenderArg::Params, "__global const real* params"),
     (RenderArg::Camera, "__global const real* camera"),
     (RenderArg::Lights, "__global const real* lights"),
@@ -168,6 +172,8 @@ pub const RENDER_TILE: [(RenderArg, &str); 22] = [
     (RenderArg::Accumulation, "__global float4* accumulation"),
     (RenderArg::RefineOnly, "const int refine_only"),
     (RenderArg::Refine, "__global const uchar* refine"),
+    (RenderArg::BruteDepths, "__global const float* brute_depths"),
+    (RenderArg::BruteSteps, "__global const uint* brute_steps"),
 ];
 
 /// The arguments of the coarse pass `cone_starts` (see
@@ -196,6 +202,44 @@ impl ConeArg {
     #[must_use]
     pub fn index(self) -> u32 {
         position(&CONE_STARTS, &self)
+    }
+}
+
+/// The arguments of `brute_depths`, the pass that marches every sample of
+/// a progressive pass before `render_tile` shades it, in programs that
+/// march inside shapes by brute force (see
+/// [`Quality::brute_step`](crate::quality::Quality::brute_step)).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[allow(missing_docs)] // Each is described by its declaration in `BRUTE_DEPTHS`.
+pub enum BruteArg {
+    Params,
+    Camera,
+    Width,
+    Height,
+    Pass,
+    Depths,
+    Steps,
+}
+
+/// `brute_depths`' declarations, in argument order. Sample `s` of the
+/// pass at pixel `(x, y)` is written at `(s · height + y) · width + x`:
+/// its depth along its ray (`+INFINITY` on a miss) and its distance
+/// evaluations.
+pub const BRUTE_DEPTHS: [(BruteArg, &str); 7] = [
+    (BruteArg::Params, "__global const real* params"),
+    (BruteArg::Camera, "__global const real* camera"),
+    (BruteArg::Width, "const int width"),
+    (BruteArg::Height, "const int height"),
+    (BruteArg::Pass, "const int pass"),
+    (BruteArg::Depths, "__global float* depths"),
+    (BruteArg::Steps, "__global uint* steps"),
+];
+
+impl BruteArg {
+    /// The argument's position in `brute_depths`.
+    #[must_use]
+    pub fn index(self) -> u32 {
+        position(&BRUTE_DEPTHS, &self)
     }
 }
 
@@ -283,6 +327,11 @@ pub(crate) fn defines(target: super::Target) -> String {
         super::Target::Render => {
             let _ = writeln!(w, "#define RENDER_TILE_ARGS \\\n    {}", args(&RENDER_TILE));
             let _ = writeln!(w, "#define CONE_STARTS_ARGS \\\n    {}", args(&CONE_STARTS));
+            let _ = writeln!(
+                w,
+                "#define BRUTE_DEPTHS_ARGS \\\n    {}",
+                args(&BRUTE_DEPTHS)
+            );
             for f in camera::FIELDS {
                 let _ = writeln!(w, "#define CAMERA_{} {}", f.name, f.offset);
             }

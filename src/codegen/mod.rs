@@ -38,8 +38,13 @@ use glam::DVec3;
 use crate::error::Result;
 use crate::ir::{Bound, CompiledScene, Ir};
 use crate::math::{DEFAULT_COLOR, DERIVATIVE_CAP, MAGNITUDE_CAP, REAL_TINY};
-use crate::quality::{Effects, Precision, Quality};
-use crate::scene::{DEFAULT_MATERIAL, Kind};
+use crate::quality::{Effects, Precision, Quality, ScreenNormals};
+use crate::scene::{DEFAULT_MATERIAL, INSIDE_HUGE, Kind};
+
+/// The most steps a ray takes within inside shapes' bounds, besides
+/// [`Quality::max_steps`]: a ray still short of the set after these many
+/// brute-force steps is a miss.
+pub const BRUTE_MAX_STEPS: u32 = 16384;
 
 /// What the generated program is for.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
@@ -133,8 +138,13 @@ pub struct KernelSource {
     pub fast_math: bool,
     /// The side of the coarse pass's tiles, in rendered pixels: the
     /// program has a `cone_starts` kernel when it is not 0
-    /// ([`Quality::cone_tile`]).
+    /// ([`Quality::cone_tile`]), which a program that marches inside shapes
+    /// by brute force never has.
     pub cone_tile: u32,
+    /// Whether the program marches inside shapes by brute force
+    /// ([`Quality::brute_step`]): its `render_tile` then shades from the
+    /// depths a `brute_depths` kernel leaves, which runs first.
+    pub brute: bool,
     /// Where the program's `DE` has its origin in the scene: the scene's
     /// outermost baked translation for [`Target::Render`] (see
     /// [`Ir::local_frame`]), zero otherwise. The renderer moves the camera
@@ -291,13 +301,25 @@ pub fn emit_ir(ir: &Ir, options: &Options) -> Result<KernelSource> {
             .iter()
             .any(|n| matches!(n, Kind::Material { .. }));
     emitter.emit(materials);
+    // Inside shapes are marched by brute force within their region.
+    let features = Features {
+        materials,
+        inside: ir.has_inside_shapes(),
+        brute: match options.target {
+            Target::Render => ir.brute_region().map(|b| Bound {
+                centre: b.centre - origin,
+                ..b
+            }),
+            Target::Evaluate => None,
+        },
+    };
     let used = std::mem::take(&mut emitter.used);
     let customs: Vec<_> = emitter.customs.values().cloned().collect();
     let powers: Vec<u32> = emitter.powers.iter().copied().collect();
     let constants = std::mem::take(&mut emitter.constants);
 
     let mut w = writer::Writer::new(precision);
-    header(&mut w, options, materials);
+    header(&mut w, options, &features);
     for helper in helpers::closure(used) {
         w.line(format!("/* ---- {} ---- */", helper.name()));
         w.raw(helper.source());
@@ -322,6 +344,9 @@ pub fn emit_ir(ir: &Ir, options: &Options) -> Result<KernelSource> {
             lines: definition.matches('\n').count() - 2,
         });
         w.raw(&definition);
+        if let Some(wrapper) = shape.opencl_wrapper() {
+            w.raw(&wrapper);
+        }
         w.line("");
     }
     w.line("/* ---- scene ---- */");
@@ -331,7 +356,7 @@ pub fn emit_ir(ir: &Ir, options: &Options) -> Result<KernelSource> {
         options,
         origin,
         scene_bound(ir, options, origin),
-        materials,
+        &features,
     );
     kernel.custom_regions = custom_regions;
     kernel.constants = constants;
@@ -350,10 +375,10 @@ pub fn emit_handwritten(scene_functions: &str, options: &Options) -> Result<Kern
     options.quality.validate()?;
     options.effects.validate_for(options.quality.precision)?;
     let mut w = writer::Writer::new(options.quality.precision);
-    header(&mut w, options, false);
+    header(&mut w, options, &Features::default());
     w.line("/* ---- scene (hand-written) ---- */");
     w.raw(scene_functions);
-    Ok(finish(w, options, DVec3::ZERO, None, false))
+    Ok(finish(w, options, DVec3::ZERO, None, &Features::default()))
 }
 
 /// The switch of the march's stop at the scene's bounding sphere.
@@ -366,16 +391,32 @@ const CONE: &str = "ENABLE_CONE";
 /// ([`Quality::bounces`]): on for scenes that set a material.
 const MATERIALS: &str = "ENABLE_MATERIALS";
 
+/// The switch of brute-force marching ([`Quality::brute_step`]): on for
+/// rendering scenes with an inside shape.
+const BRUTE: &str = "ENABLE_BRUTE";
+
+/// What a scene asks of its program beyond the quality and effects.
+#[derive(Debug, Clone, Copy, Default)]
+pub(crate) struct Features {
+    /// It sets a material (rendering only).
+    pub(crate) materials: bool,
+    /// It holds an inside shape, whose value is `±INSIDE_HUGE`.
+    pub(crate) inside: bool,
+    /// Where its rays step by brute force, in the program's frame
+    /// (rendering a scene with inside shapes only).
+    pub(crate) brute: Option<Bound>,
+}
+
 /// The target kernel for `options`, with the blocks of the effects that are
 /// off removed (and the stop at the scene's bounding sphere, which only
 /// programs for a bounded scene keep): what every program for these
 /// options ends with.
 #[must_use]
 pub fn target_kernel(options: &Options) -> String {
-    kernel_with(options, false, false)
+    kernel_with(options, false, &Features::default())
 }
 
-fn kernel_with(options: &Options, bounded: bool, materials: bool) -> String {
+fn kernel_with(options: &Options, bounded: bool, features: &Features) -> String {
     let kernel = match options.target {
         Target::Render => include_str!("../../kernels/march.cl"),
         Target::Evaluate => include_str!("../../kernels/eval.cl"),
@@ -387,13 +428,26 @@ fn kernel_with(options: &Options, bounded: bool, materials: bool) -> String {
     if bounded {
         on.push(SCENE_BOUND);
     }
-    if options.target == Target::Render && options.quality.cone_tile > 0 {
+    if cone_tile(options, features) > 0 {
         on.push(CONE);
     }
-    if materials {
+    if features.materials {
         on.push(MATERIALS);
     }
+    if features.brute.is_some() {
+        on.push(BRUTE);
+    }
     select_blocks(kernel, &on)
+}
+
+/// The coarse pass's tile side: none for evaluation, nor where inside
+/// shapes (which a cone cannot see) are marched by brute force.
+fn cone_tile(options: &Options, features: &Features) -> u32 {
+    if options.target == Target::Render && features.brute.is_none() {
+        options.quality.cone_tile
+    } else {
+        0
+    }
 }
 
 /// The sphere a rendering program's rays stop at, in the program's frame:
@@ -420,9 +474,20 @@ fn finish(
     options: &Options,
     origin: DVec3,
     bound: Option<Bound>,
-    materials: bool,
+    features: &Features,
 ) -> KernelSource {
     EMISSIONS.fetch_add(1, Ordering::Relaxed);
+    if let Some(b) = features.brute {
+        w.line("/* The sphere inside shapes lie in: marched by brute force. */");
+        let c = b.centre;
+        w.line(format!(
+            "#define BRUTE_CENTRE (real3)({}, {}, {})",
+            w.float(c.x),
+            w.float(c.y),
+            w.float(c.z)
+        ));
+        w.line(format!("#define BRUTE_RADIUS {}", w.float(b.radius)));
+    }
     if let Some(b) = bound {
         w.line("/* The sphere around the scene (src/ir/bounds.rs). */");
         let c = b.centre;
@@ -443,17 +508,15 @@ fn finish(
         }
     ));
     let kernel_start = w.len();
-    w.raw(&kernel_with(options, bound.is_some(), materials));
+    w.raw(&kernel_with(options, bound.is_some(), features));
     let source = w.finish();
     KernelSource {
         hash: fnv1a(source.as_bytes()),
         source,
         precision: options.quality.precision,
         fast_math: options.quality.fast_math,
-        cone_tile: match options.target {
-            Target::Render => options.quality.cone_tile,
-            Target::Evaluate => 0,
-        },
+        cone_tile: cone_tile(options, features),
+        brute: features.brute.is_some(),
         origin,
         kernel_start,
         custom_regions: Vec::new(),
@@ -461,7 +524,8 @@ fn finish(
     }
 }
 
-fn header(w: &mut writer::Writer, options: &Options, materials: bool) {
+fn header(w: &mut writer::Writer, options: &Options, features: &Features) {
+    let materials = features.materials;
     let q = &options.quality;
     let e = &options.effects;
     w.line("/* Generated by fractal-sdf. */");
@@ -527,8 +591,20 @@ fn header(w: &mut writer::Writer, options: &Options, materials: bool) {
     if on.contains(&Effect::Fog) {
         defines.push(("FOG_DENSITY", f(e.fog_density)));
     }
-    if options.target == Target::Render && q.cone_tile > 0 {
+    if cone_tile(options, features) > 0 {
         defines.push(("CONE_TILE", q.cone_tile.to_string()));
+    }
+    if features.inside {
+        defines.push(("INSIDE_HUGE", f(INSIDE_HUGE)));
+    }
+    if features.brute.is_some() {
+        defines.push(("BRUTE_STEP", f(q.brute_step)));
+        defines.push(("BRUTE_MAX_STEPS", BRUTE_MAX_STEPS.to_string()));
+        let method = match q.screen_normals {
+            ScreenNormals::Differences => 0,
+            ScreenNormals::LeastSquares => 1,
+        };
+        defines.push(("SCREEN_NORMALS", method.to_string()));
     }
     if materials {
         let values: Vec<String> = DEFAULT_MATERIAL.iter().map(|&v| f(v)).collect();
@@ -546,6 +622,9 @@ fn header(w: &mut writer::Writer, options: &Options, materials: bool) {
     }
     if materials {
         w.line(format!("#define {MATERIALS}"));
+    }
+    if features.brute.is_some() {
+        w.line(format!("#define {BRUTE}"));
     }
     w.line("/* The kernel interface (src/codegen/interface.rs). */");
     w.raw(&interface::defines(options.target));

@@ -27,9 +27,10 @@ pub(crate) fn check_custom(shape: &CustomShape) -> Result<()> {
         name: shape.name().into(),
         reason,
     };
-    let function = shape.function_name();
-    if let Some(why) = generated(&function) {
-        return Err(bad(format!("its OpenCL function `{function}` {why}")));
+    for function in std::iter::once(shape.function_name()).chain(shape.test_name()) {
+        if let Some(why) = generated(&function) {
+            return Err(bad(format!("its OpenCL function `{function}` {why}")));
+        }
     }
     for (param, _) in shape.params() {
         if let Some(why) = generated(param) {
@@ -88,7 +89,16 @@ fn library_texts() -> Vec<String> {
                 target,
             };
             let mut w = Writer::new(precision);
-            header(&mut w, &options, true);
+            let features = super::Features {
+                materials: true,
+                inside: true,
+                brute: Some(crate::ir::Bound {
+                    centre: DVec3::ZERO,
+                    radius: 1.0,
+                    slope: 1.0,
+                }),
+            };
+            header(&mut w, &options, &features);
             texts.push(w.finish());
         }
     }

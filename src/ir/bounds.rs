@@ -16,7 +16,8 @@
 //! Bounds are computed from baked values. A node whose extent depends on a
 //! dynamic value it cannot bound over the value's whole range (a dynamic
 //! translation, scale or rounding radius) has no bound, and neither does a
-//! plane, an unlimited repetition, a twist, a bend or a custom shape.
+//! plane, an unlimited repetition, a twist, a bend or a custom shape with a
+//! distance estimate (an inside shape is bounded by its stated bounds).
 
 use glam::DVec3;
 
@@ -94,7 +95,7 @@ impl Bound {
     }
 
     /// The smallest sphere around both, with the smaller slope.
-    fn around(self, other: Bound) -> Self {
+    pub(super) fn around(self, other: Bound) -> Self {
         let (a, b) = if self.radius >= other.radius {
             (self, other)
         } else {
@@ -131,7 +132,7 @@ impl Ir {
 }
 
 /// The bound of one node from its children's.
-fn bound(node: &IrNode, done: &[Option<Bound>]) -> Option<Bound> {
+pub(super) fn bound(node: &IrNode, done: &[Option<Bound>]) -> Option<Bound> {
     let of = |c: &NodeId| done[c.index()];
     let baked = Scalar::baked;
     let origin = DVec3::ZERO;
@@ -310,11 +311,14 @@ fn bound(node: &IrNode, done: &[Option<Bound>]) -> Option<Bound> {
                 },
             }
         }
-        Kind::Plane { .. }
-        | Kind::Repeat { .. }
-        | Kind::Twist { .. }
-        | Kind::Bend { .. }
-        | Kind::Custom { .. } => return None,
+        Kind::Plane { .. } | Kind::Repeat { .. } | Kind::Twist { .. } | Kind::Bend { .. } => {
+            return None;
+        }
+        // An inside shape's value is `INSIDE_HUGE` outside its bounds.
+        Kind::Custom { shape, .. } => {
+            let (centre, radius) = shape.inside_bounds()?.ball();
+            Bound::sphere(centre, radius)
+        }
     })
 }
 

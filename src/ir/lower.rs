@@ -63,6 +63,7 @@ pub(super) fn lower(geometry: &Node) -> Result<Ir> {
     // them (nested scales, chained translations), so the folded values are
     // checked again.
     ir.check_limits(&F64_LIMITS)?;
+    ir.check_inside()?;
     Ok(ir)
 }
 

@@ -13,6 +13,7 @@
 
 mod bounds;
 mod compiled;
+mod inside;
 mod lower;
 mod params;
 

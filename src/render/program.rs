@@ -302,6 +302,7 @@ mod tests {
             hash: 0,
             fast_math: false,
             cone_tile: 0,
+            brute: false,
             origin: DVec3::ZERO,
             kernel_start: 0,
             constants: Vec::new(),

@@ -18,7 +18,9 @@ use super::memory::{available_host_memory, check_host_memory, frame_host_bytes};
 use super::program::{self, BuildInfo};
 use super::upscale;
 use super::viewport::{Viewport, check_frame_inputs, pack_lights};
-use crate::codegen::interface::{CONE_STARTS, ConeArg, RENDER_TILE, RenderArg, camera};
+use crate::codegen::interface::{
+    BRUTE_DEPTHS, BruteArg, CONE_STARTS, ConeArg, RENDER_TILE, RenderArg, camera,
+};
 use crate::codegen::{self, KernelSource};
 use crate::error::{Error, Result};
 use crate::ir::{CompiledScene, ParamValues};
@@ -72,6 +74,9 @@ const TILES_IN_FLIGHT: usize = 2;
 const KERNEL_NAME: &str = "render_tile";
 const CONE_KERNEL_NAME: &str = "cone_starts";
 
+/// The brute-force pass of programs that march inside shapes.
+const BRUTE_KERNEL_NAME: &str = "brute_depths";
+
 /// Renders one scene on one OpenCL device.
 ///
 /// It is built from a [`CompiledScene`]: the scene is validated and lowered
@@ -109,6 +114,9 @@ pub struct Renderer {
     /// The coarse pass, in a program that has one
     /// ([`Quality::cone_tile`]).
     cone: Option<Kernel>,
+    /// The brute-force pass, in a program that marches inside shapes
+    /// ([`Quality::brute_step`]).
+    brute: Option<BrutePass>,
     local: (usize, usize),
     inputs: Inputs,
     targets: Targets,
@@ -246,6 +254,7 @@ impl Renderer {
         let (program, build, compiled) = program::build(&selected, &context, &source)?;
         let kernel = make_kernel(&program, &queue, &inputs, &targets)?;
         let cone = make_cone(&program, &queue, &inputs, &targets, &source)?;
+        let brute = BrutePass::new(&program, &queue, &inputs, &source)?;
         let local = local_size(&kernel, &selected)?;
         Ok(Renderer {
             selected,
@@ -260,6 +269,7 @@ impl Renderer {
             builds: u64::from(compiled),
             kernel,
             cone,
+            brute,
             local,
             inputs,
             targets,
@@ -880,6 +890,7 @@ impl Renderer {
         }
         self.kernel = make_kernel(&program, &self.queue, &self.inputs, &self.targets)?;
         self.cone = make_cone(&program, &self.queue, &self.inputs, &self.targets, &source)?;
+        self.brute = BrutePass::new(&program, &self.queue, &self.inputs, &source)?;
         self.local = local_size(&self.kernel, &self.selected)?;
         self.source = source;
         self.build = build;
@@ -1028,6 +1039,19 @@ impl Renderer {
             Some(cone) => Some(self.coarse_pass(cone, width, height)?),
             None => None,
         };
+        let brute = match &mut self.brute {
+            Some(pass) => {
+                let samples = self.options.quality.supersampling.max(1).pow(2);
+                Some(pass.run(
+                    &self.queue,
+                    &self.inputs,
+                    k,
+                    (width, height, samples),
+                    self.pass,
+                )?)
+            }
+            None => None,
+        };
         let (share, shares) = self.share;
         let mine = || {
             dispatch::tiles(width, height, self.options.tile_size)
@@ -1069,6 +1093,7 @@ impl Renderer {
         }
         self.queue.finish().map_err(opencl)?;
         events.extend(coarse);
+        events.extend(brute);
         Ok(match profiled_time(&events) {
             Some(kernel) => (kernel, true),
             None => (launched.elapsed(), false),
@@ -1260,6 +1285,133 @@ fn make_cone(
     b.build().map(Some).map_err(opencl)
 }
 
+/// The brute-force pass (`brute_depths`) and the depths and evaluations it
+/// leaves for `render_tile`, one per sample of a pass and pixel.
+#[derive(Debug)]
+struct BrutePass {
+    kernel: Kernel,
+    depths: Buffer<f32>,
+    steps: Buffer<u32>,
+    /// Samples the buffers hold.
+    len: usize,
+}
+
+impl BrutePass {
+    /// The pass of a program that marches inside shapes by brute force,
+    /// with buffers of one sample until a frame sizes them.
+    fn new(
+        program: &Program,
+        queue: &Queue,
+        inputs: &Inputs,
+        source: &KernelSource,
+    ) -> Result<Option<Self>> {
+        if !source.brute {
+            return Ok(None);
+        }
+        let (depths, steps) = Self::buffers(queue, 1)?;
+        let mut b = Kernel::builder();
+        b.program(program)
+            .name(BRUTE_KERNEL_NAME)
+            .queue(queue.clone());
+        for (arg, _) in BRUTE_DEPTHS {
+            match arg {
+                BruteArg::Params => inputs.params.push_arg(&mut b),
+                BruteArg::Camera => inputs.camera.push_arg(&mut b),
+                BruteArg::Width | BruteArg::Height | BruteArg::Pass => {
+                    b.arg(0i32);
+                }
+                BruteArg::Depths => {
+                    b.arg(&depths);
+                }
+                BruteArg::Steps => {
+                    b.arg(&steps);
+                }
+            }
+        }
+        let kernel = b.build().map_err(opencl)?;
+        Ok(Some(BrutePass {
+            kernel,
+            depths,
+            steps,
+            len: 1,
+        }))
+    }
+
+    fn buffers(queue: &Queue, len: usize) -> Result<(Buffer<f32>, Buffer<u32>)> {
+        let make = || {
+            Buffer::builder()
+                .queue(queue.clone())
+                .flags(MemFlags::new().read_write())
+                .len(len.max(1))
+        };
+        Ok((
+            make().build().map_err(opencl)?,
+            Buffer::<u32>::builder()
+                .queue(queue.clone())
+                .flags(MemFlags::new().read_write())
+                .len(len.max(1))
+                .build()
+                .map_err(opencl)?,
+        ))
+    }
+
+    /// Launches the pass over `samples` samples of every pixel of a
+    /// `width` × `height` rendering, and points `render`'s arguments at
+    /// what it leaves.
+    fn run(
+        &mut self,
+        queue: &Queue,
+        inputs: &Inputs,
+        render: &Kernel,
+        (width, height, samples): (u32, u32, u32),
+        pass: i32,
+    ) -> Result<Event> {
+        let len = width as usize * height as usize * samples as usize;
+        if self.len < len {
+            let (depths, steps) =
+                Self::buffers(queue, len).map_err(|e| too_large(width, height, &format!("{e}")))?;
+            self.depths = depths;
+            self.steps = steps;
+            self.len = len;
+        }
+        let k = &self.kernel;
+        let set = |a: BruteArg, v: i32| k.set_arg(a.index(), v).map_err(opencl);
+        #[allow(clippy::cast_possible_wrap)] // sizes are at most MAX_IMAGE_SIDE
+        {
+            set(BruteArg::Width, width as i32)?;
+            set(BruteArg::Height, height as i32)?;
+        }
+        set(BruteArg::Pass, pass)?;
+        inputs.params.set_arg(k, BruteArg::Params.index())?;
+        inputs.camera.set_arg(k, BruteArg::Camera.index())?;
+        k.set_arg(BruteArg::Depths.index(), &self.depths)
+            .map_err(opencl)?;
+        k.set_arg(BruteArg::Steps.index(), &self.steps)
+            .map_err(opencl)?;
+        render
+            .set_arg(RenderArg::BruteDepths.index(), &self.depths)
+            .map_err(opencl)?;
+        render
+            .set_arg(RenderArg::BruteSteps.index(), &self.steps)
+            .map_err(opencl)?;
+        let global = (
+            width.next_multiple_of(8) as usize,
+            height.next_multiple_of(8) as usize,
+        );
+        let mut event = Event::empty();
+        // SAFETY: every buffer argument is alive in `self` or `inputs`, and
+        // the kernel bounds-checks every work item against the image.
+        unsafe {
+            k.cmd()
+                .global_work_size(global)
+                .enew(&mut event)
+                .enq()
+                .map_err(opencl)?;
+        }
+        Ok(event)
+    }
+}
+
 /// The kernel with every argument bound: buffers to the current ones,
 /// scalars to 0 until a frame sets them. Positions come from
 /// [`RENDER_TILE`], the one list of `render_tile`'s arguments.
@@ -1300,6 +1452,14 @@ fn make_kernel(program: &Program, queue: &Queue, inputs: &Inputs, t: &Targets) -
             }
             RenderArg::Refine => {
                 b.arg(&t.refine);
+            }
+            // Stand-ins of the right types until a brute-force pass binds
+            // its own (only its programs read them).
+            RenderArg::BruteDepths => {
+                b.arg(&t.starts);
+            }
+            RenderArg::BruteSteps => {
+                b.arg(&t.steps);
             }
             RenderArg::LightCount
             | RenderArg::Width
@@ -1489,6 +1649,11 @@ impl Targets {
         k.set_arg(RenderArg::Accumulation.index(), &self.accumulation)
             .map_err(opencl)?;
         k.set_arg(RenderArg::Refine.index(), &self.refine)
+            .map_err(opencl)?;
+        // Stand-ins until a brute-force pass binds its own.
+        k.set_arg(RenderArg::BruteDepths.index(), &self.starts)
+            .map_err(opencl)?;
+        k.set_arg(RenderArg::BruteSteps.index(), &self.steps)
             .map_err(opencl)
     }
 

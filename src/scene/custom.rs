@@ -38,6 +38,148 @@ use crate::error::{Error, Result};
 /// parameter values in declaration order.
 pub type CpuDistance = dyn Fn(DVec3, &[f64]) -> f64 + Send + Sync;
 
+/// The Rust membership test of an inside shape (see
+/// [`InsideShape`](super::InsideShape)): the point and the parameter values
+/// in declaration order.
+pub type CpuInside = dyn Fn(DVec3, &[f64]) -> bool + Send + Sync;
+
+/// The magnitude of an inside shape's value: `-INSIDE_HUGE` in the set,
+/// `INSIDE_HUGE` out of it. Larger than any distance a scene measures, so
+/// unions, intersections and subtractions of it with distance estimates
+/// keep the membership of the result in its sign, and a march never
+/// mistakes it for a distance to step by (see
+/// [`InsideShape`](super::InsideShape)); small enough that its square (soft
+/// shadows square distances), even scaled a thousandfold, stays finite in
+/// `f32`.
+pub const INSIDE_HUGE: f64 = 1e15;
+
+/// What a custom shape's functions compute.
+enum Form {
+    /// A distance estimate.
+    Distance(Box<CpuDistance>),
+    /// A membership test, clipped to bounds.
+    Inside {
+        test: Box<CpuInside>,
+        bounds: InsideBounds,
+    },
+}
+
+/// The region an inside shape's set lies in, stated by its author: the
+/// set is clipped to it, code generation marches by brute force only
+/// within it, and it is the shape's bound for pruning.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum InsideBounds {
+    /// A ball.
+    Sphere {
+        /// The ball's centre.
+        centre: DVec3,
+        /// Its radius, positive.
+        radius: f64,
+    },
+    /// An axis-aligned box.
+    Cuboid {
+        /// The box's centre.
+        centre: DVec3,
+        /// Its half extents along x, y and z, each positive.
+        half_extents: DVec3,
+    },
+}
+
+impl InsideBounds {
+    /// The ball of `radius` around `centre`.
+    #[must_use]
+    pub fn sphere(centre: DVec3, radius: f64) -> Self {
+        InsideBounds::Sphere { centre, radius }
+    }
+
+    /// The axis-aligned box around `centre` with `half_extents`.
+    #[must_use]
+    pub fn cuboid(centre: DVec3, half_extents: DVec3) -> Self {
+        InsideBounds::Cuboid {
+            centre,
+            half_extents,
+        }
+    }
+
+    /// Whether `p` lies in the region (its boundary included).
+    #[must_use]
+    pub fn contains(&self, p: DVec3) -> bool {
+        match *self {
+            InsideBounds::Sphere { centre, radius } => (p - centre).length() <= radius,
+            InsideBounds::Cuboid {
+                centre,
+                half_extents,
+            } => ((p - centre).abs() - half_extents).max_element() <= 0.0,
+        }
+    }
+
+    /// The smallest ball around the region: its centre and radius.
+    #[must_use]
+    pub fn ball(&self) -> (DVec3, f64) {
+        match *self {
+            InsideBounds::Sphere { centre, radius } => (centre, radius),
+            InsideBounds::Cuboid {
+                centre,
+                half_extents,
+            } => (centre, half_extents.length()),
+        }
+    }
+
+    /// Why the region cannot bound a shape, or `None`: every value finite,
+    /// the radius and half extents positive.
+    fn problem(&self) -> Option<String> {
+        let finite = |v: DVec3| v.is_finite();
+        match *self {
+            InsideBounds::Sphere { centre, radius } => {
+                if !finite(centre) {
+                    Some(format!(
+                        "the bounding sphere's centre {centre} is not finite"
+                    ))
+                } else if !(radius.is_finite() && radius > 0.0) {
+                    Some(format!(
+                        "the bounding sphere's radius must be positive and finite, got {radius}"
+                    ))
+                } else {
+                    None
+                }
+            }
+            InsideBounds::Cuboid {
+                centre,
+                half_extents,
+            } => {
+                if !finite(centre) {
+                    Some(format!("the bounding box's centre {centre} is not finite"))
+                } else if !(finite(half_extents) && half_extents.min_element() > 0.0) {
+                    Some(format!(
+                        "the bounding box's half extents must be positive and finite, got \
+                         {half_extents}"
+                    ))
+                } else {
+                    None
+                }
+            }
+        }
+    }
+
+    /// An OpenCL C expression, true where `p` lies outside the region.
+    fn opencl_outside(&self) -> String {
+        let lit = |v: f64| format!("R({v:?})");
+        let vec = |v: DVec3| format!("(real3)({}, {}, {})", lit(v.x), lit(v.y), lit(v.z));
+        match *self {
+            InsideBounds::Sphere { centre, radius } => {
+                format!("length(p - {}) > {}", vec(centre), lit(radius))
+            }
+            InsideBounds::Cuboid {
+                centre,
+                half_extents,
+            } => {
+                let q = format!("fabs(p - {}) - {}", vec(centre), vec(half_extents));
+                format!("any(isgreater({q}, (real3)(R(0.0))))")
+            }
+        }
+    }
+}
+
 /// A user-defined shape. Cheap to clone (shared).
 ///
 /// The OpenCL body is the body of a function
@@ -64,7 +206,7 @@ pub type CpuDistance = dyn Fn(DVec3, &[f64]) -> f64 + Send + Sync;
 ///   generated header's (`DETAIL`, `GAMMA`, `R`, `MAX_STEPS`,
 ///   `CAMERA_ORIGIN`, ...) and OpenCL's (`M_PI`, `FLT_MAX`);
 /// - `params` (the generated functions' buffer of dynamic parameter
-///   values) and the prefixes of generated names: `custom_`, `sd_`,
+///   values) and the prefixes of generated names: `custom_`, `inside_`, `sd_`,
 ///   `march_`, `cl_`, and the specialised Mandelbulbs `mandelbulb_pN`;
 /// - every other name the generated program defines or calls (its
 ///   typedefs, helper functions such as `twist_bound`, `DE` and `DE_shade`),
@@ -102,7 +244,7 @@ pub struct CustomShape(Arc<Inner>);
 struct Inner {
     name: String,
     params: Vec<(String, Rule)>,
-    cpu: Box<CpuDistance>,
+    cpu: Form,
     /// The CPU function's type, when it holds no data (so the type alone
     /// says what it computes); `None` otherwise.
     cpu_type: Option<TypeId>,
@@ -121,6 +263,48 @@ impl CustomShape {
     where
         F: Fn(DVec3, &[f64]) -> f64 + Send + Sync + 'static,
     {
+        let cpu_type = (std::mem::size_of::<F>() == 0).then(TypeId::of::<F>);
+        Self::define(
+            name,
+            params,
+            Form::Distance(Box::new(cpu)),
+            cpu_type,
+            opencl_body,
+        )
+    }
+
+    /// Defines an inside shape: see [`InsideShape::new`](super::InsideShape::new).
+    pub(super) fn new_inside<F>(
+        name: &str,
+        params: &[(&str, Rule)],
+        bounds: InsideBounds,
+        test: F,
+        opencl_body: &str,
+    ) -> Result<Self>
+    where
+        F: Fn(DVec3, &[f64]) -> bool + Send + Sync + 'static,
+    {
+        if let Some(why) = bounds.problem() {
+            return Err(Error::CustomShape {
+                name: name.chars().take(48).collect(),
+                reason: why,
+            });
+        }
+        let cpu_type = (std::mem::size_of::<F>() == 0).then(TypeId::of::<F>);
+        let form = Form::Inside {
+            test: Box::new(test),
+            bounds,
+        };
+        Self::define(name, params, form, cpu_type, opencl_body)
+    }
+
+    fn define(
+        name: &str,
+        params: &[(&str, Rule)],
+        cpu: Form,
+        cpu_type: Option<TypeId>,
+        opencl_body: &str,
+    ) -> Result<Self> {
         let bad = |reason: String| Error::CustomShape {
             name: name.chars().take(48).collect(),
             reason,
@@ -146,8 +330,8 @@ impl CustomShape {
         Ok(CustomShape(Arc::new(Inner {
             name: name.into(),
             params: params.iter().map(|(n, r)| ((*n).to_string(), *r)).collect(),
-            cpu: Box::new(cpu),
-            cpu_type: (std::mem::size_of::<F>() == 0).then(TypeId::of::<F>),
+            cpu,
+            cpu_type,
             opencl: opencl_body.into(),
         })))
     }
@@ -169,32 +353,95 @@ impl CustomShape {
         self.0.params.len()
     }
 
-    /// Evaluates the CPU distance function.
+    /// Evaluates the CPU distance function. For an inside shape, the
+    /// value scenes compose: `-INSIDE_HUGE` where `p` is in the set (within
+    /// the bounds), `INSIDE_HUGE` elsewhere.
     #[must_use]
     pub fn distance(&self, p: DVec3, args: &[f64]) -> f64 {
-        (self.0.cpu)(p, args)
+        match &self.0.cpu {
+            Form::Distance(f) => f(p, args),
+            Form::Inside { test, bounds } => {
+                if bounds.contains(p) && test(p, args) {
+                    -INSIDE_HUGE
+                } else {
+                    INSIDE_HUGE
+                }
+            }
+        }
     }
 
-    /// The OpenCL function name, `custom_NAME`.
+    /// The bounds of an inside shape (see
+    /// [`InsideShape`](super::InsideShape)); `None` for a shape with a
+    /// distance estimate.
+    #[must_use]
+    pub fn inside_bounds(&self) -> Option<InsideBounds> {
+        match &self.0.cpu {
+            Form::Distance(_) => None,
+            Form::Inside { bounds, .. } => Some(*bounds),
+        }
+    }
+
+    /// The OpenCL function name, `custom_NAME`: the shape's value as scenes
+    /// compose it (the distance, or an inside shape's `±INSIDE_HUGE`).
     #[must_use]
     pub fn function_name(&self) -> String {
         format!("custom_{}", self.0.name)
     }
 
-    /// The full OpenCL C function definition.
+    /// The OpenCL function an inside shape's body defines, `inside_NAME`,
+    /// or `None` for a shape with a distance estimate.
+    #[must_use]
+    pub fn test_name(&self) -> Option<String> {
+        self.inside_bounds()
+            .map(|_| format!("inside_{}", self.0.name))
+    }
+
+    /// The OpenCL C function definition of the body: `custom_NAME`
+    /// returning a distance, or an inside shape's `inside_NAME` returning
+    /// nonzero in the set. The signature takes one line, the closing brace
+    /// another.
     #[must_use]
     pub fn opencl_definition(&self) -> String {
-        let params: String = self
+        let (ty, name) = match self.test_name() {
+            Some(test) => ("int", test),
+            None => ("real", self.function_name()),
+        };
+        format!(
+            "{ty} {name}(real3 p{}) {{\n{}\n}}\n",
+            self.signature_params(),
+            self.0.opencl.trim_end()
+        )
+    }
+
+    /// For an inside shape, the definition of `custom_NAME`, the value
+    /// scenes compose: `INSIDE_HUGE` outside the bounds (where the test is
+    /// not run) or the set, `-INSIDE_HUGE` in it. `None` for a shape with a
+    /// distance estimate.
+    #[must_use]
+    pub fn opencl_wrapper(&self) -> Option<String> {
+        let bounds = self.inside_bounds()?;
+        let test = self.test_name()?;
+        let args: String = self
             .0
             .params
             .iter()
-            .map(|(n, _)| format!(", real {n}"))
+            .map(|(n, _)| format!(", {n}"))
             .collect();
-        format!(
-            "real {}(real3 p{params}) {{\n{}\n}}\n",
+        Some(format!(
+            "real {}(real3 p{}) {{\n    if ({}) {{\n        return INSIDE_HUGE;\n    }}\n    \
+             return {test}(p{args}) ? -INSIDE_HUGE : INSIDE_HUGE;\n}}\n",
             self.function_name(),
-            self.0.opencl.trim_end()
-        )
+            self.signature_params(),
+            bounds.opencl_outside(),
+        ))
+    }
+
+    fn signature_params(&self) -> String {
+        self.0
+            .params
+            .iter()
+            .map(|(n, _)| format!(", real {n}"))
+            .collect()
     }
 
     /// A node of this shape with the given parameter values (plain numbers
@@ -223,6 +470,8 @@ impl CustomShape {
             Some("the parameters (names or rules) differ")
         } else if a.opencl != b.opencl {
             Some("the OpenCL bodies differ")
+        } else if self.inside_bounds() != other.inside_bounds() {
+            Some("the bounds (or whether it is an inside test) differ")
         } else if a.cpu_type.is_none() || b.cpu_type.is_none() {
             Some(
                 "a CPU function holds data (a closure that captures values, a function pointer \

@@ -6,6 +6,7 @@
 
 pub mod build;
 mod custom;
+mod inside;
 mod material;
 pub(crate) mod names;
 mod node;
@@ -19,7 +20,11 @@ pub use build::{
     capped_cone, capsule, cuboid, cylinder, ellipsoid, julia, mandelbulb, menger, octahedron,
     plane, round_box, sierpinski, sphere, torus,
 };
-pub use custom::{CpuDistance, CustomShape};
+pub use custom::{CpuDistance, CpuInside, CustomShape, INSIDE_HUGE, InsideBounds};
+pub use inside::{
+    InsideShape, MANDELBOX_BAILOUT, MANDELBOX_HALF_SIDE, MANDELBULB_BAILOUT, mandelbox_contains,
+    mandelbulb_contains,
+};
 pub use material::{DEFAULT_MATERIAL, MATERIAL_LEN, Material};
 pub(crate) use node::Mapper;
 pub use node::{

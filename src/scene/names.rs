@@ -19,7 +19,8 @@
 //!    `M_PI`, `FLT_MAX`, `CLK_LOCAL_MEM_FENCE`);
 //! 4. `params`, the generated functions' name for the buffer of dynamic
 //!    parameter values, and the prefixes of names code generation writes:
-//!    `custom_` (custom shapes), `sd_` (the helper library), `march_` (the
+//!    `custom_` (custom shapes), `inside_` (inside shapes' tests), `sd_`
+//!    (the helper library), `march_` (the
 //!    marcher), `cl_` (extensions), and `mandelbulb_pN` (specialised
 //!    Mandelbulbs);
 //! 5. every name the generated program itself defines or calls: code
@@ -89,7 +90,7 @@ const BUILTIN_PREFIXES: &str = "\
 /// Prefixes of names code generation writes (or an OpenCL extension
 /// defines).
 const GENERATED_PREFIXES: &str = "\
-    custom_ sd_ march_ cl_ \
+    custom_ inside_ sd_ march_ cl_ \
 ";
 
 /// Whether `name` is one of the words of `list`.

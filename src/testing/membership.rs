@@ -19,26 +19,7 @@ use glam::{DMat3, DQuat, DVec3};
 /// ```
 #[must_use]
 pub fn mandelbulb_inside(p: DVec3, power: f64, iterations: u32, bailout: f64) -> bool {
-    let mut z = p;
-    for _ in 0..iterations {
-        let r = z.length();
-        if r > bailout {
-            return false;
-        }
-        z = if r == 0.0 {
-            p
-        } else {
-            let polar = (z.z / r).clamp(-1.0, 1.0).acos() * power;
-            let azimuth = z.y.atan2(z.x) * power;
-            let direction = DVec3::new(
-                polar.sin() * azimuth.cos(),
-                polar.sin() * azimuth.sin(),
-                polar.cos(),
-            );
-            direction * r.powf(power) + p
-        };
-    }
-    z.length() <= bailout
+    crate::scene::mandelbulb_contains(p, power, iterations, bailout)
 }
 
 /// Whether `p` is in the 3D slice at `w = slice_w` of the quaternion Julia
