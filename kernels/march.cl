@@ -346,7 +346,7 @@ MarchResult march_ray(real3 ro, real3 rd, real start, const MarchCamera* cam, re
         if (g <= R(0.0)) {
             r.hit = 1;
             r.closest = R(0.0);
-            if (i > 0) {
+            if (r.steps > 1) {
                 r.t = march_refine(ro, rd, cam, prev_t, prev_g, r.t, g, side, params, &r.steps);
             }
             return r;
@@ -414,13 +414,13 @@ real3 march_normal(real3 p, real h, real3 rd, __global const real* params) {
 // 1.25) keeps AO_DISTANCE.
 #define AO_FALLOFF R(1.5)
 #define AO_VIEW_FRACTION R(0.2)
-real march_ambient_occlusion(real3 p, real3 n, real view_height,
+real march_ambient_occlusion(real3 p, real3 n, real view_height, real offset,
                              __global const real* params) {
     real reach = fmax(fmin(AO_DISTANCE, AO_VIEW_FRACTION * view_height), REAL_TINY);
     real missing = R(0.0);
     real expected = R(0.0);
     for (int i = 0; i < AO_SAMPLES; ++i) {
-        real h = reach * ((real)i + R(0.5)) / (real)AO_SAMPLES;
+        real h = reach * ((real)i + offset) / (real)AO_SAMPLES;
         real weight = exp(-AO_FALLOFF * h / reach);
         real d = DE(p + n * h, params);
         missing += weight * clamp(h - d, R(0.0), h);
@@ -583,12 +583,14 @@ real march_thinness(real3 p, real3 n, real depth, __global const real* params, u
 
 // Ambient occlusion at p from the distance estimate (see
 // march_ambient_occlusion), or 1 without it; the image is view_height
-// scene units high at p's distance. Adds its evaluations to *evals.
-real march_occlusion(real3 p, real3 n, real view_height, __global const real* params,
-                     uint* evals) {
+// scene units high at p's distance. The samples lie at offset (0.5: the
+// midpoints) of their intervals along the normal. Adds its evaluations to
+// *evals.
+real march_occlusion(real3 p, real3 n, real view_height, real offset,
+                     __global const real* params, uint* evals) {
     real occlusion = R(1.0);
 #ifdef ENABLE_AO
-    occlusion = march_ambient_occlusion(p, n, view_height, params);
+    occlusion = march_ambient_occlusion(p, n, view_height, offset, params);
     *evals += (uint)AO_SAMPLES;
 #endif
     return occlusion;
@@ -825,7 +827,7 @@ real3 march_paths(real3 p, real3 n, real3 rd, real eps, real t, const MarchCamer
             color += march_branch(next, stack, &top);
             continue;
         }
-        real occlusion = march_occlusion(q, nq, footprint * cam->image_h, params, evals);
+        real occlusion = march_occlusion(q, nq, footprint * cam->image_h, R(0.5), params, evals);
         real3 lit = march_shade(q, nq, b.rd, eq, occlusion, params, lights, light_count, evals);
         color += march_split(q, nq, b.rd, eq, travelled, b.weight, b.depth, lit, params, stack,
                              &top, evals);
@@ -948,7 +950,8 @@ real march_brute_phase(uint pixel, uint j) {
 }
 
 // The brute-force pass: marches sample s of this pass at every pixel and
-// leaves its depth (+INFINITY on a miss) and evaluations at
+// leaves its depth (on a miss, -1 - the angle of its nearest miss, which
+// the glow reads: a negative value) and evaluations at
 // (s * height + y) * width + x, for render_tile to shade: the normal and
 // occlusion of a point of an inside shape need its neighbours' hits.
 __kernel void brute_depths(BRUTE_DEPTHS_ARGS) {
@@ -970,7 +973,7 @@ __kernel void brute_depths(BRUTE_DEPTHS_ARGS) {
         cam.phase = march_brute_phase(pixel, j);
         MarchResult m = march_ray(ro, rd, R(0.0), &cam, R(1.0), params);
         int at = (s * height + y) * width + x;
-        depths[at] = m.hit ? (float)m.t : INFINITY;
+        depths[at] = m.hit ? (float)m.t : (float)(R(-1.0) - m.closest);
         steps[at] = (uint)m.steps;
     }
 }
@@ -984,7 +987,7 @@ int march_stored_point(const MarchCamera* cam, __global const float* depths, int
         return 0;
     }
     float t = depths[(s * height + y) * width + x];
-    if (isinf(t)) {
+    if (t < 0.0f) {
         return 0;
     }
     real py;
@@ -996,57 +999,71 @@ int march_stored_point(const MarchCamera* cam, __global const float* depths, int
 }
 
 // Neighbours whose hit points lie within this many brute-force steps (and
-// at least this many footprints) of a pixel's are on its surface.
+// at least this many footprints) of a pixel's, per pixel between them, are
+// on its surface.
 #define MARCH_SCREEN_REACH R(6.0)
+// The least-squares fit takes the neighbours up to this many pixels away.
+#define MARCH_FIT_RADIUS 1
+
+// The hit of sample s at the pixel (dx, dy) away from (x, y), if it lies
+// on the same surface as p (see MARCH_SCREEN_REACH).
+int march_neighbour(const MarchCamera* cam, __global const float* depths, int x, int y, int dx,
+                    int dy, int s, int width, int height, uint j, real3 p, real reach,
+                    real3* q) {
+    return march_stored_point(cam, depths, x + dx, y + dy, s, width, height, j, q) &&
+           length(*q - p) <= reach * (real)max(abs(dx), abs(dy));
+}
 
 // The normal at p, the hit of sample s at pixel (x, y) along rd, from its
-// eight neighbours' hits on the same surface (see MARCH_SCREEN_REACH).
-// SCREEN_NORMALS 0: the cross product of the central differences across
-// the pixel, one-sided where a neighbour is elsewhere. 1: Englund's least
-// squares: the plane through the hits, p's among them, that best predicts
-// their depth along the view from their offsets across it (the jittered
-// steps put their noise in depth); the differences where the hits do not
-// span a plane. Faces the viewer; -rd where no plane can be found.
+// neighbours' hits on the same surface. SCREEN_NORMALS 0: the cross
+// product of the central differences across the pixel, one-sided where a
+// neighbour is elsewhere. 1: Englund's least squares: the plane through
+// the hits of the pixels up to MARCH_FIT_RADIUS away, p's among them, that
+// best predicts their depth along the view from their offsets across it
+// (the jittered steps put their noise in depth); the differences where
+// the hits do not span a plane. Faces the viewer; -rd where no plane can
+// be found.
 real3 march_screen_normal(const MarchCamera* cam, __global const float* depths, int x, int y,
                           int s, int width, int height, uint j, real3 p, real3 rd,
                           real footprint) {
     real reach = MARCH_SCREEN_REACH * fmax(BRUTE_STEP, R(1.0)) * footprint;
-    real3 q[9];
-    int ok[9];
-    for (int k = 0; k < 9; ++k) {
-        q[k] = p;
-        ok[k] = k == 4;
-        real3 at;
-        if (k != 4 &&
-            march_stored_point(cam, depths, x + k % 3 - 1, y + k / 3 - 1, s, width, height, j,
-                               &at) &&
-            length(at - p) <= reach) {
-            q[k] = at;
-            ok[k] = 1;
-        }
-    }
-    // Central differences, or one-sided ones (q[k] is p where not ok).
-    real3 du = q[5] - q[3];
-    real3 dv = q[7] - q[1];
-    real3 n = (ok[3] || ok[5]) && (ok[1] || ok[7]) ? cross(du, dv) : (real3)(R(0.0));
+    real3 left = p;
+    real3 right = p;
+    real3 up = p;
+    real3 down = p;
+    int across = march_neighbour(cam, depths, x, y, -1, 0, s, width, height, j, p, reach, &left);
+    across |= march_neighbour(cam, depths, x, y, 1, 0, s, width, height, j, p, reach, &right);
+    int along = march_neighbour(cam, depths, x, y, 0, -1, s, width, height, j, p, reach, &up);
+    along |= march_neighbour(cam, depths, x, y, 0, 1, s, width, height, j, p, reach, &down);
+    // Central differences, or one-sided ones (a missing neighbour is p).
+    real3 n = across && along ? cross(right - left, down - up) : (real3)(R(0.0));
     if (SCREEN_NORMALS == 1) {
-        real3 mean = (real3)(R(0.0));
+        const int side = 2 * MARCH_FIT_RADIUS + 1;
+        real3 sum = (real3)(R(0.0));
+        real3 pts[(2 * MARCH_FIT_RADIUS + 1) * (2 * MARCH_FIT_RADIUS + 1)];
+        int ok[(2 * MARCH_FIT_RADIUS + 1) * (2 * MARCH_FIT_RADIUS + 1)];
         real count = R(0.0);
-        for (int k = 0; k < 9; ++k) {
+        for (int k = 0; k < side * side; ++k) {
+            int dx = k % side - MARCH_FIT_RADIUS;
+            int dy = k / side - MARCH_FIT_RADIUS;
+            pts[k] = p;
+            ok[k] = (dx == 0 && dy == 0) ||
+                    march_neighbour(cam, depths, x, y, dx, dy, s, width, height, j, p, reach,
+                                    &pts[k]);
             if (ok[k]) {
-                mean += q[k];
+                sum += pts[k];
                 count += R(1.0);
             }
         }
-        mean /= count;
+        real3 mean = sum / count;
         real suu = R(0.0);
         real suv = R(0.0);
         real svv = R(0.0);
         real suw = R(0.0);
         real svw = R(0.0);
-        for (int k = 0; k < 9; ++k) {
+        for (int k = 0; k < side * side; ++k) {
             if (ok[k]) {
-                real3 d = q[k] - mean;
+                real3 d = pts[k] - mean;
                 real u = dot(d, cam->right);
                 real v = dot(d, cam->up);
                 real w = dot(d, cam->forward);
@@ -1169,9 +1186,9 @@ __kernel void render_tile(RENDER_TILE_ARGS) {
         {
             int at = (s * height + y) * width + x;
             float t = brute_depths[at];
-            m.hit = !isinf(t);
+            m.hit = t >= 0.0f;
             m.t = m.hit ? (real)t : R(0.0);
-            m.closest = R(1.0);
+            m.closest = m.hit ? R(0.0) : R(-1.0) - (real)t;
             m.steps = (int)brute_steps[at];
         }
 #endif
@@ -1212,18 +1229,25 @@ __kernel void render_tile(RENDER_TILE_ARGS) {
                     view_height = (real)INFINITY;
                 }
             }
-            real occlusion = R(1.0);
+            // Occlusion samples at the midpoints of their intervals.
+            real offset = R(0.5);
+#ifdef ENABLE_BRUTE
+            // The distance's samples along the normal see inside shapes
+            // only where they land in one (a value of -INSIDE_HUGE counts
+            // as fully occluded): jittered like the march's steps, so
+            // passes average the all-or-nothing samples instead of
+            // banding them.
+            offset = march_brute_phase(pixel, j);
+#endif
+            real occlusion = march_occlusion(p, n, view_height, offset, params, &total_evals);
 #ifdef ENABLE_BRUTE
 #ifdef ENABLE_AO
-            // Inside shapes occlude what the distance cannot see: every
-            // hit takes its occlusion from the screen.
-            occlusion = march_screen_occlusion(&cam, brute_depths, x, y, s, width, height, j, p,
-                                               n, footprint, view_height);
+            // The neighbours' depths add what the screen shows around the
+            // hit.
+            occlusion *= march_screen_occlusion(&cam, brute_depths, x, y, s, width, height, j, p,
+                                                n, footprint, view_height);
 #endif
 #endif
-            if (!stored) {
-                occlusion = march_occlusion(p, n, view_height, params, &total_evals);
-            }
             color = march_shade(p, n, rd, DETAIL * footprint, occlusion, params, lights,
                                 light_count, &total_evals);
 #ifdef ENABLE_MATERIALS
@@ -1260,10 +1284,11 @@ __kernel void render_tile(RENDER_TILE_ARGS) {
 
     // Later passes leave the outputs of the first: the same rays.
     if (write_aovs && pass <= 0) {
-        // Brute-forced rays report their first sample's: its normal needs
-        // the neighbours' samples.
-        if (!stored && (SUPERSAMPLING > 1 || cam.aperture > R(0.0))) {
-            // The colour samples are jittered: trace the pixel centre.
+        // The colour samples are jittered: trace the pixel centre. Brute
+        // forced rays report their first sample's instead: its normal
+        // needs the neighbours' samples.
+        int jittered = SUPERSAMPLING > 1 || cam.aperture > R(0.0);
+        if (jittered && !stored) {
             real3 ro;
             real3 rd;
             march_camera_ray(&cam, ((real)x + R(0.5)) * cam.pixel_scale,

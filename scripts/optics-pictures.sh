@@ -12,6 +12,10 @@
 #   docs/materials.png            the materials scene, 4 progressive passes
 #   docs/materials-bounces-N.png  its glass and mirror after 0, 1 and 4
 #                                 bounces
+#   docs/mandelbox.png            the mandelbox scene (an inside shape, brute
+#                                 force), 4 progressive passes
+#   docs/mandelbulb-escape-N.png  the mandelbulb_escape scene at 320x240
+#                                 after 1 and 16 passes
 #
 #   scripts/optics-pictures.sh
 set -euo pipefail
@@ -35,4 +39,8 @@ done
 render materials --size 640x400 --passes 4 -o docs/materials.png
 for n in 0 1 4; do
     render materials --size 320x200 --bounces "$n" -o "docs/materials-bounces-$n.png"
+done
+render mandelbox --size 640x400 --passes 4 -o docs/mandelbox.png
+for n in 1 16; do
+    render mandelbulb_escape --size 320x240 --passes "$n" -o "docs/mandelbulb-escape-$n.png"
 done

@@ -28,7 +28,9 @@
 //!   [`Scene::add`] builds), `Subtract(a: .., b: ..)`, `Intersect(a: ..,
 //!   b: ..)`, `SmoothUnion(k: 0.1, a: .., b: ..)` and the other smooth
 //!   forms, and `Custom(name: "gyroid", args: [0.1])` for a shape passed to
-//!   [`SceneFile::parse_with`]. Fractal settings left out take the
+//!   [`SceneFile::parse_with`] or a built-in inside shape
+//!   ([`InsideShape::builtin`]: `Custom(name: "mandelbox_escape", args:
+//!   [-1.5, 12])`). Fractal settings left out take the
 //!   builders' defaults (Mandelbulb: 12 iterations, bailout 2).
 //! - **Numbers**: a parameter is a number (baked) or `param("name",
 //!   default)` (dynamic, see [`param`](crate::scene::param)); a vector is `(x, y,
@@ -75,8 +77,8 @@ use crate::animation::{CameraPath, Keyframe, Motion};
 use crate::error::{Error, Result};
 use crate::quality::{Effects, Precision, Preset, Quality, ScreenNormals};
 use crate::scene::{
-    Axis, Camera, CsgOp, CustomShape, Kind, Light, Mandelbulb, Material, Menger, Node, NodeKind,
-    Param, Param3, QuaternionJulia, Scene, Sierpinski, param3,
+    Axis, Camera, CsgOp, CustomShape, InsideShape, Kind, Light, Mandelbulb, Material, Menger, Node,
+    NodeKind, Param, Param3, QuaternionJulia, Scene, Sierpinski, param3,
 };
 
 /// The format version this library reads and writes.
@@ -1705,12 +1707,19 @@ impl Located<NodeRepr> {
             NodeRepr::Cut { a, b } => csg(CsgOp::Cut, None, child(a)?, child(b)?),
             NodeRepr::SmoothCut { k, a, b } => csg(CsgOp::Cut, Some(k), child(a)?, child(b)?),
             NodeRepr::Custom { name, args } => {
-                let shape = shapes.iter().find(|s| s.name() == name).ok_or_else(|| {
+                // Shapes given first, then the built-in inside shapes.
+                let builtin = InsideShape::builtin(name).map(CustomShape::from);
+                let shape = shapes
+                    .iter()
+                    .find(|s| s.name() == name)
+                    .or(builtin.as_ref());
+                let shape = shape.ok_or_else(|| {
                     let known: Vec<&str> = shapes.iter().map(CustomShape::name).collect();
                     fail(if known.is_empty() {
                         format!(
                             "no custom shape named `{name}` was given to read this file with \
-                             (`SceneFile::parse_with` or `load_with` take them)"
+                             (`SceneFile::parse_with` or `load_with` take them), and no built-in \
+                             inside shape has that name"
                         )
                     } else {
                         format!(

@@ -19,9 +19,9 @@ use crate::error::Result;
 use crate::file::SceneFile;
 use crate::quality::{Effects, Glow, Quality};
 use crate::scene::{
-    Axis, Camera, Light, Mandelbulb, Material, Node, QuaternionJulia, Scene, capped_cone, capsule,
-    cuboid, cylinder, ellipsoid, julia, menger, octahedron, param, param3, plane, round_box,
-    sierpinski, sphere, torus,
+    Axis, Camera, InsideShape, Light, Mandelbulb, Material, Node, QuaternionJulia, Scene,
+    capped_cone, capsule, cuboid, cylinder, ellipsoid, julia, menger, octahedron, param, param3,
+    plane, round_box, sierpinski, sphere, torus,
 };
 
 /// Every gallery scene by name.
@@ -40,6 +40,8 @@ pub fn all() -> Vec<(&'static str, Scene)> {
         ("depth_of_field", depth_of_field()),
         ("cross_section", cross_section()),
         ("materials", materials()),
+        ("mandelbulb_escape", mandelbulb_escape()),
+        ("mandelbox", mandelbox()),
     ]
 }
 
@@ -83,7 +85,8 @@ pub fn motions(name: &str) -> Vec<Motion> {
 
 /// The gallery's scene `name` as a scene file: the scene, production
 /// quality with 2×2 supersampling (4×4 for a camera with a lens, whose
-/// blur needs more samples), the default effects with a pale blue
+/// blur needs more samples; brute-force steps of 2 footprints for a scene
+/// with inside shapes), the default effects with a pale blue
 /// glow, its [`motions`], and for `benchmark` its [`benchmark_path`]. The
 /// crate's `scenes/` folder holds these files (`scenes/NAME.ron`), as
 /// [`SceneFile::to_text`] writes them.
@@ -91,9 +94,15 @@ pub fn motions(name: &str) -> Vec<Motion> {
 pub fn file(name: &str) -> Option<SceneFile> {
     let scene = by_name(name)?;
     let samples = if scene.camera.aperture > 0.0 { 4 } else { 2 };
+    let mut quality = Quality::production().supersampling(samples);
+    if scene.compile().is_ok_and(|c| c.ir().has_inside_shapes()) {
+        // Brute-force steps of 2 footprints: the four jittered samples of
+        // a pixel average their noise.
+        quality = quality.brute_step(2.0);
+    }
     Some(SceneFile {
         scene,
-        quality: Some(Quality::production().supersampling(samples)),
+        quality: Some(quality),
         effects: Effects::default().glow(Glow::new(dvec3(0.6, 0.75, 1.0), 0.6)),
         path: (name == "benchmark").then(|| benchmark_path().expect("a constant path")),
         motions: motions(name),
@@ -264,6 +273,39 @@ pub fn materials() -> Scene {
                 .color(dvec3(1.0, 0.85, 0.7))
                 .intensity(0.8),
         ])
+}
+
+/// The gallery's [`mandelbulb`] drawn from its escape-time test alone:
+/// an [`InsideShape::mandelbulb`] of power 8 and 10 iterations, marched by
+/// brute force, with the same camera and lights. Its surface is the set's
+/// own, rougher than the estimate's, which is drawn DETAIL pixels out.
+#[must_use]
+pub fn mandelbulb_escape() -> Scene {
+    let bulb = InsideShape::mandelbulb()
+        .node([8.0, 10.0])
+        .rotate(DVec3::X, -FRAC_PI_2)
+        .color(dvec3(0.9, 0.6, 0.35));
+    let reference = mandelbulb();
+    Scene::new(bulb)
+        .with_camera(reference.camera)
+        .with_lights(reference.lights)
+}
+
+/// A Mandelbox of scale −1.5 and 12 iterations standing on a floor: a set
+/// the library has no distance estimate for, drawn from its escape-time
+/// test ([`InsideShape::mandelbox`]) by brute force, beside a floor that
+/// is still sphere-traced.
+#[must_use]
+pub fn mandelbox() -> Scene {
+    let scale = 0.5;
+    let boxed = InsideShape::mandelbox()
+        .node([-1.5, 12.0])
+        .rotate(DVec3::Y, 0.6)
+        .scale(scale)
+        .color(dvec3(0.5, 0.62, 0.85));
+    Scene::new(boxed.union(floor(2.0 * scale)))
+        .with_camera(Camera::look_at(dvec3(2.9, 2.0, 3.8), dvec3(0.0, -0.2, 0.0)).fov(40.0))
+        .with_lights(key_and_fill())
 }
 
 /// Smooth union, subtraction and intersection of transformed primitives.

@@ -15,7 +15,10 @@
 //!   [`Node`](crate::Node), a [`cpu::Evaluator`](crate::cpu::Evaluator) or a
 //!   closure `Fn(DVec3) -> f64`. [`check_device_matches_cpu`] (feature
 //!   `opencl`) runs a node's generated OpenCL code on a device and compares
-//!   it with the CPU reference.
+//!   it with the CPU reference, and [`check_inside_matches_device`] does
+//!   the same for an [`InsideShape`](crate::scene::InsideShape)'s
+//!   membership test. [`check_inside_agrees_with_de`] checks that a
+//!   distance estimate and a membership test describe the same set.
 //! - [`parameter_sites`] and [`substitute`] list and replace every scalar
 //!   parameter of any node kind, from the one list of every node's
 //!   parameters: for driving hostile values through every parameter.
@@ -59,11 +62,13 @@ mod strategy;
 
 pub use check::{
     Check, DistanceField, Failure, GeneratedProgram, LIPSCHITZ_TOLERANCE, MIN_BALL_FRACTION,
-    ROUNDING_ALLOWANCE, SHELL_FACTOR, Tested, check_exact, check_lipschitz,
-    check_never_overestimates,
+    ROUNDING_ALLOWANCE, SHELL_FACTOR, Tested, check_exact, check_inside_agrees_with_de,
+    check_lipschitz, check_never_overestimates,
 };
 #[cfg(feature = "opencl")]
-pub use device::{check_device_matches_cpu, random_points, spicy_points};
+pub use device::{
+    check_device_matches_cpu, check_inside_matches_device, random_points, spicy_points,
+};
 pub use membership::{julia_inside, mandelbulb_inside, menger_inside, sierpinski_inside};
 pub use sample::near_surface_points;
 pub use sites::{Site, parameter_sites, substitute};

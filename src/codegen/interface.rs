@@ -223,7 +223,8 @@ pub enum BruteArg {
 
 /// `brute_depths`' declarations, in argument order. Sample `s` of the
 /// pass at pixel `(x, y)` is written at `(s · height + y) · width + x`:
-/// its depth along its ray (`+INFINITY` on a miss) and its distance
+/// its depth along its ray (on a miss, `-1` less the angle of the ray's
+/// nearest miss, which drives the glow: a negative value) and its distance
 /// evaluations.
 pub const BRUTE_DEPTHS: [(BruteArg, &str); 7] = [
     (BruteArg::Params, "__global const real* params"),

@@ -39,12 +39,7 @@ use crate::error::Result;
 use crate::ir::{Bound, CompiledScene, Ir};
 use crate::math::{DEFAULT_COLOR, DERIVATIVE_CAP, MAGNITUDE_CAP, REAL_TINY};
 use crate::quality::{Effects, Precision, Quality, ScreenNormals};
-use crate::scene::{DEFAULT_MATERIAL, INSIDE_HUGE, Kind};
-
-/// The most steps a ray takes within inside shapes' bounds, besides
-/// [`Quality::max_steps`]: a ray still short of the set after these many
-/// brute-force steps is a miss.
-pub const BRUTE_MAX_STEPS: u32 = 16384;
+use crate::scene::{BRUTE_MAX_STEPS, DEFAULT_MATERIAL, INSIDE_HUGE, Kind};
 
 /// What the generated program is for.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]

@@ -23,7 +23,9 @@ use crate::ir::{
     reach, swaps, union_chain,
 };
 use crate::math::F32_LIMITS;
-use crate::scene::{CsgOp, DEFAULT_MATERIAL, Kind, MATERIAL_LEN, Node};
+use crate::scene::{
+    BRUTE_MAX_STEPS, CsgOp, DEFAULT_MATERIAL, INSIDE_HUGE, Kind, MATERIAL_LEN, Node,
+};
 
 /// What the scene is like at one point.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -610,6 +612,83 @@ pub struct Hit {
 /// of regula falsi.
 #[must_use]
 pub fn march(eval: &Evaluator, ray: Ray, settings: &MarchSettings) -> Hit {
+    march_with(eval, ray, settings, None)
+}
+
+/// Brute-force marching of a scene with inside shapes (see
+/// [`InsideShape`](crate::scene::InsideShape)), as the kernel's
+/// `march_ray` does it: within `region` (the scene's
+/// [`Ir::brute_region`]) steps of at most `step` footprints on a lattice
+/// that starts `phase` of a step past where the ray enters it, or the
+/// sphere tracer's step where that is shorter.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Brute {
+    /// The step within the region, in footprints
+    /// ([`Quality::brute_step`](crate::Quality)).
+    pub step: f64,
+    /// The sphere the scene's inside shapes lie in.
+    pub region: Bound,
+    /// Where the lattice starts, in `[0, 1)` of a step.
+    pub phase: f64,
+}
+
+impl Brute {
+    /// The brute-force march of `eval`'s scene with `step` footprints and
+    /// `phase`; `None` for a scene without inside shapes.
+    #[must_use]
+    pub fn of(eval: &Evaluator, step: f64, phase: f64) -> Option<Self> {
+        eval.ir().brute_region().map(|region| Brute {
+            step,
+            region,
+            phase,
+        })
+    }
+
+    /// Where `ray` is within the region: `(enter, exit)`, `enter > exit`
+    /// where it misses.
+    fn span(&self, ray: Ray) -> (f64, f64) {
+        let oc = ray.origin - self.region.centre;
+        let b = oc.dot(ray.direction);
+        let disc = b * b - (oc.length_squared() - self.region.radius * self.region.radius);
+        if disc < 0.0 {
+            return (1.0, -1.0);
+        }
+        let root = disc.sqrt();
+        (-b - root, -b + root)
+    }
+}
+
+/// [`march`] with brute-force steps within inside shapes' region (see
+/// [`Brute`]): the kernel's `march_ray` in a program that has them. A
+/// crossing into an inside shape, whose value has only a sign, is located
+/// by bisection.
+#[must_use]
+pub fn march_brute(eval: &Evaluator, ray: Ray, settings: &MarchSettings, brute: &Brute) -> Hit {
+    march_with(eval, ray, settings, Some(brute))
+}
+
+/// The kernel's `march_brute_step`: a step from `t` of at most `step` that
+/// does not pass the next sample of the lattice (kept in `next`, negative
+/// before the first) within `span`.
+fn brute_step(t: f64, step: f64, span: (f64, f64), h: f64, phase: f64, next: &mut f64) -> f64 {
+    if t + step <= span.0 || t >= span.1 {
+        return step;
+    }
+    if *next < 0.0 {
+        *next = t.max(span.0) + phase * h;
+    }
+    if *next <= t {
+        *next = t + h;
+    }
+    let to_next = *next - t;
+    if to_next > step {
+        return step;
+    }
+    *next += h;
+    to_next
+}
+
+fn march_with(eval: &Evaluator, ray: Ray, settings: &MarchSettings, brute: Option<&Brute>) -> Hit {
     let surface = |t: f64| settings.detail * settings.footprint(t);
     let level = |t: f64| eval.distance(ray.origin + ray.direction * t) - surface(t);
     let lipschitz = 1.0 + settings.detail * settings.footprint_per_unit;
@@ -624,7 +703,14 @@ pub fn march(eval: &Evaluator, ray: Ray, settings: &MarchSettings) -> Hit {
         steps,
         closest,
     };
-    for i in 0..settings.max_steps {
+    let span = brute.map_or((1.0, -1.0), |b| b.span(ray));
+    let mut next_sample = -1.0;
+    let mut brute_steps = 0;
+    // Steps that count towards `max_steps`: brute-force ones do not, up to
+    // BRUTE_MAX_STEPS of them.
+    let mut i = 0;
+    while i < settings.max_steps {
+        i += 1;
         let d = eval.distance(ray.origin + ray.direction * t);
         let g = d - surface(t);
         steps += 1;
@@ -638,7 +724,7 @@ pub fn march(eval: &Evaluator, ray: Ray, settings: &MarchSettings) -> Hit {
             closest = closest.min(d / (t + d));
         }
         if g <= 0.0 {
-            if i > 0 {
+            if steps > 1 {
                 let (depth, extra) = refine(level, (prev_t, prev_g), (t, g), |t| {
                     settings.hit_epsilon * settings.footprint(t)
                 });
@@ -650,9 +736,22 @@ pub fn march(eval: &Evaluator, ray: Ray, settings: &MarchSettings) -> Hit {
         let plain = g / lipschitz;
         let shortest = settings.hit_epsilon * settings.footprint(t);
         relaxed = omega > 1.0 && omega * plain > plain.max(shortest);
+        let mut step = (omega * plain).max(shortest);
+        if let Some(b) = brute {
+            let h = b.step * settings.footprint(t.max(span.0));
+            let capped = brute_step(t, step, span, h, b.phase, &mut next_sample);
+            if capped < step {
+                step = capped;
+                relaxed = false;
+                if brute_steps < BRUTE_MAX_STEPS {
+                    brute_steps += 1;
+                    i -= 1;
+                }
+            }
+        }
         prev_t = t;
         prev_g = g;
-        t += (omega * plain).max(shortest);
+        t += step;
         if t > settings.max_distance {
             return stop(false, t, steps, closest);
         }
@@ -678,7 +777,11 @@ fn refine(
     let mut evaluations = 0;
     while evaluations < REFINE_LIMIT && t1 - t0 > tolerance(t1) {
         // `max` then `min`, like OpenCL's `clamp`: a NaN lands on `t0`.
-        let t = (t0 + (t1 - t0) * (g0 / (g0 - g1))).max(t0).min(t1);
+        let mut t = (t0 + (t1 - t0) * (g0 / (g0 - g1))).max(t0).min(t1);
+        // An inside shape's value has a sign and no size: halve the bracket.
+        if g0.abs().max(g1.abs()) >= 0.5 * INSIDE_HUGE {
+            t = 0.5 * (t0 + t1);
+        }
         let v = g(t);
         evaluations += 1;
         if v > 0.0 {

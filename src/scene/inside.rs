@@ -184,6 +184,11 @@ impl From<InsideShape> for CustomShape {
     }
 }
 
+/// The most steps a ray takes within inside shapes' bounds, besides
+/// [`Quality::max_steps`](crate::Quality): a ray still short of the set
+/// after these many brute-force steps is a miss.
+pub const BRUTE_MAX_STEPS: u32 = 16384;
+
 /// The escape radius of [`InsideShape::mandelbulb`].
 pub const MANDELBULB_BAILOUT: f64 = 2.0;
 

@@ -22,8 +22,8 @@ pub use build::{
 };
 pub use custom::{CpuDistance, CpuInside, CustomShape, INSIDE_HUGE, InsideBounds};
 pub use inside::{
-    InsideShape, MANDELBOX_BAILOUT, MANDELBOX_HALF_SIDE, MANDELBULB_BAILOUT, mandelbox_contains,
-    mandelbulb_contains,
+    BRUTE_MAX_STEPS, InsideShape, MANDELBOX_BAILOUT, MANDELBOX_HALF_SIDE, MANDELBULB_BAILOUT,
+    mandelbox_contains, mandelbulb_contains,
 };
 pub use material::{DEFAULT_MATERIAL, MATERIAL_LEN, Material};
 pub(crate) use node::Mapper;

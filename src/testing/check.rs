@@ -82,6 +82,12 @@ pub enum Check {
     /// The device can run the check (there is an OpenCL platform and
     /// device, with double precision if asked, and the kernel runs).
     Device,
+    /// An inside shape's OpenCL test agrees with its CPU test.
+    InsideMatchesDevice,
+    /// A distance estimate and a membership test describe the same set:
+    /// the estimate's sign is the membership wherever it is farther than a
+    /// margin from 0.
+    InsideAgreesWithDe,
 }
 
 /// A broken invariant: the worst violation a checker found, and how many
@@ -101,6 +107,8 @@ pub enum Check {
 /// | `Exact` | `[p]` | `[d(p), analytic(p)]` | `\|d(p) - analytic(p)\|` | the tolerance at `p` |
 /// | `DeviceMatchesCpu` | `[p]` | `[device, cpu]` | the relative error | the tolerance |
 /// | `Build`, `Device` | none | none | 0 | 0 |
+/// | `InsideMatchesDevice` | `[p]`, the first disagreement | `[device, cpu]` (1 inside, 0 outside) | the fraction of points that disagree | the fraction allowed |
+/// | `InsideAgreesWithDe` | `[p]` | `[d(p)]` | `\|d(p)\|` where its sign is wrong | the margin |
 ///
 /// A check that ran generated OpenCL code keeps the program in `program`
 /// (and saves it to a file it names), so a failure can be read against the
@@ -280,6 +288,27 @@ impl Failure {
                 self.allowed,
                 tally("points")
             ),
+            Check::InsideMatchesDevice => write!(
+                f,
+                "the device's membership test disagrees with the CPU's on a fraction {} of the \
+                 points (allowed {}): first at p = {}, {} on the device but {} on the CPU; {}",
+                self.measured,
+                self.allowed,
+                p[0],
+                if v[0] > 0.5 { "inside" } else { "outside" },
+                if v[1] > 0.5 { "inside" } else { "outside" },
+                tally("points")
+            ),
+            Check::InsideAgreesWithDe => write!(
+                f,
+                "the distance estimate and the membership test disagree: d(p) = {} at p = {}, \
+                 but p is {} the set (only |d| <= {} may disagree); {}",
+                v[0],
+                p[0],
+                if v[0] > 0.0 { "inside" } else { "outside" },
+                self.allowed,
+                tally("points beyond the margin")
+            ),
         }
     }
 }
@@ -320,6 +349,75 @@ impl<F: Fn(DVec3) -> f64> DistanceField for F {
     fn distance_fn(&self) -> Result<Box<dyn Fn(DVec3) -> f64 + '_>, Failure> {
         Ok(Box::new(self))
     }
+}
+
+/// Checks that the distance estimate `de` and the membership test `inside`
+/// describe the same set: at every point where `|d(p)| > margin`, `d(p) <
+/// 0` exactly where `inside(p)`. Near the surface the two legitimately
+/// differ (an estimate's zero level and an escape-time set at a finite
+/// iteration count are not the same surface), so `margin` is the width of
+/// the band that is not compared: a few pixel footprints of the view the
+/// two are drawn at.
+///
+/// Returns how many points lay beyond the margin (`inputs`) and, as
+/// `worst`, the largest `|d|` among points in the band whose sign
+/// disagrees, over the margin (so at most 1).
+///
+/// # Errors
+/// The point beyond the margin with the largest `|d|` whose sign is wrong;
+/// the first non-finite distance; [`Check::TooFewTested`] when no point
+/// lies beyond the margin.
+///
+/// ```
+/// use fractal_sdf::prelude::*;
+/// use fractal_sdf::testing::check_inside_agrees_with_de;
+/// let points = [dvec3(0.2, 0.0, 0.0), dvec3(1.5, 0.3, 0.0), dvec3(0.99, 0.0, 0.0)];
+/// let ball = |p: DVec3| p.length() < 1.0;
+/// check_inside_agrees_with_de(&sphere(1.0), ball, &points, 0.05)?;
+/// // A sphere of radius 1.2 says (1.1, 0, 0) is inside.
+/// let far = [dvec3(1.1, 0.0, 0.0)];
+/// assert!(check_inside_agrees_with_de(&sphere(1.2), ball, &far, 0.05).is_err());
+/// # Ok::<(), fractal_sdf::testing::Failure>(())
+/// ```
+pub fn check_inside_agrees_with_de<F: DistanceField + ?Sized>(
+    de: &F,
+    inside: impl Fn(DVec3) -> bool,
+    points: &[DVec3],
+    margin: f64,
+) -> Result<Tested, Failure> {
+    let d = de.distance_fn()?;
+    let mut tally = Tally::new();
+    let mut band = 0.0f64;
+    for &p in points {
+        let v = d(p);
+        if !v.is_finite() {
+            tally.fail(Failure::new(Check::Finite, vec![p], vec![v], v, 0.0));
+            continue;
+        }
+        let agrees = (v < 0.0) == inside(p);
+        if v.abs() <= margin {
+            if !agrees {
+                band = band.max(v.abs() / margin.max(f64::MIN_POSITIVE));
+            }
+            continue;
+        }
+        if agrees {
+            tally.pass(0.0);
+        } else {
+            tally.fail(Failure::new(
+                Check::InsideAgreesWithDe,
+                vec![p],
+                vec![v],
+                v.abs(),
+                margin,
+            ));
+        }
+    }
+    let tested = tally.finish()?;
+    Ok(Tested {
+        worst: band,
+        ..tested
+    })
 }
 
 /// Keeps the worst of a run of violations and counts them.

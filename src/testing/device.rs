@@ -8,7 +8,7 @@ use crate::cpu::Evaluator;
 use crate::error::Error;
 use crate::quality::Precision;
 use crate::render::{DeviceSelector, PointEvaluator};
-use crate::scene::Node;
+use crate::scene::{InsideShape, Node};
 
 /// Deterministic pseudo-random points in the cube `[-extent, extent]^3`
 /// (xorshift64 from `seed`), for checks that must not vary between runs.
@@ -147,6 +147,93 @@ pub fn check_device_matches_cpu(
         }
     }
     tally.finish().map_err(keep)
+}
+
+/// Checks an inside shape's OpenCL test against its CPU test at `points`,
+/// with parameter values `args`: whether each point is in the set. Near the
+/// set's surface an `F32` test may decide a point differently from the
+/// CPU's `f64` one (an orbit that escapes at the last iteration), so a
+/// fraction `allowed` of the points may disagree; 0 demands agreement
+/// everywhere.
+///
+/// Returns the points tested and, as `worst`, the fraction that disagreed
+/// over `allowed`.
+///
+/// # Errors
+/// [`Check::Valid`], [`Check::Build`] or [`Check::Device`] as
+/// [`check_device_matches_cpu`]; [`Check::InsideMatchesDevice`] with the
+/// first disagreeing point when more than `allowed` of them disagree.
+///
+/// ```no_run
+/// use fractal_sdf::prelude::*;
+/// use fractal_sdf::render::DeviceSelector;
+/// use fractal_sdf::testing::{check_inside_matches_device, random_points};
+///
+/// let points = random_points(2000, 2.0, 3);
+/// let bulb = InsideShape::mandelbulb();
+/// check_inside_matches_device(&bulb, &[8.0, 8.0], &DeviceSelector::auto(), Precision::F64, &points, 0.0)?;
+/// # Ok::<(), fractal_sdf::testing::Failure>(())
+/// ```
+pub fn check_inside_matches_device(
+    shape: &InsideShape,
+    args: &[f64],
+    device: &DeviceSelector,
+    precision: Precision,
+    points: &[DVec3],
+    allowed: f64,
+) -> Result<Tested, Failure> {
+    let node = shape.node(args.iter().copied());
+    Evaluator::new(&node).map_err(|e| Failure {
+        detail: e.to_string(),
+        ..Failure::new(Check::Valid, vec![], vec![], 0.0, 0.0)
+    })?;
+    let twin = PointEvaluator::new(&node, precision, device).map_err(not_run)?;
+    let got = twin
+        .eval(points)
+        .map_err(|e| keep_source(not_run(e), twin.source()))?;
+    let mut first: Option<(DVec3, bool, bool)> = None;
+    let mut violations = 0;
+    for (&p, g) in points.iter().zip(&got) {
+        let device_in = g.distance < 0.0;
+        let cpu_in = shape.contains(p, args);
+        if device_in != cpu_in {
+            violations += 1;
+            first.get_or_insert((p, device_in, cpu_in));
+        }
+    }
+    #[allow(clippy::cast_precision_loss)]
+    let fraction = violations as f64 / points.len().max(1) as f64;
+    match first {
+        Some((p, device_in, cpu_in)) if fraction > allowed => {
+            let failure = Failure {
+                violations,
+                checked: points.len(),
+                ..Failure::new(
+                    Check::InsideMatchesDevice,
+                    vec![p],
+                    vec![f64::from(u8::from(device_in)), f64::from(u8::from(cpu_in))],
+                    fraction,
+                    allowed,
+                )
+            };
+            Err(keep_source(failure, twin.source()))
+        }
+        _ if points.is_empty() => Err(Failure {
+            detail: "points".into(),
+            violations: 1,
+            ..Failure::new(Check::TooFewTested, vec![], vec![], 0.0, 1.0)
+        }),
+        _ => Ok(Tested {
+            inputs: points.len(),
+            balls: points.len(),
+            signs: 0,
+            worst: if allowed > 0.0 {
+                fraction / allowed
+            } else {
+                0.0
+            },
+        }),
+    }
 }
 
 /// The failure for a device check that could not run: the program did not

@@ -48,13 +48,23 @@ typedef float4 real4;
     const int pass, \
     __global float4* accumulation, \
     const int refine_only, \
-    __global const uchar* refine
+    __global const uchar* refine, \
+    __global const float* brute_depths, \
+    __global const uint* brute_steps
 #define CONE_STARTS_ARGS \
     __global const real* params, \
     __global const real* camera, \
     const int width, \
     const int height, \
     __global float* starts
+#define BRUTE_DEPTHS_ARGS \
+    __global const real* params, \
+    __global const real* camera, \
+    const int width, \
+    const int height, \
+    const int pass, \
+    __global float* depths, \
+    __global uint* steps
 #define CAMERA_ORIGIN 0
 #define CAMERA_ORTHOGRAPHIC 3
 #define CAMERA_RIGHT 4

@@ -134,6 +134,10 @@ struct RenderArgs {
     /// (0 to 8; default: the quality's).
     #[arg(long, value_name = "N")]
     bounces: Option<u32>,
+    /// The brute-force step through shapes given by an inside test, in
+    /// pixel footprints (default: the quality's).
+    #[arg(long, value_name = "FOOTPRINTS")]
+    brute_step: Option<f64>,
 }
 
 impl RenderArgs {
@@ -389,6 +393,9 @@ fn render(args: &RenderArgs, settings: &Settings) -> Outcome {
     }
     if let Some(bounces) = args.bounces {
         job.options.quality.bounces = bounces;
+    }
+    if let Some(step) = args.brute_step {
+        job.options.quality.brute_step = step;
     }
     let (width, height) = job.size;
     let start = Instant::now();

@@ -65,6 +65,7 @@ typedef struct {
     real aperture;    // the thin lens's radius (0: a pinhole)
     real focus;       // the distance along forward that is in focus
     int orthographic;
+    real phase;       // where a ray's brute-force steps start, in [0, 1) of a step
 } MarchCamera;
 
 MarchCamera march_load_camera(__global const real* c) {
@@ -84,6 +85,7 @@ MarchCamera march_load_camera(__global const real* c) {
     cam.shift = vload2(0, c + CAMERA_SHIFT);
     cam.aperture = c[CAMERA_APERTURE];
     cam.focus = c[CAMERA_FOCUS_DISTANCE];
+    cam.phase = R(0.5);
     return cam;
 }
 
@@ -244,6 +246,7 @@ int march_glow_settled(real3 p, real3 rd, real t) {
     return SCENE_BOUND_SLOPE * (a * length(q) - SCENE_BOUND_RADIUS) >= k * t;
 }
 
+
 // Side 1 marches towards the surface from outside, side -1 towards the
 // way out from inside it (g and its Lipschitz bound are the same up to
 // sign).
@@ -278,7 +281,7 @@ MarchResult march_ray(real3 ro, real3 rd, real start, const MarchCamera* cam, re
         if (g <= R(0.0)) {
             r.hit = 1;
             r.closest = R(0.0);
-            if (i > 0) {
+            if (r.steps > 1) {
                 r.t = march_refine(ro, rd, cam, prev_t, prev_g, r.t, g, side, params, &r.steps);
             }
             return r;
@@ -286,9 +289,10 @@ MarchResult march_ray(real3 ro, real3 rd, real start, const MarchCamera* cam, re
         real plain = g / lipschitz;
         real shortest = HIT_EPSILON * march_footprint(cam, r.t);
         relaxed = omega > R(1.0) && omega * plain > fmax(plain, shortest);
+        real step = fmax(omega * plain, shortest);
         prev_t = r.t;
         prev_g = g;
-        r.t += fmax(omega * plain, shortest);
+        r.t += step;
         if (r.t > MAX_DISTANCE) {
             return r;
         }
@@ -328,13 +332,13 @@ real3 march_normal(real3 p, real h, real3 rd, __global const real* params) {
 // 1.25) keeps AO_DISTANCE.
 #define AO_FALLOFF R(1.5)
 #define AO_VIEW_FRACTION R(0.2)
-real march_ambient_occlusion(real3 p, real3 n, real view_height,
+real march_ambient_occlusion(real3 p, real3 n, real view_height, real offset,
                              __global const real* params) {
     real reach = fmax(fmin(AO_DISTANCE, AO_VIEW_FRACTION * view_height), REAL_TINY);
     real missing = R(0.0);
     real expected = R(0.0);
     for (int i = 0; i < AO_SAMPLES; ++i) {
-        real h = reach * ((real)i + R(0.5)) / (real)AO_SAMPLES;
+        real h = reach * ((real)i + offset) / (real)AO_SAMPLES;
         real weight = exp(-AO_FALLOFF * h / reach);
         real d = DE(p + n * h, params);
         missing += weight * clamp(h - d, R(0.0), h);
@@ -379,6 +383,7 @@ real march_shadow(real3 ro, real3 rd, real max_t, real eps, real start, real sof
         if (h < eps) {
             return R(0.0);
         }
+
         if (softness > R(0.0)) {
             // The closest point to the surface between this sample and the
             // previous one, estimated from the two distance spheres. They
@@ -393,7 +398,8 @@ real march_shadow(real3 ro, real3 rd, real max_t, real eps, real start, real sof
                 return R(0.0);
             }
         }
-        t += fmax(h, eps);
+        real step = fmax(h, eps);
+        t += step;
     }
     visible = clamp(visible, R(0.0), R(1.0));
     return visible * visible * (R(3.0) - R(2.0) * visible);
@@ -415,10 +421,22 @@ real3 march_background(const MarchCamera* cam, real py) {
 }
 
 
-// Lit colour of the surface point p with normal n, seen along rd; the
-// image is view_height scene units high at p's distance. Adds its distance
-// evaluations (DE_shade, DE_material, occlusion, shadow rays, thickness)
-// to *evals.
+// Ambient occlusion at p from the distance estimate (see
+// march_ambient_occlusion), or 1 without it; the image is view_height
+// scene units high at p's distance. The samples lie at offset (0.5: the
+// midpoints) of their intervals along the normal. Adds its evaluations to
+// *evals.
+real march_occlusion(real3 p, real3 n, real view_height, real offset,
+                     __global const real* params, uint* evals) {
+    real occlusion = R(1.0);
+    occlusion = march_ambient_occlusion(p, n, view_height, offset, params);
+    *evals += (uint)AO_SAMPLES;
+    return occlusion;
+}
+
+// Lit colour of the surface point p with normal n, seen along rd, with the
+// sky's light scaled by occlusion (1: open). Adds its distance evaluations
+// (DE_shade, DE_material, shadow rays, thickness) to *evals.
 //
 // Every light adds albedo * diffuse * n.l plus the Blinn-Phong highlight
 // specular * (n.h)^shininess * n.l, the diffuse term being Lambert's (1)
@@ -427,7 +445,7 @@ real3 march_background(const MarchCamera* cam, real py) {
 // albedo * s * thinness * -n.l: it shows through thin parts, unshadowed
 // (the shape itself stands between). Without materials the highlight is
 // MARCH_SPECULAR and MARCH_SHININESS, the default material's.
-real3 march_shade(real3 p, real3 n, real3 rd, real eps, real view_height,
+real3 march_shade(real3 p, real3 n, real3 rd, real eps, real occlusion,
                   __global const real* params, __global const real* lights, int light_count,
                   uint* evals) {
     real3 albedo;
@@ -438,9 +456,6 @@ real3 march_shade(real3 p, real3 n, real3 rd, real eps, real view_height,
     real specular_strength = MARCH_SPECULAR;
     real shininess = MARCH_SHININESS;
 
-    real occlusion = R(1.0);
-    occlusion = march_ambient_occlusion(p, n, view_height, params);
-    *evals += (uint)AO_SAMPLES;
     real3 sky = mix(SKY_BOTTOM, SKY_TOP, R(0.5) + R(0.5) * n.y);
     real3 color = albedo * sky * (MARCH_AMBIENT * occlusion);
 
@@ -567,6 +582,25 @@ void march_sample_point(uint pixel, uint j, int s, real* jx, real* jy) {
     }
 }
 
+// The ray of sample j (the s-th of its pass) of rendered pixel (x, y),
+// whose index is pixel: its image row *py, origin and direction.
+void march_sample_ray(const MarchCamera* cam, int x, int y, uint pixel, uint j, int s, real* py,
+                      real3* ro, real3* rd) {
+    real jx;
+    real jy;
+    march_sample_point(pixel, j, s, &jx, &jy);
+    // A pinhole needs no lens point.
+    real2 lens = (real2)(R(0.0));
+    if (cam->aperture > R(0.0)) {
+        lens = march_disc(march_lens_point(pixel, j));
+    }
+    // Rendered pixel (x, y) covers pixel_scale image pixels each way.
+    real px = ((real)x + jx) * cam->pixel_scale;
+    *py = ((real)y + jy) * cam->pixel_scale;
+    march_lens_ray(cam, px, *py, lens, ro, rd);
+}
+
+
 // One launch shades the tile [x0, x0 + tile_w) x [y0, y0 + tile_h) of a
 // width x height image. The global size may be rounded up past the tile.
 //
@@ -610,22 +644,18 @@ __kernel void render_tile(RENDER_TILE_ARGS) {
     uint total_evals = 0;
     MarchResult centre = {R(0.0), R(1.0), 0, 0};
     real3 centre_normal = (real3)(R(0.0));
+    // Whether the rays come marched by brute_depths.
+    int stored = 0;
     for (int s = 0; s < per_pass; ++s) {
-        real jx;
-        real jy;
-        march_sample_point(pixel, first + (uint)s, s, &jx, &jy);
-        // A pinhole needs no lens point.
-        real2 lens = (real2)(R(0.0));
-        if (cam.aperture > R(0.0)) {
-            lens = march_disc(march_lens_point(pixel, first + (uint)s));
-        }
-        // Rendered pixel (x, y) covers pixel_scale image pixels each way.
-        real px = ((real)x + jx) * cam.pixel_scale;
-        real py = ((real)y + jy) * cam.pixel_scale;
+        const uint j = first + (uint)s;
+        real py;
         real3 ro;
         real3 rd;
-        march_lens_ray(&cam, px, py, lens, &ro, &rd);
-        MarchResult m = march_ray(ro, rd, start, &cam, R(1.0), params);
+        march_sample_ray(&cam, x, y, pixel, j, s, &py, &ro, &rd);
+        MarchResult m;
+        if (!stored) {
+            m = march_ray(ro, rd, start, &cam, R(1.0), params);
+        }
         total_steps += (uint)m.steps;
         total_evals += (uint)m.steps;
 
@@ -635,18 +665,27 @@ __kernel void render_tile(RENDER_TILE_ARGS) {
         if (m.hit) {
             real3 p = ro + rd * m.t;
             real footprint = march_footprint(&cam, m.t);
-            n = march_normal(p, NORMAL_EPSILON * footprint, rd, params);
-            total_evals += MARCH_NORMAL_EVALUATIONS;
             real view_height = footprint * cam.image_h;
-            if (m.t <= R(0.0)) {
-                // The ray starts inside the surface (a camera within a
-                // solid): shade the nearest point of the surface instead.
-                // No view to scale occlusion to: it keeps AO_DISTANCE.
-                p -= n * DE(p, params);
-                total_evals += 1u;
-                view_height = (real)INFINITY;
+            // Whether p lies in an inside shape, which has no distance to
+            // take a normal or occlusion from.
+            int in_set = 0;
+            if (!in_set) {
+                n = march_normal(p, NORMAL_EPSILON * footprint, rd, params);
+                total_evals += MARCH_NORMAL_EVALUATIONS;
+                if (m.t <= R(0.0)) {
+                    // The ray starts inside the surface (a camera within a
+                    // solid): shade the nearest point of the surface
+                    // instead. No view to scale occlusion to: it keeps
+                    // AO_DISTANCE.
+                    p -= n * DE(p, params);
+                    total_evals += 1u;
+                    view_height = (real)INFINITY;
+                }
             }
-            color = march_shade(p, n, rd, DETAIL * footprint, view_height, params, lights,
+            // Occlusion samples at the midpoints of their intervals.
+            real offset = R(0.5);
+            real occlusion = march_occlusion(p, n, view_height, offset, params, &total_evals);
+            color = march_shade(p, n, rd, DETAIL * footprint, occlusion, params, lights,
                                 light_count, &total_evals);
         }
         sum += color;
@@ -670,8 +709,11 @@ __kernel void render_tile(RENDER_TILE_ARGS) {
 
     // Later passes leave the outputs of the first: the same rays.
     if (write_aovs && pass <= 0) {
-        if (SUPERSAMPLING > 1 || cam.aperture > R(0.0)) {
-            // The colour samples are jittered: trace the pixel centre.
+        // The colour samples are jittered: trace the pixel centre. Brute
+        // forced rays report their first sample's instead: its normal
+        // needs the neighbours' samples.
+        int jittered = SUPERSAMPLING > 1 || cam.aperture > R(0.0);
+        if (jittered && !stored) {
             real3 ro;
             real3 rd;
             march_camera_ray(&cam, ((real)x + R(0.5)) * cam.pixel_scale,

@@ -1,0 +1,510 @@
+//! Inside shapes: sets given only by a membership test, marched by brute
+//! force (see `fractal_sdf::scene::InsideShape`).
+
+use fractal_sdf::cpu::{self, Brute, Ray};
+use fractal_sdf::prelude::*;
+use fractal_sdf::render::{DeviceSelector, Frame, RenderOptions, Renderer};
+use fractal_sdf::scene::{INSIDE_HUGE, Rule};
+use fractal_sdf::testing::{
+    check_inside_agrees_with_de, check_inside_matches_device, random_points,
+};
+
+const RADIUS: f64 = 1.0;
+
+/// A ball known only by `|p| < r`.
+fn ball() -> InsideShape {
+    InsideShape::new(
+        "ball",
+        &[("r", Rule::Positive)],
+        InsideBounds::sphere(DVec3::ZERO, 1.5),
+        |p, a| p.length() < a[0],
+        "return length(p) < r;",
+    )
+    .unwrap()
+}
+
+fn camera() -> Camera {
+    Camera::look_at(dvec3(0.0, 0.4, 3.2), DVec3::ZERO).fov(40.0)
+}
+
+fn options(quality: Quality) -> RenderOptions {
+    let mut options = RenderOptions {
+        quality,
+        ..RenderOptions::default()
+    };
+    options.effects.shadows = false;
+    options
+}
+
+fn frame(
+    scene: &Scene,
+    quality: Quality,
+    (w, h): (u32, u32),
+) -> (Frame, fractal_sdf::render::Viewport) {
+    let mut renderer = Renderer::with_options(scene, &options(quality)).unwrap();
+    let frame = renderer.render_with_aovs(w, h).unwrap();
+    (frame, renderer.viewport(w, h).unwrap())
+}
+
+/// Where the ray first meets the sphere of `radius` about `centre`.
+fn sphere_hit(ray: Ray, centre: DVec3, radius: f64) -> Option<f64> {
+    let oc = ray.origin - centre;
+    let b = oc.dot(ray.direction);
+    let disc = b * b - (oc.length_squared() - radius * radius);
+    (disc >= 0.0).then(|| -b - disc.sqrt()).filter(|t| *t > 0.0)
+}
+
+/// The chord a ray cuts through the sphere.
+fn chord(ray: Ray, centre: DVec3, radius: f64) -> f64 {
+    let oc = ray.origin - centre;
+    let b = oc.dot(ray.direction);
+    let disc = b * b - (oc.length_squared() - radius * radius);
+    2.0 * disc.max(0.0).sqrt()
+}
+
+fn angle_degrees(a: DVec3, b: DVec3) -> f64 {
+    a.normalize()
+        .dot(b.normalize())
+        .clamp(-1.0, 1.0)
+        .acos()
+        .to_degrees()
+}
+
+#[test]
+fn brute_force_hits_lie_within_a_step_of_the_surface() {
+    let scene = Scene::new(ball().node([RADIUS])).with_camera(camera());
+    let step = 2.0;
+    let quality = Quality::production().brute_step(step);
+    let (frame, view) = frame(&scene, quality, (96, 72));
+    let settings = view.march_settings(&quality);
+    let (mut hits, mut worst, mut grazing_misses) = (0, 0.0f64, 0);
+    for y in 0..frame.height() {
+        for x in 0..frame.width() {
+            let i = frame.index(x, y);
+            let ray = view.ray(f64::from(x) + 0.5, f64::from(y) + 0.5);
+            let footprint = settings.footprint(f64::from(frame.depth[i]));
+            match (frame.hit[i], sphere_hit(ray, DVec3::ZERO, RADIUS)) {
+                (true, Some(t)) => {
+                    hits += 1;
+                    let error = (f64::from(frame.depth[i]) - t).abs() / footprint;
+                    worst = worst.max(error);
+                }
+                (true, None) => panic!("pixel ({x}, {y}) hits outside the ball"),
+                (false, Some(_)) => {
+                    // Only a ray whose chord is shorter than a step may pass.
+                    let h = step * settings.footprint(3.2);
+                    assert!(
+                        chord(ray, DVec3::ZERO, RADIUS) < 2.0 * h,
+                        "pixel ({x}, {y}) misses the ball across a chord of {}",
+                        chord(ray, DVec3::ZERO, RADIUS)
+                    );
+                    grazing_misses += 1;
+                }
+                (false, None) => {}
+            }
+        }
+    }
+    eprintln!(
+        "ball, brute step {step}: {hits} hits, depth error at most {worst:.4} footprints, \
+         {grazing_misses} grazing rays missed"
+    );
+    assert!(hits > 1500, "{hits} hits");
+    assert!(
+        worst <= step,
+        "a hit is {worst} footprints off, more than a step"
+    );
+}
+
+#[test]
+fn bisection_locates_the_crossing_to_hit_epsilon() {
+    let node = ball().node([RADIUS]);
+    let eval = cpu::Evaluator::new(&node).unwrap();
+    for hit_epsilon in [0.05, 0.001] {
+        let settings = cpu::MarchSettings {
+            footprint_base: 0.0,
+            footprint_per_unit: 0.004,
+            detail: 0.5,
+            hit_epsilon,
+            max_steps: 512,
+            ..cpu::MarchSettings::default()
+        };
+        let mut worst = 0.0f64;
+        let mut rays = 0;
+        for k in 0..200 {
+            let phase = f64::from(k) / 200.0;
+            let target = dvec3(
+                0.3 * (f64::from(k) * 0.37).sin(),
+                0.3 * (f64::from(k) * 0.71).cos(),
+                0.0,
+            );
+            let origin = dvec3(0.0, 0.4, 3.2);
+            let ray = Ray {
+                origin,
+                direction: (target - origin).normalize(),
+            };
+            let brute = Brute::of(&eval, 4.0, phase).expect("a scene with an inside shape");
+            let hit = cpu::march_brute(&eval, ray, &settings, &brute);
+            let t = sphere_hit(ray, DVec3::ZERO, RADIUS).unwrap();
+            assert!(hit.hit, "ray {k} misses");
+            let error = (hit.depth - t).abs() / settings.footprint(t);
+            worst = worst.max(error);
+            rays += 1;
+        }
+        eprintln!("bisection, hit_epsilon {hit_epsilon}: {rays} rays, worst {worst:.5} footprints");
+        assert!(
+            worst <= hit_epsilon * 1.01,
+            "located to {worst} footprints, not {hit_epsilon}"
+        );
+    }
+}
+
+#[test]
+fn the_device_marches_as_the_cpu_twin_does() {
+    let scene = Scene::new(ball().node([RADIUS])).with_camera(camera());
+    let quality = Quality::production().precision(Precision::F64);
+    let (frame, view) = frame(&scene, quality, (64, 48));
+    let settings = view.march_settings(&quality);
+    let eval = cpu::Evaluator::new(&ball().node([RADIUS])).unwrap();
+    let mut compared = 0;
+    for y in 0..frame.height() {
+        for x in 0..frame.width() {
+            let i = frame.index(x, y);
+            let ray = view.ray(f64::from(x) + 0.5, f64::from(y) + 0.5);
+            // Another phase: the two agree to where the crossing is located.
+            let brute = Brute::of(&eval, quality.brute_step, 0.5).unwrap();
+            let cpu = cpu::march_brute(&eval, ray, &settings, &brute);
+            if chord(ray, DVec3::ZERO, RADIUS) < 4.0 * settings.footprint(3.2) {
+                continue;
+            }
+            assert_eq!(frame.hit[i], cpu.hit, "pixel ({x}, {y})");
+            if cpu.hit {
+                let gap = (f64::from(frame.depth[i]) - cpu.depth).abs();
+                let allowed = 2.0 * quality.hit_epsilon * settings.footprint(cpu.depth) + 1e-5;
+                assert!(
+                    gap <= allowed,
+                    "pixel ({x}, {y}): depths {} and {}",
+                    frame.depth[i],
+                    cpu.depth
+                );
+                compared += 1;
+            }
+        }
+    }
+    assert!(compared > 400, "{compared} hits compared");
+}
+
+#[test]
+fn screen_space_normals_of_a_sphere_are_close_to_its_own() {
+    let scene = Scene::new(ball().node([RADIUS])).with_camera(camera());
+    for (method, mean_limit, typical_limit) in [
+        (ScreenNormals::Differences, 1.0, 0.75),
+        (ScreenNormals::LeastSquares, 1.0, 0.75),
+    ] {
+        let quality = Quality::production().screen_normals(method);
+        let (frame, view) = frame(&scene, quality, (96, 72));
+        let mut angles = Vec::new();
+        for y in 0..frame.height() {
+            for x in 0..frame.width() {
+                let i = frame.index(x, y);
+                let ray = view.ray(f64::from(x) + 0.5, f64::from(y) + 0.5);
+                // Away from the silhouette, where every neighbour is on the ball.
+                if !frame.hit[i] || chord(ray, DVec3::ZERO, RADIUS) < 0.6 {
+                    continue;
+                }
+                let p = ray.origin + ray.direction * f64::from(frame.depth[i]);
+                let n = DVec3::from(frame.normal[i].map(f64::from));
+                angles.push(angle_degrees(n, p));
+            }
+        }
+        angles.sort_by(f64::total_cmp);
+        let mean = angles.iter().sum::<f64>() / angles.len() as f64;
+        let median = angles[angles.len() / 2];
+        let p95 = angles[angles.len() * 95 / 100];
+        eprintln!(
+            "{method:?}: {} pixels, mean {mean:.2}°, median {median:.2}°, 95th percentile {p95:.2}°",
+            angles.len()
+        );
+        assert!(angles.len() > 1000);
+        assert!(mean < mean_limit, "{method:?}: mean angle {mean}°");
+        assert!(median < typical_limit, "{method:?}: median angle {median}°");
+    }
+}
+
+#[test]
+fn a_mixed_scene_draws_both_kinds() {
+    let left = dvec3(-0.7, 0.0, 0.0);
+    let right = dvec3(0.7, 0.0, 0.0);
+    let inside = ball()
+        .node([0.5])
+        .translate(left)
+        .color(dvec3(0.9, 0.2, 0.1));
+    let estimated = sphere(0.5).translate(right).color(dvec3(0.1, 0.3, 0.9));
+    let alone = Scene::new(estimated.clone()).with_camera(camera());
+    let scene = Scene::new(inside.union(estimated)).with_camera(camera());
+    let quality = Quality::production();
+    let (plain, _) = frame(&alone, quality, (96, 72));
+    let (frame, view) = frame(&scene, quality, (96, 72));
+    let (mut on_inside, mut on_estimated) = (0, 0);
+    for y in 0..frame.height() {
+        for x in 0..frame.width() {
+            let i = frame.index(x, y);
+            let ray = view.ray(f64::from(x) + 0.5, f64::from(y) + 0.5);
+            if !frame.hit[i] {
+                continue;
+            }
+            let p = ray.origin + ray.direction * f64::from(frame.depth[i]);
+            let n = DVec3::from(frame.normal[i].map(f64::from));
+            let pixel = frame.image.get_pixel(x, y).0;
+            if (p - left).length() < 0.55 {
+                on_inside += 1;
+                assert!(
+                    pixel[0] > pixel[2],
+                    "pixel ({x}, {y}) on the red ball: {pixel:?}"
+                );
+            } else {
+                assert!((p - right).length() < 0.55, "pixel ({x}, {y}) hits {p}");
+                on_estimated += 1;
+                assert!(
+                    pixel[2] > pixel[0],
+                    "pixel ({x}, {y}) on the blue sphere: {pixel:?}"
+                );
+                // The estimate's own normal, as in a scene without inside
+                // shapes (at a hit the brute-force lattice moves by up to
+                // hit_epsilon footprints).
+                if chord(ray, right, 0.5) > 0.2 {
+                    assert!(plain.hit[i], "pixel ({x}, {y})");
+                    let m = DVec3::from(plain.normal[i].map(f64::from));
+                    let angle = angle_degrees(n, m);
+                    assert!(angle < 0.5, "pixel ({x}, {y}): normals {n} and {m}");
+                }
+            }
+        }
+    }
+    eprintln!("mixed: {on_inside} pixels on the inside ball, {on_estimated} on the sphere");
+    assert!(on_inside > 300 && on_estimated > 300);
+    // The same scene on the CPU: the inside shape's value composes by sign.
+    let eval = cpu::Evaluator::new(scene.geometry.as_ref().unwrap()).unwrap();
+    assert_eq!(eval.distance(left), -INSIDE_HUGE);
+    assert!((eval.distance(right) + 0.5).abs() < 1e-12);
+    assert!((eval.distance(DVec3::ZERO) - 0.2).abs() < 1e-12);
+}
+
+#[test]
+fn bad_bounds_and_combinations_are_refused_clearly() {
+    let test = |p: DVec3, _: &[f64]| p.length() < 1.0;
+    for (bounds, says) in [
+        (
+            InsideBounds::sphere(DVec3::ZERO, 0.0),
+            "radius must be positive",
+        ),
+        (
+            InsideBounds::sphere(DVec3::ZERO, f64::NAN),
+            "radius must be positive",
+        ),
+        (
+            InsideBounds::sphere(dvec3(f64::INFINITY, 0.0, 0.0), 1.0),
+            "centre",
+        ),
+        (
+            InsideBounds::cuboid(DVec3::ZERO, dvec3(1.0, -1.0, 1.0)),
+            "half extents",
+        ),
+    ] {
+        let err = InsideShape::new("blob", &[], bounds, test, "return 1;").unwrap_err();
+        let text = err.to_string();
+        assert!(matches!(err, Error::CustomShape { .. }), "{text}");
+        assert!(text.contains(says), "{text}");
+    }
+    let shape = ball();
+    let set = || shape.node([1.0]);
+    for (node, says) in [
+        (set().smooth_union(sphere(1.0), 0.1), "smooth union"),
+        (
+            sphere(1.0).smooth_subtract(set(), 0.1),
+            "smooth subtraction",
+        ),
+        (set().round(0.1), "rounding"),
+        (set().onion(0.1), "onion"),
+        (set().repeat(dvec3(3.0, 3.0, 3.0)), "without bound"),
+        (set().twist(0.5), "without bound"),
+        (
+            set().translate(param3("at", dvec3(1.0, 0.0, 0.0))),
+            "without bound",
+        ),
+        (
+            set().union(sphere(1.0).material(Material::mirror())),
+            "materials",
+        ),
+    ] {
+        let err = Scene::new(node).compile().unwrap_err();
+        let text = err.to_string();
+        assert!(matches!(err, Error::InsideShape { .. }), "{text}");
+        assert!(text.contains("inside shape `ball`"), "{text}");
+        assert!(text.contains(says), "{text}");
+    }
+    // What is allowed: hard booleans, transforms, mirrors, limited
+    // repetition, colours.
+    let allowed = set()
+        .subtract(sphere(0.5))
+        .intersect(cuboid(dvec3(2.0, 2.0, 2.0)))
+        .union(sphere(0.3).subtract(set().scale(0.2)))
+        .mirror(Axis::X)
+        .repeat_limited(dvec3(3.0, 3.0, 3.0), [1, 0, 0])
+        .rotate(DVec3::Y, 0.3)
+        .color(dvec3(0.5, 0.5, 0.5));
+    Scene::new(allowed).compile().unwrap();
+}
+
+#[test]
+fn inside_tests_match_on_the_device() {
+    let device = DeviceSelector::auto();
+    let points = random_points(4000, 2.2, 11);
+    for (shape, args) in [
+        (InsideShape::mandelbulb(), [8.0, 10.0]),
+        (InsideShape::mandelbox(), [-1.5, 12.0]),
+    ] {
+        let name = shape.shape().name().to_string();
+        let exact =
+            check_inside_matches_device(&shape, &args, &device, Precision::F64, &points, 0.0)
+                .unwrap_or_else(|f| panic!("{name} in F64: {f}"));
+        let rounded =
+            check_inside_matches_device(&shape, &args, &device, Precision::F32, &points, 0.01)
+                .unwrap_or_else(|f| panic!("{name} in F32: {f}"));
+        eprintln!(
+            "{name}: {} points agree in F64; in F32 {:.4} of the allowed 1% disagree",
+            exact.inputs, rounded.worst
+        );
+    }
+    // A twin that tests another set is caught.
+    let wrong = InsideShape::new(
+        "wrong_ball",
+        &[("r", Rule::Positive)],
+        InsideBounds::sphere(DVec3::ZERO, 1.5),
+        |p, a| p.length() < a[0],
+        "return length(p) < r * R(0.9);",
+    )
+    .unwrap();
+    let err = check_inside_matches_device(&wrong, &[1.0], &device, Precision::F32, &points, 0.001)
+        .unwrap_err();
+    assert!(
+        err.to_string().contains("membership test disagrees"),
+        "{err}"
+    );
+}
+
+#[test]
+fn the_estimate_and_the_test_of_the_mandelbulb_agree() {
+    use fractal_sdf::scene::Mandelbulb;
+    let de = Node::from(Mandelbulb::new(8.0).iterations(10));
+    let bulb = InsideShape::mandelbulb();
+    let points = random_points(20000, 1.3, 5);
+    let margin = 0.025;
+    let tested =
+        check_inside_agrees_with_de(&de, |p| bulb.contains(p, &[8.0, 10.0]), &points, margin)
+            .unwrap_or_else(|f| panic!("{f}"));
+    eprintln!(
+        "Mandelbulb: {} of {} points beyond {margin} agree; within it, disagreement up to {:.3} of the margin",
+        tested.inputs,
+        points.len(),
+        tested.worst
+    );
+    assert!(tested.inputs > 15000);
+    // The checker catches a set that is not the estimate's.
+    let err = check_inside_agrees_with_de(&de, |p| bulb.contains(p, &[7.0, 10.0]), &points, margin)
+        .unwrap_err();
+    assert!(err.to_string().contains("disagree"), "{err}");
+}
+
+/// The mean brightness of the floor pixels within `radius` of `centre`
+/// (in the floor's plane) that the camera sees, from the depth AOVs.
+fn floor_brightness(
+    frame: &Frame,
+    view: &fractal_sdf::render::Viewport,
+    centre: DVec3,
+    radius: f64,
+) -> (f64, usize) {
+    let (mut sum, mut n) = (0.0, 0);
+    for y in 0..frame.height() {
+        for x in 0..frame.width() {
+            let i = frame.index(x, y);
+            if !frame.hit[i] {
+                continue;
+            }
+            let ray = view.ray(f64::from(x) + 0.5, f64::from(y) + 0.5);
+            let p = ray.origin + ray.direction * f64::from(frame.depth[i]);
+            let on_floor = (p.y + RADIUS).abs() < 0.05 && p.length() > RADIUS + 0.02;
+            if on_floor && dvec3(p.x - centre.x, 0.0, p.z - centre.z).length() < radius {
+                let px = frame.image.get_pixel(x, y).0;
+                sum += f64::from(px[0]) + f64::from(px[1]) + f64::from(px[2]);
+                n += 1;
+            }
+        }
+    }
+    (sum / (3.0 * n.max(1) as f64), n)
+}
+
+#[test]
+fn inside_shapes_cast_shadows_and_occlude() {
+    // A ball resting on a floor, lit from straight above.
+    let scene = Scene::new(ball().node([RADIUS]).union(plane(DVec3::Y, RADIUS)))
+        .with_camera(Camera::look_at(dvec3(0.0, 1.5, 4.0), dvec3(0.0, -0.6, 0.0)).fov(45.0))
+        .with_lights(vec![Light::directional(DVec3::Y)]);
+    let render = |shadows: bool, occlusion: bool| {
+        let mut options = options(Quality::production());
+        options.effects.shadows = shadows;
+        options.effects.ambient_occlusion = occlusion;
+        // Occlusion dims the sky's light: seen alone, without the sun.
+        let scene = if occlusion {
+            scene.clone().with_lights(vec![])
+        } else {
+            scene.clone()
+        };
+        let mut renderer = Renderer::with_options(&scene, &options).unwrap();
+        let frame = renderer.render_with_aovs(96, 72).unwrap();
+        (frame, renderer.viewport(96, 72).unwrap())
+    };
+    let (lit, view) = render(false, false);
+    let (shadowed, _) = render(true, false);
+    let (occluded, _) = render(false, true);
+    let (open_sky, _) = {
+        let mut options = options(Quality::production());
+        options.effects.ambient_occlusion = false;
+        let mut renderer =
+            Renderer::with_options(&scene.clone().with_lights(vec![]), &options).unwrap();
+        (renderer.render_with_aovs(96, 72).unwrap(), ())
+    };
+    // Under the ball, within 0.8 of its foot; the open floor beyond 1.6.
+    let under = |f: &Frame| floor_brightness(f, &view, DVec3::ZERO, 0.8);
+    let open = |f: &Frame| {
+        let (a, _) = floor_brightness(f, &view, dvec3(2.2, 0.0, 0.8), 0.4);
+        a
+    };
+    let ((bright, n), (dark, _)) = (under(&lit), under(&shadowed));
+    let ((sky, _), (dim, _)) = (under(&open_sky), under(&occluded));
+    eprintln!(
+        "floor under the ball ({n} pixels): {bright:.1} unshadowed, {dark:.1} shadowed; in the \
+         sky's light alone {sky:.1}, {dim:.1} with occlusion; open floor {:.1} and {:.1} \
+         (shadows), {:.1} and {:.1} (occlusion)",
+        open(&lit),
+        open(&shadowed),
+        open(&open_sky),
+        open(&occluded)
+    );
+    assert!(n > 50, "{n} floor pixels under the ball");
+    assert!(
+        dark < 0.6 * bright,
+        "the ball's shadow: {dark} against {bright}"
+    );
+    assert!(
+        dim < 0.9 * sky,
+        "occlusion next to the ball: {dim} against {sky}"
+    );
+    assert!(
+        (open(&shadowed) - open(&lit)).abs() < 2.0,
+        "no shadow on the open floor"
+    );
+    assert!(
+        open(&occluded) > 0.95 * open(&open_sky),
+        "the open floor is open"
+    );
+}
