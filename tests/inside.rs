@@ -503,6 +503,30 @@ fn inside_shapes_cast_shadows_and_occlude() {
         (open(&shadowed) - open(&lit)).abs() < 2.0,
         "no shadow on the open floor"
     );
+    // The ball's top faces the light: a set's rough surface does not
+    // shadow itself.
+    let top = |f: &Frame| {
+        let (mut sum, mut n) = (0.0, 0);
+        for y in 0..f.height() {
+            for x in 0..f.width() {
+                let i = f.index(x, y);
+                let ray = view.ray(f64::from(x) + 0.5, f64::from(y) + 0.5);
+                let p = ray.origin + ray.direction * f64::from(f.depth[i]);
+                if f.hit[i] && p.y > 0.6 && p.length() < RADIUS + 0.05 {
+                    sum += f64::from(f.image.get_pixel(x, y).0[0]);
+                    n += 1;
+                }
+            }
+        }
+        (sum / f64::from(n.max(1)), n)
+    };
+    let ((top_lit, n), (top_shadowed, _)) = (top(&lit), top(&shadowed));
+    eprintln!("the ball's top ({n} pixels): {top_lit:.1} unshadowed, {top_shadowed:.1} shadowed");
+    assert!(n > 100, "{n} pixels on the ball's top");
+    assert!(
+        (top_lit - top_shadowed).abs() < 3.0,
+        "the ball shadows its own top: {top_shadowed} against {top_lit}"
+    );
     assert!(
         open(&occluded) > 0.95 * open(&open_sky),
         "the open floor is open"
