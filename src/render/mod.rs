@@ -76,7 +76,7 @@ pub use dispatch::{DEFAULT_TILE_SIZE, MAX_IMAGE_SIDE};
 pub use points::{PointEvaluator, PointSample};
 pub use program::{BuildInfo, PROGRAM_CACHE_CAPACITY, program_builds};
 pub use renderer::{RenderOptions, Renderer};
-pub use sampling::{SamplePoint, sample_point};
+pub use sampling::{SamplePoint, brute_phase, sample_point};
 pub use stereo::compose;
 pub use viewport::Viewport;
 

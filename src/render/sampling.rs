@@ -52,6 +52,27 @@ pub fn sample_point(width: u32, x: u32, y: u32, j: u32, supersampling: u32) -> S
     }
 }
 
+/// Where the brute-force steps of sample `j` of rendered pixel `(x, y)` of
+/// an image `width` pixels wide start, in `[0, 1)` of a step: the kernel's
+/// `march_brute_phase`, the phase
+/// [`cpu::Brute`](crate::cpu::Brute) takes to march exactly the kernel's
+/// lattice. A per-pixel offset, advanced by the golden ratio's fraction
+/// from one sample to the next. (In `F32` kernels the phase of a large `j`
+/// is rounded; sample 0's is exact in both precisions.)
+///
+/// ```
+/// use fractal_sdf::render::brute_phase;
+/// let phase = brute_phase(64, 3, 5, 0);
+/// assert!((0.0..1.0).contains(&phase));
+/// assert_ne!(phase, brute_phase(64, 3, 5, 1));
+/// ```
+#[must_use]
+pub fn brute_phase(width: u32, x: u32, y: u32, j: u32) -> f64 {
+    let pixel = y.wrapping_mul(width).wrapping_add(x);
+    let u = jitter(pixel, 0, 2) + 0.618_033_988_749_894_8 * f64::from(j);
+    u - u.floor()
+}
+
 /// The kernel's `march_hash`.
 fn hash(mut x: u32) -> u32 {
     x ^= x >> 16;
