@@ -565,8 +565,10 @@ fn a_rough_set_is_not_shadowed_by_its_own_dust() {
     };
     let (open, shadowed) = (mean_lit(&render(false)), mean_lit(&render(true)));
     eprintln!("Mandelbulb's set: mean red {open:.1} unshadowed, {shadowed:.1} shadowed");
+    // Measured: 0.97 of the unshadowed mean; 0.93 when the first shadow
+    // samples count the dust.
     assert!(
-        shadowed > 0.8 * open,
+        shadowed > 0.95 * open,
         "shadows darken the set from {open} to {shadowed}"
     );
     assert!(shadowed < open, "the set shadows itself somewhere");
