@@ -13,12 +13,18 @@ const RADIUS: f64 = 1.0;
 
 /// A ball known only by `|p| < r`.
 fn ball() -> InsideShape {
+    ball_shape("ball", 1.5, "return length(p) < r;")
+}
+
+/// A shape called `name` whose CPU test is `|p| < r`, with its OpenCL
+/// body and bounds of `bounds` about the origin.
+fn ball_shape(name: &str, bounds: f64, opencl: &str) -> InsideShape {
     InsideShape::new(
-        "ball",
+        name,
         &[("r", Rule::Positive)],
-        InsideBounds::sphere(DVec3::ZERO, 1.5),
+        InsideBounds::sphere(DVec3::ZERO, bounds),
         |p, a| p.length() < a[0],
-        "return length(p) < r;",
+        opencl,
     )
     .unwrap()
 }
@@ -381,14 +387,7 @@ fn inside_tests_match_on_the_device() {
         );
     }
     // A twin that tests another set is caught.
-    let wrong = InsideShape::new(
-        "wrong_ball",
-        &[("r", Rule::Positive)],
-        InsideBounds::sphere(DVec3::ZERO, 1.5),
-        |p, a| p.length() < a[0],
-        "return length(p) < r * R(0.9);",
-    )
-    .unwrap();
+    let wrong = ball_shape("wrong_ball", 1.5, "return length(p) < r * R(0.9);");
     let err = check_inside_matches_device(&wrong, &[1.0], &device, Precision::F32, &points, 0.001)
         .unwrap_err();
     assert!(
@@ -632,14 +631,7 @@ fn occlusion_sees_what_the_screen_shows() {
 
 #[test]
 fn bounds_clip_the_set_on_both_twins() {
-    let clipped = InsideShape::new(
-        "clipped_ball",
-        &[("r", Rule::Positive)],
-        InsideBounds::sphere(DVec3::ZERO, 0.6),
-        |p, a| p.length() < a[0],
-        "return length(p) < r;",
-    )
-    .unwrap();
+    let clipped = ball_shape("clipped_ball", 0.6, "return length(p) < r;");
     assert!(clipped.contains(dvec3(0.5, 0.0, 0.0), &[1.0]));
     assert!(!clipped.contains(dvec3(0.8, 0.0, 0.0), &[1.0]));
     let points = random_points(2000, 1.2, 17);

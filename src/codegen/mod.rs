@@ -462,6 +462,20 @@ fn scene_bound(ir: &Ir, options: &Options, origin: DVec3) -> Option<Bound> {
         .then_some(local)
 }
 
+/// Defines `NAME_CENTRE` and `NAME_RADIUS`, the sphere of `bound`, under a
+/// comment saying what it is.
+fn define_sphere(w: &mut writer::Writer, what: &str, name: &str, bound: &Bound) {
+    w.line(format!("/* {what} */"));
+    let c = bound.centre;
+    w.line(format!(
+        "#define {name}_CENTRE (real3)({}, {}, {})",
+        w.float(c.x),
+        w.float(c.y),
+        w.float(c.z)
+    ));
+    w.line(format!("#define {name}_RADIUS {}", w.float(bound.radius)));
+}
+
 /// Appends the target kernel (with the scene's bounding sphere, if it has
 /// one) and hashes the program.
 fn finish(
@@ -473,26 +487,16 @@ fn finish(
 ) -> KernelSource {
     EMISSIONS.fetch_add(1, Ordering::Relaxed);
     if let Some(b) = features.brute {
-        w.line("/* The sphere inside shapes lie in: marched by brute force. */");
-        let c = b.centre;
-        w.line(format!(
-            "#define BRUTE_CENTRE (real3)({}, {}, {})",
-            w.float(c.x),
-            w.float(c.y),
-            w.float(c.z)
-        ));
-        w.line(format!("#define BRUTE_RADIUS {}", w.float(b.radius)));
+        let what = "The sphere inside shapes lie in: marched by brute force.";
+        define_sphere(&mut w, what, "BRUTE", &b);
     }
     if let Some(b) = bound {
-        w.line("/* The sphere around the scene (src/ir/bounds.rs). */");
-        let c = b.centre;
-        w.line(format!(
-            "#define SCENE_BOUND_CENTRE (real3)({}, {}, {})",
-            w.float(c.x),
-            w.float(c.y),
-            w.float(c.z)
-        ));
-        w.line(format!("#define SCENE_BOUND_RADIUS {}", w.float(b.radius)));
+        define_sphere(
+            &mut w,
+            "The sphere around the scene (src/ir/bounds.rs).",
+            "SCENE_BOUND",
+            &b,
+        );
         w.line(format!("#define SCENE_BOUND_SLOPE {}", w.float(b.slope)));
     }
     w.line(format!(
