@@ -624,7 +624,7 @@ pub fn march(eval: &Evaluator, ray: Ray, settings: &MarchSettings) -> Hit {
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Brute {
     /// The step within the region, in footprints
-    /// ([`Quality::brute_step`](crate::Quality)).
+    /// ([`Quality::brute_step`](crate::quality::Quality::brute_step)).
     pub step: f64,
     /// The sphere the scene's inside shapes lie in.
     pub region: Bound,

@@ -1,52 +1,5 @@
-//! Shapes given by a membership test instead of a distance estimate: the
-//! escape-time sets that have no usable estimate, drawn by brute-force
-//! marching.
-//!
-//! ```
-//! use fractal_sdf::prelude::*;
-//! use fractal_sdf::scene::{InsideBounds, InsideShape, Rule};
-//!
-//! // A ball of radius r, known only by |p| < r.
-//! let ball = InsideShape::new(
-//!     "ball",
-//!     &[("r", Rule::Positive)],
-//!     InsideBounds::sphere(DVec3::ZERO, 2.0),
-//!     |p, a| p.length() < a[0],
-//!     "return length(p) < r;",
-//! )?;
-//! let eval = cpu::Evaluator::new(&ball.node([1.0]))?;
-//! assert!(eval.distance(dvec3(0.5, 0.0, 0.0)) < 0.0);
-//! assert!(eval.distance(dvec3(1.5, 0.0, 0.0)) > 0.0);
-//! # Ok::<(), fractal_sdf::Error>(())
-//! ```
-//!
-//! # How a scene uses one
-//!
-//! An inside shape is a [`CustomShape`] whose value is `-INSIDE_HUGE` in
-//! the set and [`INSIDE_HUGE`](super::INSIDE_HUGE) outside it: a value of
-//! the right sign and no size. Hard unions, subtractions, intersections
-//! and cuts with distance-estimated shapes keep membership exactly (the
-//! minimum of a distance and `±INSIDE_HUGE` is inside where either is),
-//! and every transform, mirror, limited repetition, elongation, colour
-//! and material moves or paints it like any node.
-//!
-//! A renderer marches a scene that holds one by *brute force* within the
-//! shapes' bounds: steps of [`Quality::brute_step`](crate::Quality)
-//! pixel footprints, jittered per pixel and pass, or the distance to the
-//! nearest distance-estimated surface where that is shorter (mixed scenes
-//! are still sphere-traced), and outside the bounds the usual sphere
-//! tracing. The first step that lands in the set is refined by bisection
-//! to [`Quality::hit_epsilon`](crate::Quality) footprints. Normals and
-//! ambient occlusion come from the depth of neighbouring pixels (screen
-//! space, see [`Quality::screen_normals`](crate::Quality)).
-//!
-//! What needs a distance is refused with an [`Error::InsideShape`]: a
-//! smooth boolean, rounding or an onion shell over an inside shape; an
-//! unlimited repetition, twist or bend over one (its bounds would be
-//! unbounded); and materials in the same scene (secondary rays need a
-//! normal at every hit).
-//!
-//! [`Error::InsideShape`]: crate::Error::InsideShape
+//! Shapes given by a membership test instead of a distance estimate (see
+//! [`InsideShape`]).
 
 use glam::DVec3;
 
@@ -57,13 +10,61 @@ use crate::error::Result;
 
 /// A user-defined shape given by a membership test: a Rust function (the
 /// CPU reference) and its OpenCL C twin, with the region the set lies in.
-/// Cheap to clone (shared). See the [module documentation](self).
+/// It draws the escape-time sets that have no usable distance estimate,
+/// by brute-force marching. Cheap to clone (shared).
+///
+/// ```
+/// use fractal_sdf::prelude::*;
+/// use fractal_sdf::scene::{InsideBounds, InsideShape, Rule};
+///
+/// // A ball of radius r, known only by |p| < r.
+/// let ball = InsideShape::new(
+///     "ball",
+///     &[("r", Rule::Positive)],
+///     InsideBounds::sphere(DVec3::ZERO, 2.0),
+///     |p, a| p.length() < a[0],
+///     "return length(p) < r;",
+/// )?;
+/// let eval = cpu::Evaluator::new(&ball.node([1.0]))?;
+/// assert!(eval.distance(dvec3(0.5, 0.0, 0.0)) < 0.0);
+/// assert!(eval.distance(dvec3(1.5, 0.0, 0.0)) > 0.0);
+/// # Ok::<(), fractal_sdf::Error>(())
+/// ```
 ///
 /// The OpenCL body is the body of a function
 /// `int inside_NAME(real3 p, real PARAM1, ...)` that returns nonzero where
 /// `p` is in the set. It runs only within the bounds: the set is clipped
 /// to them. Names follow [`CustomShape`]'s rules, and the function
 /// `inside_NAME` may not be a name the generated program already uses.
+///
+/// # How a scene uses one
+///
+/// An inside shape is a [`CustomShape`] whose value is `-INSIDE_HUGE` in
+/// the set and [`INSIDE_HUGE`](super::INSIDE_HUGE) outside it: a value of
+/// the right sign and no size. Hard unions, subtractions, intersections
+/// and cuts with distance-estimated shapes keep membership exactly (the
+/// minimum of a distance and `±INSIDE_HUGE` is inside where either is),
+/// and every transform, mirror, limited repetition, elongation and colour
+/// moves or paints it like any node.
+///
+/// A renderer marches a scene that holds one by *brute force* within the
+/// shapes' bounds: steps of
+/// [`Quality::brute_step`](crate::quality::Quality::brute_step) pixel
+/// footprints, jittered per pixel and pass, or the distance to the nearest
+/// distance-estimated surface where that is shorter (mixed scenes are
+/// still sphere-traced), and outside the bounds the usual sphere tracing.
+/// The first step that lands in the set is refined by bisection to
+/// [`Quality::hit_epsilon`](crate::quality::Quality::hit_epsilon)
+/// footprints. Normals and ambient occlusion come from the depth of
+/// neighbouring pixels (screen space, see
+/// [`Quality::screen_normals`](crate::quality::Quality::screen_normals)).
+///
+/// What needs a distance is refused with an
+/// [`Error::InsideShape`](crate::Error::InsideShape): a smooth boolean,
+/// rounding or an onion shell over an inside shape; an unlimited
+/// repetition, twist, bend or dynamic transform over one (its bounds would
+/// be unbounded); and materials in the same scene (secondary rays need a
+/// normal at every hit).
 #[derive(Clone, Debug, PartialEq)]
 pub struct InsideShape(CustomShape);
 
@@ -185,7 +186,7 @@ impl From<InsideShape> for CustomShape {
 }
 
 /// The most steps a ray takes within inside shapes' bounds, besides
-/// [`Quality::max_steps`](crate::Quality): a ray still short of the set
+/// [`Quality::max_steps`](crate::quality::Quality::max_steps): a ray still short of the set
 /// after these many brute-force steps is a miss.
 pub const BRUTE_MAX_STEPS: u32 = 16384;
 
