@@ -33,7 +33,8 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parent.parent
 # The judges: every device test that checks what the kernels compute, not
 # their text. render_quality and render_sizes cover supersampling (jitter,
-# the AOVs' centre ray) and sizes that tiles do not divide.
+# the AOVs' centre ray) and sizes that tiles do not divide; inside, the
+# brute-force march of shapes with only a membership test.
 JUDGES = [
     "conformance",
     "render_effects",
@@ -42,6 +43,7 @@ JUDGES = [
     "render_sizes",
     "smooth_oracle",
     "golden",
+    "inside",
 ]
 TIMEOUT_S = 300
 
