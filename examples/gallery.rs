@@ -7,8 +7,13 @@ mod common;
 fn main() -> std::process::ExitCode {
     common::run(|| {
         let size = common::size_arg((640, 480));
-        let options = common::gallery_options();
         for (name, scene) in fractal_sdf::gallery::all() {
+            let mut options = common::gallery_options();
+            // Scenes with inside shapes take their scene file's coarser
+            // brute-force step: the 2×2 samples average its noise.
+            if let Some(quality) = fractal_sdf::gallery::file(name).and_then(|f| f.quality) {
+                options.quality.brute_step = quality.brute_step;
+            }
             common::render_to_png(name, &scene, &options, size)?;
         }
         Ok(())
