@@ -45,6 +45,15 @@ if ! command -v dpkg-query >/dev/null 2>&1; then
     exit 1
 fi
 
+# --- Cargo tools ----------------------------------------------------------------
+# cargo-hack checks every feature on its own (scripts/test.sh). Built from
+# crates.io once; `--locked` uses the versions its authors tested.
+CARGO_HACK_VERSION=0.6.46
+if ! cargo hack --version >/dev/null 2>&1; then
+    say "installing cargo-hack $CARGO_HACK_VERSION (cargo install)"
+    cargo install --locked --quiet cargo-hack --version "$CARGO_HACK_VERSION"
+fi
+
 missing=()
 for pkg in "${REQUIRED_PACKAGES[@]}"; do
     status=$(dpkg-query -W -f='${Status}' "$pkg" 2>/dev/null || true)

@@ -3,9 +3,10 @@
 # version, lints, tests, docs, and the crate as packaged for crates.io.
 # Prints a header per step and the total wall time at the end.
 #
-# Every step uses every feature (`--all-features`: the viewer's window and
+# The tests use every feature (`--all-features`: the viewer's window and
 # the `proptest` testing toolkit, which the property tests require), so the
-# crate is compiled once per mode.
+# crate is compiled once per mode; two cheap checks (no code generation)
+# cover the default features and each feature alone.
 set -euo pipefail
 
 CARGO=${CARGO:-cargo}
@@ -32,6 +33,12 @@ step "$CARGO" fmt --all -- --check
 # Every locked dependency's rust-version against ours (Cargo.toml).
 step bash scripts/msrv_check.sh
 step "$CARGO" clippy --all-targets --all-features -- -D warnings
+# What a contributor's plain `cargo test` builds, and every feature alone
+# and none at all: a target that needs a feature without saying so
+# (`required-features`), or code that compiles only with everything on,
+# fails here. Checks only: no code generation.
+step "$CARGO" check --all-targets
+step "$CARGO" hack check --each-feature --no-dev-deps
 # The binary tests/viewer_smoke.rs runs (`cargo test` builds examples only as
 # test harnesses); the test profile shares the library build with the tests.
 step "$CARGO" build --profile test --all-features --example viewer
