@@ -320,6 +320,13 @@ fn bad_bounds_and_combinations_are_refused_clearly() {
             InsideBounds::cuboid(DVec3::ZERO, dvec3(1.0, -1.0, 1.0)),
             "half extents",
         ),
+        // Regression: bounds of 1e300 passed, then panicked in code
+        // generation ("non-finite literal").
+        (InsideBounds::sphere(DVec3::ZERO, 1e300), "reach 1e300"),
+        (
+            InsideBounds::cuboid(dvec3(0.0, 2e12, 0.0), DVec3::ONE),
+            "from the origin",
+        ),
     ] {
         let err = InsideShape::new("blob", &[], bounds, test, "return 1;").unwrap_err();
         let text = err.to_string();
@@ -337,7 +344,8 @@ fn bad_bounds_and_combinations_are_refused_clearly() {
         (set().round(0.1), "rounding"),
         (set().onion(0.1), "onion"),
         (set().repeat(dvec3(3.0, 3.0, 3.0)), "without bound"),
-        (set().twist(0.5), "without bound"),
+        (set().twist(0.5), "twist or a bend"),
+        (set().bend(0.5), "twist or a bend"),
         (
             set().translate(param3("at", dvec3(1.0, 0.0, 0.0))),
             "without bound",

@@ -638,3 +638,51 @@ fn dynamic_values_keep_relational_rules() {
     let err = eval.set_param("n.x", 0.0).unwrap_err();
     assert!(matches!(err, Error::ZeroVector { .. }), "{err}");
 }
+
+/// Regression: a twist or bend rate of 1e20 was accepted and rendered
+/// black; rates are limited to what marching can follow.
+#[test]
+fn warp_rates_beyond_the_limit_are_refused() {
+    use fractal_sdf::scene::MAX_WARP_RATE;
+    for node in [
+        sphere(1.0).twist(1e20),
+        sphere(1.0).bend(-1e20),
+        sphere(1.0).twist(MAX_WARP_RATE * 1.01),
+    ] {
+        let err = error_of(node);
+        assert!(
+            matches!(err, Error::OutOfRange { ref param, .. } if param == "rate"),
+            "{err}"
+        );
+    }
+    assert!(
+        Scene::new(sphere(1.0).twist(MAX_WARP_RATE))
+            .validate()
+            .is_ok()
+    );
+}
+
+/// Regression: far from a twisted or bent shape its estimate shrank with
+/// the warp's stretch (towards `1 / rate`), whatever the true distance.
+/// Now it is at least the distance to the ball around the warped shape,
+/// measured here against a sphere on the warp's axis (which the warp
+/// leaves unchanged, so its true distance is known).
+#[test]
+fn a_warped_shape_keeps_its_distance_far_away() {
+    for (node, axis) in [
+        (sphere(0.5).twist(3.0), dvec3(0.0, 1.0, 0.0)),
+        (sphere(0.5).bend(3.0), dvec3(0.0, 0.0, 1.0)),
+    ] {
+        let eval = cpu::Evaluator::new(&node).unwrap();
+        for p in [
+            dvec3(20.0, 0.0, 0.0),
+            dvec3(0.0, 30.0, 5.0),
+            dvec3(-7.0, 3.0, 9.0),
+        ] {
+            let d = eval.distance(p);
+            let exact = p.length() - 0.5;
+            assert!(d <= exact + 1e-9, "{p}: {d} overestimates {exact}");
+            assert!(d >= 0.9 * exact, "{p} (axis {axis}): {d} against {exact}");
+        }
+    }
+}

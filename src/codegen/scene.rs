@@ -799,6 +799,20 @@ impl<'a> SceneEmitter<'a> {
         }
     }
 
+    /// A twist's or bend's estimate `warped`, raised to the distance to the
+    /// ball around its warped child where it has that bound
+    /// (`ir::warp_ball`; the CPU reference does the same).
+    fn warp_floor(&self, id: NodeId, p: &str, warped: &str) -> String {
+        match self.bounds[id.index()] {
+            Some(ball) => {
+                let [x, y, z] = ball.centre.to_array().map(|v| self.w.float(v));
+                let r = self.w.float(ball.radius);
+                format!("fmax({warped}, length({p} - (real3)({x}, {y}, {z})) - {r})")
+            }
+            None => warped.to_string(),
+        }
+    }
+
     /// Leaving a node after its children: the lines that combine their
     /// results.
     fn leave(&mut self, id: NodeId, p: &str, needs_color: bool, children: Vec<Vars>) -> Vars {
@@ -842,14 +856,16 @@ impl<'a> SceneEmitter<'a> {
                 self.used.insert(Helper::Warp);
                 let rho = format!("hypot({p}.x, {p}.z)");
                 let c = child();
-                self.post(id, c, &format!("twist_bound({{d}}, {k}, {rho})"))
+                let d = self.warp_floor(id, p, &format!("twist_bound({{d}}, {k}, {rho})"));
+                self.post(id, c, &d)
             }
             Kind::Bend { rate, .. } => {
                 let k = w(self, *rate);
                 self.used.insert(Helper::Warp);
                 let rho = format!("hypot({p}.x, {p}.y)");
                 let c = child();
-                self.post(id, c, &format!("bend_bound({{d}}, {k}, {rho})"))
+                let d = self.warp_floor(id, p, &format!("bend_bound({{d}}, {k}, {rho})"));
+                self.post(id, c, &d)
             }
             Kind::Csg { op, smoothing, .. } => {
                 let (a, b) = (child(), child());

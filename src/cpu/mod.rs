@@ -19,8 +19,8 @@ use std::collections::HashMap;
 
 use crate::ir::SHRINK;
 use crate::ir::{
-    Bound, CompiledScene, Ir, IrNode, NodeId, ParamValues, Reach, Scalar, costs, is_hard_union,
-    reach, swaps, union_chain,
+    Bound, CompiledScene, Ir, IrNode, NodeId, ParamValues, Reach, Scalar, ball_distance, costs,
+    is_hard_union, reach, swaps, union_chain,
 };
 use crate::math::F32_LIMITS;
 use crate::scene::{
@@ -145,6 +145,15 @@ impl Evaluator {
     pub fn with_pruning(mut self, on: bool) -> Self {
         self.prune = on;
         self
+    }
+
+    /// A twist's or bend's estimate is at least the distance to the ball
+    /// around its warped child (its bound, `ir::warp_ball`), as the kernels
+    /// compute it, wherever that bound exists.
+    fn warp_floor<T: Real>(&self, id: usize, distance: &mut T, p: V3<T>) {
+        if let Some(ball) = &self.bounds[id] {
+            *distance = distance.max(ball_distance(ball, p));
+        }
     }
 
     /// Whether the second operand `b` of a union or subtraction (with
@@ -413,11 +422,13 @@ impl Evaluator {
             Kind::Twist { rate, child } => {
                 let mut out = of(child);
                 out.distance = sdf::twist_bound(out.distance, s(*rate), p.x.hypot(p.z));
+                self.warp_floor(id, &mut out.distance, p);
                 out
             }
             Kind::Bend { rate, child } => {
                 let mut out = of(child);
                 out.distance = sdf::bend_bound(out.distance, s(*rate), p.x.hypot(p.y));
+                self.warp_floor(id, &mut out.distance, p);
                 out
             }
             Kind::Csg {

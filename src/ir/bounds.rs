@@ -16,16 +16,18 @@
 //! Bounds are computed from baked values. A node whose extent depends on a
 //! dynamic value it cannot bound over the value's whole range (a dynamic
 //! translation, scale or rounding radius) has no bound, and neither does a
-//! plane, an unlimited repetition, a twist, a bend or a custom shape with a
-//! distance estimate (an inside shape is bounded by its stated bounds).
+//! plane, an unlimited repetition or a custom shape with a distance
+//! estimate (an inside shape is bounded by its stated bounds). A twist or
+//! a bend is bounded where its child is (`warp_ball`).
 
 use glam::DVec3;
 
 use super::{Ir, IrNode, NodeId, Scalar, baked3};
 use crate::math::{
-    JULIA_FAR_FIELD, JULIA_FAR_FIELD_SLOPE, Limits, julia_radius, mandelbulb_radius, rotation_rows,
+    JULIA_FAR_FIELD, JULIA_FAR_FIELD_SLOPE, Limits, Real, V3, julia_radius, mandelbulb_radius,
+    rotation_rows,
 };
-use crate::scene::{CsgOp, Kind};
+use crate::scene::{Axis, CsgOp, Kind};
 
 /// A conservative bounding sphere of a node, in the coordinates the node
 /// sees: wherever `slope · (|p − centre| − radius) > 0`, the node's
@@ -95,7 +97,7 @@ impl Bound {
     }
 
     /// The smallest sphere around both, with the smaller slope.
-    pub(super) fn around(self, other: Bound) -> Self {
+    pub(crate) fn around(self, other: Bound) -> Self {
         let (a, b) = if self.radius >= other.radius {
             (self, other)
         } else {
@@ -311,7 +313,11 @@ pub(super) fn bound(node: &IrNode, done: &[Option<Bound>]) -> Option<Bound> {
                 },
             }
         }
-        Kind::Plane { .. } | Kind::Repeat { .. } | Kind::Twist { .. } | Kind::Bend { .. } => {
+        // The estimate is at least the distance to this ball (see
+        // `warp_ball`), so the bound holds with slope 1.
+        Kind::Twist { child, .. } => warp_ball(Axis::Y, of(child)?),
+        Kind::Bend { child, .. } => warp_ball(Axis::Z, of(child)?),
+        Kind::Plane { .. } | Kind::Repeat { .. } => {
             return None;
         }
         // An inside shape's value is `INSIDE_HUGE` outside its bounds.
@@ -320,6 +326,35 @@ pub(super) fn bound(node: &IrNode, done: &[Option<Bound>]) -> Option<Bound> {
             Bound::sphere(centre, radius)
         }
     })
+}
+
+/// The ball around a warped child whose own bound is `child`: a twist
+/// turns each point about the y axis (a bend about the z axis) by an angle
+/// that depends on the point, which keeps its distance from that `axis`
+/// and its coordinate along it. The child's shape lies in its ball, so the
+/// warped shape lies in the cylinder of the points whose distance from the
+/// axis and coordinate along it the ball allows, and in the ball around
+/// that cylinder, centred on the axis. Its distance never exceeds the
+/// distance to the warped shape, so the warp's estimate is the larger of
+/// its Lipschitz-scaled child estimate and this ball's distance
+/// (`cpu::Evaluator` and code generation): far from the shape the estimate
+/// no longer shrinks with the stretch of the warp there, and the bound
+/// holds with slope 1.
+pub(crate) fn warp_ball(axis: Axis, child: Bound) -> Bound {
+    let i = axis.index();
+    let mut centre = DVec3::ZERO;
+    centre[i] = child.centre[i];
+    let mut radial = child.centre;
+    radial[i] = 0.0;
+    Bound::sphere(centre, (radial.length() + child.radius).hypot(child.radius))
+}
+
+/// The distance from `p` to `ball`'s sphere, as a warp's estimate uses it
+/// (see [`warp_ball`]): `|p − centre| − radius`, without the slope or the
+/// shrinking that pruning applies.
+pub(crate) fn ball_distance<T: Real>(ball: &Bound, p: V3<T>) -> T {
+    let centre = V3::<f64>::from(ball.centre).cast::<T>();
+    (p - centre).length() - T::of(ball.radius)
 }
 
 /// A tree of hard unions, flattened: its operands in the order pruning

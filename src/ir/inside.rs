@@ -118,6 +118,11 @@ impl Ir {
                      smaller copy instead"
                         .into(),
                 ),
+                Kind::Twist { .. } | Kind::Bend { .. } if holds => Some(
+                    "a twist or a bend divides a distance by its stretch, and an inside shape \
+                     has none: warp the point in the membership test itself"
+                        .into(),
+                ),
                 Kind::Material { .. } => Some(
                     "materials need a normal at every hit of a reflected or refracted ray, which \
                      a scene with inside shapes has only on screen: colour its nodes instead"
@@ -131,7 +136,7 @@ impl Ir {
                 {
                     Some(
                         "this node spreads an inside shape without bound (an unlimited \
-                         repetition, a twist, a bend, or a dynamic translation or scale), so \
+                         repetition, or a dynamic translation or scale), so \
                          there is no region to march by brute force: use a limited repetition \
                          or baked values"
                             .into(),

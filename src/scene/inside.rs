@@ -61,8 +61,8 @@ use crate::error::Result;
 ///
 /// What needs a distance is refused with an
 /// [`Error::InsideShape`](crate::Error::InsideShape): a smooth boolean,
-/// rounding or an onion shell over an inside shape; an unlimited
-/// repetition, twist, bend or dynamic transform over one (its bounds would
+/// rounding, an onion shell, a twist or a bend over an inside shape; an
+/// unlimited repetition or dynamic transform over one (its bounds would
 /// be unbounded); and materials in the same scene (secondary rays need a
 /// normal at every hit).
 #[derive(Clone, Debug, PartialEq)]

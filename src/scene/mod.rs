@@ -20,7 +20,9 @@ pub use build::{
     capped_cone, capsule, cuboid, cylinder, ellipsoid, julia, mandelbulb, menger, octahedron,
     plane, round_box, sierpinski, sphere, torus,
 };
-pub use custom::{CpuDistance, CpuInside, CustomShape, INSIDE_HUGE, InsideBounds};
+pub use custom::{
+    CpuDistance, CpuInside, CustomShape, INSIDE_HUGE, InsideBounds, MAX_INSIDE_REACH,
+};
 pub use inside::{
     BRUTE_MAX_STEPS, InsideShape, MANDELBOX_BAILOUT, MANDELBOX_HALF_SIDE, MANDELBULB_BAILOUT,
     mandelbox_contains, mandelbulb_contains,
@@ -28,8 +30,8 @@ pub use inside::{
 pub use material::{DEFAULT_MATERIAL, MATERIAL_LEN, Material};
 pub(crate) use node::Mapper;
 pub use node::{
-    Axis, CsgOp, Kind, MAX_ESCAPE_ITERATIONS, MAX_FOLD_ITERATIONS, Mandelbulb, Menger, Node,
-    NodeKind, ParamSpec, QuaternionJulia, Rule, Sierpinski,
+    Axis, CsgOp, Kind, MAX_ESCAPE_ITERATIONS, MAX_FOLD_ITERATIONS, MAX_WARP_RATE, Mandelbulb,
+    Menger, Node, NodeKind, ParamSpec, QuaternionJulia, Rule, Sierpinski,
 };
 pub use param::{Param, Param3, param, param3};
 pub use stereo::{Stereo, StereoLayout};

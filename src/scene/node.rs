@@ -40,6 +40,16 @@ impl Axis {
     }
 }
 
+/// The largest magnitude of a twist's or bend's rate, in radians per unit
+/// (16 turns per unit). The warp stretches space by about `|rate| rho / 2`
+/// at distance `rho` from its axis and its estimate shrinks as much, so
+/// a larger rate leaves marching without the steps to reach the surface:
+/// scale the scene up instead.
+pub const MAX_WARP_RATE: f64 = 100.0;
+
+/// The rule of a twist's or bend's rate.
+const WARP_RATE: Rule = Rule::Range(-MAX_WARP_RATE, MAX_WARP_RATE);
+
 /// The boolean operation of a [`Kind::Csg`] node.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum CsgOp {
@@ -318,12 +328,14 @@ pub enum Kind<S, V, C> {
     /// The twist stretches space by up to `L(rho) = t/2 + sqrt(1 + t^2/4)`,
     /// `t = |rate| rho`, at distance `rho` from the y axis; the child's
     /// distance `d` is divided by `L(rho + |d| / L(rho))`, the largest
-    /// stretch within reach, so the result stays a bound. Far from the axis
-    /// the bound tends to `1 / |rate|` whatever the true distance: intersect
-    /// the twisted node with a bounding cylinder (the twist keeps height and
-    /// distance from the axis) to keep rays fast there.
+    /// stretch within reach, so the result stays a bound. Where the child
+    /// has a bound, the estimate is also at least the distance to the ball
+    /// around the twisted child (the twist keeps height and distance from
+    /// the axis), so far from the shape it stays a distance, and the twist
+    /// slows and darkens nothing around it.
     Twist {
-        /// Radians of twist per unit along y.
+        /// Radians of twist per unit along y, at most [`MAX_WARP_RATE`] in
+        /// magnitude.
         rate: S,
         /// The twisted node.
         child: C,
@@ -331,10 +343,13 @@ pub enum Kind<S, V, C> {
     /// Bends the child in the xy plane by `rate` radians per unit of x.
     /// Local stretch `L(rho) = 1 + |rate| rho` (rho: length of `p.xy`); the
     /// distance is divided by `L(rho + |d| / L(rho))`, so it stays a bound.
-    /// Far away it tends to `1 / |rate|`: intersect the bent node with a
-    /// bounding sphere (the bend keeps the distance from the origin).
+    /// Where the child has a bound, the estimate is also at least the
+    /// distance to the ball around the bent child (the bend keeps `p.z`
+    /// and the length of `p.xy`), so far from the shape it stays a
+    /// distance.
     Bend {
-        /// Radians of bend per unit along x.
+        /// Radians of bend per unit along x, at most [`MAX_WARP_RATE`] in
+        /// magnitude.
         rate: S,
         /// The bent node.
         child: C,
@@ -736,11 +751,11 @@ impl<S, V, C> Kind<S, V, C> {
                 child: m.child(child)?,
             },
             Kind::Twist { rate, child } => Kind::Twist {
-                rate: m.scalar(rate, spec("rate", Finite))?,
+                rate: m.scalar(rate, spec("rate", WARP_RATE))?,
                 child: m.child(child)?,
             },
             Kind::Bend { rate, child } => Kind::Bend {
-                rate: m.scalar(rate, spec("rate", Finite))?,
+                rate: m.scalar(rate, spec("rate", WARP_RATE))?,
                 child: m.child(child)?,
             },
             Kind::Csg {

@@ -162,7 +162,7 @@ real DE(real3 p0, __global const real* params) {
         real3 p2 = (real3)(k1 * p1.x - s1 * p1.z, p1.y, s1 * p1.x + k1 * p1.z);
         /* .../intersect/a:twist/cuboid */
         real d0 = sd_box(p2, (real3)(0.25f, 0.6f, 0.25f));
-        real d1 = twist_bound(d0, 2.0f, hypot(p1.x, p1.z));
+        real d1 = fmax(twist_bound(d0, 2.0f, hypot(p1.x, p1.z)), length(p1 - (real3)(0.0f, 0.0f, 0.0f)) - 0.98488575f);
         /* .../color/intersect/b:cylinder */
         real d2 = sd_cylinder(p1, 0.36f, 0.6f);
         /* .../a:translate/color/intersect */
@@ -186,7 +186,7 @@ real DE(real3 p0, __global const real* params) {
         real3 p4 = (real3)(k7 * p3.x - s7 * p3.y, s7 * p3.x + k7 * p3.y, p3.z);
         /* .../intersect/a:bend/cuboid */
         real d6 = sd_box(p4, (real3)(0.6f, 0.1f, 0.2f));
-        real d7 = bend_bound(d6, 0.8f, hypot(p3.x, p3.y));
+        real d7 = fmax(bend_bound(d6, 0.8f, hypot(p3.x, p3.y)), length(p3 - (real3)(0.0f, 0.0f, 0.0f)) - 0.9055385f);
         /* .../color/intersect/b:sphere */
         real d8 = sd_sphere(p3, 0.65f);
         /* .../b:translate/color/intersect */
@@ -291,7 +291,7 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
         real3 p2 = (real3)(k1 * p1.x - s1 * p1.z, p1.y, s1 * p1.x + k1 * p1.z);
         /* .../intersect/a:twist/cuboid */
         real d0 = sd_box(p2, (real3)(0.25f, 0.6f, 0.25f));
-        real d1 = twist_bound(d0, 2.0f, hypot(p1.x, p1.z));
+        real d1 = fmax(twist_bound(d0, 2.0f, hypot(p1.x, p1.z)), length(p1 - (real3)(0.0f, 0.0f, 0.0f)) - 0.98488575f);
         /* .../color/intersect/b:cylinder */
         real d2 = sd_cylinder(p1, 0.36f, 0.6f);
         /* .../a:translate/color/intersect */
@@ -322,7 +322,7 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
         real3 p4 = (real3)(k7 * p3.x - s7 * p3.y, s7 * p3.x + k7 * p3.y, p3.z);
         /* .../intersect/a:bend/cuboid */
         real d6 = sd_box(p4, (real3)(0.6f, 0.1f, 0.2f));
-        real d7 = bend_bound(d6, 0.8f, hypot(p3.x, p3.y));
+        real d7 = fmax(bend_bound(d6, 0.8f, hypot(p3.x, p3.y)), length(p3 - (real3)(0.0f, 0.0f, 0.0f)) - 0.9055385f);
         /* .../color/intersect/b:sphere */
         real d8 = sd_sphere(p3, 0.65f);
         /* .../b:translate/color/intersect */
