@@ -35,8 +35,8 @@ use std::sync::atomic::{AtomicU64, Ordering};
 
 use glam::DVec3;
 
-use crate::error::Result;
-use crate::ir::{Bound, CompiledScene, Ir};
+use crate::error::{Error, Result};
+use crate::ir::{Bound, CompiledScene, Ir, union_chain};
 use crate::math::{DEFAULT_COLOR, DERIVATIVE_CAP, MAGNITUDE_CAP, REAL_TINY};
 use crate::quality::{Effects, Precision, Quality, ScreenNormals};
 use crate::scene::{BRUTE_MAX_STEPS, DEFAULT_MATERIAL, INSIDE_HUGE, Kind};
@@ -307,6 +307,7 @@ pub fn emit_ir(ir: &Ir, options: &Options) -> Result<KernelSource> {
             }),
             Target::Evaluate => None,
         },
+        glow: glow_bound(ir, options, origin),
     };
     let used = std::mem::take(&mut emitter.used);
     let customs: Vec<_> = emitter.customs.values().cloned().collect();
@@ -345,6 +346,7 @@ pub fn emit_ir(ir: &Ir, options: &Options) -> Result<KernelSource> {
         w.line("");
     }
     w.line("/* ---- scene ---- */");
+    unwritable(&body, precision)?;
     w.raw(&body.finish());
     let mut kernel = finish(
         w,
@@ -352,7 +354,7 @@ pub fn emit_ir(ir: &Ir, options: &Options) -> Result<KernelSource> {
         origin,
         scene_bound(ir, options, origin),
         &features,
-    );
+    )?;
     kernel.custom_regions = custom_regions;
     kernel.constants = constants;
     Ok(kernel)
@@ -373,7 +375,25 @@ pub fn emit_handwritten(scene_functions: &str, options: &Options) -> Result<Kern
     header(&mut w, options, &Features::default());
     w.line("/* ---- scene (hand-written) ---- */");
     w.raw(scene_functions);
-    Ok(finish(w, options, DVec3::ZERO, None, &Features::default()))
+    finish(w, options, DVec3::ZERO, None, &Features::default())
+}
+
+/// The error for a value `w` could not write as a literal of `precision`
+/// (one that validation let through), if there is one.
+fn unwritable(w: &writer::Writer, precision: Precision) -> Result<()> {
+    match w.unwritable() {
+        None => Ok(()),
+        Some(value) => {
+            let limits = precision.limits();
+            Err(Error::Precision {
+                node: "scene".into(),
+                param: "a value of the generated program".into(),
+                value,
+                precision: limits.precision,
+                limit: limits.max,
+            })
+        }
+    }
 }
 
 /// The switch of the march's stop at the scene's bounding sphere.
@@ -390,6 +410,10 @@ const MATERIALS: &str = "ENABLE_MATERIALS";
 /// rendering scenes with an inside shape.
 const BRUTE: &str = "ENABLE_BRUTE";
 
+/// The switch of the march's glow test against the sphere around the
+/// shapes that glow ([`glow_bound`]).
+const GLOW_BOUND: &str = "ENABLE_GLOW_BOUND";
+
 /// What a scene asks of its program beyond the quality and effects.
 #[derive(Debug, Clone, Copy, Default)]
 pub(crate) struct Features {
@@ -400,6 +424,10 @@ pub(crate) struct Features {
     /// Where its rays step by brute force, in the program's frame
     /// (rendering a scene with inside shapes only).
     pub(crate) brute: Option<Bound>,
+    /// The sphere around the shapes that glow, in the program's frame:
+    /// for a glowing scene without a bound of its own, the bounded
+    /// operands of its root's union (see [`glow_bound`]).
+    pub(crate) glow: Option<Bound>,
 }
 
 /// The target kernel for `options`, with the blocks of the effects that are
@@ -432,6 +460,9 @@ fn kernel_with(options: &Options, bounded: bool, features: &Features) -> String 
     if features.brute.is_some() {
         on.push(BRUTE);
     }
+    if features.glow.is_some() {
+        on.push(GLOW_BOUND);
+    }
     select_blocks(kernel, &on)
 }
 
@@ -453,6 +484,38 @@ fn scene_bound(ir: &Ir, options: &Options, origin: DVec3) -> Option<Bound> {
         return None;
     }
     let bound = ir.bounds()[ir.root().index()]?;
+    let local = Bound {
+        centre: bound.centre - origin,
+        ..bound
+    };
+    local
+        .fits(options.quality.precision.limits())
+        .then_some(local)
+}
+
+/// The sphere around the shapes whose near misses glow, in the program's
+/// frame, for a rendering program with glow whose scene has no bound: its
+/// root is a union of unbounded operands (a floor plane, an infinite
+/// repetition) and bounded ones, and only the bounded ones glow. A ray
+/// grazing an infinite plane comes arbitrarily near it at the horizon
+/// without any shape there to glow; the march measures a near miss as at
+/// least the distance to this sphere, which the glowing shapes' distance
+/// never falls below (`ENABLE_GLOW_BOUND` in `march.cl`).
+fn glow_bound(ir: &Ir, options: &Options, origin: DVec3) -> Option<Bound> {
+    let glowing = Effect::enabled(options).contains(&Effect::Glow);
+    if options.target != Target::Render || !glowing {
+        return None;
+    }
+    let bounds = ir.bounds();
+    if bounds[ir.root().index()].is_some() {
+        return None;
+    }
+    let chain = union_chain(ir, ir.root(), &bounds)?;
+    let bound = chain
+        .operands
+        .iter()
+        .filter_map(|o| bounds[o.index()])
+        .reduce(Bound::around)?;
     let local = Bound {
         centre: bound.centre - origin,
         ..bound
@@ -484,7 +547,7 @@ fn finish(
     origin: DVec3,
     bound: Option<Bound>,
     features: &Features,
-) -> KernelSource {
+) -> Result<KernelSource> {
     EMISSIONS.fetch_add(1, Ordering::Relaxed);
     if let Some(b) = features.brute {
         let what = "The sphere inside shapes lie in: marched by brute force.";
@@ -499,6 +562,11 @@ fn finish(
         );
         w.line(format!("#define SCENE_BOUND_SLOPE {}", w.float(b.slope)));
     }
+    if let Some(b) = features.glow {
+        let what = "The sphere around the shapes that glow (the scene has no bound).";
+        define_sphere(&mut w, what, "GLOW_BOUND", &b);
+        w.line(format!("#define GLOW_BOUND_SLOPE {}", w.float(b.slope)));
+    }
     w.line(format!(
         "/* ---- kernel: {} ---- */",
         match options.target {
@@ -508,8 +576,9 @@ fn finish(
     ));
     let kernel_start = w.len();
     w.raw(&kernel_with(options, bound.is_some(), features));
+    unwritable(&w, options.quality.precision)?;
     let source = w.finish();
-    KernelSource {
+    Ok(KernelSource {
         hash: fnv1a(source.as_bytes()),
         source,
         precision: options.quality.precision,
@@ -520,7 +589,7 @@ fn finish(
         kernel_start,
         custom_regions: Vec::new(),
         constants: Vec::new(),
-    }
+    })
 }
 
 fn header(w: &mut writer::Writer, options: &Options, features: &Features) {

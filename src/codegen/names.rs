@@ -97,6 +97,11 @@ fn library_texts() -> Vec<String> {
                     radius: 1.0,
                     slope: 1.0,
                 }),
+                glow: Some(crate::ir::Bound {
+                    centre: DVec3::ZERO,
+                    radius: 1.0,
+                    slope: 1.0,
+                }),
             };
             header(&mut w, &options, &features);
             texts.push(w.finish());

@@ -1,6 +1,7 @@
 //! A small source writer: indentation, a fixed statement style and the one
 //! place float literals are formatted.
 
+use std::cell::Cell;
 use std::fmt::Write as _;
 
 use crate::ir::Scalar;
@@ -18,6 +19,9 @@ pub(crate) struct Writer {
     precision: Precision,
     /// Each parameter slot's name, as a comment safe to emit.
     slot_names: Vec<String>,
+    /// The first value asked for as a literal that the precision cannot
+    /// hold: code generation returns an error for it rather than emit it.
+    unwritable: Cell<Option<f64>>,
 }
 
 impl Writer {
@@ -27,6 +31,7 @@ impl Writer {
             indent: 0,
             precision,
             slot_names: Vec::new(),
+            unwritable: Cell::new(None),
         }
     }
 
@@ -84,10 +89,23 @@ impl Writer {
     /// A float literal of the kernel's precision that reads back as exactly
     /// `v` rounded to that precision: `1.0f`, `(-0.5f)`, `1e-30f`. F64 has no
     /// suffix. Values the precision cannot hold never reach code generation
-    /// (validation and the precision's limits refuse them); if one did,
-    /// this panics rather than emit `inf`.
+    /// (validation and the precision's limits refuse them); if one did, it
+    /// is written as `0` and kept for [`Writer::unwritable`], so that code
+    /// generation returns an error instead of a program holding `inf`.
     pub(crate) fn float(&self, v: f64) -> String {
-        literal(v, self.precision)
+        if fits(v, self.precision) {
+            literal(v, self.precision)
+        } else {
+            if self.unwritable.get().is_none() {
+                self.unwritable.set(Some(v));
+            }
+            literal(0.0, self.precision)
+        }
+    }
+
+    /// The first value [`Writer::float`] could not write, if any.
+    pub(crate) fn unwritable(&self) -> Option<f64> {
+        self.unwritable.get()
     }
 
     /// The precision literals are written in.
@@ -139,6 +157,15 @@ fn comment_text(text: &str) -> String {
         .collect()
 }
 
+/// Whether `v` is finite in `precision`.
+fn fits(v: f64, precision: Precision) -> bool {
+    #[allow(clippy::cast_possible_truncation)]
+    match precision {
+        Precision::F32 => (v as f32).is_finite(),
+        Precision::F64 => v.is_finite(),
+    }
+}
+
 /// Formats `v` as an OpenCL C literal of `precision` that reads back as
 /// exactly `v` rounded to that precision: `1.0f`, `(-0.5f)`, `1e-30f` (F64
 /// has no suffix). Negative values are parenthesised.
@@ -148,13 +175,8 @@ fn comment_text(text: &str) -> String {
 /// literal (it would read back as infinity).
 #[must_use]
 pub fn literal(v: f64, precision: Precision) -> String {
-    #[allow(clippy::cast_possible_truncation)]
-    let fits = match precision {
-        Precision::F32 => (v as f32).is_finite(),
-        Precision::F64 => v.is_finite(),
-    };
     assert!(
-        fits,
+        fits(v, precision),
         "non-finite literal {v} reached code generation for {precision:?}"
     );
     let mut s = String::new();
@@ -201,6 +223,19 @@ mod tests {
             let d = literal(v, Precision::F64);
             assert_eq!(d.trim_matches(['(', ')']).parse::<f64>().unwrap(), v, "{d}");
         }
+    }
+
+    #[test]
+    fn values_a_precision_cannot_hold_are_kept_not_written() {
+        let w = Writer::new(Precision::F32);
+        assert_eq!(w.float(1.5), "1.5f");
+        assert_eq!(w.unwritable(), None);
+        assert_eq!(w.float(1e300), "0.0f");
+        assert_eq!(w.float(f64::NAN), "0.0f");
+        assert_eq!(w.unwritable(), Some(1e300));
+        let w = Writer::new(Precision::F64);
+        assert_eq!(w.float(1e300), "1e300");
+        assert_eq!(w.unwritable(), None);
     }
 
     #[test]

@@ -32,7 +32,7 @@ use glam::DVec3;
 use super::names;
 use super::node::{Kind, Node, Rule};
 use super::param::Param;
-use crate::error::{Error, Result};
+use crate::error::{Error, Result, fmt_value};
 
 /// The Rust distance function of a custom shape: the point and the
 /// parameter values in declaration order.
@@ -52,6 +52,12 @@ pub type CpuInside = dyn Fn(DVec3, &[f64]) -> bool + Send + Sync;
 /// shadows square distances), even scaled a thousandfold, stays finite in
 /// `f32`.
 pub const INSIDE_HUGE: f64 = 1e15;
+
+/// How far from the origin an inside shape's bounds may reach: a thousandth
+/// of [`INSIDE_HUGE`], so that the sign-only value stays larger than any
+/// distance measured around the shape, and well within what `F32` kernels
+/// compute with.
+pub const MAX_INSIDE_REACH: f64 = 1e12;
 
 /// What a custom shape's functions compute.
 enum Form {
@@ -126,8 +132,28 @@ impl InsideBounds {
     }
 
     /// Why the region cannot bound a shape, or `None`: every value finite,
-    /// the radius and half extents positive.
+    /// the radius and half extents positive, and the region within
+    /// [`MAX_INSIDE_REACH`] of the origin.
     fn problem(&self) -> Option<String> {
+        let shape = self.shape_problem();
+        if shape.is_some() {
+            return shape;
+        }
+        let (centre, radius) = self.ball();
+        let reach = centre.length() + radius;
+        (reach > MAX_INSIDE_REACH).then(|| {
+            format!(
+                "the bounds reach {} from the origin, past {}: an inside shape's value \
+                 outside its set is {}, which must exceed every distance in its scene",
+                fmt_value(reach),
+                fmt_value(MAX_INSIDE_REACH),
+                fmt_value(INSIDE_HUGE)
+            )
+        })
+    }
+
+    /// Why the region's own values cannot bound a shape, or `None`.
+    fn shape_problem(&self) -> Option<String> {
         let finite = |v: DVec3| v.is_finite();
         match *self {
             InsideBounds::Sphere { centre, radius } => {
