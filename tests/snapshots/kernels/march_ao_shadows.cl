@@ -276,7 +276,8 @@ MarchResult march_ray(real3 ro, real3 rd, real start, const MarchCamera* cam, re
             continue;
         }
         if (d > R(0.0)) {
-            r.closest = fmin(r.closest, d / (r.t + d));
+            real near = d;
+            r.closest = fmin(r.closest, near / (r.t + near));
         }
         if (g <= R(0.0)) {
             r.hit = 1;
@@ -314,6 +315,16 @@ real3 march_normal(real3 p, real h, real3 rd, __global const real* params) {
     return len > REAL_TINY ? g / len : -rd;
 }
 
+// The normal n of a surface that a ray along rd reached from outside,
+// which faces the ray. Differences over a step wider than the detail
+// beneath it (a fractal's dust) can point away; mirrored towards the
+// viewer, occlusion and shadow rays leave the surface instead of starting
+// inside it and darkening a lit pixel to black.
+real3 march_facing(real3 n, real3 rd) {
+    real away = dot(n, rd);
+    return away > R(0.0) ? normalize(n - R(2.0) * away * rd) : n;
+}
+
 // Ambient occlusion: how much closer the surface is than expected along
 // the normal out to a reach r, nearer points weighing more:
 //   1 - integral of w(h) clamp(h - DE(p + n h), 0, h) dh
@@ -331,6 +342,11 @@ real3 march_normal(real3 p, real h, real3 rd, __global const real* params) {
 // (0.25), a scene of unit size seen from a few units (view_height above
 // 1.25) keeps AO_DISTANCE.
 #define AO_FALLOFF R(1.5)
+// Occlusion never goes below this: where every sample lands inside the
+// shape (dust finer than the normal's step, a crevice narrower than the
+// first sample) the estimate knows no more than "dark", and a surface
+// under the sky keeps a trace of its light instead of reading as a hole.
+#define AO_FLOOR R(0.015625) // 2^-6
 #define AO_VIEW_FRACTION R(0.2)
 real march_ambient_occlusion(real3 p, real3 n, real view_height, real offset,
                              __global const real* params) {
@@ -344,7 +360,7 @@ real march_ambient_occlusion(real3 p, real3 n, real view_height, real offset,
         missing += weight * clamp(h - d, R(0.0), h);
         expected += weight * h;
     }
-    return clamp(R(1.0) - missing / expected, R(0.0), R(1.0));
+    return clamp(R(1.0) - missing / expected, AO_FLOOR, R(1.0));
 }
 
 // Visibility of a light from ro along rd, from distance start to max_t: 0
@@ -672,7 +688,9 @@ __kernel void render_tile(RENDER_TILE_ARGS) {
             if (!in_set) {
                 n = march_normal(p, NORMAL_EPSILON * footprint, rd, params);
                 total_evals += MARCH_NORMAL_EVALUATIONS;
-                if (m.t <= R(0.0)) {
+                if (m.t > R(0.0)) {
+                    n = march_facing(n, rd);
+                } else {
                     // The ray starts inside the surface (a camera within a
                     // solid): shade the nearest point of the surface
                     // instead. No view to scale occlusion to: it keeps
