@@ -11,6 +11,7 @@ use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::{LazyLock, Mutex, MutexGuard, PoisonError};
 use std::time::{Duration, Instant, SystemTime};
 
+use image::codecs::jpeg::JpegEncoder;
 use image::codecs::png::PngEncoder;
 use image::{ExtendedColorType, ImageEncoder, ImageError, RgbaImage};
 
@@ -61,17 +62,88 @@ use crate::error::{Error, Result};
 /// with a zero side, which PNG cannot hold.
 pub fn save_png(image: &RgbaImage, path: impl AsRef<Path>) -> Result<()> {
     let target = path.as_ref();
+    check_pixels(image, target, "a PNG")?;
+    write_atomic(target, "image", |file| encode(image, file))
+}
+
+/// The image formats [`save_image`] writes, by file extension.
+pub const IMAGE_EXTENSIONS: [&str; 3] = ["png", "jpg", "jpeg"];
+
+/// Saves `image` in the format its path's extension names (`.png`, or
+/// `.jpg`/`.jpeg` for a JPEG of quality 95 without the alpha channel),
+/// atomically as [`save_png`] writes; the extension's case does not matter,
+/// and a path without one (a device such as `/dev/stdout`) gets a PNG.
+///
+/// ```
+/// use fractal_sdf::image::{Rgba, RgbaImage};
+///
+/// let dir = std::env::temp_dir().join("fractal-sdf-doc-formats");
+/// let image = RgbaImage::from_pixel(2, 2, Rgba([255, 0, 0, 255]));
+/// fractal_sdf::output::save_image(&image, dir.join("red.jpg"))?;
+/// assert_eq!(&std::fs::read(dir.join("red.jpg")).unwrap()[..3], &[0xff, 0xd8, 0xff]);
+/// assert!(fractal_sdf::output::save_image(&image, dir.join("red.xyz")).is_err());
+/// # std::fs::remove_dir_all(dir).ok();
+/// # Ok::<(), fractal_sdf::Error>(())
+/// ```
+///
+/// # Errors
+/// As [`save_png`]; an [`Error::Io`] of kind `Unsupported` naming the
+/// supported extensions for a path whose extension is none of
+/// [`IMAGE_EXTENSIONS`] (nothing is written).
+pub fn save_image(image: &RgbaImage, path: impl AsRef<Path>) -> Result<()> {
+    let target = path.as_ref();
+    let extension = image_extension(target)?;
+    match extension.as_deref() {
+        None | Some("png") => save_png(image, target),
+        _ => {
+            check_pixels(image, target, "a JPEG")?;
+            write_atomic(target, "image", |file| encode_jpeg(image, file))
+        }
+    }
+}
+
+/// The lower-case extension of an image path [`save_image`] can write
+/// (`None` for a path without one), checked before anything is rendered.
+///
+/// # Errors
+/// As [`save_image`] for an extension it does not write.
+pub fn image_extension(target: &Path) -> Result<Option<String>> {
+    let extension = target
+        .extension()
+        .map(|e| e.to_string_lossy().to_ascii_lowercase());
+    match extension.as_deref() {
+        None => Ok(None),
+        Some(e) if IMAGE_EXTENSIONS.contains(&e) => Ok(extension),
+        other => Err(Error::io(
+            target,
+            "cannot choose an image format",
+            io::Error::new(
+                io::ErrorKind::Unsupported,
+                format!(
+                    "`.{}` is not a format this library writes: the file name must end in \
+                     one of .{}",
+                    other.unwrap_or_default(),
+                    IMAGE_EXTENSIONS.join(", .")
+                ),
+            ),
+        )),
+    }
+}
+
+/// An [`Error::Resolution`] for an image with a zero side, which `format`
+/// cannot hold.
+fn check_pixels(image: &RgbaImage, target: &Path, format: &str) -> Result<()> {
     if image.width() == 0 || image.height() == 0 {
         return Err(Error::Resolution {
             width: image.width(),
             height: image.height(),
             reason: format!(
-                "a PNG needs at least 1 pixel on each side; nothing was written to {}",
+                "{format} needs at least 1 pixel on each side; nothing was written to {}",
                 target.display()
             ),
         });
     }
-    write_atomic(target, "image", |file| encode(image, file))
+    Ok(())
 }
 
 /// Writes a file the way [`save_png`] does: into a temporary file beside
@@ -148,6 +220,24 @@ fn encode(image: &RgbaImage, out: impl Write) -> io::Result<()> {
             image.width(),
             image.height(),
             ExtendedColorType::Rgba8,
+        )
+        .map_err(|e| match e {
+            ImageError::IoError(e) => e,
+            other => io::Error::new(io::ErrorKind::InvalidData, other),
+        })?;
+    writer.flush()
+}
+
+/// Encodes `image` as a JPEG of quality 95, its alpha dropped.
+fn encode_jpeg(image: &RgbaImage, out: impl Write) -> io::Result<()> {
+    let rgb = image::DynamicImage::ImageRgba8(image.clone()).to_rgb8();
+    let mut writer = BufWriter::new(out);
+    JpegEncoder::new_with_quality(&mut writer, 95)
+        .write_image(
+            rgb.as_raw(),
+            rgb.width(),
+            rgb.height(),
+            ExtendedColorType::Rgb8,
         )
         .map_err(|e| match e {
             ImageError::IoError(e) => e,

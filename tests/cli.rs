@@ -539,3 +539,95 @@ fn mesh_and_volume_write_files_and_refuse_bad_grids() {
         );
     }
 }
+
+/// Regression: `-o x.jpg` wrote PNG bytes into a `.jpg` file. The format
+/// follows the extension, and an extension no format has is refused
+/// before anything renders.
+#[test]
+fn the_image_format_follows_the_output_extension() {
+    let dir = scratch("formats");
+    let xyz = dir.join("out.xyz");
+    let out = run(
+        &dir,
+        "",
+        &[
+            "render",
+            "mandelbulb",
+            "-o",
+            xyz.to_str().unwrap(),
+            "--size",
+            "8x6",
+        ],
+    );
+    assert_eq!(out.status.code(), Some(2), "{}", text(&out));
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        stderr.contains(".xyz") && stderr.contains(".png, .jpg, .jpeg"),
+        "{stderr}"
+    );
+    assert!(!xyz.exists());
+    if gpu::device().is_none() {
+        return;
+    }
+    for (name, magic) in [
+        ("out.jpg", &[0xff, 0xd8, 0xff][..]),
+        ("out.PNG", b"\x89PNG"),
+    ] {
+        let path = dir.join(name);
+        let out = run(
+            &dir,
+            "",
+            &[
+                "render",
+                "primitives",
+                "--preset",
+                "draft",
+                "--size",
+                "16x12",
+                "-o",
+                path.to_str().unwrap(),
+            ],
+        );
+        assert!(out.status.success(), "{}", text(&out));
+        let bytes = std::fs::read(&path).unwrap();
+        assert_eq!(&bytes[..magic.len()], magic, "{name}");
+    }
+}
+
+/// Regression: a scene with a lens rendered in one pass was grainy with no
+/// hint of the passes its blur needs.
+#[test]
+fn a_lens_rendered_in_one_pass_says_how_many_passes_it_needs() {
+    if gpu::device().is_none() {
+        return;
+    }
+    let dir = scratch("lens-note");
+    let png = dir.join("lens.png");
+    let png = png.to_str().unwrap();
+    let lens = [
+        "render",
+        "primitives",
+        "--aperture",
+        "0.05",
+        "--preset",
+        "draft",
+        "--size",
+        "16x12",
+        "-o",
+        png,
+    ];
+    let out = run(&dir, "", &lens);
+    assert!(out.status.success(), "{}", text(&out));
+    assert!(
+        String::from_utf8_lossy(&out.stderr).contains("--passes 16"),
+        "{}",
+        text(&out)
+    );
+    let out = run(&dir, "", &[&lens[..], &["--passes", "2"]].concat());
+    assert!(out.status.success(), "{}", text(&out));
+    assert!(
+        !String::from_utf8_lossy(&out.stderr).contains("--passes"),
+        "{}",
+        text(&out)
+    );
+}

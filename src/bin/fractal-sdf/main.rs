@@ -13,7 +13,7 @@ use fractal_sdf::SceneFile;
 use fractal_sdf::animation::CameraPath;
 use fractal_sdf::codegen::{self, Options};
 use fractal_sdf::gallery;
-use fractal_sdf::output::{save_png, verify_png};
+use fractal_sdf::output::{image_extension, save_image, verify_png};
 use fractal_sdf::prelude::*;
 use fractal_sdf::render::{
     DeviceKind, DeviceSelector, EdgeThresholds, RenderOptions, Renderer, devices,
@@ -41,7 +41,7 @@ struct Cli {
 
 #[derive(Subcommand)]
 enum Command {
-    /// Render one image to a PNG.
+    /// Render one image to a PNG or JPEG (by the output's extension).
     Render(RenderArgs),
     /// Render a camera path to numbered PNG frames (resumable), then a video.
     Sequence(SequenceArgs),
@@ -100,14 +100,17 @@ struct SceneArgs {
 struct RenderArgs {
     #[command(flatten)]
     scene: SceneArgs,
-    /// The PNG to write.
+    /// The image to write: `.png`, or `.jpg`/`.jpeg` (the extension
+    /// chooses the format; any other is refused before rendering).
     #[arg(short, long, value_name = "FILE")]
     output: PathBuf,
     /// Progressive passes: the image is the mean of N passes of the
-    /// preset's samples, each at new points in the pixel and on the lens.
-    #[arg(long, default_value_t = 1, value_name = "N",
+    /// preset's samples, each at new points in the pixel and on the lens
+    /// (default 1; a camera with a lens needs about 16 for a smooth blur,
+    /// and the command says so when it renders one with a single pass).
+    #[arg(long, value_name = "N",
           value_parser = clap::value_parser!(u32).range(1..=4096))]
-    passes: u32,
+    passes: Option<u32>,
     /// Adaptive supersampling: N passes at the pixels that differ from a
     /// neighbour (edges, creases, shadow borders), one elsewhere.
     #[arg(long, value_name = "N", conflicts_with_all = ["passes", "stereo"],
@@ -382,6 +385,7 @@ fn spinner(message: String) -> ProgressBar {
 }
 
 fn render(args: &RenderArgs, settings: &Settings) -> Outcome {
+    image_extension(&args.output).map_err(|e| usage(e.to_string()))?;
     let stereo = args.stereo()?;
     let mut job = Job::new(&args.scene, settings)?;
     let camera = &mut job.file.scene.camera;
@@ -396,6 +400,15 @@ fn render(args: &RenderArgs, settings: &Settings) -> Outcome {
     }
     if let Some(step) = args.brute_step {
         job.options.quality.brute_step = step;
+    }
+    let passes = args.passes.unwrap_or(1);
+    let plain = stereo.is_none() && args.adaptive.is_none();
+    let aperture = job.file.scene.camera.aperture;
+    if plain && passes == 1 && aperture > 0.0 {
+        eprintln!(
+            "note: the camera has a lens (aperture {aperture}), whose blur one pass leaves \
+             grainy: --passes {LENS_PASSES} renders a smooth one in {LENS_PASSES} times the time"
+        );
     }
     let (width, height) = job.size;
     let start = Instant::now();
@@ -413,18 +426,23 @@ fn render(args: &RenderArgs, settings: &Settings) -> Outcome {
                 ));
                 frame.image
             }),
-        (None, None) if args.passes > 1 => progressive(&mut renderer, width, height, args.passes),
+        (None, None) if passes > 1 => progressive(&mut renderer, width, height, passes),
         (None, None) => renderer.render(width, height),
     };
     bar.finish_and_clear();
     let image = image?;
-    save_png(&image, &args.output)?;
+    save_image(&image, &args.output)?;
     if let Some(refined) = refined {
         println!("{refined}");
     }
     let (width, height) = image.dimensions();
+    let passes = if passes > 1 && plain {
+        format!(", {passes} passes")
+    } else {
+        String::new()
+    };
     println!(
-        "{}: {width}x{height}, {} quality, {:.2} s on {}",
+        "{}: {width}x{height}, {} quality{passes}, {:.2} s on {}",
         args.output.display(),
         job.preset_name(),
         start.elapsed().as_secs_f64(),
@@ -432,6 +450,11 @@ fn render(args: &RenderArgs, settings: &Settings) -> Outcome {
     );
     Ok(())
 }
+
+/// The progressive passes the command suggests for a render through a
+/// lens: enough for the gallery's lens scene at its own quality to show a
+/// smooth blur.
+const LENS_PASSES: u32 = 16;
 
 /// The mean of `passes` progressive passes (fewer past the renderer's
 /// sample limit, where the image has converged).
