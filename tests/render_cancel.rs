@@ -128,3 +128,77 @@ fn a_slow_custom_body_is_stopped_between_tiles() {
     let frame = quick.render_with_aovs(w, h).unwrap();
     assert!(frame.hit.iter().any(|&h| h));
 }
+
+/// Set in the child process of
+/// [`a_launch_that_never_ends_is_abandoned_at_the_watchdog`], which runs
+/// the endless body where its stuck launch cannot hold up other tests.
+const ENDLESS_CHILD: &str = "FRACTAL_SDF_ENDLESS_CHILD";
+
+/// Regression: a custom body that never ends hung the render, with no
+/// way out. Under a deadline, a watchdog abandons a launch still running
+/// at twice the deadline: the frame fails with the deadline's error, the
+/// renderer refuses further frames, and dropping it does not wait. The
+/// device keeps running the endless launch until the process ends, so
+/// this test runs it in a child process of its own.
+#[test]
+fn a_launch_that_never_ends_is_abandoned_at_the_watchdog() {
+    let Some(_) = gpu::device() else { return };
+    if std::env::var(ENDLESS_CHILD).is_ok() {
+        let shape = CustomShape::new(
+            "endless",
+            &[],
+            |p, _| p.length() - 1.0,
+            "volatile int spin = 1;
+             while (spin) {}
+             return length(p) - R(1.0);",
+        )
+        .unwrap();
+        let scene = Scene::new(shape.node::<f64>([]))
+            .with_camera(Camera::look_at(dvec3(0.0, 0.0, 3.0), DVec3::ZERO));
+        let deadline = Duration::from_millis(500);
+        let mut renderer = Renderer::with_options(&scene, &options(None, Some(deadline))).unwrap();
+        let start = Instant::now();
+        let err = renderer.render(16, 12).unwrap_err();
+        assert!(matches!(err, Error::Deadline { .. }), "{err}");
+        assert!(
+            start.elapsed() < Duration::from_secs(10),
+            "{:?}",
+            start.elapsed()
+        );
+        let again = renderer.render(16, 12).unwrap_err().to_string();
+        assert!(again.contains("abandoned"), "{again}");
+        drop(renderer);
+        println!("endless launch abandoned after {:?}", start.elapsed());
+        return;
+    }
+    let mut child = std::process::Command::new(std::env::current_exe().unwrap())
+        .args([
+            "--exact",
+            "a_launch_that_never_ends_is_abandoned_at_the_watchdog",
+            "--nocapture",
+            "--test-threads=1",
+        ])
+        .env(ENDLESS_CHILD, "1")
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let start = Instant::now();
+    let status = loop {
+        if let Some(status) = child.try_wait().unwrap() {
+            break status;
+        }
+        if start.elapsed() > Duration::from_secs(120) {
+            child.kill().unwrap();
+            panic!("the child hung: the watchdog did not abandon the launch");
+        }
+        std::thread::sleep(Duration::from_millis(50));
+    };
+    let out = child.wait_with_output().unwrap();
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        status.success() && stdout.contains("endless launch abandoned"),
+        "{status:?}\n{stdout}\n{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+}

@@ -43,8 +43,12 @@ pub struct RenderOptions {
     /// [`RenderOptions::cancel`] take effect sooner.
     pub tile_size: u32,
     /// The longest a frame may take: once it has passed, no further tile is
-    /// launched and the frame fails with [`Error::Deadline`] (after the
-    /// tiles in flight finish). `None`: no limit.
+    /// launched and the frame fails with [`Error::Deadline`] after the
+    /// tiles in flight finish. A watchdog bounds that wait too: a launch
+    /// still running at twice the deadline (a custom shape whose body
+    /// never ends, say) is abandoned and the frame fails at once; OpenCL
+    /// cannot stop a launch, so the device may go on running it, and the
+    /// renderer refuses further frames (make a new one). `None`: no limit.
     pub deadline: Option<Duration>,
     /// A token that stops a frame between tiles, from any thread (see
     /// [`CancelToken`]); the frame fails with [`Error::Cancelled`].
@@ -136,6 +140,25 @@ pub struct Renderer {
     /// Whether launches render only the pixels of the refine buffer
     /// (the kernel's `refine_only`).
     refine_only: bool,
+    /// Whether a launch was abandoned at its frame's watchdog (see
+    /// [`RenderOptions::deadline`]): the device may still be running it,
+    /// so the renderer refuses further frames and, when dropped, leaves its
+    /// OpenCL objects to the process's end rather than wait for it.
+    abandoned: bool,
+}
+
+impl Drop for Renderer {
+    fn drop(&mut self) {
+        if self.abandoned {
+            // Releasing the last reference to a queue waits for its
+            // commands on some platforms: one reference more, never
+            // released, keeps this drop from waiting on a launch that may
+            // never end.
+            std::mem::forget(self.queue.clone());
+            std::mem::forget(self.context.clone());
+            std::mem::forget(self.kernel.clone());
+        }
+    }
 }
 
 /// Progressive rendering's state: the passes in the accumulation buffers.
@@ -279,6 +302,7 @@ impl Renderer {
             pass: -1,
             progress: None,
             refine_only: false,
+            abandoned: false,
         })
     }
 
@@ -958,6 +982,38 @@ impl Renderer {
         Ok(event)
     }
 
+    /// Waits for `event` (a tile launch; the queue is in order, so every
+    /// command before it too). Under a deadline the wait is a watchdog: a
+    /// launch still running at twice the deadline (the frame's time, then
+    /// as long again for the launches in flight) is given up, and the
+    /// [`Error::Deadline`] to fail the frame with is returned: the caller
+    /// marks the renderer abandoned. `(tiles, total)`: the tiles launched
+    /// so far and the frame's, for the error.
+    fn settle(
+        &self,
+        event: Option<&Event>,
+        launched: Instant,
+        (tiles, total): (usize, usize),
+    ) -> Result<Option<Error>> {
+        let Some(event) = event else { return Ok(None) };
+        let Some(deadline) = self.options.deadline else {
+            return event.wait_for().map(|()| None).map_err(opencl);
+        };
+        let mut pause = Duration::from_micros(50);
+        while !event.is_complete().map_err(opencl)? {
+            if launched.elapsed() >= deadline.saturating_mul(2) {
+                return Ok(Some(Error::Deadline {
+                    deadline,
+                    tiles,
+                    total,
+                }));
+            }
+            std::thread::sleep(pause);
+            pause = (pause * 2).min(Duration::from_millis(5));
+        }
+        Ok(None)
+    }
+
     /// The error that stops a frame before its next tile, if any: a
     /// cancelled token, or a deadline that has passed.
     fn stop(&self, launched: Instant, tiles: usize, total: usize) -> Option<Error> {
@@ -982,6 +1038,13 @@ impl Renderer {
     /// Uploads the frame's inputs, launches every tile and waits for them.
     /// Returns the kernel time and whether it comes from profiling events.
     fn run(&mut self, width: u32, height: u32, aovs: bool) -> Result<(Duration, bool)> {
+        if self.abandoned {
+            return Err(Error::OpenCl(
+                "an earlier frame's launch was abandoned at its deadline and may still be \
+                 running on the device: make a new renderer"
+                    .into(),
+            ));
+        }
         self.timing = None;
         check_size(width, height)?;
         let view = self.viewport(width, height)?;
@@ -1064,11 +1127,19 @@ impl Renderer {
             if let Some(stop) = self.stop(launched, events.len(), total) {
                 // Let the tiles in flight finish before the buffers are
                 // touched again.
-                self.queue.finish().map_err(opencl)?;
+                if let Some(e) = self.settle(events.last(), launched, (events.len(), total))? {
+                    self.abandoned = true;
+                    return Err(e);
+                }
                 return Err(stop);
             }
             if let Some(before) = events.len().checked_sub(TILES_IN_FLIGHT) {
-                events[before].wait_for().map_err(opencl)?;
+                if let Some(e) =
+                    self.settle(Some(&events[before]), launched, (events.len(), total))?
+                {
+                    self.abandoned = true;
+                    return Err(e);
+                }
             }
             #[allow(clippy::cast_possible_wrap)]
             {
@@ -1090,6 +1161,10 @@ impl Renderer {
                     .map_err(opencl)?;
             }
             events.push(event);
+        }
+        if let Some(e) = self.settle(events.last(), launched, (total, total))? {
+            self.abandoned = true;
+            return Err(e);
         }
         self.queue.finish().map_err(opencl)?;
         events.extend(coarse);

@@ -94,6 +94,23 @@ struct SceneArgs {
     /// (a name twice uses that device twice).
     #[arg(long, value_name = "all|NAME,...", conflicts_with = "device")]
     devices: Option<String>,
+    /// The longest a frame may take, in seconds: past it the command stops
+    /// with an error instead of waiting (a launch still running at twice
+    /// the time is abandoned).
+    #[arg(long, value_name = "SECONDS", value_parser = parse_seconds)]
+    deadline: Option<Duration>,
+}
+
+/// A positive, finite number of seconds.
+fn parse_seconds(text: &str) -> std::result::Result<Duration, String> {
+    let seconds: f64 = text
+        .trim()
+        .parse()
+        .map_err(|_| format!("`{text}` is not a number of seconds"))?;
+    Duration::try_from_secs_f64(seconds)
+        .ok()
+        .filter(|d| !d.is_zero())
+        .ok_or_else(|| format!("`{text}`: expected a positive number of seconds"))
 }
 
 #[derive(Args)]
@@ -344,6 +361,7 @@ impl Job {
             quality: quality(preset, &file, settings),
             effects: file.effects,
             device: device.map_or_else(DeviceSelector::auto, DeviceSelector::device),
+            deadline: args.deadline,
             ..RenderOptions::default()
         };
         Ok(Job {
