@@ -459,3 +459,24 @@ fn the_distance_kernels_agree_with_the_point_kernel() {
         );
     }
 }
+
+#[test]
+fn an_inside_only_shape_meshes_within_its_own_bound() {
+    // Its value is a sign (±1e15), not a distance: nothing may be culled
+    // by distance, and the box is its whole bound.
+    let scene = compiled(InsideShape::mandelbulb().node([8.0, 10.0]));
+    let options = GridOptions::default().resolution(32).sampler(Sampler::Cpu);
+    let mesh = mesh::extract(&scene, &options).unwrap();
+    assert!(mesh.triangles.len() > 1000, "{}", mesh.triangles.len());
+    assert_eq!(mesh.stats.blocks_sampled, mesh.stats.blocks);
+    let topology = mesh.topology();
+    assert_eq!(topology.boundary_edges, 0, "{topology:?}");
+    assert_eq!(topology.misoriented_edges, 0, "{topology:?}");
+    // The set lies in the ball of radius 1.104 that the estimate's
+    // Mandelbulb fills; every vertex lies between samples of the grid.
+    let reach = 1.104 + 1.8 * mesh.voxel_size;
+    for p in &mesh.positions {
+        assert!(f64::from(p.length()) < reach, "vertex at {p}");
+    }
+    assert!(mesh.volume() > 1.0 && mesh.volume() < 4.0 / 3.0 * PI * 1.104f64.powi(3));
+}

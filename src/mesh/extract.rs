@@ -6,7 +6,7 @@ use std::collections::HashMap;
 use glam::{DVec3, Vec3};
 
 use super::dual::{Mesher, SIDE};
-use super::grid::{Grid, Progress, Stage, occupied, plan};
+use super::grid::{Grid, Progress, Stage, every_leaf, occupied, plan};
 use super::sharpen::sharpen;
 use super::{GridOptions, Sampling};
 use crate::error::{Error, Result};
@@ -158,7 +158,14 @@ pub fn extract_with_progress(
 ) -> Result<Mesh> {
     let (grid, sampling) = plan(scene, options, progress)?;
     let count = grid.cells.map(|c| c.div_ceil(CHUNK));
-    let (blocks, octree) = occupied(&sampling, &grid, CHUNK, 1, count, Stage::Culling, progress)?;
+    // Inside-only shapes give a sign, not a distance: no block can be
+    // dropped, and there are no tangent planes to fit.
+    let signs_only = scene.ir().has_inside_shapes();
+    let (blocks, octree) = if signs_only {
+        (every_leaf(count), 0)
+    } else {
+        occupied(&sampling, &grid, CHUNK, 1, count, Stage::Culling, progress)?
+    };
     let mut mesher = Mesher::new(grid);
     let total = blocks.len() as u64;
     let per = (SIDE as usize).pow(3);
@@ -191,7 +198,7 @@ pub fn extract_with_progress(
     }
     let (mut mesh, crossings) = mesher.finish();
     let mut sharpening = 0;
-    if options.sharp {
+    if options.sharp && !signs_only {
         progress(Progress {
             stage: Stage::Sharpening,
             done: 0,
