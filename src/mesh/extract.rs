@@ -7,6 +7,7 @@ use glam::{DVec3, Vec3};
 
 use super::dual::{Mesher, SIDE};
 use super::grid::{Grid, Progress, Stage, every_leaf, occupied, plan};
+use super::manifold::repair;
 use super::sharpen::sharpen;
 use super::{GridOptions, Sampling};
 use crate::error::{Error, Result};
@@ -108,6 +109,19 @@ impl Mesh {
             }
         }
         out
+    }
+
+    /// Vertices at a position an earlier vertex holds (`-0.0` and `0.0`
+    /// are one position): zero for every mesh [`extract`] makes, so that
+    /// files without indices (STL) and tools that weld equal positions
+    /// see the same surface as the indices.
+    #[must_use]
+    pub fn duplicate_positions(&self) -> usize {
+        let mut seen = std::collections::HashSet::with_capacity(self.positions.len());
+        self.positions
+            .iter()
+            .filter(|p| !seen.insert(p.to_array().map(|c| (c + 0.0).to_bits())))
+            .count()
     }
 
     /// The enclosed volume (the divergence theorem over the triangles):
@@ -212,6 +226,12 @@ pub fn extract_with_progress(
             &mut mesh.normals,
         )?;
     }
+    repair(
+        &mut mesh.positions,
+        &mut mesh.normals,
+        &mut mesh.triangles,
+        grid.spacing,
+    );
     mesh.colors = shade(&sampling, &mesh.positions, progress)?;
     mesh.stats = MeshStats {
         cells: grid.cells,

@@ -15,6 +15,10 @@ use crate::error::Result;
 /// and keeps nearly parallel planes from throwing a vertex far away.
 const REGULARISATION: f64 = 0.05;
 
+/// How far inside its cell a fitted vertex stays, in voxels: two cells'
+/// vertices clamped towards their shared face or corner stay apart.
+const INSET: f64 = 1e-3;
+
 /// The step of the differences that give the tangent planes at edge
 /// crossings, in voxels: small, so that a plane near a crease is the
 /// plane of its own side.
@@ -67,7 +71,7 @@ impl Crossings {
 }
 
 /// Moves every vertex to its cell's best fit of the crossings' tangent
-/// planes, and gives it the distance field's gradient there as its
+/// planes (kept [`INSET`] inside the cell), and gives it the distance field's gradient there as its
 /// normal, except in the grid's outer layer of cells, where a box may cut
 /// the scene. Returns the distance evaluations it took.
 pub(crate) fn sharpen(
@@ -105,7 +109,7 @@ pub(crate) fn sharpen(
         }
         let fit = mean + a.inverse() * b;
         let cell = DVec3::from_array(crossings.cells[v].map(f64::from));
-        let placed = fit.clamp(cell, cell + DVec3::ONE);
+        let placed = fit.clamp(cell + DVec3::splat(INSET), cell + DVec3::splat(1.0 - INSET));
         if placed.is_finite() {
             *position = world(placed).as_vec3();
         }

@@ -149,11 +149,13 @@ pub fn mesh(args: &MeshArgs) -> Outcome {
     let mesh = mesh?;
     mesh.write(&args.output)?;
     let topology = mesh.topology();
-    let shape = if topology.is_closed_manifold() {
-        "closed 2-manifold".to_string()
+    let duplicates = mesh.duplicate_positions();
+    let shape = if topology.is_closed_manifold() && duplicates == 0 {
+        "closed 2-manifold, every vertex at its own position".to_string()
     } else {
         format!(
-            "{} boundary, {} non-manifold, {} misoriented of {} edges",
+            "{} boundary, {} non-manifold, {} misoriented of {} edges, {duplicates} vertices at \
+             a shared position",
             topology.boundary_edges,
             topology.non_manifold_edges,
             topology.misoriented_edges,
