@@ -623,3 +623,58 @@ fn a_rotated_menger_sponge_at_128_cells_is_a_closed_manifold_as_files_read_back(
     assert!(stl.is_clean(), "STL {stl:?}");
     assert!(mesh.triangles.len() > 500_000, "{}", mesh.triangles.len());
 }
+
+#[test]
+fn a_volumes_values_lie_in_its_band_with_the_scenes_signs() {
+    // An inside-only shape gives ±1e15 (a sign), a fractal's estimate
+    // inside is no distance, a sphere's is exact.
+    let dir = scratch("band");
+    let shapes = [
+        ("escape", InsideShape::mandelbulb().node([8.0, 10.0])),
+        ("estimate", mandelbulb(8.0)),
+        ("sphere", sphere(1.0)),
+    ];
+    for (name, node) in shapes {
+        let scene = compiled(node);
+        let options = GridOptions::default()
+            .bounds(Aabb::cube(DVec3::ZERO, 1.3))
+            .resolution(32)
+            .precision(Precision::F64)
+            .sampler(Sampler::Cpu);
+        let volume = mesh::sample_volume(&scene, &options).unwrap();
+        let band = volume.band();
+        assert!(
+            (f64::from(band) - mesh::BAND_VOXELS * volume.spacing).abs() < 1e-6,
+            "{name}: band {band}"
+        );
+        let eval = cpu::Evaluator::from_compiled(&scene);
+        let [nx, ny, nz] = volume.dims;
+        let (mut inside, mut clamped_inside) = (0, 0);
+        for k in 0..nz {
+            for j in 0..ny {
+                for i in 0..nx {
+                    let d = eval.distance(volume.point([i, j, k]));
+                    let got = volume.distance([i, j, k]);
+                    assert!(got.abs() <= band, "{name}: {got} at ({i}, {j}, {k})");
+                    assert_eq!(got < 0.0, d < 0.0, "{name}: sign {got} vs {d}");
+                    if d.abs() < f64::from(band) {
+                        assert!((f64::from(got) - d).abs() < 1e-6, "{name}: {got} vs {d}");
+                    }
+                    inside += usize::from(d < 0.0);
+                    clamped_inside += usize::from(got == -band);
+                }
+            }
+        }
+        assert!(inside > 1000, "{name}: {inside} samples inside");
+        // The estimate stays small inside the Mandelbulb; the others
+        // reach the band.
+        assert!(
+            name == "estimate" || clamped_inside > 0,
+            "{name}: nothing deep inside"
+        );
+        let path = dir.join(format!("{name}.nrrd"));
+        volume.write_nrrd(&path).unwrap();
+        let (_, values) = read_nrrd(&path);
+        assert!(values.iter().all(|v| v.abs() <= band), "{name}");
+    }
+}

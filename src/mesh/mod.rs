@@ -88,5 +88,7 @@ mod write;
 pub use extract::{CHUNK, Mesh, MeshStats, Topology, extract, extract_with_progress};
 pub use grid::{Aabb, GridOptions, MAX_RESOLUTION, Progress, Stage};
 pub use sample::Sampler;
-pub use volume::{MAX_VOLUME_SAMPLES, Volume, sample_volume, sample_volume_with_progress};
+pub use volume::{
+    BAND_VOXELS, MAX_VOLUME_SAMPLES, Volume, sample_volume, sample_volume_with_progress,
+};
 pub use write::MeshFormat;

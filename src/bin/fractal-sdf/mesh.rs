@@ -57,7 +57,10 @@ pub struct MeshArgs {
 pub struct VolumeArgs {
     #[command(flatten)]
     grid: GridArgs,
-    /// The NRRD file of signed distances to write (raw little-endian f32).
+    /// The NRRD file of signed distances to write (raw little-endian f32,
+    /// negative inside), clamped to ±3 sample spacings around the surface:
+    /// far from it a fractal's estimate is no distance and an inside-only
+    /// shape gives only a sign.
     #[arg(short, long, value_name = "FILE", required_unless_present = "slices")]
     output: Option<PathBuf>,
     /// A directory for one PNG per z slice: white inside, black outside.
