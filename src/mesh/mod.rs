@@ -51,6 +51,13 @@
 //! - **Every vertex at its own position** ([`Mesh::duplicate_positions`]
 //!   is zero), so an STL file, which has no indices, and tools that weld
 //!   equal positions (slicers, `trimesh`) see the same surface.
+//! - **Accurate in volume**: the enclosed volume of smooth shapes
+//!   converges at second order in the voxel size (the sphere +0.006% at
+//!   128 cells); shapes with edges keep them, because each crossing is
+//!   moved onto the surface before the fit (the Menger
+//!   sponge of level 4 −0.25% at 128 cells, where linear crossings lost
+//!   4.93%); only features smaller than about a voxel are lost. The table,
+//!   and the command that measures it, is `docs/mesh-volumes.md`.
 //! - **Not checked**: that no two triangles intersect (dual contouring's
 //!   fitted vertices can fold a sheet where a feature is thinner than a
 //!   voxel).
