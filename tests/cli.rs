@@ -446,6 +446,10 @@ fn mesh_and_volume_write_files_and_refuse_bad_grids() {
     assert!(out.status.success(), "{}", text(&out));
     let said = String::from_utf8_lossy(&out.stdout);
     assert!(said.contains("triangles") && said.contains("32x"), "{said}");
+    assert!(
+        said.contains("closed 2-manifold, every vertex at its own position"),
+        "{said}"
+    );
     let mut file = std::fs::File::open(&stl).unwrap();
     let mesh = stl_io::read_stl(&mut file).unwrap();
     assert!(mesh.faces.len() > 1000, "{} faces", mesh.faces.len());
@@ -504,8 +508,17 @@ fn mesh_and_volume_write_files_and_refuse_bad_grids() {
         ],
     );
     assert!(out.status.success(), "{}", text(&out));
-    assert!(std::fs::read(&nrrd).unwrap().starts_with(b"NRRD0004\n"));
+    let written = std::fs::read(&nrrd).unwrap();
+    assert!(written.starts_with(b"NRRD0004\n"));
+    assert!(String::from_utf8_lossy(&written[..200]).contains("\n# clamped to +-"));
     assert_eq!(std::fs::read_dir(&slices).unwrap().count(), 21);
+    // The help names the band the values are clamped to.
+    let out = run(&dir, "", &["volume", "--help"]);
+    let band = format!(
+        "clamped to ±{} sample spacings",
+        fractal_sdf::mesh::BAND_VOXELS
+    );
+    assert!(text(&out).contains(&band), "{}", text(&out));
 
     for (args, code, says) in [
         (

@@ -3,10 +3,15 @@
 //! throughput; and accuracy against exact shapes (the distance of vertices
 //! to the surface, and the Hausdorff distance to a sphere, a box and a
 //! torus) against resolution. Writes `out/menger.stl` and `out/mandelbulb.ply`.
+//! With `--volumes`, only the enclosed volume of shapes whose exact volume
+//! is known (sphere, box, torus, cylinder, capsule, Menger sponge levels 1
+//! to 4) against resolution, with its rate of convergence.
 //!
 //! `cargo run --release --example mesh [-- --resolutions 128,256,512]`
+//! `cargo run --release --example mesh -- --volumes [--resolutions 32,64,128,256]`
 
 mod hausdorff;
+mod volumes;
 
 use std::time::Instant;
 
@@ -16,14 +21,18 @@ use fractal_sdf::render::DeviceSelector;
 
 fn main() -> Result<()> {
     let mut args = pico_args::Arguments::from_env();
-    let resolutions: Vec<u32> = args
+    let volume_table = args.contains("--volumes");
+    let resolutions: Option<Vec<u32>> = args
         .opt_value_from_fn("--resolutions", |s: &str| {
             s.split(',')
                 .map(str::parse)
                 .collect::<std::result::Result<Vec<u32>, _>>()
         })
-        .expect("--resolutions takes numbers separated by commas")
-        .unwrap_or_else(|| vec![128, 256, 512]);
+        .expect("--resolutions takes numbers separated by commas");
+    if volume_table {
+        return volumes::table(&resolutions.unwrap_or_else(|| vec![32, 64, 128, 256]));
+    }
+    let resolutions = resolutions.unwrap_or_else(|| vec![128, 256, 512]);
     let device = Sampler::Device(DeviceSelector::auto());
     std::fs::create_dir_all("out").ok();
 

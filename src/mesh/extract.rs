@@ -6,7 +6,8 @@ use std::collections::HashMap;
 use glam::{DVec3, Vec3};
 
 use super::dual::{Mesher, SIDE};
-use super::grid::{Grid, Progress, Stage, occupied, plan};
+use super::grid::{Grid, Progress, Stage, every_leaf, occupied, plan};
+use super::manifold::repair;
 use super::sharpen::sharpen;
 use super::{GridOptions, Sampling};
 use crate::error::{Error, Result};
@@ -110,6 +111,19 @@ impl Mesh {
         out
     }
 
+    /// Vertices at a position an earlier vertex holds (`-0.0` and `0.0`
+    /// are one position): zero for every mesh [`extract`] makes, so that
+    /// files without indices (STL) and tools that weld equal positions
+    /// see the same surface as the indices.
+    #[must_use]
+    pub fn duplicate_positions(&self) -> usize {
+        let mut seen = std::collections::HashSet::with_capacity(self.positions.len());
+        self.positions
+            .iter()
+            .filter(|p| !seen.insert(p.to_array().map(|c| (c + 0.0).to_bits())))
+            .count()
+    }
+
     /// The enclosed volume (the divergence theorem over the triangles):
     /// positive for a closed mesh oriented outwards.
     #[must_use]
@@ -158,7 +172,14 @@ pub fn extract_with_progress(
 ) -> Result<Mesh> {
     let (grid, sampling) = plan(scene, options, progress)?;
     let count = grid.cells.map(|c| c.div_ceil(CHUNK));
-    let (blocks, octree) = occupied(&sampling, &grid, CHUNK, 1, count, Stage::Culling, progress)?;
+    // Inside-only shapes give a sign, not a distance: no block can be
+    // dropped, and there are no tangent planes to fit.
+    let signs_only = scene.ir().has_inside_shapes();
+    let (blocks, octree) = if signs_only {
+        (every_leaf(count), 0)
+    } else {
+        occupied(&sampling, &grid, CHUNK, 1, count, Stage::Culling, progress)?
+    };
     let mut mesher = Mesher::new(grid);
     let total = blocks.len() as u64;
     let per = (SIDE as usize).pow(3);
@@ -191,7 +212,7 @@ pub fn extract_with_progress(
     }
     let (mut mesh, crossings) = mesher.finish();
     let mut sharpening = 0;
-    if options.sharp {
+    if options.sharp && !signs_only {
         progress(Progress {
             stage: Stage::Sharpening,
             done: 0,
@@ -205,6 +226,12 @@ pub fn extract_with_progress(
             &mut mesh.normals,
         )?;
     }
+    repair(
+        &mut mesh.positions,
+        &mut mesh.normals,
+        &mut mesh.triangles,
+        grid.spacing,
+    );
     mesh.colors = shade(&sampling, &mesh.positions, progress)?;
     mesh.stats = MeshStats {
         cells: grid.cells,

@@ -87,7 +87,9 @@ pub struct GridOptions {
     /// gradients: four more evaluations per crossing and per vertex), so
     /// box edges, corners and CSG creases stay sharp, and take normals
     /// from the gradient at the vertex; `false`: Surface Nets' mean of the
-    /// crossings and the grid's gradient. Default `true`.
+    /// crossings and the grid's gradient. Default `true`. Scenes with an
+    /// inside-only shape ([`InsideShape`](crate::scene::InsideShape)) have
+    /// no gradient and always take the mean.
     pub sharp: bool,
     /// Dynamic parameters to set before sampling, by name (the rest keep
     /// their defaults).
@@ -246,7 +248,13 @@ pub(crate) fn plan(
         Some(b) => b,
         None => {
             let found = scene_box(scene)?;
-            let tight = tighten(&sampling, found, progress)?;
+            // An inside-only shape's value is no distance: nothing can
+            // be proved empty, so its bound stays whole.
+            let tight = if scene.ir().has_inside_shapes() {
+                found
+            } else {
+                tighten(&sampling, found, progress)?
+            };
             let margin = MARGIN_VOXELS * tight.size().max_element() / f64::from(options.resolution);
             Aabb::new(
                 tight.min - DVec3::splat(margin),
@@ -374,6 +382,21 @@ pub(crate) fn occupied(
     }
     leaves.sort_unstable_by_key(|l| (l[2], l[1], l[0]));
     Ok((leaves, evaluations))
+}
+
+/// Every leaf of a grid of `count` leaves, in the order [`occupied`]
+/// gives them: for scenes whose values are no distances, where nothing
+/// can be dropped.
+pub(crate) fn every_leaf(count: [u32; 3]) -> Vec<[u32; 3]> {
+    let mut out = Vec::new();
+    for z in 0..count[2] {
+        for y in 0..count[1] {
+            for x in 0..count[0] {
+                out.push([x, y, z]);
+            }
+        }
+    }
+    out
 }
 
 /// The children of the node `lo..hi`: each axis longer than one leaf

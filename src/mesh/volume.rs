@@ -1,6 +1,18 @@
 //! Dense voxel grids of signed distances: NRRD files (a short text header
 //! and raw little-endian `f32`, which volume tools such as 3D Slicer,
 //! ParaView and Fiji read) and PNG slice stacks.
+//!
+//! The stored values are clamped to a narrow band of
+//! ±[`BAND_VOXELS`] samples' spacings around the surface. Far from the
+//! surface a value says little: inside a fractal its estimate is no
+//! distance, and an inside-only shape ([`InsideShape`]) has no distance
+//! at all, only a sign (±10¹⁵). Unclamped, those values span twenty
+//! orders of magnitude and a viewer's transfer function or iso-surface
+//! slider has nothing to hold on to; clamped, every value is within a few
+//! spacings, the sign is kept (negative inside), and a value inside the
+//! band is the scene's own estimate.
+//!
+//! [`InsideShape`]: crate::scene::InsideShape
 
 use std::io::{BufWriter, Write};
 use std::path::{Path, PathBuf};
@@ -18,7 +30,13 @@ use crate::output::write_atomic;
 /// The most samples a volume may hold (2 GiB of `f32`).
 pub const MAX_VOLUME_SAMPLES: u64 = 1 << 29;
 
-/// Signed distances at every sample of a regular grid: negative inside.
+/// The half width of the band a volume's values are clamped to, in
+/// samples' spacings: every stored value lies in
+/// `[-BAND_VOXELS · spacing, BAND_VOXELS · spacing]`.
+pub const BAND_VOXELS: f64 = 3.0;
+
+/// Signed distances at every sample of a regular grid: negative inside,
+/// clamped to ±[`BAND_VOXELS`] spacings (see [`Volume::band`]).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Volume {
     /// The position of sample `(0, 0, 0)`.
@@ -27,11 +45,20 @@ pub struct Volume {
     pub spacing: f64,
     /// Samples along each axis.
     pub dims: [u32; 3],
-    /// The distances, `x` fastest, then `y`, then `z`.
+    /// The distances, `x` fastest, then `y`, then `z`; each within
+    /// [`Volume::band`] of zero, with the scene's sign (a sample where
+    /// the scene gives no number counts as outside).
     pub distances: Vec<f32>,
 }
 
 impl Volume {
+    /// The largest magnitude a stored value has: [`BAND_VOXELS`] times
+    /// the spacing (as an `f32`).
+    #[must_use]
+    pub fn band(&self) -> f32 {
+        band(self.spacing)
+    }
+
     /// The index of sample `(i, j, k)` in [`Volume::distances`].
     #[must_use]
     pub fn index(&self, [i, j, k]: [u32; 3]) -> usize {
@@ -66,9 +93,13 @@ impl Volume {
             write!(
                 out,
                 "NRRD0004\n# signed distances written by fractal-sdf: negative inside\n\
+                 # clamped to +-{} ({BAND_VOXELS} spacings)\n\
                  type: float\ndimension: 3\nsizes: {x} {y} {z}\nspacings: {h} {h} {h}\n\
                  axis mins: {} {} {}\nendian: little\nencoding: raw\n\n",
-                o.x, o.y, o.z
+                self.band(),
+                o.x,
+                o.y,
+                o.z
             )?;
             for d in &self.distances {
                 out.write_all(&d.to_le_bytes())?;
@@ -153,6 +184,7 @@ pub fn sample_volume_with_progress(
         }
     }
     let per = (CHUNK as usize).pow(3);
+    let band = band(grid.spacing);
     let total = starts.len() as u64;
     let mut done = 0u64;
     for batch in starts.chunks(256) {
@@ -164,7 +196,11 @@ pub fn sample_volume_with_progress(
                 let at = [0, 1, 2].map(|a| start[a].unsigned_abs() + local[a]);
                 if (0..3).all(|a| at[a] < dims[a]) {
                     let i = volume.index(at);
-                    volume.distances[i] = *d;
+                    volume.distances[i] = if d.is_nan() {
+                        band
+                    } else {
+                        d.clamp(-band, band)
+                    };
                 }
             }
         }
@@ -176,4 +212,12 @@ pub fn sample_volume_with_progress(
         });
     }
     Ok(volume)
+}
+
+/// [`BAND_VOXELS`] spacings as an `f32`, at least the smallest positive
+/// one (so that a clamped value keeps its sign).
+fn band(spacing: f64) -> f32 {
+    #[allow(clippy::cast_possible_truncation)] // Grids are far below f32::MAX.
+    let band = (BAND_VOXELS * spacing) as f32;
+    band.max(f32::MIN_POSITIVE)
 }

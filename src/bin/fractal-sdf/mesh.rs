@@ -57,7 +57,10 @@ pub struct MeshArgs {
 pub struct VolumeArgs {
     #[command(flatten)]
     grid: GridArgs,
-    /// The NRRD file of signed distances to write (raw little-endian f32).
+    /// The NRRD file of signed distances to write (raw little-endian f32,
+    /// negative inside), clamped to ±3 sample spacings around the surface:
+    /// far from it a fractal's estimate is no distance and an inside-only
+    /// shape gives only a sign.
     #[arg(short, long, value_name = "FILE", required_unless_present = "slices")]
     output: Option<PathBuf>,
     /// A directory for one PNG per z slice: white inside, black outside.
@@ -149,11 +152,13 @@ pub fn mesh(args: &MeshArgs) -> Outcome {
     let mesh = mesh?;
     mesh.write(&args.output)?;
     let topology = mesh.topology();
-    let shape = if topology.is_closed_manifold() {
-        "closed 2-manifold".to_string()
+    let duplicates = mesh.duplicate_positions();
+    let shape = if topology.is_closed_manifold() && duplicates == 0 {
+        "closed 2-manifold, every vertex at its own position".to_string()
     } else {
         format!(
-            "{} boundary, {} non-manifold, {} misoriented of {} edges",
+            "{} boundary, {} non-manifold, {} misoriented of {} edges, {duplicates} vertices at \
+             a shared position",
             topology.boundary_edges,
             topology.non_manifold_edges,
             topology.misoriented_edges,
