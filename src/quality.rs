@@ -192,8 +192,9 @@ pub struct Quality {
     /// only whether it is in a set, and features thinner than a step may
     /// be missed. Each pixel and progressive pass starts its steps at a
     /// different offset, so passes converge on the set's surface. In
-    /// `(0, 64]`; 4 in `draft`, 2 in `preview`, 1 in `production`, 0.5 in
-    /// `reference`. Scenes without inside shapes ignore it.
+    /// `[0.125, 64]` ([`MIN_BRUTE_STEP`]); 4 in `draft`, 2 in `preview`, 1
+    /// in `production`, 0.5 in `reference`. Scenes without inside shapes
+    /// ignore it.
     pub brute_step: f64,
     /// How a scene with inside shapes estimates the normal where a ray
     /// meets an inside shape, which has no distance to differentiate: from
@@ -431,11 +432,19 @@ impl Quality {
         check(
             "brute_step",
             self.brute_step,
-            self.brute_step > 0.0 && self.brute_step <= 64.0,
-            "in (0, 64] pixel footprints",
+            (MIN_BRUTE_STEP..=64.0).contains(&self.brute_step),
+            "in [0.125, 64] pixel footprints",
         )
     }
 }
+
+/// The smallest [`Quality::brute_step`], in pixel footprints. A ray takes
+/// at most [`BRUTE_MAX_STEPS`](crate::scene::BRUTE_MAX_STEPS) brute-force
+/// steps, so smaller steps would stop short of the sets they are meant to
+/// find (an image of sky) instead of seeing them finer: at this step the
+/// budget still crosses 2,048 footprints, a region deeper than a 4K
+/// image is wide.
+pub const MIN_BRUTE_STEP: f64 = 0.125;
 
 /// Builder methods, one per knob: each returns the settings with that knob
 /// changed, so a preset is adjusted in one expression. Like the fields,

@@ -4,7 +4,7 @@
 use glam::DVec3;
 
 use super::sample::{Sampler, Sampling};
-use crate::error::{Error, Result};
+use crate::error::{Error, Result, fmt_value};
 use crate::ir::{Bound, CompiledScene, union_chain};
 use crate::quality::Precision;
 
@@ -64,9 +64,33 @@ impl Aabb {
                 ),
             });
         }
+        let side = (self.max - self.min).min_element();
+        let reach = self.min.abs().max(self.max.abs()).max_element();
+        if side < MIN_BOX_SIDE || side < MIN_RELATIVE_SIDE * reach {
+            return Err(Error::Invalid {
+                what: "grid bounds",
+                reason: format!(
+                    "the box from {} to {} is {} wide on its narrowest axis: at least {} and \
+                     {} of its largest coordinate are needed to tell its samples apart",
+                    self.min,
+                    self.max,
+                    fmt_value(side),
+                    fmt_value(MIN_BOX_SIDE),
+                    fmt_value(MIN_RELATIVE_SIDE)
+                ),
+            });
+        }
         Ok(())
     }
 }
+
+/// The narrowest a sampled box may be on any axis.
+const MIN_BOX_SIDE: f64 = 1e-12;
+
+/// The narrowest a sampled box may be on any axis, as a share of its
+/// largest coordinate: single precision (device sampling) keeps about
+/// seven digits, so a narrower box would sample the same points again.
+const MIN_RELATIVE_SIDE: f64 = 1e-5;
 
 /// Where and how finely a scene is sampled for a mesh or a volume.
 #[derive(Debug, Clone, PartialEq)]

@@ -4,7 +4,7 @@
 use glam::DVec3;
 
 use crate::cpu::Evaluator;
-use crate::error::Result;
+use crate::error::{Error, Result};
 use crate::ir::CompiledScene;
 use crate::quality::Precision;
 #[cfg(feature = "opencl")]
@@ -70,9 +70,9 @@ impl Sampling {
     /// The distance at every point.
     pub fn distances(&self, points: &[DVec3]) -> Result<Vec<f64>> {
         match self {
-            Sampling::Cpu { eval, precision } => Ok(on_cores(points.len(), |i| {
+            Sampling::Cpu { eval, precision } => on_cores(eval, points.len(), |i| {
                 distance(eval, *precision, points[i])
-            })),
+            }),
             #[cfg(feature = "opencl")]
             Sampling::Device(device) => device.distances(points),
         }
@@ -81,9 +81,9 @@ impl Sampling {
     /// The colour (linear RGB) `DE_shade` gives at every point.
     pub fn colors(&self, points: &[DVec3]) -> Result<Vec<DVec3>> {
         match self {
-            Sampling::Cpu { eval, .. } => Ok(on_cores(points.len(), |i| {
+            Sampling::Cpu { eval, .. } => on_cores(eval, points.len(), |i| {
                 eval.sample::<f64>(points[i].into()).color.into()
-            })),
+            }),
             #[cfg(feature = "opencl")]
             Sampling::Device(device) => {
                 Ok(device.eval(points)?.into_iter().map(|s| s.color).collect())
@@ -103,7 +103,7 @@ impl Sampling {
     ) -> Result<Vec<f32>> {
         let per = (side as usize).pow(3);
         match self {
-            Sampling::Cpu { eval, precision } => Ok(on_cores(per * blocks.len(), |i| {
+            Sampling::Cpu { eval, precision } => on_cores(eval, per * blocks.len(), |i| {
                 let b = blocks[i / per];
                 let s = u32::try_from(i % per).expect("a block is small");
                 let at = [s % side, (s / side) % side, s / (side * side)];
@@ -117,7 +117,7 @@ impl Sampling {
                 #[allow(clippy::cast_possible_truncation)] // Grids hold f32.
                 let d = distance(eval, *precision, p) as f32;
                 d
-            })),
+            }),
             #[cfg(feature = "opencl")]
             Sampling::Device(device) => {
                 #[allow(clippy::cast_possible_truncation)] // Grids hold f32.
@@ -139,20 +139,69 @@ fn distance(eval: &Evaluator, precision: Precision, p: DVec3) -> f64 {
     }
 }
 
-/// `f(i)` for every `i < len`, split over the machine's cores.
-fn on_cores<T: Send + Default + Clone>(len: usize, f: impl Fn(usize) -> T + Sync) -> Vec<T> {
+/// `f(i)` for every `i < len`, split over the machine's cores. The only
+/// code of a user's that `f` runs is a custom shape's CPU function (of
+/// `eval`'s scene): where one panics, the error says so with its message
+/// instead of the threads' panic hiding it.
+fn on_cores<T: Send + Default + Clone>(
+    eval: &Evaluator,
+    len: usize,
+    f: impl Fn(usize) -> T + Sync,
+) -> Result<Vec<T>> {
     let mut out = vec![T::default(); len];
     let cores = std::thread::available_parallelism().map_or(1, std::num::NonZero::get);
     let per = len.div_ceil(cores).max(1024);
-    std::thread::scope(|s| {
-        for (k, part) in out.chunks_mut(per).enumerate() {
-            let f = &f;
-            s.spawn(move || {
-                for (j, v) in part.iter_mut().enumerate() {
-                    *v = f(k * per + j);
-                }
-            });
-        }
+    let panics: Vec<String> = std::thread::scope(|s| {
+        let threads: Vec<_> = out
+            .chunks_mut(per)
+            .enumerate()
+            .map(|(k, part)| {
+                let f = &f;
+                s.spawn(move || {
+                    std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+                        for (j, v) in part.iter_mut().enumerate() {
+                            *v = f(k * per + j);
+                        }
+                    }))
+                    .err()
+                    .map(|payload| panic_message(payload.as_ref()))
+                })
+            })
+            .collect();
+        threads
+            .into_iter()
+            .filter_map(|t| t.join().ok().flatten())
+            .collect()
     });
-    out
+    match panics.into_iter().next() {
+        None => Ok(out),
+        Some(message) => {
+            let names: Vec<&str> = eval
+                .ir()
+                .nodes()
+                .iter()
+                .filter_map(|n| match n {
+                    crate::scene::Kind::Custom { shape, .. } => Some(shape.name()),
+                    _ => None,
+                })
+                .collect();
+            Err(Error::CustomShape {
+                name: if names.is_empty() {
+                    "?".into()
+                } else {
+                    names.join("`, `")
+                },
+                reason: format!("its CPU function panicked while sampling: {message}"),
+            })
+        }
+    }
+}
+
+/// The text a panic carries, where it is a string.
+fn panic_message(payload: &(dyn std::any::Any + Send)) -> String {
+    payload
+        .downcast_ref::<&str>()
+        .map(|s| (*s).to_string())
+        .or_else(|| payload.downcast_ref::<String>().cloned())
+        .unwrap_or_else(|| "(no message)".into())
 }

@@ -4,8 +4,9 @@
 
 use image::{Rgba, RgbaImage};
 
+use super::dispatch::MAX_IMAGE_SIDE;
 use super::renderer::Renderer;
-use crate::error::Result;
+use crate::error::{Error, Result};
 use crate::scene::{Stereo, StereoLayout};
 
 impl Renderer {
@@ -15,8 +16,26 @@ impl Renderer {
     ///
     /// # Errors
     /// As [`Stereo::eyes`] and [`Renderer::render`] (each eye's size is
-    /// checked as a frame's).
+    /// checked as a frame's); [`Error::Resolution`] where the laid-out
+    /// picture would pass the largest side.
     pub fn render_stereo(&mut self, width: u32, height: u32, stereo: &Stereo) -> Result<RgbaImage> {
+        let (w, h) = (u64::from(width), u64::from(height));
+        let (pw, ph) = match stereo.layout {
+            StereoLayout::Anaglyph => (w, h),
+            StereoLayout::SideBySide => (2 * w, h),
+            StereoLayout::OverUnder => (w, 2 * h),
+        };
+        if pw.max(ph) > u64::from(MAX_IMAGE_SIDE) {
+            return Err(Error::Resolution {
+                width,
+                height,
+                reason: format!(
+                    "the {} picture of two such eyes is {pw}x{ph}, and each side must be at \
+                     most {MAX_IMAGE_SIDE} pixels",
+                    stereo.layout.name()
+                ),
+            });
+        }
         let centre = *self.camera();
         let eyes = stereo.eyes(&centre)?;
         let mut images = Vec::with_capacity(2);
