@@ -98,6 +98,20 @@ pub enum Error {
         /// What is wrong.
         reason: String,
     },
+    /// A motion of a dynamic parameter ([`Motion`](crate::animation::Motion))
+    /// is invalid: a period that is not a finite number above 0, or a
+    /// value that is not finite.
+    #[error("motion of `{name}`: `{field}` must be {expected}, got {}", fmt_value(*.value))]
+    Motion {
+        /// The dynamic parameter it moves.
+        name: String,
+        /// The field as written: `period`, `center`, `amplitude`, `radius`.
+        field: &'static str,
+        /// The offending value.
+        value: f64,
+        /// What it must be.
+        expected: &'static str,
+    },
     /// Text given to a parser (a key script, a frame range, a size) does
     /// not say what it should.
     #[error("invalid {what}: {reason}")]

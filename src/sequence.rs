@@ -272,7 +272,8 @@ impl Sequence {
     ///
     /// # Errors
     /// [`Error::Invalid`], before anything is rendered, for an index that
-    /// is not a frame of the sequence; then the first render, parameter or
+    /// is not a frame of the sequence, and [`Error::Motion`] for a motion
+    /// that does not validate ([`Motion::validate`]); then the first render, parameter or
     /// file error; the frames saved before it stay on disk.
     pub fn render(
         &self,
@@ -288,6 +289,9 @@ impl Sequence {
                 "frame {index} is not in the sequence (frames 0..{})",
                 self.frames
             )));
+        }
+        for motion in motions {
+            motion.validate()?;
         }
         let base = *renderer.camera();
         for &index in indices {

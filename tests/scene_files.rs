@@ -436,3 +436,38 @@ mod properties {
         }
     }
 }
+
+#[test]
+fn a_motion_period_must_be_a_positive_finite_number() {
+    for period in ["NaN", "inf", "0", "-2", "-0.0"] {
+        for motion in [
+            format!("Oscillate(name: \"power\", center: 8, amplitude: 1, period: {period})"),
+            format!("Orbit(name: \"at\", center: (0, 0, 0), radius: 1, period: {period})"),
+        ] {
+            let text = format!(
+                "(version: 1, geometry: Translate(offset: param3(\"at\", (0, 0, 0)), \
+                 child: Sphere(radius: param(\"power\", 1))),\n motions: [{motion}])"
+            );
+            let err = SceneFile::parse(&text).unwrap_err();
+            let message = err.to_string();
+            assert!(
+                message.contains("`period` must be a finite number of seconds > 0, got"),
+                "{text}: {message}"
+            );
+            assert!(message.starts_with("<scene>:2:"), "{message}");
+            let Error::SceneFile { cause, .. } = &err else {
+                panic!("{err:?}")
+            };
+            assert!(
+                matches!(
+                    cause.as_deref(),
+                    Some(Error::Motion {
+                        field: "period",
+                        ..
+                    })
+                ),
+                "{err:?}"
+            );
+        }
+    }
+}
