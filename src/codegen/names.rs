@@ -40,6 +40,92 @@ pub(crate) fn check_custom(shape: &CustomShape) -> Result<()> {
     Ok(())
 }
 
+/// Why a custom shape's OpenCL body cannot be emitted as given, or `None`:
+/// a NUL or other control character (which the compiler would stop at or
+/// misread), braces that close the shape's function early or leave it
+/// open (code after the early close would stand at file scope, where it
+/// could redefine `DE` or any generated name), or a `#define`/`#undef` of
+/// a name the generated program uses (a macro reaches past the body).
+/// Lines are counted from 1, the body's first line.
+pub(crate) fn body_problem(body: &str) -> Option<String> {
+    let line_of = |offset: usize| body[..offset].matches('\n').count() + 1;
+    if let Some((at, c)) = body
+        .char_indices()
+        .find(|&(_, c)| c.is_control() && !matches!(c, '\t' | '\n' | '\r'))
+    {
+        let what = if c == '\0' {
+            "a NUL byte".to_string()
+        } else {
+            format!("the control character U+{:04X}", u32::from(c))
+        };
+        return Some(format!(
+            "the OpenCL body contains {what} (line {} of the body)",
+            line_of(at)
+        ));
+    }
+    let code = strip_comments(body);
+    let mut depth = 0usize;
+    let mut quote = None;
+    let mut escaped = false;
+    for (at, c) in code.char_indices() {
+        if let Some(q) = quote {
+            if escaped {
+                escaped = false;
+            } else if c == '\\' {
+                escaped = true;
+            } else if c == q {
+                quote = None;
+            }
+            continue;
+        }
+        match c {
+            '"' | '\'' => quote = Some(c),
+            '{' => depth += 1,
+            '}' if depth == 0 => {
+                return Some(format!(
+                    "the OpenCL body closes a brace it did not open (line {} of the body): \
+                     what follows would stand outside the shape's function",
+                    line_of(at)
+                ));
+            }
+            '}' => depth -= 1,
+            _ => {}
+        }
+    }
+    if depth > 0 {
+        return Some(format!(
+            "the OpenCL body leaves {depth} brace(s) open: the shape's function would not end"
+        ));
+    }
+    let mut continued = false;
+    for (i, line) in code.lines().enumerate() {
+        let directive = !continued && line.trim_start().starts_with('#');
+        continued = line.trim_end().ends_with('\\');
+        let Some(rest) = directive.then(|| line.trim_start()[1..].trim_start()) else {
+            continue;
+        };
+        for word in ["define", "undef"] {
+            let Some(after) = rest.strip_prefix(word) else {
+                continue;
+            };
+            let Some((name, _)) = identifiers(after).first().copied() else {
+                continue;
+            };
+            let taken = generated(name).is_some()
+                || name.starts_with("custom_")
+                || name.starts_with("inside_");
+            if taken {
+                return Some(format!(
+                    "the OpenCL body's `#{word} {name}` (line {} of the body) would change \
+                     a name the generated program uses",
+                    i + 1
+                ));
+            }
+        }
+    }
+    None
+}
+
 /// Why the file-scope name `name` (a custom shape's function) would
 /// collide with the generated program, or `None`.
 pub(crate) fn generated(name: &str) -> Option<String> {

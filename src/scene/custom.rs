@@ -217,6 +217,16 @@ impl InsideBounds {
 /// (`radius`, `half_length`) and none of these rules gets in the way. A
 /// refused name is an [`Error::CustomShape`] saying which rule it breaks.
 ///
+/// # Bodies
+///
+/// The body is emitted inside the shape's function, so it is refused
+/// ([`Error::CustomShape`]) before anything is compiled if it could not
+/// stay there or would change the program around it: a NUL byte or
+/// another control character (tabs and line ends are fine), a `}` that
+/// closes the function early (what follows would stand at file scope,
+/// where it could define `DE` or `DE_shade` again) or braces left open,
+/// and a `#define` or `#undef` of a name the generated program uses.
+///
 /// # Build errors
 ///
 /// The body is code you write and is emitted as given. If the OpenCL
@@ -258,7 +268,8 @@ impl CustomShape {
     /// # Errors
     /// [`Error::CustomShape`] if a name is not a valid identifier or is
     /// reserved (see [Names](CustomShape#names)), a parameter name repeats
-    /// or is `p`, or the body is empty.
+    /// or is `p`, or the body is empty or cannot be emitted as given (see
+    /// [Bodies](CustomShape#bodies)).
     pub fn new<F>(name: &str, params: &[(&str, Rule)], cpu: F, opencl_body: &str) -> Result<Self>
     where
         F: Fn(DVec3, &[f64]) -> f64 + Send + Sync + 'static,
@@ -326,6 +337,9 @@ impl CustomShape {
         }
         if opencl_body.trim().is_empty() {
             return Err(bad("the OpenCL body is empty".into()));
+        }
+        if let Some(why) = crate::codegen::names::body_problem(opencl_body) {
+            return Err(bad(why));
         }
         Ok(CustomShape(Arc::new(Inner {
             name: name.into(),
