@@ -183,16 +183,17 @@ impl Camera {
         let Projection::Perspective { fov_y_degrees } = self.projection else {
             return bad("stereo needs a perspective camera".into());
         };
-        if !(separation >= 0.0 && separation.is_finite()) {
-            return bad(format!(
-                "eye separation must be finite and >= 0, got {}",
-                fmt_value(separation)
-            ));
-        }
+        // The convergence first: a default separation is made from it.
         if !(convergence > 0.0 && convergence.is_finite()) {
             return bad(format!(
                 "convergence distance must be finite and > 0, got {}",
                 fmt_value(convergence)
+            ));
+        }
+        if !(separation >= 0.0 && separation.is_finite()) {
+            return bad(format!(
+                "eye separation must be finite and >= 0, got {}",
+                fmt_value(separation)
             ));
         }
         // Half the window's height at unit distance: the shift's unit.
