@@ -36,8 +36,9 @@ pub enum Error {
     /// quotients in the kernel would overflow, underflow or fall below
     /// what the precision resolves.
     #[error(
-        "{node}: `{param}` = {value} cannot be represented safely in {precision} \
+        "{node}: `{param}` = {} cannot be represented safely in {precision} \
          (its magnitude passes the limit {limit:e}); {}",
+        fmt_value(*.value),
         precision_hint(precision)
     )]
     Precision {
@@ -385,6 +386,22 @@ pub type Result<T, E = Error> = std::result::Result<T, E>;
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn precision_errors_print_their_value_short() {
+        let err = Error::Precision {
+            node: "camera".into(),
+            param: "position.z".into(),
+            value: 1e300,
+            precision: "F64",
+            limit: 1e150,
+        };
+        assert_eq!(
+            err.to_string(),
+            "camera: `position.z` = 1e300 cannot be represented safely in F64 (its magnitude \
+             passes the limit 1e150); rescale the scene"
+        );
+    }
 
     #[test]
     fn numbers_in_messages_are_short_and_exact() {
