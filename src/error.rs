@@ -171,6 +171,18 @@ pub enum Error {
         /// What it must be.
         expected: String,
     },
+    /// An effects setting ([`Effects`](crate::quality::Effects)) is out of
+    /// range.
+    #[error("effects setting `{setting}` must be {expected}, got {}", fmt_value(*.value))]
+    Effects {
+        /// The setting's name, as a scene file writes it (`gamma`,
+        /// `glow.strength`).
+        setting: &'static str,
+        /// The offending value.
+        value: f64,
+        /// What it must be.
+        expected: String,
+    },
     /// The renderer's tile side is zero.
     #[error("tile size must be at least 1 pixel, got {value}")]
     TileSize {
