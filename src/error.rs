@@ -198,10 +198,16 @@ pub enum Error {
         max: usize,
     },
     /// No dynamic parameter has this name.
-    #[error("the scene has no dynamic parameter named `{name}`")]
+    #[error(
+        "the scene has no dynamic parameter named `{name}`; {}",
+        known_params(known)
+    )]
     UnknownParam {
         /// The name that was asked for.
         name: String,
+        /// The names the scene's dynamic parameters have (a vector
+        /// parameter's as `name.x`, `name.y`, `name.z`), in order.
+        known: Vec<String>,
     },
     /// One dynamic parameter name is used with different defaults or by
     /// parameters with different rules.
@@ -380,6 +386,16 @@ impl fmt::Display for FmtValue {
         } else {
             write!(f, "{v}")
         }
+    }
+}
+
+/// The list of dynamic parameters an [`Error::UnknownParam`] offers.
+fn known_params(known: &[String]) -> String {
+    if known.is_empty() {
+        "it has none".into()
+    } else {
+        let names: Vec<String> = known.iter().map(|n| format!("`{n}`")).collect();
+        format!("it has {}", names.join(", "))
     }
 }
 

@@ -372,7 +372,9 @@ fn read(text: &str, file: &Path, shapes: &[CustomShape]) -> Result<SceneFile> {
             .map_err(|e| located(motion.site, e))?;
         for (name, value) in extremes(&motion.value) {
             if !compiled.params().slots().iter().any(|s| s.name == name) {
-                return Err(located(motion.site, Error::UnknownParam { name }));
+                let known = compiled.params().slots().iter();
+                let known = known.map(|s| s.name.clone()).collect();
+                return Err(located(motion.site, Error::UnknownParam { name, known }));
             }
             defaults
                 .clone()
