@@ -471,3 +471,42 @@ fn a_motion_period_must_be_a_positive_finite_number() {
         }
     }
 }
+
+#[test]
+fn a_byte_order_mark_is_not_part_of_the_text() {
+    let file = SceneFile::parse("\u{feff}(version: 1, geometry: Sphere(radius: 1))").unwrap();
+    assert_eq!(file.scene.geometry, Some(sphere(1.0)));
+    // Columns are counted as an editor shows them, without the mark.
+    let err = SceneFile::parse("\u{feff}(version: 1, geometry: Sphere(radius: -1))")
+        .unwrap_err()
+        .to_string();
+    assert!(err.starts_with("<scene>:1:24: sphere"), "{err}");
+}
+
+#[test]
+fn a_camera_too_far_away_is_named_as_such() {
+    // Beside a target one unit away, a camera at 1e39 cannot tell the
+    // view's direction: its position is what is wrong.
+    for (position, target, says) in [
+        (
+            "(1e39, 0, 0)",
+            "(1e39, 0, 1)",
+            "position (1e39, 0, 0) is too large",
+        ),
+        (
+            "(0, 0, 1e200)",
+            "(1, 0, 1e200)",
+            "`position.z` = 1e200 cannot be",
+        ),
+    ] {
+        let text = format!(
+            "(version: 1, geometry: Sphere(radius: 1), camera: (position: {position}, target: {target}))"
+        );
+        let err = SceneFile::parse(&text).unwrap_err().to_string();
+        assert!(!err.contains("target equals position"), "{position}: {err}");
+        assert!(err.contains(says), "{position}: {err}");
+    }
+    let text = "(version: 1, geometry: Sphere(radius: 1), camera: (position: (0, 0, 2), target: (0, 0, 2)))";
+    let err = SceneFile::parse(text).unwrap_err().to_string();
+    assert!(err.contains("target equals position"), "{err}");
+}

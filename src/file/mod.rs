@@ -253,6 +253,8 @@ impl From<Scene> for SceneFile {
 
 /// Parses, converts and validates; every error located in `text`.
 fn read(text: &str, file: &Path, shapes: &[CustomShape]) -> Result<SceneFile> {
+    // A byte order mark some editors write is not part of the text.
+    let text = text.strip_prefix('\u{feff}').unwrap_or(text);
     let at = |line: usize, column: usize, reason: String, cause: Option<Error>| Error::SceneFile {
         file: file.to_path_buf(),
         line,

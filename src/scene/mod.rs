@@ -250,8 +250,18 @@ impl Camera {
             within("camera", name, v, Magnitude::Coordinate)?;
         }
         let view = self.target - self.position;
-        if view.length() <= f64::EPSILON * self.position.length().max(1.0) {
+        if view.length() == 0.0 {
             return bad("target equals position");
+        }
+        if view.length() <= f64::EPSILON * self.position.length().max(1.0) {
+            return Err(Error::Camera {
+                reason: format!(
+                    "position {} is too large for a target {} away: at that magnitude the \
+                     view's direction cannot be resolved (move the camera, or rescale the scene)",
+                    fmt_vec(self.position),
+                    fmt_value(view.length())
+                ),
+            });
         }
         let Some(up) = normalize(self.up) else {
             return bad("up is zero");
@@ -307,6 +317,16 @@ impl Camera {
         }
         Ok(())
     }
+}
+
+/// A vector as a message writes it, each component as [`fmt_value`] does.
+fn fmt_vec(v: DVec3) -> String {
+    format!(
+        "({}, {}, {})",
+        fmt_value(v.x),
+        fmt_value(v.y),
+        fmt_value(v.z)
+    )
 }
 
 impl Default for Camera {
