@@ -510,3 +510,37 @@ fn a_camera_too_far_away_is_named_as_such() {
     let err = SceneFile::parse(text).unwrap_err().to_string();
     assert!(err.contains("target equals position"), "{err}");
 }
+
+#[test]
+fn messages_name_the_words_written_not_internal_types() {
+    let node = |geometry: &str| {
+        let text = format!("(version: 1, geometry: {geometry})");
+        SceneFile::parse(&text).unwrap_err().to_string()
+    };
+    for (geometry, says) in [
+        (
+            "Material(material: Glass(ior: 1.5, colour: 1), child: Sphere(radius: 1))",
+            "`Glass(..)` is not a material",
+        ),
+        (
+            "Material(material: (roughness: 0.2, colour: 1), child: Sphere(radius: 1))",
+            "colour",
+        ),
+        (
+            "Mandelbulb(power: 8, iterations: 4.5)",
+            "`iterations` must be a whole number",
+        ),
+        (
+            "Menger(iterations: -3)",
+            "`iterations` must be a whole number",
+        ),
+        (
+            "RepeatLimited(period: 1, limit: (1, 2.5, 1), child: Sphere(radius: 0.2))",
+            "`limit` must be whole numbers",
+        ),
+    ] {
+        let message = node(geometry);
+        assert!(message.contains(says), "{geometry}: {message}");
+        assert!(!message.contains("Repr"), "{geometry}: {message}");
+    }
+}

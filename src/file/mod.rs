@@ -267,6 +267,11 @@ fn read(text: &str, file: &Path, shapes: &[CustomShape]) -> Result<SceneFile> {
             ron::Error::ExceededRecursionLimit => {
                 format!("nodes are nested more than {MAX_NESTING} deep")
             }
+            ron::Error::ExpectedDifferentStructName { expected, found } => format!(
+                "`{found}(..)` is not a {}: write `{expected}(..)`, or just `(..)`, with \
+                 the fields the scene-file reference lists",
+                expected.to_lowercase()
+            ),
             code => code.to_string(),
         };
         at(e.span.start.line, e.span.start.col, reason, None)

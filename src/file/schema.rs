@@ -8,13 +8,14 @@ use crate::quality::{Effects, Precision, Preset, Quality, ScreenNormals};
 use crate::scene::{Axis, Camera, Light, Material, Param, Param3, Scene};
 
 use super::locate::Located;
+use super::values::count;
 
 // ---------------------------------------------------------------------------
 // The file's shape
 
 /// A whole file.
 #[derive(Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
+#[serde(deny_unknown_fields, rename = "Scene")]
 pub(super) struct FileRepr {
     pub(super) version: u32,
     pub(super) geometry: Located<NodeRepr>,
@@ -42,10 +43,14 @@ pub(super) fn default_lights() -> Vec<Located<Light>> {
 
 /// A quality preset and the settings that differ from it.
 #[derive(Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
+#[serde(deny_unknown_fields, rename = "Quality")]
 pub(super) struct QualityRepr {
     preset: Preset,
-    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[serde(
+        default,
+        skip_serializing_if = "Option::is_none",
+        deserialize_with = "count::max_steps"
+    )]
     max_steps: Option<u32>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     detail: Option<f64>,
@@ -55,25 +60,53 @@ pub(super) struct QualityRepr {
     max_distance: Option<f64>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     normal_epsilon: Option<f64>,
-    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[serde(
+        default,
+        skip_serializing_if = "Option::is_none",
+        deserialize_with = "count::ao_samples"
+    )]
     ao_samples: Option<u32>,
-    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[serde(
+        default,
+        skip_serializing_if = "Option::is_none",
+        deserialize_with = "count::shadow_steps"
+    )]
     shadow_steps: Option<u32>,
-    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[serde(
+        default,
+        skip_serializing_if = "Option::is_none",
+        deserialize_with = "count::fractal_iterations"
+    )]
     fractal_iterations: Option<u32>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     precision: Option<Precision>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     over_relaxation: Option<f64>,
-    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[serde(
+        default,
+        skip_serializing_if = "Option::is_none",
+        deserialize_with = "count::supersampling"
+    )]
     supersampling: Option<u32>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     fast_math: Option<bool>,
-    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[serde(
+        default,
+        skip_serializing_if = "Option::is_none",
+        deserialize_with = "count::resolution_scale"
+    )]
     resolution_scale: Option<u32>,
-    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[serde(
+        default,
+        skip_serializing_if = "Option::is_none",
+        deserialize_with = "count::cone_tile"
+    )]
     cone_tile: Option<u32>,
-    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[serde(
+        default,
+        skip_serializing_if = "Option::is_none",
+        deserialize_with = "count::bounces"
+    )]
     bounces: Option<u32>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     brute_step: Option<f64>,
@@ -197,7 +230,7 @@ pub(super) fn zero() -> Param {
 /// A material as written in a file: only the values that differ from
 /// [`Material::default`] need be named.
 #[derive(Serialize, Deserialize, Default)]
-#[serde(default, deny_unknown_fields)]
+#[serde(default, deny_unknown_fields, rename = "Material")]
 pub(super) struct MaterialRepr {
     #[serde(skip_serializing_if = "Option::is_none")]
     roughness: Option<Param>,
@@ -258,7 +291,7 @@ impl MaterialRepr {
 
 /// A node as written in a file.
 #[derive(Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
+#[serde(deny_unknown_fields, rename = "Node")]
 pub(super) enum NodeRepr {
     Sphere {
         radius: Param,
@@ -300,19 +333,20 @@ pub(super) enum NodeRepr {
     },
     Mandelbulb {
         power: Param,
-        #[serde(default = "twelve")]
+        #[serde(default = "twelve", deserialize_with = "count::iterations")]
         iterations: u32,
         #[serde(default = "two")]
         bailout: Param,
     },
     Menger {
+        #[serde(deserialize_with = "count::iterations")]
         iterations: u32,
         #[serde(default = "three")]
         scale: Param,
     },
     Julia {
         c: [Param; 4],
-        #[serde(default = "twelve")]
+        #[serde(default = "twelve", deserialize_with = "count::iterations")]
         iterations: u32,
         #[serde(default = "four")]
         bailout: Param,
@@ -320,6 +354,7 @@ pub(super) enum NodeRepr {
         slice_w: Param,
     },
     Sierpinski {
+        #[serde(deserialize_with = "count::iterations")]
         iterations: u32,
         #[serde(default = "two")]
         scale: Param,
@@ -359,6 +394,7 @@ pub(super) enum NodeRepr {
     },
     RepeatLimited {
         period: Param3,
+        #[serde(deserialize_with = "count::limit")]
         limit: [u32; 3],
         child: Child,
     },

@@ -7,6 +7,7 @@ use serde::de::{self, Deserializer, MapAccess, SeqAccess, Visitor};
 use serde::ser::{SerializeTupleVariant, Serializer};
 use serde::{Deserialize, Serialize};
 
+use crate::error::fmt_value;
 use crate::scene::{Param, Param3, param3};
 
 // ---------------------------------------------------------------------------
@@ -178,5 +179,119 @@ impl<'de> Visitor<'de> for Param3Visitor {
 impl<'de> Deserialize<'de> for Param3 {
     fn deserialize<D: Deserializer<'de>>(d: D) -> std::result::Result<Self, D::Error> {
         d.deserialize_any(Param3Visitor)
+    }
+}
+
+// ---------------------------------------------------------------------------
+// Counts: whole numbers, read from any number so that `iterations: 4.5`
+// says what is wrong with it rather than failing on the `.5`.
+
+/// A number as written, before it is known to be whole.
+struct Number(f64);
+
+struct NumberVisitor;
+
+impl Visitor<'_> for NumberVisitor {
+    type Value = Number;
+
+    fn expecting(&self, f: &mut fmt::Formatter) -> fmt::Result {
+        f.write_str("a whole number")
+    }
+
+    fn visit_f64<E>(self, v: f64) -> std::result::Result<Number, E> {
+        Ok(Number(v))
+    }
+
+    #[allow(clippy::cast_precision_loss)] // Only compared with u32's range.
+    fn visit_i64<E>(self, v: i64) -> std::result::Result<Number, E> {
+        Ok(Number(v as f64))
+    }
+
+    #[allow(clippy::cast_precision_loss)]
+    fn visit_u64<E>(self, v: u64) -> std::result::Result<Number, E> {
+        Ok(Number(v as f64))
+    }
+}
+
+impl<'de> Deserialize<'de> for Number {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> std::result::Result<Self, D::Error> {
+        d.deserialize_any(NumberVisitor)
+    }
+}
+
+/// `value` as a count, or the message naming `field`.
+fn whole(field: &str, value: f64) -> std::result::Result<u32, String> {
+    if value.fract() == 0.0 && (0.0..=f64::from(u32::MAX)).contains(&value) {
+        // Whole and in range: the conversion is exact.
+        #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss)]
+        return Ok(value as u32);
+    }
+    Err(format!(
+        "`{field}` must be a whole number from 0 to {}, got {}",
+        u32::MAX,
+        fmt_value(value)
+    ))
+}
+
+/// Readers of the counts of a file, one per field so that each error
+/// names its field (serde's `deserialize_with` takes a function).
+pub(super) mod count {
+    use serde::Deserialize;
+    use serde::de::{self, Deserializer};
+
+    use super::{Number, whole};
+
+    macro_rules! counts {
+        ($($field:ident),*) => {$(
+            /// The field's count.
+            pub(in crate::file) fn $field<'de, D: Deserializer<'de>>(
+                d: D,
+            ) -> Result<u32, D::Error> {
+                let Number(v) = Number::deserialize(d)?;
+                whole(stringify!($field), v).map_err(de::Error::custom)
+            }
+        )*};
+    }
+
+    macro_rules! optional_counts {
+        ($($name:ident => $field:literal),*) => {$(
+            /// The field's count, where the file gives one.
+            pub(in crate::file) fn $name<'de, D: Deserializer<'de>>(
+                d: D,
+            ) -> Result<Option<u32>, D::Error> {
+                match Option::<Number>::deserialize(d)? {
+                    Some(Number(v)) => whole($field, v).map(Some).map_err(de::Error::custom),
+                    None => Ok(None),
+                }
+            }
+        )*};
+    }
+
+    counts!(iterations);
+    optional_counts!(
+        max_steps => "max_steps",
+        ao_samples => "ao_samples",
+        shadow_steps => "shadow_steps",
+        fractal_iterations => "fractal_iterations",
+        supersampling => "supersampling",
+        resolution_scale => "resolution_scale",
+        cone_tile => "cone_tile",
+        bounces => "bounces"
+    );
+
+    /// A limited repetition's `limit`: three counts.
+    pub(in crate::file) fn limit<'de, D: Deserializer<'de>>(d: D) -> Result<[u32; 3], D::Error> {
+        let [x, y, z] = <[Number; 3]>::deserialize(d)?;
+        let mut out = [0; 3];
+        for (slot, Number(v)) in out.iter_mut().zip([x, y, z]) {
+            *slot = whole("limit", v).map_err(|_| {
+                de::Error::custom(format!(
+                    "`limit` must be whole numbers from 0 to {}, got {}",
+                    u32::MAX,
+                    crate::error::fmt_value(v)
+                ))
+            })?;
+        }
+        Ok(out)
     }
 }
