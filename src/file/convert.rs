@@ -201,6 +201,16 @@ impl NodeRepr {
                 a,
                 b,
             } => {
+                // A cut by a plane is written as `Node::cut_plane` makes it.
+                if let (CsgOp::Cut, None, Kind::Plane { normal, offset }) =
+                    (op, &smoothing, b.kind())
+                {
+                    return NodeRepr::CutPlane {
+                        normal: normal.clone(),
+                        offset: offset.clone(),
+                        child: child(&a),
+                    };
+                }
                 let (a, b) = (child(&a), child(&b));
                 match (op, smoothing) {
                     (CsgOp::Union, None) => NodeRepr::Union(vec![*a, *b]),
@@ -449,6 +459,18 @@ impl Located<NodeRepr> {
                 csg(CsgOp::Intersect, Some(k), child(a)?, child(b)?)
             }
             NodeRepr::Cut { a, b } => csg(CsgOp::Cut, None, child(a)?, child(b)?),
+            NodeRepr::CutPlane {
+                normal,
+                offset,
+                child: c,
+            } => {
+                let node = child(c)?.cut_plane(normal.clone(), offset.clone());
+                // The plane stands where the cut is written.
+                if let Some(plane) = node.kind().children().get(1) {
+                    sites.insert(plane, site);
+                }
+                node
+            }
             NodeRepr::SmoothCut { k, a, b } => csg(CsgOp::Cut, Some(k), child(a)?, child(b)?),
             NodeRepr::Custom { name, args } => {
                 // Shapes given first, then the built-in inside shapes.

@@ -101,6 +101,7 @@ pub(super) const NAMES: &[&str] = &[
     "SmoothSubtract",
     "SmoothIntersect",
     "Cut",
+    "CutPlane",
     "SmoothCut",
     "Custom",
     "param",

@@ -442,6 +442,11 @@ pub(super) enum NodeRepr {
         a: Child,
         b: Child,
     },
+    CutPlane {
+        normal: Param3,
+        offset: Param,
+        child: Child,
+    },
     SmoothCut {
         k: Param,
         a: Child,
