@@ -23,6 +23,13 @@
 //! )
 //! ```
 //!
+//! The [reference](mod@reference) lists every node, field, unit and default: shapes,
+//! fractals, operations, booleans, cut planes (`CutPlane(normal: ..,
+//! offset: .., child: ..)`), materials, the camera, lights, quality,
+//! effects, camera paths and motions. **Angles are in radians** (the
+//! camera's `fov_y_degrees` says its own unit), as in the Rust API and
+//! for dynamic parameters.
+//!
 //! - **Nodes** are written as in Rust's [`Kind`](crate::scene::Kind), with
 //!   the booleans named: `Union([a, b, ...])` (any number of operands, what
 //!   [`Scene::add`] builds), `Subtract(a: .., b: ..)`, `Intersect(a: ..,
@@ -70,6 +77,7 @@ use serde::Deserialize;
 mod convert;
 mod layout;
 mod locate;
+pub mod reference;
 mod schema;
 mod values;
 
