@@ -553,7 +553,9 @@ fn a_cut_plane_is_a_node_of_its_own() {
     let expected = sphere(1.0).cut_plane(dvec3(1.0, 0.0, 0.0), param("cut", 0.0));
     assert_eq!(file.scene.geometry, Some(expected.clone()));
     // Written back as a cut plane, and read back equal.
-    let written = SceneFile::new(Scene::new(expected.clone())).to_text().unwrap();
+    let written = SceneFile::new(Scene::new(expected.clone()))
+        .to_text()
+        .unwrap();
     assert!(written.contains("CutPlane("), "{written}");
     assert_eq!(
         SceneFile::parse(&written).unwrap().scene.geometry,
@@ -564,9 +566,11 @@ fn a_cut_plane_is_a_node_of_its_own() {
                  offset: param(\"cut\", 0))))";
     assert_eq!(SceneFile::parse(older).unwrap(), file);
     // A zero normal is blamed on the cut plane as written.
-    let err = SceneFile::parse("(version: 1,\n geometry: CutPlane(normal: 0, offset: 0, child: Sphere(radius: 1)))")
-        .unwrap_err()
-        .to_string();
+    let err = SceneFile::parse(
+        "(version: 1,\n geometry: CutPlane(normal: 0, offset: 0, child: Sphere(radius: 1)))",
+    )
+    .unwrap_err()
+    .to_string();
     assert!(err.starts_with("<scene>:2:12:"), "{err}");
     assert!(err.contains("`normal`"), "{err}");
 }
