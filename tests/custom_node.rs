@@ -291,6 +291,20 @@ fn custom_bodies_that_would_leave_their_function_are_refused_before_compiling() 
             "if (p.x > R(0.0)) {\n    return R(1.0);",
             "leaves 1 brace(s) open",
         ),
+    ];
+    for (body, says) in refused {
+        match define(body) {
+            Err(err @ Error::CustomShape { .. }) => {
+                let text = err.to_string();
+                assert!(text.starts_with("custom shape `blob`: "), "{text}");
+                assert!(text.contains(says), "{body:?}: {text}");
+            }
+            other => panic!("{body:?} was not refused: {other:?}"),
+        }
+    }
+    // A macro of a generated name is refused by code generation, before
+    // anything is compiled.
+    let directives = [
         (
             "#define DE broken\nreturn length(p) - R(1.0);",
             "`#define DE` (line 1 of the body)",
@@ -304,14 +318,15 @@ fn custom_bodies_that_would_leave_their_function_are_refused_before_compiling() 
             "`#define custom_other`",
         ),
     ];
-    for (body, says) in refused {
-        match define(body) {
+    for (body, says) in directives {
+        let shape = define(body).unwrap();
+        let compiled = Scene::new(shape.node(Vec::<f64>::new())).compile().unwrap();
+        match codegen::emit(&compiled, &Options::default()) {
             Err(err @ Error::CustomShape { .. }) => {
                 let text = err.to_string();
-                assert!(text.starts_with("custom shape `blob`: "), "{text}");
                 assert!(text.contains(says), "{body:?}: {text}");
             }
-            other => panic!("{body:?} was not refused: {other:?}"),
+            other => panic!("{body:?} was not refused: {:?}", other.err()),
         }
     }
     // Braces in blocks, comments and character literals, and macros of

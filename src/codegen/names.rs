@@ -12,6 +12,7 @@ use super::{Options, Target, header, helpers::Helper, power, writer::Writer};
 use crate::error::{Error, Result};
 use crate::quality::{Effects, Glow, Precision, Quality};
 use crate::scene::CustomShape;
+use crate::scene::names::strip_comments;
 
 /// Why `name` cannot be a custom shape's parameter: rules 1 to 4 (see
 /// `scene::names`) or a name the generated program gives a meaning.
@@ -37,66 +38,18 @@ pub(crate) fn check_custom(shape: &CustomShape) -> Result<()> {
             return Err(bad(format!("parameter `{param}` {why}")));
         }
     }
+    if let Some(why) = body_directive_problem(shape.opencl_body()) {
+        return Err(bad(why));
+    }
     Ok(())
 }
 
-/// Why a custom shape's OpenCL body cannot be emitted as given, or `None`:
-/// a NUL or other control character (which the compiler would stop at or
-/// misread), braces that close the shape's function early or leave it
-/// open (code after the early close would stand at file scope, where it
-/// could redefine `DE` or any generated name), or a `#define`/`#undef` of
-/// a name the generated program uses (a macro reaches past the body).
-/// Lines are counted from 1, the body's first line.
-pub(crate) fn body_problem(body: &str) -> Option<String> {
-    let line_of = |offset: usize| body[..offset].matches('\n').count() + 1;
-    if let Some((at, c)) = body
-        .char_indices()
-        .find(|&(_, c)| c.is_control() && !matches!(c, '\t' | '\n' | '\r'))
-    {
-        let what = if c == '\0' {
-            "a NUL byte".to_string()
-        } else {
-            format!("the control character U+{:04X}", u32::from(c))
-        };
-        return Some(format!(
-            "the OpenCL body contains {what} (line {} of the body)",
-            line_of(at)
-        ));
-    }
+/// Why a custom shape's OpenCL body would change the program around it,
+/// or `None`: a `#define` or `#undef` of a name the generated program
+/// uses (a macro reaches past the body). Lines are counted from 1, the
+/// body's first line.
+pub(crate) fn body_directive_problem(body: &str) -> Option<String> {
     let code = strip_comments(body);
-    let mut depth = 0usize;
-    let mut quote = None;
-    let mut escaped = false;
-    for (at, c) in code.char_indices() {
-        if let Some(q) = quote {
-            if escaped {
-                escaped = false;
-            } else if c == '\\' {
-                escaped = true;
-            } else if c == q {
-                quote = None;
-            }
-            continue;
-        }
-        match c {
-            '"' | '\'' => quote = Some(c),
-            '{' => depth += 1,
-            '}' if depth == 0 => {
-                return Some(format!(
-                    "the OpenCL body closes a brace it did not open (line {} of the body): \
-                     what follows would stand outside the shape's function",
-                    line_of(at)
-                ));
-            }
-            '}' => depth -= 1,
-            _ => {}
-        }
-    }
-    if depth > 0 {
-        return Some(format!(
-            "the OpenCL body leaves {depth} brace(s) open: the shape's function would not end"
-        ));
-    }
     let mut continued = false;
     for (i, line) in code.lines().enumerate() {
         let directive = !continued && line.trim_start().starts_with('#');
@@ -278,29 +231,6 @@ fn identifiers(text: &str) -> Vec<(&str, usize)> {
             }
         } else {
             i += 1;
-        }
-    }
-    out
-}
-
-/// `source` with its `/* */` and `//` comments blanked (newlines kept, so
-/// lines keep their numbers).
-fn strip_comments(source: &str) -> String {
-    let mut out = String::with_capacity(source.len());
-    let mut rest = source;
-    while !rest.is_empty() {
-        if let Some(after) = rest.strip_prefix("/*") {
-            let end = after.find("*/").map_or(after.len(), |e| e + 2);
-            out.extend(after[..end].chars().filter(|&c| c == '\n'));
-            out.push(' ');
-            rest = &after[end..];
-        } else if let Some(after) = rest.strip_prefix("//") {
-            let end = after.find('\n').unwrap_or(after.len());
-            rest = &after[end..];
-        } else {
-            let c = rest.chars().next().expect("not empty");
-            out.push(c);
-            rest = &rest[c.len_utf8()..];
         }
     }
     out
