@@ -316,6 +316,79 @@ pub enum Motion {
 }
 
 impl Motion {
+    /// The dynamic parameter (or vector parameter) it moves.
+    #[must_use]
+    pub fn name(&self) -> &str {
+        match self {
+            Motion::Oscillate { name, .. } | Motion::Orbit { name, .. } => name,
+        }
+    }
+
+    /// Checks the motion: a period that is a finite number above 0, and
+    /// finite values.
+    ///
+    /// ```
+    /// use fractal_sdf::animation::Motion;
+    /// let still = Motion::Oscillate {
+    ///     name: "power".into(),
+    ///     center: 8.0,
+    ///     amplitude: 2.0,
+    ///     period: f64::NAN,
+    /// };
+    /// let err = still.validate().unwrap_err();
+    /// assert_eq!(
+    ///     err.to_string(),
+    ///     "motion of `power`: `period` must be a finite number of seconds > 0, got NaN"
+    /// );
+    /// ```
+    ///
+    /// # Errors
+    /// [`Error::Motion`] naming the first field that is wrong.
+    pub fn validate(&self) -> Result<()> {
+        let (fields, period) = match self {
+            Motion::Oscillate {
+                center,
+                amplitude,
+                period,
+                ..
+            } => (
+                vec![("center", *center), ("amplitude", *amplitude)],
+                *period,
+            ),
+            Motion::Orbit {
+                center,
+                radius,
+                period,
+                ..
+            } => (
+                vec![
+                    ("center", center.x),
+                    ("center", center.y),
+                    ("center", center.z),
+                    ("radius", *radius),
+                ],
+                *period,
+            ),
+        };
+        let bad = |field, value, expected| {
+            Err(Error::Motion {
+                name: self.name().to_string(),
+                field,
+                value,
+                expected,
+            })
+        };
+        if !(period > 0.0 && period.is_finite()) {
+            return bad("period", period, "a finite number of seconds > 0");
+        }
+        for (field, value) in fields {
+            if !value.is_finite() {
+                return bad(field, value, "finite");
+            }
+        }
+        Ok(())
+    }
+
     /// The parameter values at `time` seconds, as `(slot name, value)`. A
     /// period that is not positive stands still at the start.
     #[must_use]

@@ -36,8 +36,9 @@ pub enum Error {
     /// quotients in the kernel would overflow, underflow or fall below
     /// what the precision resolves.
     #[error(
-        "{node}: `{param}` = {value} cannot be represented safely in {precision} \
+        "{node}: `{param}` = {} cannot be represented safely in {precision} \
          (its magnitude passes the limit {limit:e}); {}",
+        fmt_value(*.value),
         precision_hint(precision)
     )]
     Precision {
@@ -98,6 +99,20 @@ pub enum Error {
         /// What is wrong.
         reason: String,
     },
+    /// A motion of a dynamic parameter ([`Motion`](crate::animation::Motion))
+    /// is invalid: a period that is not a finite number above 0, or a
+    /// value that is not finite.
+    #[error("motion of `{name}`: `{field}` must be {expected}, got {}", fmt_value(*.value))]
+    Motion {
+        /// The dynamic parameter it moves.
+        name: String,
+        /// The field as written: `period`, `center`, `amplitude`, `radius`.
+        field: &'static str,
+        /// The offending value.
+        value: f64,
+        /// What it must be.
+        expected: &'static str,
+    },
     /// Text given to a parser (a key script, a frame range, a size) does
     /// not say what it should.
     #[error("invalid {what}: {reason}")]
@@ -156,6 +171,18 @@ pub enum Error {
         /// What it must be.
         expected: String,
     },
+    /// An effects setting ([`Effects`](crate::quality::Effects)) is out of
+    /// range.
+    #[error("effects setting `{setting}` must be {expected}, got {}", fmt_value(*.value))]
+    Effects {
+        /// The setting's name, as a scene file writes it (`gamma`,
+        /// `glow.strength`).
+        setting: &'static str,
+        /// The offending value.
+        value: f64,
+        /// What it must be.
+        expected: String,
+    },
     /// The renderer's tile side is zero.
     #[error("tile size must be at least 1 pixel, got {value}")]
     TileSize {
@@ -171,10 +198,16 @@ pub enum Error {
         max: usize,
     },
     /// No dynamic parameter has this name.
-    #[error("the scene has no dynamic parameter named `{name}`")]
+    #[error(
+        "the scene has no dynamic parameter named `{name}`; {}",
+        known_params(known)
+    )]
     UnknownParam {
         /// The name that was asked for.
         name: String,
+        /// The names the scene's dynamic parameters have (a vector
+        /// parameter's as `name.x`, `name.y`, `name.z`), in order.
+        known: Vec<String>,
     },
     /// One dynamic parameter name is used with different defaults or by
     /// parameters with different rules.
@@ -356,6 +389,16 @@ impl fmt::Display for FmtValue {
     }
 }
 
+/// The list of dynamic parameters an [`Error::UnknownParam`] offers.
+fn known_params(known: &[String]) -> String {
+    if known.is_empty() {
+        "it has none".into()
+    } else {
+        let names: Vec<String> = known.iter().map(|n| format!("`{n}`")).collect();
+        format!("it has {}", names.join(", "))
+    }
+}
+
 /// What an [`Error::Precision`] suggests.
 fn precision_hint(precision: &str) -> &'static str {
     if precision == "F32" {
@@ -371,6 +414,22 @@ pub type Result<T, E = Error> = std::result::Result<T, E>;
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn precision_errors_print_their_value_short() {
+        let err = Error::Precision {
+            node: "camera".into(),
+            param: "position.z".into(),
+            value: 1e300,
+            precision: "F64",
+            limit: 1e150,
+        };
+        assert_eq!(
+            err.to_string(),
+            "camera: `position.z` = 1e300 cannot be represented safely in F64 (its magnitude \
+             passes the limit 1e150); rescale the scene"
+        );
+    }
 
     #[test]
     fn numbers_in_messages_are_short_and_exact() {

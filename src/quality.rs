@@ -704,7 +704,7 @@ impl Effects {
     /// [`Precision::limits`].
     ///
     /// # Errors
-    /// [`Error::Quality`] naming the first setting outside its own range;
+    /// [`Error::Effects`] naming the first setting outside its own range;
     /// [`Error::Precision`] for one the precision cannot compute with.
     pub fn validate_for(&self, precision: Precision) -> Result<()> {
         self.check_ranges()?;
@@ -730,7 +730,7 @@ impl Effects {
 
     /// Each value's own range.
     fn check_ranges(&self) -> Result<()> {
-        let bad = |setting: &'static str, value: f64, expected: &str| Error::Quality {
+        let bad = |setting: &'static str, value: f64, expected: &str| Error::Effects {
             setting,
             value,
             expected: expected.into(),
@@ -984,12 +984,21 @@ mod tests {
             ao_distance: 0.0,
             ..Effects::default()
         };
-        assert!(matches!(
-            e.validate(),
-            Err(Error::Quality {
-                setting: "ao_distance",
-                ..
-            })
-        ));
+        let err = e.validate().unwrap_err();
+        assert!(
+            matches!(
+                err,
+                Error::Effects {
+                    setting: "ao_distance",
+                    ..
+                }
+            ),
+            "{err:?}"
+        );
+        // Effects are not part of the quality: their errors say so.
+        assert_eq!(
+            err.to_string(),
+            "effects setting `ao_distance` must be finite and > 0, got 0"
+        );
     }
 }

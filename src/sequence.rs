@@ -272,7 +272,8 @@ impl Sequence {
     ///
     /// # Errors
     /// [`Error::Invalid`], before anything is rendered, for an index that
-    /// is not a frame of the sequence; then the first render, parameter or
+    /// is not a frame of the sequence, and [`Error::Motion`] for a motion
+    /// that does not validate ([`Motion::validate`]); then the first render, parameter or
     /// file error; the frames saved before it stay on disk.
     pub fn render(
         &self,
@@ -288,6 +289,9 @@ impl Sequence {
                 "frame {index} is not in the sequence (frames 0..{})",
                 self.frames
             )));
+        }
+        for motion in motions {
+            motion.validate()?;
         }
         let base = *renderer.camera();
         for &index in indices {
@@ -342,24 +346,31 @@ pub fn parse_range(text: &str, total: u32) -> Result<Range<u32>> {
             .map_err(|_| bad(format!("`{text}`: `{s}` is not a frame number")))
     };
     let text = text.trim();
-    let range = if let Some((a, b)) = text.split_once("..=") {
+    // Ends are counted in u64, so that `..=4294967295` ends one past the
+    // largest u32 rather than being cut back to it.
+    let (start, end) = if let Some((a, b)) = text.split_once("..=") {
         let end = number(b)?.ok_or_else(|| bad(format!("`{text}`: `..=` needs an end")))?;
-        number(a)?.unwrap_or(0)..end.saturating_add(1)
+        (number(a)?.unwrap_or(0), u64::from(end) + 1)
     } else if let Some((a, b)) = text.split_once("..") {
-        number(a)?.unwrap_or(0)..number(b)?.unwrap_or(total)
+        (
+            number(a)?.unwrap_or(0),
+            u64::from(number(b)?.unwrap_or(total)),
+        )
     } else {
         let n = number(text)?.ok_or_else(|| bad("the range is empty".into()))?;
-        n..n.saturating_add(1)
+        (n, u64::from(n) + 1)
     };
-    if range.is_empty() {
+    if u64::from(start) >= end {
         return Err(bad(format!("`{text}` contains no frame")));
     }
-    if range.end > total {
+    if end > u64::from(total) {
         return Err(bad(format!(
             "`{text}` reaches past the last frame ({} of frames 0..{total})",
-            range.end - 1
+            end - 1
         )));
     }
+    // `end` is at most `total` here.
+    let range = start..u32::try_from(end).unwrap_or(total);
     Ok(range)
 }
 
@@ -375,6 +386,25 @@ mod tests {
         let mut names: Vec<String> = [10, 2, 100, 1].map(frame_name).to_vec();
         names.sort();
         assert_eq!(names, [1, 2, 10, 100].map(frame_name));
+    }
+
+    #[test]
+    fn a_range_to_the_largest_frame_number_keeps_its_end() {
+        // `..=u32::MAX` ends past any sequence's last frame (frames are
+        // numbered below u32::MAX): refused, never cut back to fit.
+        for text in ["0..=4294967295", "4294967295", "4294967294..=4294967295"] {
+            let err = parse_range(text, u32::MAX).unwrap_err().to_string();
+            assert!(
+                err.contains("(4294967295 of frames 0..4294967295)"),
+                "{text}: {err}"
+            );
+        }
+        assert_eq!(parse_range("..=4294967294", u32::MAX).unwrap(), 0..u32::MAX);
+        assert_eq!(
+            parse_range("4294967294", u32::MAX).unwrap(),
+            4294967294..u32::MAX
+        );
+        assert_eq!(parse_range("5..", u32::MAX).unwrap(), 5..u32::MAX);
     }
 
     #[test]

@@ -359,7 +359,7 @@ fn bad_input_is_a_clear_error_and_a_nonzero_exit() {
     std::fs::write(&bad, "(version: 1,\n  geometry: Sphere(radius: -2))").unwrap();
     let png = dir.join("x.png");
     let o = png.to_str().unwrap();
-    let cases: [(&[&str], &str, i32, &str); 9] = [
+    let cases: [(&[&str], &str, i32, &str); 10] = [
         (
             &["render", bad.to_str().unwrap(), "-o", o],
             "",
@@ -389,6 +389,12 @@ fn bad_input_is_a_clear_error_and_a_nonzero_exit() {
             "",
             2,
             "expected NAME=VALUE",
+        ),
+        (
+            &["render", "benchmark", "-o", o, "--set", "orbit=1"],
+            "",
+            1,
+            "no dynamic parameter named `orbit`; it has `orbit.x`, `orbit.y`, `orbit.z`",
         ),
         (
             &["render", "csg", "-o", o],

@@ -271,6 +271,76 @@ fn custom_shape_definitions_are_checked() {
     ));
 }
 
+#[test]
+fn custom_bodies_that_would_leave_their_function_are_refused_before_compiling() {
+    let define = |body: &str| CustomShape::new("blob", &[], |p, _| p.length() - 1.0, body);
+    let refused = [
+        (
+            "return length(p)\0 - R(1.0);",
+            "a NUL byte (line 1 of the body)",
+        ),
+        (
+            "return length(p) - R(1.0);\u{7}",
+            "control character U+0007",
+        ),
+        (
+            "return length(p) - R(1.0);\n}\nreal DE(real3 p) {\n    return R(0.0);",
+            "closes a brace it did not open (line 2 of the body)",
+        ),
+        (
+            "if (p.x > R(0.0)) {\n    return R(1.0);",
+            "leaves 1 brace(s) open",
+        ),
+    ];
+    for (body, says) in refused {
+        match define(body) {
+            Err(err @ Error::CustomShape { .. }) => {
+                let text = err.to_string();
+                assert!(text.starts_with("custom shape `blob`: "), "{text}");
+                assert!(text.contains(says), "{body:?}: {text}");
+            }
+            other => panic!("{body:?} was not refused: {other:?}"),
+        }
+    }
+    // A macro of a generated name is refused by code generation, before
+    // anything is compiled.
+    let directives = [
+        (
+            "#define DE broken\nreturn length(p) - R(1.0);",
+            "`#define DE` (line 1 of the body)",
+        ),
+        (
+            "  # undef DE_shade\nreturn length(p) - R(1.0);",
+            "`#undef DE_shade`",
+        ),
+        (
+            "#define custom_other 1\nreturn R(0.0);",
+            "`#define custom_other`",
+        ),
+    ];
+    for (body, says) in directives {
+        let shape = define(body).unwrap();
+        let compiled = Scene::new(shape.node(Vec::<f64>::new())).compile().unwrap();
+        match codegen::emit(&compiled, &Options::default()) {
+            Err(err @ Error::CustomShape { .. }) => {
+                let text = err.to_string();
+                assert!(text.contains(says), "{body:?}: {text}");
+            }
+            other => panic!("{body:?} was not refused: {:?}", other.err()),
+        }
+    }
+    // Braces in blocks, comments and character literals, and macros of
+    // the body's own, are fine.
+    for body in [
+        "{\n    real r = length(p); // }\n    return r - R(1.0);\n}",
+        "/* } */ return length(p) - R(1.0);",
+        "#define RADIUS_OF_BLOB R(1.0)\nreturn length(p) - RADIUS_OF_BLOB;",
+        "\treturn length(p) - R(1.0);\r\n",
+    ] {
+        assert!(define(body).is_ok(), "{body:?}: {:?}", define(body).err());
+    }
+}
+
 /// The reason a parameter name is refused, if it is.
 /// Why a shape with parameter `param` is refused: by `CustomShape::new`
 /// (OpenCL's words, reserved spellings), or when a program using it is

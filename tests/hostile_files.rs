@@ -10,6 +10,7 @@ use std::fs::{self, File};
 use std::path::{Path, PathBuf};
 use std::time::{Duration, SystemTime};
 
+use fractal_sdf::SceneFile;
 use fractal_sdf::animation::{CameraPath, Keyframe};
 use fractal_sdf::error::fmt_value;
 use fractal_sdf::image::{self, Rgba, RgbaImage};
@@ -488,4 +489,225 @@ fn sequence_errors_blame_the_right_argument() {
     assert!(text(f64::INFINITY, 1.0).contains("frame rate"));
     assert!(text(24.0, f64::INFINITY).contains("duration"));
     assert!(text(24.0, 0.0).contains("duration"));
+}
+
+// ---------------------------------------------------------- scene files
+
+/// Every field of every node, each given a value `@`.
+const NODE_FIELDS: &[(&str, &str)] = &[
+    ("Sphere(radius: @)", "radius"),
+    ("Cuboid(half_extents: @)", "half_extents"),
+    ("RoundBox(half_extents: 1, radius: @)", "radius"),
+    ("Torus(major_radius: @, minor_radius: 0.2)", "major_radius"),
+    ("Torus(major_radius: 1, minor_radius: @)", "minor_radius"),
+    ("Cylinder(radius: @, half_height: 1)", "radius"),
+    ("Cylinder(radius: 1, half_height: @)", "half_height"),
+    ("Capsule(a: @, b: (0, 1, 0), radius: 0.2)", "a"),
+    ("Capsule(a: 0, b: (0, 1, 0), radius: @)", "radius"),
+    ("Plane(normal: @, offset: 0)", "normal"),
+    ("Plane(normal: (0, 1, 0), offset: @)", "offset"),
+    ("Octahedron(size: @)", "size"),
+    (
+        "CappedCone(half_height: @, bottom_radius: 1, top_radius: 0.5)",
+        "half_height",
+    ),
+    (
+        "CappedCone(half_height: 1, bottom_radius: @, top_radius: 0.5)",
+        "bottom_radius",
+    ),
+    (
+        "CappedCone(half_height: 1, bottom_radius: 1, top_radius: @)",
+        "top_radius",
+    ),
+    ("Ellipsoid(radii: @)", "radii"),
+    ("Mandelbulb(power: @)", "power"),
+    ("Mandelbulb(power: 8, iterations: @)", "iterations"),
+    ("Mandelbulb(power: 8, bailout: @)", "bailout"),
+    ("Menger(iterations: @)", "iterations"),
+    ("Menger(iterations: 3, scale: @)", "scale"),
+    ("Julia(c: (@, 0, 0, 0))", "c"),
+    ("Julia(c: (0, 0, 0, 0), iterations: @)", "iterations"),
+    ("Julia(c: (0, 0, 0, 0), bailout: @)", "bailout"),
+    ("Julia(c: (0, 0, 0, 0), slice_w: @)", "slice_w"),
+    ("Sierpinski(iterations: @)", "iterations"),
+    ("Sierpinski(iterations: 3, scale: @)", "scale"),
+    ("Translate(offset: @, child: Sphere(radius: 1))", "offset"),
+    (
+        "Rotate(axis: (0, 1, 0), angle: @, child: Sphere(radius: 1))",
+        "angle",
+    ),
+    (
+        "Rotate(axis: (@, 0, 0), angle: 1, child: Sphere(radius: 1))",
+        "axis",
+    ),
+    ("Scale(factor: @, child: Sphere(radius: 1))", "factor"),
+    ("Round(radius: @, child: Sphere(radius: 1))", "radius"),
+    ("Onion(thickness: @, child: Sphere(radius: 1))", "thickness"),
+    ("Elongate(extents: @, child: Sphere(radius: 1))", "extents"),
+    ("Repeat(period: @, child: Sphere(radius: 0.2))", "period"),
+    (
+        "RepeatLimited(period: @, limit: (1, 1, 1), child: Sphere(radius: 0.2))",
+        "period",
+    ),
+    (
+        "RepeatLimited(period: 1, limit: (@, 1, 1), child: Sphere(radius: 0.2))",
+        "limit",
+    ),
+    ("Twist(rate: @, child: Sphere(radius: 1))", "rate"),
+    ("Bend(rate: @, child: Sphere(radius: 1))", "rate"),
+    ("Color(color: @, child: Sphere(radius: 1))", "color"),
+    (
+        "Material(material: (roughness: @), child: Sphere(radius: 1))",
+        "roughness",
+    ),
+    (
+        "Material(material: (ior: @), child: Sphere(radius: 1))",
+        "ior",
+    ),
+    (
+        "Material(material: (transparency: @), child: Sphere(radius: 1))",
+        "transparency",
+    ),
+    (
+        "CutPlane(normal: @, offset: 0, child: Sphere(radius: 1))",
+        "normal",
+    ),
+    (
+        "CutPlane(normal: (1, 0, 0), offset: @, child: Sphere(radius: 1))",
+        "offset",
+    ),
+    (
+        "SmoothUnion(k: @, a: Sphere(radius: 1), b: Sphere(radius: 1))",
+        "k",
+    ),
+    (
+        "SmoothSubtract(k: @, a: Sphere(radius: 1), b: Sphere(radius: 1))",
+        "k",
+    ),
+    (
+        "SmoothIntersect(k: @, a: Sphere(radius: 1), b: Sphere(radius: 1))",
+        "k",
+    ),
+    (
+        "SmoothCut(k: @, a: Sphere(radius: 1), b: Sphere(radius: 1))",
+        "k",
+    ),
+    (
+        "Custom(name: \"mandelbox_escape\", args: [@, 12])",
+        "mandelbox_escape",
+    ),
+];
+
+/// Hostile values as a file writes them.
+const FILE_VALUES: &[&str] = &[
+    "4.5",
+    "-1",
+    "-3.5",
+    "NaN",
+    "inf",
+    "-inf",
+    "1e39",
+    "1e400",
+    "-0.0",
+    "4294967296",
+    "0",
+];
+
+/// `text` parses to a scene or gives a typed scene-file error naming
+/// `word`; never a panic.
+fn file_case(text: &str, word: &str) -> Result<(), String> {
+    let outcome = std::panic::catch_unwind(|| SceneFile::parse(text));
+    match outcome {
+        Err(_) => Err(format!("{text}: panicked")),
+        Ok(Ok(_)) => Ok(()),
+        Ok(Err(err @ Error::SceneFile { .. })) => {
+            let message = err.to_string();
+            if message.contains(word) && !message.contains("Repr") {
+                Ok(())
+            } else {
+                Err(format!(
+                    "{text}: the message does not name `{word}`: {message}"
+                ))
+            }
+        }
+        Ok(Err(other)) => Err(format!("{text}: not a scene-file error: {other:?}")),
+    }
+}
+
+#[test]
+fn every_node_field_given_a_hostile_value_is_refused_by_name_or_read() {
+    let mut failures = Vec::new();
+    let mut cases = 0;
+    for (node, field) in NODE_FIELDS {
+        for value in FILE_VALUES {
+            for bom in ["", "\u{feff}"] {
+                cases += 1;
+                let text = format!(
+                    "{bom}(version: 1,\n geometry: {})",
+                    node.replace('@', value)
+                );
+                if let Err(why) = file_case(&text, field) {
+                    failures.push(why);
+                }
+            }
+        }
+    }
+    // Counts among the quality settings, the camera's angle, motions.
+    let settings: &[(&str, &str)] = &[
+        ("quality: (preset: Draft, max_steps: @)", "max_steps"),
+        (
+            "quality: (preset: Draft, supersampling: @)",
+            "supersampling",
+        ),
+        ("quality: (preset: Draft, bounces: @)", "bounces"),
+        ("quality: (preset: Draft, detail: @)", "detail"),
+        (
+            "camera: (projection: Perspective(fov_y_degrees: @))",
+            "field of view",
+        ),
+        ("camera: (position: (0, 0, @))", "position"),
+        ("effects: (gamma: @)", "gamma"),
+        ("effects: (fog_density: @)", "fog_density"),
+        (
+            "motions: [Oscillate(name: \"r\", center: 1, amplitude: 0.1, period: @)]",
+            "period",
+        ),
+        (
+            "motions: [Oscillate(name: \"r\", center: @, amplitude: 0.1, period: 1)]",
+            "r",
+        ),
+    ];
+    for (setting, word) in settings {
+        for value in FILE_VALUES {
+            cases += 1;
+            let text = format!(
+                "(version: 1, geometry: Sphere(radius: param(\"r\", 1)),\n {})",
+                setting.replace('@', value)
+            );
+            if let Err(why) = file_case(&text, word) {
+                failures.push(why);
+            }
+        }
+    }
+    // Wrong material spellings name what was written.
+    for (material, word) in [
+        ("Glass(ior: 1.5)", "Glass"),
+        ("Mirror()", "Mirror"),
+        ("(colour: 1)", "colour"),
+        ("Material(ior: 1.5, tint: 2)", "tint"),
+    ] {
+        cases += 1;
+        let text = format!(
+            "(version: 1, geometry: Material(material: {material}, child: Sphere(radius: 1)))"
+        );
+        if let Err(why) = file_case(&text, word) {
+            failures.push(why);
+        }
+    }
+    assert!(
+        failures.is_empty(),
+        "{} of {cases} hostile scene-file cases failed:\n{}",
+        failures.len(),
+        failures.join("\n")
+    );
 }

@@ -68,7 +68,7 @@ fn invalid_settings_are_refused_before_anything_runs() {
     assert!(
         matches!(
             err,
-            Error::Quality {
+            Error::Effects {
                 setting: "gamma",
                 ..
             }

@@ -436,3 +436,141 @@ mod properties {
         }
     }
 }
+
+#[test]
+fn a_motion_period_must_be_a_positive_finite_number() {
+    for period in ["NaN", "inf", "0", "-2", "-0.0"] {
+        for motion in [
+            format!("Oscillate(name: \"power\", center: 8, amplitude: 1, period: {period})"),
+            format!("Orbit(name: \"at\", center: (0, 0, 0), radius: 1, period: {period})"),
+        ] {
+            let text = format!(
+                "(version: 1, geometry: Translate(offset: param3(\"at\", (0, 0, 0)), \
+                 child: Sphere(radius: param(\"power\", 1))),\n motions: [{motion}])"
+            );
+            let err = SceneFile::parse(&text).unwrap_err();
+            let message = err.to_string();
+            assert!(
+                message.contains("`period` must be a finite number of seconds > 0, got"),
+                "{text}: {message}"
+            );
+            assert!(message.starts_with("<scene>:2:"), "{message}");
+            let Error::SceneFile { cause, .. } = &err else {
+                panic!("{err:?}")
+            };
+            assert!(
+                matches!(
+                    cause.as_deref(),
+                    Some(Error::Motion {
+                        field: "period",
+                        ..
+                    })
+                ),
+                "{err:?}"
+            );
+        }
+    }
+}
+
+#[test]
+fn a_byte_order_mark_is_not_part_of_the_text() {
+    let file = SceneFile::parse("\u{feff}(version: 1, geometry: Sphere(radius: 1))").unwrap();
+    assert_eq!(file.scene.geometry, Some(sphere(1.0)));
+    // Columns are counted as an editor shows them, without the mark.
+    let err = SceneFile::parse("\u{feff}(version: 1, geometry: Sphere(radius: -1))")
+        .unwrap_err()
+        .to_string();
+    assert!(err.starts_with("<scene>:1:24: sphere"), "{err}");
+}
+
+#[test]
+fn a_camera_too_far_away_is_named_as_such() {
+    // Beside a target one unit away, a camera at 1e39 cannot tell the
+    // view's direction: its position is what is wrong.
+    for (position, target, says) in [
+        (
+            "(1e39, 0, 0)",
+            "(1e39, 0, 1)",
+            "position (1e39, 0, 0) is too large",
+        ),
+        (
+            "(0, 0, 1e200)",
+            "(1, 0, 1e200)",
+            "`position.z` = 1e200 cannot be",
+        ),
+    ] {
+        let text = format!(
+            "(version: 1, geometry: Sphere(radius: 1), camera: (position: {position}, target: {target}))"
+        );
+        let err = SceneFile::parse(&text).unwrap_err().to_string();
+        assert!(!err.contains("target equals position"), "{position}: {err}");
+        assert!(err.contains(says), "{position}: {err}");
+    }
+    let text = "(version: 1, geometry: Sphere(radius: 1), camera: (position: (0, 0, 2), target: (0, 0, 2)))";
+    let err = SceneFile::parse(text).unwrap_err().to_string();
+    assert!(err.contains("target equals position"), "{err}");
+}
+
+#[test]
+fn messages_name_the_words_written_not_internal_types() {
+    let node = |geometry: &str| {
+        let text = format!("(version: 1, geometry: {geometry})");
+        SceneFile::parse(&text).unwrap_err().to_string()
+    };
+    for (geometry, says) in [
+        (
+            "Material(material: Glass(ior: 1.5, colour: 1), child: Sphere(radius: 1))",
+            "`Glass(..)` is not a material",
+        ),
+        (
+            "Material(material: (roughness: 0.2, colour: 1), child: Sphere(radius: 1))",
+            "colour",
+        ),
+        (
+            "Mandelbulb(power: 8, iterations: 4.5)",
+            "`iterations` must be a whole number",
+        ),
+        (
+            "Menger(iterations: -3)",
+            "`iterations` must be a whole number",
+        ),
+        (
+            "RepeatLimited(period: 1, limit: (1, 2.5, 1), child: Sphere(radius: 0.2))",
+            "`limit` must be whole numbers",
+        ),
+    ] {
+        let message = node(geometry);
+        assert!(message.contains(says), "{geometry}: {message}");
+        assert!(!message.contains("Repr"), "{geometry}: {message}");
+    }
+}
+
+#[test]
+fn a_cut_plane_is_a_node_of_its_own() {
+    let text = "(version: 1, geometry: CutPlane(normal: (1, 0, 0), offset: param(\"cut\", 0),\n\
+                child: Sphere(radius: 1)))";
+    let file = SceneFile::parse(text).unwrap();
+    let expected = sphere(1.0).cut_plane(dvec3(1.0, 0.0, 0.0), param("cut", 0.0));
+    assert_eq!(file.scene.geometry, Some(expected.clone()));
+    // Written back as a cut plane, and read back equal.
+    let written = SceneFile::new(Scene::new(expected.clone()))
+        .to_text()
+        .unwrap();
+    assert!(written.contains("CutPlane("), "{written}");
+    assert_eq!(
+        SceneFile::parse(&written).unwrap().scene.geometry,
+        Some(expected)
+    );
+    // The older spelling, a cut by a plane node, still reads.
+    let older = "(version: 1, geometry: Cut(a: Sphere(radius: 1), b: Plane(normal: (1, 0, 0), \
+                 offset: param(\"cut\", 0))))";
+    assert_eq!(SceneFile::parse(older).unwrap(), file);
+    // A zero normal is blamed on the cut plane as written.
+    let err = SceneFile::parse(
+        "(version: 1,\n geometry: CutPlane(normal: 0, offset: 0, child: Sphere(radius: 1)))",
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(err.starts_with("<scene>:2:12:"), "{err}");
+    assert!(err.contains("`normal`"), "{err}");
+}

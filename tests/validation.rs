@@ -468,8 +468,13 @@ fn dynamic_parameters_are_checked_when_set() {
     );
     let err = eval.set_param("radius", 2.0).unwrap_err();
     assert!(
-        matches!(&err, Error::UnknownParam { name } if name == "radius"),
+        matches!(&err, Error::UnknownParam { name, .. } if name == "radius"),
         "{err:?}"
+    );
+    // The message lists the names the scene has.
+    assert_eq!(
+        err.to_string(),
+        "the scene has no dynamic parameter named `radius`; it has `r`"
     );
     // Failed sets leave the value alone.
     assert_eq!(eval.values().get("r"), Some(1.0));

@@ -12,6 +12,7 @@ use super::{Options, Target, header, helpers::Helper, power, writer::Writer};
 use crate::error::{Error, Result};
 use crate::quality::{Effects, Glow, Precision, Quality};
 use crate::scene::CustomShape;
+use crate::scene::names::strip_comments;
 
 /// Why `name` cannot be a custom shape's parameter: rules 1 to 4 (see
 /// `scene::names`) or a name the generated program gives a meaning.
@@ -37,7 +38,45 @@ pub(crate) fn check_custom(shape: &CustomShape) -> Result<()> {
             return Err(bad(format!("parameter `{param}` {why}")));
         }
     }
+    if let Some(why) = body_directive_problem(shape.opencl_body()) {
+        return Err(bad(why));
+    }
     Ok(())
+}
+
+/// Why a custom shape's OpenCL body would change the program around it,
+/// or `None`: a `#define` or `#undef` of a name the generated program
+/// uses (a macro reaches past the body). Lines are counted from 1, the
+/// body's first line.
+pub(crate) fn body_directive_problem(body: &str) -> Option<String> {
+    let code = strip_comments(body);
+    let mut continued = false;
+    for (i, line) in code.lines().enumerate() {
+        let directive = !continued && line.trim_start().starts_with('#');
+        continued = line.trim_end().ends_with('\\');
+        let Some(rest) = directive.then(|| line.trim_start()[1..].trim_start()) else {
+            continue;
+        };
+        for word in ["define", "undef"] {
+            let Some(after) = rest.strip_prefix(word) else {
+                continue;
+            };
+            let Some((name, _)) = identifiers(after).first().copied() else {
+                continue;
+            };
+            let taken = generated(name).is_some()
+                || name.starts_with("custom_")
+                || name.starts_with("inside_");
+            if taken {
+                return Some(format!(
+                    "the OpenCL body's `#{word} {name}` (line {} of the body) would change \
+                     a name the generated program uses",
+                    i + 1
+                ));
+            }
+        }
+    }
+    None
 }
 
 /// Why the file-scope name `name` (a custom shape's function) would
@@ -197,29 +236,6 @@ fn identifiers(text: &str) -> Vec<(&str, usize)> {
             }
         } else {
             i += 1;
-        }
-    }
-    out
-}
-
-/// `source` with its `/* */` and `//` comments blanked (newlines kept, so
-/// lines keep their numbers).
-fn strip_comments(source: &str) -> String {
-    let mut out = String::with_capacity(source.len());
-    let mut rest = source;
-    while !rest.is_empty() {
-        if let Some(after) = rest.strip_prefix("/*") {
-            let end = after.find("*/").map_or(after.len(), |e| e + 2);
-            out.extend(after[..end].chars().filter(|&c| c == '\n'));
-            out.push(' ');
-            rest = &after[end..];
-        } else if let Some(after) = rest.strip_prefix("//") {
-            let end = after.find('\n').unwrap_or(after.len());
-            rest = &after[end..];
-        } else {
-            let c = rest.chars().next().expect("not empty");
-            out.push(c);
-            rest = &rest[c.len_utf8()..];
         }
     }
     out

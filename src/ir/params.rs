@@ -176,7 +176,10 @@ impl ParamValues {
             .slots
             .iter()
             .position(|s| s.name == name)
-            .ok_or_else(|| Error::UnknownParam { name: name.into() })?;
+            .ok_or_else(|| Error::UnknownParam {
+                name: name.into(),
+                known: self.layout.slots.iter().map(|s| s.name.clone()).collect(),
+            })?;
         let spec = &self.layout.slots[slot];
         check_rule(
             || spec.used_at.0.clone(),

@@ -243,6 +243,17 @@ impl InsideBounds {
 /// (`radius`, `half_length`) and none of these rules gets in the way. A
 /// refused name is an [`Error::CustomShape`] saying which rule it breaks.
 ///
+/// # Bodies
+///
+/// The body is emitted inside the shape's function, so it is refused
+/// ([`Error::CustomShape`]) before anything is compiled if it could not
+/// stay there or would change the program around it: [`CustomShape::new`]
+/// refuses a NUL byte or another control character (tabs and line ends
+/// are fine), a `}` that closes the function early (what follows would
+/// stand at file scope, where it could define `DE` or `DE_shade` again)
+/// or braces left open; code generation refuses a `#define` or `#undef`
+/// of a name the generated program uses.
+///
 /// # Build errors
 ///
 /// The body is code you write and is emitted as given. If the OpenCL
@@ -284,7 +295,8 @@ impl CustomShape {
     /// # Errors
     /// [`Error::CustomShape`] if a name is not a valid identifier or is
     /// reserved (see [Names](CustomShape#names)), a parameter name repeats
-    /// or is `p`, or the body is empty.
+    /// or is `p`, or the body is empty or cannot be emitted as given (see
+    /// [Bodies](CustomShape#bodies)).
     pub fn new<F>(name: &str, params: &[(&str, Rule)], cpu: F, opencl_body: &str) -> Result<Self>
     where
         F: Fn(DVec3, &[f64]) -> f64 + Send + Sync + 'static,
@@ -353,6 +365,9 @@ impl CustomShape {
         if opencl_body.trim().is_empty() {
             return Err(bad("the OpenCL body is empty".into()));
         }
+        if let Some(why) = body_problem(opencl_body) {
+            return Err(bad(why));
+        }
         Ok(CustomShape(Arc::new(Inner {
             name: name.into(),
             params: params.iter().map(|(n, r)| ((*n).to_string(), *r)).collect(),
@@ -366,6 +381,12 @@ impl CustomShape {
     #[must_use]
     pub fn name(&self) -> &str {
         &self.0.name
+    }
+
+    /// The OpenCL body as given.
+    #[must_use]
+    pub fn opencl_body(&self) -> &str {
+        &self.0.opencl
     }
 
     /// The parameters' names and rules, in order.
@@ -527,6 +548,66 @@ impl fmt::Debug for CustomShape {
             .field("params", &self.0.params)
             .finish_non_exhaustive()
     }
+}
+
+/// Why a custom shape's OpenCL body cannot stay inside the shape's
+/// function, or `None`: a NUL or other control character (which the
+/// compiler would stop at or misread), or braces that close the function
+/// early or leave it open (code after an early close would stand at file
+/// scope, where it could define `DE` or any generated name again). Lines
+/// are counted from 1, the body's first line. Code generation refuses
+/// `#define`s of generated names as well.
+fn body_problem(body: &str) -> Option<String> {
+    let line_of = |offset: usize| body[..offset].matches('\n').count() + 1;
+    if let Some((at, c)) = body
+        .char_indices()
+        .find(|&(_, c)| c.is_control() && !matches!(c, '\t' | '\n' | '\r'))
+    {
+        let what = if c == '\0' {
+            "a NUL byte".to_string()
+        } else {
+            format!("the control character U+{:04X}", u32::from(c))
+        };
+        return Some(format!(
+            "the OpenCL body contains {what} (line {} of the body)",
+            line_of(at)
+        ));
+    }
+    let code = super::names::strip_comments(body);
+    let mut depth = 0usize;
+    let mut quote = None;
+    let mut escaped = false;
+    for (at, c) in code.char_indices() {
+        if let Some(q) = quote {
+            if escaped {
+                escaped = false;
+            } else if c == '\\' {
+                escaped = true;
+            } else if c == q {
+                quote = None;
+            }
+            continue;
+        }
+        match c {
+            '"' | '\'' => quote = Some(c),
+            '{' => depth += 1,
+            '}' if depth == 0 => {
+                return Some(format!(
+                    "the OpenCL body closes a brace it did not open (line {} of the body): \
+                     what follows would stand outside the shape's function",
+                    line_of(at)
+                ));
+            }
+            '}' => depth -= 1,
+            _ => {}
+        }
+    }
+    if depth > 0 {
+        return Some(format!(
+            "the OpenCL body leaves {depth} brace(s) open: the shape's function would not end"
+        ));
+    }
+    None
 }
 
 fn check_identifier(s: &str) -> std::result::Result<(), String> {

@@ -185,16 +185,17 @@ impl Camera {
         let Projection::Perspective { fov_y_degrees } = self.projection else {
             return bad("stereo needs a perspective camera".into());
         };
-        if !(separation >= 0.0 && separation.is_finite()) {
-            return bad(format!(
-                "eye separation must be finite and >= 0, got {}",
-                fmt_value(separation)
-            ));
-        }
+        // The convergence first: a default separation is made from it.
         if !(convergence > 0.0 && convergence.is_finite()) {
             return bad(format!(
                 "convergence distance must be finite and > 0, got {}",
                 fmt_value(convergence)
+            ));
+        }
+        if !(separation >= 0.0 && separation.is_finite()) {
+            return bad(format!(
+                "eye separation must be finite and >= 0, got {}",
+                fmt_value(separation)
             ));
         }
         // Half the window's height at unit distance: the shift's unit.
@@ -251,8 +252,18 @@ impl Camera {
             within("camera", name, v, Magnitude::Coordinate)?;
         }
         let view = self.target - self.position;
-        if view.length() <= f64::EPSILON * self.position.length().max(1.0) {
+        if view.length() == 0.0 {
             return bad("target equals position");
+        }
+        if view.length() <= f64::EPSILON * self.position.length().max(1.0) {
+            return Err(Error::Camera {
+                reason: format!(
+                    "position {} is too large for a target {} away: at that magnitude the \
+                     view's direction cannot be resolved (move the camera, or rescale the scene)",
+                    fmt_vec(self.position),
+                    fmt_value(view.length())
+                ),
+            });
         }
         let Some(up) = normalize(self.up) else {
             return bad("up is zero");
@@ -308,6 +319,16 @@ impl Camera {
         }
         Ok(())
     }
+}
+
+/// A vector as a message writes it, each component as [`fmt_value`] does.
+fn fmt_vec(v: DVec3) -> String {
+    format!(
+        "({}, {}, {})",
+        fmt_value(v.x),
+        fmt_value(v.y),
+        fmt_value(v.z)
+    )
 }
 
 impl Default for Camera {

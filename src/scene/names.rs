@@ -165,3 +165,26 @@ pub(crate) fn reserved(name: &str) -> Option<String> {
     }
     None
 }
+
+/// `source` with its `/* */` and `//` comments blanked (newlines kept, so
+/// lines keep their numbers).
+pub(crate) fn strip_comments(source: &str) -> String {
+    let mut out = String::with_capacity(source.len());
+    let mut rest = source;
+    while !rest.is_empty() {
+        if let Some(after) = rest.strip_prefix("/*") {
+            let end = after.find("*/").map_or(after.len(), |e| e + 2);
+            out.extend(after[..end].chars().filter(|&c| c == '\n'));
+            out.push(' ');
+            rest = &after[end..];
+        } else if let Some(after) = rest.strip_prefix("//") {
+            let end = after.find('\n').unwrap_or(after.len());
+            rest = &after[end..];
+        } else {
+            let c = rest.chars().next().expect("not empty");
+            out.push(c);
+            rest = &rest[c.len_utf8()..];
+        }
+    }
+    out
+}

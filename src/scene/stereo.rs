@@ -117,6 +117,14 @@ impl Stereo {
     ///
     /// # Errors
     /// As [`Camera::eyes`].
+    ///
+    /// ```
+    /// use fractal_sdf::prelude::*;
+    /// use fractal_sdf::scene::{Stereo, StereoLayout};
+    /// let stereo = Stereo::new(StereoLayout::Anaglyph).convergence(f64::NAN);
+    /// let err = stereo.eyes(&Camera::default()).unwrap_err().to_string();
+    /// assert!(err.contains("convergence distance must be finite and > 0, got NaN"), "{err}");
+    /// ```
     pub fn eyes(&self, camera: &Camera) -> Result<[Camera; 2]> {
         let convergence = self.convergence.unwrap_or_else(|| camera.focus_distance());
         let separation = self

@@ -345,6 +345,12 @@ impl Job {
         };
         let device = args.device.clone().or_else(|| settings.device.clone());
         let sets = parse_sets(&args.set)?;
+        // Checked before a device is opened: a misspelt name is reported,
+        // with the names the scene has, on any machine.
+        let mut values = file.scene.compile()?.default_values();
+        for (name, value) in &sets {
+            values.set(name, *value)?;
+        }
         let devices = match args.devices.as_deref() {
             None => None,
             Some("all") => Some(every_device()?),
