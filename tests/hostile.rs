@@ -692,3 +692,13 @@ fn hostile_values_are_refused_by_name_or_computed_finitely() {
         t.failures.join("\n")
     );
 }
+
+mod hostile_classes;
+
+/// The classes of bad input found by trying the library from outside, as
+/// generated cases (see `hostile_classes`): each a typed error or a
+/// result checked to be right, with a table per class.
+#[test]
+fn the_classes_found_from_outside_end_in_a_typed_error_or_a_checked_result() {
+    hostile_classes::run(gpu::device().is_some());
+}

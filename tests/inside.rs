@@ -653,3 +653,32 @@ fn bounds_clip_the_set_on_both_twins() {
     )
     .unwrap_or_else(|f| panic!("{f}"));
 }
+
+/// Regression: a membership test that panics while a mesh is sampled on
+/// the CPU surfaced as the threads' panic, without its message; it is an
+/// error naming the shape and saying what the test said.
+#[test]
+fn a_panicking_membership_test_is_an_error_with_its_message() {
+    let shape = InsideShape::new(
+        "touchy",
+        &[],
+        InsideBounds::sphere(DVec3::ZERO, 1.0),
+        |p, _| {
+            assert!(p.x < 0.5, "touchy cannot look right of 0.5");
+            p.length() < 0.8
+        },
+        "return length(p) < R(0.8);",
+    )
+    .unwrap();
+    let scene = Scene::new(shape.node::<f64>([])).compile().unwrap();
+    let options = fractal_sdf::mesh::GridOptions::default()
+        .resolution(16)
+        .sampler(fractal_sdf::mesh::Sampler::Cpu);
+    let err = fractal_sdf::mesh::extract(&scene, &options).unwrap_err();
+    let text = err.to_string();
+    assert!(matches!(err, Error::CustomShape { .. }), "{text}");
+    assert!(
+        text.contains("touchy") && text.contains("right of 0.5"),
+        "{text}"
+    );
+}

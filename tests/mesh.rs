@@ -233,6 +233,17 @@ fn bad_grids_say_what_is_wrong() {
                 .bounds(Aabb::new(DVec3::splat(-1e308), DVec3::splat(1e308))),
             "finite",
         ),
+        // Regression: a box 1e-300 wide collapsed to one point's samples.
+        (
+            cpu.clone()
+                .bounds(Aabb::new(DVec3::ZERO, DVec3::splat(1e-300))),
+            "narrowest axis",
+        ),
+        (
+            cpu.clone()
+                .bounds(Aabb::new(dvec3(1e6, 0.0, 0.0), dvec3(1e6 + 1e-3, 1.0, 1.0))),
+            "narrowest axis",
+        ),
     ];
     for (options, says) in cases {
         let err = mesh::extract(&scene, &options).unwrap_err();

@@ -162,3 +162,42 @@ fn renders_8k() {
         "covered {coverage}, expected {expected}"
     );
 }
+
+/// Regression: a tiny image must still see a shape that fills the view, at
+/// every preset (draft traces fewer rays than pixels).
+#[test]
+fn a_shape_filling_the_view_is_hit_at_the_smallest_sizes() {
+    let Some(_) = gpu::device() else { return };
+    let scene = Scene::new(sphere(1.0))
+        .with_camera(Camera::look_at(dvec3(0.0, 0.0, 1.6), DVec3::ZERO).fov(45.0));
+    for preset in Preset::ALL {
+        let mut r = Renderer::new(&scene, preset.quality()).unwrap();
+        for (w, h) in [(1, 1), (2, 1), (1, 2), (3, 3)] {
+            let frame = r.render_with_aovs(w, h).unwrap();
+            assert!(
+                frame.hit.iter().all(|&h| h),
+                "{} at {w}x{h}: {:?}",
+                preset.name(),
+                frame.hit
+            );
+        }
+    }
+}
+
+/// Regression: a side-by-side pair of eyes wider together than the
+/// largest image side saturated its width instead of being refused.
+#[test]
+fn a_stereo_picture_past_the_largest_side_is_refused() {
+    let Some(_) = gpu::device() else { return };
+    use fractal_sdf::scene::{Stereo, StereoLayout};
+    let mut r = Renderer::new(&gpu::sphere_box_floor(), gpu::quick()).unwrap();
+    let stereo = Stereo {
+        layout: StereoLayout::SideBySide,
+        eye_separation: None,
+        convergence: None,
+    };
+    let side = fractal_sdf::render::MAX_IMAGE_SIDE;
+    let err = r.render_stereo(side, 8, &stereo).unwrap_err();
+    assert!(matches!(err, Error::Resolution { .. }), "{err}");
+    assert!(err.to_string().contains("side-by-side"), "{err}");
+}

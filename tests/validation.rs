@@ -691,3 +691,23 @@ fn a_warped_shape_keeps_its_distance_far_away() {
         }
     }
 }
+
+/// Regression: a brute-force step of 1e-9 footprints was accepted and
+/// rendered only sky (the steps ran out before reaching any set).
+#[test]
+fn brute_steps_too_small_to_reach_a_set_are_refused() {
+    use fractal_sdf::quality::MIN_BRUTE_STEP;
+    for step in [1e-9, 0.0, MIN_BRUTE_STEP * 0.99] {
+        let err = Quality::production()
+            .brute_step(step)
+            .validate()
+            .unwrap_err();
+        assert!(err.to_string().contains("brute_step"), "{err}");
+    }
+    assert!(
+        Quality::production()
+            .brute_step(MIN_BRUTE_STEP)
+            .validate()
+            .is_ok()
+    );
+}
