@@ -1133,13 +1133,12 @@ impl Renderer {
                 }
                 return Err(stop);
             }
-            if let Some(before) = events.len().checked_sub(TILES_IN_FLIGHT) {
-                if let Some(e) =
-                    self.settle(Some(&events[before]), launched, (events.len(), total))?
-                {
-                    self.abandoned = true;
-                    return Err(e);
-                }
+            let before = events.len().checked_sub(TILES_IN_FLIGHT);
+            if let Some(e) =
+                self.settle(before.map(|i| &events[i]), launched, (events.len(), total))?
+            {
+                self.abandoned = true;
+                return Err(e);
             }
             #[allow(clippy::cast_possible_wrap)]
             {

@@ -328,11 +328,14 @@ fn custom_bodies(row: &mut Row) {
     }
 }
 
+/// A class of cases: adds its cases to a row.
+type Class = fn(&mut Row);
+
 /// Runs every class and prints the table; fails on any case that ended
 /// neither as a typed error nor as a checked result.
 pub fn run(with_device: bool) {
     let mut rows: Vec<(&str, Row)> = Vec::new();
-    let classes: [(&str, fn(&mut Row)); 6] = [
+    let classes: [(&str, Class); 6] = [
         ("twist and bend rates", warp_rates),
         ("inside shapes' bounds", inside_bounds),
         ("brute-force steps", brute_steps),
