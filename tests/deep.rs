@@ -154,10 +154,11 @@ fn a_hundred_thousand_added_spheres_render() {
     let (scene, centres) = many_spheres(100_000);
     let scene = scene.with_camera(Camera::look_at(dvec3(2.2, 1.7, 2.9), DVec3::ZERO));
     let compiled = scene.compile().unwrap();
-    // One loop, not 100,000 copies of the sphere's code.
+    // One loop, not 100,000 copies of the sphere's code (which would be
+    // megabytes): the program is about the size of the marcher itself.
     let source = codegen::emit(&compiled, &Options::default()).unwrap();
     assert!(
-        source.source.len() < 40_000,
+        source.source.len() < 48_000,
         "{} bytes",
         source.source.len()
     );
