@@ -1323,6 +1323,9 @@ __kernel void render_tile(RENDER_TILE_ARGS) {
             if (centre.hit) {
                 real h = NORMAL_EPSILON * march_footprint(&cam, centre.t);
                 centre_normal = march_normal(ro + rd * centre.t, h, rd, params);
+                if (centre.t > R(0.0)) {
+                    centre_normal = march_facing(centre_normal, rd);
+                }
             }
         }
         depth[idx] = centre.hit ? (float)centre.t : INFINITY;

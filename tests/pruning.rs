@@ -136,7 +136,12 @@ fn bounds_follow_the_tree() {
     );
     assert!(bound(plane(DVec3::Y, 0.0)).is_none());
     assert!(bound(sphere(1.0).translate(param3("at", dvec3(0.0, 0.0, 0.0)))).is_none());
-    assert!(bound(sphere(1.0).twist(1.0)).is_none());
+    // A twist keeps the distance from its axis and the height: the ball
+    // around the cylinder its child's ball sweeps.
+    let b = bound(sphere(1.0).translate(dvec3(0.5, 0.0, 0.0)).twist(1.0)).expect("bounded");
+    assert!(b.centre.length() < 1e-12, "{b:?}");
+    assert!((b.radius - 1.5f64.hypot(1.0)).abs() < 1e-12, "{b:?}");
+    assert!(bound(sphere(1.0).twist(1.0).translate(param3("at", DVec3::ZERO))).is_none());
     // A subtraction is within its first operand; a union with a plane has
     // no bound.
     let b = bound(sphere(1.0).subtract(plane(DVec3::Y, 0.0))).expect("bounded");

@@ -230,7 +230,8 @@ impl Lowering {
 
     /// Folds what can be folded at compile time: chains of baked
     /// translations, rotations and scales become one node, identity
-    /// transforms and a `k = 0` smoothing disappear, and an inner colour
+    /// transforms (twists and bends of rate 0 too) and a `k = 0` smoothing
+    /// disappear, and an inner colour
     /// under an outer one (which paints over it) is dropped. A single-child node's child
     /// is always the last node pushed, so merging pops it.
     fn fold(&mut self, node: IrNode) -> IrNode {
@@ -240,7 +241,9 @@ impl Lowering {
             | Kind::Rotate { child, .. }
             | Kind::Scale { child, .. }
             | Kind::Color { child, .. }
-            | Kind::Material { child, .. } => Some(*child),
+            | Kind::Material { child, .. }
+            | Kind::Twist { child, .. }
+            | Kind::Bend { child, .. } => Some(*child),
             _ => None,
         };
         let Some(child) = child_of(&node) else {
@@ -277,6 +280,13 @@ impl Lowering {
                 },
                 _,
             ) if *f == 1.0 => Some(inner.clone()),
+            // A warp of rate 0 is the identity (its estimate would still
+            // take the larger of the child's and its ball's distance).
+            (Kind::Twist { rate: Baked(r), .. } | Kind::Bend { rate: Baked(r), .. }, _)
+                if *r == 0.0 =>
+            {
+                Some(inner.clone())
+            }
             // The outer colour paints over the inner one.
             (
                 Kind::Color { color, .. },
