@@ -259,12 +259,12 @@ pub fn emit(scene: &CompiledScene, options: &Options) -> Result<KernelSource> {
 /// Every value written as a literal is first checked against the limits of
 /// the program's precision ([`Precision::limits`]): a baked scene value,
 /// quality knob or effect setting that precision cannot compute with is an
-/// [`Error::Precision`](crate::Error::Precision) naming it, never a
+/// [`Error::Precision`] naming it, never a
 /// program that fails to build or draws nothing.
 ///
 /// # Errors
 /// A validation error of the quality or effects;
-/// [`Error::Precision`](crate::Error::Precision) for a baked value beyond
+/// [`Error::Precision`] for a baked value beyond
 /// the precision's limits, with its node's path.
 pub fn emit_ir(ir: &Ir, options: &Options) -> Result<KernelSource> {
     options.quality.validate()?;
