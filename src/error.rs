@@ -82,6 +82,19 @@ pub enum Error {
         /// What is wrong.
         reason: String,
     },
+    /// A custom shape's text formula does not parse or check: where, and
+    /// what was expected.
+    #[error("custom shape `{name}`: formula line {line}, column {column}: {message}")]
+    Formula {
+        /// The shape's name.
+        name: String,
+        /// The line, from 1.
+        line: usize,
+        /// The column, in characters from 1.
+        column: usize,
+        /// What is wrong, and what was expected.
+        message: String,
+    },
     /// An inside shape (see [`InsideShape`](crate::scene::InsideShape))
     /// is used where a distance is needed, or its scene cannot be marched.
     #[error("inside shape `{name}` at {node}: {reason}")]

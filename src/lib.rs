@@ -177,6 +177,7 @@ pub mod animation;
 pub mod codegen;
 pub mod cpu;
 pub mod error;
+pub mod expr;
 pub mod file;
 pub mod gallery;
 pub mod ir;

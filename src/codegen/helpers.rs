@@ -1,11 +1,15 @@
-//! The hand-written OpenCL C helper library (`kernels/sdf/*.cl`), embedded
-//! at compile time, and the dependencies between its functions.
+//! The OpenCL C helper library and the dependencies between its functions:
+//! helpers printed from the formulas' expression IR
+//! ([`formulas`](super::formulas)), and the fractal estimators still
+//! hand-written in `kernels/sdf/*.cl` (embedded at compile time).
+
+use super::formulas;
+use crate::expr::Unprintable;
 
 /// One file of the helper library. Code generation records which helpers a
 /// scene calls and emits those (with their dependencies) and no others.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash)]
 pub(crate) enum Helper {
-    Length,
     Sphere,
     Cuboid,
     RoundBox,
@@ -35,8 +39,7 @@ macro_rules! source {
 impl Helper {
     /// Every helper, each after the helpers it depends on: the order they
     /// are emitted in.
-    pub(crate) const ALL: [Helper; 19] = [
-        Helper::Length,
+    pub(crate) const ALL: [Helper; 18] = [
         Helper::Sphere,
         Helper::Cuboid,
         Helper::RoundBox,
@@ -57,37 +60,52 @@ impl Helper {
         Helper::Warp,
     ];
 
-    /// The file's name in `kernels/sdf/`, without `.cl`.
+    /// The helper's name, in the program's section comments.
     pub(crate) fn name(self) -> &'static str {
-        self.file().0
-    }
-
-    /// The OpenCL C source.
-    pub(crate) fn source(self) -> &'static str {
-        self.file().1
-    }
-
-    fn file(self) -> (&'static str, &'static str) {
         match self {
-            Helper::Length => ("length", source!("length")),
-            Helper::Sphere => ("sphere", source!("sphere")),
-            Helper::Cuboid => ("cuboid", source!("cuboid")),
-            Helper::RoundBox => ("round_box", source!("round_box")),
-            Helper::Torus => ("torus", source!("torus")),
-            Helper::Cylinder => ("cylinder", source!("cylinder")),
-            Helper::Capsule => ("capsule", source!("capsule")),
-            Helper::Plane => ("plane", source!("plane")),
-            Helper::Octahedron => ("octahedron", source!("octahedron")),
-            Helper::CappedCone => ("capped_cone", source!("capped_cone")),
-            Helper::Ellipsoid => ("ellipsoid", source!("ellipsoid")),
-            Helper::Mandelbulb => ("mandelbulb", source!("mandelbulb")),
-            Helper::Menger => ("menger", source!("menger")),
-            Helper::Tetrahedron => ("tetrahedron", source!("tetrahedron")),
-            Helper::Sierpinski => ("sierpinski", source!("sierpinski")),
-            Helper::Julia => ("julia", source!("julia")),
-            Helper::SmoothMin => ("smooth_min", source!("smooth_min")),
-            Helper::Rotate => ("rotate", source!("rotate")),
-            Helper::Warp => ("warp", source!("warp")),
+            Helper::Sphere => "sphere",
+            Helper::Cuboid => "cuboid",
+            Helper::RoundBox => "round_box",
+            Helper::Torus => "torus",
+            Helper::Cylinder => "cylinder",
+            Helper::Capsule => "capsule",
+            Helper::Plane => "plane",
+            Helper::Octahedron => "octahedron",
+            Helper::CappedCone => "capped_cone",
+            Helper::Ellipsoid => "ellipsoid",
+            Helper::Mandelbulb => "mandelbulb",
+            Helper::Menger => "menger",
+            Helper::Tetrahedron => "tetrahedron",
+            Helper::Sierpinski => "sierpinski",
+            Helper::Julia => "julia",
+            Helper::SmoothMin => "smooth_min",
+            Helper::Rotate => "rotate",
+            Helper::Warp => "warp",
+        }
+    }
+
+    /// The OpenCL C source: printed from the formula, or the fractal's
+    /// hand-written file.
+    pub(crate) fn source(self) -> Result<String, Unprintable> {
+        match self {
+            Helper::Sphere => formulas::sphere(),
+            Helper::Cuboid => formulas::cuboid(),
+            Helper::RoundBox => formulas::round_box(),
+            Helper::Torus => formulas::torus(),
+            Helper::Cylinder => formulas::cylinder(),
+            Helper::Capsule => formulas::capsule(),
+            Helper::Plane => formulas::plane(),
+            Helper::Octahedron => formulas::octahedron(),
+            Helper::CappedCone => formulas::capped_cone(),
+            Helper::Ellipsoid => formulas::ellipsoid(),
+            Helper::Tetrahedron => formulas::tetrahedron(),
+            Helper::SmoothMin => formulas::smooth_min(),
+            Helper::Rotate => formulas::rotate(),
+            Helper::Warp => formulas::warp(),
+            Helper::Mandelbulb => Ok(source!("mandelbulb").to_string()),
+            Helper::Menger => Ok(source!("menger").to_string()),
+            Helper::Sierpinski => Ok(source!("sierpinski").to_string()),
+            Helper::Julia => Ok(source!("julia").to_string()),
         }
     }
 
@@ -95,7 +113,6 @@ impl Helper {
     pub(crate) fn deps(self) -> &'static [Helper] {
         match self {
             Helper::Menger => &[Helper::Cuboid],
-            Helper::Ellipsoid => &[Helper::Length],
             Helper::Sierpinski => &[Helper::Tetrahedron],
             _ => &[],
         }
@@ -133,5 +150,17 @@ mod tests {
             closure([Helper::Sierpinski]),
             vec![Helper::Tetrahedron, Helper::Sierpinski]
         );
+    }
+
+    #[test]
+    fn every_helper_prints() {
+        for h in Helper::ALL {
+            let source = h.source().unwrap();
+            assert!(
+                source.contains('{') && source.ends_with("}\n"),
+                "{}",
+                h.name()
+            );
+        }
     }
 }

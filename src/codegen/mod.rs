@@ -21,6 +21,7 @@
 //! # Ok::<(), fractal_sdf::Error>(())
 //! ```
 
+mod formulas;
 mod helpers;
 pub mod interface;
 pub(crate) mod names;
@@ -318,7 +319,10 @@ pub fn emit_ir(ir: &Ir, options: &Options) -> Result<KernelSource> {
     header(&mut w, options, &features);
     for helper in helpers::closure(used) {
         w.line(format!("/* ---- {} ---- */", helper.name()));
-        w.raw(helper.source());
+        w.raw(&helper.source().map_err(|e| Error::Invalid {
+            what: "formula",
+            reason: e.to_string(),
+        })?);
         w.line("");
     }
     for n in powers {

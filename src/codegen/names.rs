@@ -146,7 +146,7 @@ fn library_texts() -> Vec<String> {
             texts.push(w.finish());
         }
     }
-    texts.extend(Helper::ALL.iter().map(|h| h.source().to_string()));
+    texts.extend(Helper::ALL.iter().filter_map(|h| h.source().ok()));
     texts.push(power::mandelbulb_helper(8));
     texts.push(include_str!("../../kernels/march.cl").into());
     texts.push(include_str!("../../kernels/eval.cl").into());

@@ -314,7 +314,7 @@ impl Evaluator {
                 }
                 Scalar::Dynamic(_) => {
                     let k = V3::<f64>::from(*axis).cast::<T>();
-                    rotate(p, k, -s(*angle))
+                    sdf::rotate_axis(p, k, -s(*angle))
                 }
             },
             Kind::Scale { factor, .. } => p / s(*factor),
@@ -329,11 +329,13 @@ impl Evaluator {
             Kind::Repeat { period, .. } => repeat(p, v(*period), None),
             Kind::RepeatLimited { period, limit, .. } => repeat(p, v(*period), Some(*limit)),
             Kind::Twist { rate, .. } => {
-                let (sn, cs) = (s(*rate) * p.y).sin_cos();
+                let a = s(*rate) * p.y;
+                let (sn, cs) = (a.sin(), a.cos());
                 v3(cs * p.x - sn * p.z, p.y, sn * p.x + cs * p.z)
             }
             Kind::Bend { rate, .. } => {
-                let (sn, cs) = (s(*rate) * p.x).sin_cos();
+                let a = s(*rate) * p.x;
+                let (sn, cs) = (a.sin(), a.cos());
                 v3(cs * p.x - sn * p.y, sn * p.x + cs * p.y, p.z)
             }
             _ => p,
@@ -477,12 +479,6 @@ fn dot_row<T: Real>(row: V3<T>, p: V3<T>) -> T {
         }
     }
     sum.unwrap_or_else(T::zero)
-}
-
-/// Rotates `p` by `angle` around the unit axis `k` (Rodrigues' formula).
-fn rotate<T: Real>(p: V3<T>, k: V3<T>, angle: T) -> V3<T> {
-    let (sn, cs) = angle.sin_cos();
-    p * cs + k.cross(p) * sn + k * (k.dot(p) * (T::one() - cs))
 }
 
 /// Folds `p` into the cell of size `c` around the origin (no folding on

@@ -1,6 +1,13 @@
-//! Distance formulas for every primitive and fractal, generic over the
-//! precision. Each has a twin in `kernels/*.cl` that performs the same
-//! operations in the same order; the conformance tests hold them together.
+//! Distance formulas for every primitive and fractal.
+//!
+//! The primitives, the smooth minimum, the rotation and the warp bounds
+//! are written once, generic over [`Num`]: the CPU reference runs them in
+//! `f32`/`f64`, and code generation traces them into the expression IR
+//! ([`crate::expr`]) and prints their OpenCL helpers from it, so there is
+//! no second copy to drift. Their value-dependent choices are
+//! [`Num::select`]s. The fractal estimators are still generic over
+//! [`Real`] (their loops exit early), with hand-written OpenCL twins in
+//! `kernels/sdf/` that the conformance tests hold to them.
 //!
 //! Sources: the primitives and smooth minimum follow Inigo Quilez's
 //! "distance functions" article; the fractal estimators follow Quilez
@@ -8,38 +15,38 @@
 //! kaleidoscopic IFS (Menger, Sierpinski).
 
 pub use crate::math::{JULIA_FAR_FIELD, JULIA_FAR_FIELD_SLOPE, julia_radius};
-use crate::math::{Real, V3, escape_radius, mandelbulb_radius, v3};
+use crate::math::{Num, Real, V3, escape_radius, mandelbulb_radius, v3};
 
 /// Exact distance to a sphere of radius `r` at the origin.
 #[must_use]
-pub fn sphere<T: Real>(p: V3<T>, r: T) -> T {
+pub fn sphere<T: Num>(p: V3<T>, r: T) -> T {
     p.length() - r
 }
 
 /// Exact distance to an axis-aligned box with half extents `b`.
 #[must_use]
-pub fn cuboid<T: Real>(p: V3<T>, b: V3<T>) -> T {
+pub fn cuboid<T: Num>(p: V3<T>, b: V3<T>) -> T {
     let q = p.abs() - b;
     q.max_s(T::zero()).length() + q.max_element().min(T::zero())
 }
 
 /// Exact distance to a box of half extents `b` with edges rounded by `r`.
 #[must_use]
-pub fn round_box<T: Real>(p: V3<T>, b: V3<T>, r: T) -> T {
+pub fn round_box<T: Num>(p: V3<T>, b: V3<T>, r: T) -> T {
     let q = p.abs() - b + V3::splat(r);
     q.max_s(T::zero()).length() + q.max_element().min(T::zero()) - r
 }
 
 /// Exact distance to a torus around the y axis.
 #[must_use]
-pub fn torus<T: Real>(p: V3<T>, major: T, minor: T) -> T {
+pub fn torus<T: Num>(p: V3<T>, major: T, minor: T) -> T {
     let qx = p.x.hypot(p.z) - major;
     qx.hypot(p.y) - minor
 }
 
 /// Exact distance to a capped cylinder along y.
 #[must_use]
-pub fn cylinder<T: Real>(p: V3<T>, r: T, h: T) -> T {
+pub fn cylinder<T: Num>(p: V3<T>, r: T, h: T) -> T {
     let dx = p.x.hypot(p.z) - r;
     let dy = p.y.abs() - h;
     dx.max(dy).min(T::zero()) + dx.max(T::zero()).hypot(dy.max(T::zero()))
@@ -47,7 +54,7 @@ pub fn cylinder<T: Real>(p: V3<T>, r: T, h: T) -> T {
 
 /// Exact distance to a capsule around the segment `a`-`b`.
 #[must_use]
-pub fn capsule<T: Real>(p: V3<T>, a: V3<T>, b: V3<T>, r: T) -> T {
+pub fn capsule<T: Num>(p: V3<T>, a: V3<T>, b: V3<T>, r: T) -> T {
     let pa = p - a;
     let ba = b - a;
     let h = (pa.dot(ba) / ba.dot(ba).max(T::tiny()))
@@ -61,54 +68,48 @@ pub fn capsule<T: Real>(p: V3<T>, a: V3<T>, b: V3<T>, r: T) -> T {
 /// square of a tiny or huge component is formed; a zero `n` gives the
 /// constant `offset`).
 #[must_use]
-pub fn plane<T: Real>(p: V3<T>, n: V3<T>, offset: T) -> T {
+pub fn plane<T: Num>(p: V3<T>, n: V3<T>, offset: T) -> T {
     let m = n.abs().max_element();
-    let mut n = n;
-    if m > T::zero() {
-        n = n / m;
-        n = n / n.length();
-    }
+    let scaled = n / m;
+    let n = V3::select(m.gt(T::zero()), scaled / scaled.length(), n);
     p.dot(n) + offset
 }
 
 /// Exact distance to the octahedron `|x| + |y| + |z| <= s`.
 #[must_use]
-pub fn octahedron<T: Real>(p: V3<T>, s: T) -> T {
+pub fn octahedron<T: Num>(p: V3<T>, s: T) -> T {
     let p = p.abs();
     let m = p.x + p.y + p.z - s;
     let three = T::of(3.0);
-    let q = if three * p.x < m {
-        p
-    } else if three * p.y < m {
-        v3(p.y, p.z, p.x)
-    } else if three * p.z < m {
-        v3(p.z, p.x, p.y)
-    } else {
-        return m * T::of(0.577_350_269_189_625_8);
-    };
+    let (cx, cy, cz) = (
+        (three * p.x).lt(m),
+        (three * p.y).lt(m),
+        (three * p.z).lt(m),
+    );
+    let q = V3::select(cx, p, V3::select(cy, v3(p.y, p.z, p.x), v3(p.z, p.x, p.y)));
     let k = (T::of(0.5) * (q.z - q.y + s)).max(T::zero()).min(s);
-    v3(q.x, q.y - s + k, q.z - k).length()
+    T::select(
+        cx | cy | cz,
+        v3(q.x, q.y - s + k, q.z - k).length(),
+        m * T::of(0.577_350_269_189_625_8),
+    )
 }
 
 /// Exact distance to a capped cone along y: radius `r1` at `-h`, `r2` at
 /// `+h`.
 #[must_use]
-pub fn capped_cone<T: Real>(p: V3<T>, h: T, r1: T, r2: T) -> T {
+pub fn capped_cone<T: Num>(p: V3<T>, h: T, r1: T, r2: T) -> T {
     let (qx, qy) = (p.x.hypot(p.z), p.y);
     let (k1x, k1y) = (r2, h);
     let (k2x, k2y) = (r2 - r1, T::of(2.0) * h);
-    let cap_r = if qy < T::zero() { r1 } else { r2 };
+    let cap_r = T::select(qy.lt(T::zero()), r1, r2);
     let (cax, cay) = (qx - qx.min(cap_r), qy.abs() - h);
     let k2_len2 = (k2x * k2x + k2y * k2y).max(T::tiny());
     let t = (((k1x - qx) * k2x + (k1y - qy) * k2y) / k2_len2)
         .max(T::zero())
         .min(T::one());
     let (cbx, cby) = (qx - k1x + k2x * t, qy - k1y + k2y * t);
-    let s = if cbx < T::zero() && cay < T::zero() {
-        -T::one()
-    } else {
-        T::one()
-    };
+    let s = T::select(cbx.lt(T::zero()) & cay.lt(T::zero()), -T::one(), T::one());
     s * (cax * cax + cay * cay).min(cbx * cbx + cby * cby).sqrt()
 }
 
@@ -125,14 +126,15 @@ pub fn capped_cone<T: Real>(p: V3<T>, h: T, r1: T, r2: T) -> T {
 /// `(k0 - 1) min(r)`: scaling by `1 / r` stretches no length by more than
 /// `1 / min(r)`, so this never exceeds the true depth.
 #[must_use]
-pub fn ellipsoid<T: Real>(p: V3<T>, r: V3<T>) -> T {
+pub fn ellipsoid<T: Num>(p: V3<T>, r: V3<T>) -> T {
     let q = p / r;
     let k0 = q.safe_length();
-    if k0 < T::one() {
-        return (k0 - T::one()) * r.min_element();
-    }
     let k1 = (q / k0 / r).safe_length();
-    (k0 - T::one()) / k1.max(T::tiny())
+    T::select(
+        k0.lt(T::one()),
+        (k0 - T::one()) * r.min_element(),
+        (k0 - T::one()) / k1.max(T::tiny()),
+    )
 }
 
 /// A distance estimate with its orbit trap in `[0, 1]`.
@@ -226,10 +228,7 @@ pub fn mandelbulb<T: Real>(
     // Escape before r^power passes the magnitude cap: beyond it r^power
     // overflows to infinity (and NaN), and once `dr` is capped a huge r
     // inflates the estimate.
-    let escape = T::of(escape_radius(
-        power.to_f64().unwrap_or(f64::NAN),
-        bailout.to_f64().unwrap_or(f64::NAN),
-    ));
+    let escape = T::of(escape_radius(power.to_f64(), bailout.to_f64()));
     for _ in 0..iterations {
         let r = z.length();
         if r > escape {
@@ -306,7 +305,7 @@ pub fn menger<T: Real>(p: V3<T>, iterations: u32, scale: T) -> Estimate<T> {
 /// Distance bound to the tetrahedron with vertices `(1,1,1)`, `(-1,-1,1)`,
 /// `(1,-1,-1)`, `(-1,1,-1)`: the largest signed face-plane distance.
 #[must_use]
-pub fn tetrahedron<T: Real>(z: V3<T>) -> T {
+pub fn tetrahedron<T: Num>(z: V3<T>) -> T {
     let a = (-z.x - z.y - z.z).max(z.x + z.y - z.z);
     let b = (-z.x + z.y + z.z).max(z.x - z.y + z.z);
     (a.max(b) - T::one()) * T::of(0.577_350_269_189_625_8)
@@ -551,19 +550,27 @@ pub fn julia<T: Real>(p: V3<T>, c: [T; 4], w: T, iterations: u32, bailout: T) ->
     }
 }
 
+/// Rotates `p` by `angle` around the unit axis `k` (Rodrigues' formula).
+#[must_use]
+pub fn rotate_axis<T: Num>(p: V3<T>, k: V3<T>, angle: T) -> V3<T> {
+    let (sn, cs) = (angle.sin(), angle.cos());
+    p * cs + k.cross(p) * sn + k * (k.dot(p) * (T::one() - cs))
+}
+
 /// The polynomial smooth minimum of radius `k` and its blend factor: the
 /// result is `min(a, b) - h^2 k / 4` with `h = max(k - |a - b|, 0) / k`, so
 /// it is at most `k / 4` below `min(a, b)`, and exactly `min(a, b)` when
 /// `k = 0`. The second value is the weight of the larger operand's colour,
 /// in `[0, 0.5]`.
 #[must_use]
-pub fn smooth_min<T: Real>(a: T, b: T, k: T) -> (T, T) {
-    if k <= T::zero() {
-        return (a.min(b), T::zero());
-    }
+pub fn smooth_min<T: Num>(a: T, b: T, k: T) -> (T, T) {
     let h = (k - (a - b).abs()).max(T::zero()) / k;
     let m = h * h * T::of(0.5);
-    (a.min(b) - m * k * T::of(0.5), m)
+    let hard = k.le(T::zero());
+    (
+        T::select(hard, a.min(b), a.min(b) - m * k * T::of(0.5)),
+        T::select(hard, T::zero(), m),
+    )
 }
 
 /// The twist's local Lipschitz factor `t/2 + sqrt(1 + t^2/4)` at
@@ -571,14 +578,14 @@ pub fn smooth_min<T: Real>(a: T, b: T, k: T) -> (T, T) {
 /// distance `rho` from the y axis. The root is a `hypot`, so a large `t`
 /// gives a large factor rather than an infinite one (which would make
 /// every distance 0).
-fn twist_stretch<T: Real>(k: T, rho: T) -> T {
+fn twist_stretch<T: Num>(k: T, rho: T) -> T {
     let half = T::of(0.5) * k.abs() * rho;
     half + T::one().hypot(half)
 }
 
 /// The bend's local Lipschitz factor `1 + |k| rho` at distance `rho` from
 /// the z axis.
-fn bend_stretch<T: Real>(k: T, rho: T) -> T {
+fn bend_stretch<T: Num>(k: T, rho: T) -> T {
     T::one() + k.abs() * rho
 }
 
@@ -587,7 +594,7 @@ fn bend_stretch<T: Real>(k: T, rho: T) -> T {
 /// `L0 = stretch(rho)` and `L1 = stretch(rho + |d| / L0)`, every point of
 /// the ball of radius `|d| / L1` maps within `|d|` of the warped point, so
 /// `d / L1` never overestimates.
-fn warp_bound<T: Real>(d: T, rho: T, stretch: impl Fn(T) -> T) -> T {
+fn warp_bound<T: Num>(d: T, rho: T, stretch: impl Fn(T) -> T) -> T {
     let reach = d.abs() / stretch(rho);
     d / stretch(rho + reach)
 }
@@ -595,13 +602,13 @@ fn warp_bound<T: Real>(d: T, rho: T, stretch: impl Fn(T) -> T) -> T {
 /// The distance bound of a twisted child: `d / L(rho + |d| / L(rho))` with
 /// the twist stretch `L`.
 #[must_use]
-pub fn twist_bound<T: Real>(d: T, k: T, rho: T) -> T {
+pub fn twist_bound<T: Num>(d: T, k: T, rho: T) -> T {
     warp_bound(d, rho, |r| twist_stretch(k, r))
 }
 
 /// The distance bound of a bent child: `d / L(rho + |d| / L(rho))` with
 /// the bend stretch `L`.
 #[must_use]
-pub fn bend_bound<T: Real>(d: T, k: T, rho: T) -> T {
+pub fn bend_bound<T: Num>(d: T, k: T, rho: T) -> T {
     warp_bound(d, rho, |r| bend_stretch(k, r))
 }

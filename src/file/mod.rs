@@ -84,12 +84,12 @@ mod values;
 use convert::nesting;
 use layout::layout;
 use locate::{Located, SiteMap, Sites, line_and_column, locate, unknown_name};
-use schema::{FileRepr, NodeRepr, QualityRepr};
+use schema::{FileRepr, FormulaParam, FormulaRepr, NodeRepr, QualityRepr};
 
 use crate::animation::{CameraPath, Motion};
 use crate::error::{Error, Result};
 use crate::quality::{Effects, Precision, Quality};
-use crate::scene::{CustomShape, Scene};
+use crate::scene::{CustomShape, Kind, Node, Rule, Scene};
 
 /// The format version this library reads and writes.
 pub const FORMAT_VERSION: u32 = 1;
@@ -208,6 +208,19 @@ impl SceneFile {
         }
         let repr = FileRepr {
             version: FORMAT_VERSION,
+            formulas: formulas(geometry)
+                .into_iter()
+                .map(|(shape, text)| {
+                    Located::new(FormulaRepr {
+                        name: shape.name().to_string(),
+                        params: shape
+                            .params()
+                            .map(|(n, r)| FormulaParam::from_rule(n, r))
+                            .collect(),
+                        distance: text,
+                    })
+                })
+                .collect(),
             geometry: Located::new(NodeRepr::from_node(geometry)),
             camera: Located::new(self.scene.camera),
             lights: self
@@ -254,6 +267,25 @@ impl From<Scene> for SceneFile {
     fn from(scene: Scene) -> Self {
         SceneFile::new(scene)
     }
+}
+
+/// The distinct text-formula shapes in `node`, with their texts, in the
+/// order they are first met.
+fn formulas(node: &Node) -> Vec<(CustomShape, String)> {
+    fn walk(node: &Node, out: &mut Vec<(CustomShape, String)>) {
+        if let Kind::Custom { shape, .. } = node.kind()
+            && let Some(text) = shape.formula_text()
+            && !out.iter().any(|(s, _)| s.name() == shape.name())
+        {
+            out.push((shape.clone(), text.to_string()));
+        }
+        for c in node.kind().children() {
+            walk(c, out);
+        }
+    }
+    let mut out = Vec::new();
+    walk(node, &mut out);
+    out
 }
 
 // ---------------------------------------------------------------------------
@@ -322,10 +354,33 @@ fn read(text: &str, file: &Path, shapes: &[CustomShape]) -> Result<SceneFile> {
         Some((line, column)) => at(line, column, error.to_string(), Some(error)),
         None => at(1, 1, error.to_string(), Some(error)),
     };
+    // The file's own formulas first, then the shapes given.
+    let mut all: Vec<CustomShape> = Vec::with_capacity(repr.formulas.len() + shapes.len());
+    for f in &repr.formulas {
+        let params: Vec<(&str, Rule)> = f
+            .value
+            .params
+            .iter()
+            .map(|p| (p.name.as_str(), p.rule()))
+            .collect();
+        let shape = CustomShape::parse(&f.value.name, &params, &f.value.distance)
+            .map_err(|e| located(f.site, e))?;
+        if all.iter().any(|s| s.name() == shape.name()) {
+            return Err(located(
+                f.site,
+                Error::CustomShape {
+                    name: shape.name().to_string(),
+                    reason: "two formulas have this name".into(),
+                },
+            ));
+        }
+        all.push(shape);
+    }
+    all.extend(shapes.iter().cloned());
     let mut sites = SiteMap::default();
     let geometry = repr
         .geometry
-        .to_node(shapes, &mut sites, 1)
+        .to_node(&all, &mut sites, 1)
         .map_err(|(site, e)| located(site, e))?;
     let scene = Scene {
         geometry: Some(geometry),

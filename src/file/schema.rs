@@ -5,7 +5,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::animation::{Keyframe, Motion};
 use crate::quality::{Effects, Precision, Preset, Quality, ScreenNormals};
-use crate::scene::{Axis, Camera, Light, Material, Param, Param3, Scene};
+use crate::scene::{Axis, Camera, Light, Material, Param, Param3, Rule, Scene};
 
 use super::locate::Located;
 use super::values::count;
@@ -18,6 +18,8 @@ use super::values::count;
 #[serde(deny_unknown_fields, rename = "Scene")]
 pub(super) struct FileRepr {
     pub(super) version: u32,
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub(super) formulas: Vec<Located<FormulaRepr>>,
     pub(super) geometry: Located<NodeRepr>,
     #[serde(default)]
     pub(super) camera: Located<Camera>,
@@ -31,6 +33,58 @@ pub(super) struct FileRepr {
     pub(super) path: Option<Located<Vec<Keyframe>>>,
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub(super) motions: Vec<Located<Motion>>,
+}
+
+/// A custom shape written as a text formula: `Custom(name: ..)` nodes use
+/// it by name.
+#[derive(Serialize, Deserialize)]
+#[serde(deny_unknown_fields, rename = "Formula")]
+pub(super) struct FormulaRepr {
+    pub(super) name: String,
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub(super) params: Vec<FormulaParam>,
+    pub(super) distance: String,
+}
+
+/// A formula's parameter and the values it accepts: any finite value, or
+/// at least `min`, at most `max`.
+#[derive(Serialize, Deserialize)]
+#[serde(deny_unknown_fields, rename = "Param")]
+pub(super) struct FormulaParam {
+    pub(super) name: String,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub(super) min: Option<f64>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub(super) max: Option<f64>,
+}
+
+impl FormulaParam {
+    /// The rule its bounds state.
+    pub(super) fn rule(&self) -> Rule {
+        match (self.min, self.max) {
+            (None, None) => Rule::Finite,
+            (Some(lo), None) if lo == 0.0 => Rule::NonNegative,
+            (lo, hi) => Rule::Range(lo.unwrap_or(-f64::MAX), hi.unwrap_or(f64::MAX)),
+        }
+    }
+
+    /// The bounds that state `rule`.
+    pub(super) fn from_rule(name: &str, rule: Rule) -> Self {
+        let (min, max) = match rule {
+            Rule::NonNegative => (Some(0.0), None),
+            Rule::Positive => (Some(f64::MIN_POSITIVE), None),
+            Rule::Range(lo, hi) => (
+                (lo > -f64::MAX).then_some(lo),
+                (hi < f64::MAX).then_some(hi),
+            ),
+            Rule::Finite | Rule::Angle | Rule::Direction => (None, None),
+        };
+        FormulaParam {
+            name: name.to_string(),
+            min,
+            max,
+        }
+    }
 }
 
 pub(super) fn default_lights() -> Vec<Located<Light>> {

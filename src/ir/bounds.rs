@@ -320,10 +320,18 @@ pub(super) fn bound(node: &IrNode, done: &[Option<Bound>]) -> Option<Bound> {
         Kind::Plane { .. } | Kind::Repeat { .. } => {
             return None;
         }
-        // An inside shape's value is `INSIDE_HUGE` outside its bounds.
-        Kind::Custom { shape, .. } => {
-            let (centre, radius) = shape.inside_bounds()?.ball();
-            Bound::sphere(centre, radius)
+        // An inside shape's value is `INSIDE_HUGE` outside its bounds; a
+        // shape written once is at most 0 only in the box interval
+        // arithmetic finds for its baked values.
+        Kind::Custom { shape, args } => {
+            if let Some(bounds) = shape.inside_bounds() {
+                let (centre, radius) = bounds.ball();
+                Bound::sphere(centre, radius)
+            } else {
+                let values: Vec<f64> = args.iter().map(|a| baked(*a)).collect::<Option<_>>()?;
+                let [lo, hi] = shape.surface_box(&values)?;
+                Bound::sphere(0.5 * (lo + hi), 0.5 * (hi - lo).length())
+            }
         }
     })
 }

@@ -12,7 +12,7 @@ mod real;
 use glam::DVec3;
 
 pub use limits::{F32_LIMITS, F64_LIMITS, Limits, Magnitude, reduce_angle};
-pub use real::{Real, V3, v3};
+pub use real::{Num, Real, V3, v3};
 
 /// The smallest magnitude used to guard divisions and logarithms, in both
 /// twins (`REAL_TINY` in the kernels; a normal `f32`).
@@ -59,7 +59,7 @@ pub fn escape_radius(power: f64, bailout: f64) -> f64 {
 /// assert!((mandelbulb_radius(8.0_f64) - 1.104).abs() < 1e-3);
 /// ```
 #[must_use]
-pub fn mandelbulb_radius<T: Real>(power: T) -> T {
+pub fn mandelbulb_radius<T: Num>(power: T) -> T {
     T::of(2.0).powf(T::one() / (power - T::one()))
 }
 
@@ -123,7 +123,7 @@ pub fn rotation_rows(axis: DVec3, angle: f64) -> [V3<f64>; 3] {
 /// assert_eq!(julia_radius([0.0_f64, 0.0, 0.0, 0.0]), 1.0);
 /// ```
 #[must_use]
-pub fn julia_radius<T: Real>(c: [T; 4]) -> T {
+pub fn julia_radius<T: Num>(c: [T; 4]) -> T {
     let half = T::of(0.5);
     let norm = (c[0] * c[0] + c[1] * c[1] + c[2] * c[2] + c[3] * c[3]).sqrt();
     half + (half * half + norm).sqrt()

@@ -4,40 +4,36 @@
 
 use std::ops::{Add, Div, Mul, Neg, Sub};
 
-use num_traits::{Float, FloatConst};
+pub use crate::expr::Num;
 
 /// A floating-point type the reference evaluator can run in: `f32` or `f64`.
-pub trait Real: Float + FloatConst + std::fmt::Debug + Send + Sync + 'static {
-    /// Converts from `f64` (rounding to nearest for `f32`).
-    fn of(v: f64) -> Self;
-    /// The smallest magnitude used to guard divisions and logarithms. The
-    /// OpenCL kernels use the same value (`1e-30`, a normal `f32`).
-    fn tiny() -> Self {
-        Self::of(super::REAL_TINY)
-    }
-    /// The cap on fractal running derivatives, so they never overflow to
-    /// infinity (`1e30` in both precisions).
-    fn derivative_cap() -> Self {
-        Self::of(super::DERIVATIVE_CAP)
-    }
-    /// The largest magnitude an escape-time iteration may produce (`1e18`
-    /// in both precisions): the squared length of a vector this long stays
-    /// below `f32::MAX`, and dividing it by a capped derivative stays tiny.
-    fn magnitude_cap() -> Self {
-        Self::of(super::MAGNITUDE_CAP)
-    }
+///
+/// A [`Num`] whose comparisons are plain `bool`s, with an order and a
+/// conversion to `f64`: what the evaluator's own control flow needs
+/// beyond the formulas.
+pub trait Real: Num<Bool = bool> + PartialOrd + Send + Sync {
+    /// The value as `f64` (exact).
+    fn to_f64(self) -> f64;
+    /// The nearest integer, halves away from zero.
+    #[must_use]
+    fn round(self) -> Self;
 }
 
 impl Real for f32 {
-    #[allow(clippy::cast_possible_truncation)]
-    fn of(v: f64) -> Self {
-        v as f32
+    fn to_f64(self) -> f64 {
+        f64::from(self)
+    }
+    fn round(self) -> Self {
+        f32::round(self)
     }
 }
 
 impl Real for f64 {
-    fn of(v: f64) -> Self {
-        v
+    fn to_f64(self) -> f64 {
+        self
+    }
+    fn round(self) -> Self {
+        f64::round(self)
     }
 }
 
@@ -58,7 +54,7 @@ pub fn v3<T>(x: T, y: T, z: T) -> V3<T> {
     V3 { x, y, z }
 }
 
-impl<T: Real> V3<T> {
+impl<T: Num> V3<T> {
     /// All components `v`.
     #[must_use]
     pub fn splat(v: T) -> Self {
@@ -110,7 +106,7 @@ impl<T: Real> V3<T> {
     /// Euclidean length.
     #[must_use]
     pub fn length(self) -> T {
-        self.dot(self).sqrt()
+        T::length3(self.x, self.y, self.z)
     }
 
     /// Euclidean length without overflow or underflow in the squares: the
@@ -120,11 +116,11 @@ impl<T: Real> V3<T> {
     #[must_use]
     pub fn safe_length(self) -> T {
         let m = self.abs().max_element();
-        if m > T::zero() && m.is_finite() {
-            m * (self / m).length()
-        } else {
-            self.length()
-        }
+        T::select(
+            m.gt(T::zero()) & m.finite(),
+            m * (self / m).length(),
+            self.length(),
+        )
     }
 
     /// Component-wise absolute value.
@@ -145,66 +141,78 @@ impl<T: Real> V3<T> {
         self.x.max(self.y).max(self.z)
     }
 
+    /// `a` where `c` holds, else `b`, component by component.
+    #[must_use]
+    pub fn select(c: T::Bool, a: Self, b: Self) -> Self {
+        v3(
+            T::select(c, a.x, b.x),
+            T::select(c, a.y, b.y),
+            T::select(c, a.z, b.z),
+        )
+    }
+
     /// The smallest component.
     #[must_use]
     pub fn min_element(self) -> T {
         self.x.min(self.y).min(self.z)
     }
+}
 
+impl<T: Real> V3<T> {
     /// Converts to the other precision.
     #[must_use]
     pub fn cast<U: Real>(self) -> V3<U> {
         v3(
-            U::of(self.x.to_f64().unwrap_or(f64::NAN)),
-            U::of(self.y.to_f64().unwrap_or(f64::NAN)),
-            U::of(self.z.to_f64().unwrap_or(f64::NAN)),
+            U::of(self.x.to_f64()),
+            U::of(self.y.to_f64()),
+            U::of(self.z.to_f64()),
         )
     }
 }
 
-impl<T: Real> Add for V3<T> {
+impl<T: Num> Add for V3<T> {
     type Output = Self;
     fn add(self, o: Self) -> Self {
         self.zip(o, |a, b| a + b)
     }
 }
 
-impl<T: Real> Sub for V3<T> {
+impl<T: Num> Sub for V3<T> {
     type Output = Self;
     fn sub(self, o: Self) -> Self {
         self.zip(o, |a, b| a - b)
     }
 }
 
-impl<T: Real> Mul<T> for V3<T> {
+impl<T: Num> Mul<T> for V3<T> {
     type Output = Self;
     fn mul(self, s: T) -> Self {
         self.map(|c| c * s)
     }
 }
 
-impl<T: Real> Mul for V3<T> {
+impl<T: Num> Mul for V3<T> {
     type Output = Self;
     fn mul(self, o: Self) -> Self {
         self.zip(o, |a, b| a * b)
     }
 }
 
-impl<T: Real> Div for V3<T> {
+impl<T: Num> Div for V3<T> {
     type Output = Self;
     fn div(self, o: Self) -> Self {
         self.zip(o, |a, b| a / b)
     }
 }
 
-impl<T: Real> Div<T> for V3<T> {
+impl<T: Num> Div<T> for V3<T> {
     type Output = Self;
     fn div(self, s: T) -> Self {
         self.map(|c| c / s)
     }
 }
 
-impl<T: Real> Neg for V3<T> {
+impl<T: Num> Neg for V3<T> {
     type Output = Self;
     fn neg(self) -> Self {
         self.map(|c| -c)

@@ -33,6 +33,8 @@ use super::names;
 use super::node::{Kind, Node, Rule};
 use super::param::Param;
 use crate::error::{Error, Result, fmt_value};
+use crate::expr::{Distance, Formula, OpenCl, Printer, Program, Shape, Signature, trace};
+use crate::math::{V3, v3};
 
 /// The Rust distance function of a custom shape: the point and the
 /// parameter values in declaration order.
@@ -286,6 +288,11 @@ struct Inner {
     /// says what it computes); `None` otherwise.
     cpu_type: Option<TypeId>,
     opencl: String,
+    /// The traced formula of a shape written once ([`CustomShape::formula`]
+    /// or [`CustomShape::parse`]); `opencl` is then its printed function.
+    program: Option<Arc<Program>>,
+    /// The text of a shape defined by [`CustomShape::parse`].
+    text: Option<String>,
 }
 
 impl CustomShape {
@@ -309,6 +316,127 @@ impl CustomShape {
             cpu_type,
             opencl_body,
         )
+    }
+
+    /// Defines a shape from one formula, written once: the CPU reference
+    /// runs it in `f64`, code generation traces it into the expression IR
+    /// and prints its OpenCL function, and its bounds come from interval
+    /// arithmetic over it (so meshing needs no `--bounds` where the
+    /// formula bounds its shape). Its parameters are the `(name, rule)`s,
+    /// in the order `params` gets their values.
+    ///
+    /// ```
+    /// use fractal_sdf::expr::{Distance, Num};
+    /// use fractal_sdf::math::V3;
+    /// use fractal_sdf::prelude::*;
+    /// use fractal_sdf::scene::{CustomShape, Rule};
+    ///
+    /// /// A box with rounded edges: half extents `b`, rounding `r`.
+    /// struct Rounded;
+    ///
+    /// impl Distance for Rounded {
+    ///     fn distance<N: Num>(&self, p: V3<N>, a: &[N]) -> N {
+    ///         let q = p.abs() - V3::splat(a[0] - a[1]);
+    ///         q.max_s(N::zero()).length() + q.max_element().min(N::zero()) - a[1]
+    ///     }
+    /// }
+    ///
+    /// let shape = CustomShape::formula("rounded", &[("b", Rule::Positive), ("r", Rule::NonNegative)], Rounded)?;
+    /// let eval = cpu::Evaluator::new(&shape.node([1.0, 0.25]))?;
+    /// assert!((eval.distance(dvec3(2.0, 0.0, 0.0)) - 1.0).abs() < 1e-12);
+    /// # Ok::<(), fractal_sdf::Error>(())
+    /// ```
+    ///
+    /// # Errors
+    /// [`Error::CustomShape`] for a name or parameter as in
+    /// [`CustomShape::new`].
+    pub fn formula<F: Distance>(name: &str, params: &[(&str, Rule)], formula: F) -> Result<Self> {
+        let program = trace_formula(&formula, params.len());
+        let cpu_type = (std::mem::size_of::<F>() == 0).then(TypeId::of::<F>);
+        let cpu = move |p: DVec3, a: &[f64]| formula.distance(V3::from(p), a);
+        Self::define_program(name, params, program, Box::new(cpu), cpu_type)
+    }
+
+    /// Defines a shape from a text formula (see [`Formula`] for the
+    /// language): the formula is parsed, checked and traced once, and
+    /// works as [`CustomShape::formula`] does. Scene files and the
+    /// command line's `--formula` define shapes this way.
+    ///
+    /// ```
+    /// use fractal_sdf::prelude::*;
+    /// use fractal_sdf::scene::{CustomShape, Rule};
+    ///
+    /// let shape = CustomShape::parse("ball", &[("r", Rule::Positive)], "length(p) - r")?;
+    /// let eval = cpu::Evaluator::new(&shape.node([1.0]))?;
+    /// assert_eq!(eval.distance(dvec3(3.0, 0.0, 0.0)), 2.0);
+    /// # Ok::<(), fractal_sdf::Error>(())
+    /// ```
+    ///
+    /// # Errors
+    /// [`Error::Formula`] with the line and column of a syntax error, an
+    /// unknown name or a wrong type; [`Error::CustomShape`] for a name or
+    /// parameter as in [`CustomShape::new`].
+    pub fn parse(name: &str, params: &[(&str, Rule)], text: &str) -> Result<Self> {
+        let names: Vec<&str> = params.iter().map(|(n, _)| *n).collect();
+        let formula = Formula::parse(text, &names).map_err(|e| Error::Formula {
+            name: name.chars().take(48).collect(),
+            line: e.line,
+            column: e.column,
+            message: e.message,
+        })?;
+        let program = formula.program();
+        let run = program.clone();
+        // The traced program runs faster than the parsed text.
+        let cpu = move |p: DVec3, a: &[f64]| {
+            let mut inputs = vec![p.x, p.y, p.z];
+            inputs.extend_from_slice(a);
+            run.run(&inputs).first().copied().unwrap_or(f64::NAN)
+        };
+        let mut shape = Self::define_program(name, params, program, Box::new(cpu), None)?;
+        if let Some(inner) = Arc::get_mut(&mut shape.0) {
+            inner.text = Some(text.to_string());
+        }
+        Ok(shape)
+    }
+
+    /// The text of a shape defined by [`CustomShape::parse`] (how a scene
+    /// file writes it back); `None` for other shapes.
+    #[must_use]
+    pub fn formula_text(&self) -> Option<&str> {
+        self.0.text.as_deref()
+    }
+
+    fn define_program(
+        name: &str,
+        params: &[(&str, Rule)],
+        program: Program,
+        cpu: Box<CpuDistance>,
+        cpu_type: Option<TypeId>,
+    ) -> Result<Self> {
+        check_names(name, params)?;
+        let function = format!("custom_{name}");
+        let mut signature_params = vec![("p", Shape::Vec3)];
+        signature_params.extend(params.iter().map(|(n, _)| (*n, Shape::Scalar)));
+        let signature = Signature {
+            name: &function,
+            params: &signature_params,
+            result: Shape::Scalar,
+        };
+        let opencl = OpenCl
+            .function(&signature, &program)
+            .map_err(|e| Error::CustomShape {
+                name: name.into(),
+                reason: e.to_string(),
+            })?;
+        Ok(CustomShape(Arc::new(Inner {
+            name: name.into(),
+            params: params.iter().map(|(n, r)| ((*n).to_string(), *r)).collect(),
+            cpu: Form::Distance(cpu),
+            cpu_type,
+            opencl,
+            program: Some(Arc::new(program)),
+            text: None,
+        })))
     }
 
     /// Defines an inside shape: see [`InsideShape::new`](super::InsideShape::new).
@@ -347,21 +475,7 @@ impl CustomShape {
             name: name.chars().take(48).collect(),
             reason,
         };
-        check_identifier(name).map_err(|r| bad(format!("name {r}")))?;
-        let mut seen: Vec<&str> = Vec::new();
-        for (param, _) in params {
-            check_identifier(param).map_err(|r| bad(format!("parameter `{param}` {r}")))?;
-            if *param == "p" {
-                return Err(bad("parameter `p` shadows the point `p`".into()));
-            }
-            if let Some(why) = names::reserved(param) {
-                return Err(bad(format!("parameter `{param}` {why}")));
-            }
-            if seen.contains(param) {
-                return Err(bad(format!("parameter name `{param}` is used twice")));
-            }
-            seen.push(param);
-        }
+        check_names(name, params)?;
         if opencl_body.trim().is_empty() {
             return Err(bad("the OpenCL body is empty".into()));
         }
@@ -374,6 +488,8 @@ impl CustomShape {
             cpu,
             cpu_type,
             opencl: opencl_body.into(),
+            program: None,
+            text: None,
         })))
     }
 
@@ -383,10 +499,28 @@ impl CustomShape {
         &self.0.name
     }
 
-    /// The OpenCL body as given.
+    /// The OpenCL body as given, or for a shape written once
+    /// ([`CustomShape::formula`], [`CustomShape::parse`]) its printed
+    /// function.
     #[must_use]
     pub fn opencl_body(&self) -> &str {
         &self.0.opencl
+    }
+
+    /// The traced formula of a shape written once; `None` for a shape
+    /// with an OpenCL body of its own.
+    #[must_use]
+    pub fn program(&self) -> Option<&Program> {
+        self.0.program.as_deref()
+    }
+
+    /// A box holding the surface of a shape written once with these
+    /// parameter values, from interval arithmetic over its formula (see
+    /// [`crate::expr::surface_box`]); `None` where the formula does not
+    /// bound its shape, or for other shapes.
+    #[must_use]
+    pub fn surface_box(&self, args: &[f64]) -> Option<[DVec3; 2]> {
+        crate::expr::surface_box(self.program()?, args)
     }
 
     /// The parameters' names and rules, in order.
@@ -449,6 +583,9 @@ impl CustomShape {
     /// another.
     #[must_use]
     pub fn opencl_definition(&self) -> String {
+        if self.0.program.is_some() {
+            return self.0.opencl.clone();
+        }
         let (ty, name) = match self.test_name() {
             Some(test) => ("int", test),
             None => ("real", self.function_name()),
@@ -515,6 +652,9 @@ impl CustomShape {
             Some("the names differ")
         } else if a.params != b.params {
             Some("the parameters (names or rules) differ")
+        } else if let (Some(x), Some(y)) = (&a.program, &b.program) {
+            // A formula written once is its program: the CPU runs it too.
+            (x != y).then_some("the formulas differ")
         } else if a.opencl != b.opencl {
             Some("the OpenCL bodies differ")
         } else if self.inside_bounds() != other.inside_bounds() {
@@ -548,6 +688,36 @@ impl fmt::Debug for CustomShape {
             .field("params", &self.0.params)
             .finish_non_exhaustive()
     }
+}
+
+/// Traces `formula` with inputs `p.x, p.y, p.z` and `params` parameters.
+fn trace_formula<F: Distance>(formula: &F, params: usize) -> Program {
+    let n = u32::try_from(params + 3).unwrap_or(u32::MAX);
+    trace(n, |a| vec![formula.distance(v3(a[0], a[1], a[2]), &a[3..])])
+}
+
+/// Checks a shape's name and its parameters' names.
+fn check_names(name: &str, params: &[(&str, Rule)]) -> Result<()> {
+    let bad = |reason: String| Error::CustomShape {
+        name: name.chars().take(48).collect(),
+        reason,
+    };
+    check_identifier(name).map_err(|r| bad(format!("name {r}")))?;
+    let mut seen: Vec<&str> = Vec::new();
+    for (param, _) in params {
+        check_identifier(param).map_err(|r| bad(format!("parameter `{param}` {r}")))?;
+        if *param == "p" {
+            return Err(bad("parameter `p` shadows the point `p`".into()));
+        }
+        if let Some(why) = names::reserved(param) {
+            return Err(bad(format!("parameter `{param}` {why}")));
+        }
+        if seen.contains(param) {
+            return Err(bad(format!("parameter name `{param}` is used twice")));
+        }
+        seen.push(param);
+    }
+    Ok(())
 }
 
 /// Why a custom shape's OpenCL body cannot stay inside the shape's

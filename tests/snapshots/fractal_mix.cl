@@ -93,20 +93,21 @@ real sd_sphere(real3 p, real r) {
 
 /* ---- cuboid ---- */
 real sd_box(real3 p, real3 b) {
-    real3 q = fabs(p) - b;
-    return length(fmax(q, (real3)(R(0.0)))) + fmin(fmax(fmax(q.x, q.y), q.z), R(0.0));
+    real t0 = fabs(p.x) - b.x;
+    real t1 = fabs(p.y) - b.y;
+    real t2 = fabs(p.z) - b.z;
+    return length((real3)(fmax(t0, R(0.0)), fmax(t1, R(0.0)), fmax(t2, R(0.0)))) + fmin(fmax(fmax(t0, t1), t2), R(0.0));
 }
 
 /* ---- plane ---- */
-/* n is scaled by its largest component before it is normalised, so no
-   square of a tiny or huge component is formed (cpu: sdf::plane). */
 real sd_plane(real3 p, real3 n, real offset) {
-    real m = fmax(fmax(fabs(n.x), fabs(n.y)), fabs(n.z));
-    if (m > R(0.0)) {
-        n = n / m;
-        n = n / length(n);
-    }
-    return dot(p, n) + offset;
+    real t0 = fmax(fmax(fabs(n.x), fabs(n.y)), fabs(n.z));
+    real t1 = n.x / t0;
+    real t2 = n.y / t0;
+    real t3 = n.z / t0;
+    bool t4 = R(0.0) < t0;
+    real t5 = length((real3)(t1, t2, t3));
+    return (((p.x * (t4 ? (t1 / t5) : n.x)) + (p.y * (t4 ? (t2 / t5) : n.y))) + (p.z * (t4 ? (t3 / t5) : n.z))) + offset;
 }
 
 /* ---- mandelbulb ---- */
@@ -165,9 +166,8 @@ real menger(real3 p, int iterations, real scale, real* trap) {
 
 /* ---- tetrahedron ---- */
 real sd_tetrahedron(real3 z) {
-    real a = fmax(-z.x - z.y - z.z, z.x + z.y - z.z);
-    real b = fmax(-z.x + z.y + z.z, z.x - z.y + z.z);
-    return (fmax(a, b) - R(1.0)) * R(0.5773502691896258);
+    real t0 = -z.x;
+    return (fmax(fmax((t0 - z.y) - z.z, (z.x + z.y) - z.z), fmax((t0 + z.y) + z.z, (z.x - z.y) + z.z)) - R(1.0)) * R(0.5773502691896258);
 }
 
 /* ---- sierpinski ---- */
@@ -292,15 +292,12 @@ real julia(real3 p, real4 c, real w, int iterations, real bailout, real* trap) {
 }
 
 /* ---- smooth_min ---- */
-/* Polynomial smooth minimum of radius k: (value, blend weight of the far operand).
-   Exactly min(a, b) with weight 0 when k = 0. */
 real2 smooth_min(real a, real b, real k) {
-    if (k <= R(0.0)) {
-        return (real2)(fmin(a, b), R(0.0));
-    }
-    real h = fmax(k - fabs(a - b), R(0.0)) / k;
-    real m = h * h * R(0.5);
-    return (real2)(fmin(a, b) - m * k * R(0.5), m);
+    real t0 = fmax(k - fabs(a - b), R(0.0)) / k;
+    real t1 = (t0 * t0) * R(0.5);
+    bool t2 = k <= R(0.0);
+    real t3 = fmin(a, b);
+    return (real2)(t2 ? t3 : (t3 - ((t1 * k) * R(0.5))), t2 ? R(0.0) : t1);
 }
 
 /* ---- scene ---- */

@@ -90,43 +90,35 @@ typedef float8 real8;
 #define LIGHT_SOFTNESS 7
 #define LIGHT_STRIDE 8
 
-/* ---- length ---- */
-/* Euclidean length without overflow or underflow in the squares: v is
-   divided by its largest component first (cpu: V3::safe_length). */
-real safe_length(real3 v) {
-    real m = fmax(fmax(fabs(v.x), fabs(v.y)), fabs(v.z));
-    return m > R(0.0) && isfinite(m) ? m * length(v / m) : length(v);
-}
-
 /* ---- sphere ---- */
 real sd_sphere(real3 p, real r) {
     return length(p) - r;
 }
 
 /* ---- plane ---- */
-/* n is scaled by its largest component before it is normalised, so no
-   square of a tiny or huge component is formed (cpu: sdf::plane). */
 real sd_plane(real3 p, real3 n, real offset) {
-    real m = fmax(fmax(fabs(n.x), fabs(n.y)), fabs(n.z));
-    if (m > R(0.0)) {
-        n = n / m;
-        n = n / length(n);
-    }
-    return dot(p, n) + offset;
+    real t0 = fmax(fmax(fabs(n.x), fabs(n.y)), fabs(n.z));
+    real t1 = n.x / t0;
+    real t2 = n.y / t0;
+    real t3 = n.z / t0;
+    bool t4 = R(0.0) < t0;
+    real t5 = length((real3)(t1, t2, t3));
+    return (((p.x * (t4 ? (t1 / t5) : n.x)) + (p.y * (t4 ? (t2 / t5) : n.y))) + (p.z * (t4 ? (t3 / t5) : n.z))) + offset;
 }
 
 /* ---- ellipsoid ---- */
-/* Quilez's bound k0 (k0 - 1) / k1, with k0 = |p / r| and k1 = |p / r^2|,
-   computed as (k0 - 1) / |u / r| with u = (p / r) / k0, so no square of
-   p / r or p / r^2 is formed (cpu: sdf::ellipsoid). */
 real sd_ellipsoid(real3 p, real3 r) {
-    real3 q = p / r;
-    real k0 = safe_length(q);
-    if (k0 < R(1.0)) {
-        return (k0 - R(1.0)) * fmin(fmin(r.x, r.y), r.z);
-    }
-    real k1 = safe_length(q / k0 / r);
-    return (k0 - R(1.0)) / fmax(k1, REAL_TINY);
+    real t0 = p.x / r.x;
+    real t1 = p.y / r.y;
+    real t2 = p.z / r.z;
+    real t3 = fmax(fmax(fabs(t0), fabs(t1)), fabs(t2));
+    real t4 = ((R(0.0) < t3) && isfinite(t3)) ? (t3 * length((real3)(t0 / t3, t1 / t3, t2 / t3))) : length((real3)(t0, t1, t2));
+    real t5 = (t0 / t4) / r.x;
+    real t6 = (t1 / t4) / r.y;
+    real t7 = (t2 / t4) / r.z;
+    real t8 = fmax(fmax(fabs(t5), fabs(t6)), fabs(t7));
+    real t9 = t4 - R(1.0);
+    return (t4 < R(1.0)) ? (t9 * fmin(fmin(r.x, r.y), r.z)) : (t9 / fmax(((R(0.0) < t8) && isfinite(t8)) ? (t8 * length((real3)(t5 / t8, t6 / t8, t7 / t8))) : length((real3)(t5, t6, t7)), R(1e-30)));
 }
 
 /* ---- mandelbulb_p8 ---- */

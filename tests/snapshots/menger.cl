@@ -88,20 +88,21 @@ typedef float4 real4;
 
 /* ---- cuboid ---- */
 real sd_box(real3 p, real3 b) {
-    real3 q = fabs(p) - b;
-    return length(fmax(q, (real3)(R(0.0)))) + fmin(fmax(fmax(q.x, q.y), q.z), R(0.0));
+    real t0 = fabs(p.x) - b.x;
+    real t1 = fabs(p.y) - b.y;
+    real t2 = fabs(p.z) - b.z;
+    return length((real3)(fmax(t0, R(0.0)), fmax(t1, R(0.0)), fmax(t2, R(0.0)))) + fmin(fmax(fmax(t0, t1), t2), R(0.0));
 }
 
 /* ---- plane ---- */
-/* n is scaled by its largest component before it is normalised, so no
-   square of a tiny or huge component is formed (cpu: sdf::plane). */
 real sd_plane(real3 p, real3 n, real offset) {
-    real m = fmax(fmax(fabs(n.x), fabs(n.y)), fabs(n.z));
-    if (m > R(0.0)) {
-        n = n / m;
-        n = n / length(n);
-    }
-    return dot(p, n) + offset;
+    real t0 = fmax(fmax(fabs(n.x), fabs(n.y)), fabs(n.z));
+    real t1 = n.x / t0;
+    real t2 = n.y / t0;
+    real t3 = n.z / t0;
+    bool t4 = R(0.0) < t0;
+    real t5 = length((real3)(t1, t2, t3));
+    return (((p.x * (t4 ? (t1 / t5) : n.x)) + (p.y * (t4 ? (t2 / t5) : n.y))) + (p.z * (t4 ? (t3 / t5) : n.z))) + offset;
 }
 
 /* ---- menger ---- */

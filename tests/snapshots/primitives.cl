@@ -86,14 +86,6 @@ typedef float4 real4;
 #define LIGHT_SOFTNESS 7
 #define LIGHT_STRIDE 8
 
-/* ---- length ---- */
-/* Euclidean length without overflow or underflow in the squares: v is
-   divided by its largest component first (cpu: V3::safe_length). */
-real safe_length(real3 v) {
-    real m = fmax(fmax(fabs(v.x), fabs(v.y)), fabs(v.z));
-    return m > R(0.0) && isfinite(m) ? m * length(v / m) : length(v);
-}
-
 /* ---- sphere ---- */
 real sd_sphere(real3 p, real r) {
     return length(p) - r;
@@ -101,96 +93,95 @@ real sd_sphere(real3 p, real r) {
 
 /* ---- cuboid ---- */
 real sd_box(real3 p, real3 b) {
-    real3 q = fabs(p) - b;
-    return length(fmax(q, (real3)(R(0.0)))) + fmin(fmax(fmax(q.x, q.y), q.z), R(0.0));
+    real t0 = fabs(p.x) - b.x;
+    real t1 = fabs(p.y) - b.y;
+    real t2 = fabs(p.z) - b.z;
+    return length((real3)(fmax(t0, R(0.0)), fmax(t1, R(0.0)), fmax(t2, R(0.0)))) + fmin(fmax(fmax(t0, t1), t2), R(0.0));
 }
 
 /* ---- round_box ---- */
 real sd_round_box(real3 p, real3 b, real r) {
-    real3 q = fabs(p) - b + r;
-    return length(fmax(q, (real3)(R(0.0)))) + fmin(fmax(fmax(q.x, q.y), q.z), R(0.0)) - r;
+    real t0 = (fabs(p.x) - b.x) + r;
+    real t1 = (fabs(p.y) - b.y) + r;
+    real t2 = (fabs(p.z) - b.z) + r;
+    return (length((real3)(fmax(t0, R(0.0)), fmax(t1, R(0.0)), fmax(t2, R(0.0)))) + fmin(fmax(fmax(t0, t1), t2), R(0.0))) - r;
 }
 
 /* ---- torus ---- */
 real sd_torus(real3 p, real major, real minor) {
-    real qx = hypot(p.x, p.z) - major;
-    return hypot(qx, p.y) - minor;
+    return hypot(hypot(p.x, p.z) - major, p.y) - minor;
 }
 
 /* ---- cylinder ---- */
 real sd_cylinder(real3 p, real r, real h) {
-    real dx = hypot(p.x, p.z) - r;
-    real dy = fabs(p.y) - h;
-    return fmin(fmax(dx, dy), R(0.0)) + hypot(fmax(dx, R(0.0)), fmax(dy, R(0.0)));
+    real t0 = hypot(p.x, p.z) - r;
+    real t1 = fabs(p.y) - h;
+    return fmin(fmax(t0, t1), R(0.0)) + hypot(fmax(t0, R(0.0)), fmax(t1, R(0.0)));
 }
 
 /* ---- capsule ---- */
 real sd_capsule(real3 p, real3 a, real3 b, real r) {
-    real3 pa = p - a;
-    real3 ba = b - a;
-    real h = fmin(fmax(dot(pa, ba) / fmax(dot(ba, ba), REAL_TINY), R(0.0)), R(1.0));
-    return length(pa - ba * h) - r;
+    real t0 = p.x - a.x;
+    real t1 = p.y - a.y;
+    real t2 = p.z - a.z;
+    real t3 = b.x - a.x;
+    real t4 = b.y - a.y;
+    real t5 = b.z - a.z;
+    real t6 = fmin(fmax((((t0 * t3) + (t1 * t4)) + (t2 * t5)) / fmax(((t3 * t3) + (t4 * t4)) + (t5 * t5), R(1e-30)), R(0.0)), R(1.0));
+    return length((real3)(t0 - (t3 * t6), t1 - (t4 * t6), t2 - (t5 * t6))) - r;
 }
 
 /* ---- plane ---- */
-/* n is scaled by its largest component before it is normalised, so no
-   square of a tiny or huge component is formed (cpu: sdf::plane). */
 real sd_plane(real3 p, real3 n, real offset) {
-    real m = fmax(fmax(fabs(n.x), fabs(n.y)), fabs(n.z));
-    if (m > R(0.0)) {
-        n = n / m;
-        n = n / length(n);
-    }
-    return dot(p, n) + offset;
+    real t0 = fmax(fmax(fabs(n.x), fabs(n.y)), fabs(n.z));
+    real t1 = n.x / t0;
+    real t2 = n.y / t0;
+    real t3 = n.z / t0;
+    bool t4 = R(0.0) < t0;
+    real t5 = length((real3)(t1, t2, t3));
+    return (((p.x * (t4 ? (t1 / t5) : n.x)) + (p.y * (t4 ? (t2 / t5) : n.y))) + (p.z * (t4 ? (t3 / t5) : n.z))) + offset;
 }
 
 /* ---- octahedron ---- */
 real sd_octahedron(real3 p, real s) {
-    p = fabs(p);
-    real m = p.x + p.y + p.z - s;
-    real3 q;
-    if (R(3.0) * p.x < m) {
-        q = p;
-    } else if (R(3.0) * p.y < m) {
-        q = (real3)(p.y, p.z, p.x);
-    } else if (R(3.0) * p.z < m) {
-        q = (real3)(p.z, p.x, p.y);
-    } else {
-        return m * R(0.5773502691896258);
-    }
-    real k = fmin(fmax(R(0.5) * (q.z - q.y + s), R(0.0)), s);
-    return length((real3)(q.x, q.y - s + k, q.z - k));
+    real t0 = fabs(p.x);
+    real t1 = fabs(p.y);
+    real t2 = fabs(p.z);
+    real t3 = ((t0 + t1) + t2) - s;
+    bool t4 = (R(3.0) * t0) < t3;
+    bool t5 = (R(3.0) * t1) < t3;
+    real t6 = t4 ? t1 : (t5 ? t2 : t0);
+    real t7 = t4 ? t2 : (t5 ? t0 : t1);
+    real t8 = fmin(fmax(R(0.5) * ((t7 - t6) + s), R(0.0)), s);
+    return ((t4 || t5) || ((R(3.0) * t2) < t3)) ? length((real3)(t4 ? t0 : (t5 ? t1 : t2), (t6 - s) + t8, t7 - t8)) : (t3 * R(0.5773502691896258));
 }
 
 /* ---- capped_cone ---- */
 real sd_capped_cone(real3 p, real h, real r1, real r2) {
-    real qx = hypot(p.x, p.z);
-    real qy = p.y;
-    real k1x = r2, k1y = h;
-    real k2x = r2 - r1, k2y = R(2.0) * h;
-    real cap_r = qy < R(0.0) ? r1 : r2;
-    real cax = qx - fmin(qx, cap_r);
-    real cay = fabs(qy) - h;
-    real k2_len2 = fmax(k2x * k2x + k2y * k2y, REAL_TINY);
-    real t = fmin(fmax(((k1x - qx) * k2x + (k1y - qy) * k2y) / k2_len2, R(0.0)), R(1.0));
-    real cbx = qx - k1x + k2x * t;
-    real cby = qy - k1y + k2y * t;
-    real s = (cbx < R(0.0) && cay < R(0.0)) ? R(-1.0) : R(1.0);
-    return s * sqrt(fmin(cax * cax + cay * cay, cbx * cbx + cby * cby));
+    real t0 = hypot(p.x, p.z);
+    real t1 = r2 - r1;
+    real t2 = R(2.0) * h;
+    real t3 = t0 - fmin(t0, (p.y < R(0.0)) ? r1 : r2);
+    real t4 = fabs(p.y) - h;
+    real t5 = fmin(fmax((((r2 - t0) * t1) + ((h - p.y) * t2)) / fmax((t1 * t1) + (t2 * t2), R(1e-30)), R(0.0)), R(1.0));
+    real t6 = (t0 - r2) + (t1 * t5);
+    real t7 = (p.y - h) + (t2 * t5);
+    return (((t6 < R(0.0)) && (t4 < R(0.0))) ? (-R(1.0)) : R(1.0)) * sqrt(fmin((t3 * t3) + (t4 * t4), (t6 * t6) + (t7 * t7)));
 }
 
 /* ---- ellipsoid ---- */
-/* Quilez's bound k0 (k0 - 1) / k1, with k0 = |p / r| and k1 = |p / r^2|,
-   computed as (k0 - 1) / |u / r| with u = (p / r) / k0, so no square of
-   p / r or p / r^2 is formed (cpu: sdf::ellipsoid). */
 real sd_ellipsoid(real3 p, real3 r) {
-    real3 q = p / r;
-    real k0 = safe_length(q);
-    if (k0 < R(1.0)) {
-        return (k0 - R(1.0)) * fmin(fmin(r.x, r.y), r.z);
-    }
-    real k1 = safe_length(q / k0 / r);
-    return (k0 - R(1.0)) / fmax(k1, REAL_TINY);
+    real t0 = p.x / r.x;
+    real t1 = p.y / r.y;
+    real t2 = p.z / r.z;
+    real t3 = fmax(fmax(fabs(t0), fabs(t1)), fabs(t2));
+    real t4 = ((R(0.0) < t3) && isfinite(t3)) ? (t3 * length((real3)(t0 / t3, t1 / t3, t2 / t3))) : length((real3)(t0, t1, t2));
+    real t5 = (t0 / t4) / r.x;
+    real t6 = (t1 / t4) / r.y;
+    real t7 = (t2 / t4) / r.z;
+    real t8 = fmax(fmax(fabs(t5), fabs(t6)), fabs(t7));
+    real t9 = t4 - R(1.0);
+    return (t4 < R(1.0)) ? (t9 * fmin(fmin(r.x, r.y), r.z)) : (t9 / fmax(((R(0.0) < t8) && isfinite(t8)) ? (t8 * length((real3)(t5 / t8, t6 / t8, t7 / t8))) : length((real3)(t5, t6, t7)), R(1e-30)));
 }
 
 /* ---- scene ---- */

@@ -87,22 +87,20 @@ typedef float4 real4;
 #define LIGHT_STRIDE 8
 
 /* ---- plane ---- */
-/* n is scaled by its largest component before it is normalised, so no
-   square of a tiny or huge component is formed (cpu: sdf::plane). */
 real sd_plane(real3 p, real3 n, real offset) {
-    real m = fmax(fmax(fabs(n.x), fabs(n.y)), fabs(n.z));
-    if (m > R(0.0)) {
-        n = n / m;
-        n = n / length(n);
-    }
-    return dot(p, n) + offset;
+    real t0 = fmax(fmax(fabs(n.x), fabs(n.y)), fabs(n.z));
+    real t1 = n.x / t0;
+    real t2 = n.y / t0;
+    real t3 = n.z / t0;
+    bool t4 = R(0.0) < t0;
+    real t5 = length((real3)(t1, t2, t3));
+    return (((p.x * (t4 ? (t1 / t5) : n.x)) + (p.y * (t4 ? (t2 / t5) : n.y))) + (p.z * (t4 ? (t3 / t5) : n.z))) + offset;
 }
 
 /* ---- tetrahedron ---- */
 real sd_tetrahedron(real3 z) {
-    real a = fmax(-z.x - z.y - z.z, z.x + z.y - z.z);
-    real b = fmax(-z.x + z.y + z.z, z.x - z.y + z.z);
-    return (fmax(a, b) - R(1.0)) * R(0.5773502691896258);
+    real t0 = -z.x;
+    return (fmax(fmax((t0 - z.y) - z.z, (z.x + z.y) - z.z), fmax((t0 + z.y) + z.z, (z.x - z.y) + z.z)) - R(1.0)) * R(0.5773502691896258);
 }
 
 /* ---- sierpinski ---- */

@@ -18,7 +18,7 @@ use fractal_sdf::prelude::*;
 use fractal_sdf::render::{
     DeviceKind, DeviceSelector, EdgeThresholds, RenderOptions, Renderer, devices,
 };
-use fractal_sdf::scene::{Stereo, StereoLayout};
+use fractal_sdf::scene::{CustomShape, Stereo, StereoLayout};
 use fractal_sdf::sequence::{Encoded, Sequence, parse_range};
 use fractal_sdf::settings::{CONFIG_ENV, Settings, parse_preset, parse_size};
 use indicatif::{ProgressBar, ProgressStyle};
@@ -69,11 +69,31 @@ struct CompareArgs {
     b: PathBuf,
 }
 
+/// Where the scene comes from: a file or gallery name, or a text formula.
+#[derive(Args)]
+pub(crate) struct SceneSource {
+    /// A scene file (`.ron`) or a gallery scene name.
+    #[arg(required_unless_present = "formula")]
+    scene: Option<String>,
+    /// The scene as one shape written as a text formula, instead of SCENE:
+    /// the distance at the point `p` (`'length(p) - 1'`; the language is
+    /// in the crate's `expr::Formula` docs), under the default camera.
+    #[arg(long, value_name = "TEXT", conflicts_with = "scene")]
+    formula: Option<String>,
+}
+
+impl SceneSource {
+    /// The scene's name in messages.
+    fn label(&self) -> &str {
+        self.scene.as_deref().unwrap_or("formula")
+    }
+}
+
 /// What every rendering subcommand takes.
 #[derive(Args)]
 struct SceneArgs {
-    /// A scene file (`.ron`) or a gallery scene name.
-    scene: String,
+    #[command(flatten)]
+    scene: SceneSource,
     /// Quality preset: draft, preview, production or reference (default:
     /// the scene file's quality, else the settings file's preset, else
     /// production).
@@ -219,8 +239,8 @@ struct SequenceArgs {
 
 #[derive(Args)]
 struct EmitArgs {
-    /// A scene file (`.ron`) or a gallery scene name.
-    scene: String,
+    #[command(flatten)]
+    scene: SceneSource,
     /// Quality preset, which decides precision and loop bounds.
     #[arg(long)]
     preset: Option<String>,
@@ -291,8 +311,14 @@ fn run(cli: Cli) -> Outcome {
     }
 }
 
-/// A scene file's path, or a gallery name's file.
-fn load_scene(scene: &str) -> Outcome<SceneFile> {
+/// A scene file's path, a gallery name's file, or a formula's shape.
+fn load_scene(source: &SceneSource) -> Outcome<SceneFile> {
+    if let Some(text) = &source.formula {
+        let shape = CustomShape::parse("formula", &[], text)?;
+        let no_args: [f64; 0] = [];
+        return Ok(SceneFile::new(Scene::new(shape.node(no_args))));
+    }
+    let scene = source.scene.as_deref().unwrap_or_default();
     let path = Path::new(scene);
     if path.is_file() || scene.ends_with(".ron") || scene.contains(std::path::MAIN_SEPARATOR) {
         return Ok(SceneFile::load(path)?);
@@ -617,7 +643,7 @@ fn sequence(args: &SequenceArgs, settings: &Settings) -> Outcome {
     let share = range.clone().filter(mine).count();
     println!(
         "{}: frames {}..{} of {}{} at {} fps, {}x{}, {} quality -> {}/ ({} of {} on disk already)",
-        args.scene.scene,
+        args.scene.scene.label(),
         range.start,
         range.end,
         seq.frames(),
@@ -735,7 +761,7 @@ fn bench(args: &BenchArgs, settings: &Settings) -> Outcome {
     );
     println!(
         "{}: {width}x{height}, {} quality on {}",
-        args.scene.scene,
+        args.scene.scene.label(),
         job.preset_name(),
         on_devices(&renderer)
     );

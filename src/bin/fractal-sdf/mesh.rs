@@ -15,8 +15,8 @@ use super::{Outcome, load_scene, parse_sets, usage};
 /// What `mesh` and `volume` take: the scene and the grid.
 #[derive(Args)]
 pub struct GridArgs {
-    /// A scene file (`.ron`) or a gallery scene name.
-    scene: String,
+    #[command(flatten)]
+    scene: super::SceneSource,
     /// Cells along the box's longest side (1..=4096).
     #[arg(long, default_value_t = 256)]
     resolution: u32,

@@ -1,0 +1,145 @@
+//! The OpenCL helpers printed from the formulas in [`crate::cpu::sdf`]:
+//! each is traced into the expression IR and written by the OpenCL
+//! printer, so the kernel and the CPU reference run one definition.
+
+use crate::cpu::sdf;
+use crate::expr::{OpenCl, Printer, Shape, Signature, Unprintable, Var, trace};
+use crate::math::{V3, v3};
+
+use Shape::{Pair, Scalar, Vec3};
+
+/// The 3-vector of inputs `i..i + 3`.
+fn vector(a: &[Var], i: usize) -> V3<Var> {
+    v3(a[i], a[i + 1], a[i + 2])
+}
+
+/// Traces `formula` with the signature's inputs and prints it.
+fn print(
+    name: &str,
+    params: &[(&str, Shape)],
+    result: Shape,
+    formula: impl FnOnce(&[Var]) -> Vec<Var>,
+) -> Result<String, Unprintable> {
+    let signature = Signature {
+        name,
+        params,
+        result,
+    };
+    OpenCl.function(&signature, &trace(signature.inputs(), formula))
+}
+
+/// A scalar distance formula of the point `p` and further parameters.
+fn distance(
+    name: &str,
+    params: &[(&str, Shape)],
+    formula: impl FnOnce(V3<Var>, &[Var]) -> Var,
+) -> Result<String, Unprintable> {
+    let mut all = vec![("p", Vec3)];
+    all.extend_from_slice(params);
+    print(name, &all, Scalar, |a| vec![formula(vector(a, 0), &a[3..])])
+}
+
+pub(crate) fn sphere() -> Result<String, Unprintable> {
+    distance("sd_sphere", &[("r", Scalar)], |p, a| sdf::sphere(p, a[0]))
+}
+
+pub(crate) fn cuboid() -> Result<String, Unprintable> {
+    distance("sd_box", &[("b", Vec3)], |p, a| {
+        sdf::cuboid(p, vector(a, 0))
+    })
+}
+
+pub(crate) fn round_box() -> Result<String, Unprintable> {
+    distance("sd_round_box", &[("b", Vec3), ("r", Scalar)], |p, a| {
+        sdf::round_box(p, vector(a, 0), a[3])
+    })
+}
+
+pub(crate) fn torus() -> Result<String, Unprintable> {
+    distance(
+        "sd_torus",
+        &[("major", Scalar), ("minor", Scalar)],
+        |p, a| sdf::torus(p, a[0], a[1]),
+    )
+}
+
+pub(crate) fn cylinder() -> Result<String, Unprintable> {
+    distance("sd_cylinder", &[("r", Scalar), ("h", Scalar)], |p, a| {
+        sdf::cylinder(p, a[0], a[1])
+    })
+}
+
+pub(crate) fn capsule() -> Result<String, Unprintable> {
+    distance(
+        "sd_capsule",
+        &[("a", Vec3), ("b", Vec3), ("r", Scalar)],
+        |p, a| sdf::capsule(p, vector(a, 0), vector(a, 3), a[6]),
+    )
+}
+
+pub(crate) fn plane() -> Result<String, Unprintable> {
+    distance("sd_plane", &[("n", Vec3), ("offset", Scalar)], |p, a| {
+        sdf::plane(p, vector(a, 0), a[3])
+    })
+}
+
+pub(crate) fn octahedron() -> Result<String, Unprintable> {
+    distance("sd_octahedron", &[("s", Scalar)], |p, a| {
+        sdf::octahedron(p, a[0])
+    })
+}
+
+pub(crate) fn capped_cone() -> Result<String, Unprintable> {
+    distance(
+        "sd_capped_cone",
+        &[("h", Scalar), ("r1", Scalar), ("r2", Scalar)],
+        |p, a| sdf::capped_cone(p, a[0], a[1], a[2]),
+    )
+}
+
+pub(crate) fn ellipsoid() -> Result<String, Unprintable> {
+    distance("sd_ellipsoid", &[("r", Vec3)], |p, a| {
+        sdf::ellipsoid(p, vector(a, 0))
+    })
+}
+
+pub(crate) fn tetrahedron() -> Result<String, Unprintable> {
+    print("sd_tetrahedron", &[("z", Vec3)], Scalar, |a| {
+        vec![sdf::tetrahedron(vector(a, 0))]
+    })
+}
+
+pub(crate) fn smooth_min() -> Result<String, Unprintable> {
+    print(
+        "smooth_min",
+        &[("a", Scalar), ("b", Scalar), ("k", Scalar)],
+        Pair,
+        |a| {
+            let (d, m) = sdf::smooth_min(a[0], a[1], a[2]);
+            vec![d, m]
+        },
+    )
+}
+
+pub(crate) fn rotate() -> Result<String, Unprintable> {
+    print(
+        "rotate_axis",
+        &[("p", Vec3), ("k", Vec3), ("angle", Scalar)],
+        Vec3,
+        |a| {
+            let q = sdf::rotate_axis(vector(a, 0), vector(a, 3), a[6]);
+            vec![q.x, q.y, q.z]
+        },
+    )
+}
+
+pub(crate) fn warp() -> Result<String, Unprintable> {
+    let params = [("d", Scalar), ("k", Scalar), ("rho", Scalar)];
+    let twist = print("twist_bound", &params, Scalar, |a| {
+        vec![sdf::twist_bound(a[0], a[1], a[2])]
+    })?;
+    let bend = print("bend_bound", &params, Scalar, |a| {
+        vec![sdf::bend_bound(a[0], a[1], a[2])]
+    })?;
+    Ok(format!("{twist}\n{bend}"))
+}

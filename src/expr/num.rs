@@ -1,0 +1,222 @@
+//! The number type every formula is written over.
+//!
+//! A formula is a Rust function generic over [`Num`]. Run with `f32` or
+//! `f64` it computes a value (the CPU reference, the mesher, the testing
+//! toolkit); with [`Interval`](super::Interval) it bounds a value over a
+//! box; with [`Var`](super::Var) it records an expression
+//! ([`Program`](super::Program)) that a printer turns into kernel source.
+//!
+//! Control flow that depends on a value is written as [`Num::select`], not
+//! `if`: the condition of a traced value is not known when the formula
+//! runs. Both operands are evaluated, one is kept.
+
+use std::fmt::Debug;
+use std::ops::{Add, BitAnd, BitOr, Div, Mul, Neg, Not, Sub};
+
+/// A truth value of a [`Num`]: `bool` for plain numbers, a maybe for
+/// intervals, a recorded comparison for traced values.
+pub trait Logic:
+    Copy + Debug + BitAnd<Output = Self> + BitOr<Output = Self> + Not<Output = Self>
+{
+}
+
+impl Logic for bool {}
+
+/// A number a formula can be evaluated, bounded or traced with.
+///
+/// The method names are those of `f64`; each has the IEEE meaning for the
+/// plain types. `min` and `max` return the other operand when one is NaN
+/// (as `fmin`/`fmax` do in OpenCL C).
+pub trait Num:
+    Copy
+    + Debug
+    + 'static
+    + Add<Output = Self>
+    + Sub<Output = Self>
+    + Mul<Output = Self>
+    + Div<Output = Self>
+    + Neg<Output = Self>
+{
+    /// The truth values comparisons give.
+    type Bool: Logic;
+
+    /// A literal (rounded to the precision for `f32`).
+    fn of(v: f64) -> Self;
+
+    /// `0`.
+    #[must_use]
+    fn zero() -> Self {
+        Self::of(0.0)
+    }
+
+    /// `1`.
+    #[must_use]
+    fn one() -> Self {
+        Self::of(1.0)
+    }
+
+    /// The smallest magnitude used to guard divisions and logarithms
+    /// (`1e-30`, a normal `f32`).
+    #[must_use]
+    fn tiny() -> Self {
+        Self::of(crate::math::REAL_TINY)
+    }
+
+    /// The cap on fractal running derivatives (`1e30`).
+    #[must_use]
+    fn derivative_cap() -> Self {
+        Self::of(crate::math::DERIVATIVE_CAP)
+    }
+
+    /// The largest magnitude an escape-time iteration may produce (`1e18`).
+    #[must_use]
+    fn magnitude_cap() -> Self {
+        Self::of(crate::math::MAGNITUDE_CAP)
+    }
+
+    /// Square root.
+    #[must_use]
+    fn sqrt(self) -> Self;
+    /// Absolute value.
+    #[must_use]
+    fn abs(self) -> Self;
+    /// Sine.
+    #[must_use]
+    fn sin(self) -> Self;
+    /// Cosine.
+    #[must_use]
+    fn cos(self) -> Self;
+    /// Arc cosine.
+    #[must_use]
+    fn acos(self) -> Self;
+    /// `e^x`.
+    #[must_use]
+    fn exp(self) -> Self;
+    /// Natural logarithm.
+    #[must_use]
+    fn ln(self) -> Self;
+    /// Largest integer not above.
+    #[must_use]
+    fn floor(self) -> Self;
+    /// The smaller operand.
+    #[must_use]
+    fn min(self, o: Self) -> Self;
+    /// The larger operand.
+    #[must_use]
+    fn max(self, o: Self) -> Self;
+    /// `atan2(self, x)`, the angle of `(x, self)`.
+    #[must_use]
+    fn atan2(self, x: Self) -> Self;
+    /// `self^e`.
+    #[must_use]
+    fn powf(self, e: Self) -> Self;
+    /// `sqrt(self^2 + o^2)` without overflow.
+    #[must_use]
+    fn hypot(self, o: Self) -> Self;
+    /// `sqrt(x^2 + y^2 + z^2)`: the length of a 3-vector (one operation,
+    /// so a printer can use the backend's vector `length`).
+    #[must_use]
+    fn length3(x: Self, y: Self, z: Self) -> Self {
+        (x * x + y * y + z * z).sqrt()
+    }
+
+    /// `self < o`.
+    fn lt(self, o: Self) -> Self::Bool;
+    /// `self <= o`.
+    fn le(self, o: Self) -> Self::Bool;
+    /// Whether finite (neither infinite nor NaN).
+    fn finite(self) -> Self::Bool;
+    /// `a` where `c` holds, else `b`.
+    #[must_use]
+    fn select(c: Self::Bool, a: Self, b: Self) -> Self;
+
+    /// `self > o`.
+    fn gt(self, o: Self) -> Self::Bool {
+        o.lt(self)
+    }
+    /// `self >= o`.
+    fn ge(self, o: Self) -> Self::Bool {
+        o.le(self)
+    }
+    /// `min(max(self, lo), hi)`.
+    #[must_use]
+    fn clamp(self, lo: Self, hi: Self) -> Self {
+        self.max(lo).min(hi)
+    }
+    /// `self + (o - self) t`.
+    #[must_use]
+    fn mix(self, o: Self, t: Self) -> Self {
+        self + (o - self) * t
+    }
+    /// `self - floor(self)`.
+    #[must_use]
+    fn fract(self) -> Self {
+        self - self.floor()
+    }
+}
+
+macro_rules! plain {
+    ($t:ty) => {
+        impl Num for $t {
+            type Bool = bool;
+            #[allow(clippy::cast_possible_truncation)]
+            fn of(v: f64) -> Self {
+                v as $t
+            }
+            fn sqrt(self) -> Self {
+                <$t>::sqrt(self)
+            }
+            fn abs(self) -> Self {
+                <$t>::abs(self)
+            }
+            fn sin(self) -> Self {
+                <$t>::sin(self)
+            }
+            fn cos(self) -> Self {
+                <$t>::cos(self)
+            }
+            fn acos(self) -> Self {
+                <$t>::acos(self)
+            }
+            fn exp(self) -> Self {
+                <$t>::exp(self)
+            }
+            fn ln(self) -> Self {
+                <$t>::ln(self)
+            }
+            fn floor(self) -> Self {
+                <$t>::floor(self)
+            }
+            fn min(self, o: Self) -> Self {
+                <$t>::min(self, o)
+            }
+            fn max(self, o: Self) -> Self {
+                <$t>::max(self, o)
+            }
+            fn atan2(self, x: Self) -> Self {
+                <$t>::atan2(self, x)
+            }
+            fn powf(self, e: Self) -> Self {
+                <$t>::powf(self, e)
+            }
+            fn hypot(self, o: Self) -> Self {
+                <$t>::hypot(self, o)
+            }
+            fn lt(self, o: Self) -> bool {
+                self < o
+            }
+            fn le(self, o: Self) -> bool {
+                self <= o
+            }
+            fn finite(self) -> bool {
+                <$t>::is_finite(self)
+            }
+            fn select(c: bool, a: Self, b: Self) -> Self {
+                if c { a } else { b }
+            }
+        }
+    };
+}
+
+plain!(f32);
+plain!(f64);
