@@ -650,3 +650,78 @@ fn a_lens_rendered_in_one_pass_says_how_many_passes_it_needs() {
         text(&out)
     );
 }
+
+/// A scene file with a text formula renders; `--set` moves its dynamic
+/// parameter; `--formula` renders and meshes a shape with no scene file
+/// and no `--bounds`; a formula's mistake is located.
+#[test]
+fn text_formulas_render_from_files_and_the_command_line() {
+    if gpu::device().is_none() {
+        return;
+    }
+    let dir = scratch("formula");
+    let render = |name: &str, extra: &[&str]| {
+        let png = dir.join(name);
+        let mut args = vec![
+            "render",
+            "-o",
+            png.to_str().unwrap(),
+            "--size",
+            "64x48",
+            "--preset",
+            "draft",
+        ];
+        args.extend_from_slice(extra);
+        let out = run(&dir, "", &args);
+        assert!(out.status.success(), "{}", text(&out));
+        verify_png(&png, (64, 48)).unwrap();
+        image::open(&png).unwrap().to_rgba8()
+    };
+    let scene = scene_path("custom_formula");
+    let calm = render("calm.png", &[&scene]);
+    assert!(calm.pixels().any(|p| p != calm.get_pixel(0, 0)), "blank");
+    let rippled = render("rippled.png", &[&scene, "--set", "ripple=0.2"]);
+    assert_ne!(calm, rippled, "--set ripple changed nothing");
+
+    let cube = render(
+        "cube.png",
+        &[
+            "--formula",
+            "let q = abs(p) - vec3(0.5, 0.5, 0.5); max(q.x, max(q.y, q.z))",
+        ],
+    );
+    assert_ne!(
+        cube.get_pixel(32, 24),
+        cube.get_pixel(1, 1),
+        "the cube is not drawn"
+    );
+
+    let stl = dir.join("ball.stl");
+    let out = run(
+        &dir,
+        "",
+        &[
+            "mesh",
+            "--formula",
+            "length(p) - 1",
+            "-o",
+            stl.to_str().unwrap(),
+            "--resolution",
+            "32",
+        ],
+    );
+    assert!(out.status.success(), "{}", text(&out));
+    assert!(text(&out).contains("closed 2-manifold"), "{}", text(&out));
+
+    let out = run(
+        &dir,
+        "",
+        &["render", "--formula", "length(p) -", "-o", "x.png"],
+    );
+    assert!(!out.status.success());
+    assert!(
+        text(&out).contains("line 1, column 12: expected a number"),
+        "{}",
+        text(&out)
+    );
+}

@@ -15,8 +15,11 @@ use super::program::Program;
 /// The half-sizes tried for the outer cube: powers of 2 from 2^-20 to 2^40.
 const SIZES: std::ops::RangeInclusive<i32> = -20..=40;
 
-/// How many times the cube is halved along each axis when tightening.
+/// How many times a box is halved along each axis when tightening.
 const LEVELS: u32 = 4;
+
+/// The most tightening passes.
+const PASSES: usize = 3;
 
 /// A box `[min, max]` holding every point where `program` (inputs `p.x,
 /// p.y, p.z`, then `params`) can be at most 0, or `None` if intervals
@@ -46,9 +49,24 @@ pub fn surface_box(program: &Program, params: &[f64]) -> Option<[DVec3; 2]> {
             beyond && empty(lo, hi)
         })
     })?;
-    // Tighten: the boxes of a subdivision that may hold the shape.
+    // Tighten: the boxes of a subdivision that may hold the shape, then
+    // of a subdivision of the box they span, while that shrinks it.
+    let mut found = [DVec3::splat(-size), DVec3::splat(size)];
+    for _ in 0..PASSES {
+        let tighter = tighten(&empty, found)?;
+        if tighter == found {
+            break;
+        }
+        found = tighter;
+    }
+    Some(found)
+}
+
+/// The box spanned by the cells of `LEVELS` halvings of `[lo, hi]` that
+/// `empty` does not rule out, or `None` if it rules out them all.
+fn tighten(empty: &impl Fn(DVec3, DVec3) -> bool, [lo, hi]: [DVec3; 2]) -> Option<[DVec3; 2]> {
     let mut found: Option<[DVec3; 2]> = None;
-    let mut stack = vec![(DVec3::splat(-size), DVec3::splat(size), 0)];
+    let mut stack = vec![(lo, hi, 0)];
     while let Some((lo, hi, level)) = stack.pop() {
         if empty(lo, hi) {
             continue;
@@ -93,8 +111,8 @@ mod tests {
         });
         let [lo, hi] = surface_box(&ball, &[1.0]).unwrap();
         assert!(lo.x <= 0.5 && hi.x >= 1.5 && lo.y <= -0.5 && hi.y >= 0.5);
-        // One cell of 2^4 per axis of a cube of half-size 2: 1/4 of slack.
-        assert!(lo.x > 0.2 && hi.x < 1.8 && hi.y < 0.8, "{lo} {hi}");
+        // Three passes of 2^4 cells per axis: within 1/16 of a unit.
+        assert!(lo.x > 0.4 && hi.x < 1.6 && hi.y < 0.6, "{lo} {hi}");
     }
 
     #[test]
