@@ -24,7 +24,7 @@ fn main() -> std::process::ExitCode {
         let size = common::size_arg((640, 480));
         let runs: usize = value("--runs").and_then(|r| r.parse().ok()).unwrap_or(3);
         let dir = value("--out").unwrap_or_else(|| "out/bench".to_string());
-        std::fs::create_dir_all(&dir).map_err(|e| common::usage(e))?;
+        std::fs::create_dir_all(&dir).map_err(common::usage)?;
         let only = value("--scene");
         let mut csv =
             String::from("scene,build_ms,cached_build_ms,render_ms,evaluations_per_pixel\n");
@@ -65,7 +65,7 @@ fn main() -> std::process::ExitCode {
             }
             writeln!(csv, "{line}").ok();
         }
-        std::fs::write(format!("{dir}/gallery_bench.csv"), csv).map_err(|e| common::usage(e))?;
+        std::fs::write(format!("{dir}/gallery_bench.csv"), csv).map_err(common::usage)?;
         Ok(())
     })
 }

@@ -72,17 +72,24 @@ fn effects_that_are_on_are_defined() {
 }
 
 #[test]
-fn fractal_helpers_pull_in_their_dependencies_once() {
-    let src = source(menger(3).union(sierpinski(3)), &Options::default());
-    assert_eq!(src.matches("real sd_box(").count(), 1);
-    assert_eq!(src.matches("real sd_tetrahedron(").count(), 1);
+fn fractal_helpers_are_printed_once_and_stand_alone() {
+    let src = source(
+        menger(3)
+            .union(sierpinski(3))
+            .union(menger(2).translate(DVec3::X)),
+        &Options::default(),
+    );
+    assert_eq!(src.matches("real2 menger(").count(), 1);
+    assert_eq!(src.matches("real2 sierpinski(").count(), 1);
+    // The box and tetrahedron they end with are part of their formulas.
+    assert!(!src.contains("sd_box") && !src.contains("sd_tetrahedron"));
     assert!(!src.contains("mandelbulb"));
 }
 
 #[test]
 fn integer_power_eight_uses_the_trig_free_form() {
     let src = source(mandelbulb(8.0), &Options::default());
-    assert!(src.contains("mandelbulb_p8(p0, 12, 2.0f, 1.1040895f, &t0)"));
+    assert!(src.contains("mandelbulb_p8(p0, 12, 2.0f, 1.1040895f)"));
     assert!(!src.contains("acos"), "power 8 must not use trigonometry");
 
     let src = source(mandelbulb(7.5), &Options::default());
@@ -92,7 +99,7 @@ fn integer_power_eight_uses_the_trig_free_form() {
     // A dynamic power cannot be specialised.
     let src = source(mandelbulb(param("power", 8.0)), &Options::default());
     assert!(src.contains(
-        "mandelbulb(p0, params[0] /* power */, 12, fmin(2.0f, pow(MAGNITUDE_CAP, R(1.0) / params[0] /* power */)), pow(R(2.0), R(1.0) / (params[0] /* power */ - R(1.0))), &t0)"
+        "mandelbulb(p0, params[0] /* power */, 12, fmin(2.0f, pow(MAGNITUDE_CAP, R(1.0) / params[0] /* power */)), pow(R(2.0), R(1.0) / (params[0] /* power */ - R(1.0))))"
     ));
 }
 
@@ -134,14 +141,14 @@ fn baked_values_change_the_source_and_hash() {
 fn baked_iteration_counts_are_constant_loop_bounds_and_can_be_overridden() {
     let mut options = Options::default();
     let src = source(menger(4), &options);
-    assert!(src.contains("menger(p0, 4, 3.0f, &t0)"));
+    assert!(src.contains("menger(p0, 4, 3.0f)"));
     options.quality.fractal_iterations = Some(2);
     let src = source(menger(4), &options);
-    assert!(src.contains("menger(p0, 2, 3.0f, &t0)"));
+    assert!(src.contains("menger(p0, 2, 3.0f)"));
     // A cap: fewer iterations than the cap stay as they are.
     options.quality.fractal_iterations = Some(6);
     let src = source(menger(4), &options);
-    assert!(src.contains("menger(p0, 4, 3.0f, &t0)"));
+    assert!(src.contains("menger(p0, 4, 3.0f)"));
 }
 
 #[test]

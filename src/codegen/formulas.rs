@@ -2,8 +2,8 @@
 //! each is traced into the expression IR and written by the OpenCL
 //! printer, so the kernel and the CPU reference run one definition.
 
-use crate::cpu::sdf;
-use crate::expr::{OpenCl, Printer, Shape, Signature, Unprintable, Var, trace};
+use crate::cpu::sdf::{self, Estimate};
+use crate::expr::{Num, OpenCl, Printer, Shape, Signature, Unprintable, Var, trace};
 use crate::math::{V3, v3};
 
 use Shape::{Pair, Scalar, Vec3};
@@ -103,12 +103,6 @@ pub(crate) fn ellipsoid() -> Result<String, Unprintable> {
     })
 }
 
-pub(crate) fn tetrahedron() -> Result<String, Unprintable> {
-    print("sd_tetrahedron", &[("z", Vec3)], Scalar, |a| {
-        vec![sdf::tetrahedron(vector(a, 0))]
-    })
-}
-
 pub(crate) fn smooth_min() -> Result<String, Unprintable> {
     print(
         "smooth_min",
@@ -142,4 +136,101 @@ pub(crate) fn warp() -> Result<String, Unprintable> {
         vec![sdf::bend_bound(a[0], a[1], a[2])]
     })?;
     Ok(format!("{twist}\n{bend}"))
+}
+
+/// A fractal's estimate as the pair (distance, trap).
+fn pair(e: Estimate<Var>) -> Vec<Var> {
+    vec![e.distance, e.trap]
+}
+
+/// The Mandelbulb of any real power, with `acos`/`atan2`/`sin`/`cos`.
+pub(crate) fn mandelbulb() -> Result<String, Unprintable> {
+    print(
+        "mandelbulb",
+        &[
+            ("p", Vec3),
+            ("power", Scalar),
+            ("iterations", Scalar),
+            ("escape", Scalar),
+            ("ball", Scalar),
+        ],
+        Pair,
+        |a| {
+            pair(sdf::mandelbulb_estimate(
+                vector(a, 0),
+                a[3],
+                a[4],
+                a[5],
+                a[6],
+                None,
+            ))
+        },
+    )
+}
+
+/// The Mandelbulb of the integer power `n`, trig-free.
+pub(crate) fn mandelbulb_power(n: u32) -> Result<String, Unprintable> {
+    print(
+        &super::power::helper_name(n),
+        &[
+            ("p", Vec3),
+            ("iterations", Scalar),
+            ("escape", Scalar),
+            ("ball", Scalar),
+        ],
+        Pair,
+        |a| {
+            let power = Var::of(f64::from(n));
+            pair(sdf::mandelbulb_estimate(
+                vector(a, 0),
+                power,
+                a[3],
+                a[4],
+                a[5],
+                Some(n),
+            ))
+        },
+    )
+}
+
+/// The Menger sponge.
+pub(crate) fn menger() -> Result<String, Unprintable> {
+    print(
+        "menger",
+        &[("p", Vec3), ("iterations", Scalar), ("scale", Scalar)],
+        Pair,
+        |a| pair(sdf::menger_estimate(vector(a, 0), a[3], a[4])),
+    )
+}
+
+/// The Sierpinski tetrahedron.
+pub(crate) fn sierpinski() -> Result<String, Unprintable> {
+    print(
+        "sierpinski",
+        &[("p", Vec3), ("iterations", Scalar), ("scale", Scalar)],
+        Pair,
+        |a| pair(sdf::sierpinski_estimate(vector(a, 0), a[3], a[4])),
+    )
+}
+
+/// The quaternion Julia set, `c` as four numbers.
+pub(crate) fn julia() -> Result<String, Unprintable> {
+    print(
+        "julia",
+        &[
+            ("p", Vec3),
+            ("cx", Scalar),
+            ("cy", Scalar),
+            ("cz", Scalar),
+            ("cw", Scalar),
+            ("w", Scalar),
+            ("iterations", Scalar),
+            ("bailout", Scalar),
+        ],
+        Pair,
+        |a| {
+            let c = [a[3], a[4], a[5], a[6]];
+            pair(sdf::julia_estimate(vector(a, 0), c, a[7], a[8], a[9]))
+        },
+    )
 }

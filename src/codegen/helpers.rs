@@ -1,13 +1,12 @@
-//! The OpenCL C helper library and the dependencies between its functions:
-//! helpers printed from the formulas' expression IR
-//! ([`formulas`](super::formulas)), and the fractal estimators still
-//! hand-written in `kernels/sdf/*.cl` (embedded at compile time).
+//! The OpenCL C helper library: every helper printed from a formula's
+//! expression IR ([`formulas`](super::formulas)), once per program, and
+//! only those the scene calls.
 
 use super::formulas;
 use crate::expr::Unprintable;
 
-/// One file of the helper library. Code generation records which helpers a
-/// scene calls and emits those (with their dependencies) and no others.
+/// One helper of the library. Code generation records which helpers a
+/// scene calls and emits those and no others.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash)]
 pub(crate) enum Helper {
     Sphere,
@@ -22,7 +21,6 @@ pub(crate) enum Helper {
     Ellipsoid,
     Mandelbulb,
     Menger,
-    Tetrahedron,
     Sierpinski,
     Julia,
     SmoothMin,
@@ -30,16 +28,9 @@ pub(crate) enum Helper {
     Warp,
 }
 
-macro_rules! source {
-    ($file:literal) => {
-        include_str!(concat!("../../kernels/sdf/", $file, ".cl"))
-    };
-}
-
 impl Helper {
-    /// Every helper, each after the helpers it depends on: the order they
-    /// are emitted in.
-    pub(crate) const ALL: [Helper; 18] = [
+    /// Every helper, in the order they are emitted.
+    pub(crate) const ALL: [Helper; 17] = [
         Helper::Sphere,
         Helper::Cuboid,
         Helper::RoundBox,
@@ -52,7 +43,6 @@ impl Helper {
         Helper::Ellipsoid,
         Helper::Mandelbulb,
         Helper::Menger,
-        Helper::Tetrahedron,
         Helper::Sierpinski,
         Helper::Julia,
         Helper::SmoothMin,
@@ -75,7 +65,6 @@ impl Helper {
             Helper::Ellipsoid => "ellipsoid",
             Helper::Mandelbulb => "mandelbulb",
             Helper::Menger => "menger",
-            Helper::Tetrahedron => "tetrahedron",
             Helper::Sierpinski => "sierpinski",
             Helper::Julia => "julia",
             Helper::SmoothMin => "smooth_min",
@@ -84,8 +73,7 @@ impl Helper {
         }
     }
 
-    /// The OpenCL C source: printed from the formula, or the fractal's
-    /// hand-written file.
+    /// The OpenCL C source, printed from the formula.
     pub(crate) fn source(self) -> Result<String, Unprintable> {
         match self {
             Helper::Sphere => formulas::sphere(),
@@ -98,59 +86,20 @@ impl Helper {
             Helper::Octahedron => formulas::octahedron(),
             Helper::CappedCone => formulas::capped_cone(),
             Helper::Ellipsoid => formulas::ellipsoid(),
-            Helper::Tetrahedron => formulas::tetrahedron(),
+            Helper::Mandelbulb => formulas::mandelbulb(),
+            Helper::Menger => formulas::menger(),
+            Helper::Sierpinski => formulas::sierpinski(),
+            Helper::Julia => formulas::julia(),
             Helper::SmoothMin => formulas::smooth_min(),
             Helper::Rotate => formulas::rotate(),
             Helper::Warp => formulas::warp(),
-            Helper::Mandelbulb => Ok(source!("mandelbulb").to_string()),
-            Helper::Menger => Ok(source!("menger").to_string()),
-            Helper::Sierpinski => Ok(source!("sierpinski").to_string()),
-            Helper::Julia => Ok(source!("julia").to_string()),
         }
     }
-
-    /// The helpers this one calls.
-    pub(crate) fn deps(self) -> &'static [Helper] {
-        match self {
-            Helper::Menger => &[Helper::Cuboid],
-            Helper::Sierpinski => &[Helper::Tetrahedron],
-            _ => &[],
-        }
-    }
-}
-
-/// The helpers needed for `used` (adding dependencies), in library order.
-pub(crate) fn closure(used: impl IntoIterator<Item = Helper>) -> Vec<Helper> {
-    let mut needed: Vec<Helper> = used.into_iter().collect();
-    // Dependencies come first in ALL, so one backwards pass adds them all.
-    for h in Helper::ALL.iter().rev() {
-        if needed.contains(h) {
-            needed.extend_from_slice(h.deps());
-        }
-    }
-    Helper::ALL
-        .into_iter()
-        .filter(|h| needed.contains(h))
-        .collect()
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn dependencies_come_first_and_are_added() {
-        for (i, h) in Helper::ALL.iter().enumerate() {
-            for d in h.deps() {
-                let at = Helper::ALL.iter().position(|x| x == d).unwrap();
-                assert!(at < i, "{} is listed after {}", d.name(), h.name());
-            }
-        }
-        assert_eq!(
-            closure([Helper::Sierpinski]),
-            vec![Helper::Tetrahedron, Helper::Sierpinski]
-        );
-    }
 
     #[test]
     fn every_helper_prints() {

@@ -2,8 +2,9 @@
 //!
 //! The program is, in a fixed order: a header (precision typedefs, the
 //! quality constants, the kernel interface from [`interface`] and one
-//! `#define` per effect that is on), the helper
-//! functions from `kernels/sdf/` that the scene uses and nothing else, the
+//! `#define` per effect that is on), the helper functions the scene uses
+//! and nothing else (each printed from its formula's expression IR, see
+//! [`crate::expr`]), the
 //! scene's `DE()` and `DE_shade()`, and the target's kernel (the marcher, or
 //! a point evaluator for tests).
 //!
@@ -317,7 +318,10 @@ pub fn emit_ir(ir: &Ir, options: &Options) -> Result<KernelSource> {
 
     let mut w = writer::Writer::new(precision);
     header(&mut w, options, &features);
-    for helper in helpers::closure(used) {
+    for helper in helpers::Helper::ALL
+        .into_iter()
+        .filter(|h| used.contains(h))
+    {
         w.line(format!("/* ---- {} ---- */", helper.name()));
         w.raw(&helper.source().map_err(|e| Error::Invalid {
             what: "formula",
@@ -327,7 +331,10 @@ pub fn emit_ir(ir: &Ir, options: &Options) -> Result<KernelSource> {
     }
     for n in powers {
         w.line(format!("/* ---- {} ---- */", power::helper_name(n)));
-        w.raw(&power::mandelbulb_helper(n));
+        w.raw(&power::mandelbulb_helper(n).map_err(|e| Error::Invalid {
+            what: "formula",
+            reason: e.to_string(),
+        })?);
         w.line("");
     }
     let mut custom_regions = Vec::with_capacity(customs.len());

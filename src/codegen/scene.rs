@@ -380,7 +380,7 @@ impl<'a> SceneEmitter<'a> {
         }
     }
 
-    /// A fractal: the helper writes the trap through a pointer.
+    /// A fractal: the helper returns the distance and the trap.
     fn fractal(&mut self, id: NodeId, helper: Helper, args: &str) -> Vars {
         self.used.insert(helper);
         self.fractal_call(id, helper.name(), args)
@@ -389,12 +389,18 @@ impl<'a> SceneEmitter<'a> {
     /// A call of a fractal function (library or specialised).
     fn fractal_call(&mut self, id: NodeId, function: &str, args: &str) -> Vars {
         let v = vars(id);
-        self.w.line(format!("real {};", v.t));
-        self.w
-            .line(format!("real {} = {function}({args}, &{});", v.d, v.t));
+        let pair = format!("f{}", id.index());
+        self.w.line(format!("real2 {pair} = {function}({args});"));
+        self.w.line(format!("real {} = {pair}.x;", v.d));
+        let t = if self.traps() {
+            self.w.line(format!("real {} = {pair}.y;", v.t));
+            v.t
+        } else {
+            "R(1.0)".into()
+        };
         Vars {
             c: self.default_surface(),
-            t: if self.traps() { v.t } else { "R(1.0)".into() },
+            t,
             d: v.d,
         }
     }
@@ -690,7 +696,7 @@ impl<'a> SceneEmitter<'a> {
                 let n = self.iterations(f.iterations, (1, MAX_ESCAPE_ITERATIONS));
                 let [cx, cy, cz, cw] = f.c.map(|s| w(self, s));
                 let args = format!(
-                    "{p}, (real4)({cx}, {cy}, {cz}, {cw}), {}, {n}, {}",
+                    "{p}, {cx}, {cy}, {cz}, {cw}, {}, {n}, {}",
                     w(self, f.slice_w),
                     w(self, f.bailout)
                 );

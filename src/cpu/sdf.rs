@@ -1,19 +1,20 @@
-//! Distance formulas for every primitive and fractal.
+//! Distance formulas for every primitive and fractal, each written once.
 //!
-//! The primitives, the smooth minimum, the rotation and the warp bounds
-//! are written once, generic over [`Num`]: the CPU reference runs them in
-//! `f32`/`f64`, and code generation traces them into the expression IR
-//! ([`crate::expr`]) and prints their OpenCL helpers from it, so there is
-//! no second copy to drift. Their value-dependent choices are
-//! [`Num::select`]s. The fractal estimators are still generic over
-//! [`Real`] (their loops exit early), with hand-written OpenCL twins in
-//! `kernels/sdf/` that the conformance tests hold to them.
+//! Every formula here is generic over [`Num`]: the CPU reference runs it
+//! in `f32`/`f64`, bounds run it in intervals, and code generation traces
+//! it into the expression IR ([`crate::expr`]) and prints the kernels'
+//! helpers from it, so there is no second copy to drift. Value-dependent
+//! choices are [`Num::select`]s and the fractals' loops are
+//! [`Num::iterate`]s (bounded, with early exits), so tracing records them
+//! instead of running them. The conformance tests still compare the CPU
+//! and the device on random and spicy points: they now test the printer.
 //!
 //! Sources: the primitives and smooth minimum follow Inigo Quilez's
 //! "distance functions" article; the fractal estimators follow Quilez
 //! (quaternion Julia), White/Nylander and Hart (Mandelbulb) and Knighty's
 //! kaleidoscopic IFS (Menger, Sierpinski).
 
+use crate::expr::Step;
 pub use crate::math::{JULIA_FAR_FIELD, JULIA_FAR_FIELD_SLOPE, julia_radius};
 use crate::math::{Num, Real, V3, escape_radius, mandelbulb_radius, v3};
 
@@ -146,37 +147,44 @@ pub struct Estimate<T> {
     pub trap: T,
 }
 
-/// `x^n` by binary exponentiation (the same multiplications as the OpenCL
-/// twin `pow_int`).
+/// `x^n` by binary exponentiation, with no multiplication by 1 (`x^0` is
+/// 1).
 #[must_use]
-pub fn pow_int<T: Real>(x: T, n: u32) -> T {
-    let mut result = T::one();
+pub fn pow_int<T: Num>(x: T, n: u32) -> T {
+    let mut result: Option<T> = None;
     let mut base = x;
     let mut e = n;
     while e > 0 {
         if e & 1 == 1 {
-            result = result * base;
+            result = Some(result.map_or(base, |r| r * base));
         }
-        base = base * base;
         e >>= 1;
+        if e > 0 {
+            base = base * base;
+        }
     }
-    result
+    result.unwrap_or_else(T::one)
 }
 
 /// `(cos, sin)` of `n` times the angle whose cosine and sine are `(c, s)`,
 /// by binary exponentiation of `c + i s`: the trig-free integer power.
-fn angle_power<T: Real>(c: T, s: T, n: u32) -> (T, T) {
-    let (mut rc, mut rs) = (T::one(), T::zero());
+fn angle_power<T: Num>(c: T, s: T, n: u32) -> (T, T) {
+    let mut result: Option<(T, T)> = None;
     let (mut bc, mut bs) = (c, s);
     let mut e = n;
     while e > 0 {
         if e & 1 == 1 {
-            (rc, rs) = (rc * bc - rs * bs, rc * bs + rs * bc);
+            result = Some(match result {
+                None => (bc, bs),
+                Some((rc, rs)) => (rc * bc - rs * bs, rc * bs + rs * bc),
+            });
         }
-        (bc, bs) = (bc * bc - bs * bs, T::of(2.0) * bc * bs);
         e >>= 1;
+        if e > 0 {
+            (bc, bs) = (bc * bc - bs * bs, T::of(2.0) * bc * bs);
+        }
     }
-    (rc, rs)
+    result.unwrap_or((T::one(), T::zero()))
 }
 
 /// Beyond `MANDELBULB_FAR_FIELD` times [`mandelbulb_radius`] the
@@ -196,15 +204,9 @@ pub const MANDELBULB_FAR_FIELD: f64 = 1.5;
 /// `power`); otherwise the map uses `acos`/`atan2`/`sin`/`cos`. The orbit
 /// trap is the smallest `|z|` reached, clamped to `[0, 1]`. The orbit
 /// escapes beyond `bailout`, or sooner if `r^power` would pass
-/// [`Real::magnitude_cap`] (only for large powers and bailouts).
-///
-/// With `rho` = [`mandelbulb_radius`] and `outer = |p| - rho` (a proven
-/// lower bound of the distance outside the ball, and an upper bound of the
-/// depth inside it): beyond [`MANDELBULB_FAR_FIELD`]` * rho` the result is
-/// `outer` and the trap 1 (what the orbit gives there, as `|z| > 1`), with
-/// no iteration; nearer, it is `max(estimate, outer)`. The maximum of two
-/// lower bounds is one, so rays from far away land on the ball instead of
-/// overshooting the set.
+/// [`Num::magnitude_cap`] (only for large powers and bailouts): see
+/// [`escape_radius`](crate::math::escape_radius). The formula itself is
+/// [`mandelbulb_estimate`].
 #[must_use]
 pub fn mandelbulb<T: Real>(
     p: V3<T>,
@@ -213,59 +215,89 @@ pub fn mandelbulb<T: Real>(
     bailout: T,
     integer_power: Option<u32>,
 ) -> Estimate<T> {
-    let ball = mandelbulb_radius(power);
-    let r0 = p.length();
-    let outer = r0 - ball;
-    if r0 > T::of(MANDELBULB_FAR_FIELD) * ball {
-        return Estimate {
-            distance: outer,
-            trap: T::one(),
-        };
-    }
-    let mut z = p;
-    let mut dr = T::one();
-    let mut trap = T::one();
     // Escape before r^power passes the magnitude cap: beyond it r^power
     // overflows to infinity (and NaN), and once `dr` is capped a huge r
     // inflates the estimate.
     let escape = T::of(escape_radius(power.to_f64(), bailout.to_f64()));
-    for _ in 0..iterations {
+    let count = T::of(f64::from(iterations));
+    mandelbulb_estimate(
+        p,
+        power,
+        count,
+        escape,
+        mandelbulb_radius(power),
+        integer_power,
+    )
+}
+
+/// The Mandelbulb estimate, written once (the CPU reference and the
+/// kernels' `mandelbulb` helpers): `iterations` steps at most, escaping
+/// beyond `escape`, in the ball of radius `ball`.
+///
+/// With `outer = |p| - ball` (a proven lower bound of the distance outside
+/// the ball, and an upper bound of the depth inside it): beyond
+/// [`MANDELBULB_FAR_FIELD`]` * ball` the result is `outer` and the trap 1
+/// (what the orbit gives there, as `|z| > 1`), with no iteration; nearer,
+/// it is `max(estimate, outer)`. The maximum of two lower bounds is one,
+/// so rays from far away land on the ball instead of overshooting the set.
+#[must_use]
+pub fn mandelbulb_estimate<T: Num>(
+    p: V3<T>,
+    power: T,
+    iterations: T,
+    escape: T,
+    ball: T,
+    integer_power: Option<u32>,
+) -> Estimate<T> {
+    let r0 = p.length();
+    let outer = r0 - ball;
+    let far = r0.gt(T::of(MANDELBULB_FAR_FIELD) * ball);
+    let count = T::select(far, T::zero(), iterations);
+    let start = [p.x, p.y, p.z, T::one(), T::one()];
+    let [x, y, z, dr, trap] = T::iterate(count, start, |_, [x, y, z, dr, trap]| {
+        let z = v3(x, y, z);
         let r = z.length();
-        if r > escape {
-            break;
-        }
-        trap = trap.min(r);
+        let trap = trap.min(r);
         // r^(power - 1), by repeated multiplication in the integer form.
         let r_pow = match integer_power {
             Some(n) => pow_int(r, n - 1),
             None => r.powf(power - T::one()),
         };
-        dr = (power * r_pow * dr + T::one()).min(T::derivative_cap());
+        let dr = (power * r_pow * dr + T::one()).min(T::derivative_cap());
         let zr = r_pow * r;
-        let rho = z.x.hypot(z.y);
         let (st, ct, sp, cp) = match integer_power {
             Some(n) => {
+                let rho = z.x.hypot(z.y);
                 let inv_r = T::one() / r.max(T::tiny());
                 let (ct, st) = angle_power(z.z * inv_r, rho * inv_r, n);
-                let (cp, sp) = if rho > T::tiny() {
-                    angle_power(z.x / rho, z.y / rho, n)
-                } else {
-                    (T::one(), T::zero())
-                };
+                // On the z axis the azimuth is 0.
+                let off_axis = rho.gt(T::tiny());
+                let (cp, sp) = angle_power(
+                    T::select(off_axis, z.x / rho, T::one()),
+                    T::select(off_axis, z.y / rho, T::zero()),
+                    n,
+                );
                 (st, ct, sp, cp)
             }
             None => {
-                let theta = (z.z / r.max(T::tiny())).max(-T::one()).min(T::one()).acos() * power;
+                let cos_theta = (z.z / r.max(T::tiny())).clamp(-T::one(), T::one());
+                let theta = cos_theta.acos() * power;
                 let phi = z.y.atan2(z.x) * power;
                 (theta.sin(), theta.cos(), phi.sin(), phi.cos())
             }
         };
-        z = v3(st * cp, st * sp, ct) * zr + p;
-    }
-    let r = z.length();
+        let z = v3(st * cp, st * sp, ct) * zr + p;
+        Step {
+            stop_before: Some(r.gt(escape)),
+            next: [z.x, z.y, z.z, dr, trap],
+            stop_after: None,
+        }
+    });
+    let r = v3(x, y, z).length();
+    let estimate = (T::of(0.5) * r.max(T::tiny()).ln() * r / dr).max(outer);
     Estimate {
-        distance: (T::of(0.5) * r.max(T::tiny()).ln() * r / dr).max(outer),
-        trap,
+        distance: T::select(far, outer, estimate),
+        trap: T::select(far, T::one(), trap),
     }
 }
 
@@ -273,31 +305,33 @@ pub fn mandelbulb<T: Real>(
 /// region, scale about the kept cube, and finish with the exact box
 /// distance divided by `scale^iterations`.
 #[must_use]
-pub fn menger<T: Real>(p: V3<T>, iterations: u32, scale: T) -> Estimate<T> {
-    let mut z = p;
-    let mut s = T::one();
-    let mut trap = T::one();
+pub fn menger<T: Num>(p: V3<T>, iterations: u32, scale: T) -> Estimate<T> {
+    menger_estimate(p, T::of(f64::from(iterations)), scale)
+}
+
+/// [`menger`] with the iteration count as a number: the formula written
+/// once (the kernels' `menger` helper).
+#[must_use]
+pub fn menger_estimate<T: Num>(p: V3<T>, iterations: T, scale: T) -> Estimate<T> {
     let shift = scale - T::one();
-    for _ in 0..iterations {
-        z = z.abs();
-        if z.x < z.y {
-            z = v3(z.y, z.x, z.z);
+    let start = [p.x, p.y, p.z, T::one(), T::one()];
+    let [x, y, z, s, trap] = T::iterate(iterations, start, |_, [x, y, z, s, trap]| {
+        let z = v3(x, y, z).abs();
+        // Sort the components, largest first.
+        let z = V3::select(z.x.lt(z.y), v3(z.y, z.x, z.z), z);
+        let z = V3::select(z.x.lt(z.z), v3(z.z, z.y, z.x), z);
+        let z = V3::select(z.y.lt(z.z), v3(z.x, z.z, z.y), z);
+        let trap = trap.min(z.length() * T::of(0.577_350_269_189_625_8));
+        let w = v3(z.x * scale - shift, z.y * scale - shift, z.z * scale);
+        let wz = T::select(w.z.gt(T::of(0.5) * shift), w.z - shift, w.z);
+        Step {
+            stop_before: None,
+            next: [w.x, w.y, wz, s * scale, trap],
+            stop_after: None,
         }
-        if z.x < z.z {
-            z = v3(z.z, z.y, z.x);
-        }
-        if z.y < z.z {
-            z = v3(z.x, z.z, z.y);
-        }
-        trap = trap.min(z.length() * T::of(0.577_350_269_189_625_8));
-        z = v3(z.x * scale - shift, z.y * scale - shift, z.z * scale);
-        if z.z > T::of(0.5) * shift {
-            z.z = z.z - shift;
-        }
-        s = s * scale;
-    }
+    });
     Estimate {
-        distance: cuboid(z, V3::splat(T::one())) / s,
+        distance: cuboid(v3(x, y, z), V3::splat(T::one())) / s,
         trap,
     }
 }
@@ -315,27 +349,31 @@ pub fn tetrahedron<T: Num>(z: V3<T>) -> T {
 /// the vertex `(1,1,1)`, scale about it, finish with the tetrahedron bound
 /// divided by `scale^iterations`.
 #[must_use]
-pub fn sierpinski<T: Real>(p: V3<T>, iterations: u32, scale: T) -> Estimate<T> {
-    let mut z = p;
-    let mut s = T::one();
-    let mut trap = T::one();
+pub fn sierpinski<T: Num>(p: V3<T>, iterations: u32, scale: T) -> Estimate<T> {
+    sierpinski_estimate(p, T::of(f64::from(iterations)), scale)
+}
+
+/// [`sierpinski`] with the iteration count as a number: the formula
+/// written once (the kernels' `sierpinski` helper).
+#[must_use]
+pub fn sierpinski_estimate<T: Num>(p: V3<T>, iterations: T, scale: T) -> Estimate<T> {
     let shift = scale - T::one();
-    for _ in 0..iterations {
-        if z.x + z.y < T::zero() {
-            z = v3(-z.y, -z.x, z.z);
+    let start = [p.x, p.y, p.z, T::one(), T::one()];
+    let [x, y, z, s, trap] = T::iterate(iterations, start, |_, [x, y, z, s, trap]| {
+        let z = v3(x, y, z);
+        let z = V3::select((z.x + z.y).lt(T::zero()), v3(-z.y, -z.x, z.z), z);
+        let z = V3::select((z.x + z.z).lt(T::zero()), v3(-z.z, z.y, -z.x), z);
+        let z = V3::select((z.y + z.z).lt(T::zero()), v3(z.x, -z.z, -z.y), z);
+        let trap = trap.min(z.length() * T::of(0.577_350_269_189_625_8));
+        let w = z * scale - V3::splat(shift);
+        Step {
+            stop_before: None,
+            next: [w.x, w.y, w.z, s * scale, trap],
+            stop_after: None,
         }
-        if z.x + z.z < T::zero() {
-            z = v3(-z.z, z.y, -z.x);
-        }
-        if z.y + z.z < T::zero() {
-            z = v3(z.x, -z.z, -z.y);
-        }
-        trap = trap.min(z.length() * T::of(0.577_350_269_189_625_8));
-        z = z * scale - V3::splat(shift);
-        s = s * scale;
-    }
+    });
     Estimate {
-        distance: tetrahedron(z) / s,
+        distance: tetrahedron(v3(x, y, z)) / s,
         trap,
     }
 }
@@ -373,18 +411,26 @@ pub const JULIA_BOUND_EXTRA: u32 = 2;
 /// quaternion set contains its critical point 0 exactly when `c'` is in
 /// the Mandelbrot set.
 #[must_use]
-pub fn julia_critical_leaves<T: Real>(c: [T; 4], steps: u32, radius2: T) -> bool {
+pub fn julia_critical_leaves<T: Num<Bool = bool>>(c: [T; 4], steps: u32, radius2: T) -> bool {
+    critical_leaves(c, T::of(f64::from(steps)), radius2)
+}
+
+/// [`julia_critical_leaves`] with the step count as a number, for any
+/// [`Num`].
+fn critical_leaves<T: Num>(c: [T; 4], steps: T, radius2: T) -> T::Bool {
     let cy = (c[1] * c[1] + c[2] * c[2] + c[3] * c[3]).sqrt();
-    let (mut x, mut y) = (T::zero(), T::zero());
-    for _ in 0..steps {
+    let [_, _, left] = T::iterate(steps, [T::zero(), T::zero(), T::zero()], |_, [x, y, _]| {
         let two_x = T::of(2.0) * x;
-        x = x * x - y * y + c[0];
-        y = two_x * y + cy;
-        if x * x + y * y > radius2 {
-            return true;
+        let x = x * x - y * y + c[0];
+        let y = two_x * y + cy;
+        let leaves = (x * x + y * y).gt(radius2);
+        Step {
+            stop_before: None,
+            next: [x, y, T::select(leaves, T::one(), T::zero())],
+            stop_after: Some(leaves),
         }
-    }
-    false
+    });
+    left.gt(T::of(0.5))
 }
 
 /// A proven lower bound of the distance from `(p, w)` to the points whose
@@ -415,41 +461,59 @@ pub fn julia_critical_leaves<T: Real>(c: [T; 4], steps: u32, radius2: T) -> bool
 /// only raise a bound that is already below `T / 1e30`) and the orbit
 /// stops at [`Real::magnitude_cap`], so nothing overflows.
 #[must_use]
-pub fn julia_bound<T: Real>(p: V3<T>, c: [T; 4], w: T, steps: u32, edge: T, guess: T) -> T {
+pub fn julia_bound<T: Num>(p: V3<T>, c: [T; 4], w: T, steps: u32, edge: T, guess: T) -> T {
+    orbit_bound(p, c, w, T::of(f64::from(steps) + 1.0), edge, guess)
+}
+
+/// [`julia_bound`] over the first `points` points of the orbit (`steps +
+/// 1`), the count as a number.
+fn orbit_bound<T: Num>(p: V3<T>, c: [T; 4], w: T, points: T, edge: T, guess: T) -> T {
     let cap = T::derivative_cap();
     let far2 = T::magnitude_cap() * T::magnitude_cap();
-    let mut z = [p.x, p.y, p.z, w];
-    let mut mz2 = z[0] * z[0] + z[1] * z[1] + z[2] * z[2] + z[3] * z[3];
-    let (mut a, mut b, mut d) = (T::one(), T::zero(), T::one());
-    let mut best = T::zero();
-    for k in 0..=steps {
-        if mz2 > far2 {
-            break;
-        }
+    let mz2 = p.x * p.x + p.y * p.y + p.z * p.z + w * w;
+    let start = [
+        p.x,
+        p.y,
+        p.z,
+        w,
+        mz2,
+        T::one(),
+        T::zero(),
+        T::one(),
+        T::zero(),
+    ];
+    let [.., best] = T::iterate(points, start, |_, [z0, z1, z2, z3, mz2, a, b, d, best]| {
+        let stop = mz2.gt(far2);
         let r = mz2.sqrt();
         let t = r - edge;
-        if t > T::zero() {
-            best = best.max(t / (a + b * t));
-        }
-        if k == steps {
-            break;
-        }
-        d = (d * T::of(2.0) * r).min(cap);
+        let best = T::select(t.gt(T::zero()), best.max(t / (a + b * t)), best);
+        // The last point's step is computed and not used: only `best` is.
+        let d = (d * T::of(2.0) * r).min(cap);
         let tau = (guess * d).min(cap);
         let s = (mz2 + tau).sqrt().max(T::tiny());
         let half_inv = T::of(0.5) / s;
-        b = (a * half_inv + b).min(cap);
-        a = (a * (r + s - tau * half_inv)).min(cap);
-        let two_x = T::of(2.0) * z[0];
-        z = [
-            z[0] * z[0] - z[1] * z[1] - z[2] * z[2] - z[3] * z[3] + c[0],
-            two_x * z[1] + c[1],
-            two_x * z[2] + c[2],
-            two_x * z[3] + c[3],
-        ];
-        mz2 = z[0] * z[0] + z[1] * z[1] + z[2] * z[2] + z[3] * z[3];
-    }
+        let b = (a * half_inv + b).min(cap);
+        let a = (a * (r + s - tau * half_inv)).min(cap);
+        let z = square_plus(z0, z1, z2, z3, c);
+        let mz2 = z[0] * z[0] + z[1] * z[1] + z[2] * z[2] + z[3] * z[3];
+        Step {
+            stop_before: Some(stop),
+            next: [z[0], z[1], z[2], z[3], mz2, a, b, d, best],
+            stop_after: None,
+        }
+    });
     best
+}
+
+/// `z^2 + c` for the quaternion `z = (x, y, z, w)`, real part first.
+fn square_plus<T: Num>(z0: T, z1: T, z2: T, z3: T, c: [T; 4]) -> [T; 4] {
+    let two_x = T::of(2.0) * z0;
+    [
+        z0 * z0 - z1 * z1 - z2 * z2 - z3 * z3 + c[0],
+        two_x * z1 + c[1],
+        two_x * z2 + c[2],
+        two_x * z3 + c[3],
+    ]
 }
 
 /// The quaternion Julia estimate for `z -> z^2 + c` at the point `(p, w)`
@@ -499,54 +563,58 @@ pub fn julia_bound<T: Real>(p: V3<T>, c: [T; 4], w: T, steps: u32, edge: T, gues
 /// factor of 256 at a point 3.1e-5 from a connected set with bailout 1e6
 /// and 36 iterations).
 #[must_use]
-pub fn julia<T: Real>(p: V3<T>, c: [T; 4], w: T, iterations: u32, bailout: T) -> Estimate<T> {
+pub fn julia<T: Num>(p: V3<T>, c: [T; 4], w: T, iterations: u32, bailout: T) -> Estimate<T> {
+    julia_estimate(p, c, w, T::of(f64::from(iterations)), bailout)
+}
+
+/// [`julia`] with the iteration count as a number: the formula written
+/// once (the kernels' `julia` helper).
+#[must_use]
+pub fn julia_estimate<T: Num>(p: V3<T>, c: [T; 4], w: T, iterations: T, bailout: T) -> Estimate<T> {
     let radius = julia_radius(c);
     let edge = radius.min(bailout);
-    let mut z = [p.x, p.y, p.z, w];
-    let dot = |q: &[T; 4]| q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3];
-    let mut mz2 = dot(&z);
+    let mz2 = p.x * p.x + p.y * p.y + p.z * p.z + w * w;
     let r0 = mz2.sqrt();
-    if r0 > T::of(JULIA_FAR_FIELD) * edge {
-        return Estimate {
-            distance: T::of(JULIA_FAR_FIELD_SLOPE) * (r0 - edge),
-            trap: T::one(),
-        };
-    }
-    let mut md2 = T::one();
-    let mut trap = mz2;
+    let far = r0.gt(T::of(JULIA_FAR_FIELD) * edge);
     let bailout2 = bailout * bailout;
-    let mut n = 0;
-    for _ in 0..iterations {
-        let next = md2 * T::of(4.0) * mz2;
-        if next > T::derivative_cap() {
-            break;
-        }
-        md2 = next;
-        let two_x = T::of(2.0) * z[0];
-        z = [
-            z[0] * z[0] - z[1] * z[1] - z[2] * z[2] - z[3] * z[3] + c[0],
-            two_x * z[1] + c[1],
-            two_x * z[2] + c[2],
-            two_x * z[3] + c[3],
-        ];
-        mz2 = dot(&z);
-        trap = trap.min(mz2);
-        n += 1;
-        if mz2 > bailout2 {
-            break;
-        }
-    }
+    let count = T::select(far, T::zero(), iterations);
+    let start = [p.x, p.y, p.z, w, mz2, T::one(), mz2, T::zero()];
+    let [.., mz2, md2, trap, n] =
+        T::iterate(count, start, |_, [z0, z1, z2, z3, mz2, md2, trap, n]| {
+            let next = md2 * T::of(4.0) * mz2;
+            let z = square_plus(z0, z1, z2, z3, c);
+            let mz2 = z[0] * z[0] + z[1] * z[1] + z[2] * z[2] + z[3] * z[3];
+            Step {
+                stop_before: Some(next.gt(T::derivative_cap())),
+                next: [
+                    z[0],
+                    z[1],
+                    z[2],
+                    z[3],
+                    mz2,
+                    next,
+                    trap.min(mz2),
+                    n + T::one(),
+                ],
+                stop_after: Some(mz2.gt(bailout2)),
+            }
+        });
     let ratio = (mz2 / md2.max(T::tiny())).sqrt();
-    let mut distance = T::of(0.25) * mz2.max(T::tiny()).ln() * ratio;
+    let estimate = T::of(0.25) * mz2.max(T::tiny()).ln() * ratio;
+    // The critical orbit is followed only where the bailout alone does not
+    // already call for the bound, and neither runs far away.
     let critical = T::of(JULIA_CRITICAL_RADIUS);
-    if bailout < T::of(JULIA_TRUSTED_BAILOUT) * radius
-        || julia_critical_leaves(c, n + JULIA_CRITICAL_MARGIN, critical * critical)
-    {
-        distance = distance.min(julia_bound(p, c, w, n + JULIA_BOUND_EXTRA, edge, ratio));
-    }
+    let distrust = bailout.lt(T::of(JULIA_TRUSTED_BAILOUT) * radius);
+    let margin = T::of(f64::from(JULIA_CRITICAL_MARGIN));
+    let orbit_steps = T::select(distrust | far, T::zero(), n + margin);
+    let bounded = distrust | critical_leaves(c, orbit_steps, critical * critical);
+    let extra = T::of(f64::from(JULIA_BOUND_EXTRA) + 1.0);
+    let points = T::select(bounded & !far, n + extra, T::zero());
+    let bound = orbit_bound(p, c, w, points, edge, ratio);
+    let near = T::select(bounded, estimate.min(bound), estimate);
     Estimate {
-        distance,
-        trap: trap.sqrt().min(T::one()),
+        distance: T::select(far, T::of(JULIA_FAR_FIELD_SLOPE) * (r0 - edge), near),
+        trap: T::select(far, T::one(), trap.sqrt().min(T::one())),
     }
 }
 

@@ -11,7 +11,8 @@
 
 use std::ops::{Add, BitAnd, BitOr, Div, Mul, Neg, Not, Sub};
 
-use super::num::{Logic, Num};
+use super::num::{Logic, MAX_LOOP_STEPS, Num};
+use super::program::Step;
 
 /// A closed interval `[lo, hi]` of `f64`, possibly unbounded.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -314,6 +315,54 @@ impl Num for Interval {
             (false, true) => b,
             _ => a.hull(b),
         }
+    }
+    /// Every state some point of the box can end with: the loop follows
+    /// the state of the points that go on, and gathers the state wherever
+    /// some points may stop (their count reached, or a stop that may hold).
+    fn iterate_dyn(
+        count: Self,
+        mut state: Vec<Self>,
+        body: &mut dyn FnMut(Self, &[Self]) -> Step<Self>,
+    ) -> Vec<Self> {
+        let mut ended: Option<Vec<Interval>> = None;
+        let mut gather = |state: &[Interval]| {
+            ended = Some(match ended.take() {
+                None => state.to_vec(),
+                Some(e) => e.iter().zip(state).map(|(a, b)| a.hull(*b)).collect(),
+            });
+        };
+        let mut i = 0u32;
+        loop {
+            let at = f64::from(i);
+            // Points whose count is at most `i` end here.
+            if at >= count.hi || i >= MAX_LOOP_STEPS {
+                break;
+            }
+            if at >= count.lo {
+                gather(&state);
+            }
+            let step = body(Interval::point(at), &state);
+            if let Some(b) = step.stop_before {
+                if b.can_be_true && !b.can_be_false {
+                    break;
+                }
+                if b.can_be_true {
+                    gather(&state);
+                }
+            }
+            state = step.next;
+            if let Some(b) = step.stop_after {
+                if b.can_be_true && !b.can_be_false {
+                    break;
+                }
+                if b.can_be_true {
+                    gather(&state);
+                }
+            }
+            i += 1;
+        }
+        gather(&state);
+        ended.unwrap_or(state)
     }
 }
 

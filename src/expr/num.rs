@@ -13,6 +13,12 @@
 use std::fmt::Debug;
 use std::ops::{Add, BitAnd, BitOr, Div, Mul, Neg, Not, Sub};
 
+use super::program::Step;
+
+/// The most steps a loop takes in plain numbers, whatever its count: a
+/// count of infinity still ends.
+pub const MAX_LOOP_STEPS: u32 = 1 << 20;
+
 /// A truth value of a [`Num`]: `bool` for plain numbers, a maybe for
 /// intervals, a recorded comparison for traced values.
 pub trait Logic:
@@ -130,6 +136,47 @@ pub trait Num:
     #[must_use]
     fn select(c: Self::Bool, a: Self, b: Self) -> Self;
 
+    /// Runs `body` at most `count` times (the index from 0) on a state that
+    /// starts as `init`, with the state's size known only at run time (see
+    /// [`Num::iterate`]).
+    fn iterate_dyn(
+        count: Self,
+        init: Vec<Self>,
+        body: &mut dyn FnMut(Self, &[Self]) -> Step<Self>,
+    ) -> Vec<Self>;
+
+    /// A bounded loop: runs `body` at most `count` times (index `0, 1,
+    /// ...`) on a state that starts as `init`. Each step gives the next
+    /// state and, optionally, where the loop ends before the step (keeping
+    /// the state) or after it. Traced, it is one loop in the program, not
+    /// an unrolled copy per step.
+    ///
+    /// ```
+    /// use fractal_sdf::expr::{Num, Step};
+    /// // Doubles until past 100, at most 10 times.
+    /// let [x] = f64::iterate(10.0, [3.0], |_, [x]| Step {
+    ///     stop_before: None,
+    ///     next: [2.0 * x],
+    ///     stop_after: Some(2.0 * x > 100.0),
+    /// });
+    /// assert_eq!(x, 192.0);
+    /// ```
+    fn iterate<const K: usize>(
+        count: Self,
+        init: [Self; K],
+        mut body: impl FnMut(Self, [Self; K]) -> Step<Self, [Self; K]>,
+    ) -> [Self; K] {
+        let out = Self::iterate_dyn(count, init.to_vec(), &mut |i, s: &[Self]| {
+            let step = body(i, std::array::from_fn(|j| s[j]));
+            Step {
+                stop_before: step.stop_before,
+                next: step.next.to_vec(),
+                stop_after: step.stop_after,
+            }
+        });
+        std::array::from_fn(|j| out[j])
+    }
+
     /// `self > o`.
     fn gt(self, o: Self) -> Self::Bool {
         o.lt(self)
@@ -213,6 +260,46 @@ macro_rules! plain {
             }
             fn select(c: bool, a: Self, b: Self) -> Self {
                 if c { a } else { b }
+            }
+            fn iterate_dyn(
+                count: Self,
+                mut state: Vec<Self>,
+                body: &mut dyn FnMut(Self, &[Self]) -> Step<Self>,
+            ) -> Vec<Self> {
+                let mut i = 0u32;
+                #[allow(clippy::cast_precision_loss)]
+                while (i as $t) < count && i < MAX_LOOP_STEPS {
+                    let step = body(i as $t, &state);
+                    if step.stop_before == Some(true) {
+                        break;
+                    }
+                    state = step.next;
+                    if step.stop_after == Some(true) {
+                        break;
+                    }
+                    i += 1;
+                }
+                state
+            }
+            fn iterate<const K: usize>(
+                count: Self,
+                mut state: [Self; K],
+                mut body: impl FnMut(Self, [Self; K]) -> Step<Self, [Self; K]>,
+            ) -> [Self; K] {
+                let mut i = 0u32;
+                #[allow(clippy::cast_precision_loss)]
+                while (i as $t) < count && i < MAX_LOOP_STEPS {
+                    let step = body(i as $t, state);
+                    if step.stop_before == Some(true) {
+                        break;
+                    }
+                    state = step.next;
+                    if step.stop_after == Some(true) {
+                        break;
+                    }
+                    i += 1;
+                }
+                state
             }
         }
     };

@@ -6,9 +6,7 @@
 //! are written inline; values read more often get a name. [`OpenCl`]
 //! writes OpenCL C; a second backend is a second [`Printer`].
 
-use std::fmt::Write as _;
-
-use super::program::{Binary, Op, Program, Unary, ValueId};
+use super::program::{Binary, Loop, Op, Program, Unary, ValueId};
 
 /// The shape of a parameter or result: how many scalar inputs or outputs
 /// it stands for.
@@ -136,17 +134,31 @@ fn literal(v: f64) -> Result<String, Unprintable> {
     })
 }
 
-struct OpenClWriter<'p> {
-    program: &'p Program,
-    inputs: Vec<String>,
-    /// Each value's text where it is read: a name, or its inlined
-    /// expression.
-    text: Vec<String>,
-    /// The vector parameter whose three components start at each input.
-    vectors: Vec<Option<String>>,
+/// Writes a program's statements, and the text each value is read as.
+struct OpenClWriter {
+    /// The statements so far.
+    out: String,
+    /// The temporaries' prefix: `t` unless a parameter could be one.
+    prefix: String,
+    /// Temporaries and loops named so far (names are unique in the
+    /// function, so nested blocks never shadow).
+    temps: u32,
+    loops: u32,
 }
 
-impl OpenClWriter<'_> {
+/// One program being written: the text each input and each value so far
+/// is read as, and the enclosing programs' values (innermost last).
+struct Block<'b> {
+    program: &'b Program,
+    inputs: &'b [String],
+    /// The vector parameter whose three components start at each input.
+    vectors: &'b [Option<String>],
+    outer: &'b [&'b [String]],
+    text: Vec<String>,
+    indent: usize,
+}
+
+impl Block<'_> {
     fn atom(&self, v: ValueId) -> &str {
         &self.text[v.index()]
     }
@@ -169,11 +181,18 @@ impl OpenClWriter<'_> {
         None
     }
 
-    /// The expression of `op`, parenthesised unless it is a call.
-    fn expression(&self, op: Op) -> Result<String, Unprintable> {
-        Ok(match op {
+    /// The expression of `op`, parenthesised unless it is a call; `None`
+    /// for a loop (written as statements).
+    fn expression(&self, op: Op) -> Result<Option<String>, Unprintable> {
+        Ok(Some(match op {
             Op::Const(v) => literal(v)?,
             Op::Input(i) => self.inputs[i as usize].clone(),
+            Op::Capture(up, v) => {
+                let at = self.outer.len() - up as usize;
+                self.outer[at][v.index()].clone()
+            }
+            Op::Loop(_) => return Ok(None),
+            Op::Element(l, k) => format!("{}_{k}", self.atom(l)),
             Op::Unary(u, a) => {
                 let (a, inner) = (self.atom(a), self.arg(a));
                 match u {
@@ -221,8 +240,179 @@ impl OpenClWriter<'_> {
             Op::Select(c, a, b) => {
                 format!("({} ? {} : {})", self.atom(c), self.atom(a), self.atom(b))
             }
-        })
+        }))
     }
+}
+
+impl OpenClWriter {
+    fn line(&mut self, indent: usize, text: &str) {
+        for _ in 0..indent {
+            self.out.push_str("    ");
+        }
+        self.out.push_str(text);
+        self.out.push('\n');
+    }
+
+    fn temp(&mut self) -> String {
+        let name = format!("{}{}", self.prefix, self.temps);
+        self.temps += 1;
+        name
+    }
+
+    /// Names `text` as a temporary of type `ty`, unless it is already a
+    /// plain name or literal.
+    fn name(&mut self, indent: usize, ty: &str, text: &str) -> String {
+        if is_simple(text) {
+            return text.to_string();
+        }
+        let name = self.temp();
+        self.line(indent, &format!("{ty} {name} = {};", unwrap(text)));
+        name
+    }
+
+    /// Writes the statements of the block's live values; with `split`,
+    /// first those `split` needs, then `if (split) break;`, then the rest.
+    fn block(&mut self, b: &mut Block<'_>, split: Option<ValueId>) -> Result<(), Unprintable> {
+        let program = b.program;
+        let uses = program.uses();
+        let live = program.live();
+        // Values a loop reads are named: a loop body never recomputes an
+        // expression of the program around it.
+        let mut named = vec![false; program.ops.len()];
+        for op in &program.ops {
+            if let Op::Loop(_) = op {
+                for v in op.operands(&program.loops) {
+                    named[v.index()] = true;
+                }
+            }
+        }
+        let first: Vec<bool> = match split {
+            Some(v) => {
+                let mut need = vec![false; program.ops.len()];
+                need[v.index()] = true;
+                for i in (0..program.ops.len()).rev() {
+                    if need[i] {
+                        for o in program.ops[i].operands(&program.loops) {
+                            need[o.index()] = true;
+                        }
+                    }
+                }
+                need
+            }
+            None => vec![true; program.ops.len()],
+        };
+        b.text = vec![String::new(); program.ops.len()];
+        let passes: &[bool] = if split.is_some() {
+            &[true, false]
+        } else {
+            &[true]
+        };
+        for &pass in passes {
+            for (i, op) in program.ops.iter().enumerate() {
+                if !live[i] || first[i] != pass {
+                    continue;
+                }
+                self.op(b, i, *op, uses[i] > 1 || named[i])?;
+            }
+            if pass && let Some(v) = split {
+                let cond = unwrap(b.atom(v)).to_string();
+                self.line(b.indent, &format!("if ({cond}) {{"));
+                self.line(b.indent + 1, "break;");
+                self.line(b.indent, "}");
+            }
+        }
+        Ok(())
+    }
+
+    /// Writes value `i` of the block: inline, named, or a loop.
+    fn op(&mut self, b: &mut Block<'_>, i: usize, op: Op, name: bool) -> Result<(), Unprintable> {
+        if let Op::Loop(n) = op {
+            b.text[i] = self.write_loop(b, &b.program.loops[n as usize])?;
+            return Ok(());
+        }
+        let text = b.expression(op)?.unwrap_or_default();
+        let trivial = matches!(
+            op,
+            Op::Const(_) | Op::Input(_) | Op::Capture(..) | Op::Element(..)
+        );
+        b.text[i] = if name && !trivial {
+            let ty = if op.is_logic() { "bool" } else { "real" };
+            let t = self.temp();
+            self.line(b.indent, &format!("{ty} {t} = {};", unwrap(&text)));
+            t
+        } else {
+            text
+        };
+        Ok(())
+    }
+
+    /// Writes a loop; its text is the prefix of its state's names.
+    fn write_loop(&mut self, b: &Block<'_>, l: &Loop) -> Result<String, Unprintable> {
+        let id = self.loops;
+        self.loops += 1;
+        let state = format!("{}s{id}", self.prefix);
+        let index = format!("{}i{id}", self.prefix);
+        let indent = b.indent;
+        for (j, v) in l.init.iter().enumerate() {
+            let init = unwrap(b.atom(*v)).to_string();
+            self.line(indent, &format!("real {state}_{j} = {init};"));
+        }
+        let count = unwrap(b.atom(l.count)).to_string();
+        self.line(
+            indent,
+            &format!("for (int {index} = 0; {index} < {count}; {index}++) {{"),
+        );
+        let mut inputs = vec![format!("(real){index}")];
+        inputs.extend((0..l.init.len()).map(|j| format!("{state}_{j}")));
+        let mut outer: Vec<&[String]> = b.outer.to_vec();
+        outer.push(&b.text);
+        let mut body = Block {
+            program: &l.body,
+            inputs: &inputs,
+            vectors: &[],
+            outer: &outer,
+            text: Vec::new(),
+            indent: indent + 1,
+        };
+        self.block(&mut body, l.stop_before_output())?;
+        // The next state and the stop are read before the state changes.
+        let k = l.init.len();
+        let mut next = Vec::with_capacity(k);
+        for (j, v) in l.body.outputs[..k].iter().enumerate() {
+            let text = body.atom(*v).to_string();
+            next.push(if text == format!("{state}_{j}") {
+                None
+            } else {
+                Some(self.name(indent + 1, "real", &text))
+            });
+        }
+        let stop = match l.stop_after_output() {
+            Some(v) => {
+                let text = body.atom(v).to_string();
+                Some(self.name(indent + 1, "bool", &text))
+            }
+            None => None,
+        };
+        for (j, n) in next.iter().enumerate() {
+            if let Some(n) = n {
+                self.line(indent + 1, &format!("{state}_{j} = {n};"));
+            }
+        }
+        if let Some(stop) = stop {
+            self.line(indent + 1, &format!("if ({stop}) {{"));
+            self.line(indent + 2, "break;");
+            self.line(indent + 1, "}");
+        }
+        self.line(indent, "}");
+        Ok(state)
+    }
+}
+
+/// Whether `text` is a name or a literal, cheap to read twice.
+fn is_simple(text: &str) -> bool {
+    text.chars()
+        .all(|c| c.is_ascii_alphanumeric() || c == '_' || c == '.')
+        || (text.starts_with("R(") && text.ends_with(')') && !text[2..].contains('('))
 }
 
 /// Values as a call's arguments.
@@ -271,38 +461,33 @@ impl Printer for OpenCl {
                 vectors.push(None);
             }
         }
-        let mut w = OpenClWriter {
-            program,
-            inputs,
-            text: Vec::with_capacity(program.ops.len()),
-            vectors,
-        };
-        let uses = program.uses();
-        let live = program.live();
-        let mut body = String::new();
-        let mut named = 0;
-        // Temporaries are `t0`, `t1`, ...: with more underscores while a
-        // parameter could be one of them.
+        // Temporaries are `t0`, `t1`, ..., loops' states `ts0_0` and
+        // indices `ti0`: with more underscores while a parameter's name
+        // starts with the prefix.
         let mut prefix = String::from("t");
-        while signature.params.iter().any(|(n, _)| {
-            n.strip_prefix(prefix.as_str())
-                .is_some_and(|rest| rest.chars().all(|c| c.is_ascii_digit()))
-        }) {
+        while signature
+            .params
+            .iter()
+            .any(|(n, _)| n.starts_with(prefix.as_str()))
+        {
             prefix.push('_');
         }
-        for (i, op) in program.ops.iter().enumerate() {
-            let text = w.expression(*op)?;
-            let inline = matches!(op, Op::Const(_) | Op::Input(_)) || uses[i] <= 1 || !live[i];
-            if inline {
-                w.text.push(text);
-            } else {
-                let ty = if op.is_logic() { "bool" } else { "real" };
-                writeln!(body, "    {ty} {prefix}{named} = {};", unwrap(&text)).ok();
-                w.text.push(format!("{prefix}{named}"));
-                named += 1;
-            }
-        }
-        let outputs: Vec<&str> = program.outputs.iter().map(|v| w.atom(*v)).collect();
+        let mut w = OpenClWriter {
+            out: String::new(),
+            prefix,
+            temps: 0,
+            loops: 0,
+        };
+        let mut block = Block {
+            program,
+            inputs: &inputs,
+            vectors: &vectors,
+            outer: &[],
+            text: Vec::new(),
+            indent: 1,
+        };
+        w.block(&mut block, None)?;
+        let outputs: Vec<&str> = program.outputs.iter().map(|v| block.atom(*v)).collect();
         let (ty, result) = match signature.result {
             Shape::Scalar => ("real", unwrap(outputs[0]).to_string()),
             Shape::Pair => ("real2", format!("(real2)({})", args(&outputs))),
@@ -321,9 +506,10 @@ impl Printer for OpenCl {
             })
             .collect();
         Ok(format!(
-            "{ty} {}({}) {{\n{body}    return {result};\n}}\n",
+            "{ty} {}({}) {{\n{}    return {result};\n}}\n",
             signature.name,
-            params.join(", ")
+            params.join(", "),
+            w.out
         ))
     }
 }

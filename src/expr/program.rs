@@ -106,6 +106,65 @@ pub enum Op {
     Length3(ValueId, ValueId, ValueId),
     /// `a` where the truth value `c` holds, else `b`.
     Select(ValueId, ValueId, ValueId),
+    /// A value of an enclosing program (a loop's body reading the values
+    /// around it): how many programs out, and its place there.
+    Capture(u32, ValueId),
+    /// Loop number `n` of [`Program::loops`]: its value is its final state.
+    Loop(u32),
+    /// Component `k` of a loop's final state.
+    Element(ValueId, u32),
+}
+
+/// A bounded loop: its body runs at most `count` times (the index from 0)
+/// on the state, which starts as `init`; it stops early where the body says
+/// so. Every loop terminates: `count` is a value, not a condition.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Loop {
+    /// How many times the body may run (in the enclosing program).
+    pub count: ValueId,
+    /// The first state (in the enclosing program).
+    pub init: Vec<ValueId>,
+    /// The body: inputs the index then the state; outputs the next state,
+    /// then the `stop_before` truth value if [`Loop::stop_before`], then
+    /// the `stop_after` one if [`Loop::stop_after`].
+    pub body: Program,
+    /// Whether the body gives a truth value that ends the loop before its
+    /// step (the state stays as it was).
+    pub stop_before: bool,
+    /// Whether the body gives a truth value that ends the loop after its
+    /// step.
+    pub stop_after: bool,
+}
+
+impl Loop {
+    /// The body's output that ends the loop before the step.
+    #[must_use]
+    pub fn stop_before_output(&self) -> Option<ValueId> {
+        self.stop_before.then(|| self.body.outputs[self.init.len()])
+    }
+
+    /// The body's output that ends the loop after the step.
+    #[must_use]
+    pub fn stop_after_output(&self) -> Option<ValueId> {
+        self.stop_after
+            .then(|| self.body.outputs[self.init.len() + usize::from(self.stop_before)])
+    }
+
+    /// The values of the program `depth` levels out that the body (and
+    /// the loops in it) read.
+    fn outer_reads(&self, depth: u32, out: &mut Vec<ValueId>) {
+        for op in &self.body.ops {
+            if let Op::Capture(up, v) = op
+                && *up == depth
+                && !out.contains(v)
+            {
+                out.push(*v);
+            }
+        }
+        for inner in &self.body.loops {
+            inner.outer_reads(depth + 1, out);
+        }
+    }
 }
 
 impl Op {
@@ -119,14 +178,22 @@ impl Op {
         }
     }
 
-    /// The values this operation reads.
+    /// The values of its own program this operation reads (a loop: its
+    /// count, first state and what its body reads of this program).
     #[must_use]
-    pub fn operands(&self) -> Vec<ValueId> {
+    pub fn operands(&self, loops: &[Loop]) -> Vec<ValueId> {
         match *self {
-            Op::Const(_) | Op::Input(_) => Vec::new(),
-            Op::Unary(_, a) => vec![a],
+            Op::Const(_) | Op::Input(_) | Op::Capture(..) => Vec::new(),
+            Op::Unary(_, a) | Op::Element(a, _) => vec![a],
             Op::Binary(_, a, b) => vec![a, b],
             Op::Length3(a, b, c) | Op::Select(a, b, c) => vec![a, b, c],
+            Op::Loop(n) => {
+                let l = &loops[n as usize];
+                let mut v = vec![l.count];
+                v.extend_from_slice(&l.init);
+                l.outer_reads(1, &mut v);
+                v
+            }
         }
     }
 
@@ -139,6 +206,9 @@ impl Op {
             Op::Binary(b, x, y) => Key::Binary(b, x, y),
             Op::Length3(x, y, z) => Key::Length3(x, y, z),
             Op::Select(c, a, b) => Key::Select(c, a, b),
+            Op::Capture(up, v) => Key::Capture(up, v),
+            Op::Loop(n) => Key::Loop(n),
+            Op::Element(v, k) => Key::Element(v, k),
         }
     }
 }
@@ -151,6 +221,9 @@ enum Key {
     Binary(Binary, ValueId, ValueId),
     Length3(ValueId, ValueId, ValueId),
     Select(ValueId, ValueId, ValueId),
+    Capture(u32, ValueId),
+    Loop(u32),
+    Element(ValueId, u32),
 }
 
 /// A recorded formula: operations in order, how many scalar inputs it
@@ -163,29 +236,33 @@ pub struct Program {
     pub inputs: u32,
     /// The returned values, in order.
     pub outputs: Vec<ValueId>,
+    /// The loops its [`Op::Loop`]s name.
+    pub loops: Vec<Loop>,
 }
 
-/// A value of a program run: a number or a truth value.
-#[derive(Debug, Clone, Copy)]
+/// A value of a program run: a number, a truth value or a loop's state.
+#[derive(Debug, Clone)]
 enum Slot<N: Num> {
     Number(N),
     Truth(N::Bool),
+    State(Vec<N>),
 }
 
 impl<N: Num> Slot<N> {
-    fn number(self) -> N {
+    fn number(&self) -> N {
         match self {
-            Slot::Number(n) => n,
+            Slot::Number(n) => *n,
             // Programs are typed when recorded; a truth value read as a
             // number is the checked programs' bug, and reads as NaN.
-            Slot::Truth(_) => N::of(f64::NAN),
+            Slot::Truth(_) | Slot::State(_) => N::of(f64::NAN),
         }
     }
 
-    fn truth(self) -> N::Bool {
+    fn truth(&self) -> N::Bool {
         match self {
-            Slot::Truth(b) => b,
+            Slot::Truth(b) => *b,
             Slot::Number(n) => n.finite() & !n.finite(),
+            Slot::State(_) => N::of(0.0).lt(N::of(0.0)),
         }
     }
 }
@@ -196,6 +273,16 @@ impl Program {
     /// Missing inputs read as NaN.
     #[must_use]
     pub fn run<N: Num>(&self, inputs: &[N]) -> Vec<N> {
+        let slots = self.run_in(inputs, &[]);
+        self.outputs
+            .iter()
+            .map(|v| slots[v.index()].number())
+            .collect()
+    }
+
+    /// Runs the program with `outer` the slots of the enclosing programs
+    /// (innermost last), giving every value's slot.
+    fn run_in<N: Num>(&self, inputs: &[N], outer: &[&[Slot<N>]]) -> Vec<Slot<N>> {
         let mut slots: Vec<Slot<N>> = Vec::with_capacity(self.ops.len());
         for op in &self.ops {
             let n = |v: ValueId| slots[v.index()].number();
@@ -222,13 +309,27 @@ impl Program {
                 },
                 Op::Length3(x, y, z) => Slot::Number(N::length3(n(x), n(y), n(z))),
                 Op::Select(c, x, y) => Slot::Number(N::select(b(c), n(x), n(y))),
+                Op::Capture(up, v) => {
+                    let at = outer.len().checked_sub(up as usize);
+                    at.and_then(|at| outer[at].get(v.index()))
+                        .cloned()
+                        .unwrap_or(Slot::Number(N::of(f64::NAN)))
+                }
+                Op::Element(v, k) => match &slots[v.index()] {
+                    Slot::State(s) => Slot::Number(s[k as usize]),
+                    _ => Slot::Number(N::of(f64::NAN)),
+                },
+                Op::Loop(index) => {
+                    let l = &self.loops[index as usize];
+                    let init: Vec<N> = l.init.iter().map(|v| n(*v)).collect();
+                    let mut levels: Vec<&[Slot<N>]> = outer.to_vec();
+                    levels.push(&slots);
+                    Slot::State(run_loop(l, n(l.count), init, &levels))
+                }
             };
             slots.push(slot);
         }
-        self.outputs
-            .iter()
-            .map(|v| slots[v.index()].number())
-            .collect()
+        slots
     }
 
     /// How many times each value is read (by operations and outputs).
@@ -236,7 +337,7 @@ impl Program {
     pub fn uses(&self) -> Vec<u32> {
         let mut uses = vec![0u32; self.ops.len()];
         for op in &self.ops {
-            for v in op.operands() {
+            for v in op.operands(&self.loops) {
                 uses[v.index()] += 1;
             }
         }
@@ -255,13 +356,43 @@ impl Program {
         }
         for i in (0..self.ops.len()).rev() {
             if live[i] {
-                for v in self.ops[i].operands() {
+                for v in self.ops[i].operands(&self.loops) {
                     live[v.index()] = true;
                 }
             }
         }
         live
     }
+}
+
+/// Runs a loop in any number type, through [`Num::iterate`].
+fn run_loop<N: Num>(l: &Loop, count: N, init: Vec<N>, outer: &[&[Slot<N>]]) -> Vec<N> {
+    let k = init.len();
+    N::iterate_dyn(count, init, &mut |index: N, state: &[N]| {
+        let mut inputs = Vec::with_capacity(k + 1);
+        inputs.push(index);
+        inputs.extend_from_slice(state);
+        let slots = l.body.run_in(&inputs, outer);
+        let get = |v: ValueId| slots[v.index()].number();
+        let truth = |v: Option<ValueId>| v.map(|v| slots[v.index()].truth());
+        Step {
+            stop_before: truth(l.stop_before_output()),
+            next: l.body.outputs[..k].iter().map(|v| get(*v)).collect(),
+            stop_after: truth(l.stop_after_output()),
+        }
+    })
+}
+
+/// One step of a loop (see [`Num::iterate`]).
+#[derive(Debug, Clone)]
+pub struct Step<N: Num, S = Vec<N>> {
+    /// Where this holds, the loop ends before the step: the state stays
+    /// as it was.
+    pub stop_before: Option<N::Bool>,
+    /// The next state.
+    pub next: S,
+    /// Where this holds, the loop ends after the step.
+    pub stop_after: Option<N::Bool>,
 }
 
 /// Applies a numeric [`Unary`] operation.
@@ -300,6 +431,7 @@ pub(crate) fn binary<N: Num>(op: Binary, a: N, b: N) -> N {
 #[derive(Debug, Default)]
 struct Tape {
     ops: Vec<Op>,
+    loops: Vec<Loop>,
     seen: HashMap<Key, ValueId>,
 }
 
@@ -317,11 +449,32 @@ impl Tape {
 }
 
 thread_local! {
-    /// The tapes being recorded on this thread, innermost last.
+    /// The tapes being recorded on this thread, innermost last: a loop's
+    /// body is recorded on a tape of its own.
     static TAPES: RefCell<Vec<Tape>> = const { RefCell::new(Vec::new()) };
 }
 
-fn record(op: Op) -> ValueId {
+/// The depth of the innermost tape.
+fn depth() -> u32 {
+    TAPES.with(|t| u32::try_from(t.borrow().len()).unwrap_or(u32::MAX))
+}
+
+/// `v`'s place on the innermost tape: a value of an enclosing tape is
+/// read through an [`Op::Capture`].
+fn resolve(level: u32, id: ValueId) -> ValueId {
+    let here = depth();
+    assert!(
+        level <= here && here > 0,
+        "a traced value is used only inside expr::trace, and a loop's values only inside its body"
+    );
+    if level == here {
+        id
+    } else {
+        push(Op::Capture(here - level, id))
+    }
+}
+
+fn push(op: Op) -> ValueId {
     TAPES.with(|t| {
         t.borrow_mut()
             .last_mut()
@@ -330,14 +483,58 @@ fn record(op: Op) -> ValueId {
     })
 }
 
+/// Records `op` on the innermost tape, as a value of that tape.
+fn record(op: Op) -> Var {
+    Var {
+        level: depth(),
+        id: push(op),
+    }
+}
+
 /// A number being traced: running a formula on `Var`s records its
 /// operations into a [`Program`] (see [`trace`]).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct Var(pub(crate) ValueId);
+pub struct Var {
+    level: u32,
+    id: ValueId,
+}
+
+impl Var {
+    /// Its place on the innermost tape.
+    fn here(self) -> ValueId {
+        resolve(self.level, self.id)
+    }
+}
 
 /// A truth value being traced.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct VarBool(pub(crate) ValueId);
+pub struct VarBool(Var);
+
+/// Pops the innermost tape when dropped, so that a panic in a formula
+/// leaves no tape behind.
+struct Pop;
+
+impl Drop for Pop {
+    fn drop(&mut self) {
+        TAPES.with(|t| t.borrow_mut().pop());
+    }
+}
+
+/// Records `f` on a new tape with `inputs` inputs.
+fn record_program(inputs: u32, f: impl FnOnce(&[Var]) -> Vec<ValueId>) -> Program {
+    TAPES.with(|t| t.borrow_mut().push(Tape::default()));
+    let guard = Pop;
+    let args: Vec<Var> = (0..inputs).map(|i| record(Op::Input(i))).collect();
+    let outputs = f(&args);
+    let tape = TAPES.with(|t| std::mem::take(t.borrow_mut().last_mut().expect("pushed above")));
+    drop(guard);
+    Program {
+        ops: tape.ops,
+        inputs,
+        outputs,
+        loops: tape.loops,
+    }
+}
 
 /// Records `f` run on `inputs` scalar inputs as a [`Program`] returning the
 /// values `f` returns.
@@ -348,24 +545,53 @@ pub struct VarBool(pub(crate) ValueId);
 /// assert_eq!(program.run(&[3.0_f64, 4.0]), vec![5.0]);
 /// ```
 pub fn trace(inputs: u32, f: impl FnOnce(&[Var]) -> Vec<Var>) -> Program {
-    TAPES.with(|t| t.borrow_mut().push(Tape::default()));
-    // The tape is popped even if `f` panics, so a later trace starts clean.
-    struct Pop;
-    impl Drop for Pop {
-        fn drop(&mut self) {
-            TAPES.with(|t| t.borrow_mut().pop());
+    record_program(inputs, |args| f(args).into_iter().map(Var::here).collect())
+}
+
+/// Records a loop: its body on a tape of its own, then the loop and its
+/// final state on the enclosing tape.
+fn record_loop(
+    count: Var,
+    init: &[Var],
+    body: &mut dyn FnMut(Var, &[Var]) -> Step<Var>,
+) -> Vec<Var> {
+    let count = count.here();
+    let init: Vec<ValueId> = init.iter().map(|v| v.here()).collect();
+    let k = init.len();
+    let (mut stop_before, mut stop_after) = (false, false);
+    let inputs = u32::try_from(k + 1).expect("a loop's state is small");
+    let body = record_program(inputs, |args| {
+        let step = body(args[0], &args[1..]);
+        let mut outputs: Vec<ValueId> = step.next.iter().map(|v| v.here()).collect();
+        assert_eq!(outputs.len(), k, "a loop's body keeps the state's size");
+        if let Some(b) = step.stop_before {
+            stop_before = true;
+            outputs.push(b.0.here());
         }
-    }
-    let guard = Pop;
-    let args: Vec<Var> = (0..inputs).map(|i| Var(record(Op::Input(i)))).collect();
-    let outputs: Vec<ValueId> = f(&args).into_iter().map(|v| v.0).collect();
-    let tape = TAPES.with(|t| std::mem::take(t.borrow_mut().last_mut().expect("pushed above")));
-    drop(guard);
-    Program {
-        ops: tape.ops,
-        inputs,
-        outputs,
-    }
+        if let Some(b) = step.stop_after {
+            stop_after = true;
+            outputs.push(b.0.here());
+        }
+        outputs
+    });
+    let index = TAPES.with(|t| {
+        let mut tapes = t.borrow_mut();
+        let tape = tapes
+            .last_mut()
+            .expect("a loop is traced inside expr::trace");
+        tape.loops.push(Loop {
+            count,
+            init,
+            body,
+            stop_before,
+            stop_after,
+        });
+        u32::try_from(tape.loops.len() - 1).expect("fewer than 2^32 loops")
+    });
+    let state = push(Op::Loop(index));
+    (0..k)
+        .map(|j| record(Op::Element(state, u32::try_from(j).unwrap_or(u32::MAX))))
+        .collect()
 }
 
 impl Logic for VarBool {}
@@ -373,21 +599,21 @@ impl Logic for VarBool {}
 impl BitAnd for VarBool {
     type Output = Self;
     fn bitand(self, o: Self) -> Self {
-        VarBool(record(Op::Binary(Binary::And, self.0, o.0)))
+        VarBool(record(Op::Binary(Binary::And, self.0.here(), o.0.here())))
     }
 }
 
 impl BitOr for VarBool {
     type Output = Self;
     fn bitor(self, o: Self) -> Self {
-        VarBool(record(Op::Binary(Binary::Or, self.0, o.0)))
+        VarBool(record(Op::Binary(Binary::Or, self.0.here(), o.0.here())))
     }
 }
 
 impl Not for VarBool {
     type Output = Self;
     fn not(self) -> Self {
-        VarBool(record(Op::Unary(Unary::Not, self.0)))
+        VarBool(record(Op::Unary(Unary::Not, self.0.here())))
     }
 }
 
@@ -396,7 +622,7 @@ macro_rules! var_binary {
         impl $trait for Var {
             type Output = Self;
             fn $method(self, o: Self) -> Self {
-                Var(record(Op::Binary(Binary::$op, self.0, o.0)))
+                self.binary(Binary::$op, o)
             }
         }
     };
@@ -416,11 +642,16 @@ impl Neg for Var {
 
 impl Var {
     fn unary(self, u: Unary) -> Self {
-        Var(record(Op::Unary(u, self.0)))
+        record(Op::Unary(u, self.here()))
     }
 
     fn binary(self, b: Binary, o: Self) -> Self {
-        Var(record(Op::Binary(b, self.0, o.0)))
+        let (x, y) = (self.here(), o.here());
+        record(Op::Binary(b, x, y))
+    }
+
+    fn truth(self, b: Binary, o: Self) -> VarBool {
+        VarBool(self.binary(b, o))
     }
 }
 
@@ -428,7 +659,7 @@ impl Num for Var {
     type Bool = VarBool;
 
     fn of(v: f64) -> Self {
-        Var(record(Op::Const(v)))
+        record(Op::Const(v))
     }
     fn sqrt(self) -> Self {
         self.unary(Unary::Sqrt)
@@ -470,21 +701,30 @@ impl Num for Var {
         self.binary(Binary::Hypot, o)
     }
     fn length3(x: Self, y: Self, z: Self) -> Self {
-        Var(record(Op::Length3(x.0, y.0, z.0)))
+        let (x, y, z) = (x.here(), y.here(), z.here());
+        record(Op::Length3(x, y, z))
     }
     fn lt(self, o: Self) -> VarBool {
-        VarBool(record(Op::Binary(Binary::Lt, self.0, o.0)))
+        self.truth(Binary::Lt, o)
     }
     fn le(self, o: Self) -> VarBool {
-        VarBool(record(Op::Binary(Binary::Le, self.0, o.0)))
+        self.truth(Binary::Le, o)
     }
     fn finite(self) -> VarBool {
-        VarBool(record(Op::Unary(Unary::Finite, self.0)))
+        VarBool(self.unary(Unary::Finite))
     }
     fn select(c: VarBool, a: Self, b: Self) -> Self {
         if a == b {
             return a;
         }
-        Var(record(Op::Select(c.0, a.0, b.0)))
+        let (c, a, b) = (c.0.here(), a.here(), b.here());
+        record(Op::Select(c, a, b))
+    }
+    fn iterate_dyn(
+        count: Self,
+        init: Vec<Self>,
+        body: &mut dyn FnMut(Self, &[Self]) -> Step<Self>,
+    ) -> Vec<Self> {
+        record_loop(count, &init, body)
     }
 }

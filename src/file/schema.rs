@@ -63,7 +63,7 @@ impl FormulaParam {
     pub(super) fn rule(&self) -> Rule {
         match (self.min, self.max) {
             (None, None) => Rule::Finite,
-            (Some(lo), None) if lo == 0.0 => Rule::NonNegative,
+            (Some(0.0), None) => Rule::NonNegative,
             (lo, hi) => Rule::Range(lo.unwrap_or(-f64::MAX), hi.unwrap_or(f64::MAX)),
         }
     }

@@ -110,9 +110,8 @@ impl<T: Num> V3<T> {
     }
 
     /// Euclidean length without overflow or underflow in the squares: the
-    /// vector is divided by its largest component first (the kernels'
-    /// `safe_length`, in `kernels/sdf/length.cl`). A zero or non-finite
-    /// vector gives [`V3::length`].
+    /// vector is divided by its largest component first. A zero or
+    /// non-finite vector gives [`V3::length`].
     #[must_use]
     pub fn safe_length(self) -> T {
         let m = self.abs().max_element();

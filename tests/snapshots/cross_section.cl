@@ -98,61 +98,53 @@ real sd_plane(real3 p, real3 n, real offset) {
 }
 
 /* ---- mandelbulb_p8 ---- */
-/* Mandelbulb of power 8, unrolled: no loop over the power, no trigonometry. */
-real mandelbulb_p8(real3 p, int iterations, real escape, real ball, real* trap) {
-    real r0 = length(p);
-    real outer = r0 - ball;
-    if (r0 > R(1.5) * ball) {
-        *trap = R(1.0);
-        return outer;
-    }
-    real3 z = p;
-    real dr = R(1.0);
-    real t = R(1.0);
-    for (int i = 0; i < iterations; i++) {
-        real r = length(z);
-        if (r > escape) {
+real2 mandelbulb_p8(real3 p, real iterations, real escape, real ball) {
+    real t0 = length(p);
+    real t1 = t0 - ball;
+    bool t2 = (R(1.5) * ball) < t0;
+    real t3 = t2 ? R(0.0) : iterations;
+    real ts0_0 = p.x;
+    real ts0_1 = p.y;
+    real ts0_2 = p.z;
+    real ts0_3 = R(1.0);
+    real ts0_4 = R(1.0);
+    for (int ti0 = 0; ti0 < t3; ti0++) {
+        real t4 = length((real3)(ts0_0, ts0_1, ts0_2));
+        if (escape < t4) {
             break;
         }
-        t = fmin(t, r);
-        real qb0 = r * r;
-        real qr1 = r * qb0;
-        real qb1 = qb0 * qb0;
-        real qr2 = qr1 * qb1;
-        real r_pow = qr2;
-        dr = fmin(R(8.0) * r_pow * dr + R(1.0), DERIVATIVE_CAP);
-        real zr = r_pow * r;
-        real rho = hypot(z.x, z.y);
-        real inv_r = R(1.0) / fmax(r, REAL_TINY);
-        real ct = z.z * inv_r;
-        real st = rho * inv_r;
-        real cp = R(1.0);
-        real sp = R(0.0);
-        if (rho > REAL_TINY) {
-            cp = z.x / rho;
-            sp = z.y / rho;
-        }
-        real thbc0 = ct * ct - st * st;
-        real thbs0 = R(2.0) * ct * st;
-        real thbc1 = thbc0 * thbc0 - thbs0 * thbs0;
-        real thbs1 = R(2.0) * thbc0 * thbs0;
-        real thbc2 = thbc1 * thbc1 - thbs1 * thbs1;
-        real thbs2 = R(2.0) * thbc1 * thbs1;
-        real thc = thbc2;
-        real ths = thbs2;
-        real phbc0 = cp * cp - sp * sp;
-        real phbs0 = R(2.0) * cp * sp;
-        real phbc1 = phbc0 * phbc0 - phbs0 * phbs0;
-        real phbs1 = R(2.0) * phbc0 * phbs0;
-        real phbc2 = phbc1 * phbc1 - phbs1 * phbs1;
-        real phbs2 = R(2.0) * phbc1 * phbs1;
-        real phc = phbc2;
-        real phs = phbs2;
-        z = (real3)(ths * phc, ths * phs, thc) * zr + p;
+        real t5 = t4 * t4;
+        real t6 = (t4 * t5) * (t5 * t5);
+        real t7 = t6 * t4;
+        real t8 = hypot(ts0_0, ts0_1);
+        real t9 = R(1.0) / fmax(t4, R(1e-30));
+        real t10 = ts0_2 * t9;
+        real t11 = t8 * t9;
+        real t12 = (t10 * t10) - (t11 * t11);
+        real t13 = (R(2.0) * t10) * t11;
+        real t14 = (t12 * t12) - (t13 * t13);
+        real t15 = (R(2.0) * t12) * t13;
+        real t16 = (R(2.0) * t14) * t15;
+        bool t17 = R(1e-30) < t8;
+        real t18 = t17 ? (ts0_0 / t8) : R(1.0);
+        real t19 = t17 ? (ts0_1 / t8) : R(0.0);
+        real t20 = (t18 * t18) - (t19 * t19);
+        real t21 = (R(2.0) * t18) * t19;
+        real t22 = (t20 * t20) - (t21 * t21);
+        real t23 = (R(2.0) * t20) * t21;
+        real t24 = ((t16 * ((t22 * t22) - (t23 * t23))) * t7) + p.x;
+        real t25 = ((t16 * ((R(2.0) * t22) * t23)) * t7) + p.y;
+        real t26 = (((t14 * t14) - (t15 * t15)) * t7) + p.z;
+        real t27 = fmin(((R(8.0) * t6) * ts0_3) + R(1.0), R(1e30));
+        real t28 = fmin(ts0_4, t4);
+        ts0_0 = t24;
+        ts0_1 = t25;
+        ts0_2 = t26;
+        ts0_3 = t27;
+        ts0_4 = t28;
     }
-    real r = length(z);
-    *trap = t;
-    return fmax(R(0.5) * log(fmax(r, REAL_TINY)) * r / dr, outer);
+    real t29 = length((real3)(ts0_0, ts0_1, ts0_2));
+    return (real2)(t2 ? t1 : fmax(((R(0.5) * log(fmax(t29, R(1e-30)))) * t29) / ts0_3, t1), t2 ? R(1.0) : ts0_4);
 }
 
 /* ---- scene ---- */
@@ -167,8 +159,8 @@ real DE(real3 p0, __global const real* params) {
         /* .../a:cut/a:color/rotate */
         real3 p1 = (real3)(p0.x, -p0.z, p0.y);
         /* .../a:color/rotate/mandelbulb */
-        real t0;
-        real d0 = mandelbulb_p8(p1, 10, 2.0f, 1.1040895f, &t0);
+        real2 f0 = mandelbulb_p8(p1, 10, 2.0f, 1.1040895f);
+        real d0 = f0.x;
         /* union/a:cut/b:plane */
         real d3 = sd_plane(p0, (real3)(0.0f, 0.28734788f, 0.95782626f), params[0] /* cut */);
         /* union/a:cut */
@@ -198,8 +190,9 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
         /* .../a:cut/a:color/rotate */
         real3 p1 = (real3)(p0.x, -p0.z, p0.y);
         /* .../a:color/rotate/mandelbulb */
-        real t0;
-        real d0 = mandelbulb_p8(p1, 10, 2.0f, 1.1040895f, &t0);
+        real2 f0 = mandelbulb_p8(p1, 10, 2.0f, 1.1040895f);
+        real d0 = f0.x;
+        real t0 = f0.y;
         /* union/a:cut/a:color */
         real3 c2 = (real3)(0.95f, 0.7f, 0.45f);
         /* union/a:cut/b:plane */

@@ -91,14 +91,6 @@ real sd_sphere(real3 p, real r) {
     return length(p) - r;
 }
 
-/* ---- cuboid ---- */
-real sd_box(real3 p, real3 b) {
-    real t0 = fabs(p.x) - b.x;
-    real t1 = fabs(p.y) - b.y;
-    real t2 = fabs(p.z) - b.z;
-    return length((real3)(fmax(t0, R(0.0)), fmax(t1, R(0.0)), fmax(t2, R(0.0)))) + fmin(fmax(fmax(t0, t1), t2), R(0.0));
-}
-
 /* ---- plane ---- */
 real sd_plane(real3 p, real3 n, real offset) {
     real t0 = fmax(fmax(fabs(n.x), fabs(n.y)), fabs(n.z));
@@ -111,184 +103,222 @@ real sd_plane(real3 p, real3 n, real offset) {
 }
 
 /* ---- mandelbulb ---- */
-/* Mandelbulb of any real power, with acos/atan2/sin/cos. */
-real mandelbulb(real3 p, real power, int iterations, real escape, real ball, real* trap) {
-    /* The ball of radius `ball` = 2^(1 / (power - 1)) holds the set (proof: cpu::sdf::mandelbulb_radius);
-       beyond 1.5 times its radius (MANDELBULB_FAR_FIELD), its distance alone. */
-    real r0 = length(p);
-    real outer = r0 - ball;
-    if (r0 > R(1.5) * ball) {
-        *trap = R(1.0);
-        return outer;
-    }
-    real3 z = p;
-    real dr = R(1.0);
-    real t = R(1.0);
-    for (int i = 0; i < iterations; i++) {
-        real r = length(z);
-        if (r > escape) {
+real2 mandelbulb(real3 p, real power, real iterations, real escape, real ball) {
+    real t0 = length(p);
+    real t1 = t0 - ball;
+    bool t2 = (R(1.5) * ball) < t0;
+    real t3 = t2 ? R(0.0) : iterations;
+    real ts0_0 = p.x;
+    real ts0_1 = p.y;
+    real ts0_2 = p.z;
+    real ts0_3 = R(1.0);
+    real ts0_4 = R(1.0);
+    for (int ti0 = 0; ti0 < t3; ti0++) {
+        real t4 = length((real3)(ts0_0, ts0_1, ts0_2));
+        if (escape < t4) {
             break;
         }
-        t = fmin(t, r);
-        real r_pow = pow(r, power - R(1.0));
-        dr = fmin(power * r_pow * dr + R(1.0), DERIVATIVE_CAP);
-        real zr = r_pow * r;
-        real theta = acos(fmin(fmax(z.z / fmax(r, REAL_TINY), R(-1.0)), R(1.0))) * power;
-        real phi = atan2(z.y, z.x) * power;
-        real st = sin(theta);
-        z = (real3)(st * cos(phi), st * sin(phi), cos(theta)) * zr + p;
+        real t5 = pow(t4, power - R(1.0));
+        real t6 = t5 * t4;
+        real t7 = acos(fmin(fmax(ts0_2 / fmax(t4, R(1e-30)), -R(1.0)), R(1.0))) * power;
+        real t8 = atan2(ts0_1, ts0_0) * power;
+        real t9 = sin(t7);
+        real t10 = ((t9 * cos(t8)) * t6) + p.x;
+        real t11 = ((t9 * sin(t8)) * t6) + p.y;
+        real t12 = (cos(t7) * t6) + p.z;
+        real t13 = fmin(((power * t5) * ts0_3) + R(1.0), R(1e30));
+        real t14 = fmin(ts0_4, t4);
+        ts0_0 = t10;
+        ts0_1 = t11;
+        ts0_2 = t12;
+        ts0_3 = t13;
+        ts0_4 = t14;
     }
-    real r = length(z);
-    *trap = t;
-    return fmax(R(0.5) * log(fmax(r, REAL_TINY)) * r / dr, outer);
+    real t15 = length((real3)(ts0_0, ts0_1, ts0_2));
+    return (real2)(t2 ? t1 : fmax(((R(0.5) * log(fmax(t15, R(1e-30)))) * t15) / ts0_3, t1), t2 ? R(1.0) : ts0_4);
 }
 
 /* ---- menger ---- */
-/* Menger sponge, KIFS form: fold, scale about the kept cube, box bound. */
-real menger(real3 p, int iterations, real scale, real* trap) {
-    real3 z = p;
-    real s = R(1.0);
-    real t = R(1.0);
-    real shift = scale - R(1.0);
-    for (int i = 0; i < iterations; i++) {
-        z = fabs(z);
-        if (z.x < z.y) z = z.yxz;
-        if (z.x < z.z) z = z.zyx;
-        if (z.y < z.z) z = z.xzy;
-        t = fmin(t, length(z) * R(0.5773502691896258));
-        z = (real3)(z.x * scale - shift, z.y * scale - shift, z.z * scale);
-        if (z.z > R(0.5) * shift) z.z = z.z - shift;
-        s = s * scale;
+real2 menger(real3 p, real iterations, real scale) {
+    real t0 = scale - R(1.0);
+    real ts0_0 = p.x;
+    real ts0_1 = p.y;
+    real ts0_2 = p.z;
+    real ts0_3 = R(1.0);
+    real ts0_4 = R(1.0);
+    for (int ti0 = 0; ti0 < iterations; ti0++) {
+        real t1 = fabs(ts0_0);
+        real t2 = fabs(ts0_1);
+        real t3 = fabs(ts0_2);
+        bool t4 = t1 < t2;
+        real t5 = t4 ? t2 : t1;
+        real t6 = t4 ? t1 : t2;
+        bool t7 = t5 < t3;
+        real t8 = t7 ? t3 : t5;
+        real t9 = t7 ? t5 : t3;
+        bool t10 = t6 < t9;
+        real t11 = t10 ? t9 : t6;
+        real t12 = t10 ? t6 : t9;
+        real t13 = t12 * scale;
+        real t14 = (t8 * scale) - t0;
+        real t15 = (t11 * scale) - t0;
+        real t16 = ((R(0.5) * t0) < t13) ? (t13 - t0) : t13;
+        real t17 = ts0_3 * scale;
+        real t18 = fmin(ts0_4, length((real3)(t8, t11, t12)) * R(0.5773502691896258));
+        ts0_0 = t14;
+        ts0_1 = t15;
+        ts0_2 = t16;
+        ts0_3 = t17;
+        ts0_4 = t18;
     }
-    *trap = t;
-    return sd_box(z, (real3)(R(1.0))) / s;
-}
-
-/* ---- tetrahedron ---- */
-real sd_tetrahedron(real3 z) {
-    real t0 = -z.x;
-    return (fmax(fmax((t0 - z.y) - z.z, (z.x + z.y) - z.z), fmax((t0 + z.y) + z.z, (z.x - z.y) + z.z)) - R(1.0)) * R(0.5773502691896258);
+    real t19 = fabs(ts0_0) - R(1.0);
+    real t20 = fabs(ts0_1) - R(1.0);
+    real t21 = fabs(ts0_2) - R(1.0);
+    return (real2)((length((real3)(fmax(t19, R(0.0)), fmax(t20, R(0.0)), fmax(t21, R(0.0)))) + fmin(fmax(fmax(t19, t20), t21), R(0.0))) / ts0_3, ts0_4);
 }
 
 /* ---- sierpinski ---- */
-/* Sierpinski tetrahedron, KIFS form: reflect towards (1,1,1), scale about it. */
-real sierpinski(real3 p, int iterations, real scale, real* trap) {
-    real3 z = p;
-    real s = R(1.0);
-    real t = R(1.0);
-    real shift = scale - R(1.0);
-    for (int i = 0; i < iterations; i++) {
-        if (z.x + z.y < R(0.0)) z = (real3)(-z.y, -z.x, z.z);
-        if (z.x + z.z < R(0.0)) z = (real3)(-z.z, z.y, -z.x);
-        if (z.y + z.z < R(0.0)) z = (real3)(z.x, -z.z, -z.y);
-        t = fmin(t, length(z) * R(0.5773502691896258));
-        z = z * scale - (real3)(shift);
-        s = s * scale;
+real2 sierpinski(real3 p, real iterations, real scale) {
+    real t0 = scale - R(1.0);
+    real ts0_0 = p.x;
+    real ts0_1 = p.y;
+    real ts0_2 = p.z;
+    real ts0_3 = R(1.0);
+    real ts0_4 = R(1.0);
+    for (int ti0 = 0; ti0 < iterations; ti0++) {
+        bool t1 = (ts0_0 + ts0_1) < R(0.0);
+        real t2 = t1 ? (-ts0_1) : ts0_0;
+        real t3 = t1 ? (-ts0_0) : ts0_1;
+        bool t4 = (t2 + ts0_2) < R(0.0);
+        real t5 = t4 ? (-ts0_2) : t2;
+        real t6 = t4 ? (-t2) : ts0_2;
+        bool t7 = (t3 + t6) < R(0.0);
+        real t8 = t7 ? (-t6) : t3;
+        real t9 = t7 ? (-t3) : t6;
+        real t10 = (t5 * scale) - t0;
+        real t11 = (t8 * scale) - t0;
+        real t12 = (t9 * scale) - t0;
+        real t13 = ts0_3 * scale;
+        real t14 = fmin(ts0_4, length((real3)(t5, t8, t9)) * R(0.5773502691896258));
+        ts0_0 = t10;
+        ts0_1 = t11;
+        ts0_2 = t12;
+        ts0_3 = t13;
+        ts0_4 = t14;
     }
-    *trap = t;
-    return sd_tetrahedron(z) / s;
+    real t15 = -ts0_0;
+    return (real2)(((fmax(fmax((t15 - ts0_1) - ts0_2, (ts0_0 + ts0_1) - ts0_2), fmax((t15 + ts0_1) + ts0_2, (ts0_0 - ts0_1) + ts0_2)) - R(1.0)) * R(0.5773502691896258)) / ts0_3, ts0_4);
 }
 
 /* ---- julia ---- */
-/* The radius of the ball that holds the quaternion Julia set of c (cpu::sdf::julia_radius). */
-real julia_radius(real4 c) {
-    return R(0.5) + sqrt(R(0.5) * R(0.5) + sqrt(dot(c, c)));
-}
-
-/* Whether the critical orbit 0, c, c^2 + c, ... (as the complex orbit of
-   c.x + i |c.yzw|) leaves |w|^2 <= radius2 within `steps` steps. */
-int julia_critical_leaves(real4 c, int steps, real radius2) {
-    real cy = sqrt(c.y * c.y + c.z * c.z + c.w * c.w);
-    real x = R(0.0);
-    real y = R(0.0);
-    for (int i = 0; i < steps; i++) {
-        real two_x = R(2.0) * x;
-        x = x * x - y * y + c.x;
-        y = two_x * y + cy;
-        if (x * x + y * y > radius2) {
-            return 1;
-        }
-    }
-    return 0;
-}
-
-/* A proven lower bound of the distance to the points whose orbits stay
-   within `edge`, from the first steps + 1 points of the orbit; 0 where none
-   proves escape (proof: cpu::sdf::julia_bound). */
-real julia_bound(real3 p, real4 c, real w, int steps, real edge, real guess) {
-    real far2 = R(1e18) * R(1e18);
-    real4 z = (real4)(p, w);
-    real mz2 = dot(z, z);
-    real a = R(1.0);
-    real b = R(0.0);
-    real d = R(1.0);
-    real best = R(0.0);
-    for (int k = 0; k <= steps; k++) {
-        if (mz2 > far2) {
+real2 julia(real3 p, real cx, real cy, real cz, real cw, real w, real iterations, real bailout) {
+    real t0 = cy * cy;
+    real t1 = cz * cz;
+    real t2 = cw * cw;
+    real t3 = R(0.5) + sqrt((R(0.5) * R(0.5)) + sqrt((((cx * cx) + t0) + t1) + t2));
+    real t4 = fmin(t3, bailout);
+    real t5 = (((p.x * p.x) + (p.y * p.y)) + (p.z * p.z)) + (w * w);
+    real t6 = sqrt(t5);
+    bool t7 = (R(1.5) * t4) < t6;
+    real t8 = bailout * bailout;
+    real t9 = t7 ? R(0.0) : iterations;
+    real ts0_0 = p.x;
+    real ts0_1 = p.y;
+    real ts0_2 = p.z;
+    real ts0_3 = w;
+    real ts0_4 = t5;
+    real ts0_5 = R(1.0);
+    real ts0_6 = t5;
+    real ts0_7 = R(0.0);
+    for (int ti0 = 0; ti0 < t9; ti0++) {
+        real t10 = (ts0_5 * R(4.0)) * ts0_4;
+        if (R(1e30) < t10) {
             break;
         }
-        real r = sqrt(mz2);
-        real t = r - edge;
-        if (t > R(0.0)) {
-            best = fmax(best, t / (a + b * t));
-        }
-        if (k == steps) {
-            break;
-        }
-        d = fmin(d * R(2.0) * r, DERIVATIVE_CAP);
-        real tau = fmin(guess * d, DERIVATIVE_CAP);
-        real s = fmax(sqrt(mz2 + tau), REAL_TINY);
-        real half_inv = R(0.5) / s;
-        b = fmin(a * half_inv + b, DERIVATIVE_CAP);
-        a = fmin(a * (r + s - tau * half_inv), DERIVATIVE_CAP);
-        real two_x = R(2.0) * z.x;
-        z = (real4)(z.x * z.x - z.y * z.y - z.z * z.z - z.w * z.w, two_x * z.y, two_x * z.z, two_x * z.w) + c;
-        mz2 = dot(z, z);
-    }
-    return best;
-}
-
-/* Quaternion Julia z -> z^2 + c at the point (p, w), real part first: 0.9
-   times the ball's distance far away (beyond 1.5 radii, JULIA_FAR_FIELD);
-   nearer the escape-time estimate where trusted (bailout >= 2.5 radii,
-   critical orbit within 0.9 for n + 2 steps), else no more than
-   julia_bound (cpu::sdf::julia). */
-real julia(real3 p, real4 c, real w, int iterations, real bailout, real* trap) {
-    real radius = julia_radius(c);
-    real edge = fmin(radius, bailout);
-    real4 z = (real4)(p, w);
-    real mz2 = dot(z, z);
-    real r0 = sqrt(mz2);
-    if (r0 > R(1.5) * edge) {
-        *trap = R(1.0);
-        return R(0.9) * (r0 - edge);
-    }
-    real md2 = R(1.0);
-    real t = mz2;
-    real bailout2 = bailout * bailout;
-    int n = 0;
-    for (int i = 0; i < iterations; i++) {
-        real next = md2 * R(4.0) * mz2;
-        if (next > DERIVATIVE_CAP) {
-            break;
-        }
-        md2 = next;
-        real two_x = R(2.0) * z.x;
-        z = (real4)(z.x * z.x - z.y * z.y - z.z * z.z - z.w * z.w, two_x * z.y, two_x * z.z, two_x * z.w) + c;
-        mz2 = dot(z, z);
-        t = fmin(t, mz2);
-        n++;
-        if (mz2 > bailout2) {
+        real t11 = R(2.0) * ts0_0;
+        real t12 = ((((ts0_0 * ts0_0) - (ts0_1 * ts0_1)) - (ts0_2 * ts0_2)) - (ts0_3 * ts0_3)) + cx;
+        real t13 = (t11 * ts0_1) + cy;
+        real t14 = (t11 * ts0_2) + cz;
+        real t15 = (t11 * ts0_3) + cw;
+        real t16 = (((t12 * t12) + (t13 * t13)) + (t14 * t14)) + (t15 * t15);
+        real t17 = fmin(ts0_6, t16);
+        real t18 = ts0_7 + R(1.0);
+        bool t19 = t8 < t16;
+        ts0_0 = t12;
+        ts0_1 = t13;
+        ts0_2 = t14;
+        ts0_3 = t15;
+        ts0_4 = t16;
+        ts0_5 = t10;
+        ts0_6 = t17;
+        ts0_7 = t18;
+        if (t19) {
             break;
         }
     }
-    *trap = fmin(sqrt(t), R(1.0));
-    real ratio = sqrt(mz2 / fmax(md2, REAL_TINY));
-    real d = R(0.25) * log(fmax(mz2, REAL_TINY)) * ratio;
-    if (bailout < R(2.5) * radius || julia_critical_leaves(c, n + 2, R(0.9) * R(0.9))) {
-        d = fmin(d, julia_bound(p, c, w, n + 2, edge, ratio));
+    real t20 = sqrt(ts0_4 / fmax(ts0_5, R(1e-30)));
+    real t21 = (R(0.25) * log(fmax(ts0_4, R(1e-30)))) * t20;
+    bool t22 = bailout < (R(2.5) * t3);
+    real t23 = (t22 || t7) ? R(0.0) : (ts0_7 + R(2.0));
+    real t24 = R(0.9) * R(0.9);
+    real t25 = sqrt((t0 + t1) + t2);
+    real ts1_0 = R(0.0);
+    real ts1_1 = R(0.0);
+    real ts1_2 = R(0.0);
+    for (int ti1 = 0; ti1 < t23; ti1++) {
+        real t26 = ((ts1_0 * ts1_0) - (ts1_1 * ts1_1)) + cx;
+        real t27 = ((R(2.0) * ts1_0) * ts1_1) + t25;
+        bool t28 = t24 < ((t26 * t26) + (t27 * t27));
+        real t29 = t28 ? R(1.0) : R(0.0);
+        ts1_0 = t26;
+        ts1_1 = t27;
+        ts1_2 = t29;
+        if (t28) {
+            break;
+        }
     }
-    return d;
+    bool t30 = t22 || (R(0.5) < ts1_2);
+    real t31 = (t30 && (!t7)) ? (ts0_7 + R(3.0)) : R(0.0);
+    real t32 = R(1e18) * R(1e18);
+    real ts2_0 = p.x;
+    real ts2_1 = p.y;
+    real ts2_2 = p.z;
+    real ts2_3 = w;
+    real ts2_4 = t5;
+    real ts2_5 = R(1.0);
+    real ts2_6 = R(0.0);
+    real ts2_7 = R(1.0);
+    real ts2_8 = R(0.0);
+    for (int ti2 = 0; ti2 < t31; ti2++) {
+        if (t32 < ts2_4) {
+            break;
+        }
+        real t33 = sqrt(ts2_4);
+        real t34 = t33 - t4;
+        real t35 = fmin((ts2_7 * R(2.0)) * t33, R(1e30));
+        real t36 = fmin(t20 * t35, R(1e30));
+        real t37 = fmax(sqrt(ts2_4 + t36), R(1e-30));
+        real t38 = R(0.5) / t37;
+        real t39 = R(2.0) * ts2_0;
+        real t40 = ((((ts2_0 * ts2_0) - (ts2_1 * ts2_1)) - (ts2_2 * ts2_2)) - (ts2_3 * ts2_3)) + cx;
+        real t41 = (t39 * ts2_1) + cy;
+        real t42 = (t39 * ts2_2) + cz;
+        real t43 = (t39 * ts2_3) + cw;
+        real t44 = (((t40 * t40) + (t41 * t41)) + (t42 * t42)) + (t43 * t43);
+        real t45 = fmin(ts2_5 * ((t33 + t37) - (t36 * t38)), R(1e30));
+        real t46 = fmin((ts2_5 * t38) + ts2_6, R(1e30));
+        real t47 = (R(0.0) < t34) ? fmax(ts2_8, t34 / (ts2_5 + (ts2_6 * t34))) : ts2_8;
+        ts2_0 = t40;
+        ts2_1 = t41;
+        ts2_2 = t42;
+        ts2_3 = t43;
+        ts2_4 = t44;
+        ts2_5 = t45;
+        ts2_6 = t46;
+        ts2_7 = t35;
+        ts2_8 = t47;
+    }
+    return (real2)(t7 ? (R(0.9) * (t6 - t4)) : (t30 ? fmin(t21, ts2_8) : t21), t7 ? R(1.0) : fmin(sqrt(ts0_6), R(1.0)));
 }
 
 /* ---- smooth_min ---- */
@@ -314,8 +344,8 @@ real DE(real3 p0, __global const real* params) {
         /* .../b:translate/color/scale */
         real3 p2 = p1 / 0.35f;
         /* .../color/scale/sierpinski */
-        real t17;
-        real d17 = sierpinski(p2, 5, 2.0f, &t17);
+        real2 f17 = sierpinski(p2, 5, 2.0f);
+        real d17 = f17.x;
         real d18 = d17 * 0.35f;
         /* union/a:smooth_union: the second operand only within reach of its bound */
         real u21 = d18;
@@ -326,8 +356,8 @@ real DE(real3 p0, __global const real* params) {
             /* .../b:translate/color/scale */
             real3 p4 = p3 / 0.5f;
             /* .../color/scale/julia */
-            real t12;
-            real d12 = julia(p4, (real4)((-0.2f), 0.6f, 0.2f, 0.2f), 0.0f, 12, 4.0f, &t12);
+            real2 f12 = julia(p4, (-0.2f), 0.6f, 0.2f, 0.2f, 0.0f, 12, 4.0f);
+            real d12 = f12.x;
             real d13 = d12 * 0.5f;
             /* .../a:smooth_union/a:smooth_union: the second operand only within reach of its bound */
             real u16 = d13;
@@ -338,8 +368,8 @@ real DE(real3 p0, __global const real* params) {
                 /* .../color/smooth_subtract/a:scale */
                 real3 p6 = p5 / 0.45f;
                 /* .../smooth_subtract/a:scale/menger */
-                real t5;
-                real d5 = menger(p6, 3, 3.0f, &t5);
+                real2 f5 = menger(p6, 3, 3.0f);
+                real d5 = f5.x;
                 real d6 = d5 * 0.45f;
                 /* .../color/smooth_subtract: the second operand only within reach of its bound */
                 real u8 = d6;
@@ -365,8 +395,8 @@ real DE(real3 p0, __global const real* params) {
                     /* .../color/scale/rotate */
                     real3 p9 = (real3)(p8.x, -p8.z, p8.y);
                     /* .../scale/rotate/mandelbulb */
-                    real t0;
-                    real d0 = mandelbulb(p9, params[0] /* power */, 8, fmin(2.0f, pow(MAGNITUDE_CAP, R(1.0) / params[0] /* power */)), pow(R(2.0), R(1.0) / (params[0] /* power */ - R(1.0))), &t0);
+                    real2 f0 = mandelbulb(p9, params[0] /* power */, 8, fmin(2.0f, pow(MAGNITUDE_CAP, R(1.0) / params[0] /* power */)), pow(R(2.0), R(1.0) / (params[0] /* power */ - R(1.0))));
+                    real d0 = f0.x;
                     real d2 = d0 * 0.5f;
                     /* .../a:smooth_union/a:smooth_union/a:smooth_union */
                     real x11 = u8;
@@ -414,8 +444,9 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
         /* .../b:translate/color/scale */
         real3 p2 = p1 / 0.35f;
         /* .../color/scale/sierpinski */
-        real t17;
-        real d17 = sierpinski(p2, 5, 2.0f, &t17);
+        real2 f17 = sierpinski(p2, 5, 2.0f);
+        real d17 = f17.x;
+        real t17 = f17.y;
         real d18 = d17 * 0.35f;
         /* .../a:smooth_union/b:translate/color */
         real3 c19 = (real3)(0.95f, 0.8f, 0.4f);
@@ -430,8 +461,9 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
             /* .../b:translate/color/scale */
             real3 p4 = p3 / 0.5f;
             /* .../color/scale/julia */
-            real t12;
-            real d12 = julia(p4, (real4)((-0.2f), 0.6f, 0.2f, 0.2f), 0.0f, 12, 4.0f, &t12);
+            real2 f12 = julia(p4, (-0.2f), 0.6f, 0.2f, 0.2f, 0.0f, 12, 4.0f);
+            real d12 = f12.x;
+            real t12 = f12.y;
             real d13 = d12 * 0.5f;
             /* .../a:smooth_union/b:translate/color */
             real3 c14 = (real3)(0.4f, 0.7f, 0.95f);
@@ -446,8 +478,9 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
                 /* .../color/smooth_subtract/a:scale */
                 real3 p6 = p5 / 0.45f;
                 /* .../smooth_subtract/a:scale/menger */
-                real t5;
-                real d5 = menger(p6, 3, 3.0f, &t5);
+                real2 f5 = menger(p6, 3, 3.0f);
+                real d5 = f5.x;
+                real t5 = f5.y;
                 real d6 = d5 * 0.45f;
                 /* .../color/smooth_subtract: the second operand only within reach of its bound */
                 real u8 = d6;
@@ -480,8 +513,9 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
                     /* .../color/scale/rotate */
                     real3 p9 = (real3)(p8.x, -p8.z, p8.y);
                     /* .../scale/rotate/mandelbulb */
-                    real t0;
-                    real d0 = mandelbulb(p9, params[0] /* power */, 8, fmin(2.0f, pow(MAGNITUDE_CAP, R(1.0) / params[0] /* power */)), pow(R(2.0), R(1.0) / (params[0] /* power */ - R(1.0))), &t0);
+                    real2 f0 = mandelbulb(p9, params[0] /* power */, 8, fmin(2.0f, pow(MAGNITUDE_CAP, R(1.0) / params[0] /* power */)), pow(R(2.0), R(1.0) / (params[0] /* power */ - R(1.0))));
+                    real d0 = f0.x;
+                    real t0 = f0.y;
                     real d2 = d0 * 0.5f;
                     /* .../a:smooth_union/a:translate/color */
                     real3 c3 = (real3)(0.9f, 0.55f, 0.3f);

@@ -87,119 +87,129 @@ typedef float4 real4;
 #define LIGHT_STRIDE 8
 
 /* ---- julia ---- */
-/* The radius of the ball that holds the quaternion Julia set of c (cpu::sdf::julia_radius). */
-real julia_radius(real4 c) {
-    return R(0.5) + sqrt(R(0.5) * R(0.5) + sqrt(dot(c, c)));
-}
-
-/* Whether the critical orbit 0, c, c^2 + c, ... (as the complex orbit of
-   c.x + i |c.yzw|) leaves |w|^2 <= radius2 within `steps` steps. */
-int julia_critical_leaves(real4 c, int steps, real radius2) {
-    real cy = sqrt(c.y * c.y + c.z * c.z + c.w * c.w);
-    real x = R(0.0);
-    real y = R(0.0);
-    for (int i = 0; i < steps; i++) {
-        real two_x = R(2.0) * x;
-        x = x * x - y * y + c.x;
-        y = two_x * y + cy;
-        if (x * x + y * y > radius2) {
-            return 1;
-        }
-    }
-    return 0;
-}
-
-/* A proven lower bound of the distance to the points whose orbits stay
-   within `edge`, from the first steps + 1 points of the orbit; 0 where none
-   proves escape (proof: cpu::sdf::julia_bound). */
-real julia_bound(real3 p, real4 c, real w, int steps, real edge, real guess) {
-    real far2 = R(1e18) * R(1e18);
-    real4 z = (real4)(p, w);
-    real mz2 = dot(z, z);
-    real a = R(1.0);
-    real b = R(0.0);
-    real d = R(1.0);
-    real best = R(0.0);
-    for (int k = 0; k <= steps; k++) {
-        if (mz2 > far2) {
+real2 julia(real3 p, real cx, real cy, real cz, real cw, real w, real iterations, real bailout) {
+    real t0 = cy * cy;
+    real t1 = cz * cz;
+    real t2 = cw * cw;
+    real t3 = R(0.5) + sqrt((R(0.5) * R(0.5)) + sqrt((((cx * cx) + t0) + t1) + t2));
+    real t4 = fmin(t3, bailout);
+    real t5 = (((p.x * p.x) + (p.y * p.y)) + (p.z * p.z)) + (w * w);
+    real t6 = sqrt(t5);
+    bool t7 = (R(1.5) * t4) < t6;
+    real t8 = bailout * bailout;
+    real t9 = t7 ? R(0.0) : iterations;
+    real ts0_0 = p.x;
+    real ts0_1 = p.y;
+    real ts0_2 = p.z;
+    real ts0_3 = w;
+    real ts0_4 = t5;
+    real ts0_5 = R(1.0);
+    real ts0_6 = t5;
+    real ts0_7 = R(0.0);
+    for (int ti0 = 0; ti0 < t9; ti0++) {
+        real t10 = (ts0_5 * R(4.0)) * ts0_4;
+        if (R(1e30) < t10) {
             break;
         }
-        real r = sqrt(mz2);
-        real t = r - edge;
-        if (t > R(0.0)) {
-            best = fmax(best, t / (a + b * t));
-        }
-        if (k == steps) {
-            break;
-        }
-        d = fmin(d * R(2.0) * r, DERIVATIVE_CAP);
-        real tau = fmin(guess * d, DERIVATIVE_CAP);
-        real s = fmax(sqrt(mz2 + tau), REAL_TINY);
-        real half_inv = R(0.5) / s;
-        b = fmin(a * half_inv + b, DERIVATIVE_CAP);
-        a = fmin(a * (r + s - tau * half_inv), DERIVATIVE_CAP);
-        real two_x = R(2.0) * z.x;
-        z = (real4)(z.x * z.x - z.y * z.y - z.z * z.z - z.w * z.w, two_x * z.y, two_x * z.z, two_x * z.w) + c;
-        mz2 = dot(z, z);
-    }
-    return best;
-}
-
-/* Quaternion Julia z -> z^2 + c at the point (p, w), real part first: 0.9
-   times the ball's distance far away (beyond 1.5 radii, JULIA_FAR_FIELD);
-   nearer the escape-time estimate where trusted (bailout >= 2.5 radii,
-   critical orbit within 0.9 for n + 2 steps), else no more than
-   julia_bound (cpu::sdf::julia). */
-real julia(real3 p, real4 c, real w, int iterations, real bailout, real* trap) {
-    real radius = julia_radius(c);
-    real edge = fmin(radius, bailout);
-    real4 z = (real4)(p, w);
-    real mz2 = dot(z, z);
-    real r0 = sqrt(mz2);
-    if (r0 > R(1.5) * edge) {
-        *trap = R(1.0);
-        return R(0.9) * (r0 - edge);
-    }
-    real md2 = R(1.0);
-    real t = mz2;
-    real bailout2 = bailout * bailout;
-    int n = 0;
-    for (int i = 0; i < iterations; i++) {
-        real next = md2 * R(4.0) * mz2;
-        if (next > DERIVATIVE_CAP) {
-            break;
-        }
-        md2 = next;
-        real two_x = R(2.0) * z.x;
-        z = (real4)(z.x * z.x - z.y * z.y - z.z * z.z - z.w * z.w, two_x * z.y, two_x * z.z, two_x * z.w) + c;
-        mz2 = dot(z, z);
-        t = fmin(t, mz2);
-        n++;
-        if (mz2 > bailout2) {
+        real t11 = R(2.0) * ts0_0;
+        real t12 = ((((ts0_0 * ts0_0) - (ts0_1 * ts0_1)) - (ts0_2 * ts0_2)) - (ts0_3 * ts0_3)) + cx;
+        real t13 = (t11 * ts0_1) + cy;
+        real t14 = (t11 * ts0_2) + cz;
+        real t15 = (t11 * ts0_3) + cw;
+        real t16 = (((t12 * t12) + (t13 * t13)) + (t14 * t14)) + (t15 * t15);
+        real t17 = fmin(ts0_6, t16);
+        real t18 = ts0_7 + R(1.0);
+        bool t19 = t8 < t16;
+        ts0_0 = t12;
+        ts0_1 = t13;
+        ts0_2 = t14;
+        ts0_3 = t15;
+        ts0_4 = t16;
+        ts0_5 = t10;
+        ts0_6 = t17;
+        ts0_7 = t18;
+        if (t19) {
             break;
         }
     }
-    *trap = fmin(sqrt(t), R(1.0));
-    real ratio = sqrt(mz2 / fmax(md2, REAL_TINY));
-    real d = R(0.25) * log(fmax(mz2, REAL_TINY)) * ratio;
-    if (bailout < R(2.5) * radius || julia_critical_leaves(c, n + 2, R(0.9) * R(0.9))) {
-        d = fmin(d, julia_bound(p, c, w, n + 2, edge, ratio));
+    real t20 = sqrt(ts0_4 / fmax(ts0_5, R(1e-30)));
+    real t21 = (R(0.25) * log(fmax(ts0_4, R(1e-30)))) * t20;
+    bool t22 = bailout < (R(2.5) * t3);
+    real t23 = (t22 || t7) ? R(0.0) : (ts0_7 + R(2.0));
+    real t24 = R(0.9) * R(0.9);
+    real t25 = sqrt((t0 + t1) + t2);
+    real ts1_0 = R(0.0);
+    real ts1_1 = R(0.0);
+    real ts1_2 = R(0.0);
+    for (int ti1 = 0; ti1 < t23; ti1++) {
+        real t26 = ((ts1_0 * ts1_0) - (ts1_1 * ts1_1)) + cx;
+        real t27 = ((R(2.0) * ts1_0) * ts1_1) + t25;
+        bool t28 = t24 < ((t26 * t26) + (t27 * t27));
+        real t29 = t28 ? R(1.0) : R(0.0);
+        ts1_0 = t26;
+        ts1_1 = t27;
+        ts1_2 = t29;
+        if (t28) {
+            break;
+        }
     }
-    return d;
+    bool t30 = t22 || (R(0.5) < ts1_2);
+    real t31 = (t30 && (!t7)) ? (ts0_7 + R(3.0)) : R(0.0);
+    real t32 = R(1e18) * R(1e18);
+    real ts2_0 = p.x;
+    real ts2_1 = p.y;
+    real ts2_2 = p.z;
+    real ts2_3 = w;
+    real ts2_4 = t5;
+    real ts2_5 = R(1.0);
+    real ts2_6 = R(0.0);
+    real ts2_7 = R(1.0);
+    real ts2_8 = R(0.0);
+    for (int ti2 = 0; ti2 < t31; ti2++) {
+        if (t32 < ts2_4) {
+            break;
+        }
+        real t33 = sqrt(ts2_4);
+        real t34 = t33 - t4;
+        real t35 = fmin((ts2_7 * R(2.0)) * t33, R(1e30));
+        real t36 = fmin(t20 * t35, R(1e30));
+        real t37 = fmax(sqrt(ts2_4 + t36), R(1e-30));
+        real t38 = R(0.5) / t37;
+        real t39 = R(2.0) * ts2_0;
+        real t40 = ((((ts2_0 * ts2_0) - (ts2_1 * ts2_1)) - (ts2_2 * ts2_2)) - (ts2_3 * ts2_3)) + cx;
+        real t41 = (t39 * ts2_1) + cy;
+        real t42 = (t39 * ts2_2) + cz;
+        real t43 = (t39 * ts2_3) + cw;
+        real t44 = (((t40 * t40) + (t41 * t41)) + (t42 * t42)) + (t43 * t43);
+        real t45 = fmin(ts2_5 * ((t33 + t37) - (t36 * t38)), R(1e30));
+        real t46 = fmin((ts2_5 * t38) + ts2_6, R(1e30));
+        real t47 = (R(0.0) < t34) ? fmax(ts2_8, t34 / (ts2_5 + (ts2_6 * t34))) : ts2_8;
+        ts2_0 = t40;
+        ts2_1 = t41;
+        ts2_2 = t42;
+        ts2_3 = t43;
+        ts2_4 = t44;
+        ts2_5 = t45;
+        ts2_6 = t46;
+        ts2_7 = t35;
+        ts2_8 = t47;
+    }
+    return (real2)(t7 ? (R(0.9) * (t6 - t4)) : (t30 ? fmin(t21, ts2_8) : t21), t7 ? R(1.0) : fmin(sqrt(ts0_6), R(1.0)));
 }
 
 /* ---- scene ---- */
 real DE(real3 p0, __global const real* params) {
     /* color/julia */
-    real t0;
-    real d0 = julia(p0, (real4)((-0.2f), 0.6f, 0.2f, 0.2f), 0.0f, 11, 4.0f, &t0);
+    real2 f0 = julia(p0, (-0.2f), 0.6f, 0.2f, 0.2f, 0.0f, 11, 4.0f);
+    real d0 = f0.x;
     return d0;
 }
 
 real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     /* color/julia */
-    real t0;
-    real d0 = julia(p0, (real4)((-0.2f), 0.6f, 0.2f, 0.2f), 0.0f, 11, 4.0f, &t0);
+    real2 f0 = julia(p0, (-0.2f), 0.6f, 0.2f, 0.2f, 0.0f, 11, 4.0f);
+    real d0 = f0.x;
+    real t0 = f0.y;
     /* color */
     real3 c1 = (real3)(0.45f, 0.7f, 0.95f);
     *color = c1;

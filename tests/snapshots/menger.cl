@@ -86,14 +86,6 @@ typedef float4 real4;
 #define LIGHT_SOFTNESS 7
 #define LIGHT_STRIDE 8
 
-/* ---- cuboid ---- */
-real sd_box(real3 p, real3 b) {
-    real t0 = fabs(p.x) - b.x;
-    real t1 = fabs(p.y) - b.y;
-    real t2 = fabs(p.z) - b.z;
-    return length((real3)(fmax(t0, R(0.0)), fmax(t1, R(0.0)), fmax(t2, R(0.0)))) + fmin(fmax(fmax(t0, t1), t2), R(0.0));
-}
-
 /* ---- plane ---- */
 real sd_plane(real3 p, real3 n, real offset) {
     real t0 = fmax(fmax(fabs(n.x), fabs(n.y)), fabs(n.z));
@@ -106,24 +98,42 @@ real sd_plane(real3 p, real3 n, real offset) {
 }
 
 /* ---- menger ---- */
-/* Menger sponge, KIFS form: fold, scale about the kept cube, box bound. */
-real menger(real3 p, int iterations, real scale, real* trap) {
-    real3 z = p;
-    real s = R(1.0);
-    real t = R(1.0);
-    real shift = scale - R(1.0);
-    for (int i = 0; i < iterations; i++) {
-        z = fabs(z);
-        if (z.x < z.y) z = z.yxz;
-        if (z.x < z.z) z = z.zyx;
-        if (z.y < z.z) z = z.xzy;
-        t = fmin(t, length(z) * R(0.5773502691896258));
-        z = (real3)(z.x * scale - shift, z.y * scale - shift, z.z * scale);
-        if (z.z > R(0.5) * shift) z.z = z.z - shift;
-        s = s * scale;
+real2 menger(real3 p, real iterations, real scale) {
+    real t0 = scale - R(1.0);
+    real ts0_0 = p.x;
+    real ts0_1 = p.y;
+    real ts0_2 = p.z;
+    real ts0_3 = R(1.0);
+    real ts0_4 = R(1.0);
+    for (int ti0 = 0; ti0 < iterations; ti0++) {
+        real t1 = fabs(ts0_0);
+        real t2 = fabs(ts0_1);
+        real t3 = fabs(ts0_2);
+        bool t4 = t1 < t2;
+        real t5 = t4 ? t2 : t1;
+        real t6 = t4 ? t1 : t2;
+        bool t7 = t5 < t3;
+        real t8 = t7 ? t3 : t5;
+        real t9 = t7 ? t5 : t3;
+        bool t10 = t6 < t9;
+        real t11 = t10 ? t9 : t6;
+        real t12 = t10 ? t6 : t9;
+        real t13 = t12 * scale;
+        real t14 = (t8 * scale) - t0;
+        real t15 = (t11 * scale) - t0;
+        real t16 = ((R(0.5) * t0) < t13) ? (t13 - t0) : t13;
+        real t17 = ts0_3 * scale;
+        real t18 = fmin(ts0_4, length((real3)(t8, t11, t12)) * R(0.5773502691896258));
+        ts0_0 = t14;
+        ts0_1 = t15;
+        ts0_2 = t16;
+        ts0_3 = t17;
+        ts0_4 = t18;
     }
-    *trap = t;
-    return sd_box(z, (real3)(R(1.0))) / s;
+    real t19 = fabs(ts0_0) - R(1.0);
+    real t20 = fabs(ts0_1) - R(1.0);
+    real t21 = fabs(ts0_2) - R(1.0);
+    return (real2)((length((real3)(fmax(t19, R(0.0)), fmax(t20, R(0.0)), fmax(t21, R(0.0)))) + fmin(fmax(fmax(t19, t20), t21), R(0.0))) / ts0_3, ts0_4);
 }
 
 /* ---- scene ---- */
@@ -138,8 +148,8 @@ real DE(real3 p0, __global const real* params) {
         /* union/a:color/rotate */
         real3 p1 = (real3)(0.87758255f * p0.x + (-0.47942555f) * p0.z, p0.y, 0.47942555f * p0.x + 0.87758255f * p0.z);
         /* .../a:color/rotate/menger */
-        real t0;
-        real d0 = menger(p1, 4, 3.0f, &t0);
+        real2 f0 = menger(p1, 4, 3.0f);
+        real d0 = f0.x;
         real x5 = d3;
         real y5 = d0;
         real d5 = fmin(x5, y5);
@@ -163,8 +173,9 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
         /* union/a:color/rotate */
         real3 p1 = (real3)(0.87758255f * p0.x + (-0.47942555f) * p0.z, p0.y, 0.47942555f * p0.x + 0.87758255f * p0.z);
         /* .../a:color/rotate/menger */
-        real t0;
-        real d0 = menger(p1, 4, 3.0f, &t0);
+        real2 f0 = menger(p1, 4, 3.0f);
+        real d0 = f0.x;
+        real t0 = f0.y;
         /* union/a:color */
         real3 c2 = (real3)(0.85f, 0.85f, 0.8f);
         real x5 = d3;

@@ -97,29 +97,37 @@ real sd_plane(real3 p, real3 n, real offset) {
     return (((p.x * (t4 ? (t1 / t5) : n.x)) + (p.y * (t4 ? (t2 / t5) : n.y))) + (p.z * (t4 ? (t3 / t5) : n.z))) + offset;
 }
 
-/* ---- tetrahedron ---- */
-real sd_tetrahedron(real3 z) {
-    real t0 = -z.x;
-    return (fmax(fmax((t0 - z.y) - z.z, (z.x + z.y) - z.z), fmax((t0 + z.y) + z.z, (z.x - z.y) + z.z)) - R(1.0)) * R(0.5773502691896258);
-}
-
 /* ---- sierpinski ---- */
-/* Sierpinski tetrahedron, KIFS form: reflect towards (1,1,1), scale about it. */
-real sierpinski(real3 p, int iterations, real scale, real* trap) {
-    real3 z = p;
-    real s = R(1.0);
-    real t = R(1.0);
-    real shift = scale - R(1.0);
-    for (int i = 0; i < iterations; i++) {
-        if (z.x + z.y < R(0.0)) z = (real3)(-z.y, -z.x, z.z);
-        if (z.x + z.z < R(0.0)) z = (real3)(-z.z, z.y, -z.x);
-        if (z.y + z.z < R(0.0)) z = (real3)(z.x, -z.z, -z.y);
-        t = fmin(t, length(z) * R(0.5773502691896258));
-        z = z * scale - (real3)(shift);
-        s = s * scale;
+real2 sierpinski(real3 p, real iterations, real scale) {
+    real t0 = scale - R(1.0);
+    real ts0_0 = p.x;
+    real ts0_1 = p.y;
+    real ts0_2 = p.z;
+    real ts0_3 = R(1.0);
+    real ts0_4 = R(1.0);
+    for (int ti0 = 0; ti0 < iterations; ti0++) {
+        bool t1 = (ts0_0 + ts0_1) < R(0.0);
+        real t2 = t1 ? (-ts0_1) : ts0_0;
+        real t3 = t1 ? (-ts0_0) : ts0_1;
+        bool t4 = (t2 + ts0_2) < R(0.0);
+        real t5 = t4 ? (-ts0_2) : t2;
+        real t6 = t4 ? (-t2) : ts0_2;
+        bool t7 = (t3 + t6) < R(0.0);
+        real t8 = t7 ? (-t6) : t3;
+        real t9 = t7 ? (-t3) : t6;
+        real t10 = (t5 * scale) - t0;
+        real t11 = (t8 * scale) - t0;
+        real t12 = (t9 * scale) - t0;
+        real t13 = ts0_3 * scale;
+        real t14 = fmin(ts0_4, length((real3)(t5, t8, t9)) * R(0.5773502691896258));
+        ts0_0 = t10;
+        ts0_1 = t11;
+        ts0_2 = t12;
+        ts0_3 = t13;
+        ts0_4 = t14;
     }
-    *trap = t;
-    return sd_tetrahedron(z) / s;
+    real t15 = -ts0_0;
+    return (real2)(((fmax(fmax((t15 - ts0_1) - ts0_2, (ts0_0 + ts0_1) - ts0_2), fmax((t15 + ts0_1) + ts0_2, (ts0_0 - ts0_1) + ts0_2)) - R(1.0)) * R(0.5773502691896258)) / ts0_3, ts0_4);
 }
 
 /* ---- scene ---- */
@@ -132,8 +140,8 @@ real DE(real3 p0, __global const real* params) {
     real g4 = 0.33333334f * (length(p0 - (real3)(0.0f)) * 0.9999f - 1.7320508f);
     if (!(g4 > u4 && g4 > R(0.0))) {
         /* union/a:color/sierpinski */
-        real t0;
-        real d0 = sierpinski(p0, 7, 2.0f, &t0);
+        real2 f0 = sierpinski(p0, 7, 2.0f);
+        real d0 = f0.x;
         real x4 = d2;
         real y4 = d0;
         real d4 = fmin(x4, y4);
@@ -155,8 +163,9 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     real g4 = 0.33333334f * (length(p0 - (real3)(0.0f)) * 0.9999f - 1.7320508f);
     if (!(g4 > u4 && g4 > R(0.0))) {
         /* union/a:color/sierpinski */
-        real t0;
-        real d0 = sierpinski(p0, 7, 2.0f, &t0);
+        real2 f0 = sierpinski(p0, 7, 2.0f);
+        real d0 = f0.x;
+        real t0 = f0.y;
         /* union/a:color */
         real3 c1 = (real3)(0.95f, 0.75f, 0.45f);
         real x4 = d2;
