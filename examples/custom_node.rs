@@ -1,9 +1,10 @@
-//! A user-defined shape next to built-in ones: a hexagonal prism, with its
-//! Rust distance function (the CPU reference) and its OpenCL C twin.
+//! A user-defined shape next to built-in ones: a hexagonal prism, its
+//! distance written once as a Rust function generic over the number type
+//! (the CPU reference runs it; the OpenCL C is printed from it).
 //!
 //! `cargo run --release --example custom_node` writes `out/custom_node.png`.
 //! `tests/custom_node.rs` proves the same shape a bound and checks that the
-//! two definitions agree, using only the public API.
+//! CPU and the device agree, using only the public API.
 
 mod common;
 #[path = "common/hex_prism.rs"]

@@ -13,7 +13,7 @@
 use std::fmt::Debug;
 use std::ops::{Add, BitAnd, BitOr, Div, Mul, Neg, Not, Sub};
 
-use super::program::Step;
+use super::program::{Binary, Step, Unary, binary, unary};
 
 /// The most steps a loop takes in plain numbers, whatever its count: a
 /// count of infinity still ends.
@@ -124,6 +124,26 @@ pub trait Num:
     #[must_use]
     fn length3(x: Self, y: Self, z: Self) -> Self {
         (x * x + y * y + z * z).sqrt()
+    }
+
+    /// A numeric [`Unary`] operation on each component of a 3-vector (one
+    /// vector operation when traced).
+    #[must_use]
+    fn unary3(u: Unary, a: [Self; 3]) -> [Self; 3] {
+        a.map(|x| unary(u, x))
+    }
+
+    /// A numeric [`Binary`] operation on each pair of components (one
+    /// vector operation when traced).
+    #[must_use]
+    fn binary3(b: Binary, x: [Self; 3], y: [Self; 3]) -> [Self; 3] {
+        [0, 1, 2].map(|i| binary(b, x[i], y[i]))
+    }
+
+    /// The 3-vector `a` where `c` holds, else `b`.
+    #[must_use]
+    fn select3(c: Self::Bool, a: [Self; 3], b: [Self; 3]) -> [Self; 3] {
+        [0, 1, 2].map(|i| Self::select(c, a[i], b[i]))
     }
 
     /// `self < o`.

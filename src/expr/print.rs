@@ -58,6 +58,9 @@ pub enum Unprintable {
     /// A literal that is NaN or infinite.
     #[error("the non-finite literal {0} cannot be written")]
     Literal(f64),
+    /// A comparison of 3-vectors (the IR compares numbers only).
+    #[error("a comparison of 3-vectors cannot be written")]
+    Vector,
     /// The program's inputs or outputs do not match the signature.
     #[error("the program has {program} {what}, the signature {signature}")]
     Arity {
@@ -168,17 +171,32 @@ impl Block<'_> {
         unwrap(self.atom(v))
     }
 
-    /// A vector parameter, when `x, y, z` are its components in order.
+    /// A vector parameter or value, when `x, y, z` are its components in
+    /// order.
     fn whole_vector(&self, x: ValueId, y: ValueId, z: ValueId) -> Option<&str> {
         let ops = &self.program.ops;
-        if let (Op::Input(a), Op::Input(b), Op::Input(c)) =
-            (ops[x.index()], ops[y.index()], ops[z.index()])
-            && b == a + 1
-            && c == a + 2
-        {
-            return self.vectors.get(a as usize)?.as_deref();
+        match (ops[x.index()], ops[y.index()], ops[z.index()]) {
+            (Op::Input(a), Op::Input(b), Op::Input(c)) if b == a + 1 && c == a + 2 => {
+                self.vectors.get(a as usize)?.as_deref()
+            }
+            (Op::Component(a, 0), Op::Component(b, 1), Op::Component(c, 2)) if a == b && b == c => {
+                Some(self.arg(a))
+            }
+            _ => None,
         }
-        None
+    }
+
+    /// A vector operand: a splat (`(real3)(s)`) as the scalar `s` where
+    /// OpenCL C takes a scalar for a vector.
+    fn vector_operand(&self, v: ValueId, scalar_ok: bool) -> &str {
+        if scalar_ok
+            && let Op::Make3(x, y, z) = self.program.ops[v.index()]
+            && x == y
+            && y == z
+        {
+            return self.atom(x);
+        }
+        self.atom(v)
     }
 
     /// The expression of `op`, parenthesised unless it is a call; `None`
@@ -227,6 +245,51 @@ impl Block<'_> {
                     Binary::Pow => format!("pow({ax}, {ay})"),
                     Binary::Hypot => format!("hypot({ax}, {ay})"),
                 }
+            }
+            Op::Make3(x, y, z) => match self.whole_vector(x, y, z) {
+                Some(v) => v.to_string(),
+                None if x == y && y == z => format!("((real3)({}))", self.arg(x)),
+                None => format!(
+                    "((real3)({}, {}, {}))",
+                    self.arg(x),
+                    self.arg(y),
+                    self.arg(z)
+                ),
+            },
+            Op::Component(v, i) => format!("{}.{}", self.atom(v), ["x", "y", "z"][i as usize]),
+            Op::Unary3(u, a) => return self.expression(Op::Unary(u, a)),
+            Op::Binary3(b, x, y) => {
+                // OpenCL C takes a scalar second operand for a vector in
+                // arithmetic, `fmin` and `fmax`.
+                let scalar_ok = matches!(
+                    b,
+                    Binary::Add
+                        | Binary::Sub
+                        | Binary::Mul
+                        | Binary::Div
+                        | Binary::Min
+                        | Binary::Max
+                );
+                let x = self.vector_operand(x, scalar_ok && matches!(b, Binary::Add | Binary::Mul));
+                let y = self.vector_operand(y, scalar_ok);
+                let (ax, ay) = (unwrap(x), unwrap(y));
+                match b {
+                    Binary::Add => format!("({x} + {y})"),
+                    Binary::Sub => format!("({x} - {y})"),
+                    Binary::Mul => format!("({x} * {y})"),
+                    Binary::Div => format!("({x} / {y})"),
+                    Binary::Min => format!("fmin({ax}, {ay})"),
+                    Binary::Max => format!("fmax({ax}, {ay})"),
+                    Binary::Atan2 => format!("atan2({ax}, {ay})"),
+                    Binary::Pow => format!("pow({ax}, {ay})"),
+                    Binary::Hypot => format!("hypot({ax}, {ay})"),
+                    Binary::Lt | Binary::Le | Binary::And | Binary::Or => {
+                        return Err(Unprintable::Vector);
+                    }
+                }
+            }
+            Op::Select3(c, a, b) => {
+                format!("({} ? {} : {})", self.atom(c), self.atom(a), self.atom(b))
             }
             Op::Length3(x, y, z) => match self.whole_vector(x, y, z) {
                 Some(v) => format!("length({v})"),
@@ -334,9 +397,15 @@ impl OpenClWriter {
         let trivial = matches!(
             op,
             Op::Const(_) | Op::Input(_) | Op::Capture(..) | Op::Element(..)
-        );
+        ) || is_simple(&text);
         b.text[i] = if name && !trivial {
-            let ty = if op.is_logic() { "bool" } else { "real" };
+            let ty = if op.is_logic() {
+                "bool"
+            } else if op.is_vector() {
+                "real3"
+            } else {
+                "real"
+            };
             let t = self.temp();
             self.line(b.indent, &format!("{ty} {t} = {};", unwrap(&text)));
             t

@@ -104,6 +104,17 @@ pub enum Op {
     Binary(Binary, ValueId, ValueId),
     /// `sqrt(x^2 + y^2 + z^2)`.
     Length3(ValueId, ValueId, ValueId),
+    /// The 3-vector of three numbers.
+    Make3(ValueId, ValueId, ValueId),
+    /// Component `i` (0, 1, 2) of a 3-vector.
+    Component(ValueId, u32),
+    /// A numeric [`Unary`] operation on each component of a 3-vector.
+    Unary3(Unary, ValueId),
+    /// A numeric [`Binary`] operation on each pair of components of two
+    /// 3-vectors.
+    Binary3(Binary, ValueId, ValueId),
+    /// The 3-vector `a` where the truth value `c` holds, else `b`.
+    Select3(ValueId, ValueId, ValueId),
     /// `a` where the truth value `c` holds, else `b`.
     Select(ValueId, ValueId, ValueId),
     /// A value of an enclosing program (a loop's body reading the values
@@ -168,6 +179,15 @@ impl Loop {
 }
 
 impl Op {
+    /// Whether the operation gives a 3-vector.
+    #[must_use]
+    pub fn is_vector(&self) -> bool {
+        matches!(
+            self,
+            Op::Make3(..) | Op::Unary3(..) | Op::Binary3(..) | Op::Select3(..)
+        )
+    }
+
     /// Whether the operation gives a truth value rather than a number.
     #[must_use]
     pub fn is_logic(&self) -> bool {
@@ -184,9 +204,16 @@ impl Op {
     pub fn operands(&self, loops: &[Loop]) -> Vec<ValueId> {
         match *self {
             Op::Const(_) | Op::Input(_) | Op::Capture(..) => Vec::new(),
-            Op::Unary(_, a) | Op::Element(a, _) => vec![a],
-            Op::Binary(_, a, b) => vec![a, b],
-            Op::Length3(a, b, c) | Op::Select(a, b, c) => vec![a, b, c],
+            Op::Unary(_, a) | Op::Element(a, _) | Op::Component(a, _) | Op::Unary3(_, a) => {
+                vec![a]
+            }
+            Op::Binary(_, a, b) | Op::Binary3(_, a, b) => vec![a, b],
+            Op::Length3(a, b, c)
+            | Op::Select(a, b, c)
+            | Op::Make3(a, b, c)
+            | Op::Select3(a, b, c) => {
+                vec![a, b, c]
+            }
             Op::Loop(n) => {
                 let l = &loops[n as usize];
                 let mut v = vec![l.count];
@@ -205,6 +232,11 @@ impl Op {
             Op::Unary(u, a) => Key::Unary(u, a),
             Op::Binary(b, x, y) => Key::Binary(b, x, y),
             Op::Length3(x, y, z) => Key::Length3(x, y, z),
+            Op::Make3(x, y, z) => Key::Make3(x, y, z),
+            Op::Component(v, i) => Key::Component(v, i),
+            Op::Unary3(u, v) => Key::Unary3(u, v),
+            Op::Binary3(b, x, y) => Key::Binary3(b, x, y),
+            Op::Select3(c, a, b) => Key::Select3(c, a, b),
             Op::Select(c, a, b) => Key::Select(c, a, b),
             Op::Capture(up, v) => Key::Capture(up, v),
             Op::Loop(n) => Key::Loop(n),
@@ -220,6 +252,11 @@ enum Key {
     Unary(Unary, ValueId),
     Binary(Binary, ValueId, ValueId),
     Length3(ValueId, ValueId, ValueId),
+    Make3(ValueId, ValueId, ValueId),
+    Component(ValueId, u32),
+    Unary3(Unary, ValueId),
+    Binary3(Binary, ValueId, ValueId),
+    Select3(ValueId, ValueId, ValueId),
     Select(ValueId, ValueId, ValueId),
     Capture(u32, ValueId),
     Loop(u32),
@@ -245,6 +282,7 @@ pub struct Program {
 enum Slot<N: Num> {
     Number(N),
     Truth(N::Bool),
+    Vector([N; 3]),
     State(Vec<N>),
 }
 
@@ -254,7 +292,7 @@ impl<N: Num> Slot<N> {
             Slot::Number(n) => *n,
             // Programs are typed when recorded; a truth value read as a
             // number is the checked programs' bug, and reads as NaN.
-            Slot::Truth(_) | Slot::State(_) => N::of(f64::NAN),
+            Slot::Truth(_) | Slot::Vector(_) | Slot::State(_) => N::of(f64::NAN),
         }
     }
 
@@ -262,7 +300,14 @@ impl<N: Num> Slot<N> {
         match self {
             Slot::Truth(b) => *b,
             Slot::Number(n) => n.finite() & !n.finite(),
-            Slot::State(_) => N::of(0.0).lt(N::of(0.0)),
+            Slot::Vector(_) | Slot::State(_) => N::of(0.0).lt(N::of(0.0)),
+        }
+    }
+
+    fn vector(&self) -> [N; 3] {
+        match self {
+            Slot::Vector(v) => *v,
+            other => [other.number(); 3],
         }
     }
 }
@@ -308,6 +353,17 @@ impl Program {
                     _ => Slot::Number(binary(op, n(x), n(y))),
                 },
                 Op::Length3(x, y, z) => Slot::Number(N::length3(n(x), n(y), n(z))),
+                Op::Make3(x, y, z) => Slot::Vector([n(x), n(y), n(z)]),
+                Op::Component(v, i) => Slot::Number(slots[v.index()].vector()[i as usize]),
+                Op::Unary3(u, v) => Slot::Vector(N::unary3(u, slots[v.index()].vector())),
+                Op::Binary3(b, x, y) => {
+                    let (x, y) = (slots[x.index()].vector(), slots[y.index()].vector());
+                    Slot::Vector(N::binary3(b, x, y))
+                }
+                Op::Select3(c, x, y) => {
+                    let (x, y) = (slots[x.index()].vector(), slots[y.index()].vector());
+                    Slot::Vector(N::select3(b(c), x, y))
+                }
                 Op::Select(c, x, y) => Slot::Number(N::select(b(c), n(x), n(y))),
                 Op::Capture(up, v) => {
                     let at = outer.len().checked_sub(up as usize);
@@ -396,6 +452,7 @@ pub struct Step<N: Num, S = Vec<N>> {
 }
 
 /// Applies a numeric [`Unary`] operation.
+#[inline]
 pub(crate) fn unary<N: Num>(u: Unary, a: N) -> N {
     match u {
         Unary::Neg => -a,
@@ -412,6 +469,7 @@ pub(crate) fn unary<N: Num>(u: Unary, a: N) -> N {
 }
 
 /// Applies a numeric [`Binary`] operation.
+#[inline]
 pub(crate) fn binary<N: Num>(op: Binary, a: N, b: N) -> N {
     match op {
         Binary::Add => a + b,
@@ -594,6 +652,33 @@ fn record_loop(
         .collect()
 }
 
+/// The 3-vector of three traced numbers on the innermost tape: the vector
+/// they are the components of, or a new one made of them.
+fn vector(c: [Var; 3]) -> ValueId {
+    let [x, y, z] = c.map(Var::here);
+    let ops = TAPES.with(|t| {
+        let tapes = t.borrow();
+        let ops = &tapes.last().expect("traced inside expr::trace").ops;
+        [x, y, z].map(|v| ops[v.index()])
+    });
+    if let [
+        Op::Component(a, 0),
+        Op::Component(b, 1),
+        Op::Component(c, 2),
+    ] = ops
+        && a == b
+        && b == c
+    {
+        return a;
+    }
+    push(Op::Make3(x, y, z))
+}
+
+/// The components of the vector `v` on the innermost tape.
+fn components(v: ValueId) -> [Var; 3] {
+    [0, 1, 2].map(|i| record(Op::Component(v, i)))
+}
+
 impl Logic for VarBool {}
 
 impl BitAnd for VarBool {
@@ -703,6 +788,22 @@ impl Num for Var {
     fn length3(x: Self, y: Self, z: Self) -> Self {
         let (x, y, z) = (x.here(), y.here(), z.here());
         record(Op::Length3(x, y, z))
+    }
+    fn unary3(u: Unary, a: [Self; 3]) -> [Self; 3] {
+        let a = vector(a);
+        components(record(Op::Unary3(u, a)).id)
+    }
+    fn binary3(b: Binary, x: [Self; 3], y: [Self; 3]) -> [Self; 3] {
+        let (x, y) = (vector(x), vector(y));
+        components(record(Op::Binary3(b, x, y)).id)
+    }
+    fn select3(c: VarBool, a: [Self; 3], b: [Self; 3]) -> [Self; 3] {
+        if a == b {
+            return a;
+        }
+        let c = c.0.here();
+        let (a, b) = (vector(a), vector(b));
+        components(record(Op::Select3(c, a, b)).id)
     }
     fn lt(self, o: Self) -> VarBool {
         self.truth(Binary::Lt, o)

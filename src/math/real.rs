@@ -5,6 +5,7 @@
 use std::ops::{Add, Div, Mul, Neg, Sub};
 
 pub use crate::expr::Num;
+use crate::expr::{Binary, Unary};
 
 /// A floating-point type the reference evaluator can run in: `f32` or `f64`.
 ///
@@ -125,13 +126,30 @@ impl<T: Num> V3<T> {
     /// Component-wise absolute value.
     #[must_use]
     pub fn abs(self) -> Self {
-        self.map(T::abs)
+        Self::from_array(T::unary3(Unary::Abs, self.to_array()))
     }
 
     /// Component-wise maximum with a scalar.
     #[must_use]
     pub fn max_s(self, s: T) -> Self {
-        self.map(|c| c.max(s))
+        self.op(Binary::Max, Self::splat(s))
+    }
+
+    /// The components as an array.
+    #[must_use]
+    pub fn to_array(self) -> [T; 3] {
+        [self.x, self.y, self.z]
+    }
+
+    /// The vector of an array's components.
+    #[must_use]
+    pub fn from_array([x, y, z]: [T; 3]) -> Self {
+        v3(x, y, z)
+    }
+
+    /// A component-wise operation (one vector operation when traced).
+    fn op(self, b: Binary, o: Self) -> Self {
+        Self::from_array(T::binary3(b, self.to_array(), o.to_array()))
     }
 
     /// The largest component.
@@ -143,11 +161,7 @@ impl<T: Num> V3<T> {
     /// `a` where `c` holds, else `b`, component by component.
     #[must_use]
     pub fn select(c: T::Bool, a: Self, b: Self) -> Self {
-        v3(
-            T::select(c, a.x, b.x),
-            T::select(c, a.y, b.y),
-            T::select(c, a.z, b.z),
-        )
+        Self::from_array(T::select3(c, a.to_array(), b.to_array()))
     }
 
     /// The smallest component.
@@ -172,49 +186,49 @@ impl<T: Real> V3<T> {
 impl<T: Num> Add for V3<T> {
     type Output = Self;
     fn add(self, o: Self) -> Self {
-        self.zip(o, |a, b| a + b)
+        self.op(Binary::Add, o)
     }
 }
 
 impl<T: Num> Sub for V3<T> {
     type Output = Self;
     fn sub(self, o: Self) -> Self {
-        self.zip(o, |a, b| a - b)
+        self.op(Binary::Sub, o)
     }
 }
 
 impl<T: Num> Mul<T> for V3<T> {
     type Output = Self;
     fn mul(self, s: T) -> Self {
-        self.map(|c| c * s)
+        self.op(Binary::Mul, Self::splat(s))
     }
 }
 
 impl<T: Num> Mul for V3<T> {
     type Output = Self;
     fn mul(self, o: Self) -> Self {
-        self.zip(o, |a, b| a * b)
+        self.op(Binary::Mul, o)
     }
 }
 
 impl<T: Num> Div for V3<T> {
     type Output = Self;
     fn div(self, o: Self) -> Self {
-        self.zip(o, |a, b| a / b)
+        self.op(Binary::Div, o)
     }
 }
 
 impl<T: Num> Div<T> for V3<T> {
     type Output = Self;
     fn div(self, s: T) -> Self {
-        self.map(|c| c / s)
+        self.op(Binary::Div, Self::splat(s))
     }
 }
 
 impl<T: Num> Neg for V3<T> {
     type Output = Self;
     fn neg(self) -> Self {
-        self.map(|c| -c)
+        Self::from_array(T::unary3(Unary::Neg, self.to_array()))
     }
 }
 

@@ -88,13 +88,13 @@ typedef float4 real4;
 
 /* ---- plane ---- */
 real sd_plane(real3 p, real3 n, real offset) {
-    real t0 = fmax(fmax(fabs(n.x), fabs(n.y)), fabs(n.z));
-    real t1 = n.x / t0;
-    real t2 = n.y / t0;
-    real t3 = n.z / t0;
-    bool t4 = R(0.0) < t0;
-    real t5 = length((real3)(t1, t2, t3));
-    return (((p.x * (t4 ? (t1 / t5) : n.x)) + (p.y * (t4 ? (t2 / t5) : n.y))) + (p.z * (t4 ? (t3 / t5) : n.z))) + offset;
+    real3 t0 = fabs(n);
+    real t1 = fmax(fmax(t0.x, t0.y), t0.z);
+    real3 t2 = n / t1;
+    real t3 = length(t2);
+    real3 t4 = t2 / t3;
+    real3 t5 = (R(0.0) < t1) ? t4 : n;
+    return (((p.x * t5.x) + (p.y * t5.y)) + (p.z * t5.z)) + offset;
 }
 
 /* ---- mandelbulb_p8 ---- */
@@ -132,19 +132,18 @@ real2 mandelbulb_p8(real3 p, real iterations, real escape, real ball) {
         real t21 = (R(2.0) * t18) * t19;
         real t22 = (t20 * t20) - (t21 * t21);
         real t23 = (R(2.0) * t20) * t21;
-        real t24 = ((t16 * ((t22 * t22) - (t23 * t23))) * t7) + p.x;
-        real t25 = ((t16 * ((R(2.0) * t22) * t23)) * t7) + p.y;
-        real t26 = (((t14 * t14) - (t15 * t15)) * t7) + p.z;
-        real t27 = fmin(((R(8.0) * t6) * ts0_3) + R(1.0), R(1e30));
-        real t28 = fmin(ts0_4, t4);
-        ts0_0 = t24;
-        ts0_1 = t25;
-        ts0_2 = t26;
-        ts0_3 = t27;
-        ts0_4 = t28;
+        real3 t24 = ((real3)(t16 * ((t22 * t22) - (t23 * t23)), t16 * ((R(2.0) * t22) * t23), (t14 * t14) - (t15 * t15))) * t7;
+        real3 t25 = t24 + ((real3)(p.x, p.y, p.z));
+        real t26 = fmin(((R(8.0) * t6) * ts0_3) + R(1.0), R(1e30));
+        real t27 = fmin(ts0_4, t4);
+        ts0_0 = t25.x;
+        ts0_1 = t25.y;
+        ts0_2 = t25.z;
+        ts0_3 = t26;
+        ts0_4 = t27;
     }
-    real t29 = length((real3)(ts0_0, ts0_1, ts0_2));
-    return (real2)(t2 ? t1 : fmax(((R(0.5) * log(fmax(t29, R(1e-30)))) * t29) / ts0_3, t1), t2 ? R(1.0) : ts0_4);
+    real t28 = length((real3)(ts0_0, ts0_1, ts0_2));
+    return (real2)(t2 ? t1 : fmax(((R(0.5) * log(fmax(t28, R(1e-30)))) * t28) / ts0_3, t1), t2 ? R(1.0) : ts0_4);
 }
 
 /* ---- scene ---- */

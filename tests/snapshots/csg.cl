@@ -93,29 +93,30 @@ real sd_sphere(real3 p, real r) {
 
 /* ---- cuboid ---- */
 real sd_box(real3 p, real3 b) {
-    real t0 = fabs(p.x) - b.x;
-    real t1 = fabs(p.y) - b.y;
-    real t2 = fabs(p.z) - b.z;
-    return length((real3)(fmax(t0, R(0.0)), fmax(t1, R(0.0)), fmax(t2, R(0.0)))) + fmin(fmax(fmax(t0, t1), t2), R(0.0));
+    real3 t0 = fabs(p);
+    real3 t1 = t0 - b;
+    real3 t2 = fmax(t1, R(0.0));
+    return length(t2) + fmin(fmax(fmax(t1.x, t1.y), t1.z), R(0.0));
 }
 
 /* ---- round_box ---- */
 real sd_round_box(real3 p, real3 b, real r) {
-    real t0 = (fabs(p.x) - b.x) + r;
-    real t1 = (fabs(p.y) - b.y) + r;
-    real t2 = (fabs(p.z) - b.z) + r;
-    return (length((real3)(fmax(t0, R(0.0)), fmax(t1, R(0.0)), fmax(t2, R(0.0)))) + fmin(fmax(fmax(t0, t1), t2), R(0.0))) - r;
+    real3 t0 = fabs(p);
+    real3 t1 = t0 - b;
+    real3 t2 = t1 + r;
+    real3 t3 = fmax(t2, R(0.0));
+    return (length(t3) + fmin(fmax(fmax(t2.x, t2.y), t2.z), R(0.0))) - r;
 }
 
 /* ---- plane ---- */
 real sd_plane(real3 p, real3 n, real offset) {
-    real t0 = fmax(fmax(fabs(n.x), fabs(n.y)), fabs(n.z));
-    real t1 = n.x / t0;
-    real t2 = n.y / t0;
-    real t3 = n.z / t0;
-    bool t4 = R(0.0) < t0;
-    real t5 = length((real3)(t1, t2, t3));
-    return (((p.x * (t4 ? (t1 / t5) : n.x)) + (p.y * (t4 ? (t2 / t5) : n.y))) + (p.z * (t4 ? (t3 / t5) : n.z))) + offset;
+    real3 t0 = fabs(n);
+    real t1 = fmax(fmax(t0.x, t0.y), t0.z);
+    real3 t2 = n / t1;
+    real t3 = length(t2);
+    real3 t4 = t2 / t3;
+    real3 t5 = (R(0.0) < t1) ? t4 : n;
+    return (((p.x * t5.x) + (p.y * t5.y)) + (p.z * t5.z)) + offset;
 }
 
 /* ---- smooth_min ---- */

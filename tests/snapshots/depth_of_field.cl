@@ -88,13 +88,13 @@ typedef float4 real4;
 
 /* ---- plane ---- */
 real sd_plane(real3 p, real3 n, real offset) {
-    real t0 = fmax(fmax(fabs(n.x), fabs(n.y)), fabs(n.z));
-    real t1 = n.x / t0;
-    real t2 = n.y / t0;
-    real t3 = n.z / t0;
-    bool t4 = R(0.0) < t0;
-    real t5 = length((real3)(t1, t2, t3));
-    return (((p.x * (t4 ? (t1 / t5) : n.x)) + (p.y * (t4 ? (t2 / t5) : n.y))) + (p.z * (t4 ? (t3 / t5) : n.z))) + offset;
+    real3 t0 = fabs(n);
+    real t1 = fmax(fmax(t0.x, t0.y), t0.z);
+    real3 t2 = n / t1;
+    real t3 = length(t2);
+    real3 t4 = t2 / t3;
+    real3 t5 = (R(0.0) < t1) ? t4 : n;
+    return (((p.x * t5.x) + (p.y * t5.y)) + (p.z * t5.z)) + offset;
 }
 
 /* ---- menger ---- */
@@ -106,34 +106,26 @@ real2 menger(real3 p, real iterations, real scale) {
     real ts0_3 = R(1.0);
     real ts0_4 = R(1.0);
     for (int ti0 = 0; ti0 < iterations; ti0++) {
-        real t1 = fabs(ts0_0);
-        real t2 = fabs(ts0_1);
-        real t3 = fabs(ts0_2);
-        bool t4 = t1 < t2;
-        real t5 = t4 ? t2 : t1;
-        real t6 = t4 ? t1 : t2;
-        bool t7 = t5 < t3;
-        real t8 = t7 ? t3 : t5;
-        real t9 = t7 ? t5 : t3;
-        bool t10 = t6 < t9;
-        real t11 = t10 ? t9 : t6;
-        real t12 = t10 ? t6 : t9;
-        real t13 = t12 * scale;
-        real t14 = (t8 * scale) - t0;
-        real t15 = (t11 * scale) - t0;
-        real t16 = ((R(0.5) * t0) < t13) ? (t13 - t0) : t13;
-        real t17 = ts0_3 * scale;
-        real t18 = fmin(ts0_4, length((real3)(t8, t11, t12)) * R(0.5773502691896258));
-        ts0_0 = t14;
-        ts0_1 = t15;
-        ts0_2 = t16;
-        ts0_3 = t17;
-        ts0_4 = t18;
+        real3 t1 = fabs((real3)(ts0_0, ts0_1, ts0_2));
+        real3 t2 = (t1.x < t1.y) ? ((real3)(t1.y, t1.x, t1.z)) : t1;
+        real3 t3 = (t2.x < t2.z) ? ((real3)(t2.z, t2.y, t2.x)) : t2;
+        real3 t4 = (t3.y < t3.z) ? ((real3)(t3.x, t3.z, t3.y)) : t3;
+        real t5 = t4.z * scale;
+        real t6 = (t4.x * scale) - t0;
+        real t7 = (t4.y * scale) - t0;
+        real t8 = ((R(0.5) * t0) < t5) ? (t5 - t0) : t5;
+        real t9 = ts0_3 * scale;
+        real t10 = fmin(ts0_4, length(t4) * R(0.5773502691896258));
+        ts0_0 = t6;
+        ts0_1 = t7;
+        ts0_2 = t8;
+        ts0_3 = t9;
+        ts0_4 = t10;
     }
-    real t19 = fabs(ts0_0) - R(1.0);
-    real t20 = fabs(ts0_1) - R(1.0);
-    real t21 = fabs(ts0_2) - R(1.0);
-    return (real2)((length((real3)(fmax(t19, R(0.0)), fmax(t20, R(0.0)), fmax(t21, R(0.0)))) + fmin(fmax(fmax(t19, t20), t21), R(0.0))) / ts0_3, ts0_4);
+    real3 t11 = fabs((real3)(ts0_0, ts0_1, ts0_2));
+    real3 t12 = t11 - R(1.0);
+    real3 t13 = fmax(t12, R(0.0));
+    return (real2)((length(t13) + fmin(fmax(fmax(t12.x, t12.y), t12.z), R(0.0))) / ts0_3, ts0_4);
 }
 
 /* ---- scene ---- */

@@ -92,13 +92,13 @@ typedef float4 real4;
 
 /* ---- plane ---- */
 real sd_plane(real3 p, real3 n, real offset) {
-    real t0 = fmax(fmax(fabs(n.x), fabs(n.y)), fabs(n.z));
-    real t1 = n.x / t0;
-    real t2 = n.y / t0;
-    real t3 = n.z / t0;
-    bool t4 = R(0.0) < t0;
-    real t5 = length((real3)(t1, t2, t3));
-    return (((p.x * (t4 ? (t1 / t5) : n.x)) + (p.y * (t4 ? (t2 / t5) : n.y))) + (p.z * (t4 ? (t3 / t5) : n.z))) + offset;
+    real3 t0 = fabs(n);
+    real t1 = fmax(fmax(t0.x, t0.y), t0.z);
+    real3 t2 = n / t1;
+    real t3 = length(t2);
+    real3 t4 = t2 / t3;
+    real3 t5 = (R(0.0) < t1) ? t4 : n;
+    return (((p.x * t5.x) + (p.y * t5.y)) + (p.z * t5.z)) + offset;
 }
 
 /* ---- custom shape mandelbox_escape ---- */

@@ -97,28 +97,29 @@ real sd_sphere(real3 p, real r) {
 
 /* ---- plane ---- */
 real sd_plane(real3 p, real3 n, real offset) {
-    real t0 = fmax(fmax(fabs(n.x), fabs(n.y)), fabs(n.z));
-    real t1 = n.x / t0;
-    real t2 = n.y / t0;
-    real t3 = n.z / t0;
-    bool t4 = R(0.0) < t0;
-    real t5 = length((real3)(t1, t2, t3));
-    return (((p.x * (t4 ? (t1 / t5) : n.x)) + (p.y * (t4 ? (t2 / t5) : n.y))) + (p.z * (t4 ? (t3 / t5) : n.z))) + offset;
+    real3 t0 = fabs(n);
+    real t1 = fmax(fmax(t0.x, t0.y), t0.z);
+    real3 t2 = n / t1;
+    real t3 = length(t2);
+    real3 t4 = t2 / t3;
+    real3 t5 = (R(0.0) < t1) ? t4 : n;
+    return (((p.x * t5.x) + (p.y * t5.y)) + (p.z * t5.z)) + offset;
 }
 
 /* ---- ellipsoid ---- */
 real sd_ellipsoid(real3 p, real3 r) {
-    real t0 = p.x / r.x;
-    real t1 = p.y / r.y;
-    real t2 = p.z / r.z;
-    real t3 = fmax(fmax(fabs(t0), fabs(t1)), fabs(t2));
-    real t4 = ((R(0.0) < t3) && isfinite(t3)) ? (t3 * length((real3)(t0 / t3, t1 / t3, t2 / t3))) : length((real3)(t0, t1, t2));
-    real t5 = (t0 / t4) / r.x;
-    real t6 = (t1 / t4) / r.y;
-    real t7 = (t2 / t4) / r.z;
-    real t8 = fmax(fmax(fabs(t5), fabs(t6)), fabs(t7));
-    real t9 = t4 - R(1.0);
-    return (t4 < R(1.0)) ? (t9 * fmin(fmin(r.x, r.y), r.z)) : (t9 / fmax(((R(0.0) < t8) && isfinite(t8)) ? (t8 * length((real3)(t5 / t8, t6 / t8, t7 / t8))) : length((real3)(t5, t6, t7)), R(1e-30)));
+    real3 t0 = p / r;
+    real3 t1 = fabs(t0);
+    real t2 = fmax(fmax(t1.x, t1.y), t1.z);
+    real3 t3 = t0 / t2;
+    real t4 = ((R(0.0) < t2) && isfinite(t2)) ? (t2 * length(t3)) : length(t0);
+    real3 t5 = t0 / t4;
+    real3 t6 = t5 / r;
+    real3 t7 = fabs(t6);
+    real t8 = fmax(fmax(t7.x, t7.y), t7.z);
+    real3 t9 = t6 / t8;
+    real t10 = t4 - R(1.0);
+    return (t4 < R(1.0)) ? (t10 * fmin(fmin(r.x, r.y), r.z)) : (t10 / fmax(((R(0.0) < t8) && isfinite(t8)) ? (t8 * length(t9)) : length(t6), R(1e-30)));
 }
 
 /* ---- mandelbulb_p8 ---- */
@@ -156,19 +157,18 @@ real2 mandelbulb_p8(real3 p, real iterations, real escape, real ball) {
         real t21 = (R(2.0) * t18) * t19;
         real t22 = (t20 * t20) - (t21 * t21);
         real t23 = (R(2.0) * t20) * t21;
-        real t24 = ((t16 * ((t22 * t22) - (t23 * t23))) * t7) + p.x;
-        real t25 = ((t16 * ((R(2.0) * t22) * t23)) * t7) + p.y;
-        real t26 = (((t14 * t14) - (t15 * t15)) * t7) + p.z;
-        real t27 = fmin(((R(8.0) * t6) * ts0_3) + R(1.0), R(1e30));
-        real t28 = fmin(ts0_4, t4);
-        ts0_0 = t24;
-        ts0_1 = t25;
-        ts0_2 = t26;
-        ts0_3 = t27;
-        ts0_4 = t28;
+        real3 t24 = ((real3)(t16 * ((t22 * t22) - (t23 * t23)), t16 * ((R(2.0) * t22) * t23), (t14 * t14) - (t15 * t15))) * t7;
+        real3 t25 = t24 + ((real3)(p.x, p.y, p.z));
+        real t26 = fmin(((R(8.0) * t6) * ts0_3) + R(1.0), R(1e30));
+        real t27 = fmin(ts0_4, t4);
+        ts0_0 = t25.x;
+        ts0_1 = t25.y;
+        ts0_2 = t25.z;
+        ts0_3 = t26;
+        ts0_4 = t27;
     }
-    real t29 = length((real3)(ts0_0, ts0_1, ts0_2));
-    return (real2)(t2 ? t1 : fmax(((R(0.5) * log(fmax(t29, R(1e-30)))) * t29) / ts0_3, t1), t2 ? R(1.0) : ts0_4);
+    real t28 = length((real3)(ts0_0, ts0_1, ts0_2));
+    return (real2)(t2 ? t1 : fmax(((R(0.5) * log(fmax(t28, R(1e-30)))) * t28) / ts0_3, t1), t2 ? R(1.0) : ts0_4);
 }
 
 /* ---- scene ---- */

@@ -93,18 +93,19 @@ real sd_sphere(real3 p, real r) {
 
 /* ---- cuboid ---- */
 real sd_box(real3 p, real3 b) {
-    real t0 = fabs(p.x) - b.x;
-    real t1 = fabs(p.y) - b.y;
-    real t2 = fabs(p.z) - b.z;
-    return length((real3)(fmax(t0, R(0.0)), fmax(t1, R(0.0)), fmax(t2, R(0.0)))) + fmin(fmax(fmax(t0, t1), t2), R(0.0));
+    real3 t0 = fabs(p);
+    real3 t1 = t0 - b;
+    real3 t2 = fmax(t1, R(0.0));
+    return length(t2) + fmin(fmax(fmax(t1.x, t1.y), t1.z), R(0.0));
 }
 
 /* ---- round_box ---- */
 real sd_round_box(real3 p, real3 b, real r) {
-    real t0 = (fabs(p.x) - b.x) + r;
-    real t1 = (fabs(p.y) - b.y) + r;
-    real t2 = (fabs(p.z) - b.z) + r;
-    return (length((real3)(fmax(t0, R(0.0)), fmax(t1, R(0.0)), fmax(t2, R(0.0)))) + fmin(fmax(fmax(t0, t1), t2), R(0.0))) - r;
+    real3 t0 = fabs(p);
+    real3 t1 = t0 - b;
+    real3 t2 = t1 + r;
+    real3 t3 = fmax(t2, R(0.0));
+    return (length(t3) + fmin(fmax(fmax(t2.x, t2.y), t2.z), R(0.0))) - r;
 }
 
 /* ---- torus ---- */
@@ -121,39 +122,35 @@ real sd_cylinder(real3 p, real r, real h) {
 
 /* ---- capsule ---- */
 real sd_capsule(real3 p, real3 a, real3 b, real r) {
-    real t0 = p.x - a.x;
-    real t1 = p.y - a.y;
-    real t2 = p.z - a.z;
-    real t3 = b.x - a.x;
-    real t4 = b.y - a.y;
-    real t5 = b.z - a.z;
-    real t6 = fmin(fmax((((t0 * t3) + (t1 * t4)) + (t2 * t5)) / fmax(((t3 * t3) + (t4 * t4)) + (t5 * t5), R(1e-30)), R(0.0)), R(1.0));
-    return length((real3)(t0 - (t3 * t6), t1 - (t4 * t6), t2 - (t5 * t6))) - r;
+    real3 t0 = p - a;
+    real3 t1 = b - a;
+    real t2 = fmin(fmax((((t0.x * t1.x) + (t0.y * t1.y)) + (t0.z * t1.z)) / fmax(((t1.x * t1.x) + (t1.y * t1.y)) + (t1.z * t1.z), R(1e-30)), R(0.0)), R(1.0));
+    real3 t3 = t1 * t2;
+    real3 t4 = t0 - t3;
+    return length(t4) - r;
 }
 
 /* ---- plane ---- */
 real sd_plane(real3 p, real3 n, real offset) {
-    real t0 = fmax(fmax(fabs(n.x), fabs(n.y)), fabs(n.z));
-    real t1 = n.x / t0;
-    real t2 = n.y / t0;
-    real t3 = n.z / t0;
-    bool t4 = R(0.0) < t0;
-    real t5 = length((real3)(t1, t2, t3));
-    return (((p.x * (t4 ? (t1 / t5) : n.x)) + (p.y * (t4 ? (t2 / t5) : n.y))) + (p.z * (t4 ? (t3 / t5) : n.z))) + offset;
+    real3 t0 = fabs(n);
+    real t1 = fmax(fmax(t0.x, t0.y), t0.z);
+    real3 t2 = n / t1;
+    real t3 = length(t2);
+    real3 t4 = t2 / t3;
+    real3 t5 = (R(0.0) < t1) ? t4 : n;
+    return (((p.x * t5.x) + (p.y * t5.y)) + (p.z * t5.z)) + offset;
 }
 
 /* ---- octahedron ---- */
 real sd_octahedron(real3 p, real s) {
-    real t0 = fabs(p.x);
-    real t1 = fabs(p.y);
-    real t2 = fabs(p.z);
-    real t3 = ((t0 + t1) + t2) - s;
-    bool t4 = (R(3.0) * t0) < t3;
-    bool t5 = (R(3.0) * t1) < t3;
-    real t6 = t4 ? t1 : (t5 ? t2 : t0);
-    real t7 = t4 ? t2 : (t5 ? t0 : t1);
-    real t8 = fmin(fmax(R(0.5) * ((t7 - t6) + s), R(0.0)), s);
-    return ((t4 || t5) || ((R(3.0) * t2) < t3)) ? length((real3)(t4 ? t0 : (t5 ? t1 : t2), (t6 - s) + t8, t7 - t8)) : (t3 * R(0.5773502691896258));
+    real3 t0 = fabs(p);
+    real t1 = ((t0.x + t0.y) + t0.z) - s;
+    bool t2 = (R(3.0) * t0.x) < t1;
+    bool t3 = (R(3.0) * t0.y) < t1;
+    real3 t4 = t3 ? ((real3)(t0.y, t0.z, t0.x)) : ((real3)(t0.z, t0.x, t0.y));
+    real3 t5 = t2 ? t0 : t4;
+    real t6 = fmin(fmax(R(0.5) * ((t5.z - t5.y) + s), R(0.0)), s);
+    return ((t2 || t3) || ((R(3.0) * t0.z) < t1)) ? length((real3)(t5.x, (t5.y - s) + t6, t5.z - t6)) : (t1 * R(0.5773502691896258));
 }
 
 /* ---- capped_cone ---- */
@@ -171,17 +168,18 @@ real sd_capped_cone(real3 p, real h, real r1, real r2) {
 
 /* ---- ellipsoid ---- */
 real sd_ellipsoid(real3 p, real3 r) {
-    real t0 = p.x / r.x;
-    real t1 = p.y / r.y;
-    real t2 = p.z / r.z;
-    real t3 = fmax(fmax(fabs(t0), fabs(t1)), fabs(t2));
-    real t4 = ((R(0.0) < t3) && isfinite(t3)) ? (t3 * length((real3)(t0 / t3, t1 / t3, t2 / t3))) : length((real3)(t0, t1, t2));
-    real t5 = (t0 / t4) / r.x;
-    real t6 = (t1 / t4) / r.y;
-    real t7 = (t2 / t4) / r.z;
-    real t8 = fmax(fmax(fabs(t5), fabs(t6)), fabs(t7));
-    real t9 = t4 - R(1.0);
-    return (t4 < R(1.0)) ? (t9 * fmin(fmin(r.x, r.y), r.z)) : (t9 / fmax(((R(0.0) < t8) && isfinite(t8)) ? (t8 * length((real3)(t5 / t8, t6 / t8, t7 / t8))) : length((real3)(t5, t6, t7)), R(1e-30)));
+    real3 t0 = p / r;
+    real3 t1 = fabs(t0);
+    real t2 = fmax(fmax(t1.x, t1.y), t1.z);
+    real3 t3 = t0 / t2;
+    real t4 = ((R(0.0) < t2) && isfinite(t2)) ? (t2 * length(t3)) : length(t0);
+    real3 t5 = t0 / t4;
+    real3 t6 = t5 / r;
+    real3 t7 = fabs(t6);
+    real t8 = fmax(fmax(t7.x, t7.y), t7.z);
+    real3 t9 = t6 / t8;
+    real t10 = t4 - R(1.0);
+    return (t4 < R(1.0)) ? (t10 * fmin(fmin(r.x, r.y), r.z)) : (t10 / fmax(((R(0.0) < t8) && isfinite(t8)) ? (t8 * length(t9)) : length(t6), R(1e-30)));
 }
 
 /* ---- scene ---- */

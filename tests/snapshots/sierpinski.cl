@@ -88,13 +88,13 @@ typedef float4 real4;
 
 /* ---- plane ---- */
 real sd_plane(real3 p, real3 n, real offset) {
-    real t0 = fmax(fmax(fabs(n.x), fabs(n.y)), fabs(n.z));
-    real t1 = n.x / t0;
-    real t2 = n.y / t0;
-    real t3 = n.z / t0;
-    bool t4 = R(0.0) < t0;
-    real t5 = length((real3)(t1, t2, t3));
-    return (((p.x * (t4 ? (t1 / t5) : n.x)) + (p.y * (t4 ? (t2 / t5) : n.y))) + (p.z * (t4 ? (t3 / t5) : n.z))) + offset;
+    real3 t0 = fabs(n);
+    real t1 = fmax(fmax(t0.x, t0.y), t0.z);
+    real3 t2 = n / t1;
+    real t3 = length(t2);
+    real3 t4 = t2 / t3;
+    real3 t5 = (R(0.0) < t1) ? t4 : n;
+    return (((p.x * t5.x) + (p.y * t5.y)) + (p.z * t5.z)) + offset;
 }
 
 /* ---- sierpinski ---- */
@@ -106,28 +106,21 @@ real2 sierpinski(real3 p, real iterations, real scale) {
     real ts0_3 = R(1.0);
     real ts0_4 = R(1.0);
     for (int ti0 = 0; ti0 < iterations; ti0++) {
-        bool t1 = (ts0_0 + ts0_1) < R(0.0);
-        real t2 = t1 ? (-ts0_1) : ts0_0;
-        real t3 = t1 ? (-ts0_0) : ts0_1;
-        bool t4 = (t2 + ts0_2) < R(0.0);
-        real t5 = t4 ? (-ts0_2) : t2;
-        real t6 = t4 ? (-t2) : ts0_2;
-        bool t7 = (t3 + t6) < R(0.0);
-        real t8 = t7 ? (-t6) : t3;
-        real t9 = t7 ? (-t3) : t6;
-        real t10 = (t5 * scale) - t0;
-        real t11 = (t8 * scale) - t0;
-        real t12 = (t9 * scale) - t0;
-        real t13 = ts0_3 * scale;
-        real t14 = fmin(ts0_4, length((real3)(t5, t8, t9)) * R(0.5773502691896258));
-        ts0_0 = t10;
-        ts0_1 = t11;
-        ts0_2 = t12;
-        ts0_3 = t13;
-        ts0_4 = t14;
+        real3 t1 = ((ts0_0 + ts0_1) < R(0.0)) ? ((real3)(-ts0_1, -ts0_0, ts0_2)) : ((real3)(ts0_0, ts0_1, ts0_2));
+        real3 t2 = ((t1.x + t1.z) < R(0.0)) ? ((real3)(-t1.z, t1.y, -t1.x)) : t1;
+        real3 t3 = ((t2.y + t2.z) < R(0.0)) ? ((real3)(t2.x, -t2.z, -t2.y)) : t2;
+        real3 t4 = t3 * scale;
+        real3 t5 = t4 - t0;
+        real t6 = ts0_3 * scale;
+        real t7 = fmin(ts0_4, length(t3) * R(0.5773502691896258));
+        ts0_0 = t5.x;
+        ts0_1 = t5.y;
+        ts0_2 = t5.z;
+        ts0_3 = t6;
+        ts0_4 = t7;
     }
-    real t15 = -ts0_0;
-    return (real2)(((fmax(fmax((t15 - ts0_1) - ts0_2, (ts0_0 + ts0_1) - ts0_2), fmax((t15 + ts0_1) + ts0_2, (ts0_0 - ts0_1) + ts0_2)) - R(1.0)) * R(0.5773502691896258)) / ts0_3, ts0_4);
+    real t8 = -ts0_0;
+    return (real2)(((fmax(fmax((t8 - ts0_1) - ts0_2, (ts0_0 + ts0_1) - ts0_2), fmax((t8 + ts0_1) + ts0_2, (ts0_0 - ts0_1) + ts0_2)) - R(1.0)) * R(0.5773502691896258)) / ts0_3, ts0_4);
 }
 
 /* ---- scene ---- */
