@@ -222,6 +222,29 @@ pub trait Num:
     }
 }
 
+/// A loop in plain numbers: at most `count` steps (and
+/// [`MAX_LOOP_STEPS`]), stopping where a step says so.
+fn plain_loop<N: Num<Bool = bool> + PartialOrd, S>(
+    count: N,
+    index: impl Fn(u32) -> N,
+    mut state: S,
+    mut body: impl FnMut(N, &S) -> Step<N, S>,
+) -> S {
+    let mut i = 0u32;
+    while index(i) < count && i < MAX_LOOP_STEPS {
+        let step = body(index(i), &state);
+        if step.stop_before == Some(true) {
+            break;
+        }
+        state = step.next;
+        if step.stop_after == Some(true) {
+            break;
+        }
+        i += 1;
+    }
+    state
+}
+
 macro_rules! plain {
     ($t:ty) => {
         impl Num for $t {
@@ -283,43 +306,19 @@ macro_rules! plain {
             }
             fn iterate_dyn(
                 count: Self,
-                mut state: Vec<Self>,
+                state: Vec<Self>,
                 body: &mut dyn FnMut(Self, &[Self]) -> Step<Self>,
             ) -> Vec<Self> {
-                let mut i = 0u32;
                 #[allow(clippy::cast_precision_loss)]
-                while (i as $t) < count && i < MAX_LOOP_STEPS {
-                    let step = body(i as $t, &state);
-                    if step.stop_before == Some(true) {
-                        break;
-                    }
-                    state = step.next;
-                    if step.stop_after == Some(true) {
-                        break;
-                    }
-                    i += 1;
-                }
-                state
+                plain_loop(count, |i| i as $t, state, |i, s: &Vec<Self>| body(i, s))
             }
             fn iterate<const K: usize>(
                 count: Self,
-                mut state: [Self; K],
+                state: [Self; K],
                 mut body: impl FnMut(Self, [Self; K]) -> Step<Self, [Self; K]>,
             ) -> [Self; K] {
-                let mut i = 0u32;
                 #[allow(clippy::cast_precision_loss)]
-                while (i as $t) < count && i < MAX_LOOP_STEPS {
-                    let step = body(i as $t, state);
-                    if step.stop_before == Some(true) {
-                        break;
-                    }
-                    state = step.next;
-                    if step.stop_after == Some(true) {
-                        break;
-                    }
-                    i += 1;
-                }
-                state
+                plain_loop(count, |i| i as $t, state, |i, s: &[Self; K]| body(i, *s))
             }
         }
     };

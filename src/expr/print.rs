@@ -186,17 +186,21 @@ impl Block<'_> {
         }
     }
 
-    /// A vector operand: a splat (`(real3)(s)`) as the scalar `s` where
-    /// OpenCL C takes a scalar for a vector.
-    fn vector_operand(&self, v: ValueId, scalar_ok: bool) -> &str {
-        if scalar_ok
-            && let Op::Make3(x, y, z) = self.program.ops[v.index()]
-            && x == y
-            && y == z
-        {
-            return self.atom(x);
+    /// The scalar a vector value repeats, if it is a splat.
+    fn splat(&self, v: ValueId) -> Option<ValueId> {
+        match self.program.ops[v.index()] {
+            Op::Make3(x, y, z) if x == y && y == z => Some(x),
+            _ => None,
         }
-        self.atom(v)
+    }
+
+    /// A vector operand: a splat (`(real3)(s)`) as the scalar `s` where
+    /// `scalar` allows it.
+    fn vector_operand(&self, v: ValueId, scalar: bool) -> &str {
+        match self.splat(v) {
+            Some(s) if scalar => self.atom(s),
+            _ => self.atom(v),
+        }
     }
 
     /// The expression of `op`, parenthesised unless it is a call; `None`
@@ -227,25 +231,7 @@ impl Block<'_> {
                     Unary::Finite => format!("isfinite({inner})"),
                 }
             }
-            Op::Binary(b, x, y) => {
-                let (ax, ay) = (self.arg(x), self.arg(y));
-                let (x, y) = (self.atom(x), self.atom(y));
-                match b {
-                    Binary::Add => format!("({x} + {y})"),
-                    Binary::Sub => format!("({x} - {y})"),
-                    Binary::Mul => format!("({x} * {y})"),
-                    Binary::Div => format!("({x} / {y})"),
-                    Binary::Lt => format!("({x} < {y})"),
-                    Binary::Le => format!("({x} <= {y})"),
-                    Binary::And => format!("({x} && {y})"),
-                    Binary::Or => format!("({x} || {y})"),
-                    Binary::Min => format!("fmin({ax}, {ay})"),
-                    Binary::Max => format!("fmax({ax}, {ay})"),
-                    Binary::Atan2 => format!("atan2({ax}, {ay})"),
-                    Binary::Pow => format!("pow({ax}, {ay})"),
-                    Binary::Hypot => format!("hypot({ax}, {ay})"),
-                }
-            }
+            Op::Binary(b, x, y) => binary(b, self.atom(x), self.atom(y)),
             Op::Make3(x, y, z) => match self.whole_vector(x, y, z) {
                 Some(v) => v.to_string(),
                 None if x == y && y == z => format!("((real3)({}))", self.arg(x)),
@@ -270,23 +256,15 @@ impl Block<'_> {
                         | Binary::Min
                         | Binary::Max
                 );
-                let x = self.vector_operand(x, scalar_ok && matches!(b, Binary::Add | Binary::Mul));
-                let y = self.vector_operand(y, scalar_ok);
-                let (ax, ay) = (unwrap(x), unwrap(y));
-                match b {
-                    Binary::Add => format!("({x} + {y})"),
-                    Binary::Sub => format!("({x} - {y})"),
-                    Binary::Mul => format!("({x} * {y})"),
-                    Binary::Div => format!("({x} / {y})"),
-                    Binary::Min => format!("fmin({ax}, {ay})"),
-                    Binary::Max => format!("fmax({ax}, {ay})"),
-                    Binary::Atan2 => format!("atan2({ax}, {ay})"),
-                    Binary::Pow => format!("pow({ax}, {ay})"),
-                    Binary::Hypot => format!("hypot({ax}, {ay})"),
-                    Binary::Lt | Binary::Le | Binary::And | Binary::Or => {
-                        return Err(Unprintable::Vector);
-                    }
+                // One operand stays a vector, so the result is one.
+                let y_splat = scalar_ok && self.splat(y).is_some();
+                let x_splat = !y_splat && matches!(b, Binary::Add | Binary::Mul);
+                let x = self.vector_operand(x, x_splat);
+                let y = self.vector_operand(y, y_splat);
+                if b.is_logic() {
+                    return Err(Unprintable::Vector);
                 }
+                binary(b, x, y)
             }
             Op::Select3(c, a, b) => {
                 format!("({} ? {} : {})", self.atom(c), self.atom(a), self.atom(b))
@@ -474,6 +452,27 @@ impl OpenClWriter {
         }
         self.line(indent, "}");
         Ok(state)
+    }
+}
+
+/// `x op y` in OpenCL C, for numbers or (the arithmetic and functions)
+/// vectors.
+fn binary(b: Binary, x: &str, y: &str) -> String {
+    let (ax, ay) = (unwrap(x), unwrap(y));
+    match b {
+        Binary::Add => format!("({x} + {y})"),
+        Binary::Sub => format!("({x} - {y})"),
+        Binary::Mul => format!("({x} * {y})"),
+        Binary::Div => format!("({x} / {y})"),
+        Binary::Lt => format!("({x} < {y})"),
+        Binary::Le => format!("({x} <= {y})"),
+        Binary::And => format!("({x} && {y})"),
+        Binary::Or => format!("({x} || {y})"),
+        Binary::Min => format!("fmin({ax}, {ay})"),
+        Binary::Max => format!("fmax({ax}, {ay})"),
+        Binary::Atan2 => format!("atan2({ax}, {ay})"),
+        Binary::Pow => format!("pow({ax}, {ay})"),
+        Binary::Hypot => format!("hypot({ax}, {ay})"),
     }
 }
 

@@ -224,44 +224,31 @@ impl Op {
         }
     }
 
-    /// A hashable key: literals by their bits.
+    /// A hashable key: the variant, a literal's bits or the operation,
+    /// and the operands.
     fn key(&self) -> Key {
+        let v = |x: ValueId| x.0;
         match *self {
-            Op::Const(v) => Key::Const(v.to_bits()),
-            Op::Input(n) => Key::Input(n),
-            Op::Unary(u, a) => Key::Unary(u, a),
-            Op::Binary(b, x, y) => Key::Binary(b, x, y),
-            Op::Length3(x, y, z) => Key::Length3(x, y, z),
-            Op::Make3(x, y, z) => Key::Make3(x, y, z),
-            Op::Component(v, i) => Key::Component(v, i),
-            Op::Unary3(u, v) => Key::Unary3(u, v),
-            Op::Binary3(b, x, y) => Key::Binary3(b, x, y),
-            Op::Select3(c, a, b) => Key::Select3(c, a, b),
-            Op::Select(c, a, b) => Key::Select(c, a, b),
-            Op::Capture(up, v) => Key::Capture(up, v),
-            Op::Loop(n) => Key::Loop(n),
-            Op::Element(v, k) => Key::Element(v, k),
+            Op::Const(c) => (0, c.to_bits(), [0; 3]),
+            Op::Input(n) => (1, 0, [n, 0, 0]),
+            Op::Unary(u, a) => (2, u as u64, [v(a), 0, 0]),
+            Op::Binary(b, x, y) => (3, b as u64, [v(x), v(y), 0]),
+            Op::Length3(x, y, z) => (4, 0, [v(x), v(y), v(z)]),
+            Op::Make3(x, y, z) => (5, 0, [v(x), v(y), v(z)]),
+            Op::Component(a, i) => (6, u64::from(i), [v(a), 0, 0]),
+            Op::Unary3(u, a) => (7, u as u64, [v(a), 0, 0]),
+            Op::Binary3(b, x, y) => (8, b as u64, [v(x), v(y), 0]),
+            Op::Select3(c, a, b) => (9, 0, [v(c), v(a), v(b)]),
+            Op::Select(c, a, b) => (10, 0, [v(c), v(a), v(b)]),
+            Op::Capture(up, a) => (11, u64::from(up), [v(a), 0, 0]),
+            Op::Loop(n) => (12, u64::from(n), [0; 3]),
+            Op::Element(a, k) => (13, u64::from(k), [v(a), 0, 0]),
         }
     }
 }
 
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
-enum Key {
-    Const(u64),
-    Input(u32),
-    Unary(Unary, ValueId),
-    Binary(Binary, ValueId, ValueId),
-    Length3(ValueId, ValueId, ValueId),
-    Make3(ValueId, ValueId, ValueId),
-    Component(ValueId, u32),
-    Unary3(Unary, ValueId),
-    Binary3(Binary, ValueId, ValueId),
-    Select3(ValueId, ValueId, ValueId),
-    Select(ValueId, ValueId, ValueId),
-    Capture(u32, ValueId),
-    Loop(u32),
-    Element(ValueId, u32),
-}
+/// An operation's key on a tape (see [`Op::key`]).
+type Key = (u8, u64, [u32; 3]);
 
 /// A recorded formula: operations in order, how many scalar inputs it
 /// reads, and which values it returns.
