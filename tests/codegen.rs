@@ -89,7 +89,7 @@ fn fractal_helpers_are_printed_once_and_stand_alone() {
 #[test]
 fn integer_power_eight_uses_the_trig_free_form() {
     let src = source(mandelbulb(8.0), &Options::default());
-    assert!(src.contains("mandelbulb_p8(p0, 12, 2.0f, 1.1040895f)"));
+    assert!(src.contains("mandelbulb_p8(p0, 12, R(2.0), 1.1040895f)"));
     assert!(!src.contains("acos"), "power 8 must not use trigonometry");
 
     let src = source(mandelbulb(7.5), &Options::default());
@@ -99,7 +99,7 @@ fn integer_power_eight_uses_the_trig_free_form() {
     // A dynamic power cannot be specialised.
     let src = source(mandelbulb(param("power", 8.0)), &Options::default());
     assert!(src.contains(
-        "mandelbulb(p0, params[0] /* power */, 12, fmin(2.0f, pow(MAGNITUDE_CAP, R(1.0) / params[0] /* power */)), pow(R(2.0), R(1.0) / (params[0] /* power */ - R(1.0))))"
+        "mandelbulb(p0, params[0] /* power */, 12, fmin(R(2.0), pow(R(1e18), R(1.0) / params[0] /* power */)), pow(R(2.0), R(1.0) / (params[0] /* power */ - R(1.0))))"
     ));
 }
 
@@ -426,19 +426,19 @@ fn a_custom_shape_s_region_covers_its_body_exactly() {
 
 #[test]
 fn a_custom_parameter_named_like_the_program_s_own_functions_is_refused() {
-    // `smooth_min` is a helper of the program: not an OpenCL word, so the shape
+    // `menger` is a helper of the program: not an OpenCL word, so the shape
     // is made, but the program it would join refuses it.
     let shape = fractal_sdf::scene::CustomShape::new(
         "blob",
-        &[("smooth_min", fractal_sdf::scene::Rule::Positive)],
+        &[("menger", fractal_sdf::scene::Rule::Positive)],
         |p, a| p.length() - a[0],
-        "return length(p) - smooth_min;",
+        "return length(p) - menger;",
     )
     .unwrap();
     let compiled = Scene::new(shape.node([0.5])).compile().unwrap();
     let err = codegen::emit(&compiled, &Options::default()).unwrap_err();
     assert!(
-        err.to_string().contains("smooth_min") && err.to_string().contains("generated program"),
+        err.to_string().contains("menger") && err.to_string().contains("generated program"),
         "{err}"
     );
 }

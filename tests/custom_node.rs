@@ -411,7 +411,7 @@ fn names_with_a_meaning_in_opencl_or_the_program_are_refused() {
         "DE_shade",
         "sd_sphere",
         "sd_future",
-        "twist_bound",
+        "menger",
         "march_ray",
         "render_tile",
         "eval_points",

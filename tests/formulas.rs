@@ -38,7 +38,7 @@ fn scalar(vars: &'static [&'static str]) -> impl Strategy<Value = String> {
                 .prop_map(|(a, b, op)| format!("({a} {op} {b})")),
             (e.clone(), e.clone()).prop_map(|(a, b)| format!("({a} / (abs({b}) + 0.5))")),
             (
-                prop::sample::select(&["abs", "sin", "cos", "floor", "fract"][..]),
+                prop::sample::select(&["abs", "sin", "cos", "floor", "round", "fract"][..]),
                 e.clone()
             )
                 .prop_map(|(f, a)| format!("{f}({a})")),

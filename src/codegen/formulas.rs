@@ -9,7 +9,7 @@ use crate::math::{V3, v3};
 use Shape::{Pair, Scalar, Vec3};
 
 /// The 3-vector of inputs `i..i + 3`.
-fn vector(a: &[Var], i: usize) -> V3<Var> {
+pub(crate) fn vector(a: &[Var], i: usize) -> V3<Var> {
     v3(a[i], a[i + 1], a[i + 2])
 }
 
@@ -101,41 +101,6 @@ pub(crate) fn ellipsoid() -> Result<String, Unprintable> {
     distance("sd_ellipsoid", &[("r", Vec3)], |p, a| {
         sdf::ellipsoid(p, vector(a, 0))
     })
-}
-
-pub(crate) fn smooth_min() -> Result<String, Unprintable> {
-    print(
-        "smooth_min",
-        &[("a", Scalar), ("b", Scalar), ("k", Scalar)],
-        Pair,
-        |a| {
-            let (d, m) = sdf::smooth_min(a[0], a[1], a[2]);
-            vec![d, m]
-        },
-    )
-}
-
-pub(crate) fn rotate() -> Result<String, Unprintable> {
-    print(
-        "rotate_axis",
-        &[("p", Vec3), ("k", Vec3), ("angle", Scalar)],
-        Vec3,
-        |a| {
-            let q = sdf::rotate_axis(vector(a, 0), vector(a, 3), a[6]);
-            vec![q.x, q.y, q.z]
-        },
-    )
-}
-
-pub(crate) fn warp() -> Result<String, Unprintable> {
-    let params = [("d", Scalar), ("k", Scalar), ("rho", Scalar)];
-    let twist = print("twist_bound", &params, Scalar, |a| {
-        vec![sdf::twist_bound(a[0], a[1], a[2])]
-    })?;
-    let bend = print("bend_bound", &params, Scalar, |a| {
-        vec![sdf::bend_bound(a[0], a[1], a[2])]
-    })?;
-    Ok(format!("{twist}\n{bend}"))
 }
 
 /// A fractal's estimate as the pair (distance, trap).

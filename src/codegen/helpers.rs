@@ -23,14 +23,11 @@ pub(crate) enum Helper {
     Menger,
     Sierpinski,
     Julia,
-    SmoothMin,
-    Rotate,
-    Warp,
 }
 
 impl Helper {
     /// Every helper, in the order they are emitted.
-    pub(crate) const ALL: [Helper; 17] = [
+    pub(crate) const ALL: [Helper; 14] = [
         Helper::Sphere,
         Helper::Cuboid,
         Helper::RoundBox,
@@ -45,9 +42,6 @@ impl Helper {
         Helper::Menger,
         Helper::Sierpinski,
         Helper::Julia,
-        Helper::SmoothMin,
-        Helper::Rotate,
-        Helper::Warp,
     ];
 
     /// The helper's name, in the program's section comments.
@@ -67,9 +61,6 @@ impl Helper {
             Helper::Menger => "menger",
             Helper::Sierpinski => "sierpinski",
             Helper::Julia => "julia",
-            Helper::SmoothMin => "smooth_min",
-            Helper::Rotate => "rotate",
-            Helper::Warp => "warp",
         }
     }
 
@@ -90,9 +81,6 @@ impl Helper {
             Helper::Menger => formulas::menger(),
             Helper::Sierpinski => formulas::sierpinski(),
             Helper::Julia => formulas::julia(),
-            Helper::SmoothMin => formulas::smooth_min(),
-            Helper::Rotate => formulas::rotate(),
-            Helper::Warp => formulas::warp(),
         }
     }
 }

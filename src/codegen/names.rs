@@ -295,7 +295,7 @@ mod tests {
             "DE",
             "DE_shade",
             "sd_sphere",
-            "twist_bound",
+            "menger",
             "march_ray",
             "render_tile",
             "eval_points",
@@ -330,7 +330,7 @@ mod tests {
             ("sd_anything", "prefix"),
             ("cl_khr_fp64", "prefix"),
             ("DE_shade", "generated program"),
-            ("twist_bound", "generated program"),
+            ("menger", "generated program"),
             ("mandelbulb_p12", "generated program"),
             ("params", "buffer"),
         ] {

@@ -20,13 +20,15 @@ use std::collections::{BTreeMap, BTreeSet, HashMap};
 use std::convert::Infallible;
 use std::fmt::Write as _;
 
+use super::formulas::vector;
 use super::helpers::Helper;
 use super::writer::{INSTANCE_SLOT, Writer};
+use crate::cpu::sdf;
+use crate::expr::{Num, OpenCl, Printer, Shape, Var, trace};
 use crate::ir::{
-    Bound, Ir, IrNode, NodeId, Reach, SHRINK, Scalar, UnionChain, Vector, costs, reach, swaps,
-    union_chain,
+    Bound, Ir, IrNode, NodeId, Reach, Scalar, UnionChain, Vector, costs, reach, swaps, union_chain,
 };
-use crate::math::{F32_LIMITS, escape_radius, integer_power, mandelbulb_radius, rotation_rows};
+use crate::math::{F32_LIMITS, V3, escape_radius, integer_power, mandelbulb_radius, rotation_rows};
 use crate::quality::Precision;
 use crate::scene::{
     CsgOp, CustomShape, Kind, MAX_ESCAPE_ITERATIONS, MAX_FOLD_ITERATIONS, Mapper, ParamSpec,
@@ -39,6 +41,20 @@ struct Vars {
     d: String,
     c: String,
     t: String,
+}
+
+/// What a formula written inline reads (see `Emitter::inline`).
+#[derive(Clone, Copy)]
+enum Arg<'a> {
+    /// A point (`real3`) by name.
+    Point(&'a str),
+    /// A number by name or expression.
+    Value(&'a str),
+    /// A parameter: a baked one is a literal the trace folds, a dynamic
+    /// one its slot.
+    Scalar(Scalar),
+    /// Three parameters.
+    Vector([Scalar; 3]),
 }
 
 /// What entering a node leaves to do.
@@ -143,9 +159,9 @@ impl Mapper<Scalar, Vector, NodeId> for Rewrite {
 }
 
 /// Forgets a node's children, so that what is left describes its shape.
-struct Shape;
+struct Skeleton;
 
-impl Mapper<Scalar, Vector, NodeId> for Shape {
+impl Mapper<Scalar, Vector, NodeId> for Skeleton {
     type S2 = Scalar;
     type V2 = Vector;
     type C2 = ();
@@ -198,7 +214,7 @@ fn instance(ir: &Ir, root: NodeId) -> Option<Instance> {
             return None;
         }
         let Ok(rewritten) = node.try_map(&mut rewrite);
-        let Ok(kind) = rewritten.try_map(&mut Shape);
+        let Ok(kind) = rewritten.try_map(&mut Skeleton);
         write!(shape, "{kind:?};").expect("writing to a String cannot fail");
         at = rewritten.children().first().map(|&&c| c);
         chain.push((id, rewritten));
@@ -230,6 +246,9 @@ pub(crate) struct SceneEmitter<'a> {
     /// materials in place of colours, no traps) rather than the colour.
     material: bool,
     points: usize,
+    /// Formulas written inline so far (their temporaries are named after
+    /// their number: `e3_0`).
+    inlined: usize,
     iteration_override: Option<u32>,
     /// The helper files the emitted code calls.
     pub(crate) used: BTreeSet<Helper>,
@@ -268,6 +287,7 @@ impl<'a> SceneEmitter<'a> {
             shade: false,
             material: false,
             points: 0,
+            inlined: 0,
             iteration_override,
             used: BTreeSet::new(),
             customs: BTreeMap::new(),
@@ -344,6 +364,104 @@ impl<'a> SceneEmitter<'a> {
         name
     }
 
+    /// Writes `formula`, a function of `args` (in order, a point as three
+    /// inputs) from [`crate::cpu::sdf`], at this place of the function:
+    /// traced into the expression IR with the baked parameters as literals
+    /// (so it keeps only the code they leave) and printed by the OpenCL
+    /// printer. Gives each result's expression.
+    fn inline(
+        &mut self,
+        args: &[Arg<'_>],
+        results: &[Shape],
+        formula: impl FnOnce(&[Var]) -> Vec<Var>,
+    ) -> Vec<String> {
+        let mut inputs: Vec<(String, Shape)> = Vec::new();
+        // Each scalar the formula reads: a literal, or the next input.
+        let mut reads: Vec<Option<f64>> = Vec::new();
+        for arg in args {
+            let scalars: &[Scalar] = match arg {
+                Arg::Point(name) => {
+                    inputs.push(((*name).to_string(), Shape::Vec3));
+                    reads.extend([None; 3]);
+                    &[]
+                }
+                Arg::Value(name) => {
+                    inputs.push(((*name).to_string(), Shape::Scalar));
+                    reads.push(None);
+                    &[]
+                }
+                Arg::Scalar(s) => std::slice::from_ref(s),
+                Arg::Vector(v) => v,
+            };
+            for s in scalars {
+                match *s {
+                    Scalar::Baked(v) => reads.push(Some(self.w.checked(v))),
+                    Scalar::Dynamic(_) => {
+                        inputs.push((self.w.scalar(*s), Shape::Scalar));
+                        reads.push(None);
+                    }
+                }
+            }
+        }
+        let count = inputs.iter().map(|(_, s)| s.width()).sum();
+        let program = trace(count, |x| {
+            let mut next = x.iter();
+            let values: Vec<Var> = reads
+                .iter()
+                .map(|r| match r {
+                    Some(v) => Var::of(*v),
+                    None => *next.next().expect("an input for each read"),
+                })
+                .collect();
+            formula(&values)
+        });
+        let named: Vec<(&str, Shape)> = inputs.iter().map(|(n, s)| (n.as_str(), *s)).collect();
+        self.inlined += 1;
+        let out = OpenCl
+            .inline(&named, results, &program, &format!("e{}_", self.inlined))
+            .expect("an inline formula reads its arguments and gives its results");
+        for line in out.statements.lines() {
+            self.w.line(line);
+        }
+        out.results
+    }
+
+    /// The point a node's child sees: `map` of the node's point and `args`.
+    fn map_point(
+        &mut self,
+        p: &str,
+        args: &[Arg<'_>],
+        map: impl FnOnce(V3<Var>, &[Var]) -> V3<Var>,
+    ) -> String {
+        let mut all = vec![Arg::Point(p)];
+        all.extend_from_slice(args);
+        let [q] = take(self.inline(&all, &[Shape::Vec3], |a| {
+            map(vector(a, 0), &a[3..]).to_array().to_vec()
+        }));
+        // A point the formula named already needs no second name.
+        if q.starts_with('e') && q.chars().all(|c| c.is_ascii_alphanumeric() || c == '_') {
+            return q;
+        }
+        self.point(q)
+    }
+
+    /// A node's distance `d{id}`, `formula` of its child's distance and
+    /// `args`; colour and trap stay the child's.
+    fn map_distance(
+        &mut self,
+        id: NodeId,
+        child: Vars,
+        args: &[Arg<'_>],
+        formula: impl FnOnce(Var, &[Var]) -> Var,
+    ) -> Vars {
+        let mut all = vec![Arg::Value(&child.d)];
+        all.extend_from_slice(args);
+        let [d] = take(self.inline(&all, &[Shape::Scalar], |a| vec![formula(a[0], &a[1..])]));
+        let name = format!("d{}", id.index());
+        self.w.line(format!("real {name} = {d};"));
+        Vars { d: name, ..child }
+    }
+
     /// A fractal's iteration count under [`Quality::fractal_iterations`]
     /// (a cap), kept within the fractal's valid range.
     ///
@@ -403,14 +521,6 @@ impl<'a> SceneEmitter<'a> {
             t,
             d: v.d,
         }
-    }
-
-    /// A node that changes only the child's distance, by `expr` of `{d}`.
-    fn post(&mut self, id: NodeId, child: Vars, expr: &str) -> Vars {
-        let d = format!("d{}", id.index());
-        self.w
-            .line(format!("real {d} = {};", expr.replace("{d}", &child.d)));
-        Vars { d, ..child }
     }
 
     /// Emits the tree under `root` at point `p` without recursion: a work
@@ -542,38 +652,13 @@ impl<'a> SceneEmitter<'a> {
             Some(k) => format!("{first} + {}", self.w.scalar(*k)),
             None => first,
         };
-        let g = reach
-            .parts
-            .iter()
-            .map(|(bound, offset)| {
-                let g = self.bound_distance(p, bound);
-                if *offset > 0.0 {
-                    format!("{g} - {}", self.w.float(*offset))
-                } else {
-                    g
-                }
-            })
-            .reduce(|a, b| format!("fmin({a}, {b})"))
-            .expect("a reach has parts");
+        let [g] = take(self.inline(&[Arg::Point(p)], &[Shape::Scalar], |a| {
+            vec![reach.distance_at(vector(a, 0))]
+        }));
         self.w.line(format!("real g{i} = {g};"));
         self.w
             .open(format!("if (!(g{i} > {threshold} && g{i} > R(0.0)))"));
         self.gated.insert(id);
-    }
-
-    /// `Bound::distance` at `p`, as the kernel computes it.
-    fn bound_distance(&self, p: &str, bound: &Bound) -> String {
-        let centre = self.w.vector(bound.centre.to_array().map(Scalar::Baked));
-        let g = format!(
-            "length({p} - {centre}) * {} - {}",
-            self.w.float(SHRINK),
-            self.w.float(bound.radius)
-        );
-        if bound.slope < 1.0 {
-            format!("{} * ({g})", self.w.float(bound.slope))
-        } else {
-            g
-        }
     }
 
     /// Closes a gate: the boolean's value, computed in the block, becomes
@@ -650,20 +735,16 @@ impl<'a> SceneEmitter<'a> {
             return Step::Done(self.leaf(id, format!("{function}({p}, {args})")));
         }
         let w = |this: &Self, s: Scalar| this.w.scalar(s);
-        let v3 = |this: &Self, v: [Scalar; 3]| this.w.vector(v);
         match node {
             Kind::Mandelbulb(f) => {
                 let n = self.iterations(f.iterations, (1, MAX_ESCAPE_ITERATIONS));
                 // The escape radius: a literal when power and bailout are
-                // baked, as the CPU computes it.
-                let escape = match (f.power, f.bailout) {
-                    (Scalar::Baked(p), Scalar::Baked(b)) => self.w.float(escape_radius(p, b)),
-                    _ => format!(
-                        "fmin({}, pow(MAGNITUDE_CAP, R(1.0) / {}))",
-                        w(self, f.bailout),
-                        w(self, f.power)
-                    ),
-                };
+                // baked (folded in `f64`, as the CPU computes it).
+                let [escape] = take(self.inline(
+                    &[Arg::Scalar(f.power), Arg::Scalar(f.bailout)],
+                    &[Shape::Scalar],
+                    |a| vec![escape_radius(a[0], a[1])],
+                ));
                 // The radius of the ball that holds the set: a literal when
                 // the power is baked, rounded as the CPU computes it.
                 let ball = match f.power {
@@ -672,7 +753,11 @@ impl<'a> SceneEmitter<'a> {
                         Precision::F64 => mandelbulb_radius(p),
                     }),
                     Scalar::Dynamic(_) => {
-                        format!("pow(R(2.0), R(1.0) / ({} - R(1.0)))", w(self, f.power))
+                        let [ball] =
+                            take(self.inline(&[Arg::Scalar(f.power)], &[Shape::Scalar], |a| {
+                                vec![mandelbulb_radius(a[0])]
+                            }));
+                        ball
                     }
                 };
                 match f.power.baked().and_then(integer_power) {
@@ -708,46 +793,48 @@ impl<'a> SceneEmitter<'a> {
                 Step::Done(self.fractal(id, Helper::Sierpinski, &args))
             }
             Kind::Translate { offset, child } => {
-                let q = self.point(format!("{p} - {}", v3(self, *offset)));
+                let q = self.map_point(p, &[Arg::Vector(*offset)], |p, a| {
+                    sdf::translate(p, vector(a, 0))
+                });
                 Step::Descend(vec![(*child, q, needs_color)])
             }
             Kind::Rotate { axis, angle, child } => {
                 let q = match angle {
                     Scalar::Baked(a) => {
                         let rows = rotation_rows(*axis, -a);
-                        let [x, y, z] = rows.map(|r| self.dot_row([r.x, r.y, r.z], p));
-                        self.point(format!("(real3)({x}, {y}, {z})"))
+                        self.map_point(p, &[], |p, _| sdf::rotate_rows(p, rows))
                     }
                     Scalar::Dynamic(_) => {
-                        self.used.insert(Helper::Rotate);
-                        let k = v3(self, axis.to_array().map(Scalar::Baked));
-                        let a = format!("-{}", w(self, *angle));
-                        self.point(format!("rotate_axis({p}, {k}, {a})"))
+                        let k = axis.to_array().map(Scalar::Baked);
+                        self.map_point(p, &[Arg::Vector(k), Arg::Scalar(*angle)], |p, a| {
+                            sdf::rotate_axis(p, vector(a, 0), -a[3])
+                        })
                     }
                 };
                 Step::Descend(vec![(*child, q, needs_color)])
             }
             Kind::Scale { factor, child } => {
-                let f = w(self, *factor);
-                let q = self.point(format!("{p} / {f}"));
+                let q =
+                    self.map_point(p, &[Arg::Scalar(*factor)], |p, a| sdf::scale_point(p, a[0]));
                 Step::Descend(vec![(*child, q, needs_color)])
             }
             Kind::Mirror { axis, child } => {
-                let q = self.point(p.to_string());
-                let a = ["x", "y", "z"][axis.index()];
-                self.w.line(format!("{q}.{a} = fabs({q}.{a});"));
+                let q = self.map_point(p, &[], |p, _| sdf::mirror(p, axis.index()));
                 Step::Descend(vec![(*child, q, needs_color)])
             }
             Kind::Round { child, .. } | Kind::Onion { child, .. } => {
                 Step::Descend(vec![(*child, p.to_string(), needs_color)])
             }
             Kind::Elongate { extents, child } => {
-                let h = v3(self, *extents);
-                let q = self.point(format!("{p} - clamp({p}, -{h}, {h})"));
+                let q = self.map_point(p, &[Arg::Vector(*extents)], |p, a| {
+                    sdf::elongate(p, vector(a, 0))
+                });
                 Step::Descend(vec![(*child, q, needs_color)])
             }
             Kind::Repeat { period, child } => {
-                let q = self.repeat(p, *period, None);
+                let q = self.map_point(p, &[Arg::Vector(*period)], |p, a| {
+                    sdf::repeat(p, vector(a, 0), None)
+                });
                 Step::Descend(vec![(*child, q, needs_color)])
             }
             Kind::RepeatLimited {
@@ -755,27 +842,17 @@ impl<'a> SceneEmitter<'a> {
                 limit,
                 child,
             } => {
-                let q = self.repeat(p, *period, Some(*limit));
+                let q = self.map_point(p, &[Arg::Vector(*period)], |p, a| {
+                    sdf::repeat(p, vector(a, 0), Some(*limit))
+                });
                 Step::Descend(vec![(*child, q, needs_color)])
             }
             Kind::Twist { rate, child } => {
-                let k = w(self, *rate);
-                let i = id.index();
-                self.w.line(format!("real s{i} = sin({k} * {p}.y);"));
-                self.w.line(format!("real k{i} = cos({k} * {p}.y);"));
-                let q = self.point(format!(
-                    "(real3)(k{i} * {p}.x - s{i} * {p}.z, {p}.y, s{i} * {p}.x + k{i} * {p}.z)"
-                ));
+                let q = self.map_point(p, &[Arg::Scalar(*rate)], |p, a| sdf::twist(p, a[0]));
                 Step::Descend(vec![(*child, q, needs_color)])
             }
             Kind::Bend { rate, child } => {
-                let k = w(self, *rate);
-                let i = id.index();
-                self.w.line(format!("real s{i} = sin({k} * {p}.x);"));
-                self.w.line(format!("real k{i} = cos({k} * {p}.x);"));
-                let q = self.point(format!(
-                    "(real3)(k{i} * {p}.x - s{i} * {p}.y, s{i} * {p}.x + k{i} * {p}.y, {p}.z)"
-                ));
+                let q = self.map_point(p, &[Arg::Scalar(*rate)], |p, a| sdf::bend(p, a[0]));
                 Step::Descend(vec![(*child, q, needs_color)])
             }
             Kind::Csg { a, b, .. } => {
@@ -805,20 +882,6 @@ impl<'a> SceneEmitter<'a> {
         }
     }
 
-    /// A twist's or bend's estimate `warped`, raised to the distance to the
-    /// ball around its warped child where it has that bound
-    /// (`ir::warp_ball`; the CPU reference does the same).
-    fn warp_floor(&self, id: NodeId, p: &str, warped: &str) -> String {
-        match self.bounds[id.index()] {
-            Some(ball) => {
-                let [x, y, z] = ball.centre.to_array().map(|v| self.w.float(v));
-                let r = self.w.float(ball.radius);
-                format!("fmax({warped}, length({p} - (real3)({x}, {y}, {z})) - {r})")
-            }
-            None => warped.to_string(),
-        }
-    }
-
     /// Leaving a node after its children: the lines that combine their
     /// results.
     fn leave(&mut self, id: NodeId, p: &str, needs_color: bool, children: Vec<Vars>) -> Vars {
@@ -838,40 +901,41 @@ impl<'a> SceneEmitter<'a> {
         if self.frame == Some(id) {
             return child();
         }
-        let w = |this: &Self, s: Scalar| this.w.scalar(s);
         match node {
             Kind::Scale { factor, .. } => {
-                let f = w(self, *factor);
                 let c = child();
-                self.post(id, c, &format!("{{d}} * {f}"))
+                self.map_distance(id, c, &[Arg::Scalar(*factor)], |d, a| {
+                    sdf::scale_distance(d, a[0])
+                })
             }
             Kind::Round { radius, .. } => {
                 let c = child();
                 self.label(id);
-                let r = w(self, *radius);
-                self.post(id, c, &format!("{{d}} - {r}"))
+                self.map_distance(id, c, &[Arg::Scalar(*radius)], |d, a| sdf::rounded(d, a[0]))
             }
             Kind::Onion { thickness, .. } => {
                 let c = child();
                 self.label(id);
-                let t = w(self, *thickness);
-                self.post(id, c, &format!("fabs({{d}}) - {t}"))
+                self.map_distance(id, c, &[Arg::Scalar(*thickness)], |d, a| {
+                    sdf::onion(d, a[0])
+                })
             }
-            Kind::Twist { rate, .. } => {
-                let k = w(self, *rate);
-                self.used.insert(Helper::Warp);
-                let rho = format!("hypot({p}.x, {p}.z)");
+            Kind::Twist { rate, .. } | Kind::Bend { rate, .. } => {
+                // The estimate is raised to the distance to the ball around
+                // the warped child where it has that bound (`ir::warp_ball`;
+                // the CPU reference does the same).
+                let twist = matches!(node, Kind::Twist { .. });
+                let ball = self.bounds[id.index()];
                 let c = child();
-                let d = self.warp_floor(id, p, &format!("twist_bound({{d}}, {k}, {rho})"));
-                self.post(id, c, &d)
-            }
-            Kind::Bend { rate, .. } => {
-                let k = w(self, *rate);
-                self.used.insert(Helper::Warp);
-                let rho = format!("hypot({p}.x, {p}.y)");
-                let c = child();
-                let d = self.warp_floor(id, p, &format!("bend_bound({{d}}, {k}, {rho})"));
-                self.post(id, c, &d)
+                self.map_distance(id, c, &[Arg::Point(p), Arg::Scalar(*rate)], |d, a| {
+                    let q = vector(a, 0);
+                    let d = if twist {
+                        sdf::twisted(d, a[3], q)
+                    } else {
+                        sdf::bent(d, a[3], q)
+                    };
+                    ball.map_or(d, |b| b.floor_at(d, q))
+                })
             }
             Kind::Csg { op, smoothing, .. } => {
                 let (a, b) = (child(), child());
@@ -1049,54 +1113,9 @@ impl<'a> SceneEmitter<'a> {
         acc
     }
 
-    /// `row · p` as the CPU's `dot_row` computes it: non-zero terms, left to
-    /// right; `±1` entries need no multiplication.
-    fn dot_row(&self, row: [f64; 3], p: &str) -> String {
-        let mut sum = String::new();
-        for (a, axis) in row.into_iter().zip(["x", "y", "z"]) {
-            if a == 0.0 {
-                continue;
-            }
-            let term = match a {
-                1.0 => format!("{p}.{axis}"),
-                -1.0 => format!("-{p}.{axis}"),
-                _ => format!("{} * {p}.{axis}", self.w.float(a)),
-            };
-            if sum.is_empty() {
-                sum = term;
-            } else if let Some(negated) = term.strip_prefix('-') {
-                sum = format!("{sum} - {negated}");
-            } else {
-                sum = format!("{sum} + {term}");
-            }
-        }
-        if sum.is_empty() { "R(0.0)".into() } else { sum }
-    }
-
-    /// Folds `p` into a repetition cell, axis by axis, as `cpu::repeat` does.
-    fn repeat(&mut self, p: &str, period: [Scalar; 3], limit: Option<[u32; 3]>) -> String {
-        let q = self.point(p.to_string());
-        for (i, axis) in ["x", "y", "z"].into_iter().enumerate() {
-            let c = self.w.scalar(period[i]);
-            let mut cell = format!("round({p}.{axis} / {c})");
-            if let Some(l) = limit {
-                let l = self.w.float(f64::from(l[i]));
-                cell = format!("clamp({cell}, -{l}, {l})");
-            }
-            let fold = format!("{p}.{axis} - {c} * {cell}");
-            match period[i] {
-                Scalar::Baked(v) if v > 0.0 => self.w.line(format!("{q}.{axis} = {fold};")),
-                Scalar::Baked(_) => {}
-                Scalar::Dynamic(_) => self
-                    .w
-                    .line(format!("{q}.{axis} = {c} > R(0.0) ? {fold} : {p}.{axis};")),
-            }
-        }
-        q
-    }
-
-    /// Every boolean is a (smooth) minimum of signed operands, as in
-    /// `cpu::combine`.
+    /// A boolean of two results: the distance from [`sdf::csg`], and the
+    /// nearer operand's colour and trap, blended across a smooth seam, as
+    /// `cpu::combine` computes them.
     fn csg(
         &mut self,
         id: NodeId,
@@ -1106,43 +1125,48 @@ impl<'a> SceneEmitter<'a> {
         b: &Vars,
         needs_color: bool,
     ) -> Vars {
-        let i = id.index();
-        let (x, y) = match op {
-            CsgOp::Union => (a.d.clone(), b.d.clone()),
-            CsgOp::Subtract => (format!("-{}", a.d), b.d.clone()),
-            CsgOp::Intersect | CsgOp::Cut => (format!("-{}", a.d), format!("-{}", b.d)),
-        };
-        let sign = if op == CsgOp::Union { "" } else { "-" };
         let v = vars(id);
-        self.w.line(format!("real x{i} = {x};"));
-        self.w.line(format!("real y{i} = {y};"));
-        let blend = match k {
-            Some(k) => {
-                self.used.insert(Helper::SmoothMin);
-                let k = self.w.scalar(k);
-                self.w
-                    .line(format!("real2 m{i} = smooth_min(x{i}, y{i}, {k});"));
-                self.w.line(format!("real {} = {sign}m{i}.x;", v.d));
-                Some(format!("m{i}.y"))
-            }
-            None => {
-                self.w
-                    .line(format!("real {} = {sign}fmin(x{i}, y{i});", v.d));
-                None
-            }
-        };
+        // A cut shows its first operand's surface and trap everywhere.
+        let surface = self.shade && op != CsgOp::Cut;
+        let mut args = vec![Arg::Value(&a.d), Arg::Value(&b.d)];
+        args.extend(k.map(Arg::Scalar));
+        let blended = surface && k.is_some();
+        let mut results = vec![Shape::Scalar];
+        if surface {
+            results.push(Shape::Scalar);
+        }
+        if blended {
+            results.push(Shape::Scalar);
+        }
+        let mut out = self
+            .inline(&args, &results, |x| {
+                let c = sdf::csg(op, x[0], x[1], x.get(2).copied());
+                let mut r = vec![c.distance];
+                if surface {
+                    r.push(c.first_nearer.value());
+                }
+                if blended {
+                    r.push(c.blend);
+                }
+                r
+            })
+            .into_iter();
+        let d = out.next().expect("a boolean has a distance");
+        self.w.line(format!("real {} = {d};", v.d));
         if !self.shade {
             return v;
         }
         if op == CsgOp::Cut {
-            // A cut shows its first operand's surface and trap everywhere.
             return Vars {
                 d: v.d,
                 c: a.c.clone(),
                 t: a.t.clone(),
             };
         }
-        let near = format!("x{i} < y{i}");
+        let near = out
+            .next()
+            .expect("a shaded boolean says which operand is nearer");
+        let blend = out.next();
         let c = if needs_color {
             let ty = self.surface_type();
             self.choose(ty, &v.c, &near, (&a.c, &b.c), blend.as_deref())
@@ -1180,6 +1204,13 @@ impl<'a> SceneEmitter<'a> {
             .line(format!("{ty} {var} = {near} ? {first} : {second};"));
         var.to_string()
     }
+}
+
+/// The `N` results of an inline formula.
+fn take<const N: usize>(results: Vec<String>) -> [String; N] {
+    results
+        .try_into()
+        .unwrap_or_else(|r: Vec<String>| unreachable!("{N} results asked, {} given", r.len()))
 }
 
 fn vars(id: NodeId) -> Vars {

@@ -93,13 +93,19 @@ impl Writer {
     /// is written as `0` and kept for [`Writer::unwritable`], so that code
     /// generation returns an error instead of a program holding `inf`.
     pub(crate) fn float(&self, v: f64) -> String {
+        literal(self.checked(v), self.precision)
+    }
+
+    /// `v` where the precision holds it; otherwise 0, and `v` is kept for
+    /// [`Writer::unwritable`] (see [`Writer::float`]).
+    pub(crate) fn checked(&self, v: f64) -> f64 {
         if fits(v, self.precision) {
-            literal(v, self.precision)
+            v
         } else {
             if self.unwritable.get().is_none() {
                 self.unwritable.set(Some(v));
             }
-            literal(0.0, self.precision)
+            0.0
         }
     }
 

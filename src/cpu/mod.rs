@@ -17,10 +17,9 @@ use sdf::Estimate;
 use crate::error::Result;
 use std::collections::HashMap;
 
-use crate::ir::SHRINK;
 use crate::ir::{
-    Bound, CompiledScene, Ir, IrNode, NodeId, ParamValues, Reach, Scalar, ball_distance, costs,
-    is_hard_union, reach, swaps, union_chain,
+    Bound, CompiledScene, Ir, IrNode, NodeId, ParamValues, Reach, Scalar, costs, is_hard_union,
+    reach, swaps, union_chain,
 };
 use crate::math::F32_LIMITS;
 use crate::scene::{
@@ -152,7 +151,7 @@ impl Evaluator {
     /// compute it, wherever that bound exists.
     fn warp_floor<T: Real>(&self, id: usize, distance: &mut T, p: V3<T>) {
         if let Some(ball) = &self.bounds[id] {
-            *distance = distance.max(ball_distance(ball, p));
+            *distance = ball.floor_at(*distance, p);
         }
     }
 
@@ -170,16 +169,8 @@ impl Evaluator {
             CsgOp::Intersect | CsgOp::Cut => return false,
         };
         let g = match self.reaches.get(&b.index()) {
-            Some(reach) => reach
-                .parts
-                .iter()
-                .map(|(bound, offset)| {
-                    let g = bound_distance(bound, p);
-                    if *offset > 0.0 { g - T::of(*offset) } else { g }
-                })
-                .reduce(|x, y| x.min(y))
-                .expect("a reach has parts"),
-            None => bound_distance(&bound, p),
+            Some(reach) => reach.distance_at(p),
+            None => bound.distance_at(p),
         };
         g > threshold && g > T::zero()
     }
@@ -293,7 +284,7 @@ impl Evaluator {
         let mut acc = done[operands[0].index()];
         for &o in &operands[1..] {
             if !self.skips(CsgOp::Union, T::zero(), acc.distance, o, p) {
-                acc = combine(CsgOp::Union, T::zero(), acc, done[o.index()]);
+                acc = combine(CsgOp::Union, None, acc, done[o.index()]);
             }
         }
         acc
@@ -304,40 +295,23 @@ impl Evaluator {
         let s = |x: Scalar| self.scalar::<T>(x);
         let v = |x: [Scalar; 3]| self.vector::<T>(x);
         match node {
-            Kind::Translate { offset, .. } => p - v(*offset),
+            Kind::Translate { offset, .. } => sdf::translate(p, v(*offset)),
             Kind::Rotate { axis, angle, .. } => match angle {
                 // A baked rotation is a constant matrix (no trigonometry per
                 // evaluation); code generation emits the same rows.
-                Scalar::Baked(a) => {
-                    let [r0, r1, r2] = rotation_rows(*axis, -a).map(|r| r.cast::<T>());
-                    v3(dot_row(r0, p), dot_row(r1, p), dot_row(r2, p))
-                }
+                Scalar::Baked(a) => sdf::rotate_rows(p, rotation_rows(*axis, -a)),
                 Scalar::Dynamic(_) => {
                     let k = V3::<f64>::from(*axis).cast::<T>();
                     sdf::rotate_axis(p, k, -s(*angle))
                 }
             },
-            Kind::Scale { factor, .. } => p / s(*factor),
-            Kind::Mirror { axis, .. } => {
-                let i = axis.index();
-                p.with(i, p.get(i).abs())
-            }
-            Kind::Elongate { extents, .. } => {
-                let h = v(*extents);
-                p - p.zip(h, |c, e| c.max(-e).min(e))
-            }
-            Kind::Repeat { period, .. } => repeat(p, v(*period), None),
-            Kind::RepeatLimited { period, limit, .. } => repeat(p, v(*period), Some(*limit)),
-            Kind::Twist { rate, .. } => {
-                let a = s(*rate) * p.y;
-                let (sn, cs) = (a.sin(), a.cos());
-                v3(cs * p.x - sn * p.z, p.y, sn * p.x + cs * p.z)
-            }
-            Kind::Bend { rate, .. } => {
-                let a = s(*rate) * p.x;
-                let (sn, cs) = (a.sin(), a.cos());
-                v3(cs * p.x - sn * p.y, sn * p.x + cs * p.y, p.z)
-            }
+            Kind::Scale { factor, .. } => sdf::scale_point(p, s(*factor)),
+            Kind::Mirror { axis, .. } => sdf::mirror(p, axis.index()),
+            Kind::Elongate { extents, .. } => sdf::elongate(p, v(*extents)),
+            Kind::Repeat { period, .. } => sdf::repeat(p, v(*period), None),
+            Kind::RepeatLimited { period, limit, .. } => sdf::repeat(p, v(*period), Some(*limit)),
+            Kind::Twist { rate, .. } => sdf::twist(p, s(*rate)),
+            Kind::Bend { rate, .. } => sdf::bend(p, s(*rate)),
             _ => p,
         }
     }
@@ -408,28 +382,28 @@ impl Evaluator {
             | Kind::RepeatLimited { child, .. } => of(child),
             Kind::Scale { factor, child } => {
                 let mut out = of(child);
-                out.distance = out.distance * s(*factor);
+                out.distance = sdf::scale_distance(out.distance, s(*factor));
                 out
             }
             Kind::Round { radius, child } => {
                 let mut out = of(child);
-                out.distance = out.distance - s(*radius);
+                out.distance = sdf::rounded(out.distance, s(*radius));
                 out
             }
             Kind::Onion { thickness, child } => {
                 let mut out = of(child);
-                out.distance = out.distance.abs() - s(*thickness);
+                out.distance = sdf::onion(out.distance, s(*thickness));
                 out
             }
             Kind::Twist { rate, child } => {
                 let mut out = of(child);
-                out.distance = sdf::twist_bound(out.distance, s(*rate), p.x.hypot(p.z));
+                out.distance = sdf::twisted(out.distance, s(*rate), p);
                 self.warp_floor(id, &mut out.distance, p);
                 out
             }
             Kind::Bend { rate, child } => {
                 let mut out = of(child);
-                out.distance = sdf::bend_bound(out.distance, s(*rate), p.x.hypot(p.y));
+                out.distance = sdf::bent(out.distance, s(*rate), p);
                 self.warp_floor(id, &mut out.distance, p);
                 out
             }
@@ -439,13 +413,13 @@ impl Evaluator {
                 a,
                 b,
             } => {
-                let k = smoothing.map_or(T::zero(), s);
+                let k = smoothing.map(s);
                 let (a, b) = if self.prune && self.swapped[id] {
                     (b, a)
                 } else {
                     (a, b)
                 };
-                if self.skips(*op, k, of(a).distance, *b, p) {
+                if self.skips(*op, k.unwrap_or_else(T::zero), of(a).distance, *b, p) {
                     return of(a);
                 }
                 combine(*op, k, of(a), of(b))
@@ -467,67 +441,22 @@ impl Evaluator {
     }
 }
 
-/// `row · p` as `row.x p.x + row.y p.y + row.z p.z`, left to right, leaving
-/// out zero entries (adding an exact zero changes nothing).
-fn dot_row<T: Real>(row: V3<T>, p: V3<T>) -> T {
-    let mut sum: Option<T> = None;
-    for i in 0..3 {
-        let a = row.get(i);
-        if a != T::zero() {
-            let term = a * p.get(i);
-            sum = Some(sum.map_or(term, |s| s + term));
-        }
-    }
-    sum.unwrap_or_else(T::zero)
-}
-
-/// Folds `p` into the cell of size `c` around the origin (no folding on
-/// axes with `c = 0`), clamping the cell index to `±limit` if given.
-fn repeat<T: Real>(p: V3<T>, c: V3<T>, limit: Option<[u32; 3]>) -> V3<T> {
-    let mut q = p;
-    for i in 0..3 {
-        let ci = c.get(i);
-        if ci > T::zero() {
-            let mut cell = (p.get(i) / ci).round();
-            if let Some(l) = limit {
-                let l = T::of(f64::from(l[i]));
-                cell = cell.max(-l).min(l);
-            }
-            q = q.with(i, p.get(i) - ci * cell);
-        }
-    }
-    q
-}
-
-/// `Bound::distance` at `p` in `T`, as the kernels compute it.
-fn bound_distance<T: Real>(bound: &Bound, p: V3<T>) -> T {
-    let centre = V3::<f64>::from(bound.centre).cast::<T>();
-    T::of(bound.slope) * ((p - centre).length() * T::of(SHRINK) - T::of(bound.radius))
-}
-
 /// Hard or smooth CSG of two samples. Every operation is a (smooth) minimum
 /// of signed operands: union `min(a, b)`, subtraction `-min(-a, b)`,
 /// intersection and cut `-min(-a, -b)`. A cut keeps `a`'s colour, trap and
 /// material.
-fn combine<T: Real>(op: CsgOp, k: T, a: Sample<T>, b: Sample<T>) -> Sample<T> {
-    let (sa, sb) = match op {
-        CsgOp::Union => (T::one(), T::one()),
-        CsgOp::Subtract => (-T::one(), T::one()),
-        CsgOp::Intersect | CsgOp::Cut => (-T::one(), -T::one()),
-    };
+fn combine<T: Real>(op: CsgOp, k: Option<T>, a: Sample<T>, b: Sample<T>) -> Sample<T> {
+    let c = sdf::csg(op, a.distance, b.distance, k);
     if op == CsgOp::Cut {
-        let (x, y) = (sa * a.distance, sb * b.distance);
         return Sample {
-            distance: -sdf::smooth_min(x, y, k).0,
+            distance: c.distance,
             ..a
         };
     }
-    let (x, y) = (sa * a.distance, sb * b.distance);
-    let (m, blend) = sdf::smooth_min(x, y, k);
-    let (near, far) = if x < y { (a, b) } else { (b, a) };
-    let mix = |u: T, w: T| u + (w - u) * blend;
+    let (near, far) = if c.first_nearer { (a, b) } else { (b, a) };
+    let mix = |u: T, w: T| u + (w - u) * c.blend;
     Sample {
-        distance: if op == CsgOp::Union { m } else { -m },
+        distance: c.distance,
         color: near.color.zip(far.color, mix),
         trap: mix(near.trap, far.trap),
         material: std::array::from_fn(|i| mix(near.material[i], far.material[i])),

@@ -1,4 +1,5 @@
-//! Distance formulas for every primitive and fractal, each written once.
+//! Distance formulas for every primitive, fractal, domain operation and
+//! boolean, each written once.
 //!
 //! Every formula here is generic over [`Num`]: the CPU reference runs it
 //! in `f32`/`f64`, bounds run it in intervals, and code generation traces
@@ -17,6 +18,7 @@
 use crate::expr::Step;
 pub use crate::math::{JULIA_FAR_FIELD, JULIA_FAR_FIELD_SLOPE, julia_radius};
 use crate::math::{Num, Real, V3, escape_radius, mandelbulb_radius, v3};
+use crate::scene::CsgOp;
 
 /// Exact distance to a sphere of radius `r` at the origin.
 #[must_use]
@@ -679,4 +681,162 @@ pub fn twist_bound<T: Num>(d: T, k: T, rho: T) -> T {
 #[must_use]
 pub fn bend_bound<T: Num>(d: T, k: T, rho: T) -> T {
     warp_bound(d, rho, |r| bend_stretch(k, r))
+}
+
+// Domain operations: the point a child sees, and what becomes of its
+// distance.
+
+/// The point a child translated by `offset` sees.
+#[must_use]
+pub fn translate<T: Num>(p: V3<T>, offset: V3<T>) -> V3<T> {
+    p - offset
+}
+
+/// `p` times the constant matrix `rows` (a baked rotation), row by row,
+/// left to right: zero entries are left out and `±1` entries need no
+/// product (each exact, so the value is the full product's).
+#[must_use]
+pub fn rotate_rows<T: Num>(p: V3<T>, rows: [V3<f64>; 3]) -> V3<T> {
+    V3::from_array(rows.map(|row| {
+        let mut sum: Option<T> = None;
+        for (i, a) in row.to_array().into_iter().enumerate() {
+            let x = p.get(i);
+            sum = match (sum, a) {
+                (_, 0.0) => sum,
+                (None, 1.0) => Some(x),
+                (None, -1.0) => Some(-x),
+                (None, _) => Some(T::of(a) * x),
+                (Some(s), 1.0) => Some(s + x),
+                (Some(s), -1.0) => Some(s - x),
+                (Some(s), _) if a < 0.0 => Some(s - T::of(-a) * x),
+                (Some(s), _) => Some(s + T::of(a) * x),
+            };
+        }
+        sum.unwrap_or_else(T::zero)
+    }))
+}
+
+/// The point a child scaled by `factor` sees.
+#[must_use]
+pub fn scale_point<T: Num>(p: V3<T>, factor: T) -> V3<T> {
+    p / factor
+}
+
+/// The distance of a child scaled by `factor`, from the child's.
+#[must_use]
+pub fn scale_distance<T: Num>(d: T, factor: T) -> T {
+    d * factor
+}
+
+/// The point a child mirrored across the plane `axis = 0` sees.
+#[must_use]
+pub fn mirror<T: Num>(p: V3<T>, axis: usize) -> V3<T> {
+    p.with(axis, p.get(axis).abs())
+}
+
+/// The point a child elongated by `extents` sees: `p` less its clamp into
+/// the box `±extents`.
+#[must_use]
+pub fn elongate<T: Num>(p: V3<T>, extents: V3<T>) -> V3<T> {
+    p - p.max(-extents).min(extents)
+}
+
+/// The point a repeated child sees: `p` folded into the cell of size
+/// `period` around the origin (no folding on an axis of period 0), the
+/// cell index clamped to `±limit` if given.
+#[must_use]
+pub fn repeat<T: Num>(p: V3<T>, period: V3<T>, limit: Option<[u32; 3]>) -> V3<T> {
+    let axis = |i: usize| {
+        let (x, c) = (p.get(i), period.get(i));
+        let mut cell = (x / c).round();
+        if let Some(l) = limit {
+            let l = T::of(f64::from(l[i]));
+            cell = cell.max(-l).min(l);
+        }
+        T::select(c.gt(T::zero()), x - c * cell, x)
+    };
+    v3(axis(0), axis(1), axis(2))
+}
+
+/// The point a child twisted about the y axis at `rate` radians per unit
+/// sees.
+#[must_use]
+pub fn twist<T: Num>(p: V3<T>, rate: T) -> V3<T> {
+    let a = rate * p.y;
+    let (s, c) = (a.sin(), a.cos());
+    v3(c * p.x - s * p.z, p.y, s * p.x + c * p.z)
+}
+
+/// The point a child bent about the z axis at `rate` radians per unit
+/// sees.
+#[must_use]
+pub fn bend<T: Num>(p: V3<T>, rate: T) -> V3<T> {
+    let a = rate * p.x;
+    let (s, c) = (a.sin(), a.cos());
+    v3(c * p.x - s * p.y, s * p.x + c * p.y, p.z)
+}
+
+/// A twisted child's distance bound at `p`, from its distance `d`.
+#[must_use]
+pub fn twisted<T: Num>(d: T, rate: T, p: V3<T>) -> T {
+    twist_bound(d, rate, p.x.hypot(p.z))
+}
+
+/// A bent child's distance bound at `p`, from its distance `d`.
+#[must_use]
+pub fn bent<T: Num>(d: T, rate: T, p: V3<T>) -> T {
+    bend_bound(d, rate, p.x.hypot(p.y))
+}
+
+/// `d` raised to the distance from `p` to the ball of `radius` around
+/// `centre`, where the ball holds the shape (a warp's estimate is then
+/// never below the ball's).
+#[must_use]
+pub fn ball_floor<T: Num>(d: T, p: V3<T>, centre: V3<T>, radius: T) -> T {
+    d.max((p - centre).length() - radius)
+}
+
+/// A rounded child's distance: `radius` less.
+#[must_use]
+pub fn rounded<T: Num>(d: T, radius: T) -> T {
+    d - radius
+}
+
+/// An onion's distance: a shell of `thickness` around the child's surface.
+#[must_use]
+pub fn onion<T: Num>(d: T, thickness: T) -> T {
+    d.abs() - thickness
+}
+
+/// A boolean of two distances (see [`csg`]).
+#[derive(Clone, Copy)]
+pub struct Boolean<T: Num> {
+    /// The combined distance.
+    pub distance: T,
+    /// Where it holds, the first operand is the nearer: its colour shows.
+    pub first_nearer: T::Bool,
+    /// The weight of the farther operand's colour across a smooth seam, in
+    /// `[0, 0.5]` (0 for a hard boolean).
+    pub blend: T,
+}
+
+/// Hard (`k` = `None`) or smooth CSG of the distances `a` and `b`: every
+/// operation is a (smooth) minimum of signed operands: union `min(a, b)`,
+/// subtraction `-min(-a, b)`, intersection and cut `-min(-a, -b)`.
+#[must_use]
+pub fn csg<T: Num>(op: CsgOp, a: T, b: T, k: Option<T>) -> Boolean<T> {
+    let (x, y) = match op {
+        CsgOp::Union => (a, b),
+        CsgOp::Subtract => (-a, b),
+        CsgOp::Intersect | CsgOp::Cut => (-a, -b),
+    };
+    let (m, blend) = match k {
+        Some(k) => smooth_min(x, y, k),
+        None => (x.min(y), T::zero()),
+    };
+    Boolean {
+        distance: if op == CsgOp::Union { m } else { -m },
+        first_nearer: x.lt(y),
+        blend,
+    }
 }

@@ -260,6 +260,9 @@ impl Num for Interval {
     fn floor(self) -> Self {
         self.rising(f64::floor)
     }
+    fn round(self) -> Self {
+        self.rising(f64::round)
+    }
     fn min(self, o: Self) -> Self {
         Self::new(self.lo.min(o.lo), self.hi.min(o.hi))
     }

@@ -67,6 +67,6 @@ impl Distance for Formula {
 }
 pub use interval::{Interval, Maybe};
 pub use num::{Logic, MAX_LOOP_STEPS, Num};
-pub use print::{OpenCl, Printer, Shape, Signature, Unprintable};
+pub use print::{Inline, OpenCl, Printer, Shape, Signature, Unprintable};
 pub use program::{Binary, Loop, Op, Program, Step, Unary, ValueId, Var, VarBool, trace};
 pub use text::{FUNCTIONS, Formula, FormulaError, MAX_ITERATIONS, MAX_LENGTH};

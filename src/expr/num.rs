@@ -104,6 +104,9 @@ pub trait Num:
     /// Largest integer not above.
     #[must_use]
     fn floor(self) -> Self;
+    /// The nearest integer, halves away from zero.
+    #[must_use]
+    fn round(self) -> Self;
     /// The smaller operand.
     #[must_use]
     fn min(self, o: Self) -> Self;
@@ -276,6 +279,9 @@ macro_rules! plain {
             }
             fn floor(self) -> Self {
                 <$t>::floor(self)
+            }
+            fn round(self) -> Self {
+                <$t>::round(self)
             }
             fn min(self, o: Self) -> Self {
                 <$t>::min(self, o)

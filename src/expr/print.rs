@@ -82,6 +82,31 @@ pub trait Printer {
     /// or outputs do not match the signature.
     fn function(&self, signature: &Signature<'_>, program: &Program)
     -> Result<String, Unprintable>;
+
+    /// Statements computing `program` in the caller's function: its inputs
+    /// are read as `inputs` (each an expression of the caller, such as a
+    /// point's name or a parameter's slot, with its shape), temporaries
+    /// are named `{prefix}0`, `{prefix}1`, … and the outputs are grouped
+    /// into `results`, each as an expression.
+    ///
+    /// # Errors
+    /// As [`Printer::function`].
+    fn inline(
+        &self,
+        inputs: &[(&str, Shape)],
+        results: &[Shape],
+        program: &Program,
+        prefix: &str,
+    ) -> Result<Inline, Unprintable>;
+}
+
+/// A program written inside another function (see [`Printer::inline`]).
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Inline {
+    /// The statements, one per line, to write before the results are read.
+    pub statements: String,
+    /// Each result's expression (without enclosing parentheses).
+    pub results: Vec<String>,
 }
 
 /// The OpenCL C printer: `real` is the precision's type, literals are
@@ -89,16 +114,16 @@ pub trait Printer {
 #[derive(Debug, Clone, Copy, Default)]
 pub struct OpenCl;
 
-/// Checks a program's inputs and outputs against a signature.
-fn check_arity(signature: &Signature<'_>, program: &Program) -> Result<(), Unprintable> {
-    if program.inputs != signature.inputs() {
+/// Checks a program's inputs and outputs against the counts its caller
+/// gives.
+fn check_arity(program: &Program, inputs: u32, outputs: usize) -> Result<(), Unprintable> {
+    if program.inputs != inputs {
         return Err(Unprintable::Arity {
             what: "inputs",
             program: program.inputs as usize,
-            signature: signature.inputs() as usize,
+            signature: inputs as usize,
         });
     }
-    let outputs = signature.result.width() as usize;
     if program.outputs.len() != outputs {
         return Err(Unprintable::Arity {
             what: "outputs",
@@ -109,18 +134,24 @@ fn check_arity(signature: &Signature<'_>, program: &Program) -> Result<(), Unpri
     Ok(())
 }
 
-/// The name of each scalar input: a scalar parameter's name, or a vector
-/// parameter's component (`p.x`).
-fn input_names(signature: &Signature<'_>) -> Vec<String> {
+/// The name of each scalar input (a scalar parameter's name, or a vector
+/// parameter's component, `p.x`), and the vector parameter whose
+/// components start at each input.
+fn input_names(params: &[(&str, Shape)]) -> (Vec<String>, Vec<Option<String>>) {
     let mut names = Vec::new();
-    for (name, shape) in signature.params {
+    let mut vectors = Vec::new();
+    for (name, shape) in params {
         match shape {
             Shape::Scalar => names.push((*name).to_string()),
             Shape::Pair => names.extend(["x", "y"].map(|c| format!("{name}.{c}"))),
             Shape::Vec3 => names.extend(["x", "y", "z"].map(|c| format!("{name}.{c}"))),
         }
+        vectors.push((*shape == Shape::Vec3).then(|| (*name).to_string()));
+        for _ in 1..shape.width() {
+            vectors.push(None);
+        }
     }
-    names
+    (names, vectors)
 }
 
 /// An OpenCL C literal of the precision the header chose.
@@ -162,6 +193,20 @@ struct Block<'b> {
 }
 
 impl Block<'_> {
+    /// The expression of a result of shape `shape` whose components are
+    /// `outputs`: a vector the program computed whole where it did.
+    fn result(&self, shape: Shape, outputs: &[ValueId]) -> String {
+        let texts: Vec<&str> = outputs.iter().map(|v| self.atom(*v)).collect();
+        match shape {
+            Shape::Scalar => texts[0].to_string(),
+            Shape::Pair => format!("((real2)({}))", args(&texts)),
+            Shape::Vec3 => match self.whole_vector(outputs[0], outputs[1], outputs[2]) {
+                Some(v) => v.to_string(),
+                None => format!("((real3)({}))", args(&texts)),
+            },
+        }
+    }
+
     fn atom(&self, v: ValueId) -> &str {
         &self.text[v.index()]
     }
@@ -228,6 +273,7 @@ impl Block<'_> {
                     Unary::Exp => format!("exp({inner})"),
                     Unary::Ln => format!("log({inner})"),
                     Unary::Floor => format!("floor({inner})"),
+                    Unary::Round => format!("round({inner})"),
                     Unary::Finite => format!("isfinite({inner})"),
                 }
             }
@@ -315,7 +361,7 @@ impl OpenClWriter {
     /// first those `split` needs, then `if (split) break;`, then the rest.
     fn block(&mut self, b: &mut Block<'_>, split: Option<ValueId>) -> Result<(), Unprintable> {
         let program = b.program;
-        let uses = program.uses();
+        let uses = printed_uses(program);
         let live = program.live();
         // Values a loop reads are named: a loop body never recomputes an
         // expression of the program around it.
@@ -455,6 +501,56 @@ impl OpenClWriter {
     }
 }
 
+/// How many times each value's text is written, as the printer writes
+/// them: a vector read whole (three components made into a vector, or its
+/// length) counts once, and a component's reads count as its vector's.
+/// A value written more than once is named.
+fn printed_uses(program: &Program) -> Vec<u32> {
+    let ops = &program.ops;
+    let live = program.live();
+    let mut uses = vec![0u32; ops.len()];
+    let whole =
+        |x: ValueId, y: ValueId, z: ValueId| match (ops[x.index()], ops[y.index()], ops[z.index()])
+        {
+            (Op::Component(a, 0), Op::Component(b, 1), Op::Component(c, 2)) if a == b && b == c => {
+                Some(a)
+            }
+            _ => None,
+        };
+    let result = |outputs: &[ValueId]| match outputs {
+        [x, y, z] => whole(*x, *y, *z),
+        _ => None,
+    };
+    match result(&program.outputs) {
+        Some(v) => uses[v.index()] += 1,
+        None => program.outputs.iter().for_each(|v| uses[v.index()] += 1),
+    }
+    for i in (0..ops.len()).rev() {
+        if !live[i] {
+            continue;
+        }
+        match ops[i] {
+            Op::Make3(x, y, z) | Op::Length3(x, y, z) if uses[i] > 0 => match whole(x, y, z) {
+                Some(v) => uses[v.index()] += 1,
+                None => [x, y, z].iter().for_each(|o| uses[o.index()] += 1),
+            },
+            Op::Component(v, _) => uses[v.index()] += uses[i],
+            Op::Loop(_) => {
+                for o in ops[i].operands(&program.loops) {
+                    uses[o.index()] += 1;
+                }
+            }
+            op if uses[i] > 0 => {
+                for o in op.operands(&program.loops) {
+                    uses[o.index()] += 1;
+                }
+            }
+            _ => {}
+        }
+    }
+    uses
+}
+
 /// `x op y` in OpenCL C, for numbers or (the arithmetic and functions)
 /// vectors.
 fn binary(b: Binary, x: &str, y: &str) -> String {
@@ -520,15 +616,12 @@ impl Printer for OpenCl {
         signature: &Signature<'_>,
         program: &Program,
     ) -> Result<String, Unprintable> {
-        check_arity(signature, program)?;
-        let inputs = input_names(signature);
-        let mut vectors = Vec::new();
-        for (name, shape) in signature.params {
-            vectors.push((*shape == Shape::Vec3).then(|| (*name).to_string()));
-            for _ in 1..shape.width() {
-                vectors.push(None);
-            }
-        }
+        check_arity(
+            program,
+            signature.inputs(),
+            signature.result.width() as usize,
+        )?;
+        let (inputs, vectors) = input_names(signature.params);
         // Temporaries are `t0`, `t1`, ..., loops' states `ts0_0` and
         // indices `ti0`: with more underscores while a parameter's name
         // starts with the prefix.
@@ -555,12 +648,12 @@ impl Printer for OpenCl {
             indent: 1,
         };
         w.block(&mut block, None)?;
-        let outputs: Vec<&str> = program.outputs.iter().map(|v| block.atom(*v)).collect();
-        let (ty, result) = match signature.result {
-            Shape::Scalar => ("real", unwrap(outputs[0]).to_string()),
-            Shape::Pair => ("real2", format!("(real2)({})", args(&outputs))),
-            Shape::Vec3 => ("real3", format!("(real3)({})", args(&outputs))),
+        let ty = match signature.result {
+            Shape::Scalar => "real",
+            Shape::Pair => "real2",
+            Shape::Vec3 => "real3",
         };
+        let result = unwrap(&block.result(signature.result, &program.outputs)).to_string();
         let params: Vec<String> = signature
             .params
             .iter()
@@ -579,5 +672,47 @@ impl Printer for OpenCl {
             params.join(", "),
             w.out
         ))
+    }
+
+    fn inline(
+        &self,
+        inputs: &[(&str, Shape)],
+        results: &[Shape],
+        program: &Program,
+        prefix: &str,
+    ) -> Result<Inline, Unprintable> {
+        let width = |shapes: &mut dyn Iterator<Item = Shape>| shapes.map(Shape::width).sum::<u32>();
+        let outputs = width(&mut results.iter().copied()) as usize;
+        check_arity(program, width(&mut inputs.iter().map(|(_, s)| *s)), outputs)?;
+        let (names, vectors) = input_names(inputs);
+        let mut w = OpenClWriter {
+            out: String::new(),
+            prefix: prefix.to_string(),
+            temps: 0,
+            loops: 0,
+        };
+        let mut block = Block {
+            program,
+            inputs: &names,
+            vectors: &vectors,
+            outer: &[],
+            text: Vec::new(),
+            indent: 0,
+        };
+        w.block(&mut block, None)?;
+        let mut at = 0;
+        let results = results
+            .iter()
+            .map(|shape| {
+                let width = shape.width() as usize;
+                let text = block.result(*shape, &program.outputs[at..at + width]);
+                at += width;
+                unwrap(&text).to_string()
+            })
+            .collect();
+        Ok(Inline {
+            statements: w.out,
+            results,
+        })
     }
 }

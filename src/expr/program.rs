@@ -46,6 +46,8 @@ pub enum Unary {
     Ln,
     /// `floor(x)`
     Floor,
+    /// The nearest integer, halves away from zero (`round(x)`).
+    Round,
     /// Whether `x` is finite (a truth value).
     Finite,
     /// Logical not of a truth value.
@@ -451,6 +453,7 @@ pub(crate) fn unary<N: Num>(u: Unary, a: N) -> N {
         Unary::Exp => a.exp(),
         Unary::Ln => a.ln(),
         Unary::Floor => a.floor(),
+        Unary::Round => a.round(),
         Unary::Finite | Unary::Not => N::of(f64::NAN),
     }
 }
@@ -482,6 +485,10 @@ struct Tape {
 
 impl Tape {
     fn push(&mut self, op: Op) -> ValueId {
+        let op = match self.fold(op) {
+            Folded::Value(v) => return v,
+            Folded::Op(op) => op,
+        };
         let key = op.key();
         if let Some(&v) = self.seen.get(&key) {
             return v;
@@ -490,6 +497,106 @@ impl Tape {
         self.ops.push(op);
         self.seen.insert(key, v);
         v
+    }
+}
+
+/// An operation after constant folding: another operation to record, or
+/// a value already on the tape.
+enum Folded {
+    Op(Op),
+    Value(ValueId),
+}
+
+/// The largest literal folding writes: one every precision can hold.
+const FOLD_LIMIT: f64 = f32::MAX as f64;
+
+impl Tape {
+    /// The literal value `v` holds, if it is one.
+    fn constant(&self, v: ValueId) -> Option<f64> {
+        match self.ops[v.index()] {
+            Op::Const(c) => Some(c),
+            _ => None,
+        }
+    }
+
+    /// The literal every component of `v` holds, for a number or a
+    /// vector made of one literal.
+    fn uniform(&self, v: ValueId) -> Option<f64> {
+        match self.ops[v.index()] {
+            Op::Const(c) => Some(c),
+            Op::Make3(x, y, z) if x == y && y == z => self.constant(x),
+            _ => None,
+        }
+    }
+
+    /// The operand an exact identity leaves of `x op y`: `x · 1`, `1 · y`,
+    /// `x / 1` and `x − (+0)` equal their other operand for every value,
+    /// NaN and signed zeros included.
+    fn identity(&self, op: Binary, x: ValueId, y: ValueId) -> Option<ValueId> {
+        let is = |v: ValueId, c: f64| self.uniform(v).is_some_and(|u| u.to_bits() == c.to_bits());
+        match op {
+            Binary::Mul if is(y, 1.0) => Some(x),
+            Binary::Mul if is(x, 1.0) => Some(y),
+            Binary::Div if is(y, 1.0) => Some(x),
+            Binary::Sub if is(y, 0.0) => Some(x),
+            _ => None,
+        }
+    }
+
+    /// The truth value `v` holds, if literals decide it.
+    fn truth(&self, v: ValueId) -> Option<bool> {
+        let c = |v| self.constant(v);
+        match self.ops[v.index()] {
+            Op::Binary(Binary::Lt, x, y) => Some(c(x)? < c(y)?),
+            Op::Binary(Binary::Le, x, y) => Some(c(x)? <= c(y)?),
+            Op::Binary(Binary::And, x, y) => Some(self.truth(x)? && self.truth(y)?),
+            Op::Binary(Binary::Or, x, y) => Some(self.truth(x)? || self.truth(y)?),
+            Op::Unary(Unary::Not, a) => Some(!self.truth(a)?),
+            Op::Unary(Unary::Finite, a) => Some(c(a)?.is_finite()),
+            _ => None,
+        }
+    }
+
+    /// Folds an operation on literals to a literal (computed in `f64`,
+    /// kept only when it is finite and fits every precision), and a
+    /// selection on a decided truth value to the chosen value: a formula
+    /// traced with baked parameters prints only the code they leave.
+    fn fold(&self, op: Op) -> Folded {
+        let literal = |v: f64| {
+            if v.is_finite() && v.abs() <= FOLD_LIMIT {
+                Some(Op::Const(v))
+            } else {
+                None
+            }
+        };
+        let folded = match op {
+            Op::Unary(u, a) if !matches!(u, Unary::Not | Unary::Finite) => {
+                self.constant(a).and_then(|a| literal(unary(u, a)))
+            }
+            Op::Binary(b, x, y) if !b.is_logic() => {
+                if let Some(v) = self.identity(b, x, y) {
+                    return Folded::Value(v);
+                }
+                match (self.constant(x), self.constant(y)) {
+                    (Some(x), Some(y)) => literal(binary(b, x, y)),
+                    _ => None,
+                }
+            }
+            Op::Binary3(b, x, y) => {
+                if let Some(v) = self.identity(b, x, y) {
+                    return Folded::Value(v);
+                }
+                None
+            }
+            Op::Select(c, a, b) | Op::Select3(c, a, b) => {
+                if let Some(t) = self.truth(c) {
+                    return Folded::Value(if t { a } else { b });
+                }
+                None
+            }
+            _ => None,
+        };
+        Folded::Op(folded.unwrap_or(op))
     }
 }
 
@@ -554,6 +661,16 @@ impl Var {
 /// A truth value being traced.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct VarBool(Var);
+
+impl VarBool {
+    /// The truth value as a traced value, to return from a program:
+    /// printers write it as a condition (running the program reads it as
+    /// NaN).
+    #[must_use]
+    pub fn value(self) -> Var {
+        self.0
+    }
+}
 
 /// Pops the innermost tape when dropped, so that a panic in a formula
 /// leaves no tape behind.
@@ -756,6 +873,9 @@ impl Num for Var {
     }
     fn floor(self) -> Self {
         self.unary(Unary::Floor)
+    }
+    fn round(self) -> Self {
+        self.unary(Unary::Round)
     }
     fn min(self, o: Self) -> Self {
         self.binary(Binary::Min, o)

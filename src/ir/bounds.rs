@@ -23,8 +23,9 @@
 use glam::DVec3;
 
 use super::{Ir, IrNode, NodeId, Scalar, baked3};
+use crate::cpu::sdf::ball_floor;
 use crate::math::{
-    JULIA_FAR_FIELD, JULIA_FAR_FIELD_SLOPE, Limits, Real, V3, julia_radius, mandelbulb_radius,
+    JULIA_FAR_FIELD, JULIA_FAR_FIELD_SLOPE, Limits, Num, V3, julia_radius, mandelbulb_radius,
     rotation_rows,
 };
 use crate::scene::{Axis, CsgOp, Kind};
@@ -77,6 +78,24 @@ impl Bound {
     #[must_use]
     pub fn distance(&self, p: DVec3) -> f64 {
         self.slope * ((p - self.centre).length() * SHRINK - self.radius)
+    }
+
+    /// A warp's estimate `d` at `p`, raised to the distance to this ball
+    /// (see [`warp_ball`]): `|p − centre| − radius`, without the slope or
+    /// the shrinking that pruning applies.
+    pub(crate) fn floor_at<T: Num>(&self, d: T, p: V3<T>) -> T {
+        ball_floor(d, p, constant(self.centre), T::of(self.radius))
+    }
+
+    /// [`Bound::distance`] in any number type, as the CPU reference and
+    /// the kernels compute it (a slope of 1 needs no product).
+    pub(crate) fn distance_at<T: Num>(&self, p: V3<T>) -> T {
+        let g = (p - constant(self.centre)).length() * T::of(SHRINK) - T::of(self.radius);
+        if self.slope < 1.0 {
+            T::of(self.slope) * g
+        } else {
+            g
+        }
     }
 
     /// Whether code in a precision with `limits` can evaluate the bound
@@ -357,12 +376,9 @@ pub(crate) fn warp_ball(axis: Axis, child: Bound) -> Bound {
     Bound::sphere(centre, (radial.length() + child.radius).hypot(child.radius))
 }
 
-/// The distance from `p` to `ball`'s sphere, as a warp's estimate uses it
-/// (see [`warp_ball`]): `|p − centre| − radius`, without the slope or the
-/// shrinking that pruning applies.
-pub(crate) fn ball_distance<T: Real>(ball: &Bound, p: V3<T>) -> T {
-    let centre = V3::<f64>::from(ball.centre).cast::<T>();
-    (p - centre).length() - T::of(ball.radius)
+/// `v` as a vector of literals.
+fn constant<T: Num>(v: DVec3) -> V3<T> {
+    V3::from_array(v.to_array().map(T::of))
 }
 
 /// A tree of hard unions, flattened: its operands in the order pruning
@@ -435,6 +451,21 @@ const MAX_REACH_PARTS: usize = 8;
 #[derive(Debug, Clone, PartialEq)]
 pub(crate) struct Reach {
     pub(crate) parts: Vec<(Bound, f64)>,
+}
+
+impl Reach {
+    /// The least of its parts' bound distances, each less its offset, at
+    /// `p`: as the CPU reference and the kernels compute it.
+    pub(crate) fn distance_at<T: Num>(&self, p: V3<T>) -> T {
+        self.parts
+            .iter()
+            .map(|(bound, offset)| {
+                let g = bound.distance_at(p);
+                if *offset > 0.0 { g - T::of(*offset) } else { g }
+            })
+            .reduce(Num::min)
+            .expect("a reach has parts")
+    }
 }
 
 /// The reach of `id`, where it has a bound: at most [`MAX_REACH_PARTS`]

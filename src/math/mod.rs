@@ -36,8 +36,8 @@ pub const DEFAULT_COLOR: [f64; 3] = [0.8, 0.8, 0.8];
 /// where `r^power` would pass [`MAGNITUDE_CAP`]. Computed in
 /// `f64`; code generation emits the same value as a literal.
 #[must_use]
-pub fn escape_radius(power: f64, bailout: f64) -> f64 {
-    bailout.min(MAGNITUDE_CAP.powf(1.0 / power))
+pub fn escape_radius<T: Num>(power: T, bailout: T) -> T {
+    bailout.min(T::of(MAGNITUDE_CAP).powf(T::one() / power))
 }
 
 /// The radius `2^(1 / (power - 1))` of the ball that holds the Mandelbulb

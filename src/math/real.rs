@@ -15,26 +15,17 @@ use crate::expr::{Binary, Unary};
 pub trait Real: Num<Bool = bool> + PartialOrd + Send + Sync {
     /// The value as `f64` (exact).
     fn to_f64(self) -> f64;
-    /// The nearest integer, halves away from zero.
-    #[must_use]
-    fn round(self) -> Self;
 }
 
 impl Real for f32 {
     fn to_f64(self) -> f64 {
         f64::from(self)
     }
-    fn round(self) -> Self {
-        f32::round(self)
-    }
 }
 
 impl Real for f64 {
     fn to_f64(self) -> f64 {
         self
-    }
-    fn round(self) -> Self {
-        f64::round(self)
     }
 }
 
@@ -127,6 +118,18 @@ impl<T: Num> V3<T> {
     #[must_use]
     pub fn abs(self) -> Self {
         Self::from_array(T::unary3(Unary::Abs, self.to_array()))
+    }
+
+    /// Component-wise minimum.
+    #[must_use]
+    pub fn min(self, o: Self) -> Self {
+        self.op(Binary::Min, o)
+    }
+
+    /// Component-wise maximum.
+    #[must_use]
+    pub fn max(self, o: Self) -> Self {
+        self.op(Binary::Max, o)
     }
 
     /// Component-wise maximum with a scalar.

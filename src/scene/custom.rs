@@ -237,7 +237,7 @@ impl InsideBounds {
 ///   values) and the prefixes of generated names: `custom_`, `inside_`, `sd_`,
 ///   `march_`, `cl_`, and the specialised Mandelbulbs `mandelbulb_pN`;
 /// - every other name the generated program defines or calls (its
-///   typedefs, helper functions such as `twist_bound`, `DE` and `DE_shade`),
+///   typedefs, helper functions such as `menger`, `DE` and `DE_shade`),
 ///   read from the program's own header, helper library and kernels.
 ///
 /// The shape's function, `custom_NAME`, may not be a name the generated

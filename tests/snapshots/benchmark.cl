@@ -93,10 +93,8 @@ real sd_sphere(real3 p, real r) {
 
 /* ---- cuboid ---- */
 real sd_box(real3 p, real3 b) {
-    real3 t0 = fabs(p);
-    real3 t1 = t0 - b;
-    real3 t2 = fmax(t1, R(0.0));
-    return length(t2) + fmin(fmax(fmax(t1.x, t1.y), t1.z), R(0.0));
+    real3 t0 = fabs(p) - b;
+    return length(fmax(t0, R(0.0))) + fmin(fmax(fmax(t0.x, t0.y), t0.z), R(0.0));
 }
 
 /* ---- torus ---- */
@@ -117,9 +115,8 @@ real sd_plane(real3 p, real3 n, real offset) {
     real t1 = fmax(fmax(t0.x, t0.y), t0.z);
     real3 t2 = n / t1;
     real t3 = length(t2);
-    real3 t4 = t2 / t3;
-    real3 t5 = (R(0.0) < t1) ? t4 : n;
-    return (((p.x * t5.x) + (p.y * t5.y)) + (p.z * t5.z)) + offset;
+    real3 t4 = (R(0.0) < t1) ? (t2 / t3) : n;
+    return (((p.x * t4.x) + (p.y * t4.y)) + (p.z * t4.z)) + offset;
 }
 
 /* ---- menger ---- */
@@ -147,19 +144,8 @@ real2 menger(real3 p, real iterations, real scale) {
         ts0_3 = t9;
         ts0_4 = t10;
     }
-    real3 t11 = fabs((real3)(ts0_0, ts0_1, ts0_2));
-    real3 t12 = t11 - R(1.0);
-    real3 t13 = fmax(t12, R(0.0));
-    return (real2)((length(t13) + fmin(fmax(fmax(t12.x, t12.y), t12.z), R(0.0))) / ts0_3, ts0_4);
-}
-
-/* ---- smooth_min ---- */
-real2 smooth_min(real a, real b, real k) {
-    real t0 = fmax(k - fabs(a - b), R(0.0)) / k;
-    real t1 = (t0 * t0) * R(0.5);
-    bool t2 = k <= R(0.0);
-    real t3 = fmin(a, b);
-    return (real2)(t2 ? t3 : (t3 - ((t1 * k) * R(0.5))), t2 ? R(0.0) : t1);
+    real3 t11 = fabs((real3)(ts0_0, ts0_1, ts0_2)) - R(1.0);
+    return (real2)((length(fmax(t11, R(0.0))) + fmin(fmax(fmax(t11.x, t11.y), t11.z), R(0.0))) / ts0_3, ts0_4);
 }
 
 /* ---- mandelbulb_p8 ---- */
@@ -197,111 +183,98 @@ real2 mandelbulb_p8(real3 p, real iterations, real escape, real ball) {
         real t21 = (R(2.0) * t18) * t19;
         real t22 = (t20 * t20) - (t21 * t21);
         real t23 = (R(2.0) * t20) * t21;
-        real3 t24 = ((real3)(t16 * ((t22 * t22) - (t23 * t23)), t16 * ((R(2.0) * t22) * t23), (t14 * t14) - (t15 * t15))) * t7;
-        real3 t25 = t24 + ((real3)(p.x, p.y, p.z));
-        real t26 = fmin(((R(8.0) * t6) * ts0_3) + R(1.0), R(1e30));
-        real t27 = fmin(ts0_4, t4);
-        ts0_0 = t25.x;
-        ts0_1 = t25.y;
-        ts0_2 = t25.z;
-        ts0_3 = t26;
-        ts0_4 = t27;
+        real3 t24 = (((real3)(t16 * ((t22 * t22) - (t23 * t23)), t16 * ((R(2.0) * t22) * t23), (t14 * t14) - (t15 * t15))) * t7) + ((real3)(p.x, p.y, p.z));
+        real t25 = fmin(((R(8.0) * t6) * ts0_3) + R(1.0), R(1e30));
+        real t26 = fmin(ts0_4, t4);
+        ts0_0 = t24.x;
+        ts0_1 = t24.y;
+        ts0_2 = t24.z;
+        ts0_3 = t25;
+        ts0_4 = t26;
     }
-    real t28 = length((real3)(ts0_0, ts0_1, ts0_2));
-    return (real2)(t2 ? t1 : fmax(((R(0.5) * log(fmax(t28, R(1e-30)))) * t28) / ts0_3, t1), t2 ? R(1.0) : ts0_4);
+    real t27 = length((real3)(ts0_0, ts0_1, ts0_2));
+    return (real2)(t2 ? t1 : fmax(((R(0.5) * log(fmax(t27, R(1e-30)))) * t27) / ts0_3, t1), t2 ? R(1.0) : ts0_4);
 }
 
 /* ---- scene ---- */
 real DE(real3 p0, __global const real* params) {
     /* union */
     /* union/a:union/b:translate */
-    real3 p1 = p0 - (real3)(params[0] /* orbit.x */, params[1] /* orbit.y */, params[2] /* orbit.z */);
+    real3 p1 = p0 - ((real3)(params[0] /* orbit.x */, params[1] /* orbit.y */, params[2] /* orbit.z */));
     /* .../b:translate/color/sphere */
     real d23 = sd_sphere(p1, 0.18f);
     /* union/b:color/plane */
     real d27 = sd_plane(p0, (real3)(0.0f, 1.0f, 0.0f), 0.95f);
-    real x29 = d23;
-    real y29 = d27;
-    real d29 = fmin(x29, y29);
+    real d29 = fmin(d23, d27);
     /* union/a:union: the second operand only within reach of its bound */
     real u26 = d29;
-    real g26 = length(p0 - (real3)(0.0f, 0.05f, 0.0f)) * 0.9999f - 0.6624537f;
+    real g26 = (length(p0 - ((real3)(R(0.0), R(0.05), R(0.0)))) * R(0.9999)) - R(0.6624537082042873);
     if (!(g26 > u26 && g26 > R(0.0))) {
         /* .../a:union/a:union/a:translate */
-        real3 p2 = p0 - (real3)(0.0f, 0.05f, 0.0f);
+        real3 p2 = p0 - ((real3)(R(0.0), R(0.05), R(0.0)));
         /* .../a:translate/color/scale */
-        real3 p3 = p2 / 0.6f;
+        real3 p3 = p2 / R(0.6);
         /* .../color/scale/rotate */
         real3 p4 = (real3)(p3.x, -p3.z, p3.y);
         /* .../scale/rotate/mandelbulb */
-        real2 f0 = mandelbulb_p8(p4, 8, 2.0f, 1.1040895f);
+        real2 f0 = mandelbulb_p8(p4, 8, R(2.0), 1.1040895f);
         real d0 = f0.x;
-        real d2 = d0 * 0.6f;
-        real x26 = d29;
-        real y26 = d2;
-        real d26 = fmin(x26, y26);
+        real d2 = d0 * R(0.6);
+        real d26 = fmin(d29, d2);
         u26 = d26;
     }
     /* .../a:union/a:union: the second operand only within reach of its bound */
     real u22 = u26;
-    real g22 = length(p0 - (real3)(0.0f, (-0.95f), 0.0f)) * 0.9999f - 0.72137237f;
+    real g22 = (length(p0 - ((real3)(R(0.0), -R(0.95), R(0.0)))) * R(0.9999)) - R(0.7213723439378912);
     if (!(g22 > u22 && g22 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p5 = p0 - (real3)(0.0f, (-0.75f), 0.0f);
+        real3 p5 = p0 - ((real3)(R(0.0), -R(0.75), R(0.0)));
         /* .../color/smooth_union/a:cylinder */
         real d5 = sd_cylinder(p5, 0.35f, 0.2f);
         /* .../color/smooth_union: the second operand only within reach of its bound */
         real u8 = d5;
-        real g8 = length(p5 - (real3)(0.0f, (-0.2f), 0.0f)) * 0.9999f - 0.7088723f;
+        real g8 = (length(p5 - ((real3)(R(0.0), -R(0.2), R(0.0)))) * R(0.9999)) - R(0.7088723439378912);
         if (!(g8 > u8 + 0.05f && g8 > R(0.0))) {
             /* .../color/smooth_union/b:translate */
-            real3 p6 = p5 - (real3)(0.0f, (-0.2f), 0.0f);
+            real3 p6 = p5 - ((real3)(R(0.0), -R(0.2), R(0.0)));
             /* .../smooth_union/b:translate/cuboid */
             real d6 = sd_box(p6, (real3)(0.5f, 0.05f, 0.5f));
             /* .../b:translate/color/smooth_union */
-            real x8 = d5;
-            real y8 = d6;
-            real2 m8 = smooth_min(x8, y8, 0.05f);
-            real d8 = m8.x;
+            real e14_0 = fmax(R(0.05) - fabs(d5 - d6), R(0.0)) / R(0.05);
+            real d8 = fmin(d5, d6) - ((((e14_0 * e14_0) * R(0.5)) * R(0.05)) * R(0.5));
             u8 = d8;
         }
-        real x22 = u26;
-        real y22 = u8;
-        real d22 = fmin(x22, y22);
+        real d22 = fmin(u26, u8);
         u22 = d22;
     }
     /* .../a:union/a:union: the second operand only within reach of its bound */
     real u17 = u22;
-    real g17 = length(p0 - (real3)((-1.5f), (-0.55f), (-0.3f))) * 0.9999f - 0.6928203f;
+    real g17 = (length(p0 - ((real3)(-R(1.5), -R(0.55), -R(0.3)))) * R(0.9999)) - R(0.6928203230275509);
     if (!(g17 > u17 && g17 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p7 = p0 - (real3)((-1.5f), (-0.55f), (-0.3f));
+        real3 p7 = p0 - ((real3)(-R(1.5), -R(0.55), -R(0.3)));
         /* .../b:translate/color/rotate */
-        real3 p8 = (real3)(0.921061f * p7.x + (-0.38941833f) * p7.z, p7.y, 0.38941833f * p7.x + 0.921061f * p7.z);
+        real3 p8 = (real3)((R(0.9210609940028851) * p7.x) - (R(0.3894183423086505) * p7.z), p7.y, (R(0.3894183423086505) * p7.x) + (R(0.9210609940028851) * p7.z));
         /* .../color/rotate/scale */
-        real3 p9 = p8 / 0.4f;
+        real3 p9 = p8 / R(0.4);
         /* .../rotate/scale/menger */
         real2 f12 = menger(p9, 3, 3.0f);
         real d12 = f12.x;
-        real d13 = d12 * 0.4f;
-        real x17 = u22;
-        real y17 = d13;
-        real d17 = fmin(x17, y17);
+        real d13 = d12 * R(0.4);
+        real d17 = fmin(u22, d13);
         u17 = d17;
     }
     /* .../a:union/a:union: the second operand only within reach of its bound */
     real u11 = u17;
-    real g11 = length(p0 - (real3)(1.5f, (-0.5f), (-0.2f))) * 0.9999f - 0.45f;
+    real g11 = (length(p0 - ((real3)(R(1.5), -R(0.5), -R(0.2)))) * R(0.9999)) - R(0.44999999999999996);
     if (!(g11 > u11 && g11 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p10 = p0 - (real3)(1.5f, (-0.5f), (-0.2f));
+        real3 p10 = p0 - ((real3)(R(1.5), -R(0.5), -R(0.2)));
         /* .../b:translate/color/rotate */
-        real3 p11 = (real3)(p10.x, 0.36235777f * p10.y + 0.9320391f * p10.z, (-0.9320391f) * p10.y + 0.36235777f * p10.z);
+        real3 p11 = (real3)(p10.x, (R(0.3623577544766736) * p10.y) + (R(0.9320390859672263) * p10.z), ((-R(0.9320390859672263)) * p10.y) + (R(0.3623577544766736) * p10.z));
         /* .../color/rotate/torus */
         real d18 = sd_torus(p11, 0.35f, 0.1f);
-        real x11 = u17;
-        real y11 = d18;
-        real d11 = fmin(x11, y11);
+        real d11 = fmin(u17, d18);
         u11 = d11;
     }
     return u11;
@@ -310,7 +283,7 @@ real DE(real3 p0, __global const real* params) {
 real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     /* union */
     /* union/a:union/b:translate */
-    real3 p1 = p0 - (real3)(params[0] /* orbit.x */, params[1] /* orbit.y */, params[2] /* orbit.z */);
+    real3 p1 = p0 - ((real3)(params[0] /* orbit.x */, params[1] /* orbit.y */, params[2] /* orbit.z */));
     /* .../b:translate/color/sphere */
     real d23 = sd_sphere(p1, 0.18f);
     /* .../a:union/b:translate/color */
@@ -319,34 +292,30 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     real d27 = sd_plane(p0, (real3)(0.0f, 1.0f, 0.0f), 0.95f);
     /* union/b:color */
     real3 c28 = (real3)(0.55f, 0.55f, 0.6f);
-    real x29 = d23;
-    real y29 = d27;
-    real d29 = fmin(x29, y29);
-    real3 c29 = x29 < y29 ? c24 : c28;
+    real d29 = fmin(d23, d27);
+    real3 c29 = d23 < d27 ? c24 : c28;
     /* union/a:union: the second operand only within reach of its bound */
     real u26 = d29;
     real3 uc26 = c29;
     real ut26 = R(1.0);
-    real g26 = length(p0 - (real3)(0.0f, 0.05f, 0.0f)) * 0.9999f - 0.6624537f;
+    real g26 = (length(p0 - ((real3)(R(0.0), R(0.05), R(0.0)))) * R(0.9999)) - R(0.6624537082042873);
     if (!(g26 > u26 && g26 > R(0.0))) {
         /* .../a:union/a:union/a:translate */
-        real3 p2 = p0 - (real3)(0.0f, 0.05f, 0.0f);
+        real3 p2 = p0 - ((real3)(R(0.0), R(0.05), R(0.0)));
         /* .../a:translate/color/scale */
-        real3 p3 = p2 / 0.6f;
+        real3 p3 = p2 / R(0.6);
         /* .../color/scale/rotate */
         real3 p4 = (real3)(p3.x, -p3.z, p3.y);
         /* .../scale/rotate/mandelbulb */
-        real2 f0 = mandelbulb_p8(p4, 8, 2.0f, 1.1040895f);
+        real2 f0 = mandelbulb_p8(p4, 8, R(2.0), 1.1040895f);
         real d0 = f0.x;
         real t0 = f0.y;
-        real d2 = d0 * 0.6f;
+        real d2 = d0 * R(0.6);
         /* .../a:union/a:translate/color */
         real3 c3 = (real3)(0.9f, 0.6f, 0.35f);
-        real x26 = d29;
-        real y26 = d2;
-        real d26 = fmin(x26, y26);
-        real3 c26 = x26 < y26 ? c29 : c3;
-        real t26 = x26 < y26 ? R(1.0) : t0;
+        real d26 = fmin(d29, d2);
+        real3 c26 = d29 < d2 ? c29 : c3;
+        real t26 = d29 < d2 ? R(1.0) : t0;
         u26 = d26;
         uc26 = c26;
         ut26 = t26;
@@ -355,36 +324,33 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     real u22 = u26;
     real3 uc22 = uc26;
     real ut22 = ut26;
-    real g22 = length(p0 - (real3)(0.0f, (-0.95f), 0.0f)) * 0.9999f - 0.72137237f;
+    real g22 = (length(p0 - ((real3)(R(0.0), -R(0.95), R(0.0)))) * R(0.9999)) - R(0.7213723439378912);
     if (!(g22 > u22 && g22 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p5 = p0 - (real3)(0.0f, (-0.75f), 0.0f);
+        real3 p5 = p0 - ((real3)(R(0.0), -R(0.75), R(0.0)));
         /* .../color/smooth_union/a:cylinder */
         real d5 = sd_cylinder(p5, 0.35f, 0.2f);
         /* .../color/smooth_union: the second operand only within reach of its bound */
         real u8 = d5;
         real ut8 = R(1.0);
-        real g8 = length(p5 - (real3)(0.0f, (-0.2f), 0.0f)) * 0.9999f - 0.7088723f;
+        real g8 = (length(p5 - ((real3)(R(0.0), -R(0.2), R(0.0)))) * R(0.9999)) - R(0.7088723439378912);
         if (!(g8 > u8 + 0.05f && g8 > R(0.0))) {
             /* .../color/smooth_union/b:translate */
-            real3 p6 = p5 - (real3)(0.0f, (-0.2f), 0.0f);
+            real3 p6 = p5 - ((real3)(R(0.0), -R(0.2), R(0.0)));
             /* .../smooth_union/b:translate/cuboid */
             real d6 = sd_box(p6, (real3)(0.5f, 0.05f, 0.5f));
             /* .../b:translate/color/smooth_union */
-            real x8 = d5;
-            real y8 = d6;
-            real2 m8 = smooth_min(x8, y8, 0.05f);
-            real d8 = m8.x;
+            real e39_0 = fmax(R(0.05) - fabs(d5 - d6), R(0.0)) / R(0.05);
+            real e39_1 = (e39_0 * e39_0) * R(0.5);
+            real d8 = fmin(d5, d6) - ((e39_1 * R(0.05)) * R(0.5));
             u8 = d8;
             ut8 = R(1.0);
         }
         /* .../a:union/b:translate/color */
         real3 c9 = (real3)(0.5f, 0.5f, 0.55f);
-        real x22 = u26;
-        real y22 = u8;
-        real d22 = fmin(x22, y22);
-        real3 c22 = x22 < y22 ? uc26 : c9;
-        real t22 = x22 < y22 ? ut26 : ut8;
+        real d22 = fmin(u26, u8);
+        real3 c22 = u26 < u8 ? uc26 : c9;
+        real t22 = u26 < u8 ? ut26 : ut8;
         u22 = d22;
         uc22 = c22;
         ut22 = t22;
@@ -393,26 +359,24 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     real u17 = u22;
     real3 uc17 = uc22;
     real ut17 = ut22;
-    real g17 = length(p0 - (real3)((-1.5f), (-0.55f), (-0.3f))) * 0.9999f - 0.6928203f;
+    real g17 = (length(p0 - ((real3)(-R(1.5), -R(0.55), -R(0.3)))) * R(0.9999)) - R(0.6928203230275509);
     if (!(g17 > u17 && g17 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p7 = p0 - (real3)((-1.5f), (-0.55f), (-0.3f));
+        real3 p7 = p0 - ((real3)(-R(1.5), -R(0.55), -R(0.3)));
         /* .../b:translate/color/rotate */
-        real3 p8 = (real3)(0.921061f * p7.x + (-0.38941833f) * p7.z, p7.y, 0.38941833f * p7.x + 0.921061f * p7.z);
+        real3 p8 = (real3)((R(0.9210609940028851) * p7.x) - (R(0.3894183423086505) * p7.z), p7.y, (R(0.3894183423086505) * p7.x) + (R(0.9210609940028851) * p7.z));
         /* .../color/rotate/scale */
-        real3 p9 = p8 / 0.4f;
+        real3 p9 = p8 / R(0.4);
         /* .../rotate/scale/menger */
         real2 f12 = menger(p9, 3, 3.0f);
         real d12 = f12.x;
         real t12 = f12.y;
-        real d13 = d12 * 0.4f;
+        real d13 = d12 * R(0.4);
         /* .../a:union/b:translate/color */
         real3 c15 = (real3)(0.85f, 0.85f, 0.8f);
-        real x17 = u22;
-        real y17 = d13;
-        real d17 = fmin(x17, y17);
-        real3 c17 = x17 < y17 ? uc22 : c15;
-        real t17 = x17 < y17 ? ut22 : t12;
+        real d17 = fmin(u22, d13);
+        real3 c17 = u22 < d13 ? uc22 : c15;
+        real t17 = u22 < d13 ? ut22 : t12;
         u17 = d17;
         uc17 = c17;
         ut17 = t17;
@@ -421,21 +385,19 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     real u11 = u17;
     real3 uc11 = uc17;
     real ut11 = ut17;
-    real g11 = length(p0 - (real3)(1.5f, (-0.5f), (-0.2f))) * 0.9999f - 0.45f;
+    real g11 = (length(p0 - ((real3)(R(1.5), -R(0.5), -R(0.2)))) * R(0.9999)) - R(0.44999999999999996);
     if (!(g11 > u11 && g11 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p10 = p0 - (real3)(1.5f, (-0.5f), (-0.2f));
+        real3 p10 = p0 - ((real3)(R(1.5), -R(0.5), -R(0.2)));
         /* .../b:translate/color/rotate */
-        real3 p11 = (real3)(p10.x, 0.36235777f * p10.y + 0.9320391f * p10.z, (-0.9320391f) * p10.y + 0.36235777f * p10.z);
+        real3 p11 = (real3)(p10.x, (R(0.3623577544766736) * p10.y) + (R(0.9320390859672263) * p10.z), ((-R(0.9320390859672263)) * p10.y) + (R(0.3623577544766736) * p10.z));
         /* .../color/rotate/torus */
         real d18 = sd_torus(p11, 0.35f, 0.1f);
         /* .../a:union/b:translate/color */
         real3 c20 = (real3)(0.4f, 0.75f, 0.95f);
-        real x11 = u17;
-        real y11 = d18;
-        real d11 = fmin(x11, y11);
-        real3 c11 = x11 < y11 ? uc17 : c20;
-        real t11 = x11 < y11 ? ut17 : R(1.0);
+        real d11 = fmin(u17, d18);
+        real3 c11 = u17 < d18 ? uc17 : c20;
+        real t11 = u17 < d18 ? ut17 : R(1.0);
         u11 = d11;
         uc11 = c11;
         ut11 = t11;

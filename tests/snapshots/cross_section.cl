@@ -92,9 +92,8 @@ real sd_plane(real3 p, real3 n, real offset) {
     real t1 = fmax(fmax(t0.x, t0.y), t0.z);
     real3 t2 = n / t1;
     real t3 = length(t2);
-    real3 t4 = t2 / t3;
-    real3 t5 = (R(0.0) < t1) ? t4 : n;
-    return (((p.x * t5.x) + (p.y * t5.y)) + (p.z * t5.z)) + offset;
+    real3 t4 = (R(0.0) < t1) ? (t2 / t3) : n;
+    return (((p.x * t4.x) + (p.y * t4.y)) + (p.z * t4.z)) + offset;
 }
 
 /* ---- mandelbulb_p8 ---- */
@@ -132,18 +131,17 @@ real2 mandelbulb_p8(real3 p, real iterations, real escape, real ball) {
         real t21 = (R(2.0) * t18) * t19;
         real t22 = (t20 * t20) - (t21 * t21);
         real t23 = (R(2.0) * t20) * t21;
-        real3 t24 = ((real3)(t16 * ((t22 * t22) - (t23 * t23)), t16 * ((R(2.0) * t22) * t23), (t14 * t14) - (t15 * t15))) * t7;
-        real3 t25 = t24 + ((real3)(p.x, p.y, p.z));
-        real t26 = fmin(((R(8.0) * t6) * ts0_3) + R(1.0), R(1e30));
-        real t27 = fmin(ts0_4, t4);
-        ts0_0 = t25.x;
-        ts0_1 = t25.y;
-        ts0_2 = t25.z;
-        ts0_3 = t26;
-        ts0_4 = t27;
+        real3 t24 = (((real3)(t16 * ((t22 * t22) - (t23 * t23)), t16 * ((R(2.0) * t22) * t23), (t14 * t14) - (t15 * t15))) * t7) + ((real3)(p.x, p.y, p.z));
+        real t25 = fmin(((R(8.0) * t6) * ts0_3) + R(1.0), R(1e30));
+        real t26 = fmin(ts0_4, t4);
+        ts0_0 = t24.x;
+        ts0_1 = t24.y;
+        ts0_2 = t24.z;
+        ts0_3 = t25;
+        ts0_4 = t26;
     }
-    real t28 = length((real3)(ts0_0, ts0_1, ts0_2));
-    return (real2)(t2 ? t1 : fmax(((R(0.5) * log(fmax(t28, R(1e-30)))) * t28) / ts0_3, t1), t2 ? R(1.0) : ts0_4);
+    real t27 = length((real3)(ts0_0, ts0_1, ts0_2));
+    return (real2)(t2 ? t1 : fmax(((R(0.5) * log(fmax(t27, R(1e-30)))) * t27) / ts0_3, t1), t2 ? R(1.0) : ts0_4);
 }
 
 /* ---- scene ---- */
@@ -153,22 +151,18 @@ real DE(real3 p0, __global const real* params) {
     real d5 = sd_plane(p0, (real3)(0.0f, 1.0f, 0.0f), 1.15f);
     /* union: the second operand only within reach of its bound */
     real u7 = d5;
-    real g7 = length(p0 - (real3)(0.0f)) * 0.9999f - 1.1040895f;
+    real g7 = (length(p0) * R(0.9999)) - R(1.1040895136738123);
     if (!(g7 > u7 && g7 > R(0.0))) {
         /* .../a:cut/a:color/rotate */
         real3 p1 = (real3)(p0.x, -p0.z, p0.y);
         /* .../a:color/rotate/mandelbulb */
-        real2 f0 = mandelbulb_p8(p1, 10, 2.0f, 1.1040895f);
+        real2 f0 = mandelbulb_p8(p1, 10, R(2.0), 1.1040895f);
         real d0 = f0.x;
         /* union/a:cut/b:plane */
         real d3 = sd_plane(p0, (real3)(0.0f, 0.28734788f, 0.95782626f), params[0] /* cut */);
         /* union/a:cut */
-        real x4 = -d0;
-        real y4 = -d3;
-        real d4 = -fmin(x4, y4);
-        real x7 = d5;
-        real y7 = d4;
-        real d7 = fmin(x7, y7);
+        real d4 = -fmin(-d0, -d3);
+        real d7 = fmin(d5, d4);
         u7 = d7;
     }
     return u7;
@@ -184,12 +178,12 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     real u7 = d5;
     real3 uc7 = c6;
     real ut7 = R(1.0);
-    real g7 = length(p0 - (real3)(0.0f)) * 0.9999f - 1.1040895f;
+    real g7 = (length(p0) * R(0.9999)) - R(1.1040895136738123);
     if (!(g7 > u7 && g7 > R(0.0))) {
         /* .../a:cut/a:color/rotate */
         real3 p1 = (real3)(p0.x, -p0.z, p0.y);
         /* .../a:color/rotate/mandelbulb */
-        real2 f0 = mandelbulb_p8(p1, 10, 2.0f, 1.1040895f);
+        real2 f0 = mandelbulb_p8(p1, 10, R(2.0), 1.1040895f);
         real d0 = f0.x;
         real t0 = f0.y;
         /* union/a:cut/a:color */
@@ -197,14 +191,10 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
         /* union/a:cut/b:plane */
         real d3 = sd_plane(p0, (real3)(0.0f, 0.28734788f, 0.95782626f), params[0] /* cut */);
         /* union/a:cut */
-        real x4 = -d0;
-        real y4 = -d3;
-        real d4 = -fmin(x4, y4);
-        real x7 = d5;
-        real y7 = d4;
-        real d7 = fmin(x7, y7);
-        real3 c7 = x7 < y7 ? c6 : c2;
-        real t7 = x7 < y7 ? R(1.0) : t0;
+        real d4 = -fmin(-d0, -d3);
+        real d7 = fmin(d5, d4);
+        real3 c7 = d5 < d4 ? c6 : c2;
+        real t7 = d5 < d4 ? R(1.0) : t0;
         u7 = d7;
         uc7 = c7;
         ut7 = t7;

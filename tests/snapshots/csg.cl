@@ -93,19 +93,14 @@ real sd_sphere(real3 p, real r) {
 
 /* ---- cuboid ---- */
 real sd_box(real3 p, real3 b) {
-    real3 t0 = fabs(p);
-    real3 t1 = t0 - b;
-    real3 t2 = fmax(t1, R(0.0));
-    return length(t2) + fmin(fmax(fmax(t1.x, t1.y), t1.z), R(0.0));
+    real3 t0 = fabs(p) - b;
+    return length(fmax(t0, R(0.0))) + fmin(fmax(fmax(t0.x, t0.y), t0.z), R(0.0));
 }
 
 /* ---- round_box ---- */
 real sd_round_box(real3 p, real3 b, real r) {
-    real3 t0 = fabs(p);
-    real3 t1 = t0 - b;
-    real3 t2 = t1 + r;
-    real3 t3 = fmax(t2, R(0.0));
-    return (length(t3) + fmin(fmax(fmax(t2.x, t2.y), t2.z), R(0.0))) - r;
+    real3 t0 = (fabs(p) - b) + r;
+    return (length(fmax(t0, R(0.0))) + fmin(fmax(fmax(t0.x, t0.y), t0.z), R(0.0))) - r;
 }
 
 /* ---- plane ---- */
@@ -114,18 +109,8 @@ real sd_plane(real3 p, real3 n, real offset) {
     real t1 = fmax(fmax(t0.x, t0.y), t0.z);
     real3 t2 = n / t1;
     real t3 = length(t2);
-    real3 t4 = t2 / t3;
-    real3 t5 = (R(0.0) < t1) ? t4 : n;
-    return (((p.x * t5.x) + (p.y * t5.y)) + (p.z * t5.z)) + offset;
-}
-
-/* ---- smooth_min ---- */
-real2 smooth_min(real a, real b, real k) {
-    real t0 = fmax(k - fabs(a - b), R(0.0)) / k;
-    real t1 = (t0 * t0) * R(0.5);
-    bool t2 = k <= R(0.0);
-    real t3 = fmin(a, b);
-    return (real2)(t2 ? t3 : (t3 - ((t1 * k) * R(0.5))), t2 ? R(0.0) : t1);
+    real3 t4 = (R(0.0) < t1) ? (t2 / t3) : n;
+    return (((p.x * t4.x) + (p.y * t4.y)) + (p.z * t4.z)) + offset;
 }
 
 /* ---- scene ---- */
@@ -135,82 +120,73 @@ real DE(real3 p0, __global const real* params) {
     real d21 = sd_plane(p0, (real3)(0.0f, 1.0f, 0.0f), 0.6f);
     /* union: the second operand only within reach of its bound */
     real u23 = d21;
-    real g23 = length(p0 - (real3)((-1.0468911f), 0.0f, 0.0f)) * 0.9999f - 0.8656089f;
+    real g23 = (length(p0 - ((real3)(-R(1.0468911086754467), R(0.0), R(0.0)))) * R(0.9999)) - R(0.8656088913245535);
     if (!(g23 > u23 && g23 > R(0.0))) {
         /* .../a:union/a:union/a:translate */
-        real3 p1 = p0 - (real3)((-1.3f), 0.0f, 0.0f);
+        real3 p1 = p0 - ((real3)(-R(1.3), R(0.0), R(0.0)));
         /* .../color/smooth_union/a:sphere */
         real d0 = sd_sphere(p1, 0.55f);
         /* .../color/smooth_union: the second operand only within reach of its bound */
         real u3 = d0;
-        real g3 = length(p1 - (real3)(0.45f, 0.0f, 0.0f)) * 0.9999f - 0.6062178f;
+        real g3 = (length(p1 - ((real3)(R(0.45), R(0.0), R(0.0)))) * R(0.9999)) - R(0.606217782649107);
         if (!(g3 > u3 + 0.25f && g3 > R(0.0))) {
             /* .../color/smooth_union/b:translate */
-            real3 p2 = p1 - (real3)(0.45f, 0.0f, 0.0f);
+            real3 p2 = p1 - ((real3)(R(0.45), R(0.0), R(0.0)));
             /* .../smooth_union/b:translate/cuboid */
             real d1 = sd_box(p2, (real3)(0.35f));
             /* .../a:translate/color/smooth_union */
-            real x3 = d0;
-            real y3 = d1;
-            real2 m3 = smooth_min(x3, y3, 0.25f);
-            real d3 = m3.x;
+            real e5_0 = fmax(R(0.25) - fabs(d0 - d1), R(0.0)) / R(0.25);
+            real d3 = fmin(d0, d1) - ((((e5_0 * e5_0) * R(0.5)) * R(0.25)) * R(0.5));
             u3 = d3;
         }
-        real x23 = d21;
-        real y23 = u3;
-        real d23 = fmin(x23, y23);
+        real d23 = fmin(d21, u3);
         u23 = d23;
     }
     /* union/a:union: the second operand only within reach of its bound */
     real u20 = u23;
-    real g20 = length(p0 - (real3)(0.0f)) * 0.9999f - 0.8660254f;
+    real g20 = (length(p0) * R(0.9999)) - R(0.8660254037844386);
     if (!(g20 > u20 && g20 > R(0.0))) {
         /* .../a:union/a:union/b:rotate */
-        real3 p3 = (real3)(0.8253356f * p0.x + (-0.5646425f) * p0.z, p0.y, 0.5646425f * p0.x + 0.8253356f * p0.z);
+        real3 p3 = (real3)((R(0.8253356149096783) * p0.x) - (R(0.5646424733950354) * p0.z), p0.y, (R(0.5646424733950354) * p0.x) + (R(0.8253356149096783) * p0.z));
         /* .../color/smooth_subtract/a:round_box */
         real d6 = sd_round_box(p3, (real3)(0.5f), 0.08f);
         /* .../color/smooth_subtract: the second operand only within reach of its bound */
         real u8 = d6;
-        real g8 = length(p3 - (real3)(0.0f)) * 0.9999f - 0.62f;
+        real g8 = (length(p3) * R(0.9999)) - R(0.62);
         if (!(g8 > -u8 + 0.08f && g8 > R(0.0))) {
             /* .../color/smooth_subtract/b:sphere */
             real d7 = sd_sphere(p3, 0.62f);
             /* .../b:rotate/color/smooth_subtract */
-            real x8 = -d6;
-            real y8 = d7;
-            real2 m8 = smooth_min(x8, y8, 0.08f);
-            real d8 = -m8.x;
+            real e10_0 = -d6;
+            real e10_1 = fmax(R(0.08) - fabs(e10_0 - d7), R(0.0)) / R(0.08);
+            real d8 = -(fmin(e10_0, d7) - ((((e10_1 * e10_1) * R(0.5)) * R(0.08)) * R(0.5)));
             u8 = d8;
         }
-        real x20 = u23;
-        real y20 = u8;
-        real d20 = fmin(x20, y20);
+        real d20 = fmin(u23, u8);
         u20 = d20;
     }
     /* .../a:union/a:union: the second operand only within reach of its bound */
     real u11 = u20;
-    real g11 = length(p0 - (real3)(1.3f, (-0.23499808f), 0.186483f)) * 0.9999f - 0.6f;
+    real g11 = (length(p0 - ((real3)(R(1.3), -R(0.234998072888245), R(0.18648299048119932)))) * R(0.9999)) - R(0.6);
     if (!(g11 > u11 && g11 > R(0.0))) {
         /* union/a:union/b:translate */
-        real3 p4 = p0 - (real3)(1.3f, 0.0f, 0.0f);
+        real3 p4 = p0 - ((real3)(R(1.3), R(0.0), R(0.0)));
         /* .../a:union/b:translate/rotate */
-        real3 p5 = (real3)(p4.x, 0.62161f * p4.y + 0.7833269f * p4.z, (-0.7833269f) * p4.y + 0.62161f * p4.z);
+        real3 p5 = (real3)(p4.x, (R(0.6216099682706644) * p4.y) + (R(0.7833269096274834) * p4.z), ((-R(0.7833269096274834)) * p4.y) + (R(0.6216099682706644) * p4.z));
         /* .../color/smooth_intersect/a:translate */
-        real3 p6 = p5 - (real3)(0.0f, 0.0f, 0.3f);
+        real3 p6 = p5 - ((real3)(R(0.0), R(0.0), R(0.3)));
         /* .../smooth_intersect/a:translate/sphere */
         real d12 = sd_sphere(p6, 0.6f);
         /* .../color/smooth_intersect/b:translate */
-        real3 p7 = p5 - (real3)(0.0f, 0.0f, (-0.3f));
+        real3 p7 = p5 - ((real3)(R(0.0), R(0.0), -R(0.3)));
         /* .../smooth_intersect/b:translate/sphere */
         real d14 = sd_sphere(p7, 0.6f);
         /* .../rotate/color/smooth_intersect */
-        real x16 = -d12;
-        real y16 = -d14;
-        real2 m16 = smooth_min(x16, y16, 0.1f);
-        real d16 = -m16.x;
-        real x11 = u20;
-        real y11 = d16;
-        real d11 = fmin(x11, y11);
+        real e17_0 = -d12;
+        real e17_1 = -d14;
+        real e17_2 = fmax(R(0.1) - fabs(e17_0 - e17_1), R(0.0)) / R(0.1);
+        real d16 = -(fmin(e17_0, e17_1) - ((((e17_2 * e17_2) * R(0.5)) * R(0.1)) * R(0.5)));
+        real d11 = fmin(u20, d16);
         u11 = d11;
     }
     return u11;
@@ -226,36 +202,33 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     real u23 = d21;
     real3 uc23 = c22;
     real ut23 = R(1.0);
-    real g23 = length(p0 - (real3)((-1.0468911f), 0.0f, 0.0f)) * 0.9999f - 0.8656089f;
+    real g23 = (length(p0 - ((real3)(-R(1.0468911086754467), R(0.0), R(0.0)))) * R(0.9999)) - R(0.8656088913245535);
     if (!(g23 > u23 && g23 > R(0.0))) {
         /* .../a:union/a:union/a:translate */
-        real3 p1 = p0 - (real3)((-1.3f), 0.0f, 0.0f);
+        real3 p1 = p0 - ((real3)(-R(1.3), R(0.0), R(0.0)));
         /* .../color/smooth_union/a:sphere */
         real d0 = sd_sphere(p1, 0.55f);
         /* .../color/smooth_union: the second operand only within reach of its bound */
         real u3 = d0;
         real ut3 = R(1.0);
-        real g3 = length(p1 - (real3)(0.45f, 0.0f, 0.0f)) * 0.9999f - 0.6062178f;
+        real g3 = (length(p1 - ((real3)(R(0.45), R(0.0), R(0.0)))) * R(0.9999)) - R(0.606217782649107);
         if (!(g3 > u3 + 0.25f && g3 > R(0.0))) {
             /* .../color/smooth_union/b:translate */
-            real3 p2 = p1 - (real3)(0.45f, 0.0f, 0.0f);
+            real3 p2 = p1 - ((real3)(R(0.45), R(0.0), R(0.0)));
             /* .../smooth_union/b:translate/cuboid */
             real d1 = sd_box(p2, (real3)(0.35f));
             /* .../a:translate/color/smooth_union */
-            real x3 = d0;
-            real y3 = d1;
-            real2 m3 = smooth_min(x3, y3, 0.25f);
-            real d3 = m3.x;
+            real e23_0 = fmax(R(0.25) - fabs(d0 - d1), R(0.0)) / R(0.25);
+            real e23_1 = (e23_0 * e23_0) * R(0.5);
+            real d3 = fmin(d0, d1) - ((e23_1 * R(0.25)) * R(0.5));
             u3 = d3;
             ut3 = R(1.0);
         }
         /* .../a:union/a:translate/color */
         real3 c4 = (real3)(0.95f, 0.45f, 0.2f);
-        real x23 = d21;
-        real y23 = u3;
-        real d23 = fmin(x23, y23);
-        real3 c23 = x23 < y23 ? c22 : c4;
-        real t23 = x23 < y23 ? R(1.0) : ut3;
+        real d23 = fmin(d21, u3);
+        real3 c23 = d21 < u3 ? c22 : c4;
+        real t23 = d21 < u3 ? R(1.0) : ut3;
         u23 = d23;
         uc23 = c23;
         ut23 = t23;
@@ -264,34 +237,32 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     real u20 = u23;
     real3 uc20 = uc23;
     real ut20 = ut23;
-    real g20 = length(p0 - (real3)(0.0f)) * 0.9999f - 0.8660254f;
+    real g20 = (length(p0) * R(0.9999)) - R(0.8660254037844386);
     if (!(g20 > u20 && g20 > R(0.0))) {
         /* .../a:union/a:union/b:rotate */
-        real3 p3 = (real3)(0.8253356f * p0.x + (-0.5646425f) * p0.z, p0.y, 0.5646425f * p0.x + 0.8253356f * p0.z);
+        real3 p3 = (real3)((R(0.8253356149096783) * p0.x) - (R(0.5646424733950354) * p0.z), p0.y, (R(0.5646424733950354) * p0.x) + (R(0.8253356149096783) * p0.z));
         /* .../color/smooth_subtract/a:round_box */
         real d6 = sd_round_box(p3, (real3)(0.5f), 0.08f);
         /* .../color/smooth_subtract: the second operand only within reach of its bound */
         real u8 = d6;
         real ut8 = R(1.0);
-        real g8 = length(p3 - (real3)(0.0f)) * 0.9999f - 0.62f;
+        real g8 = (length(p3) * R(0.9999)) - R(0.62);
         if (!(g8 > -u8 + 0.08f && g8 > R(0.0))) {
             /* .../color/smooth_subtract/b:sphere */
             real d7 = sd_sphere(p3, 0.62f);
             /* .../b:rotate/color/smooth_subtract */
-            real x8 = -d6;
-            real y8 = d7;
-            real2 m8 = smooth_min(x8, y8, 0.08f);
-            real d8 = -m8.x;
+            real e28_0 = -d6;
+            real e28_1 = fmax(R(0.08) - fabs(e28_0 - d7), R(0.0)) / R(0.08);
+            real e28_2 = (e28_1 * e28_1) * R(0.5);
+            real d8 = -(fmin(e28_0, d7) - ((e28_2 * R(0.08)) * R(0.5)));
             u8 = d8;
             ut8 = R(1.0);
         }
         /* .../a:union/b:rotate/color */
         real3 c9 = (real3)(0.3f, 0.65f, 0.95f);
-        real x20 = u23;
-        real y20 = u8;
-        real d20 = fmin(x20, y20);
-        real3 c20 = x20 < y20 ? uc23 : c9;
-        real t20 = x20 < y20 ? ut23 : ut8;
+        real d20 = fmin(u23, u8);
+        real3 c20 = u23 < u8 ? uc23 : c9;
+        real t20 = u23 < u8 ? ut23 : ut8;
         u20 = d20;
         uc20 = c20;
         ut20 = t20;
@@ -300,32 +271,31 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     real u11 = u20;
     real3 uc11 = uc20;
     real ut11 = ut20;
-    real g11 = length(p0 - (real3)(1.3f, (-0.23499808f), 0.186483f)) * 0.9999f - 0.6f;
+    real g11 = (length(p0 - ((real3)(R(1.3), -R(0.234998072888245), R(0.18648299048119932)))) * R(0.9999)) - R(0.6);
     if (!(g11 > u11 && g11 > R(0.0))) {
         /* union/a:union/b:translate */
-        real3 p4 = p0 - (real3)(1.3f, 0.0f, 0.0f);
+        real3 p4 = p0 - ((real3)(R(1.3), R(0.0), R(0.0)));
         /* .../a:union/b:translate/rotate */
-        real3 p5 = (real3)(p4.x, 0.62161f * p4.y + 0.7833269f * p4.z, (-0.7833269f) * p4.y + 0.62161f * p4.z);
+        real3 p5 = (real3)(p4.x, (R(0.6216099682706644) * p4.y) + (R(0.7833269096274834) * p4.z), ((-R(0.7833269096274834)) * p4.y) + (R(0.6216099682706644) * p4.z));
         /* .../color/smooth_intersect/a:translate */
-        real3 p6 = p5 - (real3)(0.0f, 0.0f, 0.3f);
+        real3 p6 = p5 - ((real3)(R(0.0), R(0.0), R(0.3)));
         /* .../smooth_intersect/a:translate/sphere */
         real d12 = sd_sphere(p6, 0.6f);
         /* .../color/smooth_intersect/b:translate */
-        real3 p7 = p5 - (real3)(0.0f, 0.0f, (-0.3f));
+        real3 p7 = p5 - ((real3)(R(0.0), R(0.0), -R(0.3)));
         /* .../smooth_intersect/b:translate/sphere */
         real d14 = sd_sphere(p7, 0.6f);
         /* .../rotate/color/smooth_intersect */
-        real x16 = -d12;
-        real y16 = -d14;
-        real2 m16 = smooth_min(x16, y16, 0.1f);
-        real d16 = -m16.x;
+        real e35_0 = -d12;
+        real e35_1 = -d14;
+        real e35_2 = fmax(R(0.1) - fabs(e35_0 - e35_1), R(0.0)) / R(0.1);
+        real e35_3 = (e35_2 * e35_2) * R(0.5);
+        real d16 = -(fmin(e35_0, e35_1) - ((e35_3 * R(0.1)) * R(0.5)));
         /* .../b:translate/rotate/color */
         real3 c17 = (real3)(0.4f, 0.85f, 0.45f);
-        real x11 = u20;
-        real y11 = d16;
-        real d11 = fmin(x11, y11);
-        real3 c11 = x11 < y11 ? uc20 : c17;
-        real t11 = x11 < y11 ? ut20 : R(1.0);
+        real d11 = fmin(u20, d16);
+        real3 c11 = u20 < d16 ? uc20 : c17;
+        real t11 = u20 < d16 ? ut20 : R(1.0);
         u11 = d11;
         uc11 = c11;
         ut11 = t11;

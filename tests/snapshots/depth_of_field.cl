@@ -92,9 +92,8 @@ real sd_plane(real3 p, real3 n, real offset) {
     real t1 = fmax(fmax(t0.x, t0.y), t0.z);
     real3 t2 = n / t1;
     real t3 = length(t2);
-    real3 t4 = t2 / t3;
-    real3 t5 = (R(0.0) < t1) ? t4 : n;
-    return (((p.x * t5.x) + (p.y * t5.y)) + (p.z * t5.z)) + offset;
+    real3 t4 = (R(0.0) < t1) ? (t2 / t3) : n;
+    return (((p.x * t4.x) + (p.y * t4.y)) + (p.z * t4.z)) + offset;
 }
 
 /* ---- menger ---- */
@@ -122,10 +121,8 @@ real2 menger(real3 p, real iterations, real scale) {
         ts0_3 = t9;
         ts0_4 = t10;
     }
-    real3 t11 = fabs((real3)(ts0_0, ts0_1, ts0_2));
-    real3 t12 = t11 - R(1.0);
-    real3 t13 = fmax(t12, R(0.0));
-    return (real2)((length(t13) + fmin(fmax(fmax(t12.x, t12.y), t12.z), R(0.0))) / ts0_3, ts0_4);
+    real3 t11 = fabs((real3)(ts0_0, ts0_1, ts0_2)) - R(1.0);
+    return (real2)((length(fmax(t11, R(0.0))) + fmin(fmax(fmax(t11.x, t11.y), t11.z), R(0.0))) / ts0_3, ts0_4);
 }
 
 /* ---- scene ---- */
@@ -135,93 +132,83 @@ real DE(real3 p0, __global const real* params) {
     real d27 = sd_plane(p0, (real3)(0.0f, 1.0f, 0.0f), 0.36f);
     /* union: the second operand only within reach of its bound */
     real u29 = d27;
-    real g29 = length(p0 - (real3)((-1.24f), 0.0f, 1.9f)) * 0.9999f - 0.6235383f;
+    real g29 = (length(p0 - ((real3)(-R(1.24), R(0.0), R(1.9)))) * R(0.9999)) - R(0.6235382907247957);
     if (!(g29 > u29 && g29 > R(0.0))) {
         /* .../a:union/a:union/a:translate */
-        real3 p1 = p0 - (real3)((-1.24f), 0.0f, 1.9f);
+        real3 p1 = p0 - ((real3)(-R(1.24), R(0.0), R(1.9)));
         /* .../a:translate/color/scale */
-        real3 p2 = p1 / 0.36f;
+        real3 p2 = p1 / R(0.36);
         /* .../color/scale/rotate */
-        real3 p3 = (real3)(0.7648422f * p2.x + 0.64421767f * p2.z, p2.y, (-0.64421767f) * p2.x + 0.7648422f * p2.z);
+        real3 p3 = (real3)((R(0.7648421872844885) * p2.x) + (R(0.644217687237691) * p2.z), p2.y, ((-R(0.644217687237691)) * p2.x) + (R(0.7648421872844885) * p2.z));
         /* .../scale/rotate/menger */
         real2 f0 = menger(p3, 3, 3.0f);
         real d0 = f0.x;
-        real d2 = d0 * 0.36f;
-        real x29 = d27;
-        real y29 = d2;
-        real d29 = fmin(x29, y29);
+        real d2 = d0 * R(0.36);
+        real d29 = fmin(d27, d2);
         u29 = d29;
     }
     /* union/a:union: the second operand only within reach of its bound */
     real u26 = u29;
-    real g26 = length(p0 - (real3)((-0.62f), 0.0f, 0.95f)) * 0.9999f - 0.6235383f;
+    real g26 = (length(p0 - ((real3)(-R(0.62), R(0.0), R(0.95)))) * R(0.9999)) - R(0.6235382907247957);
     if (!(g26 > u26 && g26 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p4 = p0 - (real3)((-0.62f), 0.0f, 0.95f);
+        real3 p4 = p0 - ((real3)(-R(0.62), R(0.0), R(0.95)));
         /* .../b:translate/color/scale */
-        real3 p5 = p4 / 0.36f;
+        real3 p5 = p4 / R(0.36);
         /* .../color/scale/rotate */
-        real3 p6 = (real3)(0.9393727f * p5.x + 0.3428978f * p5.z, p5.y, (-0.3428978f) * p5.x + 0.9393727f * p5.z);
+        real3 p6 = (real3)((R(0.9393727128473789) * p5.x) + (R(0.34289780745545134) * p5.z), p5.y, ((-R(0.34289780745545134)) * p5.x) + (R(0.9393727128473789) * p5.z));
         /* .../scale/rotate/menger */
         real2 f5 = menger(p6, 3, 3.0f);
         real d5 = f5.x;
-        real d7 = d5 * 0.36f;
-        real x26 = u29;
-        real y26 = d7;
-        real d26 = fmin(x26, y26);
+        real d7 = d5 * R(0.36);
+        real d26 = fmin(u29, d7);
         u26 = d26;
     }
     /* .../a:union/a:union: the second operand only within reach of its bound */
     real u20 = u26;
-    real g20 = length(p0 - (real3)(0.0f)) * 0.9999f - 0.6235383f;
+    real g20 = (length(p0) * R(0.9999)) - R(0.6235382907247957);
     if (!(g20 > u20 && g20 > R(0.0))) {
         /* .../a:union/b:translate/scale */
-        real3 p7 = p0 / 0.36f;
+        real3 p7 = p0 / R(0.36);
         /* .../b:translate/scale/rotate */
         real2 f11 = menger(p7, 3, 3.0f);
         real d11 = f11.x;
-        real d12 = d11 * 0.36f;
-        real x20 = u26;
-        real y20 = d12;
-        real d20 = fmin(x20, y20);
+        real d12 = d11 * R(0.36);
+        real d20 = fmin(u26, d12);
         u20 = d20;
     }
     /* .../a:union/a:union: the second operand only within reach of its bound */
     real u14 = u20;
-    real g14 = length(p0 - (real3)(0.62f, 0.0f, (-0.95f))) * 0.9999f - 0.6235383f;
+    real g14 = (length(p0 - ((real3)(R(0.62), R(0.0), -R(0.95)))) * R(0.9999)) - R(0.6235382907247957);
     if (!(g14 > u14 && g14 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p8 = p0 - (real3)(0.62f, 0.0f, (-0.95f));
+        real3 p8 = p0 - ((real3)(R(0.62), R(0.0), -R(0.95)));
         /* .../b:translate/color/scale */
-        real3 p9 = p8 / 0.36f;
+        real3 p9 = p8 / R(0.36);
         /* .../color/scale/rotate */
-        real3 p10 = (real3)(0.9393727f * p9.x + (-0.3428978f) * p9.z, p9.y, 0.3428978f * p9.x + 0.9393727f * p9.z);
+        real3 p10 = (real3)((R(0.9393727128473789) * p9.x) - (R(0.34289780745545134) * p9.z), p9.y, (R(0.34289780745545134) * p9.x) + (R(0.9393727128473789) * p9.z));
         /* .../scale/rotate/menger */
         real2 f15 = menger(p10, 3, 3.0f);
         real d15 = f15.x;
-        real d17 = d15 * 0.36f;
-        real x14 = u20;
-        real y14 = d17;
-        real d14 = fmin(x14, y14);
+        real d17 = d15 * R(0.36);
+        real d14 = fmin(u20, d17);
         u14 = d14;
     }
     /* .../a:union/a:union: the second operand only within reach of its bound */
     real u10 = u14;
-    real g10 = length(p0 - (real3)(1.24f, 0.0f, (-1.9f))) * 0.9999f - 0.6235383f;
+    real g10 = (length(p0 - ((real3)(R(1.24), R(0.0), -R(1.9)))) * R(0.9999)) - R(0.6235382907247957);
     if (!(g10 > u10 && g10 > R(0.0))) {
         /* union/a:union/b:translate */
-        real3 p11 = p0 - (real3)(1.24f, 0.0f, (-1.9f));
+        real3 p11 = p0 - ((real3)(R(1.24), R(0.0), -R(1.9)));
         /* .../b:translate/color/scale */
-        real3 p12 = p11 / 0.36f;
+        real3 p12 = p11 / R(0.36);
         /* .../color/scale/rotate */
-        real3 p13 = (real3)(0.7648422f * p12.x + (-0.64421767f) * p12.z, p12.y, 0.64421767f * p12.x + 0.7648422f * p12.z);
+        real3 p13 = (real3)((R(0.7648421872844885) * p12.x) - (R(0.644217687237691) * p12.z), p12.y, (R(0.644217687237691) * p12.x) + (R(0.7648421872844885) * p12.z));
         /* .../scale/rotate/menger */
         real2 f21 = menger(p13, 3, 3.0f);
         real d21 = f21.x;
-        real d23 = d21 * 0.36f;
-        real x10 = u14;
-        real y10 = d23;
-        real d10 = fmin(x10, y10);
+        real d23 = d21 * R(0.36);
+        real d10 = fmin(u14, d23);
         u10 = d10;
     }
     return u10;
@@ -237,26 +224,24 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     real u29 = d27;
     real3 uc29 = c28;
     real ut29 = R(1.0);
-    real g29 = length(p0 - (real3)((-1.24f), 0.0f, 1.9f)) * 0.9999f - 0.6235383f;
+    real g29 = (length(p0 - ((real3)(-R(1.24), R(0.0), R(1.9)))) * R(0.9999)) - R(0.6235382907247957);
     if (!(g29 > u29 && g29 > R(0.0))) {
         /* .../a:union/a:union/a:translate */
-        real3 p1 = p0 - (real3)((-1.24f), 0.0f, 1.9f);
+        real3 p1 = p0 - ((real3)(-R(1.24), R(0.0), R(1.9)));
         /* .../a:translate/color/scale */
-        real3 p2 = p1 / 0.36f;
+        real3 p2 = p1 / R(0.36);
         /* .../color/scale/rotate */
-        real3 p3 = (real3)(0.7648422f * p2.x + 0.64421767f * p2.z, p2.y, (-0.64421767f) * p2.x + 0.7648422f * p2.z);
+        real3 p3 = (real3)((R(0.7648421872844885) * p2.x) + (R(0.644217687237691) * p2.z), p2.y, ((-R(0.644217687237691)) * p2.x) + (R(0.7648421872844885) * p2.z));
         /* .../scale/rotate/menger */
         real2 f0 = menger(p3, 3, 3.0f);
         real d0 = f0.x;
         real t0 = f0.y;
-        real d2 = d0 * 0.36f;
+        real d2 = d0 * R(0.36);
         /* .../a:union/a:translate/color */
         real3 c3 = (real3)(0.35f, 0.6f, 0.95f);
-        real x29 = d27;
-        real y29 = d2;
-        real d29 = fmin(x29, y29);
-        real3 c29 = x29 < y29 ? c28 : c3;
-        real t29 = x29 < y29 ? R(1.0) : t0;
+        real d29 = fmin(d27, d2);
+        real3 c29 = d27 < d2 ? c28 : c3;
+        real t29 = d27 < d2 ? R(1.0) : t0;
         u29 = d29;
         uc29 = c29;
         ut29 = t29;
@@ -265,26 +250,24 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     real u26 = u29;
     real3 uc26 = uc29;
     real ut26 = ut29;
-    real g26 = length(p0 - (real3)((-0.62f), 0.0f, 0.95f)) * 0.9999f - 0.6235383f;
+    real g26 = (length(p0 - ((real3)(-R(0.62), R(0.0), R(0.95)))) * R(0.9999)) - R(0.6235382907247957);
     if (!(g26 > u26 && g26 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p4 = p0 - (real3)((-0.62f), 0.0f, 0.95f);
+        real3 p4 = p0 - ((real3)(-R(0.62), R(0.0), R(0.95)));
         /* .../b:translate/color/scale */
-        real3 p5 = p4 / 0.36f;
+        real3 p5 = p4 / R(0.36);
         /* .../color/scale/rotate */
-        real3 p6 = (real3)(0.9393727f * p5.x + 0.3428978f * p5.z, p5.y, (-0.3428978f) * p5.x + 0.9393727f * p5.z);
+        real3 p6 = (real3)((R(0.9393727128473789) * p5.x) + (R(0.34289780745545134) * p5.z), p5.y, ((-R(0.34289780745545134)) * p5.x) + (R(0.9393727128473789) * p5.z));
         /* .../scale/rotate/menger */
         real2 f5 = menger(p6, 3, 3.0f);
         real d5 = f5.x;
         real t5 = f5.y;
-        real d7 = d5 * 0.36f;
+        real d7 = d5 * R(0.36);
         /* .../a:union/b:translate/color */
         real3 c8 = (real3)(0.5f, 0.7f, 0.9f);
-        real x26 = u29;
-        real y26 = d7;
-        real d26 = fmin(x26, y26);
-        real3 c26 = x26 < y26 ? uc29 : c8;
-        real t26 = x26 < y26 ? ut29 : t5;
+        real d26 = fmin(u29, d7);
+        real3 c26 = u29 < d7 ? uc29 : c8;
+        real t26 = u29 < d7 ? ut29 : t5;
         u26 = d26;
         uc26 = c26;
         ut26 = t26;
@@ -293,22 +276,20 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     real u20 = u26;
     real3 uc20 = uc26;
     real ut20 = ut26;
-    real g20 = length(p0 - (real3)(0.0f)) * 0.9999f - 0.6235383f;
+    real g20 = (length(p0) * R(0.9999)) - R(0.6235382907247957);
     if (!(g20 > u20 && g20 > R(0.0))) {
         /* .../a:union/b:translate/scale */
-        real3 p7 = p0 / 0.36f;
+        real3 p7 = p0 / R(0.36);
         /* .../b:translate/scale/rotate */
         real2 f11 = menger(p7, 3, 3.0f);
         real d11 = f11.x;
         real t11 = f11.y;
-        real d12 = d11 * 0.36f;
+        real d12 = d11 * R(0.36);
         /* .../a:union/a:union/b:translate */
         real3 c13 = (real3)(0.85f, 0.85f, 0.8f);
-        real x20 = u26;
-        real y20 = d12;
-        real d20 = fmin(x20, y20);
-        real3 c20 = x20 < y20 ? uc26 : c13;
-        real t20 = x20 < y20 ? ut26 : t11;
+        real d20 = fmin(u26, d12);
+        real3 c20 = u26 < d12 ? uc26 : c13;
+        real t20 = u26 < d12 ? ut26 : t11;
         u20 = d20;
         uc20 = c20;
         ut20 = t20;
@@ -317,26 +298,24 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     real u14 = u20;
     real3 uc14 = uc20;
     real ut14 = ut20;
-    real g14 = length(p0 - (real3)(0.62f, 0.0f, (-0.95f))) * 0.9999f - 0.6235383f;
+    real g14 = (length(p0 - ((real3)(R(0.62), R(0.0), -R(0.95)))) * R(0.9999)) - R(0.6235382907247957);
     if (!(g14 > u14 && g14 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p8 = p0 - (real3)(0.62f, 0.0f, (-0.95f));
+        real3 p8 = p0 - ((real3)(R(0.62), R(0.0), -R(0.95)));
         /* .../b:translate/color/scale */
-        real3 p9 = p8 / 0.36f;
+        real3 p9 = p8 / R(0.36);
         /* .../color/scale/rotate */
-        real3 p10 = (real3)(0.9393727f * p9.x + (-0.3428978f) * p9.z, p9.y, 0.3428978f * p9.x + 0.9393727f * p9.z);
+        real3 p10 = (real3)((R(0.9393727128473789) * p9.x) - (R(0.34289780745545134) * p9.z), p9.y, (R(0.34289780745545134) * p9.x) + (R(0.9393727128473789) * p9.z));
         /* .../scale/rotate/menger */
         real2 f15 = menger(p10, 3, 3.0f);
         real d15 = f15.x;
         real t15 = f15.y;
-        real d17 = d15 * 0.36f;
+        real d17 = d15 * R(0.36);
         /* .../a:union/b:translate/color */
         real3 c18 = (real3)(0.95f, 0.75f, 0.5f);
-        real x14 = u20;
-        real y14 = d17;
-        real d14 = fmin(x14, y14);
-        real3 c14 = x14 < y14 ? uc20 : c18;
-        real t14 = x14 < y14 ? ut20 : t15;
+        real d14 = fmin(u20, d17);
+        real3 c14 = u20 < d17 ? uc20 : c18;
+        real t14 = u20 < d17 ? ut20 : t15;
         u14 = d14;
         uc14 = c14;
         ut14 = t14;
@@ -345,26 +324,24 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     real u10 = u14;
     real3 uc10 = uc14;
     real ut10 = ut14;
-    real g10 = length(p0 - (real3)(1.24f, 0.0f, (-1.9f))) * 0.9999f - 0.6235383f;
+    real g10 = (length(p0 - ((real3)(R(1.24), R(0.0), -R(1.9)))) * R(0.9999)) - R(0.6235382907247957);
     if (!(g10 > u10 && g10 > R(0.0))) {
         /* union/a:union/b:translate */
-        real3 p11 = p0 - (real3)(1.24f, 0.0f, (-1.9f));
+        real3 p11 = p0 - ((real3)(R(1.24), R(0.0), -R(1.9)));
         /* .../b:translate/color/scale */
-        real3 p12 = p11 / 0.36f;
+        real3 p12 = p11 / R(0.36);
         /* .../color/scale/rotate */
-        real3 p13 = (real3)(0.7648422f * p12.x + (-0.64421767f) * p12.z, p12.y, 0.64421767f * p12.x + 0.7648422f * p12.z);
+        real3 p13 = (real3)((R(0.7648421872844885) * p12.x) - (R(0.644217687237691) * p12.z), p12.y, (R(0.644217687237691) * p12.x) + (R(0.7648421872844885) * p12.z));
         /* .../scale/rotate/menger */
         real2 f21 = menger(p13, 3, 3.0f);
         real d21 = f21.x;
         real t21 = f21.y;
-        real d23 = d21 * 0.36f;
+        real d23 = d21 * R(0.36);
         /* .../a:union/b:translate/color */
         real3 c24 = (real3)(0.95f, 0.55f, 0.35f);
-        real x10 = u14;
-        real y10 = d23;
-        real d10 = fmin(x10, y10);
-        real3 c10 = x10 < y10 ? uc14 : c24;
-        real t10 = x10 < y10 ? ut14 : t21;
+        real d10 = fmin(u14, d23);
+        real3 c10 = u14 < d23 ? uc14 : c24;
+        real t10 = u14 < d23 ? ut14 : t21;
         u10 = d10;
         uc10 = c10;
         ut10 = t10;

@@ -93,10 +93,8 @@ real sd_sphere(real3 p, real r) {
 
 /* ---- cuboid ---- */
 real sd_box(real3 p, real3 b) {
-    real3 t0 = fabs(p);
-    real3 t1 = t0 - b;
-    real3 t2 = fmax(t1, R(0.0));
-    return length(t2) + fmin(fmax(fmax(t1.x, t1.y), t1.z), R(0.0));
+    real3 t0 = fabs(p) - b;
+    return length(fmax(t0, R(0.0))) + fmin(fmax(fmax(t0.x, t0.y), t0.z), R(0.0));
 }
 
 /* ---- torus ---- */
@@ -117,22 +115,8 @@ real sd_plane(real3 p, real3 n, real offset) {
     real t1 = fmax(fmax(t0.x, t0.y), t0.z);
     real3 t2 = n / t1;
     real t3 = length(t2);
-    real3 t4 = t2 / t3;
-    real3 t5 = (R(0.0) < t1) ? t4 : n;
-    return (((p.x * t5.x) + (p.y * t5.y)) + (p.z * t5.z)) + offset;
-}
-
-/* ---- warp ---- */
-real twist_bound(real d, real k, real rho) {
-    real t0 = R(0.5) * fabs(k);
-    real t1 = t0 * rho;
-    real t2 = t0 * (rho + (fabs(d) / (t1 + hypot(R(1.0), t1))));
-    return d / (t2 + hypot(R(1.0), t2));
-}
-
-real bend_bound(real d, real k, real rho) {
-    real t0 = fabs(k);
-    return d / (R(1.0) + (t0 * (rho + (fabs(d) / (R(1.0) + (t0 * rho))))));
+    real3 t4 = (R(0.0) < t1) ? (t2 / t3) : n;
+    return (((p.x * t4.x) + (p.y * t4.y)) + (p.z * t4.z)) + offset;
 }
 
 /* ---- scene ---- */
@@ -142,120 +126,107 @@ real DE(real3 p0, __global const real* params) {
     real d35 = sd_plane(p0, (real3)(0.0f, 1.0f, 0.0f), 0.6f);
     /* union: the second operand only within reach of its bound */
     real u37 = d35;
-    real g37 = length(p0 - (real3)((-1.5f), 0.0f, 0.0f)) * 0.9999f - 0.69971424f;
+    real g37 = (length(p0 - ((real3)(-R(1.5), R(0.0), R(0.0)))) * R(0.9999)) - R(0.6997142273814361);
     if (!(g37 > u37 && g37 > R(0.0))) {
         /* .../a:union/a:union/a:translate */
-        real3 p1 = p0 - (real3)((-1.5f), 0.0f, 0.0f);
+        real3 p1 = p0 - ((real3)(-R(1.5), R(0.0), R(0.0)));
         /* .../color/intersect/a:twist */
-        real s1 = sin(2.0f * p1.y);
-        real k1 = cos(2.0f * p1.y);
-        real3 p2 = (real3)(k1 * p1.x - s1 * p1.z, p1.y, s1 * p1.x + k1 * p1.z);
+        real e3_0 = R(2.0) * p1.y;
+        real e3_1 = sin(e3_0);
+        real e3_2 = cos(e3_0);
+        real3 p2 = (real3)((e3_2 * p1.x) - (e3_1 * p1.z), p1.y, (e3_1 * p1.x) + (e3_2 * p1.z));
         /* .../intersect/a:twist/cuboid */
         real d0 = sd_box(p2, (real3)(0.25f, 0.6f, 0.25f));
-        real d1 = fmax(twist_bound(d0, 2.0f, hypot(p1.x, p1.z)), length(p1 - (real3)(0.0f, 0.0f, 0.0f)) - 0.98488575f);
+        real e4_0 = hypot(p1.x, p1.z);
+        real e4_1 = e4_0 + (fabs(d0) / (e4_0 + hypot(R(1.0), e4_0)));
+        real d1 = fmax(d0 / (e4_1 + hypot(R(1.0), e4_1)), length(p1) - R(0.9848857801796104));
         /* .../color/intersect/b:cylinder */
         real d2 = sd_cylinder(p1, 0.36f, 0.6f);
         /* .../a:translate/color/intersect */
-        real x3 = -d1;
-        real y3 = -d2;
-        real d3 = -fmin(x3, y3);
-        real x37 = d35;
-        real y37 = d3;
-        real d37 = fmin(x37, y37);
+        real d3 = -fmin(-d1, -d2);
+        real d37 = fmin(d35, d3);
         u37 = d37;
     }
     /* union/a:union: the second operand only within reach of its bound */
     real u34 = u37;
-    real g34 = length(p0 - (real3)((-0.4f), 0.0f, 0.0f)) * 0.9999f - 0.65f;
+    real g34 = (length(p0 - ((real3)(-R(0.4), R(0.0), R(0.0)))) * R(0.9999)) - R(0.65);
     if (!(g34 > u34 && g34 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p3 = p0 - (real3)((-0.4f), 0.0f, 0.0f);
+        real3 p3 = p0 - ((real3)(-R(0.4), R(0.0), R(0.0)));
         /* .../color/intersect/a:bend */
-        real s7 = sin(0.8f * p3.x);
-        real k7 = cos(0.8f * p3.x);
-        real3 p4 = (real3)(k7 * p3.x - s7 * p3.y, s7 * p3.x + k7 * p3.y, p3.z);
+        real e9_0 = R(0.8) * p3.x;
+        real e9_1 = sin(e9_0);
+        real e9_2 = cos(e9_0);
+        real3 p4 = (real3)((e9_2 * p3.x) - (e9_1 * p3.y), (e9_1 * p3.x) + (e9_2 * p3.y), p3.z);
         /* .../intersect/a:bend/cuboid */
         real d6 = sd_box(p4, (real3)(0.6f, 0.1f, 0.2f));
-        real d7 = fmax(bend_bound(d6, 0.8f, hypot(p3.x, p3.y)), length(p3 - (real3)(0.0f, 0.0f, 0.0f)) - 0.9055385f);
+        real e10_0 = hypot(p3.x, p3.y);
+        real d7 = fmax(d6 / (R(1.0) + (R(0.8) * (e10_0 + (fabs(d6) / (R(1.0) + (R(0.8) * e10_0)))))), length(p3) - R(0.9055385138137417));
         /* .../color/intersect/b:sphere */
         real d8 = sd_sphere(p3, 0.65f);
         /* .../b:translate/color/intersect */
-        real x9 = -d7;
-        real y9 = -d8;
-        real d9 = -fmin(x9, y9);
-        real x34 = u37;
-        real y34 = d9;
-        real d34 = fmin(x34, y34);
+        real d9 = -fmin(-d7, -d8);
+        real d34 = fmin(u37, d9);
         u34 = d34;
     }
     /* .../a:union/a:union: the second operand only within reach of its bound */
     real u26 = u34;
-    real g26 = length(p0 - (real3)(0.65f, 0.0f, 0.0f)) * 0.9999f - 0.49f;
+    real g26 = (length(p0 - ((real3)(R(0.65), R(0.0), R(0.0)))) * R(0.9999)) - R(0.49);
     if (!(g26 > u26 && g26 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p5 = p0 - (real3)(0.65f, 0.0f, 0.0f);
+        real3 p5 = p0 - ((real3)(R(0.65), R(0.0), R(0.0)));
         /* .../subtract/a:onion/sphere */
         real d13 = sd_sphere(p5, 0.45f);
         /* .../color/subtract/a:onion */
-        real d14 = fabs(d13) - 0.04f;
+        real d14 = fabs(d13) - R(0.04);
         /* .../color/subtract: the second operand only within reach of its bound */
         real u17 = d14;
-        real g17 = length(p5 - (real3)(0.0f, 1.2f, 0.0f)) * 0.9999f - 1.7320508f;
+        real g17 = (length(p5 - ((real3)(R(0.0), R(1.2), R(0.0)))) * R(0.9999)) - R(1.7320508075688772);
         if (!(g17 > -u17 && g17 > R(0.0))) {
             /* .../color/subtract/b:translate */
-            real3 p6 = p5 - (real3)(0.0f, 1.2f, 0.0f);
+            real3 p6 = p5 - ((real3)(R(0.0), R(1.2), R(0.0)));
             /* .../subtract/b:translate/cuboid */
             real d15 = sd_box(p6, (real3)(1.0f));
             /* .../b:translate/color/subtract */
-            real x17 = -d14;
-            real y17 = d15;
-            real d17 = -fmin(x17, y17);
+            real d17 = -fmin(-d14, d15);
             u17 = d17;
         }
-        real x26 = u34;
-        real y26 = u17;
-        real d26 = fmin(x26, y26);
+        real d26 = fmin(u34, u17);
         u26 = d26;
     }
     /* .../a:union/a:union: the second operand only within reach of its bound */
     real u20 = u26;
-    real g20 = length(p0 - (real3)(1.6f, (-0.25f), 0.0f)) * 0.9999f - 0.7649748f;
+    real g20 = (length(p0 - ((real3)(R(1.6), -R(0.25), R(0.0)))) * R(0.9999)) - R(0.7649747468305832);
     if (!(g20 > u20 && g20 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p7 = p0 - (real3)(1.6f, (-0.25f), 0.0f);
+        real3 p7 = p0 - ((real3)(R(1.6), -R(0.25), R(0.0)));
         /* .../b:translate/color/repeat_limited */
-        real3 p8 = p7;
-        p8.x = p7.x - 0.35f * clamp(round(p7.x / 0.35f), -1.0f, 1.0f);
-        p8.z = p7.z - 0.35f * clamp(round(p7.z / 0.35f), -1.0f, 1.0f);
+        real3 p8 = (real3)(p7.x - (R(0.35) * fmin(fmax(round(p7.x / R(0.35)), -R(1.0)), R(1.0))), p7.y, p7.z - (R(0.35) * fmin(fmax(round(p7.z / R(0.35)), -R(1.0)), R(1.0))));
         /* .../color/repeat_limited/elongate */
-        real3 p9 = p8 - clamp(p8, -(real3)(0.0f, 0.15f, 0.0f), (real3)(0.0f, 0.15f, 0.0f));
+        real3 e23_0 = (real3)(R(0.0), R(0.15), R(0.0));
+        real3 p9 = p8 - fmin(fmax(p8, -e23_0), e23_0);
         /* .../repeat_limited/elongate/sphere */
         real d21 = sd_sphere(p9, 0.12f);
-        real x20 = u26;
-        real y20 = d21;
-        real d20 = fmin(x20, y20);
+        real d20 = fmin(u26, d21);
         u20 = d20;
     }
     /* .../a:union/a:union: the second operand only within reach of its bound */
     real u12 = u20;
-    real g12 = length(p0 - (real3)(0.0f, 0.85f, (-0.8f))) * 0.9999f - 0.77f;
+    real g12 = (length(p0 - ((real3)(R(0.0), R(0.85), -R(0.8)))) * R(0.9999)) - R(0.77);
     if (!(g12 > u12 && g12 > R(0.0))) {
         /* union/a:union/b:translate */
-        real3 p10 = p0 - (real3)(0.0f, 0.85f, (-0.8f));
+        real3 p10 = p0 - ((real3)(R(0.0), R(0.85), -R(0.8)));
         /* .../color/round/mirror */
-        real3 p11 = p10;
-        p11.x = fabs(p11.x);
+        real3 p11 = (real3)(fabs(p10.x), p10.y, p10.z);
         /* .../round/mirror/translate */
-        real3 p12 = p11 - (real3)(0.5f, 0.0f, 0.0f);
+        real3 p12 = p11 - ((real3)(R(0.5), R(0.0), R(0.0)));
         /* .../mirror/translate/rotate */
         real3 p13 = (real3)(p12.x, p12.z, -p12.y);
         /* .../translate/rotate/torus */
         real d27 = sd_torus(p13, 0.2f, 0.06f);
         /* .../b:translate/color/round */
-        real d31 = d27 - 0.01f;
-        real x12 = u20;
-        real y12 = d31;
-        real d12 = fmin(x12, y12);
+        real d31 = d27 - R(0.01);
+        real d12 = fmin(u20, d31);
         u12 = d12;
     }
     return u12;
@@ -271,29 +242,30 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     real u37 = d35;
     real3 uc37 = c36;
     real ut37 = R(1.0);
-    real g37 = length(p0 - (real3)((-1.5f), 0.0f, 0.0f)) * 0.9999f - 0.69971424f;
+    real g37 = (length(p0 - ((real3)(-R(1.5), R(0.0), R(0.0)))) * R(0.9999)) - R(0.6997142273814361);
     if (!(g37 > u37 && g37 > R(0.0))) {
         /* .../a:union/a:union/a:translate */
-        real3 p1 = p0 - (real3)((-1.5f), 0.0f, 0.0f);
+        real3 p1 = p0 - ((real3)(-R(1.5), R(0.0), R(0.0)));
         /* .../color/intersect/a:twist */
-        real s1 = sin(2.0f * p1.y);
-        real k1 = cos(2.0f * p1.y);
-        real3 p2 = (real3)(k1 * p1.x - s1 * p1.z, p1.y, s1 * p1.x + k1 * p1.z);
+        real e34_0 = R(2.0) * p1.y;
+        real e34_1 = sin(e34_0);
+        real e34_2 = cos(e34_0);
+        real3 p2 = (real3)((e34_2 * p1.x) - (e34_1 * p1.z), p1.y, (e34_1 * p1.x) + (e34_2 * p1.z));
         /* .../intersect/a:twist/cuboid */
         real d0 = sd_box(p2, (real3)(0.25f, 0.6f, 0.25f));
-        real d1 = fmax(twist_bound(d0, 2.0f, hypot(p1.x, p1.z)), length(p1 - (real3)(0.0f, 0.0f, 0.0f)) - 0.98488575f);
+        real e35_0 = hypot(p1.x, p1.z);
+        real e35_1 = e35_0 + (fabs(d0) / (e35_0 + hypot(R(1.0), e35_0)));
+        real d1 = fmax(d0 / (e35_1 + hypot(R(1.0), e35_1)), length(p1) - R(0.9848857801796104));
         /* .../color/intersect/b:cylinder */
         real d2 = sd_cylinder(p1, 0.36f, 0.6f);
         /* .../a:translate/color/intersect */
-        real x3 = -d1;
-        real y3 = -d2;
-        real d3 = -fmin(x3, y3);
+        real e36_0 = -d1;
+        real e36_1 = -d2;
+        real d3 = -fmin(e36_0, e36_1);
         /* .../a:union/a:translate/color */
         real3 c4 = (real3)(0.9f, 0.4f, 0.4f);
-        real x37 = d35;
-        real y37 = d3;
-        real d37 = fmin(x37, y37);
-        real3 c37 = x37 < y37 ? c36 : c4;
+        real d37 = fmin(d35, d3);
+        real3 c37 = d35 < d3 ? c36 : c4;
         u37 = d37;
         uc37 = c37;
         ut37 = R(1.0);
@@ -302,30 +274,30 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     real u34 = u37;
     real3 uc34 = uc37;
     real ut34 = ut37;
-    real g34 = length(p0 - (real3)((-0.4f), 0.0f, 0.0f)) * 0.9999f - 0.65f;
+    real g34 = (length(p0 - ((real3)(-R(0.4), R(0.0), R(0.0)))) * R(0.9999)) - R(0.65);
     if (!(g34 > u34 && g34 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p3 = p0 - (real3)((-0.4f), 0.0f, 0.0f);
+        real3 p3 = p0 - ((real3)(-R(0.4), R(0.0), R(0.0)));
         /* .../color/intersect/a:bend */
-        real s7 = sin(0.8f * p3.x);
-        real k7 = cos(0.8f * p3.x);
-        real3 p4 = (real3)(k7 * p3.x - s7 * p3.y, s7 * p3.x + k7 * p3.y, p3.z);
+        real e40_0 = R(0.8) * p3.x;
+        real e40_1 = sin(e40_0);
+        real e40_2 = cos(e40_0);
+        real3 p4 = (real3)((e40_2 * p3.x) - (e40_1 * p3.y), (e40_1 * p3.x) + (e40_2 * p3.y), p3.z);
         /* .../intersect/a:bend/cuboid */
         real d6 = sd_box(p4, (real3)(0.6f, 0.1f, 0.2f));
-        real d7 = fmax(bend_bound(d6, 0.8f, hypot(p3.x, p3.y)), length(p3 - (real3)(0.0f, 0.0f, 0.0f)) - 0.9055385f);
+        real e41_0 = hypot(p3.x, p3.y);
+        real d7 = fmax(d6 / (R(1.0) + (R(0.8) * (e41_0 + (fabs(d6) / (R(1.0) + (R(0.8) * e41_0)))))), length(p3) - R(0.9055385138137417));
         /* .../color/intersect/b:sphere */
         real d8 = sd_sphere(p3, 0.65f);
         /* .../b:translate/color/intersect */
-        real x9 = -d7;
-        real y9 = -d8;
-        real d9 = -fmin(x9, y9);
+        real e42_0 = -d7;
+        real e42_1 = -d8;
+        real d9 = -fmin(e42_0, e42_1);
         /* .../a:union/b:translate/color */
         real3 c10 = (real3)(0.4f, 0.9f, 0.5f);
-        real x34 = u37;
-        real y34 = d9;
-        real d34 = fmin(x34, y34);
-        real3 c34 = x34 < y34 ? uc37 : c10;
-        real t34 = x34 < y34 ? ut37 : R(1.0);
+        real d34 = fmin(u37, d9);
+        real3 c34 = u37 < d9 ? uc37 : c10;
+        real t34 = u37 < d9 ? ut37 : R(1.0);
         u34 = d34;
         uc34 = c34;
         ut34 = t34;
@@ -334,37 +306,34 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     real u26 = u34;
     real3 uc26 = uc34;
     real ut26 = ut34;
-    real g26 = length(p0 - (real3)(0.65f, 0.0f, 0.0f)) * 0.9999f - 0.49f;
+    real g26 = (length(p0 - ((real3)(R(0.65), R(0.0), R(0.0)))) * R(0.9999)) - R(0.49);
     if (!(g26 > u26 && g26 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p5 = p0 - (real3)(0.65f, 0.0f, 0.0f);
+        real3 p5 = p0 - ((real3)(R(0.65), R(0.0), R(0.0)));
         /* .../subtract/a:onion/sphere */
         real d13 = sd_sphere(p5, 0.45f);
         /* .../color/subtract/a:onion */
-        real d14 = fabs(d13) - 0.04f;
+        real d14 = fabs(d13) - R(0.04);
         /* .../color/subtract: the second operand only within reach of its bound */
         real u17 = d14;
         real ut17 = R(1.0);
-        real g17 = length(p5 - (real3)(0.0f, 1.2f, 0.0f)) * 0.9999f - 1.7320508f;
+        real g17 = (length(p5 - ((real3)(R(0.0), R(1.2), R(0.0)))) * R(0.9999)) - R(1.7320508075688772);
         if (!(g17 > -u17 && g17 > R(0.0))) {
             /* .../color/subtract/b:translate */
-            real3 p6 = p5 - (real3)(0.0f, 1.2f, 0.0f);
+            real3 p6 = p5 - ((real3)(R(0.0), R(1.2), R(0.0)));
             /* .../subtract/b:translate/cuboid */
             real d15 = sd_box(p6, (real3)(1.0f));
             /* .../b:translate/color/subtract */
-            real x17 = -d14;
-            real y17 = d15;
-            real d17 = -fmin(x17, y17);
+            real e49_0 = -d14;
+            real d17 = -fmin(e49_0, d15);
             u17 = d17;
             ut17 = R(1.0);
         }
         /* .../a:union/b:translate/color */
         real3 c18 = (real3)(0.4f, 0.6f, 0.95f);
-        real x26 = u34;
-        real y26 = u17;
-        real d26 = fmin(x26, y26);
-        real3 c26 = x26 < y26 ? uc34 : c18;
-        real t26 = x26 < y26 ? ut34 : ut17;
+        real d26 = fmin(u34, u17);
+        real3 c26 = u34 < u17 ? uc34 : c18;
+        real t26 = u34 < u17 ? ut34 : ut17;
         u26 = d26;
         uc26 = c26;
         ut26 = t26;
@@ -373,25 +342,22 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     real u20 = u26;
     real3 uc20 = uc26;
     real ut20 = ut26;
-    real g20 = length(p0 - (real3)(1.6f, (-0.25f), 0.0f)) * 0.9999f - 0.7649748f;
+    real g20 = (length(p0 - ((real3)(R(1.6), -R(0.25), R(0.0)))) * R(0.9999)) - R(0.7649747468305832);
     if (!(g20 > u20 && g20 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p7 = p0 - (real3)(1.6f, (-0.25f), 0.0f);
+        real3 p7 = p0 - ((real3)(R(1.6), -R(0.25), R(0.0)));
         /* .../b:translate/color/repeat_limited */
-        real3 p8 = p7;
-        p8.x = p7.x - 0.35f * clamp(round(p7.x / 0.35f), -1.0f, 1.0f);
-        p8.z = p7.z - 0.35f * clamp(round(p7.z / 0.35f), -1.0f, 1.0f);
+        real3 p8 = (real3)(p7.x - (R(0.35) * fmin(fmax(round(p7.x / R(0.35)), -R(1.0)), R(1.0))), p7.y, p7.z - (R(0.35) * fmin(fmax(round(p7.z / R(0.35)), -R(1.0)), R(1.0))));
         /* .../color/repeat_limited/elongate */
-        real3 p9 = p8 - clamp(p8, -(real3)(0.0f, 0.15f, 0.0f), (real3)(0.0f, 0.15f, 0.0f));
+        real3 e54_0 = (real3)(R(0.0), R(0.15), R(0.0));
+        real3 p9 = p8 - fmin(fmax(p8, -e54_0), e54_0);
         /* .../repeat_limited/elongate/sphere */
         real d21 = sd_sphere(p9, 0.12f);
         /* .../a:union/b:translate/color */
         real3 c24 = (real3)(0.95f, 0.8f, 0.3f);
-        real x20 = u26;
-        real y20 = d21;
-        real d20 = fmin(x20, y20);
-        real3 c20 = x20 < y20 ? uc26 : c24;
-        real t20 = x20 < y20 ? ut26 : R(1.0);
+        real d20 = fmin(u26, d21);
+        real3 c20 = u26 < d21 ? uc26 : c24;
+        real t20 = u26 < d21 ? ut26 : R(1.0);
         u20 = d20;
         uc20 = c20;
         ut20 = t20;
@@ -400,28 +366,25 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     real u12 = u20;
     real3 uc12 = uc20;
     real ut12 = ut20;
-    real g12 = length(p0 - (real3)(0.0f, 0.85f, (-0.8f))) * 0.9999f - 0.77f;
+    real g12 = (length(p0 - ((real3)(R(0.0), R(0.85), -R(0.8)))) * R(0.9999)) - R(0.77);
     if (!(g12 > u12 && g12 > R(0.0))) {
         /* union/a:union/b:translate */
-        real3 p10 = p0 - (real3)(0.0f, 0.85f, (-0.8f));
+        real3 p10 = p0 - ((real3)(R(0.0), R(0.85), -R(0.8)));
         /* .../color/round/mirror */
-        real3 p11 = p10;
-        p11.x = fabs(p11.x);
+        real3 p11 = (real3)(fabs(p10.x), p10.y, p10.z);
         /* .../round/mirror/translate */
-        real3 p12 = p11 - (real3)(0.5f, 0.0f, 0.0f);
+        real3 p12 = p11 - ((real3)(R(0.5), R(0.0), R(0.0)));
         /* .../mirror/translate/rotate */
         real3 p13 = (real3)(p12.x, p12.z, -p12.y);
         /* .../translate/rotate/torus */
         real d27 = sd_torus(p13, 0.2f, 0.06f);
         /* .../b:translate/color/round */
-        real d31 = d27 - 0.01f;
+        real d31 = d27 - R(0.01);
         /* .../a:union/b:translate/color */
         real3 c32 = (real3)(0.8f, 0.5f, 0.9f);
-        real x12 = u20;
-        real y12 = d31;
-        real d12 = fmin(x12, y12);
-        real3 c12 = x12 < y12 ? uc20 : c32;
-        real t12 = x12 < y12 ? ut20 : R(1.0);
+        real d12 = fmin(u20, d31);
+        real3 c12 = u20 < d31 ? uc20 : c32;
+        real t12 = u20 < d31 ? ut20 : R(1.0);
         u12 = d12;
         uc12 = c12;
         ut12 = t12;

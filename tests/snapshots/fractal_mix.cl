@@ -97,9 +97,8 @@ real sd_plane(real3 p, real3 n, real offset) {
     real t1 = fmax(fmax(t0.x, t0.y), t0.z);
     real3 t2 = n / t1;
     real t3 = length(t2);
-    real3 t4 = t2 / t3;
-    real3 t5 = (R(0.0) < t1) ? t4 : n;
-    return (((p.x * t5.x) + (p.y * t5.y)) + (p.z * t5.z)) + offset;
+    real3 t4 = (R(0.0) < t1) ? (t2 / t3) : n;
+    return (((p.x * t4.x) + (p.y * t4.y)) + (p.z * t4.z)) + offset;
 }
 
 /* ---- mandelbulb ---- */
@@ -123,18 +122,17 @@ real2 mandelbulb(real3 p, real power, real iterations, real escape, real ball) {
         real t7 = acos(fmin(fmax(ts0_2 / fmax(t4, R(1e-30)), -R(1.0)), R(1.0))) * power;
         real t8 = atan2(ts0_1, ts0_0) * power;
         real t9 = sin(t7);
-        real3 t10 = ((real3)(t9 * cos(t8), t9 * sin(t8), cos(t7))) * t6;
-        real3 t11 = t10 + ((real3)(p.x, p.y, p.z));
-        real t12 = fmin(((power * t5) * ts0_3) + R(1.0), R(1e30));
-        real t13 = fmin(ts0_4, t4);
-        ts0_0 = t11.x;
-        ts0_1 = t11.y;
-        ts0_2 = t11.z;
-        ts0_3 = t12;
-        ts0_4 = t13;
+        real3 t10 = (((real3)(t9 * cos(t8), t9 * sin(t8), cos(t7))) * t6) + ((real3)(p.x, p.y, p.z));
+        real t11 = fmin(((power * t5) * ts0_3) + R(1.0), R(1e30));
+        real t12 = fmin(ts0_4, t4);
+        ts0_0 = t10.x;
+        ts0_1 = t10.y;
+        ts0_2 = t10.z;
+        ts0_3 = t11;
+        ts0_4 = t12;
     }
-    real t14 = length((real3)(ts0_0, ts0_1, ts0_2));
-    return (real2)(t2 ? t1 : fmax(((R(0.5) * log(fmax(t14, R(1e-30)))) * t14) / ts0_3, t1), t2 ? R(1.0) : ts0_4);
+    real t13 = length((real3)(ts0_0, ts0_1, ts0_2));
+    return (real2)(t2 ? t1 : fmax(((R(0.5) * log(fmax(t13, R(1e-30)))) * t13) / ts0_3, t1), t2 ? R(1.0) : ts0_4);
 }
 
 /* ---- menger ---- */
@@ -162,10 +160,8 @@ real2 menger(real3 p, real iterations, real scale) {
         ts0_3 = t9;
         ts0_4 = t10;
     }
-    real3 t11 = fabs((real3)(ts0_0, ts0_1, ts0_2));
-    real3 t12 = t11 - R(1.0);
-    real3 t13 = fmax(t12, R(0.0));
-    return (real2)((length(t13) + fmin(fmax(fmax(t12.x, t12.y), t12.z), R(0.0))) / ts0_3, ts0_4);
+    real3 t11 = fabs((real3)(ts0_0, ts0_1, ts0_2)) - R(1.0);
+    return (real2)((length(fmax(t11, R(0.0))) + fmin(fmax(fmax(t11.x, t11.y), t11.z), R(0.0))) / ts0_3, ts0_4);
 }
 
 /* ---- sierpinski ---- */
@@ -180,18 +176,17 @@ real2 sierpinski(real3 p, real iterations, real scale) {
         real3 t1 = ((ts0_0 + ts0_1) < R(0.0)) ? ((real3)(-ts0_1, -ts0_0, ts0_2)) : ((real3)(ts0_0, ts0_1, ts0_2));
         real3 t2 = ((t1.x + t1.z) < R(0.0)) ? ((real3)(-t1.z, t1.y, -t1.x)) : t1;
         real3 t3 = ((t2.y + t2.z) < R(0.0)) ? ((real3)(t2.x, -t2.z, -t2.y)) : t2;
-        real3 t4 = t3 * scale;
-        real3 t5 = t4 - t0;
-        real t6 = ts0_3 * scale;
-        real t7 = fmin(ts0_4, length(t3) * R(0.5773502691896258));
-        ts0_0 = t5.x;
-        ts0_1 = t5.y;
-        ts0_2 = t5.z;
-        ts0_3 = t6;
-        ts0_4 = t7;
+        real3 t4 = (t3 * scale) - t0;
+        real t5 = ts0_3 * scale;
+        real t6 = fmin(ts0_4, length(t3) * R(0.5773502691896258));
+        ts0_0 = t4.x;
+        ts0_1 = t4.y;
+        ts0_2 = t4.z;
+        ts0_3 = t5;
+        ts0_4 = t6;
     }
-    real t8 = -ts0_0;
-    return (real2)(((fmax(fmax((t8 - ts0_1) - ts0_2, (ts0_0 + ts0_1) - ts0_2), fmax((t8 + ts0_1) + ts0_2, (ts0_0 - ts0_1) + ts0_2)) - R(1.0)) * R(0.5773502691896258)) / ts0_3, ts0_4);
+    real t7 = -ts0_0;
+    return (real2)(((fmax(fmax((t7 - ts0_1) - ts0_2, (ts0_0 + ts0_1) - ts0_2), fmax((t7 + ts0_1) + ts0_2, (ts0_0 - ts0_1) + ts0_2)) - R(1.0)) * R(0.5773502691896258)) / ts0_3, ts0_4);
 }
 
 /* ---- julia ---- */
@@ -199,7 +194,7 @@ real2 julia(real3 p, real cx, real cy, real cz, real cw, real w, real iterations
     real t0 = cy * cy;
     real t1 = cz * cz;
     real t2 = cw * cw;
-    real t3 = R(0.5) + sqrt((R(0.5) * R(0.5)) + sqrt((((cx * cx) + t0) + t1) + t2));
+    real t3 = R(0.5) + sqrt(R(0.25) + sqrt((((cx * cx) + t0) + t1) + t2));
     real t4 = fmin(t3, bailout);
     real t5 = (((p.x * p.x) + (p.y * p.y)) + (p.z * p.z)) + (w * w);
     real t6 = sqrt(t5);
@@ -244,26 +239,24 @@ real2 julia(real3 p, real cx, real cy, real cz, real cw, real w, real iterations
     real t21 = (R(0.25) * log(fmax(ts0_4, R(1e-30)))) * t20;
     bool t22 = bailout < (R(2.5) * t3);
     real t23 = (t22 || t7) ? R(0.0) : (ts0_7 + R(2.0));
-    real t24 = R(0.9) * R(0.9);
-    real t25 = sqrt((t0 + t1) + t2);
+    real t24 = sqrt((t0 + t1) + t2);
     real ts1_0 = R(0.0);
     real ts1_1 = R(0.0);
     real ts1_2 = R(0.0);
     for (int ti1 = 0; ti1 < t23; ti1++) {
-        real t26 = ((ts1_0 * ts1_0) - (ts1_1 * ts1_1)) + cx;
-        real t27 = ((R(2.0) * ts1_0) * ts1_1) + t25;
-        bool t28 = t24 < ((t26 * t26) + (t27 * t27));
-        real t29 = t28 ? R(1.0) : R(0.0);
-        ts1_0 = t26;
-        ts1_1 = t27;
-        ts1_2 = t29;
-        if (t28) {
+        real t25 = ((ts1_0 * ts1_0) - (ts1_1 * ts1_1)) + cx;
+        real t26 = ((R(2.0) * ts1_0) * ts1_1) + t24;
+        bool t27 = R(0.81) < ((t25 * t25) + (t26 * t26));
+        real t28 = t27 ? R(1.0) : R(0.0);
+        ts1_0 = t25;
+        ts1_1 = t26;
+        ts1_2 = t28;
+        if (t27) {
             break;
         }
     }
-    bool t30 = t22 || (R(0.5) < ts1_2);
-    real t31 = (t30 && (!t7)) ? (ts0_7 + R(3.0)) : R(0.0);
-    real t32 = R(1e18) * R(1e18);
+    bool t29 = t22 || (R(0.5) < ts1_2);
+    real t30 = (t29 && (!t7)) ? (ts0_7 + R(3.0)) : R(0.0);
     real ts2_0 = p.x;
     real ts2_1 = p.y;
     real ts2_2 = p.z;
@@ -273,45 +266,36 @@ real2 julia(real3 p, real cx, real cy, real cz, real cw, real w, real iterations
     real ts2_6 = R(0.0);
     real ts2_7 = R(1.0);
     real ts2_8 = R(0.0);
-    for (int ti2 = 0; ti2 < t31; ti2++) {
-        if (t32 < ts2_4) {
+    for (int ti2 = 0; ti2 < t30; ti2++) {
+        if (R(1e36) < ts2_4) {
             break;
         }
-        real t33 = sqrt(ts2_4);
-        real t34 = t33 - t4;
-        real t35 = fmin((ts2_7 * R(2.0)) * t33, R(1e30));
-        real t36 = fmin(t20 * t35, R(1e30));
-        real t37 = fmax(sqrt(ts2_4 + t36), R(1e-30));
-        real t38 = R(0.5) / t37;
-        real t39 = R(2.0) * ts2_0;
-        real t40 = ((((ts2_0 * ts2_0) - (ts2_1 * ts2_1)) - (ts2_2 * ts2_2)) - (ts2_3 * ts2_3)) + cx;
-        real t41 = (t39 * ts2_1) + cy;
-        real t42 = (t39 * ts2_2) + cz;
-        real t43 = (t39 * ts2_3) + cw;
-        real t44 = (((t40 * t40) + (t41 * t41)) + (t42 * t42)) + (t43 * t43);
-        real t45 = fmin(ts2_5 * ((t33 + t37) - (t36 * t38)), R(1e30));
-        real t46 = fmin((ts2_5 * t38) + ts2_6, R(1e30));
-        real t47 = (R(0.0) < t34) ? fmax(ts2_8, t34 / (ts2_5 + (ts2_6 * t34))) : ts2_8;
-        ts2_0 = t40;
-        ts2_1 = t41;
-        ts2_2 = t42;
-        ts2_3 = t43;
-        ts2_4 = t44;
-        ts2_5 = t45;
-        ts2_6 = t46;
-        ts2_7 = t35;
-        ts2_8 = t47;
+        real t31 = sqrt(ts2_4);
+        real t32 = t31 - t4;
+        real t33 = fmin((ts2_7 * R(2.0)) * t31, R(1e30));
+        real t34 = fmin(t20 * t33, R(1e30));
+        real t35 = fmax(sqrt(ts2_4 + t34), R(1e-30));
+        real t36 = R(0.5) / t35;
+        real t37 = R(2.0) * ts2_0;
+        real t38 = ((((ts2_0 * ts2_0) - (ts2_1 * ts2_1)) - (ts2_2 * ts2_2)) - (ts2_3 * ts2_3)) + cx;
+        real t39 = (t37 * ts2_1) + cy;
+        real t40 = (t37 * ts2_2) + cz;
+        real t41 = (t37 * ts2_3) + cw;
+        real t42 = (((t38 * t38) + (t39 * t39)) + (t40 * t40)) + (t41 * t41);
+        real t43 = fmin(ts2_5 * ((t31 + t35) - (t34 * t36)), R(1e30));
+        real t44 = fmin((ts2_5 * t36) + ts2_6, R(1e30));
+        real t45 = (R(0.0) < t32) ? fmax(ts2_8, t32 / (ts2_5 + (ts2_6 * t32))) : ts2_8;
+        ts2_0 = t38;
+        ts2_1 = t39;
+        ts2_2 = t40;
+        ts2_3 = t41;
+        ts2_4 = t42;
+        ts2_5 = t43;
+        ts2_6 = t44;
+        ts2_7 = t33;
+        ts2_8 = t45;
     }
-    return (real2)(t7 ? (R(0.9) * (t6 - t4)) : (t30 ? fmin(t21, ts2_8) : t21), t7 ? R(1.0) : fmin(sqrt(ts0_6), R(1.0)));
-}
-
-/* ---- smooth_min ---- */
-real2 smooth_min(real a, real b, real k) {
-    real t0 = fmax(k - fabs(a - b), R(0.0)) / k;
-    real t1 = (t0 * t0) * R(0.5);
-    bool t2 = k <= R(0.0);
-    real t3 = fmin(a, b);
-    return (real2)(t2 ? t3 : (t3 - ((t1 * k) * R(0.5))), t2 ? R(0.0) : t1);
+    return (real2)(t7 ? (R(0.9) * (t6 - t4)) : (t29 ? fmin(t21, ts2_8) : t21), t7 ? R(1.0) : fmin(sqrt(ts0_6), R(1.0)));
 }
 
 /* ---- scene ---- */
@@ -321,91 +305,82 @@ real DE(real3 p0, __global const real* params) {
     real d22 = sd_plane(p0, (real3)(0.0f, 1.0f, 0.0f), 0.55f);
     /* union: the second operand only within reach of its bound */
     real u24 = d22;
-    real g24 = fmin(fmin(fmin(length(p0 - (real3)((-1.1f), 0.0f, 0.0f)) * 0.9999f - 1.0f - 0.075f, length(p0 - (real3)(0.0f, 0.0f, (-0.6f))) * 0.9999f - 0.7794229f - 0.075f), 0.9f * (length(p0 - (real3)(1.1f, 0.0f, 0.0f)) * 0.9999f - 1.103242f) - 0.05f), 0.33333334f * (length(p0 - (real3)(0.0f, 0.0f, 0.7f)) * 0.9999f - 0.6062178f) - 0.025f);
+    real g24 = fmin(fmin(fmin(((length(p0 - ((real3)(-R(1.1), R(0.0), R(0.0)))) * R(0.9999)) - R(1.0)) - R(0.07500000000000001), ((length(p0 - ((real3)(R(0.0), R(0.0), -R(0.6)))) * R(0.9999)) - R(0.7794228634059948)) - R(0.07500000000000001)), (R(0.9) * ((length(p0 - ((real3)(R(1.1), R(0.0), R(0.0)))) * R(0.9999)) - R(1.1032420145137176))) - R(0.05)), (R(0.3333333333333333) * ((length(p0 - ((real3)(R(0.0), R(0.0), R(0.7)))) * R(0.9999)) - R(0.606217782649107))) - R(0.025));
     if (!(g24 > u24 && g24 > R(0.0))) {
         /* union/a:smooth_union/b:translate */
-        real3 p1 = p0 - (real3)(0.0f, 0.0f, 0.7f);
+        real3 p1 = p0 - ((real3)(R(0.0), R(0.0), R(0.7)));
         /* .../b:translate/color/scale */
-        real3 p2 = p1 / 0.35f;
+        real3 p2 = p1 / R(0.35);
         /* .../color/scale/sierpinski */
         real2 f17 = sierpinski(p2, 5, 2.0f);
         real d17 = f17.x;
-        real d18 = d17 * 0.35f;
+        real d18 = d17 * R(0.35);
         /* union/a:smooth_union: the second operand only within reach of its bound */
         real u21 = d18;
-        real g21 = fmin(fmin(length(p0 - (real3)((-1.1f), 0.0f, 0.0f)) * 0.9999f - 1.0f - 0.05f, length(p0 - (real3)(0.0f, 0.0f, (-0.6f))) * 0.9999f - 0.7794229f - 0.05f), 0.9f * (length(p0 - (real3)(1.1f, 0.0f, 0.0f)) * 0.9999f - 1.103242f) - 0.025f);
+        real g21 = fmin(fmin(((length(p0 - ((real3)(-R(1.1), R(0.0), R(0.0)))) * R(0.9999)) - R(1.0)) - R(0.05), ((length(p0 - ((real3)(R(0.0), R(0.0), -R(0.6)))) * R(0.9999)) - R(0.7794228634059948)) - R(0.05)), (R(0.9) * ((length(p0 - ((real3)(R(1.1), R(0.0), R(0.0)))) * R(0.9999)) - R(1.1032420145137176))) - R(0.025));
         if (!(g21 > u21 + 0.1f && g21 > R(0.0))) {
             /* .../a:smooth_union/a:smooth_union/b:translate */
-            real3 p3 = p0 - (real3)(1.1f, 0.0f, 0.0f);
+            real3 p3 = p0 - ((real3)(R(1.1), R(0.0), R(0.0)));
             /* .../b:translate/color/scale */
-            real3 p4 = p3 / 0.5f;
+            real3 p4 = p3 / R(0.5);
             /* .../color/scale/julia */
             real2 f12 = julia(p4, (-0.2f), 0.6f, 0.2f, 0.2f, 0.0f, 12, 4.0f);
             real d12 = f12.x;
-            real d13 = d12 * 0.5f;
+            real d13 = d12 * R(0.5);
             /* .../a:smooth_union/a:smooth_union: the second operand only within reach of its bound */
             real u16 = d13;
-            real g16 = fmin(length(p0 - (real3)((-1.1f), 0.0f, 0.0f)) * 0.9999f - 1.0f - 0.025f, length(p0 - (real3)(0.0f, 0.0f, (-0.6f))) * 0.9999f - 0.7794229f - 0.025f);
+            real g16 = fmin(((length(p0 - ((real3)(-R(1.1), R(0.0), R(0.0)))) * R(0.9999)) - R(1.0)) - R(0.025), ((length(p0 - ((real3)(R(0.0), R(0.0), -R(0.6)))) * R(0.9999)) - R(0.7794228634059948)) - R(0.025));
             if (!(g16 > u16 + 0.1f && g16 > R(0.0))) {
                 /* .../a:smooth_union/a:smooth_union/b:translate */
-                real3 p5 = p0 - (real3)(0.0f, 0.0f, (-0.6f));
+                real3 p5 = p0 - ((real3)(R(0.0), R(0.0), -R(0.6)));
                 /* .../color/smooth_subtract/a:scale */
-                real3 p6 = p5 / 0.45f;
+                real3 p6 = p5 / R(0.45);
                 /* .../smooth_subtract/a:scale/menger */
                 real2 f5 = menger(p6, 3, 3.0f);
                 real d5 = f5.x;
-                real d6 = d5 * 0.45f;
+                real d6 = d5 * R(0.45);
                 /* .../color/smooth_subtract: the second operand only within reach of its bound */
                 real u8 = d6;
-                real g8 = length(p5 - (real3)(0.0f)) * 0.9999f - 0.55f;
+                real g8 = (length(p5) * R(0.9999)) - R(0.55);
                 if (!(g8 > -u8 + 0.05f && g8 > R(0.0))) {
                     /* .../color/smooth_subtract/b:sphere */
                     real d7 = sd_sphere(p5, 0.55f);
                     /* .../b:translate/color/smooth_subtract */
-                    real x8 = -d6;
-                    real y8 = d7;
-                    real2 m8 = smooth_min(x8, y8, 0.05f);
-                    real d8 = -m8.x;
+                    real e14_0 = -d6;
+                    real e14_1 = fmax(R(0.05) - fabs(e14_0 - d7), R(0.0)) / R(0.05);
+                    real d8 = -(fmin(e14_0, d7) - ((((e14_1 * e14_1) * R(0.5)) * R(0.05)) * R(0.5)));
                     u8 = d8;
                 }
                 /* .../a:smooth_union/a:smooth_union: the second operand only within reach of its bound */
                 real u11 = u8;
-                real g11 = length(p0 - (real3)((-1.1f), 0.0f, 0.0f)) * 0.9999f - 1.0f;
+                real g11 = (length(p0 - ((real3)(-R(1.1), R(0.0), R(0.0)))) * R(0.9999)) - R(1.0);
                 if (!(g11 > u11 + 0.1f && g11 > R(0.0))) {
                     /* .../a:smooth_union/a:smooth_union/a:translate */
-                    real3 p7 = p0 - (real3)((-1.1f), 0.0f, 0.0f);
+                    real3 p7 = p0 - ((real3)(-R(1.1), R(0.0), R(0.0)));
                     /* .../a:translate/color/scale */
-                    real3 p8 = p7 / 0.5f;
+                    real3 p8 = p7 / R(0.5);
                     /* .../color/scale/rotate */
                     real3 p9 = (real3)(p8.x, -p8.z, p8.y);
                     /* .../scale/rotate/mandelbulb */
-                    real2 f0 = mandelbulb(p9, params[0] /* power */, 8, fmin(2.0f, pow(MAGNITUDE_CAP, R(1.0) / params[0] /* power */)), pow(R(2.0), R(1.0) / (params[0] /* power */ - R(1.0))));
+                    real2 f0 = mandelbulb(p9, params[0] /* power */, 8, fmin(R(2.0), pow(R(1e18), R(1.0) / params[0] /* power */)), pow(R(2.0), R(1.0) / (params[0] /* power */ - R(1.0))));
                     real d0 = f0.x;
-                    real d2 = d0 * 0.5f;
+                    real d2 = d0 * R(0.5);
                     /* .../a:smooth_union/a:smooth_union/a:smooth_union */
-                    real x11 = u8;
-                    real y11 = d2;
-                    real2 m11 = smooth_min(x11, y11, 0.1f);
-                    real d11 = m11.x;
+                    real e22_0 = fmax(R(0.1) - fabs(u8 - d2), R(0.0)) / R(0.1);
+                    real d11 = fmin(u8, d2) - ((((e22_0 * e22_0) * R(0.5)) * R(0.1)) * R(0.5));
                     u11 = d11;
                 }
                 /* union/a:smooth_union/a:smooth_union */
-                real x16 = d13;
-                real y16 = u11;
-                real2 m16 = smooth_min(x16, y16, 0.1f);
-                real d16 = m16.x;
+                real e23_0 = fmax(R(0.1) - fabs(d13 - u11), R(0.0)) / R(0.1);
+                real d16 = fmin(d13, u11) - ((((e23_0 * e23_0) * R(0.5)) * R(0.1)) * R(0.5));
                 u16 = d16;
             }
             /* union/a:smooth_union */
-            real x21 = d18;
-            real y21 = u16;
-            real2 m21 = smooth_min(x21, y21, 0.1f);
-            real d21 = m21.x;
+            real e24_0 = fmax(R(0.1) - fabs(d18 - u16), R(0.0)) / R(0.1);
+            real d21 = fmin(d18, u16) - ((((e24_0 * e24_0) * R(0.5)) * R(0.1)) * R(0.5));
             u21 = d21;
         }
-        real x24 = d22;
-        real y24 = u21;
-        real d24 = fmin(x24, y24);
+        real d24 = fmin(d22, u21);
         u24 = d24;
     }
     return u24;
@@ -421,64 +396,64 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     real u24 = d22;
     real3 uc24 = c23;
     real ut24 = R(1.0);
-    real g24 = fmin(fmin(fmin(length(p0 - (real3)((-1.1f), 0.0f, 0.0f)) * 0.9999f - 1.0f - 0.075f, length(p0 - (real3)(0.0f, 0.0f, (-0.6f))) * 0.9999f - 0.7794229f - 0.075f), 0.9f * (length(p0 - (real3)(1.1f, 0.0f, 0.0f)) * 0.9999f - 1.103242f) - 0.05f), 0.33333334f * (length(p0 - (real3)(0.0f, 0.0f, 0.7f)) * 0.9999f - 0.6062178f) - 0.025f);
+    real g24 = fmin(fmin(fmin(((length(p0 - ((real3)(-R(1.1), R(0.0), R(0.0)))) * R(0.9999)) - R(1.0)) - R(0.07500000000000001), ((length(p0 - ((real3)(R(0.0), R(0.0), -R(0.6)))) * R(0.9999)) - R(0.7794228634059948)) - R(0.07500000000000001)), (R(0.9) * ((length(p0 - ((real3)(R(1.1), R(0.0), R(0.0)))) * R(0.9999)) - R(1.1032420145137176))) - R(0.05)), (R(0.3333333333333333) * ((length(p0 - ((real3)(R(0.0), R(0.0), R(0.7)))) * R(0.9999)) - R(0.606217782649107))) - R(0.025));
     if (!(g24 > u24 && g24 > R(0.0))) {
         /* union/a:smooth_union/b:translate */
-        real3 p1 = p0 - (real3)(0.0f, 0.0f, 0.7f);
+        real3 p1 = p0 - ((real3)(R(0.0), R(0.0), R(0.7)));
         /* .../b:translate/color/scale */
-        real3 p2 = p1 / 0.35f;
+        real3 p2 = p1 / R(0.35);
         /* .../color/scale/sierpinski */
         real2 f17 = sierpinski(p2, 5, 2.0f);
         real d17 = f17.x;
         real t17 = f17.y;
-        real d18 = d17 * 0.35f;
+        real d18 = d17 * R(0.35);
         /* .../a:smooth_union/b:translate/color */
         real3 c19 = (real3)(0.95f, 0.8f, 0.4f);
         /* union/a:smooth_union: the second operand only within reach of its bound */
         real u21 = d18;
         real3 uc21 = c19;
         real ut21 = t17;
-        real g21 = fmin(fmin(length(p0 - (real3)((-1.1f), 0.0f, 0.0f)) * 0.9999f - 1.0f - 0.05f, length(p0 - (real3)(0.0f, 0.0f, (-0.6f))) * 0.9999f - 0.7794229f - 0.05f), 0.9f * (length(p0 - (real3)(1.1f, 0.0f, 0.0f)) * 0.9999f - 1.103242f) - 0.025f);
+        real g21 = fmin(fmin(((length(p0 - ((real3)(-R(1.1), R(0.0), R(0.0)))) * R(0.9999)) - R(1.0)) - R(0.05), ((length(p0 - ((real3)(R(0.0), R(0.0), -R(0.6)))) * R(0.9999)) - R(0.7794228634059948)) - R(0.05)), (R(0.9) * ((length(p0 - ((real3)(R(1.1), R(0.0), R(0.0)))) * R(0.9999)) - R(1.1032420145137176))) - R(0.025));
         if (!(g21 > u21 + 0.1f && g21 > R(0.0))) {
             /* .../a:smooth_union/a:smooth_union/b:translate */
-            real3 p3 = p0 - (real3)(1.1f, 0.0f, 0.0f);
+            real3 p3 = p0 - ((real3)(R(1.1), R(0.0), R(0.0)));
             /* .../b:translate/color/scale */
-            real3 p4 = p3 / 0.5f;
+            real3 p4 = p3 / R(0.5);
             /* .../color/scale/julia */
             real2 f12 = julia(p4, (-0.2f), 0.6f, 0.2f, 0.2f, 0.0f, 12, 4.0f);
             real d12 = f12.x;
             real t12 = f12.y;
-            real d13 = d12 * 0.5f;
+            real d13 = d12 * R(0.5);
             /* .../a:smooth_union/b:translate/color */
             real3 c14 = (real3)(0.4f, 0.7f, 0.95f);
             /* .../a:smooth_union/a:smooth_union: the second operand only within reach of its bound */
             real u16 = d13;
             real3 uc16 = c14;
             real ut16 = t12;
-            real g16 = fmin(length(p0 - (real3)((-1.1f), 0.0f, 0.0f)) * 0.9999f - 1.0f - 0.025f, length(p0 - (real3)(0.0f, 0.0f, (-0.6f))) * 0.9999f - 0.7794229f - 0.025f);
+            real g16 = fmin(((length(p0 - ((real3)(-R(1.1), R(0.0), R(0.0)))) * R(0.9999)) - R(1.0)) - R(0.025), ((length(p0 - ((real3)(R(0.0), R(0.0), -R(0.6)))) * R(0.9999)) - R(0.7794228634059948)) - R(0.025));
             if (!(g16 > u16 + 0.1f && g16 > R(0.0))) {
                 /* .../a:smooth_union/a:smooth_union/b:translate */
-                real3 p5 = p0 - (real3)(0.0f, 0.0f, (-0.6f));
+                real3 p5 = p0 - ((real3)(R(0.0), R(0.0), -R(0.6)));
                 /* .../color/smooth_subtract/a:scale */
-                real3 p6 = p5 / 0.45f;
+                real3 p6 = p5 / R(0.45);
                 /* .../smooth_subtract/a:scale/menger */
                 real2 f5 = menger(p6, 3, 3.0f);
                 real d5 = f5.x;
                 real t5 = f5.y;
-                real d6 = d5 * 0.45f;
+                real d6 = d5 * R(0.45);
                 /* .../color/smooth_subtract: the second operand only within reach of its bound */
                 real u8 = d6;
                 real ut8 = t5;
-                real g8 = length(p5 - (real3)(0.0f)) * 0.9999f - 0.55f;
+                real g8 = (length(p5) * R(0.9999)) - R(0.55);
                 if (!(g8 > -u8 + 0.05f && g8 > R(0.0))) {
                     /* .../color/smooth_subtract/b:sphere */
                     real d7 = sd_sphere(p5, 0.55f);
                     /* .../b:translate/color/smooth_subtract */
-                    real x8 = -d6;
-                    real y8 = d7;
-                    real2 m8 = smooth_min(x8, y8, 0.05f);
-                    real d8 = -m8.x;
-                    real t8 = x8 < y8 ? mix(t5, R(1.0), m8.y) : mix(R(1.0), t5, m8.y);
+                    real e39_0 = -d6;
+                    real e39_1 = fmax(R(0.05) - fabs(e39_0 - d7), R(0.0)) / R(0.05);
+                    real e39_2 = (e39_1 * e39_1) * R(0.5);
+                    real d8 = -(fmin(e39_0, d7) - ((e39_2 * R(0.05)) * R(0.5)));
+                    real t8 = e39_0 < d7 ? mix(t5, R(1.0), e39_2) : mix(R(1.0), t5, e39_2);
                     u8 = d8;
                     ut8 = t8;
                 }
@@ -488,59 +463,54 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
                 real u11 = u8;
                 real3 uc11 = c9;
                 real ut11 = ut8;
-                real g11 = length(p0 - (real3)((-1.1f), 0.0f, 0.0f)) * 0.9999f - 1.0f;
+                real g11 = (length(p0 - ((real3)(-R(1.1), R(0.0), R(0.0)))) * R(0.9999)) - R(1.0);
                 if (!(g11 > u11 + 0.1f && g11 > R(0.0))) {
                     /* .../a:smooth_union/a:smooth_union/a:translate */
-                    real3 p7 = p0 - (real3)((-1.1f), 0.0f, 0.0f);
+                    real3 p7 = p0 - ((real3)(-R(1.1), R(0.0), R(0.0)));
                     /* .../a:translate/color/scale */
-                    real3 p8 = p7 / 0.5f;
+                    real3 p8 = p7 / R(0.5);
                     /* .../color/scale/rotate */
                     real3 p9 = (real3)(p8.x, -p8.z, p8.y);
                     /* .../scale/rotate/mandelbulb */
-                    real2 f0 = mandelbulb(p9, params[0] /* power */, 8, fmin(2.0f, pow(MAGNITUDE_CAP, R(1.0) / params[0] /* power */)), pow(R(2.0), R(1.0) / (params[0] /* power */ - R(1.0))));
+                    real2 f0 = mandelbulb(p9, params[0] /* power */, 8, fmin(R(2.0), pow(R(1e18), R(1.0) / params[0] /* power */)), pow(R(2.0), R(1.0) / (params[0] /* power */ - R(1.0))));
                     real d0 = f0.x;
                     real t0 = f0.y;
-                    real d2 = d0 * 0.5f;
+                    real d2 = d0 * R(0.5);
                     /* .../a:smooth_union/a:translate/color */
                     real3 c3 = (real3)(0.9f, 0.55f, 0.3f);
                     /* .../a:smooth_union/a:smooth_union/a:smooth_union */
-                    real x11 = u8;
-                    real y11 = d2;
-                    real2 m11 = smooth_min(x11, y11, 0.1f);
-                    real d11 = m11.x;
-                    real3 c11 = x11 < y11 ? mix(c9, c3, m11.y) : mix(c3, c9, m11.y);
-                    real t11 = x11 < y11 ? mix(ut8, t0, m11.y) : mix(t0, ut8, m11.y);
+                    real e47_0 = fmax(R(0.1) - fabs(u8 - d2), R(0.0)) / R(0.1);
+                    real e47_1 = (e47_0 * e47_0) * R(0.5);
+                    real d11 = fmin(u8, d2) - ((e47_1 * R(0.1)) * R(0.5));
+                    real3 c11 = u8 < d2 ? mix(c9, c3, e47_1) : mix(c3, c9, e47_1);
+                    real t11 = u8 < d2 ? mix(ut8, t0, e47_1) : mix(t0, ut8, e47_1);
                     u11 = d11;
                     uc11 = c11;
                     ut11 = t11;
                 }
                 /* union/a:smooth_union/a:smooth_union */
-                real x16 = d13;
-                real y16 = u11;
-                real2 m16 = smooth_min(x16, y16, 0.1f);
-                real d16 = m16.x;
-                real3 c16 = x16 < y16 ? mix(c14, uc11, m16.y) : mix(uc11, c14, m16.y);
-                real t16 = x16 < y16 ? mix(t12, ut11, m16.y) : mix(ut11, t12, m16.y);
+                real e48_0 = fmax(R(0.1) - fabs(d13 - u11), R(0.0)) / R(0.1);
+                real e48_1 = (e48_0 * e48_0) * R(0.5);
+                real d16 = fmin(d13, u11) - ((e48_1 * R(0.1)) * R(0.5));
+                real3 c16 = d13 < u11 ? mix(c14, uc11, e48_1) : mix(uc11, c14, e48_1);
+                real t16 = d13 < u11 ? mix(t12, ut11, e48_1) : mix(ut11, t12, e48_1);
                 u16 = d16;
                 uc16 = c16;
                 ut16 = t16;
             }
             /* union/a:smooth_union */
-            real x21 = d18;
-            real y21 = u16;
-            real2 m21 = smooth_min(x21, y21, 0.1f);
-            real d21 = m21.x;
-            real3 c21 = x21 < y21 ? mix(c19, uc16, m21.y) : mix(uc16, c19, m21.y);
-            real t21 = x21 < y21 ? mix(t17, ut16, m21.y) : mix(ut16, t17, m21.y);
+            real e49_0 = fmax(R(0.1) - fabs(d18 - u16), R(0.0)) / R(0.1);
+            real e49_1 = (e49_0 * e49_0) * R(0.5);
+            real d21 = fmin(d18, u16) - ((e49_1 * R(0.1)) * R(0.5));
+            real3 c21 = d18 < u16 ? mix(c19, uc16, e49_1) : mix(uc16, c19, e49_1);
+            real t21 = d18 < u16 ? mix(t17, ut16, e49_1) : mix(ut16, t17, e49_1);
             u21 = d21;
             uc21 = c21;
             ut21 = t21;
         }
-        real x24 = d22;
-        real y24 = u21;
-        real d24 = fmin(x24, y24);
-        real3 c24 = x24 < y24 ? c23 : uc21;
-        real t24 = x24 < y24 ? R(1.0) : ut21;
+        real d24 = fmin(d22, u21);
+        real3 c24 = d22 < u21 ? c23 : uc21;
+        real t24 = d22 < u21 ? R(1.0) : ut21;
         u24 = d24;
         uc24 = c24;
         ut24 = t24;

@@ -91,7 +91,7 @@ real2 julia(real3 p, real cx, real cy, real cz, real cw, real w, real iterations
     real t0 = cy * cy;
     real t1 = cz * cz;
     real t2 = cw * cw;
-    real t3 = R(0.5) + sqrt((R(0.5) * R(0.5)) + sqrt((((cx * cx) + t0) + t1) + t2));
+    real t3 = R(0.5) + sqrt(R(0.25) + sqrt((((cx * cx) + t0) + t1) + t2));
     real t4 = fmin(t3, bailout);
     real t5 = (((p.x * p.x) + (p.y * p.y)) + (p.z * p.z)) + (w * w);
     real t6 = sqrt(t5);
@@ -136,26 +136,24 @@ real2 julia(real3 p, real cx, real cy, real cz, real cw, real w, real iterations
     real t21 = (R(0.25) * log(fmax(ts0_4, R(1e-30)))) * t20;
     bool t22 = bailout < (R(2.5) * t3);
     real t23 = (t22 || t7) ? R(0.0) : (ts0_7 + R(2.0));
-    real t24 = R(0.9) * R(0.9);
-    real t25 = sqrt((t0 + t1) + t2);
+    real t24 = sqrt((t0 + t1) + t2);
     real ts1_0 = R(0.0);
     real ts1_1 = R(0.0);
     real ts1_2 = R(0.0);
     for (int ti1 = 0; ti1 < t23; ti1++) {
-        real t26 = ((ts1_0 * ts1_0) - (ts1_1 * ts1_1)) + cx;
-        real t27 = ((R(2.0) * ts1_0) * ts1_1) + t25;
-        bool t28 = t24 < ((t26 * t26) + (t27 * t27));
-        real t29 = t28 ? R(1.0) : R(0.0);
-        ts1_0 = t26;
-        ts1_1 = t27;
-        ts1_2 = t29;
-        if (t28) {
+        real t25 = ((ts1_0 * ts1_0) - (ts1_1 * ts1_1)) + cx;
+        real t26 = ((R(2.0) * ts1_0) * ts1_1) + t24;
+        bool t27 = R(0.81) < ((t25 * t25) + (t26 * t26));
+        real t28 = t27 ? R(1.0) : R(0.0);
+        ts1_0 = t25;
+        ts1_1 = t26;
+        ts1_2 = t28;
+        if (t27) {
             break;
         }
     }
-    bool t30 = t22 || (R(0.5) < ts1_2);
-    real t31 = (t30 && (!t7)) ? (ts0_7 + R(3.0)) : R(0.0);
-    real t32 = R(1e18) * R(1e18);
+    bool t29 = t22 || (R(0.5) < ts1_2);
+    real t30 = (t29 && (!t7)) ? (ts0_7 + R(3.0)) : R(0.0);
     real ts2_0 = p.x;
     real ts2_1 = p.y;
     real ts2_2 = p.z;
@@ -165,36 +163,36 @@ real2 julia(real3 p, real cx, real cy, real cz, real cw, real w, real iterations
     real ts2_6 = R(0.0);
     real ts2_7 = R(1.0);
     real ts2_8 = R(0.0);
-    for (int ti2 = 0; ti2 < t31; ti2++) {
-        if (t32 < ts2_4) {
+    for (int ti2 = 0; ti2 < t30; ti2++) {
+        if (R(1e36) < ts2_4) {
             break;
         }
-        real t33 = sqrt(ts2_4);
-        real t34 = t33 - t4;
-        real t35 = fmin((ts2_7 * R(2.0)) * t33, R(1e30));
-        real t36 = fmin(t20 * t35, R(1e30));
-        real t37 = fmax(sqrt(ts2_4 + t36), R(1e-30));
-        real t38 = R(0.5) / t37;
-        real t39 = R(2.0) * ts2_0;
-        real t40 = ((((ts2_0 * ts2_0) - (ts2_1 * ts2_1)) - (ts2_2 * ts2_2)) - (ts2_3 * ts2_3)) + cx;
-        real t41 = (t39 * ts2_1) + cy;
-        real t42 = (t39 * ts2_2) + cz;
-        real t43 = (t39 * ts2_3) + cw;
-        real t44 = (((t40 * t40) + (t41 * t41)) + (t42 * t42)) + (t43 * t43);
-        real t45 = fmin(ts2_5 * ((t33 + t37) - (t36 * t38)), R(1e30));
-        real t46 = fmin((ts2_5 * t38) + ts2_6, R(1e30));
-        real t47 = (R(0.0) < t34) ? fmax(ts2_8, t34 / (ts2_5 + (ts2_6 * t34))) : ts2_8;
-        ts2_0 = t40;
-        ts2_1 = t41;
-        ts2_2 = t42;
-        ts2_3 = t43;
-        ts2_4 = t44;
-        ts2_5 = t45;
-        ts2_6 = t46;
-        ts2_7 = t35;
-        ts2_8 = t47;
+        real t31 = sqrt(ts2_4);
+        real t32 = t31 - t4;
+        real t33 = fmin((ts2_7 * R(2.0)) * t31, R(1e30));
+        real t34 = fmin(t20 * t33, R(1e30));
+        real t35 = fmax(sqrt(ts2_4 + t34), R(1e-30));
+        real t36 = R(0.5) / t35;
+        real t37 = R(2.0) * ts2_0;
+        real t38 = ((((ts2_0 * ts2_0) - (ts2_1 * ts2_1)) - (ts2_2 * ts2_2)) - (ts2_3 * ts2_3)) + cx;
+        real t39 = (t37 * ts2_1) + cy;
+        real t40 = (t37 * ts2_2) + cz;
+        real t41 = (t37 * ts2_3) + cw;
+        real t42 = (((t38 * t38) + (t39 * t39)) + (t40 * t40)) + (t41 * t41);
+        real t43 = fmin(ts2_5 * ((t31 + t35) - (t34 * t36)), R(1e30));
+        real t44 = fmin((ts2_5 * t36) + ts2_6, R(1e30));
+        real t45 = (R(0.0) < t32) ? fmax(ts2_8, t32 / (ts2_5 + (ts2_6 * t32))) : ts2_8;
+        ts2_0 = t38;
+        ts2_1 = t39;
+        ts2_2 = t40;
+        ts2_3 = t41;
+        ts2_4 = t42;
+        ts2_5 = t43;
+        ts2_6 = t44;
+        ts2_7 = t33;
+        ts2_8 = t45;
     }
-    return (real2)(t7 ? (R(0.9) * (t6 - t4)) : (t30 ? fmin(t21, ts2_8) : t21), t7 ? R(1.0) : fmin(sqrt(ts0_6), R(1.0)));
+    return (real2)(t7 ? (R(0.9) * (t6 - t4)) : (t29 ? fmin(t21, ts2_8) : t21), t7 ? R(1.0) : fmin(sqrt(ts0_6), R(1.0)));
 }
 
 /* ---- scene ---- */

@@ -96,9 +96,8 @@ real sd_plane(real3 p, real3 n, real offset) {
     real t1 = fmax(fmax(t0.x, t0.y), t0.z);
     real3 t2 = n / t1;
     real t3 = length(t2);
-    real3 t4 = t2 / t3;
-    real3 t5 = (R(0.0) < t1) ? t4 : n;
-    return (((p.x * t5.x) + (p.y * t5.y)) + (p.z * t5.z)) + offset;
+    real3 t4 = (R(0.0) < t1) ? (t2 / t3) : n;
+    return (((p.x * t4.x) + (p.y * t4.y)) + (p.z * t4.z)) + offset;
 }
 
 /* ---- custom shape mandelbox_escape ---- */
@@ -129,18 +128,16 @@ real DE(real3 p0, __global const real* params) {
     real d4 = sd_plane(p0, (real3)(0.0f, 1.0f, 0.0f), 1.0f);
     /* union: the second operand only within reach of its bound */
     real u6 = d4;
-    real g6 = length(p0 - (real3)(0.0f)) * 0.9999f - 1.9485571f;
+    real g6 = (length(p0) * R(0.9999)) - R(1.948557158514987);
     if (!(g6 > u6 && g6 > R(0.0))) {
         /* union/a:color/scale */
-        real3 p1 = p0 / 0.5f;
+        real3 p1 = p0 / R(0.5);
         /* .../a:color/scale/rotate */
-        real3 p2 = (real3)(0.8253356f * p1.x + (-0.5646425f) * p1.z, p1.y, 0.5646425f * p1.x + 0.8253356f * p1.z);
+        real3 p2 = (real3)((R(0.8253356149096783) * p1.x) - (R(0.5646424733950354) * p1.z), p1.y, (R(0.5646424733950354) * p1.x) + (R(0.8253356149096783) * p1.z));
         /* .../scale/rotate/mandelbox_escape */
         real d0 = custom_mandelbox_escape(p2, (-1.5f), 12.0f);
-        real d2 = d0 * 0.5f;
-        real x6 = d4;
-        real y6 = d2;
-        real d6 = fmin(x6, y6);
+        real d2 = d0 * R(0.5);
+        real d6 = fmin(d4, d2);
         u6 = d6;
     }
     return u6;
@@ -156,21 +153,19 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     real u6 = d4;
     real3 uc6 = c5;
     real ut6 = R(1.0);
-    real g6 = length(p0 - (real3)(0.0f)) * 0.9999f - 1.9485571f;
+    real g6 = (length(p0) * R(0.9999)) - R(1.948557158514987);
     if (!(g6 > u6 && g6 > R(0.0))) {
         /* union/a:color/scale */
-        real3 p1 = p0 / 0.5f;
+        real3 p1 = p0 / R(0.5);
         /* .../a:color/scale/rotate */
-        real3 p2 = (real3)(0.8253356f * p1.x + (-0.5646425f) * p1.z, p1.y, 0.5646425f * p1.x + 0.8253356f * p1.z);
+        real3 p2 = (real3)((R(0.8253356149096783) * p1.x) - (R(0.5646424733950354) * p1.z), p1.y, (R(0.5646424733950354) * p1.x) + (R(0.8253356149096783) * p1.z));
         /* .../scale/rotate/mandelbox_escape */
         real d0 = custom_mandelbox_escape(p2, (-1.5f), 12.0f);
-        real d2 = d0 * 0.5f;
+        real d2 = d0 * R(0.5);
         /* union/a:color */
         real3 c3 = (real3)(0.5f, 0.62f, 0.85f);
-        real x6 = d4;
-        real y6 = d2;
-        real d6 = fmin(x6, y6);
-        real3 c6 = x6 < y6 ? c5 : c3;
+        real d6 = fmin(d4, d2);
+        real3 c6 = d4 < d2 ? c5 : c3;
         u6 = d6;
         uc6 = c6;
         ut6 = R(1.0);

@@ -121,18 +121,17 @@ real2 mandelbulb_p8(real3 p, real iterations, real escape, real ball) {
         real t21 = (R(2.0) * t18) * t19;
         real t22 = (t20 * t20) - (t21 * t21);
         real t23 = (R(2.0) * t20) * t21;
-        real3 t24 = ((real3)(t16 * ((t22 * t22) - (t23 * t23)), t16 * ((R(2.0) * t22) * t23), (t14 * t14) - (t15 * t15))) * t7;
-        real3 t25 = t24 + ((real3)(p.x, p.y, p.z));
-        real t26 = fmin(((R(8.0) * t6) * ts0_3) + R(1.0), R(1e30));
-        real t27 = fmin(ts0_4, t4);
-        ts0_0 = t25.x;
-        ts0_1 = t25.y;
-        ts0_2 = t25.z;
-        ts0_3 = t26;
-        ts0_4 = t27;
+        real3 t24 = (((real3)(t16 * ((t22 * t22) - (t23 * t23)), t16 * ((R(2.0) * t22) * t23), (t14 * t14) - (t15 * t15))) * t7) + ((real3)(p.x, p.y, p.z));
+        real t25 = fmin(((R(8.0) * t6) * ts0_3) + R(1.0), R(1e30));
+        real t26 = fmin(ts0_4, t4);
+        ts0_0 = t24.x;
+        ts0_1 = t24.y;
+        ts0_2 = t24.z;
+        ts0_3 = t25;
+        ts0_4 = t26;
     }
-    real t28 = length((real3)(ts0_0, ts0_1, ts0_2));
-    return (real2)(t2 ? t1 : fmax(((R(0.5) * log(fmax(t28, R(1e-30)))) * t28) / ts0_3, t1), t2 ? R(1.0) : ts0_4);
+    real t27 = length((real3)(ts0_0, ts0_1, ts0_2));
+    return (real2)(t2 ? t1 : fmax(((R(0.5) * log(fmax(t27, R(1e-30)))) * t27) / ts0_3, t1), t2 ? R(1.0) : ts0_4);
 }
 
 /* ---- scene ---- */
@@ -140,7 +139,7 @@ real DE(real3 p0, __global const real* params) {
     /* color/rotate */
     real3 p1 = (real3)(p0.x, -p0.z, p0.y);
     /* color/rotate/mandelbulb */
-    real2 f0 = mandelbulb_p8(p1, 10, 2.0, 1.1040895136738123);
+    real2 f0 = mandelbulb_p8(p1, 10, R(2.0), 1.1040895136738123);
     real d0 = f0.x;
     return d0;
 }
@@ -149,7 +148,7 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     /* color/rotate */
     real3 p1 = (real3)(p0.x, -p0.z, p0.y);
     /* color/rotate/mandelbulb */
-    real2 f0 = mandelbulb_p8(p1, 10, 2.0, 1.1040895136738123);
+    real2 f0 = mandelbulb_p8(p1, 10, R(2.0), 1.1040895136738123);
     real d0 = f0.x;
     real t0 = f0.y;
     /* color */

@@ -101,9 +101,8 @@ real sd_plane(real3 p, real3 n, real offset) {
     real t1 = fmax(fmax(t0.x, t0.y), t0.z);
     real3 t2 = n / t1;
     real t3 = length(t2);
-    real3 t4 = t2 / t3;
-    real3 t5 = (R(0.0) < t1) ? t4 : n;
-    return (((p.x * t5.x) + (p.y * t5.y)) + (p.z * t5.z)) + offset;
+    real3 t4 = (R(0.0) < t1) ? (t2 / t3) : n;
+    return (((p.x * t4.x) + (p.y * t4.y)) + (p.z * t4.z)) + offset;
 }
 
 /* ---- ellipsoid ---- */
@@ -111,15 +110,12 @@ real sd_ellipsoid(real3 p, real3 r) {
     real3 t0 = p / r;
     real3 t1 = fabs(t0);
     real t2 = fmax(fmax(t1.x, t1.y), t1.z);
-    real3 t3 = t0 / t2;
-    real t4 = ((R(0.0) < t2) && isfinite(t2)) ? (t2 * length(t3)) : length(t0);
-    real3 t5 = t0 / t4;
-    real3 t6 = t5 / r;
-    real3 t7 = fabs(t6);
-    real t8 = fmax(fmax(t7.x, t7.y), t7.z);
-    real3 t9 = t6 / t8;
-    real t10 = t4 - R(1.0);
-    return (t4 < R(1.0)) ? (t10 * fmin(fmin(r.x, r.y), r.z)) : (t10 / fmax(((R(0.0) < t8) && isfinite(t8)) ? (t8 * length(t9)) : length(t6), R(1e-30)));
+    real t3 = ((R(0.0) < t2) && isfinite(t2)) ? (t2 * length(t0 / t2)) : length(t0);
+    real3 t4 = (t0 / t3) / r;
+    real3 t5 = fabs(t4);
+    real t6 = fmax(fmax(t5.x, t5.y), t5.z);
+    real t7 = t3 - R(1.0);
+    return (t3 < R(1.0)) ? (t7 * fmin(fmin(r.x, r.y), r.z)) : (t7 / fmax(((R(0.0) < t6) && isfinite(t6)) ? (t6 * length(t4 / t6)) : length(t4), R(1e-30)));
 }
 
 /* ---- mandelbulb_p8 ---- */
@@ -157,18 +153,17 @@ real2 mandelbulb_p8(real3 p, real iterations, real escape, real ball) {
         real t21 = (R(2.0) * t18) * t19;
         real t22 = (t20 * t20) - (t21 * t21);
         real t23 = (R(2.0) * t20) * t21;
-        real3 t24 = ((real3)(t16 * ((t22 * t22) - (t23 * t23)), t16 * ((R(2.0) * t22) * t23), (t14 * t14) - (t15 * t15))) * t7;
-        real3 t25 = t24 + ((real3)(p.x, p.y, p.z));
-        real t26 = fmin(((R(8.0) * t6) * ts0_3) + R(1.0), R(1e30));
-        real t27 = fmin(ts0_4, t4);
-        ts0_0 = t25.x;
-        ts0_1 = t25.y;
-        ts0_2 = t25.z;
-        ts0_3 = t26;
-        ts0_4 = t27;
+        real3 t24 = (((real3)(t16 * ((t22 * t22) - (t23 * t23)), t16 * ((R(2.0) * t22) * t23), (t14 * t14) - (t15 * t15))) * t7) + ((real3)(p.x, p.y, p.z));
+        real t25 = fmin(((R(8.0) * t6) * ts0_3) + R(1.0), R(1e30));
+        real t26 = fmin(ts0_4, t4);
+        ts0_0 = t24.x;
+        ts0_1 = t24.y;
+        ts0_2 = t24.z;
+        ts0_3 = t25;
+        ts0_4 = t26;
     }
-    real t28 = length((real3)(ts0_0, ts0_1, ts0_2));
-    return (real2)(t2 ? t1 : fmax(((R(0.5) * log(fmax(t28, R(1e-30)))) * t28) / ts0_3, t1), t2 ? R(1.0) : ts0_4);
+    real t27 = length((real3)(ts0_0, ts0_1, ts0_2));
+    return (real2)(t2 ? t1 : fmax(((R(0.5) * log(fmax(t27, R(1e-30)))) * t27) / ts0_3, t1), t2 ? R(1.0) : ts0_4);
 }
 
 /* ---- scene ---- */
@@ -178,88 +173,76 @@ real DE(real3 p0, __global const real* params) {
     real d29 = sd_plane(p0, (real3)(0.0f, 1.0f, 0.0f), 0.45f);
     /* union: the second operand only within reach of its bound */
     real u32 = d29;
-    real g32 = length(p0 - (real3)((-1.9f), 0.0f, 0.2f)) * 0.9999f - 0.42f;
+    real g32 = (length(p0 - ((real3)(-R(1.9), R(0.0), R(0.2)))) * R(0.9999)) - R(0.42);
     if (!(g32 > u32 && g32 > R(0.0))) {
         /* .../a:union/a:union/a:translate */
-        real3 p1 = p0 - (real3)((-1.9f), 0.0f, 0.2f);
+        real3 p1 = p0 - ((real3)(-R(1.9), R(0.0), R(0.2)));
         /* .../material/color/sphere */
         real d0 = sd_sphere(p1, 0.42f);
-        real x32 = d29;
-        real y32 = d0;
-        real d32 = fmin(x32, y32);
+        real d32 = fmin(d29, d0);
         u32 = d32;
     }
     /* union/a:union: the second operand only within reach of its bound */
     real u28 = u32;
-    real g28 = length(p0 - (real3)((-0.95f), 0.0f, 0.2f)) * 0.9999f - 0.42f;
+    real g28 = (length(p0 - ((real3)(-R(0.95), R(0.0), R(0.2)))) * R(0.9999)) - R(0.42);
     if (!(g28 > u28 && g28 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p2 = p0 - (real3)((-0.95f), 0.0f, 0.2f);
+        real3 p2 = p0 - ((real3)(-R(0.95), R(0.0), R(0.2)));
         /* .../material/color/sphere */
         real d4 = sd_sphere(p2, 0.42f);
-        real x28 = u32;
-        real y28 = d4;
-        real d28 = fmin(x28, y28);
+        real d28 = fmin(u32, d4);
         u28 = d28;
     }
     /* .../a:union/a:union: the second operand only within reach of its bound */
     real u22 = u28;
-    real g22 = 0.35555556f * (length(p0 - (real3)(0.0f, 0.0f, 0.2f)) * 0.9999f - 0.45f);
+    real g22 = R(0.35555555555555557) * ((length(p0 - ((real3)(R(0.0), R(0.0), R(0.2)))) * R(0.9999)) - R(0.45));
     if (!(g22 > u22 && g22 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p3 = p0 - (real3)(0.0f, 0.0f, 0.2f);
+        real3 p3 = p0 - ((real3)(R(0.0), R(0.0), R(0.2)));
         /* .../a:union/b:translate/rotate */
-        real3 p4 = (real3)(0.87758255f * p3.x + 0.47942555f * p3.z, p3.y, (-0.47942555f) * p3.x + 0.87758255f * p3.z);
+        real3 p4 = (real3)((R(0.8775825618903728) * p3.x) + (R(0.479425538604203) * p3.z), p3.y, ((-R(0.479425538604203)) * p3.x) + (R(0.8775825618903728) * p3.z));
         /* .../material/color/ellipsoid */
         real d9 = sd_ellipsoid(p4, (real3)(0.45f, 0.45f, 0.16f));
-        real x22 = u28;
-        real y22 = d9;
-        real d22 = fmin(x22, y22);
+        real d22 = fmin(u28, d9);
         u22 = d22;
     }
     /* .../a:union/a:union: the second operand only within reach of its bound */
     real u18 = u22;
-    real g18 = length(p0 - (real3)(0.95f, 0.0f, 0.35f)) * 0.9999f - 0.42f;
+    real g18 = (length(p0 - ((real3)(R(0.95), R(0.0), R(0.35)))) * R(0.9999)) - R(0.42);
     if (!(g18 > u18 && g18 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p5 = p0 - (real3)(0.95f, 0.0f, 0.35f);
+        real3 p5 = p0 - ((real3)(R(0.95), R(0.0), R(0.35)));
         /* .../b:translate/material/sphere */
         real d15 = sd_sphere(p5, 0.42f);
-        real x18 = u22;
-        real y18 = d15;
-        real d18 = fmin(x18, y18);
+        real d18 = fmin(u22, d15);
         u18 = d18;
     }
     /* .../a:union/a:union: the second operand only within reach of its bound */
     real u14 = u18;
-    real g14 = length(p0 - (real3)(1.9f, 0.0f, 0.2f)) * 0.9999f - 0.42f;
+    real g14 = (length(p0 - ((real3)(R(1.9), R(0.0), R(0.2)))) * R(0.9999)) - R(0.42);
     if (!(g14 > u14 && g14 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p6 = p0 - (real3)(1.9f, 0.0f, 0.2f);
+        real3 p6 = p0 - ((real3)(R(1.9), R(0.0), R(0.2)));
         /* .../b:translate/material/sphere */
         real d19 = sd_sphere(p6, 0.42f);
-        real x14 = u18;
-        real y14 = d19;
-        real d14 = fmin(x14, y14);
+        real d14 = fmin(u18, d19);
         u14 = d14;
     }
     /* .../a:union/a:union: the second operand only within reach of its bound */
     real u8 = u14;
-    real g8 = length(p0 - (real3)(0.5f, 0.25f, (-1.3f))) * 0.9999f - 0.7728627f;
+    real g8 = (length(p0 - ((real3)(R(0.5), R(0.25), -R(1.3)))) * R(0.9999)) - R(0.7728626595716686);
     if (!(g8 > u8 && g8 > R(0.0))) {
         /* union/a:union/b:translate */
-        real3 p7 = p0 - (real3)(0.5f, 0.25f, (-1.3f));
+        real3 p7 = p0 - ((real3)(R(0.5), R(0.25), -R(1.3)));
         /* .../b:translate/color/scale */
-        real3 p8 = p7 / 0.7f;
+        real3 p8 = p7 / R(0.7);
         /* .../color/scale/rotate */
         real3 p9 = (real3)(p8.x, -p8.z, p8.y);
         /* .../scale/rotate/mandelbulb */
-        real2 f23 = mandelbulb_p8(p9, 8, 2.0f, 1.1040895f);
+        real2 f23 = mandelbulb_p8(p9, 8, R(2.0), 1.1040895f);
         real d23 = f23.x;
-        real d25 = d23 * 0.7f;
-        real x8 = u14;
-        real y8 = d25;
-        real d8 = fmin(x8, y8);
+        real d25 = d23 * R(0.7);
+        real d8 = fmin(u14, d25);
         u8 = d8;
     }
     return u8;
@@ -275,18 +258,16 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     real u32 = d29;
     real3 uc32 = c30;
     real ut32 = R(1.0);
-    real g32 = length(p0 - (real3)((-1.9f), 0.0f, 0.2f)) * 0.9999f - 0.42f;
+    real g32 = (length(p0 - ((real3)(-R(1.9), R(0.0), R(0.2)))) * R(0.9999)) - R(0.42);
     if (!(g32 > u32 && g32 > R(0.0))) {
         /* .../a:union/a:union/a:translate */
-        real3 p1 = p0 - (real3)((-1.9f), 0.0f, 0.2f);
+        real3 p1 = p0 - ((real3)(-R(1.9), R(0.0), R(0.2)));
         /* .../material/color/sphere */
         real d0 = sd_sphere(p1, 0.42f);
         /* .../a:translate/material/color */
         real3 c1 = (real3)(0.8f, 0.45f, 0.3f);
-        real x32 = d29;
-        real y32 = d0;
-        real d32 = fmin(x32, y32);
-        real3 c32 = x32 < y32 ? c30 : c1;
+        real d32 = fmin(d29, d0);
+        real3 c32 = d29 < d0 ? c30 : c1;
         u32 = d32;
         uc32 = c32;
         ut32 = R(1.0);
@@ -295,19 +276,17 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     real u28 = u32;
     real3 uc28 = uc32;
     real ut28 = ut32;
-    real g28 = length(p0 - (real3)((-0.95f), 0.0f, 0.2f)) * 0.9999f - 0.42f;
+    real g28 = (length(p0 - ((real3)(-R(0.95), R(0.0), R(0.2)))) * R(0.9999)) - R(0.42);
     if (!(g28 > u28 && g28 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p2 = p0 - (real3)((-0.95f), 0.0f, 0.2f);
+        real3 p2 = p0 - ((real3)(-R(0.95), R(0.0), R(0.2)));
         /* .../material/color/sphere */
         real d4 = sd_sphere(p2, 0.42f);
         /* .../b:translate/material/color */
         real3 c5 = (real3)(0.25f, 0.45f, 0.9f);
-        real x28 = u32;
-        real y28 = d4;
-        real d28 = fmin(x28, y28);
-        real3 c28 = x28 < y28 ? uc32 : c5;
-        real t28 = x28 < y28 ? ut32 : R(1.0);
+        real d28 = fmin(u32, d4);
+        real3 c28 = u32 < d4 ? uc32 : c5;
+        real t28 = u32 < d4 ? ut32 : R(1.0);
         u28 = d28;
         uc28 = c28;
         ut28 = t28;
@@ -316,21 +295,19 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     real u22 = u28;
     real3 uc22 = uc28;
     real ut22 = ut28;
-    real g22 = 0.35555556f * (length(p0 - (real3)(0.0f, 0.0f, 0.2f)) * 0.9999f - 0.45f);
+    real g22 = R(0.35555555555555557) * ((length(p0 - ((real3)(R(0.0), R(0.0), R(0.2)))) * R(0.9999)) - R(0.45));
     if (!(g22 > u22 && g22 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p3 = p0 - (real3)(0.0f, 0.0f, 0.2f);
+        real3 p3 = p0 - ((real3)(R(0.0), R(0.0), R(0.2)));
         /* .../a:union/b:translate/rotate */
-        real3 p4 = (real3)(0.87758255f * p3.x + 0.47942555f * p3.z, p3.y, (-0.47942555f) * p3.x + 0.87758255f * p3.z);
+        real3 p4 = (real3)((R(0.8775825618903728) * p3.x) + (R(0.479425538604203) * p3.z), p3.y, ((-R(0.479425538604203)) * p3.x) + (R(0.8775825618903728) * p3.z));
         /* .../material/color/ellipsoid */
         real d9 = sd_ellipsoid(p4, (real3)(0.45f, 0.45f, 0.16f));
         /* .../rotate/material/color */
         real3 c10 = (real3)(0.95f, 0.8f, 0.5f);
-        real x22 = u28;
-        real y22 = d9;
-        real d22 = fmin(x22, y22);
-        real3 c22 = x22 < y22 ? uc28 : c10;
-        real t22 = x22 < y22 ? ut28 : R(1.0);
+        real d22 = fmin(u28, d9);
+        real3 c22 = u28 < d9 ? uc28 : c10;
+        real t22 = u28 < d9 ? ut28 : R(1.0);
         u22 = d22;
         uc22 = c22;
         ut22 = t22;
@@ -339,17 +316,15 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     real u18 = u22;
     real3 uc18 = uc22;
     real ut18 = ut22;
-    real g18 = length(p0 - (real3)(0.95f, 0.0f, 0.35f)) * 0.9999f - 0.42f;
+    real g18 = (length(p0 - ((real3)(R(0.95), R(0.0), R(0.35)))) * R(0.9999)) - R(0.42);
     if (!(g18 > u18 && g18 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p5 = p0 - (real3)(0.95f, 0.0f, 0.35f);
+        real3 p5 = p0 - ((real3)(R(0.95), R(0.0), R(0.35)));
         /* .../b:translate/material/sphere */
         real d15 = sd_sphere(p5, 0.42f);
-        real x18 = u22;
-        real y18 = d15;
-        real d18 = fmin(x18, y18);
-        real3 c18 = x18 < y18 ? uc22 : DEFAULT_COLOR;
-        real t18 = x18 < y18 ? ut22 : R(1.0);
+        real d18 = fmin(u22, d15);
+        real3 c18 = u22 < d15 ? uc22 : DEFAULT_COLOR;
+        real t18 = u22 < d15 ? ut22 : R(1.0);
         u18 = d18;
         uc18 = c18;
         ut18 = t18;
@@ -358,17 +333,15 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     real u14 = u18;
     real3 uc14 = uc18;
     real ut14 = ut18;
-    real g14 = length(p0 - (real3)(1.9f, 0.0f, 0.2f)) * 0.9999f - 0.42f;
+    real g14 = (length(p0 - ((real3)(R(1.9), R(0.0), R(0.2)))) * R(0.9999)) - R(0.42);
     if (!(g14 > u14 && g14 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p6 = p0 - (real3)(1.9f, 0.0f, 0.2f);
+        real3 p6 = p0 - ((real3)(R(1.9), R(0.0), R(0.2)));
         /* .../b:translate/material/sphere */
         real d19 = sd_sphere(p6, 0.42f);
-        real x14 = u18;
-        real y14 = d19;
-        real d14 = fmin(x14, y14);
-        real3 c14 = x14 < y14 ? uc18 : DEFAULT_COLOR;
-        real t14 = x14 < y14 ? ut18 : R(1.0);
+        real d14 = fmin(u18, d19);
+        real3 c14 = u18 < d19 ? uc18 : DEFAULT_COLOR;
+        real t14 = u18 < d19 ? ut18 : R(1.0);
         u14 = d14;
         uc14 = c14;
         ut14 = t14;
@@ -377,26 +350,24 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     real u8 = u14;
     real3 uc8 = uc14;
     real ut8 = ut14;
-    real g8 = length(p0 - (real3)(0.5f, 0.25f, (-1.3f))) * 0.9999f - 0.7728627f;
+    real g8 = (length(p0 - ((real3)(R(0.5), R(0.25), -R(1.3)))) * R(0.9999)) - R(0.7728626595716686);
     if (!(g8 > u8 && g8 > R(0.0))) {
         /* union/a:union/b:translate */
-        real3 p7 = p0 - (real3)(0.5f, 0.25f, (-1.3f));
+        real3 p7 = p0 - ((real3)(R(0.5), R(0.25), -R(1.3)));
         /* .../b:translate/color/scale */
-        real3 p8 = p7 / 0.7f;
+        real3 p8 = p7 / R(0.7);
         /* .../color/scale/rotate */
         real3 p9 = (real3)(p8.x, -p8.z, p8.y);
         /* .../scale/rotate/mandelbulb */
-        real2 f23 = mandelbulb_p8(p9, 8, 2.0f, 1.1040895f);
+        real2 f23 = mandelbulb_p8(p9, 8, R(2.0), 1.1040895f);
         real d23 = f23.x;
         real t23 = f23.y;
-        real d25 = d23 * 0.7f;
+        real d25 = d23 * R(0.7);
         /* .../a:union/b:translate/color */
         real3 c26 = (real3)(0.95f, 0.7f, 0.45f);
-        real x8 = u14;
-        real y8 = d25;
-        real d8 = fmin(x8, y8);
-        real3 c8 = x8 < y8 ? uc14 : c26;
-        real t8 = x8 < y8 ? ut14 : t23;
+        real d8 = fmin(u14, d25);
+        real3 c8 = u14 < d25 ? uc14 : c26;
+        real t8 = u14 < d25 ? ut14 : t23;
         u8 = d8;
         uc8 = c8;
         ut8 = t8;
@@ -415,114 +386,102 @@ real DE_material(real3 p0, __global const real* params, real8* material) {
     /* union: the second operand only within reach of its bound */
     real u32 = d29;
     real8 uc32 = c31;
-    real g32 = length(p0 - (real3)((-1.9f), 0.0f, 0.2f)) * 0.9999f - 0.42f;
+    real g32 = (length(p0 - ((real3)(-R(1.9), R(0.0), R(0.2)))) * R(0.9999)) - R(0.42);
     if (!(g32 > u32 && g32 > R(0.0))) {
         /* .../a:union/a:union/a:translate */
-        real3 p1 = p0 - (real3)((-1.9f), 0.0f, 0.2f);
+        real3 p1 = p0 - ((real3)(-R(1.9), R(0.0), R(0.2)));
         /* .../material/color/sphere */
         real d0 = sd_sphere(p1, 0.42f);
         /* .../a:union/a:translate/material */
         real8 c2 = (real8)(0.9f, 0.0f, 32.0f, 0.0f, 0.0f, 0.0f, 0.0f, 1.0f);
-        real x32 = d29;
-        real y32 = d0;
-        real d32 = fmin(x32, y32);
-        real8 c32 = x32 < y32 ? c31 : c2;
+        real d32 = fmin(d29, d0);
+        real8 c32 = d29 < d0 ? c31 : c2;
         u32 = d32;
         uc32 = c32;
     }
     /* union/a:union: the second operand only within reach of its bound */
     real u28 = u32;
     real8 uc28 = uc32;
-    real g28 = length(p0 - (real3)((-0.95f), 0.0f, 0.2f)) * 0.9999f - 0.42f;
+    real g28 = (length(p0 - ((real3)(-R(0.95), R(0.0), R(0.2)))) * R(0.9999)) - R(0.42);
     if (!(g28 > u28 && g28 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p2 = p0 - (real3)((-0.95f), 0.0f, 0.2f);
+        real3 p2 = p0 - ((real3)(-R(0.95), R(0.0), R(0.2)));
         /* .../material/color/sphere */
         real d4 = sd_sphere(p2, 0.42f);
         /* .../a:union/b:translate/material */
         real8 c6 = (real8)(0.0f, 0.9f, 80.0f, 0.0f, 0.0f, 0.0f, 0.0f, 1.0f);
-        real x28 = u32;
-        real y28 = d4;
-        real d28 = fmin(x28, y28);
-        real8 c28 = x28 < y28 ? uc32 : c6;
+        real d28 = fmin(u32, d4);
+        real8 c28 = u32 < d4 ? uc32 : c6;
         u28 = d28;
         uc28 = c28;
     }
     /* .../a:union/a:union: the second operand only within reach of its bound */
     real u22 = u28;
     real8 uc22 = uc28;
-    real g22 = 0.35555556f * (length(p0 - (real3)(0.0f, 0.0f, 0.2f)) * 0.9999f - 0.45f);
+    real g22 = R(0.35555555555555557) * ((length(p0 - ((real3)(R(0.0), R(0.0), R(0.2)))) * R(0.9999)) - R(0.45));
     if (!(g22 > u22 && g22 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p3 = p0 - (real3)(0.0f, 0.0f, 0.2f);
+        real3 p3 = p0 - ((real3)(R(0.0), R(0.0), R(0.2)));
         /* .../a:union/b:translate/rotate */
-        real3 p4 = (real3)(0.87758255f * p3.x + 0.47942555f * p3.z, p3.y, (-0.47942555f) * p3.x + 0.87758255f * p3.z);
+        real3 p4 = (real3)((R(0.8775825618903728) * p3.x) + (R(0.479425538604203) * p3.z), p3.y, ((-R(0.479425538604203)) * p3.x) + (R(0.8775825618903728) * p3.z));
         /* .../material/color/ellipsoid */
         real d9 = sd_ellipsoid(p4, (real3)(0.45f, 0.45f, 0.16f));
         /* .../b:translate/rotate/material */
         real8 c11 = (real8)(0.0f, 0.0f, 32.0f, 1.0f, 0.3f, 0.0f, 0.0f, 1.0f);
-        real x22 = u28;
-        real y22 = d9;
-        real d22 = fmin(x22, y22);
-        real8 c22 = x22 < y22 ? uc28 : c11;
+        real d22 = fmin(u28, d9);
+        real8 c22 = u28 < d9 ? uc28 : c11;
         u22 = d22;
         uc22 = c22;
     }
     /* .../a:union/a:union: the second operand only within reach of its bound */
     real u18 = u22;
     real8 uc18 = uc22;
-    real g18 = length(p0 - (real3)(0.95f, 0.0f, 0.35f)) * 0.9999f - 0.42f;
+    real g18 = (length(p0 - ((real3)(R(0.95), R(0.0), R(0.35)))) * R(0.9999)) - R(0.42);
     if (!(g18 > u18 && g18 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p5 = p0 - (real3)(0.95f, 0.0f, 0.35f);
+        real3 p5 = p0 - ((real3)(R(0.95), R(0.0), R(0.35)));
         /* .../b:translate/material/sphere */
         real d15 = sd_sphere(p5, 0.42f);
         /* .../a:union/b:translate/material */
         real8 c16 = (real8)(0.0f, 0.25f, 32.0f, 0.0f, 0.0f, 0.0f, 1.0f, params[0] /* ior */);
-        real x18 = u22;
-        real y18 = d15;
-        real d18 = fmin(x18, y18);
-        real8 c18 = x18 < y18 ? uc22 : c16;
+        real d18 = fmin(u22, d15);
+        real8 c18 = u22 < d15 ? uc22 : c16;
         u18 = d18;
         uc18 = c18;
     }
     /* .../a:union/a:union: the second operand only within reach of its bound */
     real u14 = u18;
     real8 uc14 = uc18;
-    real g14 = length(p0 - (real3)(1.9f, 0.0f, 0.2f)) * 0.9999f - 0.42f;
+    real g14 = (length(p0 - ((real3)(R(1.9), R(0.0), R(0.2)))) * R(0.9999)) - R(0.42);
     if (!(g14 > u14 && g14 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p6 = p0 - (real3)(1.9f, 0.0f, 0.2f);
+        real3 p6 = p0 - ((real3)(R(1.9), R(0.0), R(0.2)));
         /* .../b:translate/material/sphere */
         real d19 = sd_sphere(p6, 0.42f);
         /* .../a:union/b:translate/material */
         real8 c20 = (real8)(0.0f, 0.25f, 32.0f, 0.0f, 0.0f, 1.0f, 0.0f, 1.0f);
-        real x14 = u18;
-        real y14 = d19;
-        real d14 = fmin(x14, y14);
-        real8 c14 = x14 < y14 ? uc18 : c20;
+        real d14 = fmin(u18, d19);
+        real8 c14 = u18 < d19 ? uc18 : c20;
         u14 = d14;
         uc14 = c14;
     }
     /* .../a:union/a:union: the second operand only within reach of its bound */
     real u8 = u14;
     real8 uc8 = uc14;
-    real g8 = length(p0 - (real3)(0.5f, 0.25f, (-1.3f))) * 0.9999f - 0.7728627f;
+    real g8 = (length(p0 - ((real3)(R(0.5), R(0.25), -R(1.3)))) * R(0.9999)) - R(0.7728626595716686);
     if (!(g8 > u8 && g8 > R(0.0))) {
         /* union/a:union/b:translate */
-        real3 p7 = p0 - (real3)(0.5f, 0.25f, (-1.3f));
+        real3 p7 = p0 - ((real3)(R(0.5), R(0.25), -R(1.3)));
         /* .../b:translate/color/scale */
-        real3 p8 = p7 / 0.7f;
+        real3 p8 = p7 / R(0.7);
         /* .../color/scale/rotate */
         real3 p9 = (real3)(p8.x, -p8.z, p8.y);
         /* .../scale/rotate/mandelbulb */
-        real2 f23 = mandelbulb_p8(p9, 8, 2.0f, 1.1040895f);
+        real2 f23 = mandelbulb_p8(p9, 8, R(2.0), 1.1040895f);
         real d23 = f23.x;
-        real d25 = d23 * 0.7f;
-        real x8 = u14;
-        real y8 = d25;
-        real d8 = fmin(x8, y8);
-        real8 c8 = x8 < y8 ? uc14 : DEFAULT_MATERIAL;
+        real d25 = d23 * R(0.7);
+        real d8 = fmin(u14, d25);
+        real8 c8 = u14 < d25 ? uc14 : DEFAULT_MATERIAL;
         u8 = d8;
         uc8 = c8;
     }

@@ -92,9 +92,8 @@ real sd_plane(real3 p, real3 n, real offset) {
     real t1 = fmax(fmax(t0.x, t0.y), t0.z);
     real3 t2 = n / t1;
     real t3 = length(t2);
-    real3 t4 = t2 / t3;
-    real3 t5 = (R(0.0) < t1) ? t4 : n;
-    return (((p.x * t5.x) + (p.y * t5.y)) + (p.z * t5.z)) + offset;
+    real3 t4 = (R(0.0) < t1) ? (t2 / t3) : n;
+    return (((p.x * t4.x) + (p.y * t4.y)) + (p.z * t4.z)) + offset;
 }
 
 /* ---- menger ---- */
@@ -122,10 +121,8 @@ real2 menger(real3 p, real iterations, real scale) {
         ts0_3 = t9;
         ts0_4 = t10;
     }
-    real3 t11 = fabs((real3)(ts0_0, ts0_1, ts0_2));
-    real3 t12 = t11 - R(1.0);
-    real3 t13 = fmax(t12, R(0.0));
-    return (real2)((length(t13) + fmin(fmax(fmax(t12.x, t12.y), t12.z), R(0.0))) / ts0_3, ts0_4);
+    real3 t11 = fabs((real3)(ts0_0, ts0_1, ts0_2)) - R(1.0);
+    return (real2)((length(fmax(t11, R(0.0))) + fmin(fmax(fmax(t11.x, t11.y), t11.z), R(0.0))) / ts0_3, ts0_4);
 }
 
 /* ---- scene ---- */
@@ -135,16 +132,14 @@ real DE(real3 p0, __global const real* params) {
     real d3 = sd_plane(p0, (real3)(0.0f, 1.0f, 0.0f), 1.0f);
     /* union: the second operand only within reach of its bound */
     real u5 = d3;
-    real g5 = length(p0 - (real3)(0.0f)) * 0.9999f - 1.7320508f;
+    real g5 = (length(p0) * R(0.9999)) - R(1.7320508075688772);
     if (!(g5 > u5 && g5 > R(0.0))) {
         /* union/a:color/rotate */
-        real3 p1 = (real3)(0.87758255f * p0.x + (-0.47942555f) * p0.z, p0.y, 0.47942555f * p0.x + 0.87758255f * p0.z);
+        real3 p1 = (real3)((R(0.8775825618903728) * p0.x) - (R(0.479425538604203) * p0.z), p0.y, (R(0.479425538604203) * p0.x) + (R(0.8775825618903728) * p0.z));
         /* .../a:color/rotate/menger */
         real2 f0 = menger(p1, 4, 3.0f);
         real d0 = f0.x;
-        real x5 = d3;
-        real y5 = d0;
-        real d5 = fmin(x5, y5);
+        real d5 = fmin(d3, d0);
         u5 = d5;
     }
     return u5;
@@ -160,21 +155,19 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     real u5 = d3;
     real3 uc5 = c4;
     real ut5 = R(1.0);
-    real g5 = length(p0 - (real3)(0.0f)) * 0.9999f - 1.7320508f;
+    real g5 = (length(p0) * R(0.9999)) - R(1.7320508075688772);
     if (!(g5 > u5 && g5 > R(0.0))) {
         /* union/a:color/rotate */
-        real3 p1 = (real3)(0.87758255f * p0.x + (-0.47942555f) * p0.z, p0.y, 0.47942555f * p0.x + 0.87758255f * p0.z);
+        real3 p1 = (real3)((R(0.8775825618903728) * p0.x) - (R(0.479425538604203) * p0.z), p0.y, (R(0.479425538604203) * p0.x) + (R(0.8775825618903728) * p0.z));
         /* .../a:color/rotate/menger */
         real2 f0 = menger(p1, 4, 3.0f);
         real d0 = f0.x;
         real t0 = f0.y;
         /* union/a:color */
         real3 c2 = (real3)(0.85f, 0.85f, 0.8f);
-        real x5 = d3;
-        real y5 = d0;
-        real d5 = fmin(x5, y5);
-        real3 c5 = x5 < y5 ? c4 : c2;
-        real t5 = x5 < y5 ? R(1.0) : t0;
+        real d5 = fmin(d3, d0);
+        real3 c5 = d3 < d0 ? c4 : c2;
+        real t5 = d3 < d0 ? R(1.0) : t0;
         u5 = d5;
         uc5 = c5;
         ut5 = t5;

@@ -93,19 +93,14 @@ real sd_sphere(real3 p, real r) {
 
 /* ---- cuboid ---- */
 real sd_box(real3 p, real3 b) {
-    real3 t0 = fabs(p);
-    real3 t1 = t0 - b;
-    real3 t2 = fmax(t1, R(0.0));
-    return length(t2) + fmin(fmax(fmax(t1.x, t1.y), t1.z), R(0.0));
+    real3 t0 = fabs(p) - b;
+    return length(fmax(t0, R(0.0))) + fmin(fmax(fmax(t0.x, t0.y), t0.z), R(0.0));
 }
 
 /* ---- round_box ---- */
 real sd_round_box(real3 p, real3 b, real r) {
-    real3 t0 = fabs(p);
-    real3 t1 = t0 - b;
-    real3 t2 = t1 + r;
-    real3 t3 = fmax(t2, R(0.0));
-    return (length(t3) + fmin(fmax(fmax(t2.x, t2.y), t2.z), R(0.0))) - r;
+    real3 t0 = (fabs(p) - b) + r;
+    return (length(fmax(t0, R(0.0))) + fmin(fmax(fmax(t0.x, t0.y), t0.z), R(0.0))) - r;
 }
 
 /* ---- torus ---- */
@@ -125,9 +120,7 @@ real sd_capsule(real3 p, real3 a, real3 b, real r) {
     real3 t0 = p - a;
     real3 t1 = b - a;
     real t2 = fmin(fmax((((t0.x * t1.x) + (t0.y * t1.y)) + (t0.z * t1.z)) / fmax(((t1.x * t1.x) + (t1.y * t1.y)) + (t1.z * t1.z), R(1e-30)), R(0.0)), R(1.0));
-    real3 t3 = t1 * t2;
-    real3 t4 = t0 - t3;
-    return length(t4) - r;
+    return length(t0 - (t1 * t2)) - r;
 }
 
 /* ---- plane ---- */
@@ -136,9 +129,8 @@ real sd_plane(real3 p, real3 n, real offset) {
     real t1 = fmax(fmax(t0.x, t0.y), t0.z);
     real3 t2 = n / t1;
     real t3 = length(t2);
-    real3 t4 = t2 / t3;
-    real3 t5 = (R(0.0) < t1) ? t4 : n;
-    return (((p.x * t5.x) + (p.y * t5.y)) + (p.z * t5.z)) + offset;
+    real3 t4 = (R(0.0) < t1) ? (t2 / t3) : n;
+    return (((p.x * t4.x) + (p.y * t4.y)) + (p.z * t4.z)) + offset;
 }
 
 /* ---- octahedron ---- */
@@ -147,10 +139,9 @@ real sd_octahedron(real3 p, real s) {
     real t1 = ((t0.x + t0.y) + t0.z) - s;
     bool t2 = (R(3.0) * t0.x) < t1;
     bool t3 = (R(3.0) * t0.y) < t1;
-    real3 t4 = t3 ? ((real3)(t0.y, t0.z, t0.x)) : ((real3)(t0.z, t0.x, t0.y));
-    real3 t5 = t2 ? t0 : t4;
-    real t6 = fmin(fmax(R(0.5) * ((t5.z - t5.y) + s), R(0.0)), s);
-    return ((t2 || t3) || ((R(3.0) * t0.z) < t1)) ? length((real3)(t5.x, (t5.y - s) + t6, t5.z - t6)) : (t1 * R(0.5773502691896258));
+    real3 t4 = t2 ? t0 : (t3 ? ((real3)(t0.y, t0.z, t0.x)) : ((real3)(t0.z, t0.x, t0.y)));
+    real t5 = fmin(fmax(R(0.5) * ((t4.z - t4.y) + s), R(0.0)), s);
+    return ((t2 || t3) || ((R(3.0) * t0.z) < t1)) ? length((real3)(t4.x, (t4.y - s) + t5, t4.z - t5)) : (t1 * R(0.5773502691896258));
 }
 
 /* ---- capped_cone ---- */
@@ -171,15 +162,12 @@ real sd_ellipsoid(real3 p, real3 r) {
     real3 t0 = p / r;
     real3 t1 = fabs(t0);
     real t2 = fmax(fmax(t1.x, t1.y), t1.z);
-    real3 t3 = t0 / t2;
-    real t4 = ((R(0.0) < t2) && isfinite(t2)) ? (t2 * length(t3)) : length(t0);
-    real3 t5 = t0 / t4;
-    real3 t6 = t5 / r;
-    real3 t7 = fabs(t6);
-    real t8 = fmax(fmax(t7.x, t7.y), t7.z);
-    real3 t9 = t6 / t8;
-    real t10 = t4 - R(1.0);
-    return (t4 < R(1.0)) ? (t10 * fmin(fmin(r.x, r.y), r.z)) : (t10 / fmax(((R(0.0) < t8) && isfinite(t8)) ? (t8 * length(t9)) : length(t6), R(1e-30)));
+    real t3 = ((R(0.0) < t2) && isfinite(t2)) ? (t2 * length(t0 / t2)) : length(t0);
+    real3 t4 = (t0 / t3) / r;
+    real3 t5 = fabs(t4);
+    real t6 = fmax(fmax(t5.x, t5.y), t5.z);
+    real t7 = t3 - R(1.0);
+    return (t3 < R(1.0)) ? (t7 * fmin(fmin(r.x, r.y), r.z)) : (t7 / fmax(((R(0.0) < t6) && isfinite(t6)) ? (t6 * length(t4 / t6)) : length(t4), R(1e-30)));
 }
 
 /* ---- scene ---- */
@@ -189,119 +177,101 @@ real DE(real3 p0, __global const real* params) {
     real d35 = sd_plane(p0, (real3)(0.0f, 1.0f, 0.0f), 0.4f);
     /* union: the second operand only within reach of its bound */
     real u37 = d35;
-    real g37 = length(p0 - (real3)((-1.9f), 0.0f, (-0.6f))) * 0.9999f - 0.35f;
+    real g37 = (length(p0 - ((real3)(-R(1.9), R(0.0), -R(0.6)))) * R(0.9999)) - R(0.35);
     if (!(g37 > u37 && g37 > R(0.0))) {
         /* .../a:union/a:union/a:translate */
-        real3 p1 = p0 - (real3)((-1.9f), 0.0f, (-0.6f));
+        real3 p1 = p0 - ((real3)(-R(1.9), R(0.0), -R(0.6)));
         /* .../a:translate/color/sphere */
         real d0 = sd_sphere(p1, 0.35f);
-        real x37 = d35;
-        real y37 = d0;
-        real d37 = fmin(x37, y37);
+        real d37 = fmin(d35, d0);
         u37 = d37;
     }
     /* union/a:union: the second operand only within reach of its bound */
     real u34 = u37;
-    real g34 = length(p0 - (real3)((-0.95f), 0.0f, (-0.6f))) * 0.9999f - 0.51961523f;
+    real g34 = (length(p0 - ((real3)(-R(0.95), R(0.0), -R(0.6)))) * R(0.9999)) - R(0.5196152422706632);
     if (!(g34 > u34 && g34 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p2 = p0 - (real3)((-0.95f), 0.0f, (-0.6f));
+        real3 p2 = p0 - ((real3)(-R(0.95), R(0.0), -R(0.6)));
         /* .../b:translate/color/cuboid */
         real d3 = sd_box(p2, (real3)(0.3f));
-        real x34 = u37;
-        real y34 = d3;
-        real d34 = fmin(x34, y34);
+        real d34 = fmin(u37, d3);
         u34 = d34;
     }
     /* .../a:union/a:union: the second operand only within reach of its bound */
     real u30 = u34;
-    real g30 = length(p0 - (real3)(0.0f, 0.0f, (-0.6f))) * 0.9999f - 0.51961523f;
+    real g30 = (length(p0 - ((real3)(R(0.0), R(0.0), -R(0.6)))) * R(0.9999)) - R(0.5196152422706632);
     if (!(g30 > u30 && g30 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p3 = p0 - (real3)(0.0f, 0.0f, (-0.6f));
+        real3 p3 = p0 - ((real3)(R(0.0), R(0.0), -R(0.6)));
         /* .../b:translate/color/round_box */
         real d7 = sd_round_box(p3, (real3)(0.3f), 0.08f);
-        real x30 = u34;
-        real y30 = d7;
-        real d30 = fmin(x30, y30);
+        real d30 = fmin(u34, d7);
         u30 = d30;
     }
     /* .../a:union/a:union: the second operand only within reach of its bound */
     real u26 = u30;
-    real g26 = length(p0 - (real3)(0.95f, 0.0f, (-0.6f))) * 0.9999f - 0.38f;
+    real g26 = (length(p0 - ((real3)(R(0.95), R(0.0), -R(0.6)))) * R(0.9999)) - R(0.38);
     if (!(g26 > u26 && g26 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p4 = p0 - (real3)(0.95f, 0.0f, (-0.6f));
+        real3 p4 = p0 - ((real3)(R(0.95), R(0.0), -R(0.6)));
         /* .../b:translate/color/torus */
         real d11 = sd_torus(p4, 0.28f, 0.1f);
-        real x26 = u30;
-        real y26 = d11;
-        real d26 = fmin(x26, y26);
+        real d26 = fmin(u30, d11);
         u26 = d26;
     }
     /* .../a:union/a:union: the second operand only within reach of its bound */
     real u22 = u26;
-    real g22 = length(p0 - (real3)(1.9f, 0.0f, (-0.6f))) * 0.9999f - 0.43011627f;
+    real g22 = (length(p0 - ((real3)(R(1.9), R(0.0), -R(0.6)))) * R(0.9999)) - R(0.4301162633521313);
     if (!(g22 > u22 && g22 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p5 = p0 - (real3)(1.9f, 0.0f, (-0.6f));
+        real3 p5 = p0 - ((real3)(R(1.9), R(0.0), -R(0.6)));
         /* .../b:translate/color/cylinder */
         real d15 = sd_cylinder(p5, 0.25f, 0.35f);
-        real x22 = u26;
-        real y22 = d15;
-        real d22 = fmin(x22, y22);
+        real d22 = fmin(u26, d15);
         u22 = d22;
     }
     /* .../a:union/a:union: the second operand only within reach of its bound */
     real u18 = u22;
-    real g18 = length(p0 - (real3)((-1.425f), 0.0f, 0.6f)) * 0.9999f - 0.38f;
+    real g18 = (length(p0 - ((real3)(-R(1.4249999999999998), R(0.0), R(0.6)))) * R(0.9999)) - R(0.38);
     if (!(g18 > u18 && g18 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p6 = p0 - (real3)((-1.425f), 0.0f, 0.6f);
+        real3 p6 = p0 - ((real3)(-R(1.4249999999999998), R(0.0), R(0.6)));
         /* .../b:translate/color/capsule */
         real d19 = sd_capsule(p6, (real3)(0.0f, (-0.2f), 0.0f), (real3)(0.0f, 0.2f, 0.0f), 0.18f);
-        real x18 = u22;
-        real y18 = d19;
-        real d18 = fmin(x18, y18);
+        real d18 = fmin(u22, d19);
         u18 = d18;
     }
     /* .../a:union/a:union: the second operand only within reach of its bound */
     real u14 = u18;
-    real g14 = length(p0 - (real3)((-0.475f), 0.0f, 0.6f)) * 0.9999f - 0.4f;
+    real g14 = (length(p0 - ((real3)(-R(0.475), R(0.0), R(0.6)))) * R(0.9999)) - R(0.4);
     if (!(g14 > u14 && g14 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p7 = p0 - (real3)((-0.475f), 0.0f, 0.6f);
+        real3 p7 = p0 - ((real3)(-R(0.475), R(0.0), R(0.6)));
         /* .../b:translate/color/octahedron */
         real d23 = sd_octahedron(p7, 0.4f);
-        real x14 = u18;
-        real y14 = d23;
-        real d14 = fmin(x14, y14);
+        real d14 = fmin(u18, d23);
         u14 = d14;
     }
     /* .../a:union/a:union: the second operand only within reach of its bound */
     real u10 = u14;
-    real g10 = length(p0 - (real3)(0.475f, 0.0f, 0.6f)) * 0.9999f - 0.46097723f;
+    real g10 = (length(p0 - ((real3)(R(0.475), R(0.0), R(0.6)))) * R(0.9999)) - R(0.4609772228646443);
     if (!(g10 > u10 && g10 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p8 = p0 - (real3)(0.475f, 0.0f, 0.6f);
+        real3 p8 = p0 - ((real3)(R(0.475), R(0.0), R(0.6)));
         /* .../b:translate/color/capped_cone */
         real d27 = sd_capped_cone(p8, 0.35f, 0.3f, 0.1f);
-        real x10 = u14;
-        real y10 = d27;
-        real d10 = fmin(x10, y10);
+        real d10 = fmin(u14, d27);
         u10 = d10;
     }
     /* .../a:union/a:union: the second operand only within reach of its bound */
     real u6 = u10;
-    real g6 = 0.5714286f * (length(p0 - (real3)(1.425f, 0.0f, 0.6f)) * 0.9999f - 0.35f);
+    real g6 = R(0.5714285714285715) * ((length(p0 - ((real3)(R(1.4249999999999998), R(0.0), R(0.6)))) * R(0.9999)) - R(0.35));
     if (!(g6 > u6 && g6 > R(0.0))) {
         /* union/a:union/b:translate */
-        real3 p9 = p0 - (real3)(1.425f, 0.0f, 0.6f);
+        real3 p9 = p0 - ((real3)(R(1.4249999999999998), R(0.0), R(0.6)));
         /* .../b:translate/color/ellipsoid */
         real d31 = sd_ellipsoid(p9, (real3)(0.35f, 0.2f, 0.25f));
-        real x6 = u10;
-        real y6 = d31;
-        real d6 = fmin(x6, y6);
+        real d6 = fmin(u10, d31);
         u6 = d6;
     }
     return u6;
@@ -317,18 +287,16 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     real u37 = d35;
     real3 uc37 = c36;
     real ut37 = R(1.0);
-    real g37 = length(p0 - (real3)((-1.9f), 0.0f, (-0.6f))) * 0.9999f - 0.35f;
+    real g37 = (length(p0 - ((real3)(-R(1.9), R(0.0), -R(0.6)))) * R(0.9999)) - R(0.35);
     if (!(g37 > u37 && g37 > R(0.0))) {
         /* .../a:union/a:union/a:translate */
-        real3 p1 = p0 - (real3)((-1.9f), 0.0f, (-0.6f));
+        real3 p1 = p0 - ((real3)(-R(1.9), R(0.0), -R(0.6)));
         /* .../a:translate/color/sphere */
         real d0 = sd_sphere(p1, 0.35f);
         /* .../a:union/a:translate/color */
         real3 c1 = (real3)(0.9f, 0.45f, 0.3f);
-        real x37 = d35;
-        real y37 = d0;
-        real d37 = fmin(x37, y37);
-        real3 c37 = x37 < y37 ? c36 : c1;
+        real d37 = fmin(d35, d0);
+        real3 c37 = d35 < d0 ? c36 : c1;
         u37 = d37;
         uc37 = c37;
         ut37 = R(1.0);
@@ -337,19 +305,17 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     real u34 = u37;
     real3 uc34 = uc37;
     real ut34 = ut37;
-    real g34 = length(p0 - (real3)((-0.95f), 0.0f, (-0.6f))) * 0.9999f - 0.51961523f;
+    real g34 = (length(p0 - ((real3)(-R(0.95), R(0.0), -R(0.6)))) * R(0.9999)) - R(0.5196152422706632);
     if (!(g34 > u34 && g34 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p2 = p0 - (real3)((-0.95f), 0.0f, (-0.6f));
+        real3 p2 = p0 - ((real3)(-R(0.95), R(0.0), -R(0.6)));
         /* .../b:translate/color/cuboid */
         real d3 = sd_box(p2, (real3)(0.3f));
         /* .../a:union/b:translate/color */
         real3 c4 = (real3)(0.825f, 0.5375f, 0.375f);
-        real x34 = u37;
-        real y34 = d3;
-        real d34 = fmin(x34, y34);
-        real3 c34 = x34 < y34 ? uc37 : c4;
-        real t34 = x34 < y34 ? ut37 : R(1.0);
+        real d34 = fmin(u37, d3);
+        real3 c34 = u37 < d3 ? uc37 : c4;
+        real t34 = u37 < d3 ? ut37 : R(1.0);
         u34 = d34;
         uc34 = c34;
         ut34 = t34;
@@ -358,19 +324,17 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     real u30 = u34;
     real3 uc30 = uc34;
     real ut30 = ut34;
-    real g30 = length(p0 - (real3)(0.0f, 0.0f, (-0.6f))) * 0.9999f - 0.51961523f;
+    real g30 = (length(p0 - ((real3)(R(0.0), R(0.0), -R(0.6)))) * R(0.9999)) - R(0.5196152422706632);
     if (!(g30 > u30 && g30 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p3 = p0 - (real3)(0.0f, 0.0f, (-0.6f));
+        real3 p3 = p0 - ((real3)(R(0.0), R(0.0), -R(0.6)));
         /* .../b:translate/color/round_box */
         real d7 = sd_round_box(p3, (real3)(0.3f), 0.08f);
         /* .../a:union/b:translate/color */
         real3 c8 = (real3)(0.75f, 0.625f, 0.45f);
-        real x30 = u34;
-        real y30 = d7;
-        real d30 = fmin(x30, y30);
-        real3 c30 = x30 < y30 ? uc34 : c8;
-        real t30 = x30 < y30 ? ut34 : R(1.0);
+        real d30 = fmin(u34, d7);
+        real3 c30 = u34 < d7 ? uc34 : c8;
+        real t30 = u34 < d7 ? ut34 : R(1.0);
         u30 = d30;
         uc30 = c30;
         ut30 = t30;
@@ -379,19 +343,17 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     real u26 = u30;
     real3 uc26 = uc30;
     real ut26 = ut30;
-    real g26 = length(p0 - (real3)(0.95f, 0.0f, (-0.6f))) * 0.9999f - 0.38f;
+    real g26 = (length(p0 - ((real3)(R(0.95), R(0.0), -R(0.6)))) * R(0.9999)) - R(0.38);
     if (!(g26 > u26 && g26 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p4 = p0 - (real3)(0.95f, 0.0f, (-0.6f));
+        real3 p4 = p0 - ((real3)(R(0.95), R(0.0), -R(0.6)));
         /* .../b:translate/color/torus */
         real d11 = sd_torus(p4, 0.28f, 0.1f);
         /* .../a:union/b:translate/color */
         real3 c12 = (real3)(0.675f, 0.7125f, 0.525f);
-        real x26 = u30;
-        real y26 = d11;
-        real d26 = fmin(x26, y26);
-        real3 c26 = x26 < y26 ? uc30 : c12;
-        real t26 = x26 < y26 ? ut30 : R(1.0);
+        real d26 = fmin(u30, d11);
+        real3 c26 = u30 < d11 ? uc30 : c12;
+        real t26 = u30 < d11 ? ut30 : R(1.0);
         u26 = d26;
         uc26 = c26;
         ut26 = t26;
@@ -400,19 +362,17 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     real u22 = u26;
     real3 uc22 = uc26;
     real ut22 = ut26;
-    real g22 = length(p0 - (real3)(1.9f, 0.0f, (-0.6f))) * 0.9999f - 0.43011627f;
+    real g22 = (length(p0 - ((real3)(R(1.9), R(0.0), -R(0.6)))) * R(0.9999)) - R(0.4301162633521313);
     if (!(g22 > u22 && g22 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p5 = p0 - (real3)(1.9f, 0.0f, (-0.6f));
+        real3 p5 = p0 - ((real3)(R(1.9), R(0.0), -R(0.6)));
         /* .../b:translate/color/cylinder */
         real d15 = sd_cylinder(p5, 0.25f, 0.35f);
         /* .../a:union/b:translate/color */
         real3 c16 = (real3)(0.6f, 0.8f, 0.6f);
-        real x22 = u26;
-        real y22 = d15;
-        real d22 = fmin(x22, y22);
-        real3 c22 = x22 < y22 ? uc26 : c16;
-        real t22 = x22 < y22 ? ut26 : R(1.0);
+        real d22 = fmin(u26, d15);
+        real3 c22 = u26 < d15 ? uc26 : c16;
+        real t22 = u26 < d15 ? ut26 : R(1.0);
         u22 = d22;
         uc22 = c22;
         ut22 = t22;
@@ -421,19 +381,17 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     real u18 = u22;
     real3 uc18 = uc22;
     real ut18 = ut22;
-    real g18 = length(p0 - (real3)((-1.425f), 0.0f, 0.6f)) * 0.9999f - 0.38f;
+    real g18 = (length(p0 - ((real3)(-R(1.4249999999999998), R(0.0), R(0.6)))) * R(0.9999)) - R(0.38);
     if (!(g18 > u18 && g18 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p6 = p0 - (real3)((-1.425f), 0.0f, 0.6f);
+        real3 p6 = p0 - ((real3)(-R(1.4249999999999998), R(0.0), R(0.6)));
         /* .../b:translate/color/capsule */
         real d19 = sd_capsule(p6, (real3)(0.0f, (-0.2f), 0.0f), (real3)(0.0f, 0.2f, 0.0f), 0.18f);
         /* .../a:union/b:translate/color */
         real3 c20 = (real3)(0.525f, 0.7125f, 0.675f);
-        real x18 = u22;
-        real y18 = d19;
-        real d18 = fmin(x18, y18);
-        real3 c18 = x18 < y18 ? uc22 : c20;
-        real t18 = x18 < y18 ? ut22 : R(1.0);
+        real d18 = fmin(u22, d19);
+        real3 c18 = u22 < d19 ? uc22 : c20;
+        real t18 = u22 < d19 ? ut22 : R(1.0);
         u18 = d18;
         uc18 = c18;
         ut18 = t18;
@@ -442,19 +400,17 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     real u14 = u18;
     real3 uc14 = uc18;
     real ut14 = ut18;
-    real g14 = length(p0 - (real3)((-0.475f), 0.0f, 0.6f)) * 0.9999f - 0.4f;
+    real g14 = (length(p0 - ((real3)(-R(0.475), R(0.0), R(0.6)))) * R(0.9999)) - R(0.4);
     if (!(g14 > u14 && g14 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p7 = p0 - (real3)((-0.475f), 0.0f, 0.6f);
+        real3 p7 = p0 - ((real3)(-R(0.475), R(0.0), R(0.6)));
         /* .../b:translate/color/octahedron */
         real d23 = sd_octahedron(p7, 0.4f);
         /* .../a:union/b:translate/color */
         real3 c24 = (real3)(0.45f, 0.625f, 0.75f);
-        real x14 = u18;
-        real y14 = d23;
-        real d14 = fmin(x14, y14);
-        real3 c14 = x14 < y14 ? uc18 : c24;
-        real t14 = x14 < y14 ? ut18 : R(1.0);
+        real d14 = fmin(u18, d23);
+        real3 c14 = u18 < d23 ? uc18 : c24;
+        real t14 = u18 < d23 ? ut18 : R(1.0);
         u14 = d14;
         uc14 = c14;
         ut14 = t14;
@@ -463,19 +419,17 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     real u10 = u14;
     real3 uc10 = uc14;
     real ut10 = ut14;
-    real g10 = length(p0 - (real3)(0.475f, 0.0f, 0.6f)) * 0.9999f - 0.46097723f;
+    real g10 = (length(p0 - ((real3)(R(0.475), R(0.0), R(0.6)))) * R(0.9999)) - R(0.4609772228646443);
     if (!(g10 > u10 && g10 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p8 = p0 - (real3)(0.475f, 0.0f, 0.6f);
+        real3 p8 = p0 - ((real3)(R(0.475), R(0.0), R(0.6)));
         /* .../b:translate/color/capped_cone */
         real d27 = sd_capped_cone(p8, 0.35f, 0.3f, 0.1f);
         /* .../a:union/b:translate/color */
         real3 c28 = (real3)(0.375f, 0.5375f, 0.825f);
-        real x10 = u14;
-        real y10 = d27;
-        real d10 = fmin(x10, y10);
-        real3 c10 = x10 < y10 ? uc14 : c28;
-        real t10 = x10 < y10 ? ut14 : R(1.0);
+        real d10 = fmin(u14, d27);
+        real3 c10 = u14 < d27 ? uc14 : c28;
+        real t10 = u14 < d27 ? ut14 : R(1.0);
         u10 = d10;
         uc10 = c10;
         ut10 = t10;
@@ -484,19 +438,17 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     real u6 = u10;
     real3 uc6 = uc10;
     real ut6 = ut10;
-    real g6 = 0.5714286f * (length(p0 - (real3)(1.425f, 0.0f, 0.6f)) * 0.9999f - 0.35f);
+    real g6 = R(0.5714285714285715) * ((length(p0 - ((real3)(R(1.4249999999999998), R(0.0), R(0.6)))) * R(0.9999)) - R(0.35));
     if (!(g6 > u6 && g6 > R(0.0))) {
         /* union/a:union/b:translate */
-        real3 p9 = p0 - (real3)(1.425f, 0.0f, 0.6f);
+        real3 p9 = p0 - ((real3)(R(1.4249999999999998), R(0.0), R(0.6)));
         /* .../b:translate/color/ellipsoid */
         real d31 = sd_ellipsoid(p9, (real3)(0.35f, 0.2f, 0.25f));
         /* .../a:union/b:translate/color */
         real3 c32 = (real3)(0.3f, 0.45f, 0.9f);
-        real x6 = u10;
-        real y6 = d31;
-        real d6 = fmin(x6, y6);
-        real3 c6 = x6 < y6 ? uc10 : c32;
-        real t6 = x6 < y6 ? ut10 : R(1.0);
+        real d6 = fmin(u10, d31);
+        real3 c6 = u10 < d31 ? uc10 : c32;
+        real t6 = u10 < d31 ? ut10 : R(1.0);
         u6 = d6;
         uc6 = c6;
         ut6 = t6;

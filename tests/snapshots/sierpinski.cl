@@ -92,9 +92,8 @@ real sd_plane(real3 p, real3 n, real offset) {
     real t1 = fmax(fmax(t0.x, t0.y), t0.z);
     real3 t2 = n / t1;
     real t3 = length(t2);
-    real3 t4 = t2 / t3;
-    real3 t5 = (R(0.0) < t1) ? t4 : n;
-    return (((p.x * t5.x) + (p.y * t5.y)) + (p.z * t5.z)) + offset;
+    real3 t4 = (R(0.0) < t1) ? (t2 / t3) : n;
+    return (((p.x * t4.x) + (p.y * t4.y)) + (p.z * t4.z)) + offset;
 }
 
 /* ---- sierpinski ---- */
@@ -109,18 +108,17 @@ real2 sierpinski(real3 p, real iterations, real scale) {
         real3 t1 = ((ts0_0 + ts0_1) < R(0.0)) ? ((real3)(-ts0_1, -ts0_0, ts0_2)) : ((real3)(ts0_0, ts0_1, ts0_2));
         real3 t2 = ((t1.x + t1.z) < R(0.0)) ? ((real3)(-t1.z, t1.y, -t1.x)) : t1;
         real3 t3 = ((t2.y + t2.z) < R(0.0)) ? ((real3)(t2.x, -t2.z, -t2.y)) : t2;
-        real3 t4 = t3 * scale;
-        real3 t5 = t4 - t0;
-        real t6 = ts0_3 * scale;
-        real t7 = fmin(ts0_4, length(t3) * R(0.5773502691896258));
-        ts0_0 = t5.x;
-        ts0_1 = t5.y;
-        ts0_2 = t5.z;
-        ts0_3 = t6;
-        ts0_4 = t7;
+        real3 t4 = (t3 * scale) - t0;
+        real t5 = ts0_3 * scale;
+        real t6 = fmin(ts0_4, length(t3) * R(0.5773502691896258));
+        ts0_0 = t4.x;
+        ts0_1 = t4.y;
+        ts0_2 = t4.z;
+        ts0_3 = t5;
+        ts0_4 = t6;
     }
-    real t8 = -ts0_0;
-    return (real2)(((fmax(fmax((t8 - ts0_1) - ts0_2, (ts0_0 + ts0_1) - ts0_2), fmax((t8 + ts0_1) + ts0_2, (ts0_0 - ts0_1) + ts0_2)) - R(1.0)) * R(0.5773502691896258)) / ts0_3, ts0_4);
+    real t7 = -ts0_0;
+    return (real2)(((fmax(fmax((t7 - ts0_1) - ts0_2, (ts0_0 + ts0_1) - ts0_2), fmax((t7 + ts0_1) + ts0_2, (ts0_0 - ts0_1) + ts0_2)) - R(1.0)) * R(0.5773502691896258)) / ts0_3, ts0_4);
 }
 
 /* ---- scene ---- */
@@ -130,14 +128,12 @@ real DE(real3 p0, __global const real* params) {
     real d2 = sd_plane(p0, (real3)(0.0f, 1.0f, 0.0f), 1.0f);
     /* union: the second operand only within reach of its bound */
     real u4 = d2;
-    real g4 = 0.33333334f * (length(p0 - (real3)(0.0f)) * 0.9999f - 1.7320508f);
+    real g4 = R(0.3333333333333333) * ((length(p0) * R(0.9999)) - R(1.7320508075688772));
     if (!(g4 > u4 && g4 > R(0.0))) {
         /* union/a:color/sierpinski */
         real2 f0 = sierpinski(p0, 7, 2.0f);
         real d0 = f0.x;
-        real x4 = d2;
-        real y4 = d0;
-        real d4 = fmin(x4, y4);
+        real d4 = fmin(d2, d0);
         u4 = d4;
     }
     return u4;
@@ -153,7 +149,7 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     real u4 = d2;
     real3 uc4 = c3;
     real ut4 = R(1.0);
-    real g4 = 0.33333334f * (length(p0 - (real3)(0.0f)) * 0.9999f - 1.7320508f);
+    real g4 = R(0.3333333333333333) * ((length(p0) * R(0.9999)) - R(1.7320508075688772));
     if (!(g4 > u4 && g4 > R(0.0))) {
         /* union/a:color/sierpinski */
         real2 f0 = sierpinski(p0, 7, 2.0f);
@@ -161,11 +157,9 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
         real t0 = f0.y;
         /* union/a:color */
         real3 c1 = (real3)(0.95f, 0.75f, 0.45f);
-        real x4 = d2;
-        real y4 = d0;
-        real d4 = fmin(x4, y4);
-        real3 c4 = x4 < y4 ? c3 : c1;
-        real t4 = x4 < y4 ? R(1.0) : t0;
+        real d4 = fmin(d2, d0);
+        real3 c4 = d2 < d0 ? c3 : c1;
+        real t4 = d2 < d0 ? R(1.0) : t0;
         u4 = d4;
         uc4 = c4;
         ut4 = t4;

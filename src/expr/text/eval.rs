@@ -442,6 +442,8 @@ fn call<N: Num>(name: &str, a: &[Value<N>]) -> Option<Value<N>> {
         ("log", [S(x)]) => S(x.ln()),
         ("floor", [S(x)]) => S(x.floor()),
         ("floor", [V(v)]) => map(*v, N::floor),
+        ("round", [S(x)]) => S(x.round()),
+        ("round", [V(v)]) => map(*v, N::round),
         ("fract", [S(x)]) => S(x.fract()),
         ("fract", [V(v)]) => map(*v, N::fract),
         ("min", [S(x), S(y)]) => S(x.min(*y)),

@@ -55,6 +55,7 @@ pub const FUNCTIONS: &[(&str, usize)] = &[
     ("exp", 1),
     ("log", 1),
     ("floor", 1),
+    ("round", 1),
     ("fract", 1),
     ("min", 2),
     ("max", 2),
