@@ -207,7 +207,7 @@ pub const MANDELBULB_FAR_FIELD: f64 = 1.5;
 /// trap is the smallest `|z|` reached, clamped to `[0, 1]`. The orbit
 /// escapes beyond `bailout`, or sooner if `r^power` would pass
 /// [`Num::magnitude_cap`] (only for large powers and bailouts): see
-/// [`escape_radius`](crate::math::escape_radius). The formula itself is
+/// [`escape_radius`]. The formula itself is
 /// [`mandelbulb_estimate`].
 #[must_use]
 pub fn mandelbulb<T: Real>(
@@ -459,9 +459,9 @@ fn critical_leaves<T: Num>(c: [T; 4], steps: T, radius2: T) -> T::Bool {
 ///
 /// The tangent points only make it tight: `tau_j = guess * D_j`, the gap
 /// the linearised orbit (derivative `D_j`) gives for a start gap `guess`.
-/// `A` and `B` are capped at [`Real::derivative_cap`] (a cap of `A` can
+/// `A` and `B` are capped at [`Num::derivative_cap`] (a cap of `A` can
 /// only raise a bound that is already below `T / 1e30`) and the orbit
-/// stops at [`Real::magnitude_cap`], so nothing overflows.
+/// stops at [`Num::magnitude_cap`], so nothing overflows.
 #[must_use]
 pub fn julia_bound<T: Num>(p: V3<T>, c: [T; 4], w: T, steps: u32, edge: T, guess: T) -> T {
     orbit_bound(p, c, w, T::of(f64::from(steps) + 1.0), edge, guess)
@@ -535,7 +535,7 @@ fn square_plus<T: Num>(z0: T, z1: T, z2: T, z3: T, c: [T; 4]) -> [T; 4] {
 ///    and the critical orbit (see [`julia_critical_leaves`]) stays within
 ///    [`JULIA_CRITICAL_RADIUS`] for the point's iterations and
 ///    [`JULIA_CRITICAL_MARGIN`] more. Not proven; measured (see
-///    `tests/fractals.rs`): within 0.98 of the distance at points that
+///    `tests/distance/fractals.rs`): within 0.98 of the distance at points that
 ///    escape, and at most a thin band above it at points that do not.
 /// 3. Otherwise the smaller of that estimate and [`julia_bound`]: a proven
 ///    bound where the orbit proves escape within [`JULIA_BOUND_EXTRA`]
@@ -560,7 +560,7 @@ fn square_plus<T: Num>(z0: T, z1: T, z2: T, z3: T, c: [T; 4]) -> [T; 4] {
 /// The gallery's constant is outside the Mandelbrot set too, but its
 /// critical orbit stays within 0.85 for 16 steps, so with its 11
 /// iterations it keeps the escape-time estimate. The escape loop stops
-/// before the running derivative would pass [`Real::derivative_cap`]
+/// before the running derivative would pass [`Num::derivative_cap`]
 /// (capped, it let `|z|` keep growing and inflated the estimate: by a
 /// factor of 256 at a point 3.1e-5 from a connected set with bailout 1e6
 /// and 36 iterations).

@@ -69,4 +69,6 @@ pub use interval::{Interval, Maybe};
 pub use num::{Logic, MAX_LOOP_STEPS, Num};
 pub use print::{Inline, OpenCl, Printer, Shape, Signature, Unprintable};
 pub use program::{Binary, Loop, Op, Program, Step, Unary, ValueId, Var, VarBool, trace};
-pub use text::{FUNCTIONS, Formula, FormulaError, MAX_ITERATIONS, MAX_LENGTH};
+pub use text::{
+    FUNCTIONS, Formula, FormulaError, MAX_DEPTH, MAX_ITERATIONS, MAX_LENGTH, MAX_NESTING,
+};

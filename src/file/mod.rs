@@ -30,7 +30,7 @@
 //! camera's `fov_y_degrees` says its own unit), as in the Rust API and
 //! for dynamic parameters.
 //!
-//! - **Nodes** are written as in Rust's [`Kind`](crate::scene::Kind), with
+//! - **Nodes** are written as in Rust's [`Kind`], with
 //!   the booleans named: `Union([a, b, ...])` (any number of operands, what
 //!   [`Scene::add`] builds), `Subtract(a: .., b: ..)`, `Intersect(a: ..,
 //!   b: ..)`, `SmoothUnion(k: 0.1, a: .., b: ..)` and the other smooth
@@ -270,21 +270,20 @@ impl From<Scene> for SceneFile {
 }
 
 /// The distinct text-formula shapes in `node`, with their texts, in the
-/// order they are first met.
+/// order a depth-first walk first meets them (a work list: scenes may be
+/// deeper than the stack).
 fn formulas(node: &Node) -> Vec<(CustomShape, String)> {
-    fn walk(node: &Node, out: &mut Vec<(CustomShape, String)>) {
+    let mut out: Vec<(CustomShape, String)> = Vec::new();
+    let mut todo = vec![node];
+    while let Some(node) = todo.pop() {
         if let Kind::Custom { shape, .. } = node.kind()
             && let Some(text) = shape.formula_text()
             && !out.iter().any(|(s, _)| s.name() == shape.name())
         {
             out.push((shape.clone(), text.to_string()));
         }
-        for c in node.kind().children() {
-            walk(c, out);
-        }
+        todo.extend(node.kind().children().into_iter().rev());
     }
-    let mut out = Vec::new();
-    walk(node, &mut out);
     out
 }
 

@@ -45,6 +45,13 @@ pub const MAX_ITERATIONS: u64 = 4096;
 /// The longest formula text accepted, in bytes.
 pub const MAX_LENGTH: usize = 16 * 1024;
 
+/// How deep parentheses, blocks and prefix operators may nest in a formula.
+pub const MAX_NESTING: usize = 64;
+
+/// How deep one expression's operations may stack (a chain `a + b + c`
+/// is as deep as it is long); a longer one is split with `let`.
+pub const MAX_DEPTH: usize = 256;
+
 /// The functions a formula may call, with their argument counts.
 pub const FUNCTIONS: &[(&str, usize)] = &[
     ("sqrt", 1),
@@ -144,6 +151,7 @@ impl Formula {
             text,
             tokens,
             at: 0,
+            nesting: 0,
         };
         let body = parser.block().map_err(|(at, m)| formula.locate(at, m))?;
         if parser.peek().tok != Tok::End {

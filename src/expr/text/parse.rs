@@ -128,6 +128,40 @@ pub(super) struct Parser<'t> {
     pub(super) text: &'t str,
     pub(super) tokens: Vec<Token>,
     pub(super) at: usize,
+    /// How deep the parser is in parentheses, blocks and prefixes.
+    pub(super) nesting: usize,
+}
+
+/// The error of an expression deeper than [`MAX_DEPTH`](super::MAX_DEPTH).
+fn too_deep(at: usize) -> (usize, String) {
+    (
+        at,
+        format!(
+            "an expression more than {} operations deep; split it with `let`",
+            super::MAX_DEPTH
+        ),
+    )
+}
+
+/// How deep an expression's operations stack, blocks included.
+fn depth(e: &Expr) -> usize {
+    1 + match e {
+        Expr::Num(_) | Expr::Name(..) => 0,
+        Expr::Neg(a) | Expr::Not(a) | Expr::Field(a, ..) => depth(a),
+        Expr::Binary(_, a, b, _) => depth(a).max(depth(b)),
+        Expr::Call(_, args, _) => args.iter().map(depth).max().unwrap_or(0),
+        Expr::If(c, a, b, _) => depth(c).max(block_depth(a)).max(block_depth(b)),
+    }
+}
+
+fn block_depth(b: &Block) -> usize {
+    let stmt = |s: &Stmt| match s {
+        Stmt::Let(_, e, _) | Stmt::Assign(_, e, _) | Stmt::BreakIf(e, _) => depth(e),
+        Stmt::If(c, a, b) => depth(c).max(block_depth(a)).max(block_depth(b)),
+        Stmt::For(_, _, _, body, _) => block_depth(body),
+    };
+    let value = b.value.as_ref().map_or(0, depth);
+    1 + b.stmts.iter().map(stmt).max().unwrap_or(0).max(value)
 }
 
 pub(super) type Parse<T> = Result<T, (usize, String)>;
@@ -317,9 +351,36 @@ impl Parser<'_> {
 
     fn braced(&mut self, what: &str) -> Parse<Block> {
         self.expect_sym("{", &format!("`{{` to open {what}"))?;
-        let b = self.block()?;
+        let b = self.nested(Self::block)?;
         self.expect_sym("}", &format!("`}}` to close {what}"))?;
         Ok(b)
+    }
+
+    /// Runs `parse` one level deeper, refusing more than
+    /// [`MAX_NESTING`](super::MAX_NESTING) levels.
+    fn nested<T>(&mut self, parse: impl FnOnce(&mut Self) -> Parse<T>) -> Parse<T> {
+        if self.nesting >= super::MAX_NESTING {
+            return Err((
+                self.peek().start,
+                format!(
+                    "parentheses, blocks and signs nested more than {} deep",
+                    super::MAX_NESTING
+                ),
+            ));
+        }
+        self.nesting += 1;
+        let result = parse(self);
+        self.nesting -= 1;
+        result
+    }
+
+    /// Refuses an expression whose operations stack more than
+    /// [`MAX_DEPTH`](super::MAX_DEPTH) deep.
+    fn shallow(e: Expr, at: usize) -> Parse<Expr> {
+        if depth(&e) > super::MAX_DEPTH {
+            return Err(too_deep(at));
+        }
+        Ok(e)
     }
 
     fn if_expr(&mut self) -> Parse<Expr> {
@@ -359,7 +420,9 @@ impl Parser<'_> {
     }
 
     fn expr(&mut self) -> Parse<Expr> {
-        self.binary(0)
+        let at = self.peek().start;
+        let e = self.nested(|p| p.binary(0))?;
+        Self::shallow(e, at)
     }
 
     fn binary(&mut self, level: usize) -> Parse<Expr> {
@@ -374,6 +437,8 @@ impl Parser<'_> {
             return self.unary();
         }
         let mut left = self.binary(level + 1)?;
+        // The chain's depth so far: each operator stacks on the last.
+        let mut deep = depth(&left);
         loop {
             let t = self.peek();
             let Tok::Sym(s) = t.tok else {
@@ -384,6 +449,10 @@ impl Parser<'_> {
             }
             self.at += 1;
             let right = self.binary(level + 1)?;
+            deep = deep.max(depth(&right)) + 1;
+            if deep > super::MAX_DEPTH {
+                return Err(too_deep(t.start));
+            }
             left = Expr::Binary(s, Box::new(left), Box::new(right), t.start);
             // Comparisons do not chain.
             if level == 2 {
@@ -395,11 +464,11 @@ impl Parser<'_> {
     fn unary(&mut self) -> Parse<Expr> {
         if self.is_sym("-") {
             self.at += 1;
-            return Ok(Expr::Neg(Box::new(self.unary()?)));
+            return self.nested(|p| Ok(Expr::Neg(Box::new(p.unary()?))));
         }
         if self.is_sym("!") {
             self.at += 1;
-            return Ok(Expr::Not(Box::new(self.unary()?)));
+            return self.nested(|p| Ok(Expr::Not(Box::new(p.unary()?))));
         }
         let mut e = self.primary()?;
         while self.is_sym(".") {
