@@ -6,6 +6,9 @@
 //! are written inline; values read more often get a name. [`OpenCl`]
 //! writes OpenCL C; a second backend is a second [`Printer`].
 
+use std::collections::HashMap;
+
+use super::num::MAX_LOOP_STEPS;
 use super::program::{Binary, Loop, Op, Program, Unary, ValueId};
 
 /// The shape of a parameter or result: how many scalar inputs or outputs
@@ -189,7 +192,17 @@ struct Block<'b> {
     vectors: &'b [Option<String>],
     outer: &'b [&'b [String]],
     text: Vec<String>,
+    /// The state of each loop written so far, by the loop's value.
+    states: HashMap<usize, LoopState>,
     indent: usize,
+}
+
+/// A loop's state as written: each element's text (a variable, or a
+/// component of one), and the vectors that hold three elements, by the
+/// first element's index.
+struct LoopState {
+    elements: Vec<String>,
+    vectors: Vec<(u32, String)>,
 }
 
 impl Block<'_> {
@@ -227,6 +240,16 @@ impl Block<'_> {
             (Op::Component(a, 0), Op::Component(b, 1), Op::Component(c, 2)) if a == b && b == c => {
                 Some(self.arg(a))
             }
+            (Op::Element(l, a), Op::Element(m, b), Op::Element(n, c))
+                if l == m && m == n && b == a + 1 && c == a + 2 =>
+            {
+                let state = self.states.get(&l.index())?;
+                state
+                    .vectors
+                    .iter()
+                    .find(|(first, _)| *first == a)
+                    .map(|(_, name)| name.as_str())
+            }
             _ => None,
         }
     }
@@ -259,7 +282,7 @@ impl Block<'_> {
                 self.outer[at][v.index()].clone()
             }
             Op::Loop(_) => return Ok(None),
-            Op::Element(l, k) => format!("{}_{k}", self.atom(l)),
+            Op::Element(l, k) => self.states[&l.index()].elements[k as usize].clone(),
             Op::Unary(u, a) => {
                 let (a, inner) = (self.atom(a), self.arg(a));
                 match u {
@@ -414,7 +437,9 @@ impl OpenClWriter {
     /// Writes value `i` of the block: inline, named, or a loop.
     fn op(&mut self, b: &mut Block<'_>, i: usize, op: Op, name: bool) -> Result<(), Unprintable> {
         if let Op::Loop(n) = op {
-            b.text[i] = self.write_loop(b, &b.program.loops[n as usize])?;
+            let (text, state) = self.write_loop(b, &b.program.loops[n as usize])?;
+            b.text[i] = text;
+            b.states.insert(i, state);
             return Ok(());
         }
         let text = b.expression(op)?.unwrap_or_default();
@@ -439,44 +464,104 @@ impl OpenClWriter {
         Ok(())
     }
 
-    /// Writes a loop; its text is the prefix of its state's names.
-    fn write_loop(&mut self, b: &Block<'_>, l: &Loop) -> Result<String, Unprintable> {
+    /// Writes a loop; its text is the prefix of its state's names. Three
+    /// consecutive elements that start as a vector and are always replaced
+    /// by one (or kept) are one vector variable, as a hand-written loop
+    /// keeps its point.
+    fn write_loop(&mut self, b: &Block<'_>, l: &Loop) -> Result<(String, LoopState), Unprintable> {
         let id = self.loops;
         self.loops += 1;
         let state = format!("{}s{id}", self.prefix);
         let index = format!("{}i{id}", self.prefix);
         let indent = b.indent;
-        for (j, v) in l.init.iter().enumerate() {
-            let init = unwrap(b.atom(*v)).to_string();
-            self.line(indent, &format!("real {state}_{j} = {init};"));
+        let k = l.init.len();
+        // Each element's vector (by its first element) and component.
+        let mut group: Vec<Option<(usize, usize)>> = vec![None; k];
+        let mut vectors = Vec::new();
+        let mut j = 0;
+        while j + 3 <= k {
+            let init = b.whole_vector(l.init[j], l.init[j + 1], l.init[j + 2]);
+            match init {
+                Some(text) if next_vector(&l.body, j).is_some() => {
+                    vectors.push((j, text.to_string()));
+                    for c in 0..3 {
+                        group[j + c] = Some((j, c));
+                    }
+                    j += 3;
+                }
+                _ => j += 1,
+            }
         }
+        let elements: Vec<String> = (0..k)
+            .map(|j| match group[j] {
+                Some((first, c)) => format!("{state}_{first}.{}", ["x", "y", "z"][c]),
+                None => format!("{state}_{j}"),
+            })
+            .collect();
+        for (j, v) in l.init.iter().enumerate() {
+            match group[j] {
+                Some((_, 0)) => {
+                    let init = &vectors.iter().find(|(f, _)| *f == j).expect("grouped").1;
+                    self.line(indent, &format!("real3 {state}_{j} = {};", unwrap(init)));
+                }
+                Some(_) => {}
+                None => {
+                    let init = unwrap(b.atom(*v)).to_string();
+                    self.line(indent, &format!("real {state}_{j} = {init};"));
+                }
+            }
+        }
+        // The step count as an integer, once: `i < ceil(count)` is `i <
+        // count` for every integer `i`, NaN and negative counts make no
+        // step, and the count is capped as `Num::iterate` caps it.
         let count = unwrap(b.atom(l.count)).to_string();
+        let steps = format!("{}n{id}", self.prefix);
         self.line(
             indent,
-            &format!("for (int {index} = 0; {index} < {count}; {index}++) {{"),
+            &format!(
+                "int {steps} = (int)clamp(ceil({count}), R(0.0), R({}.0));",
+                MAX_LOOP_STEPS
+            ),
+        );
+        self.line(
+            indent,
+            &format!("for (int {index} = 0; {index} < {steps}; {index}++) {{"),
         );
         let mut inputs = vec![format!("(real){index}")];
-        inputs.extend((0..l.init.len()).map(|j| format!("{state}_{j}")));
+        inputs.extend(elements.iter().cloned());
+        let mut input_vectors = vec![None; k + 1];
+        for (first, _) in &vectors {
+            input_vectors[first + 1] = Some(format!("{state}_{first}"));
+        }
         let mut outer: Vec<&[String]> = b.outer.to_vec();
         outer.push(&b.text);
         let mut body = Block {
             program: &l.body,
             inputs: &inputs,
-            vectors: &[],
+            vectors: &input_vectors,
             outer: &outer,
             text: Vec::new(),
+            states: HashMap::new(),
             indent: indent + 1,
         };
         self.block(&mut body, l.stop_before_output())?;
         // The next state and the stop are read before the state changes.
-        let k = l.init.len();
         let mut next = Vec::with_capacity(k);
         for (j, v) in l.body.outputs[..k].iter().enumerate() {
-            let text = body.atom(*v).to_string();
-            next.push(if text == format!("{state}_{j}") {
-                None
-            } else {
-                Some(self.name(indent + 1, "real", &text))
+            next.push(match group[j] {
+                Some((_, 0)) => match next_vector(&l.body, j) {
+                    Some(Some(w)) => Some(self.name(indent + 1, "real3", body.atom(w))),
+                    _ => None,
+                },
+                Some(_) => None,
+                None => {
+                    let text = body.atom(*v).to_string();
+                    if text == elements[j] {
+                        None
+                    } else {
+                        Some(self.name(indent + 1, "real", &text))
+                    }
+                }
             });
         }
         let stop = match l.stop_after_output() {
@@ -497,7 +582,37 @@ impl OpenClWriter {
             self.line(indent + 1, "}");
         }
         self.line(indent, "}");
-        Ok(state)
+        let vectors = vectors
+            .into_iter()
+            .map(|(first, _)| {
+                let first = u32::try_from(first).expect("a loop's state is small");
+                (first, format!("{state}_{first}"))
+            })
+            .collect();
+        Ok((state, LoopState { elements, vectors }))
+    }
+}
+
+/// Whether a loop body's next state at elements `j..j + 3` is one vector:
+/// `Some(Some(w))` for the components of the body's vector `w`,
+/// `Some(None)` for the three elements unchanged, `None` otherwise.
+fn next_vector(body: &Program, j: usize) -> Option<Option<ValueId>> {
+    let out = body.outputs.get(j..j + 3)?;
+    let ops = &body.ops;
+    match (
+        ops[out[0].index()],
+        ops[out[1].index()],
+        ops[out[2].index()],
+    ) {
+        (Op::Component(a, 0), Op::Component(b, 1), Op::Component(c, 2)) if a == b && b == c => {
+            Some(Some(a))
+        }
+        (Op::Input(a), Op::Input(b), Op::Input(c))
+            if a as usize == j + 1 && b == a + 1 && c == a + 2 =>
+        {
+            Some(None)
+        }
+        _ => None,
     }
 }
 
@@ -645,6 +760,7 @@ impl Printer for OpenCl {
             vectors: &vectors,
             outer: &[],
             text: Vec::new(),
+            states: HashMap::new(),
             indent: 1,
         };
         w.block(&mut block, None)?;
@@ -697,6 +813,7 @@ impl Printer for OpenCl {
             vectors: &vectors,
             outer: &[],
             text: Vec::new(),
+            states: HashMap::new(),
             indent: 0,
         };
         w.block(&mut block, None)?;

@@ -107,31 +107,28 @@ real2 mandelbulb(real3 p, real power, real iterations, real escape, real ball) {
     real t1 = t0 - ball;
     bool t2 = (R(1.5) * ball) < t0;
     real t3 = t2 ? R(0.0) : iterations;
-    real ts0_0 = p.x;
-    real ts0_1 = p.y;
-    real ts0_2 = p.z;
+    real3 ts0_0 = p;
     real ts0_3 = R(1.0);
     real ts0_4 = R(1.0);
-    for (int ti0 = 0; ti0 < t3; ti0++) {
-        real t4 = length((real3)(ts0_0, ts0_1, ts0_2));
+    int tn0 = (int)clamp(ceil(t3), R(0.0), R(1048576.0));
+    for (int ti0 = 0; ti0 < tn0; ti0++) {
+        real t4 = length(ts0_0);
         if (escape < t4) {
             break;
         }
         real t5 = pow(t4, power - R(1.0));
         real t6 = t5 * t4;
-        real t7 = acos(fmin(fmax(ts0_2 / fmax(t4, R(1e-30)), -R(1.0)), R(1.0))) * power;
-        real t8 = atan2(ts0_1, ts0_0) * power;
+        real t7 = acos(fmin(fmax(ts0_0.z / fmax(t4, R(1e-30)), -R(1.0)), R(1.0))) * power;
+        real t8 = atan2(ts0_0.y, ts0_0.x) * power;
         real t9 = sin(t7);
         real3 t10 = (((real3)(t9 * cos(t8), t9 * sin(t8), cos(t7))) * t6) + ((real3)(p.x, p.y, p.z));
         real t11 = fmin(((power * t5) * ts0_3) + R(1.0), R(1e30));
         real t12 = fmin(ts0_4, t4);
-        ts0_0 = t10.x;
-        ts0_1 = t10.y;
-        ts0_2 = t10.z;
+        ts0_0 = t10;
         ts0_3 = t11;
         ts0_4 = t12;
     }
-    real t13 = length((real3)(ts0_0, ts0_1, ts0_2));
+    real t13 = length(ts0_0);
     return (real2)(t2 ? t1 : fmax(((R(0.5) * log(fmax(t13, R(1e-30)))) * t13) / ts0_3, t1), t2 ? R(1.0) : ts0_4);
 }
 
@@ -143,7 +140,8 @@ real2 menger(real3 p, real iterations, real scale) {
     real ts0_2 = p.z;
     real ts0_3 = R(1.0);
     real ts0_4 = R(1.0);
-    for (int ti0 = 0; ti0 < iterations; ti0++) {
+    int tn0 = (int)clamp(ceil(iterations), R(0.0), R(1048576.0));
+    for (int ti0 = 0; ti0 < tn0; ti0++) {
         real3 t1 = fabs((real3)(ts0_0, ts0_1, ts0_2));
         real3 t2 = (t1.x < t1.y) ? ((real3)(t1.y, t1.x, t1.z)) : t1;
         real3 t3 = (t2.x < t2.z) ? ((real3)(t2.z, t2.y, t2.x)) : t2;
@@ -167,26 +165,23 @@ real2 menger(real3 p, real iterations, real scale) {
 /* ---- sierpinski ---- */
 real2 sierpinski(real3 p, real iterations, real scale) {
     real t0 = scale - R(1.0);
-    real ts0_0 = p.x;
-    real ts0_1 = p.y;
-    real ts0_2 = p.z;
+    real3 ts0_0 = p;
     real ts0_3 = R(1.0);
     real ts0_4 = R(1.0);
-    for (int ti0 = 0; ti0 < iterations; ti0++) {
-        real3 t1 = ((ts0_0 + ts0_1) < R(0.0)) ? ((real3)(-ts0_1, -ts0_0, ts0_2)) : ((real3)(ts0_0, ts0_1, ts0_2));
+    int tn0 = (int)clamp(ceil(iterations), R(0.0), R(1048576.0));
+    for (int ti0 = 0; ti0 < tn0; ti0++) {
+        real3 t1 = ((ts0_0.x + ts0_0.y) < R(0.0)) ? ((real3)(-ts0_0.y, -ts0_0.x, ts0_0.z)) : ts0_0;
         real3 t2 = ((t1.x + t1.z) < R(0.0)) ? ((real3)(-t1.z, t1.y, -t1.x)) : t1;
         real3 t3 = ((t2.y + t2.z) < R(0.0)) ? ((real3)(t2.x, -t2.z, -t2.y)) : t2;
         real3 t4 = (t3 * scale) - t0;
         real t5 = ts0_3 * scale;
         real t6 = fmin(ts0_4, length(t3) * R(0.5773502691896258));
-        ts0_0 = t4.x;
-        ts0_1 = t4.y;
-        ts0_2 = t4.z;
+        ts0_0 = t4;
         ts0_3 = t5;
         ts0_4 = t6;
     }
-    real t7 = -ts0_0;
-    return (real2)(((fmax(fmax((t7 - ts0_1) - ts0_2, (ts0_0 + ts0_1) - ts0_2), fmax((t7 + ts0_1) + ts0_2, (ts0_0 - ts0_1) + ts0_2)) - R(1.0)) * R(0.5773502691896258)) / ts0_3, ts0_4);
+    real t7 = -ts0_0.x;
+    return (real2)(((fmax(fmax((t7 - ts0_0.y) - ts0_0.z, (ts0_0.x + ts0_0.y) - ts0_0.z), fmax((t7 + ts0_0.y) + ts0_0.z, (ts0_0.x - ts0_0.y) + ts0_0.z)) - R(1.0)) * R(0.5773502691896258)) / ts0_3, ts0_4);
 }
 
 /* ---- julia ---- */
@@ -209,7 +204,8 @@ real2 julia(real3 p, real cx, real cy, real cz, real cw, real w, real iterations
     real ts0_5 = R(1.0);
     real ts0_6 = t5;
     real ts0_7 = R(0.0);
-    for (int ti0 = 0; ti0 < t9; ti0++) {
+    int tn0 = (int)clamp(ceil(t9), R(0.0), R(1048576.0));
+    for (int ti0 = 0; ti0 < tn0; ti0++) {
         real t10 = (ts0_5 * R(4.0)) * ts0_4;
         if (R(1e30) < t10) {
             break;
@@ -243,7 +239,8 @@ real2 julia(real3 p, real cx, real cy, real cz, real cw, real w, real iterations
     real ts1_0 = R(0.0);
     real ts1_1 = R(0.0);
     real ts1_2 = R(0.0);
-    for (int ti1 = 0; ti1 < t23; ti1++) {
+    int tn1 = (int)clamp(ceil(t23), R(0.0), R(1048576.0));
+    for (int ti1 = 0; ti1 < tn1; ti1++) {
         real t25 = ((ts1_0 * ts1_0) - (ts1_1 * ts1_1)) + cx;
         real t26 = ((R(2.0) * ts1_0) * ts1_1) + t24;
         bool t27 = R(0.81) < ((t25 * t25) + (t26 * t26));
@@ -266,7 +263,8 @@ real2 julia(real3 p, real cx, real cy, real cz, real cw, real w, real iterations
     real ts2_6 = R(0.0);
     real ts2_7 = R(1.0);
     real ts2_8 = R(0.0);
-    for (int ti2 = 0; ti2 < t30; ti2++) {
+    int tn2 = (int)clamp(ceil(t30), R(0.0), R(1048576.0));
+    for (int ti2 = 0; ti2 < tn2; ti2++) {
         if (R(1e36) < ts2_4) {
             break;
         }

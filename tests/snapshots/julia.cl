@@ -106,7 +106,8 @@ real2 julia(real3 p, real cx, real cy, real cz, real cw, real w, real iterations
     real ts0_5 = R(1.0);
     real ts0_6 = t5;
     real ts0_7 = R(0.0);
-    for (int ti0 = 0; ti0 < t9; ti0++) {
+    int tn0 = (int)clamp(ceil(t9), R(0.0), R(1048576.0));
+    for (int ti0 = 0; ti0 < tn0; ti0++) {
         real t10 = (ts0_5 * R(4.0)) * ts0_4;
         if (R(1e30) < t10) {
             break;
@@ -140,7 +141,8 @@ real2 julia(real3 p, real cx, real cy, real cz, real cw, real w, real iterations
     real ts1_0 = R(0.0);
     real ts1_1 = R(0.0);
     real ts1_2 = R(0.0);
-    for (int ti1 = 0; ti1 < t23; ti1++) {
+    int tn1 = (int)clamp(ceil(t23), R(0.0), R(1048576.0));
+    for (int ti1 = 0; ti1 < tn1; ti1++) {
         real t25 = ((ts1_0 * ts1_0) - (ts1_1 * ts1_1)) + cx;
         real t26 = ((R(2.0) * ts1_0) * ts1_1) + t24;
         bool t27 = R(0.81) < ((t25 * t25) + (t26 * t26));
@@ -163,7 +165,8 @@ real2 julia(real3 p, real cx, real cy, real cz, real cw, real w, real iterations
     real ts2_6 = R(0.0);
     real ts2_7 = R(1.0);
     real ts2_8 = R(0.0);
-    for (int ti2 = 0; ti2 < t30; ti2++) {
+    int tn2 = (int)clamp(ceil(t30), R(0.0), R(1048576.0));
+    for (int ti2 = 0; ti2 < tn2; ti2++) {
         if (R(1e36) < ts2_4) {
             break;
         }

@@ -92,22 +92,21 @@ real2 mandelbulb_p8(real3 p, real iterations, real escape, real ball) {
     real t1 = t0 - ball;
     bool t2 = (R(1.5) * ball) < t0;
     real t3 = t2 ? R(0.0) : iterations;
-    real ts0_0 = p.x;
-    real ts0_1 = p.y;
-    real ts0_2 = p.z;
+    real3 ts0_0 = p;
     real ts0_3 = R(1.0);
     real ts0_4 = R(1.0);
-    for (int ti0 = 0; ti0 < t3; ti0++) {
-        real t4 = length((real3)(ts0_0, ts0_1, ts0_2));
+    int tn0 = (int)clamp(ceil(t3), R(0.0), R(1048576.0));
+    for (int ti0 = 0; ti0 < tn0; ti0++) {
+        real t4 = length(ts0_0);
         if (escape < t4) {
             break;
         }
         real t5 = t4 * t4;
         real t6 = (t4 * t5) * (t5 * t5);
         real t7 = t6 * t4;
-        real t8 = hypot(ts0_0, ts0_1);
+        real t8 = hypot(ts0_0.x, ts0_0.y);
         real t9 = R(1.0) / fmax(t4, R(1e-30));
-        real t10 = ts0_2 * t9;
+        real t10 = ts0_0.z * t9;
         real t11 = t8 * t9;
         real t12 = (t10 * t10) - (t11 * t11);
         real t13 = (R(2.0) * t10) * t11;
@@ -115,8 +114,8 @@ real2 mandelbulb_p8(real3 p, real iterations, real escape, real ball) {
         real t15 = (R(2.0) * t12) * t13;
         real t16 = (R(2.0) * t14) * t15;
         bool t17 = R(1e-30) < t8;
-        real t18 = t17 ? (ts0_0 / t8) : R(1.0);
-        real t19 = t17 ? (ts0_1 / t8) : R(0.0);
+        real t18 = t17 ? (ts0_0.x / t8) : R(1.0);
+        real t19 = t17 ? (ts0_0.y / t8) : R(0.0);
         real t20 = (t18 * t18) - (t19 * t19);
         real t21 = (R(2.0) * t18) * t19;
         real t22 = (t20 * t20) - (t21 * t21);
@@ -124,13 +123,11 @@ real2 mandelbulb_p8(real3 p, real iterations, real escape, real ball) {
         real3 t24 = (((real3)(t16 * ((t22 * t22) - (t23 * t23)), t16 * ((R(2.0) * t22) * t23), (t14 * t14) - (t15 * t15))) * t7) + ((real3)(p.x, p.y, p.z));
         real t25 = fmin(((R(8.0) * t6) * ts0_3) + R(1.0), R(1e30));
         real t26 = fmin(ts0_4, t4);
-        ts0_0 = t24.x;
-        ts0_1 = t24.y;
-        ts0_2 = t24.z;
+        ts0_0 = t24;
         ts0_3 = t25;
         ts0_4 = t26;
     }
-    real t27 = length((real3)(ts0_0, ts0_1, ts0_2));
+    real t27 = length(ts0_0);
     return (real2)(t2 ? t1 : fmax(((R(0.5) * log(fmax(t27, R(1e-30)))) * t27) / ts0_3, t1), t2 ? R(1.0) : ts0_4);
 }
 

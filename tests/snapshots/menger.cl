@@ -104,7 +104,8 @@ real2 menger(real3 p, real iterations, real scale) {
     real ts0_2 = p.z;
     real ts0_3 = R(1.0);
     real ts0_4 = R(1.0);
-    for (int ti0 = 0; ti0 < iterations; ti0++) {
+    int tn0 = (int)clamp(ceil(iterations), R(0.0), R(1048576.0));
+    for (int ti0 = 0; ti0 < tn0; ti0++) {
         real3 t1 = fabs((real3)(ts0_0, ts0_1, ts0_2));
         real3 t2 = (t1.x < t1.y) ? ((real3)(t1.y, t1.x, t1.z)) : t1;
         real3 t3 = (t2.x < t2.z) ? ((real3)(t2.z, t2.y, t2.x)) : t2;

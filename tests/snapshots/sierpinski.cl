@@ -99,26 +99,23 @@ real sd_plane(real3 p, real3 n, real offset) {
 /* ---- sierpinski ---- */
 real2 sierpinski(real3 p, real iterations, real scale) {
     real t0 = scale - R(1.0);
-    real ts0_0 = p.x;
-    real ts0_1 = p.y;
-    real ts0_2 = p.z;
+    real3 ts0_0 = p;
     real ts0_3 = R(1.0);
     real ts0_4 = R(1.0);
-    for (int ti0 = 0; ti0 < iterations; ti0++) {
-        real3 t1 = ((ts0_0 + ts0_1) < R(0.0)) ? ((real3)(-ts0_1, -ts0_0, ts0_2)) : ((real3)(ts0_0, ts0_1, ts0_2));
+    int tn0 = (int)clamp(ceil(iterations), R(0.0), R(1048576.0));
+    for (int ti0 = 0; ti0 < tn0; ti0++) {
+        real3 t1 = ((ts0_0.x + ts0_0.y) < R(0.0)) ? ((real3)(-ts0_0.y, -ts0_0.x, ts0_0.z)) : ts0_0;
         real3 t2 = ((t1.x + t1.z) < R(0.0)) ? ((real3)(-t1.z, t1.y, -t1.x)) : t1;
         real3 t3 = ((t2.y + t2.z) < R(0.0)) ? ((real3)(t2.x, -t2.z, -t2.y)) : t2;
         real3 t4 = (t3 * scale) - t0;
         real t5 = ts0_3 * scale;
         real t6 = fmin(ts0_4, length(t3) * R(0.5773502691896258));
-        ts0_0 = t4.x;
-        ts0_1 = t4.y;
-        ts0_2 = t4.z;
+        ts0_0 = t4;
         ts0_3 = t5;
         ts0_4 = t6;
     }
-    real t7 = -ts0_0;
-    return (real2)(((fmax(fmax((t7 - ts0_1) - ts0_2, (ts0_0 + ts0_1) - ts0_2), fmax((t7 + ts0_1) + ts0_2, (ts0_0 - ts0_1) + ts0_2)) - R(1.0)) * R(0.5773502691896258)) / ts0_3, ts0_4);
+    real t7 = -ts0_0.x;
+    return (real2)(((fmax(fmax((t7 - ts0_0.y) - ts0_0.z, (ts0_0.x + ts0_0.y) - ts0_0.z), fmax((t7 + ts0_0.y) + ts0_0.z, (ts0_0.x - ts0_0.y) + ts0_0.z)) - R(1.0)) * R(0.5773502691896258)) / ts0_3, ts0_4);
 }
 
 /* ---- scene ---- */
