@@ -30,11 +30,11 @@ bench:
 
 snapshots:
 	@echo "==> snapshots: regenerating codegen snapshots"
-	UPDATE_SNAPSHOTS=1 $(CARGO) test --test snapshots
+	UPDATE_SNAPSHOTS=1 $(CARGO) test --test kernel snapshots
 
 fmt:
 	$(CARGO) fmt --all
 
 golden:
 	@echo "==> golden: regenerating golden render images"
-	UPDATE_GOLDEN=1 $(CARGO) test --test golden
+	UPDATE_GOLDEN=1 $(CARGO) test --test render golden

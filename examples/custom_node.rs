@@ -3,7 +3,7 @@
 //! (the CPU reference runs it; the OpenCL C is printed from it).
 //!
 //! `cargo run --release --example custom_node` writes `out/custom_node.png`.
-//! `tests/custom_node.rs` proves the same shape a bound and checks that the
+//! `tests/kernel/custom_node.rs` proves the same shape a bound and checks that the
 //! CPU and the device agree, using only the public API.
 
 mod common;

@@ -25,7 +25,7 @@ rm -f "$skipped"
 
 # Property tests draw their cases from a fixed seed here, so a failure
 # reproduces exactly: rerun with the seed printed below. Failing cases are
-# also kept in tests/*.proptest-regressions and tried first on every run.
+# also kept in tests/SUITE/*.proptest-regressions and tried first on every run.
 export PROPTEST_RNG_SEED=${PROPTEST_RNG_SEED:-20261201}
 printf '==> proptest seed: PROPTEST_RNG_SEED=%s\n' "$PROPTEST_RNG_SEED"
 

@@ -1,5 +1,5 @@
 //! The custom shape of `examples/custom_node.rs`, shared with
-//! `tests/custom_node.rs`.
+//! `tests/kernel/custom_node.rs`.
 
 use fractal_sdf::expr::{Distance, Num};
 use fractal_sdf::math::V3;

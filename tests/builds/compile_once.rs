@@ -3,7 +3,7 @@
 //!
 //! One test in its own binary: the counters are process-wide.
 
-mod gpu;
+use crate::gpu;
 
 use fractal_sdf::codegen;
 use fractal_sdf::ir;
@@ -18,6 +18,7 @@ fn counts() -> (u64, u64) {
 #[test]
 fn a_renderer_lowers_once_and_frame_inputs_never_generate_code() {
     let Some(_) = gpu::device() else { return };
+    let _turn = crate::serial();
     let scene = gpu::sphere_box_floor();
 
     // Building a renderer from a scene: one lowering, one program.

@@ -1,12 +1,10 @@
 //! Dynamic scenes: animated parameters change the image every frame with
 //! no new program; frame timings; frame sequences on disk.
 //!
-//! The tests here take turns (`SERIAL`), so the process-wide count of
+//! The tests here take turns (`serial`), so the process-wide count of
 //! program builds sees only the test that reads it.
 
-mod gpu;
-
-use std::sync::{Mutex, MutexGuard, PoisonError};
+use crate::gpu;
 
 use fractal_sdf::animation::Motion;
 use fractal_sdf::gallery;
@@ -14,11 +12,7 @@ use fractal_sdf::prelude::*;
 use fractal_sdf::render::{Renderer, program_builds};
 use fractal_sdf::sequence::Sequence;
 
-static SERIAL: Mutex<()> = Mutex::new(());
-
-fn serial() -> MutexGuard<'static, ()> {
-    SERIAL.lock().unwrap_or_else(PoisonError::into_inner)
-}
+use crate::serial;
 
 fn set(renderer: &mut Renderer, motions: &[Motion], time: f64) {
     for m in motions {

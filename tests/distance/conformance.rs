@@ -9,7 +9,7 @@
 //! from. The check is the public `testing::check_device_matches_cpu`, and
 //! each run prints the worst error it measured.
 
-mod gpu;
+use crate::gpu;
 
 use fractal_sdf::prelude::*;
 use fractal_sdf::render::{DeviceInfo, DeviceKind, DeviceSelector, PointEvaluator};

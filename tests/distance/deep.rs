@@ -2,7 +2,7 @@
 //! user's tree. Each test runs on a thread with a small stack, so a
 //! recursive walk anywhere would overflow it.
 
-mod gpu;
+use crate::gpu;
 
 use fractal_sdf::codegen::{self, Options};
 use fractal_sdf::prelude::*;

@@ -4,9 +4,7 @@
 //! `cpu::sdf` (nearest points on segments, circles and triangles, 2D
 //! polygons for solids of revolution).
 
-mod common;
-
-use common::analytic::{self, exact_distance};
+use crate::common::analytic::{self, exact_distance};
 use fractal_sdf::prelude::*;
 use fractal_sdf::testing::{self, Failure, check_exact, point};
 use proptest::prelude::*;

@@ -7,7 +7,7 @@
 //! scene scaled by 1e6 and seen from 1e6 times as far renders the image of
 //! the unit scene.
 
-mod gpu;
+use crate::gpu;
 
 use fractal_sdf::cpu::{self, Evaluator, MarchSettings, Ray};
 use fractal_sdf::metrics::psnr;

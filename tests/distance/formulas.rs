@@ -3,7 +3,7 @@
 //! shape from one generic function (or one text formula) renders, meshes
 //! without bounds and passes the testing toolkit's checks.
 
-mod gpu;
+use crate::gpu;
 
 use fractal_sdf::expr::{Distance, Formula, Interval, Num, Program};
 use fractal_sdf::math::V3;
@@ -340,4 +340,30 @@ fn a_formula_never_reaches_the_source_as_text() {
         "{}",
         shape.opencl_body()
     );
+}
+
+/// The longest formulas, as deep as their length allows, end in a value or
+/// a located error on a test thread's small stack: nesting and chains are
+/// never followed by recursion as deep as the text.
+#[test]
+fn the_deepest_formulas_are_refused_or_evaluated_without_overflowing() {
+    let parse = |text: &str| CustomShape::parse("deep", &[("r", Rule::Positive)], text);
+    let nested = format!("{}length(p) - r{}", "(".repeat(7000), ")".repeat(7000));
+    let err = parse(&nested).unwrap_err().to_string();
+    assert!(err.contains("nested"), "{err}");
+    let negated = format!("{}(length(p) - r)", "-".repeat(12000));
+    let err = parse(&negated).unwrap_err().to_string();
+    assert!(err.contains("nested"), "{err}");
+    let chain = format!("length(p) - r{}", " + 0".repeat(3000));
+    let err = parse(&chain).unwrap_err().to_string();
+    assert!(err.contains("operations deep"), "{err}");
+    // As deep as allowed: it evaluates, on the CPU and as bounds.
+    let chain = format!(
+        "length(p) - r{}",
+        " + 0".repeat(fractal_sdf::expr::MAX_DEPTH - 3)
+    );
+    let shape = parse(&chain).unwrap();
+    let d = shape.distance(DVec3::new(2.0, 0.0, 0.0), &[0.5]);
+    assert!((d - 1.5).abs() < 1e-12, "{d}");
+    assert!(shape.surface_box(&[0.5]).is_some());
 }

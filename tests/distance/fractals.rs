@@ -25,10 +25,9 @@
 //! with 12, 0.001 with 16). `julia_worst_ratio_is_measured` prints the
 //! worst ratios; the estimator's docs (`cpu::sdf::julia`) say why the
 //! constants outside the Mandelbrot set needed a proven bound.
-mod common;
 
+use crate::common::fixtures::{self, JULIA_C};
 use approx::relative_eq;
-use common::fixtures::{self, JULIA_C};
 use fractal_sdf::cpu::sdf;
 use fractal_sdf::prelude::*;
 use fractal_sdf::scene::Kind;
@@ -1065,7 +1064,7 @@ fn julia_ratios(case: &JuliaCase) -> Vec<(f64, DVec3, DVec3, bool)> {
 /// 2.5 ball radii, critical orbit within 0.9 for the iterations and 2
 /// more). It also asserts that no ratio found exceeds 1. `make test` runs
 /// 200 cases; for the README's figures run
-/// `JULIA_CASES=3000 cargo test --release --test fractals -- --nocapture julia_worst_ratio`.
+/// `JULIA_CASES=3000 cargo test --release --features proptest --test distance -- --nocapture julia_worst_ratio`.
 #[test]
 fn julia_worst_ratio_is_measured() {
     use proptest::strategy::ValueTree;

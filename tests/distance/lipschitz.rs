@@ -4,9 +4,7 @@
 //! the twisted or bent geometry; the ellipsoid never exceeds its true
 //! distance.
 
-mod common;
-
-use common::analytic::ellipsoid_distance;
+use crate::common::analytic::ellipsoid_distance;
 use fractal_sdf::prelude::*;
 use fractal_sdf::testing::{
     self, Check, bounded_node, check_lipschitz, check_never_overestimates, exact_node, point,

@@ -3,7 +3,7 @@
 //! robustly, the CPU reference stays finite for every accepted value, and
 //! the quality knobs stay above what the precision can resolve.
 
-mod gpu;
+use crate::gpu;
 
 use fractal_sdf::codegen;
 use fractal_sdf::cpu::{self, Evaluator};

@@ -13,7 +13,7 @@
 //! Checked on the CPU reference (both precisions) and on the device, so a
 //! change to the blend made in both twins alike is caught here, not only by
 //! the golden images.
-mod gpu;
+use crate::gpu;
 
 use fractal_sdf::prelude::*;
 use fractal_sdf::render::{DeviceSelector, PointEvaluator};

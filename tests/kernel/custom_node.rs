@@ -4,8 +4,8 @@
 //! and its OpenCL twin matches its Rust definition; deliberately broken
 //! variants are caught.
 
-mod gpu;
-#[path = "../examples/common/hex_prism.rs"]
+use crate::gpu;
+#[path = "../../examples/common/hex_prism.rs"]
 mod hex_prism;
 
 use fractal_sdf::codegen::{self, Options, Target};
@@ -54,7 +54,7 @@ proptest! {
 /// (PoCL) the worst errors measured over the 2,000 points below are
 /// 2.4e-7 in F32 and 1.7e-16 in F64; the tolerances are about 40 and 60
 /// times those. GPUs are not measured here and keep 1e-4 and 1e-10, as in
-/// `tests/conformance.rs`.
+/// `tests/distance/conformance.rs`.
 fn device_tolerance(precision: Precision, device: &DeviceInfo) -> f64 {
     match (precision, device.kind) {
         (Precision::F32, DeviceKind::Cpu) => 1e-5,

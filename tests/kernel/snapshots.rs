@@ -4,7 +4,7 @@
 //! effects the scenes use (`tests/snapshots/kernels/`), as code generation
 //! appends it. After an intended change to code generation or the kernels,
 //! regenerate them with `make snapshots` (`UPDATE_SNAPSHOTS=1 cargo test
-//! --test snapshots`) and review the diff.
+//! --test kernel snapshots`) and review the diff.
 
 use std::collections::BTreeMap;
 use std::path::PathBuf;

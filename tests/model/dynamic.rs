@@ -2,10 +2,8 @@
 //! baking that value would, and never changes the lowered structure (so
 //! no recompilation is needed).
 
-mod common;
-
+use crate::common::fixtures;
 use approx::relative_eq;
-use common::fixtures;
 use fractal_sdf::ir::{Ir, Scalar};
 use fractal_sdf::prelude::*;
 use fractal_sdf::scene::Kind;

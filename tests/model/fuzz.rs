@@ -3,9 +3,9 @@
 //! failure or a NaN; random invalid inputs always give a typed error.
 //!
 //! `make test` runs 64 scenes; set `FUZZ_CASES` for more
-//! (`FUZZ_CASES=2000 cargo test --release --test fuzz`).
+//! (`FUZZ_CASES=2000 cargo test --release --features proptest --test model fuzz`).
 
-mod gpu;
+use crate::gpu;
 
 use fractal_sdf::prelude::*;
 use fractal_sdf::render::Renderer;
@@ -29,7 +29,7 @@ fn random_scenes_build_and_render_without_nan() {
         cases: cases(64),
         // A failing scene is kept, and tried first on every later run.
         failure_persistence: Some(Box::new(FileFailurePersistence::Direct(
-            "tests/fuzz.proptest-regressions",
+            "tests/model/fuzz.proptest-regressions",
         ))),
         source_file: Some(file!()),
         ..Config::default()

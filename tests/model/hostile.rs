@@ -17,7 +17,7 @@
 //!
 //! The test prints a summary (cases, errors, accepted, rendered).
 
-mod gpu;
+use crate::gpu;
 
 use std::panic::{AssertUnwindSafe, catch_unwind};
 

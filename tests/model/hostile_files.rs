@@ -4,7 +4,7 @@
 //! script numbers. Each gives a typed, readable error or correct output;
 //! none crashes, hangs or writes something wrong silently.
 
-mod gpu;
+use crate::gpu;
 
 use std::fs::{self, File};
 use std::path::{Path, PathBuf};

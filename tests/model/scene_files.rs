@@ -3,9 +3,9 @@
 //! gallery as written today, and every kind of bad file is an error that
 //! names the line and column of what is wrong.
 //!
-//! `UPDATE_SCENES=1 cargo test --test scene_files` rewrites `scenes/`.
+//! `UPDATE_SCENES=1 cargo test --features proptest --test model scene_files` rewrites `scenes/`.
 
-mod gpu;
+use crate::gpu;
 
 use std::path::{Path, PathBuf};
 
@@ -41,7 +41,7 @@ fn the_shipped_scene_files_are_the_gallery() {
             expected.save(&path).unwrap();
         }
         let loaded = SceneFile::load(&path).unwrap_or_else(|e| {
-            panic!("{e} (run `UPDATE_SCENES=1 cargo test --test scene_files`)")
+            panic!("{e} (run `UPDATE_SCENES=1 cargo test --features proptest --test model scene_files`)")
         });
         assert_eq!(loaded, expected, "{} is out of date", path.display());
     }

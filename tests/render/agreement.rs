@@ -1,6 +1,6 @@
 //! The OpenCL marcher agrees with the CPU reference, ray for ray.
 
-mod gpu;
+use crate::gpu;
 
 use fractal_sdf::cpu::{self, Evaluator, Ray};
 use fractal_sdf::prelude::*;

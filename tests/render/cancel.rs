@@ -1,7 +1,7 @@
 //! A render stops between tiles: when its token is cancelled, from any
 //! thread, or when its deadline passes; the renderer stays usable.
 
-mod gpu;
+use crate::gpu;
 
 use std::time::{Duration, Instant};
 

@@ -1,7 +1,7 @@
 //! Cut planes: a shape cut open shows its own colour and orbit trap on
 //! the cut face, and a cut moves without a new program.
 
-mod gpu;
+use crate::gpu;
 
 use fractal_sdf::prelude::*;
 use fractal_sdf::render::Renderer;

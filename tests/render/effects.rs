@@ -1,6 +1,6 @@
 //! Each lighting effect does what it is for, where it should.
 
-mod gpu;
+use crate::gpu;
 
 use fractal_sdf::cpu::{self, Evaluator, MarchSettings, Ray};
 use fractal_sdf::prelude::*;

@@ -1,7 +1,7 @@
 //! Bad settings and bad programs are typed errors with what is needed to
 //! fix them.
 
-mod gpu;
+use crate::gpu;
 
 use fractal_sdf::prelude::*;
 use fractal_sdf::render::{DeviceSelector, RenderOptions, Renderer, devices};

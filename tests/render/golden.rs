@@ -1,9 +1,9 @@
 //! Golden renders: every gallery scene at 96×64 compared with the committed
 //! reference images in `tests/golden/` (PSNR at least [`min_psnr`]). After an intended
 //! change to shading or a scene, regenerate them with `make golden`
-//! (`UPDATE_GOLDEN=1 cargo test --test golden`) and look at the new images.
+//! (`UPDATE_GOLDEN=1 cargo test --test render golden`) and look at the new images.
 
-mod gpu;
+use crate::gpu;
 
 use std::path::PathBuf;
 

@@ -2,7 +2,7 @@
 //! same depths, the same image without glow (and within half a step of an
 //! 8-bit pixel's glow with it), in fewer steps.
 
-mod gpu;
+use crate::gpu;
 
 use fractal_sdf::gallery;
 use fractal_sdf::prelude::*;

@@ -3,7 +3,7 @@
 //! the secondary rays of mirrors and glass against rays traced
 //! analytically on the CPU.
 
-mod gpu;
+use crate::gpu;
 
 use fractal_sdf::cpu::{Evaluator, shade};
 use fractal_sdf::prelude::*;

@@ -1,7 +1,7 @@
 //! Frames split across devices: the same device listed twice renders the
 //! pixels one device renders, before and after the scene's values change.
 
-mod gpu;
+use crate::gpu;
 
 use fractal_sdf::prelude::*;
 use fractal_sdf::render::{DeviceSelector, RenderOptions, Renderer};

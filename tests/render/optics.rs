@@ -3,7 +3,7 @@
 //! against the CPU twin of the rays the kernel traces
 //! ([`Viewport::lens_ray`], [`sample_point`]) or against geometry.
 
-mod gpu;
+use crate::gpu;
 
 use fractal_sdf::cpu::{self, Evaluator};
 use fractal_sdf::prelude::*;

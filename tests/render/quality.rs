@@ -1,7 +1,7 @@
 //! Every `Quality` knob reaches the kernel and does what it says, and the
 //! evaluation counter counts every distance evaluation.
 
-mod gpu;
+use crate::gpu;
 
 use fractal_sdf::cpu::Evaluator;
 use fractal_sdf::prelude::*;

@@ -1,6 +1,6 @@
 //! Any image size renders, tiling changes nothing, and no pixel is NaN.
 
-mod gpu;
+use crate::gpu;
 
 use fractal_sdf::prelude::*;
 use fractal_sdf::render::{Frame, RenderOptions, Renderer};

@@ -2,7 +2,7 @@
 //! rendering fewer pixels (`resolution_scale`) and relaxed math
 //! (`fast_math`).
 
-mod gpu;
+use crate::gpu;
 
 use fractal_sdf::gallery;
 use fractal_sdf::metrics::psnr;

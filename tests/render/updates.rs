@@ -1,7 +1,7 @@
 //! Frame-to-frame changes (parameters, camera, lights) reuse the program;
 //! quality and effects changes build a new one, once.
 
-mod gpu;
+use crate::gpu;
 
 use fractal_sdf::prelude::*;
 use fractal_sdf::render::{RenderOptions, Renderer};
@@ -158,7 +158,7 @@ fn f64_renders_where_the_device_supports_it() {
 #[test]
 fn hand_written_functions_survive_lights_quality_and_effects() {
     let Some(_) = gpu::device() else { return };
-    let functions = include_str!("../benches/mandelbulb_handwritten.cl");
+    let functions = include_str!("../../benches/mandelbulb_handwritten.cl");
     let scene = fractal_sdf::gallery::mandelbulb().compile().unwrap();
     let mut r =
         Renderer::with_scene_functions(scene, &RenderOptions::default(), functions).unwrap();

@@ -1,0 +1,26 @@
+//! Distances: exact primitives against independent oracles, fractal
+//! estimates, Lipschitz bounds, the smooth minimum, CPU against device
+//! conformance, formulas written once, numerics at the extremes and deep
+//! scenes.
+//!
+//! One test binary per concern: each file here is a module.
+
+#[path = "../common/mod.rs"]
+mod common;
+#[path = "../gpu/mod.rs"]
+mod gpu;
+
+#[cfg(feature = "proptest")]
+mod conformance;
+mod deep;
+#[cfg(feature = "proptest")]
+mod exact;
+mod extremes;
+#[cfg(feature = "proptest")]
+mod formulas;
+#[cfg(feature = "proptest")]
+mod fractals;
+#[cfg(feature = "proptest")]
+mod lipschitz;
+mod numeric;
+mod smooth_oracle;

@@ -1,0 +1,24 @@
+//! Rendering through OpenCL: agreement with the CPU, cancelling, cuts,
+//! effects, errors, materials, optics, quality, sizes, frame-to-frame
+//! updates, the golden gallery, march bounds, several devices and the speed
+//! knobs.
+//!
+//! One test binary per concern: each file here is a module.
+
+#[path = "../gpu/mod.rs"]
+mod gpu;
+
+mod agreement;
+mod cancel;
+mod cuts;
+mod effects;
+mod errors;
+mod golden;
+mod march_bounds;
+mod materials;
+mod multi_device;
+mod optics;
+mod quality;
+mod sizes;
+mod speed_knobs;
+mod updates;
