@@ -2,7 +2,8 @@
 //! (power 8, 10 iterations) drawn from its estimate (`mandelbulb`) and
 //! from its escape-time test alone (`mandelbulb_escape`, an
 //! `InsideShape`), with the same camera, at several brute-force step
-//! lengths. Prints Markdown tables for the README:
+//! lengths. Prints Markdown tables for the guide (`docs/guide/fractals.md`,
+//! "Brute force against the estimate"):
 //!
 //! - per step length: the share of pixels whose hit flag agrees with the
 //!   estimate's image, the mean depth difference where both hit (in scene

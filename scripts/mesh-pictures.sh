@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Draws the README's mesh pictures from written mesh files with an
+# Draws the mesh pictures in `docs/` from written mesh files with an
 # independent renderer, Debian's `f3d` (installed here if it is missing),
 # headless under Xvfb:
 #

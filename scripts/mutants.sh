@@ -1,9 +1,9 @@
 #!/usr/bin/env bash
-# `make mutants`: how many deliberate bugs the tests catch (README, "How
-# this is tested"). Not part of `make test`.
+# `make mutants`: how many deliberate bugs the tests catch (the guide, "How
+# it is tested"). Not part of `make test`.
 #
 #   Rust: cargo-mutants over src/cpu, src/ir, src/codegen and src/testing
-#         (.cargo/mutants.toml), each mutant judged by the test files that
+#         (.cargo/mutants.toml), each mutant judged by the test suites that
 #         exercise that code. Every mutant takes a rebuild, so by default one
 #         round-robin shard of 20 (every 20th mutant, spread over every
 #         file) runs: MUTANTS_SHARD=0/20. MUTANTS_SHARD=all runs them all.

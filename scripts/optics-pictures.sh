@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Renders the README's pictures of the camera's optics and of cuts with
+# Renders the pictures in `docs/` of the camera's optics and of cuts with
 # `fractal-sdf render`:
 #
 #   docs/depth-of-field.png       the depth_of_field scene, 32 progressive passes

@@ -5,6 +5,14 @@
 //! as typed Rust values; evaluate them exactly on the CPU, or compile them to
 //! OpenCL C and ray-march them on any OpenCL device.
 //!
+//! ## Guide
+//!
+//! The [`guide`] explains the crate chapter by chapter: getting started,
+//! scenes in Rust and in files, fractals, quality and its measured cost,
+//! optics, materials, animation, meshes, the command line, clusters,
+//! custom shapes, performance, reliability, testing and packaging. Its
+//! examples are doctests.
+//!
 //! ## The pipeline
 //!
 //! Each stage is a module and a function of the previous stage's output:
@@ -180,6 +188,7 @@ pub mod error;
 pub mod expr;
 pub mod file;
 pub mod gallery;
+pub mod guide;
 pub mod ir;
 pub mod math;
 pub mod mesh;

@@ -91,7 +91,7 @@ fn footprints(setting: &str, value: f64, limits: &Limits) -> Result<()> {
 ///
 /// The presets, cheapest first: [`Quality::draft`], [`Quality::preview`],
 /// [`Quality::production`] and [`Quality::reference`]. Their measured
-/// cost and error are in the README ("Speed versus accuracy"), produced by
+/// cost and error are in [the guide](crate::guide::quality), produced by
 /// `cargo run --release --example tradeoff`.
 ///
 /// Two knobs decide *what* is drawn: `detail` (the surface lies where the
@@ -297,7 +297,7 @@ impl Quality {
     /// samples, 256 shadow steps, exact math, every ray marched from the
     /// camera (no coarse pass). It is converged: halving its relaxation
     /// factor or dividing its `hit_epsilon` by ten changes its image by
-    /// less than the presets differ from it (see the README).
+    /// less than the presets differ from it (see [the guide](crate::guide::quality)).
     #[must_use]
     pub fn reference() -> Self {
         Quality {

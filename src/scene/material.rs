@@ -37,7 +37,7 @@ use super::param::Param;
 /// How a surface answers light: the values that the renderer's one
 /// shading formula reads (Oren–Nayar diffuse, a Blinn–Phong highlight,
 /// subsurface light through thin parts, reflections and refraction; see
-/// [`Node::material`](super::Node::material) and the README).
+/// [`Node::material`](super::Node::material) and [the guide](crate::guide::materials)).
 ///
 /// `Material::default()` is the look of every surface without a material:
 /// Lambert diffuse with a Blinn–Phong highlight of strength 0.25 and
