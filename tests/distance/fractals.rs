@@ -1063,7 +1063,7 @@ fn julia_ratios(case: &JuliaCase) -> Vec<(f64, DVec3, DVec3, bool)> {
 /// whose constant keeps the escape-time estimate there (bailout at least
 /// 2.5 ball radii, critical orbit within 0.9 for the iterations and 2
 /// more). It also asserts that no ratio found exceeds 1. `make test` runs
-/// 200 cases; for the README's figures run
+/// 200 cases; for the guide's figures run
 /// `JULIA_CASES=3000 cargo test --release --features proptest --test distance -- --nocapture julia_worst_ratio`.
 #[test]
 fn julia_worst_ratio_is_measured() {
