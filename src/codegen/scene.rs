@@ -26,7 +26,8 @@ use super::writer::{INSTANCE_SLOT, Writer};
 use crate::cpu::sdf;
 use crate::expr::{Num, OpenCl, Printer, Shape, Var, trace};
 use crate::ir::{
-    Bound, Ir, IrNode, NodeId, Reach, Scalar, UnionChain, Vector, costs, reach, swaps, union_chain,
+    Bound, Ir, IrNode, NodeId, Reach, Scalar, UnionChain, Vector, constant, costs, reach, swaps,
+    union_chain,
 };
 use crate::math::{F32_LIMITS, V3, escape_radius, integer_power, mandelbulb_radius, rotation_rows};
 use crate::quality::Precision;
@@ -934,7 +935,9 @@ impl<'a> SceneEmitter<'a> {
                     } else {
                         sdf::bent(d, a[3], q)
                     };
-                    ball.map_or(d, |b| b.floor_at(d, q))
+                    ball.map_or(d, |b| {
+                        sdf::ball_floor(d, q, constant(b.centre), Var::of(b.radius))
+                    })
                 })
             }
             Kind::Csg { op, smoothing, .. } => {

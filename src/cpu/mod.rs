@@ -18,8 +18,8 @@ use crate::error::Result;
 use std::collections::HashMap;
 
 use crate::ir::{
-    Bound, CompiledScene, Ir, IrNode, NodeId, ParamValues, Reach, Scalar, costs, is_hard_union,
-    reach, swaps, union_chain,
+    Bound, CompiledScene, Ir, IrNode, NodeId, ParamValues, Reach, Scalar, constant, costs,
+    is_hard_union, reach, swaps, union_chain,
 };
 use crate::math::F32_LIMITS;
 use crate::scene::{
@@ -151,7 +151,7 @@ impl Evaluator {
     /// compute it, wherever that bound exists.
     fn warp_floor<T: Real>(&self, id: usize, distance: &mut T, p: V3<T>) {
         if let Some(ball) = &self.bounds[id] {
-            *distance = ball.floor_at(*distance, p);
+            *distance = sdf::ball_floor(*distance, p, constant(ball.centre), T::of(ball.radius));
         }
     }
 

@@ -23,7 +23,6 @@
 use glam::DVec3;
 
 use super::{Ir, IrNode, NodeId, Scalar, baked3};
-use crate::cpu::sdf::ball_floor;
 use crate::math::{
     JULIA_FAR_FIELD, JULIA_FAR_FIELD_SLOPE, Limits, Num, V3, julia_radius, mandelbulb_radius,
     rotation_rows,
@@ -78,13 +77,6 @@ impl Bound {
     #[must_use]
     pub fn distance(&self, p: DVec3) -> f64 {
         self.slope * ((p - self.centre).length() * SHRINK - self.radius)
-    }
-
-    /// A warp's estimate `d` at `p`, raised to the distance to this ball
-    /// (see [`warp_ball`]): `|p − centre| − radius`, without the slope or
-    /// the shrinking that pruning applies.
-    pub(crate) fn floor_at<T: Num>(&self, d: T, p: V3<T>) -> T {
-        ball_floor(d, p, constant(self.centre), T::of(self.radius))
     }
 
     /// [`Bound::distance`] in any number type, as the CPU reference and
@@ -377,7 +369,7 @@ pub(crate) fn warp_ball(axis: Axis, child: Bound) -> Bound {
 }
 
 /// `v` as a vector of literals.
-fn constant<T: Num>(v: DVec3) -> V3<T> {
+pub(crate) fn constant<T: Num>(v: DVec3) -> V3<T> {
     V3::from_array(v.to_array().map(T::of))
 }
 

@@ -23,7 +23,9 @@ use std::sync::atomic::{AtomicU64, Ordering};
 use glam::DVec3;
 
 pub use bounds::{Bound, SHRINK};
-pub(crate) use bounds::{Reach, UnionChain, costs, is_hard_union, reach, swaps, union_chain};
+pub(crate) use bounds::{
+    Reach, UnionChain, constant, costs, is_hard_union, reach, swaps, union_chain,
+};
 pub use compiled::CompiledScene;
 pub use params::{Constraint, ParamLayout, ParamSlot, ParamValues, Relation};
 

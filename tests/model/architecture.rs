@@ -12,12 +12,19 @@ use std::path::{Path, PathBuf};
 /// `FrameTiming` the renderer reports.
 const STAGES: &[(&str, &[&str])] = &[
     ("error", &[]),
-    ("math", &[]),
+    // The foundation: `math`'s vectors are generic over `expr`'s numbers,
+    // and `expr`'s formulas use `math`'s vectors and guards.
+    ("math", &["expr"]),
+    ("expr", &["math"]),
     ("quality", &["error", "math"]),
-    ("scene", &["error", "math"]),
-    ("ir", &["error", "math", "scene"]),
-    ("cpu", &["error", "scene", "ir", "math"]),
-    ("codegen", &["error", "scene", "ir", "math", "quality"]),
+    ("scene", &["error", "math", "expr"]),
+    ("ir", &["error", "math", "expr", "scene"]),
+    ("cpu", &["error", "scene", "ir", "math", "expr"]),
+    // Code generation prints the formulas of `cpu::sdf` through `expr`.
+    (
+        "codegen",
+        &["error", "scene", "ir", "math", "expr", "cpu", "quality"],
+    ),
     (
         "render",
         &[
