@@ -171,13 +171,11 @@ fn a_launch_that_never_ends_is_abandoned_at_the_watchdog() {
         println!("endless launch abandoned after {:?}", start.elapsed());
         return;
     }
+    // The test's name in its suite: its module path without the crate.
+    let module = module_path!().split_once("::").map_or("", |(_, m)| m);
+    let name = format!("{module}::a_launch_that_never_ends_is_abandoned_at_the_watchdog");
     let mut child = std::process::Command::new(std::env::current_exe().unwrap())
-        .args([
-            "--exact",
-            "a_launch_that_never_ends_is_abandoned_at_the_watchdog",
-            "--nocapture",
-            "--test-threads=1",
-        ])
+        .args(["--exact", name.as_str(), "--nocapture", "--test-threads=1"])
         .env(ENDLESS_CHILD, "1")
         .stdout(std::process::Stdio::piped())
         .stderr(std::process::Stdio::piped())
@@ -197,7 +195,9 @@ fn a_launch_that_never_ends_is_abandoned_at_the_watchdog() {
     let out = child.wait_with_output().unwrap();
     let stdout = String::from_utf8_lossy(&out.stdout);
     assert!(
-        status.success() && stdout.contains("endless launch abandoned"),
+        status.success()
+            && stdout.contains("1 passed")
+            && stdout.contains("endless launch abandoned"),
         "{status:?}\n{stdout}\n{}",
         String::from_utf8_lossy(&out.stderr)
     );
