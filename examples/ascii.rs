@@ -10,12 +10,10 @@ fn render(name: &str, geometry: &Node, camera: Camera) -> Result<()> {
     let (w, h) = (72usize, 32usize);
     let tan = (45f64.to_radians() * 0.5).tan();
     let shades = b" .:-=+*#%@";
-    let settings = MarchSettings {
-        max_steps: 200,
-        max_distance: 20.0,
-        footprint_base: 1e-3,
-        ..Default::default()
-    };
+    let settings = MarchSettings::default()
+        .max_steps(200)
+        .max_distance(20.0)
+        .footprint_base(1e-3);
     let light = dvec3(0.6, 0.8, 0.4).normalize();
     println!("{name}:");
     for j in 0..h {
@@ -25,14 +23,7 @@ fn render(name: &str, geometry: &Node, camera: Camera) -> Result<()> {
             let x = (2.0 * (i as f64 + 0.5) / w as f64 - 1.0) * tan * (w as f64 / h as f64) * 0.5;
             let y = (1.0 - 2.0 * (j as f64 + 0.5) / h as f64) * tan;
             let direction = (forward + right * x + up * y).normalize();
-            let hit = march(
-                &eval,
-                Ray {
-                    origin: camera.position,
-                    direction,
-                },
-                &settings,
-            );
+            let hit = march(&eval, Ray::new(camera.position, direction), &settings);
             let c = if hit.hit {
                 let p = camera.position + direction * hit.depth;
                 let lambert = eval.normal(p, 1e-4).dot(light).max(0.0);

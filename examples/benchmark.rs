@@ -17,6 +17,8 @@ use std::time::{Duration, Instant};
 
 use fractal_sdf::gallery;
 use fractal_sdf::prelude::*;
+use fractal_sdf::quality::Glow;
+use fractal_sdf::quality::Preset;
 use fractal_sdf::render::{RenderOptions, Renderer};
 use fractal_sdf::view::FrameStats;
 
@@ -184,17 +186,10 @@ fn main() -> std::process::ExitCode {
             return Err(common::usage(format!("unexpected arguments {rest:?}")));
         }
 
-        let options = RenderOptions {
-            quality: preset.quality(),
-            effects: Effects {
-                glow: Some(Glow {
-                    color: dvec3(0.6, 0.75, 1.0),
-                    strength: 0.6,
-                }),
-                ..Effects::default() // ambient occlusion and shadows on
-            },
-            ..RenderOptions::default()
-        };
+        // Ambient occlusion and shadows are on by default.
+        let options = RenderOptions::default()
+            .quality(preset.quality())
+            .effects(Effects::default().glow(Some(Glow::new(dvec3(0.6, 0.75, 1.0), 0.6))));
         let mut renderer = Renderer::with_options(&gallery::benchmark(), &options)?;
         let device = renderer.device().clone();
         let cpu = common::cpu_model();

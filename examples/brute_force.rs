@@ -28,13 +28,12 @@ use common::measure::compare;
 use fractal_sdf::gallery;
 use fractal_sdf::metrics::psnr;
 use fractal_sdf::prelude::*;
+use fractal_sdf::quality::ScreenNormals;
 use fractal_sdf::render::{Frame, RenderOptions, Renderer};
+use glam::Vec3;
 
 fn options(quality: Quality) -> RenderOptions {
-    RenderOptions {
-        quality,
-        ..RenderOptions::default()
-    }
+    RenderOptions::default().quality(quality)
 }
 
 /// A frame with its AOVs and the milliseconds it took (after one untimed

@@ -11,6 +11,8 @@ mod common;
 mod hex_prism;
 
 use fractal_sdf::prelude::*;
+use fractal_sdf::scene::Param;
+use fractal_sdf::scene::octahedron;
 
 fn main() -> std::process::ExitCode {
     common::run(|| {

@@ -10,6 +10,7 @@
 use std::time::Instant;
 
 use fractal_sdf::codegen::{self, Options};
+use fractal_sdf::cpu;
 use fractal_sdf::prelude::*;
 use fractal_sdf::render::{RenderOptions, Renderer};
 
@@ -59,10 +60,7 @@ fn run(n: usize) -> fractal_sdf::Result<()> {
     println!("one CPU distance: {:?} (d = {d:.4})", t.elapsed());
     let scene = scene.with_camera(Camera::look_at(dvec3(2.2, 1.7, 2.9), DVec3::ZERO));
     let t = Instant::now();
-    let options = RenderOptions {
-        quality: Quality::draft(),
-        ..RenderOptions::default()
-    };
+    let options = RenderOptions::default().quality(Quality::draft());
     let mut renderer = Renderer::from_compiled(scene.compile()?, &options)?;
     println!("renderer (build the program): {:?}", t.elapsed());
     for frame in ["first", "second"] {

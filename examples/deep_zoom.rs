@@ -44,7 +44,10 @@ mod common;
 use fractal_sdf::cpu::{self, Evaluator, MarchSettings, Ray};
 use fractal_sdf::metrics::psnr;
 use fractal_sdf::prelude::*;
+use fractal_sdf::quality::Precision;
 use fractal_sdf::render::{RenderOptions, Renderer};
+use fractal_sdf::scene::Mandelbulb;
+use image::RgbaImage;
 
 /// Iterations of the bulb: each resolves detail about 8 times finer, so
 /// 16 keep structure in view down to about 1e-14.
@@ -72,15 +75,10 @@ fn bulb() -> Node {
 fn surface_point() -> Result<(DVec3, DVec3)> {
     let eval = Evaluator::new(&bulb())?;
     let direction = (TARGET - CAMERA).normalize();
-    let ray = Ray {
-        origin: CAMERA,
-        direction,
-    };
-    let settings = MarchSettings {
-        max_steps: 100_000,
-        footprint_base: 1e-12,
-        ..MarchSettings::default()
-    };
+    let ray = Ray::new(CAMERA, direction);
+    let settings = MarchSettings::default()
+        .max_steps(100_000)
+        .footprint_base(1e-12);
     let hit = cpu::march(&eval, ray, &settings);
     assert!(hit.hit, "the view ray misses the bulb");
     // Step on in small steps until inside, then bisect the crossing.
@@ -128,16 +126,11 @@ const KEY_LIGHT: DVec3 = DVec3::new(0.5, 0.8, 0.35);
 fn key_light_blocked(point: DVec3, offset: f64) -> Result<Option<f64>> {
     let eval = Evaluator::new(&bulb())?;
     let direction = KEY_LIGHT.normalize();
-    let settings = MarchSettings {
-        max_steps: 100_000,
-        max_distance: 10.0,
-        footprint_base: 1e-3 * offset,
-        ..MarchSettings::default()
-    };
-    let ray = Ray {
-        origin: point + direction * offset,
-        direction,
-    };
+    let settings = MarchSettings::default()
+        .max_steps(100_000)
+        .max_distance(10.0)
+        .footprint_base(1e-3 * offset);
+    let ray = Ray::new(point + direction * offset, direction);
     let hit = cpu::march(&eval, ray, &settings);
     Ok(hit.hit.then_some(hit.depth))
 }
@@ -148,11 +141,9 @@ fn render(
     occlusion: bool,
     size: (u32, u32),
 ) -> Result<RgbaImage> {
-    let options = RenderOptions {
-        quality: Quality::production().precision(precision).max_steps(1024),
-        effects: Effects::default().ambient_occlusion(occlusion),
-        ..RenderOptions::default()
-    };
+    let options = RenderOptions::default()
+        .quality(Quality::production().precision(precision).max_steps(1024))
+        .effects(Effects::default().ambient_occlusion(occlusion));
     Renderer::with_options(scene, &options)?.render(size.0, size.1)
 }
 

@@ -6,6 +6,7 @@
 use fractal_sdf::codegen::{self, Options};
 use fractal_sdf::gallery;
 use fractal_sdf::prelude::*;
+use fractal_sdf::quality::Precision;
 
 fn main() -> Result<()> {
     let mut args = std::env::args().skip(1);
@@ -21,10 +22,7 @@ fn main() -> Result<()> {
         );
         std::process::exit(2);
     };
-    let options = Options {
-        quality: Quality::default().precision(precision),
-        ..Options::default()
-    };
+    let options = Options::default().quality(Quality::default().precision(precision));
     let scene = scene.compile()?;
     let kernel = codegen::emit(&scene, &options)?;
     print!("{}", kernel.source);

@@ -34,10 +34,7 @@ fn main() -> std::process::ExitCode {
             }
             // The plain gallery settings, one pass: a lens renders its
             // single pass too, so both builds draw the same samples.
-            let options = RenderOptions {
-                quality: Quality::production(),
-                ..RenderOptions::default()
-            };
+            let options = RenderOptions::default().quality(Quality::production());
             let t = Instant::now();
             let mut renderer = Renderer::with_options(&scene, &options)?;
             let build_ms = t.elapsed().as_secs_f64() * 1e3;

@@ -14,6 +14,7 @@ use std::time::Instant;
 
 use fractal_sdf::gallery;
 use fractal_sdf::prelude::*;
+use fractal_sdf::quality::Glow;
 use fractal_sdf::render::{RenderOptions, Renderer};
 
 /// Median milliseconds of `runs` renders, after one warm-up.
@@ -38,13 +39,7 @@ fn arg_value(name: &str) -> Option<String> {
 }
 
 fn effects_on() -> Effects {
-    Effects {
-        glow: Some(Glow {
-            color: dvec3(0.6, 0.75, 1.0),
-            strength: 0.6,
-        }),
-        ..Effects::default()
-    }
+    Effects::default().glow(Some(Glow::new(dvec3(0.6, 0.75, 1.0), 0.6)))
 }
 
 fn main() -> std::process::ExitCode {
@@ -69,11 +64,7 @@ fn main() -> std::process::ExitCode {
             for &size in sizes {
                 let mut row = Vec::new();
                 for (label, effects) in [("on", effects_on()), ("off", Effects::none())] {
-                    let options = RenderOptions {
-                        quality,
-                        effects,
-                        ..RenderOptions::default()
-                    };
+                    let options = RenderOptions::default().quality(quality).effects(effects);
                     let mut renderer = Renderer::with_options(&scene, &options)?;
                     device.clone_from(&renderer.device().label());
                     let ms = time_ms(&mut renderer, size, runs)?;
@@ -92,11 +83,9 @@ fn main() -> std::process::ExitCode {
         // functions; renders alternate so drift affects both alike.
         let size = *sizes.last().expect("at least one size");
         let scene = gallery::mandelbulb();
-        let options = RenderOptions {
-            quality,
-            effects: effects_on(),
-            ..RenderOptions::default()
-        };
+        let options = RenderOptions::default()
+            .quality(quality)
+            .effects(effects_on());
         let scene = scene.compile()?;
         let mut generated = Renderer::from_compiled(scene.clone(), &options)?;
         let mut handwritten = Renderer::with_scene_functions(

@@ -14,7 +14,8 @@ use std::path::{Path, PathBuf};
 use fractal_sdf::animation::CameraPath;
 use fractal_sdf::gallery;
 use fractal_sdf::prelude::*;
-use fractal_sdf::render::{RenderOptions, Renderer};
+use fractal_sdf::quality::Preset;
+use fractal_sdf::render::Renderer;
 use fractal_sdf::sequence::{Encoded, Sequence, parse_range};
 use indicatif::{ProgressBar, ProgressStyle};
 
@@ -127,10 +128,7 @@ fn main() -> std::process::ExitCode {
         );
 
         if !todo.is_empty() {
-            let options = RenderOptions {
-                quality: preset.quality(),
-                ..common::gallery_options()
-            };
+            let options = common::gallery_options().quality(preset.quality());
             let mut renderer = Renderer::with_options(&scene, &options)?;
             let bar = ProgressBar::new(todo.len() as u64);
             bar.set_style(

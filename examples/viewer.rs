@@ -3,7 +3,7 @@
 //! `cargo run --release --features viewer --example viewer -- fractal_mix`
 //! `cargo run --release --features viewer --example viewer -- my_scene.ron`
 //!
-//! A scene file (`.ron`, see `fractal_sdf::SceneFile`) brings its
+//! A scene file (`.ron`, see `fractal_sdf::file::SceneFile`) brings its
 //! quality, effects and motions, and is reloaded whenever it changes on
 //! disk (polled: its modification time and size): a good file replaces the
 //! scene (keeping the program when only parameter defaults or the lights
@@ -23,11 +23,13 @@ use std::path::{Path, PathBuf};
 use std::rc::Rc;
 use std::time::{Duration, Instant, SystemTime};
 
-use fractal_sdf::SceneFile;
 use fractal_sdf::animation::Motion;
 use fractal_sdf::codegen;
+use fractal_sdf::file::SceneFile;
+use fractal_sdf::ir::CompiledScene;
 use fractal_sdf::ir::ParamLayout;
 use fractal_sdf::prelude::*;
+use fractal_sdf::quality::Preset;
 use fractal_sdf::render::{DeviceSelector, RenderOptions, Renderer};
 use fractal_sdf::scene::{Stereo, StereoLayout};
 use fractal_sdf::settings::Settings;
@@ -36,6 +38,7 @@ use fractal_sdf::view::{
     blit_scaled, reduced_size,
 };
 use fractal_sdf::{gallery, output};
+use image::RgbaImage;
 use winit::application::ApplicationHandler;
 use winit::dpi::PhysicalSize;
 use winit::event::{ElementState, MouseButton, MouseScrollDelta, WindowEvent};
@@ -434,12 +437,10 @@ impl Viewer {
         settings.glow |= args.glow;
         let renderer = Renderer::with_options(
             &scene,
-            &RenderOptions {
-                quality: settings.quality(),
-                effects: settings.effects(),
-                device,
-                ..RenderOptions::default()
-            },
+            &RenderOptions::default()
+                .quality(settings.quality())
+                .effects(settings.effects())
+                .device(device),
         )?;
         println!(
             "{name}: {} on {} (build {:.0} ms)",
@@ -492,10 +493,8 @@ impl Viewer {
     /// The fly camera at `camera`, keeping the mouse sensitivity (and the
     /// speed given on the command line).
     fn fly_from(&self, camera: &Camera) -> FlyCamera {
-        let mut fly = FlyCamera {
-            sensitivity: self.fly.sensitivity,
-            ..FlyCamera::from_camera(camera)
-        };
+        let mut fly = FlyCamera::from_camera(camera);
+        fly.sensitivity = self.fly.sensitivity;
         if let Some(speed) = self.args.speed {
             fly.speed = speed;
         }
@@ -510,12 +509,10 @@ impl Viewer {
                 self.changed = true;
             }
             Action::ResetCamera => {
-                let speed = self.fly.speed;
-                self.fly = FlyCamera {
-                    speed,
-                    sensitivity: self.fly.sensitivity,
-                    ..FlyCamera::from_camera(&self.scene.camera)
-                };
+                let mut fly = FlyCamera::from_camera(&self.scene.camera);
+                fly.speed = self.fly.speed;
+                fly.sensitivity = self.fly.sensitivity;
+                self.fly = fly;
                 self.changed = true;
             }
             Action::Screenshot => self.screenshot_wanted = true,
@@ -613,11 +610,10 @@ impl Viewer {
         let (quality, effects) = (settings.quality(), settings.effects());
         let source = codegen::emit(
             &compiled,
-            &codegen::Options {
-                quality,
-                effects,
-                target: codegen::Target::Render,
-            },
+            &codegen::Options::default()
+                .quality(quality)
+                .effects(effects)
+                .target(codegen::Target::Render),
         )?;
         let same_program = source == *self.renderer.source()
             && same_slots(self.renderer.scene().params(), compiled.params());
@@ -625,11 +621,12 @@ impl Viewer {
         let how = if same_program && update_in_place(&mut self.renderer, &compiled).is_ok() {
             "same program"
         } else {
-            let options = RenderOptions {
-                quality,
-                effects,
-                ..self.renderer.options().clone()
-            };
+            let options = self
+                .renderer
+                .options()
+                .clone()
+                .quality(quality)
+                .effects(effects);
             let r = fresh.insert(Renderer::from_compiled(compiled, &options)?);
             if r.build_info().cached {
                 "cached program"
@@ -796,7 +793,7 @@ impl Viewer {
                 let (ew, eh) = match layout {
                     StereoLayout::Anaglyph => (w, h),
                     StereoLayout::SideBySide => ((w / 2).max(1), h),
-                    StereoLayout::OverUnder => (w, (h / 2).max(1)),
+                    _ => (w, (h / 2).max(1)),
                 };
                 self.renderer.render_stereo(ew, eh, &Stereo::new(layout))
             }

@@ -30,6 +30,7 @@ use crate::scene::Camera;
 /// The camera's position and target at a time, in seconds.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
+#[non_exhaustive]
 pub struct Keyframe {
     /// Time in seconds from the start of the path.
     pub time: f64,
@@ -287,6 +288,7 @@ fn catmull_rom(
 /// ```
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
+#[non_exhaustive]
 pub enum Motion {
     /// `name` = `center` + `amplitude` · sin(2π t / `period`).
     Oscillate {

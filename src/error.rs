@@ -141,7 +141,7 @@ pub enum Error {
     #[error("{}:{line}:{column}: {reason}", file.display())]
     SceneFile {
         /// The file, or `<scene>` for text read with
-        /// [`SceneFile::parse`](crate::SceneFile::parse).
+        /// [`SceneFile::parse`](crate::file::SceneFile::parse).
         file: PathBuf,
         /// The line of the offending text, from 1.
         line: usize,
@@ -375,16 +375,8 @@ fn custom_place(line: usize, text: &str) -> String {
 /// back to the same value, in scientific notation when it is very large or
 /// very small (`1e300`, `-2.5e-7`), plainly otherwise (`0.25`, `-3`,
 /// `NaN`, `inf`), so a message never holds hundreds of digits.
-///
-/// ```
-/// use fractal_sdf::error::fmt_value;
-/// assert_eq!(fmt_value(1e300).to_string(), "1e300");
-/// assert_eq!(fmt_value(-2.5e-7).to_string(), "-2.5e-7");
-/// assert_eq!(fmt_value(0.25).to_string(), "0.25");
-/// assert_eq!(fmt_value(f64::NAN).to_string(), "NaN");
-/// ```
 #[must_use]
-pub fn fmt_value(value: f64) -> impl fmt::Display {
+pub(crate) fn fmt_value(value: f64) -> impl fmt::Display {
     FmtValue(value)
 }
 
@@ -427,6 +419,15 @@ pub type Result<T, E = Error> = std::result::Result<T, E>;
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn values_print_short_and_round_trip() {
+        assert_eq!(fmt_value(1e300).to_string(), "1e300");
+        assert_eq!(fmt_value(-2.5e-7).to_string(), "-2.5e-7");
+        assert_eq!(fmt_value(0.25).to_string(), "0.25");
+        assert_eq!(fmt_value(0.5).to_string(), "0.5");
+        assert_eq!(fmt_value(f64::NAN).to_string(), "NaN");
+    }
 
     #[test]
     fn precision_errors_print_their_value_short() {

@@ -72,6 +72,7 @@
 //!
 //! ```
 //! use fractal_sdf::prelude::*;
+//! use fractal_sdf::cpu;
 //!
 //! // A Mandelbulb of power 8, moved to the left.
 //! let bulb = mandelbulb(8.0).translate(dvec3(-1.5, 0.0, 0.0));
@@ -140,6 +141,7 @@
 //!
 //! ```
 //! use fractal_sdf::prelude::*;
+//! use fractal_sdf::cpu;
 //!
 //! let scene = Scene::new(sphere(param("radius", 1.0))).compile()?;
 //! let mut eval = cpu::Evaluator::from_compiled(&scene);
@@ -181,10 +183,13 @@
 // feature adds; an ordinary build never sets `docsrs`.
 #![cfg_attr(docsrs, feature(doc_cfg))]
 
+#[macro_use]
+mod macros;
+
 pub mod animation;
 pub mod codegen;
 pub mod cpu;
-pub mod error;
+mod error;
 pub mod expr;
 pub mod file;
 pub mod gallery;
@@ -205,26 +210,28 @@ pub mod testing;
 pub mod view;
 
 pub use error::{Error, Result};
-pub use file::SceneFile;
-pub use ir::CompiledScene;
-pub use scene::{Node, Scene};
 
 /// The [`image`](https://docs.rs/image) crate, whose `RgbaImage` every
 /// render returns, with its PNG codec.
 pub use image;
 
-/// Everything needed to write scenes: `use fractal_sdf::prelude::*;`.
+/// The [`glam`](https://docs.rs/glam) crate, whose `f64` vectors and
+/// quaternions every scene is written in.
+pub use glam;
+
+/// What a first scene needs, in 24 names: `use fractal_sdf::prelude::*;`.
+///
+/// The scene and its parts, the quality, the common shapes and fractals,
+/// dynamic parameters, the crate's error, and glam's `DVec3`, `dvec3` and
+/// `DQuat`. Everything else is named through its module
+/// (`fractal_sdf::scene::ellipsoid`, `fractal_sdf::cpu::Evaluator`,
+/// `fractal_sdf::glam::EulerRot`).
 pub mod prelude {
-    pub use crate::cpu;
     pub use crate::error::{Error, Result};
-    pub use crate::ir::CompiledScene;
-    pub use crate::quality::{Effects, Glow, Precision, Preset, Quality, ScreenNormals};
+    pub use crate::quality::{Effects, Quality};
     pub use crate::scene::{
-        Axis, Camera, InsideBounds, InsideShape, Light, Mandelbulb, Material, Menger, Node, Param,
-        Param3, Projection, QuaternionJulia, Scene, Sierpinski, capped_cone, capsule, cuboid,
-        cylinder, ellipsoid, julia, mandelbulb, menger, octahedron, param, param3, plane,
-        round_box, sierpinski, sphere, torus,
+        Camera, Light, Material, Node, Scene, capsule, cuboid, cylinder, julia, mandelbulb, menger,
+        param, plane, round_box, sierpinski, sphere, torus,
     };
-    pub use glam::{DQuat, DVec2, DVec3, EulerRot, Vec3, dvec2, dvec3, vec3};
-    pub use image::RgbaImage;
+    pub use glam::{DQuat, DVec3, dvec3};
 }

@@ -14,6 +14,7 @@ use crate::math::{F32_LIMITS, F64_LIMITS, Limits, Magnitude};
 
 /// Floating-point precision of the generated kernel.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default, Serialize, Deserialize)]
+#[non_exhaustive]
 pub enum Precision {
     /// 32-bit floats: fastest, every device supports them.
     #[default]
@@ -39,6 +40,7 @@ impl Precision {
     ///
     /// ```
     /// use fractal_sdf::prelude::*;
+    /// use fractal_sdf::quality::Precision;
     /// assert_eq!(Precision::F32.limits().max, 1e18);
     /// assert_eq!(Precision::F64.limits().min, 1e-150);
     /// ```
@@ -113,6 +115,7 @@ fn footprints(setting: &str, value: f64, limits: &Limits) -> Result<()> {
 /// `1e-150` to `1e150` in `F64`). [`Effects`] values keep the same
 /// bounds on sizes.
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[non_exhaustive]
 pub struct Quality {
     /// Give up on a ray after this many steps.
     pub max_steps: u32,
@@ -208,6 +211,7 @@ pub struct Quality {
 /// depth is within a few brute-force steps of the pixel's (the same
 /// surface).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default, Serialize, Deserialize)]
+#[non_exhaustive]
 pub enum ScreenNormals {
     /// The cross product of central differences of the hit points left and
     /// right, above and below (one-sided where a neighbour is on another
@@ -453,6 +457,7 @@ pub const MIN_BRUTE_STEP: f64 = 0.125;
 ///
 /// ```
 /// use fractal_sdf::prelude::*;
+/// use fractal_sdf::quality::Precision;
 ///
 /// let q = Quality::production()
 ///     .supersampling(2)
@@ -612,6 +617,7 @@ impl Default for Quality {
 /// Glow around surfaces, from how closely a ray passed them.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
+#[non_exhaustive]
 pub struct Glow {
     /// Linear RGB colour of the glow.
     pub color: DVec3,
@@ -630,6 +636,7 @@ impl Glow {
 /// Lighting effects. Each one that is off is left out of the kernel.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
+#[non_exhaustive]
 pub struct Effects {
     /// Ambient occlusion (needs [`Quality::ao_samples`] > 0).
     pub ambient_occlusion: bool,
@@ -773,6 +780,7 @@ impl Effects {
 ///
 /// ```
 /// use fractal_sdf::prelude::*;
+/// use fractal_sdf::quality::Glow;
 ///
 /// let effects = Effects::default()
 ///     .shadows(false)
@@ -848,6 +856,7 @@ impl Effects {
 
 /// The named quality presets, in increasing cost.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default, Serialize, Deserialize)]
+#[non_exhaustive]
 pub enum Preset {
     /// [`Quality::draft`].
     Draft,

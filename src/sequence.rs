@@ -212,6 +212,7 @@ impl Sequence {
 
 /// What [`Sequence::encode`] did.
 #[derive(Debug, Clone, PartialEq, Eq)]
+#[non_exhaustive]
 pub enum Encoded {
     /// The video was written.
     Written,
@@ -250,6 +251,7 @@ impl std::fmt::Display for Encoded {
 /// A frame [`Sequence::render`] has just written.
 #[cfg(feature = "opencl")]
 #[derive(Debug, Clone, PartialEq)]
+#[non_exhaustive]
 pub struct RenderedFrame {
     /// The frame's index in the sequence.
     pub index: u32,

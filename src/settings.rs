@@ -48,6 +48,7 @@ pub const CONFIG_ENV: &str = "FRACTAL_SDF_CONFIG";
 /// default applies).
 #[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
+#[non_exhaustive]
 pub struct Settings {
     /// The quality preset, by name in the file (`"preview"`).
     #[serde(default, with = "preset_name", skip_serializing_if = "Option::is_none")]
@@ -66,6 +67,7 @@ pub struct Settings {
 /// The interactive viewer's settings.
 #[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
+#[non_exhaustive]
 pub struct ViewerSettings {
     /// Radians of turn per pixel of mouse motion.
     #[serde(default, skip_serializing_if = "Option::is_none")]

@@ -12,7 +12,7 @@
 //!   return the worst violation as a [`Failure`] that says where, what was
 //!   measured and what was allowed. [`near_surface_points`] samples where
 //!   an estimate is most at risk, using only a membership test. They accept anything that is a [`DistanceField`]: a
-//!   [`Node`](crate::Node), a [`cpu::Evaluator`](crate::cpu::Evaluator) or a
+//!   [`Node`](crate::scene::Node), a [`cpu::Evaluator`](crate::cpu::Evaluator) or a
 //!   closure `Fn(DVec3) -> f64`. [`check_device_matches_cpu`] (feature
 //!   `opencl`) runs a node's generated OpenCL code on a device and compares
 //!   it with the CPU reference, and [`check_inside_matches_device`] does

@@ -7,9 +7,13 @@ mod gpu;
 use std::f64::consts::PI;
 use std::path::PathBuf;
 
+use fractal_sdf::cpu;
+use fractal_sdf::ir::CompiledScene;
 use fractal_sdf::mesh::{self, Aabb, GridOptions, Mesh, Sampler, Volume};
 use fractal_sdf::prelude::*;
+use fractal_sdf::quality::Precision;
 use fractal_sdf::render::DeviceSelector;
+use fractal_sdf::scene::InsideShape;
 
 fn scratch(name: &str) -> PathBuf {
     let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR"))

@@ -7,6 +7,7 @@ use fractal_sdf::image::Rgba;
 use fractal_sdf::metrics::{mask_mismatch, mean_depth_error, psnr, ssim};
 use fractal_sdf::prelude::*;
 use fractal_sdf::render::{Frame, Renderer};
+use image::RgbaImage;
 
 /// How many timed renders to take.
 #[derive(Debug, Clone, Copy)]

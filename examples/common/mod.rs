@@ -8,6 +8,8 @@ pub mod sheet;
 use std::time::Instant;
 
 use fractal_sdf::prelude::*;
+use fractal_sdf::quality::Glow;
+use fractal_sdf::quality::Preset;
 use fractal_sdf::render::{RenderOptions, Renderer};
 
 /// Runs an example's body, printing an error (with its message, not its
@@ -74,11 +76,9 @@ pub fn render_to_png(
 /// The options the gallery renders with: production quality with 2×2
 /// supersampling and a soft glow.
 pub fn gallery_options() -> RenderOptions {
-    RenderOptions {
-        quality: Quality::production().supersampling(2),
-        effects: Effects::default().glow(Glow::new(dvec3(0.6, 0.75, 1.0), 0.6)),
-        ..RenderOptions::default()
-    }
+    RenderOptions::default()
+        .quality(Quality::production().supersampling(2))
+        .effects(Effects::default().glow(Glow::new(dvec3(0.6, 0.75, 1.0), 0.6)))
 }
 
 /// A command-line error as the crate's error type.

@@ -37,6 +37,7 @@ use std::fmt::Write as _;
 use common::measure::{self, Errors, Runs, Timing, compare};
 use fractal_sdf::prelude::*;
 use fractal_sdf::render::{EdgeThresholds, Frame, RenderOptions, Renderer};
+use image::RgbaImage;
 
 /// The fractal scenes of the gallery.
 const SCENES: [&str; 4] = ["mandelbulb", "menger", "julia", "sierpinski"];
@@ -108,9 +109,10 @@ impl Study {
                 speedup: rows.first().map_or(1.0, |one| one.timing.median_ms / ms),
                 evaluations,
                 errors: compare(
-                    &Frame {
-                        image,
-                        ..centre.clone()
+                    &{
+                        let mut frame = centre.clone();
+                        frame.image = image;
+                        frame
                     },
                     &best,
                 ),
@@ -158,11 +160,9 @@ impl Study {
     }
 
     fn renderer(&self, scene: &Scene, quality: Quality) -> Result<Renderer> {
-        let options = RenderOptions {
-            quality,
-            effects: self.effects,
-            ..RenderOptions::default()
-        };
+        let options = RenderOptions::default()
+            .quality(quality)
+            .effects(self.effects);
         Renderer::with_options(scene, &options)
     }
 
@@ -207,15 +207,7 @@ fn presets() -> Vec<(String, Quality)> {
         ("reference", Quality::reference()),
     ]
     .into_iter()
-    .map(|(n, q)| {
-        (
-            n.to_string(),
-            Quality {
-                supersampling: 1,
-                ..q
-            },
-        )
-    })
+    .map(|(n, q)| (n.to_string(), q.supersampling(1)))
     .collect()
 }
 
@@ -226,17 +218,11 @@ fn floor() -> Vec<(String, Quality)> {
     vec![
         (
             "reference ω/2".to_string(),
-            Quality {
-                over_relaxation: r.over_relaxation / 2.0,
-                ..r
-            },
+            r.over_relaxation(r.over_relaxation / 2.0),
         ),
         (
             "reference ε/10".to_string(),
-            Quality {
-                hit_epsilon: r.hit_epsilon / 10.0,
-                ..r
-            },
+            r.hit_epsilon(r.hit_epsilon / 10.0),
         ),
     ]
 }
@@ -356,20 +342,14 @@ fn front(rows: &[Row]) -> String {
 
 /// The reference at one sample per pixel.
 fn reference() -> Quality {
-    Quality {
-        supersampling: 1,
-        ..Quality::reference()
-    }
+    Quality::reference().supersampling(1)
 }
 
 /// Production quality with N×N samples per pixel, N = 1 to 3.
 fn anti_aliasing() -> Vec<(String, Quality)> {
     (1..=3)
         .map(|n| {
-            let q = Quality {
-                supersampling: n,
-                ..Quality::production()
-            };
+            let q = Quality::production().supersampling(n);
             (format!("production {n}x{n}"), q)
         })
         .collect()
@@ -500,13 +480,7 @@ fn main() -> std::process::ExitCode {
                     size: (size.0 / 2, size.1 / 2),
                     ..once
                 };
-                let best = aa.frame(
-                    &scene,
-                    Quality {
-                        supersampling: 4,
-                        ..Quality::production()
-                    },
-                )?;
+                let best = aa.frame(&scene, Quality::production().supersampling(4))?;
                 let mut aa_rows = aa.group(name, &scene, "aa", anti_aliasing(), (1.0, &best))?;
                 let one = aa_rows[0].timing.median_ms;
                 for r in &mut aa_rows {

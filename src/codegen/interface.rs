@@ -12,6 +12,7 @@ use std::fmt::Write as _;
 /// A field of a packed buffer of reals: where it starts and how many reals
 /// it spans.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[non_exhaustive]
 pub struct Field {
     /// The name the kernel sees, after the buffer's prefix
     /// (`CAMERA_ORIGIN`).
@@ -114,6 +115,7 @@ pub mod light {
 /// The arguments of the rendering kernel `render_tile`, in order.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 #[allow(missing_docs)] // Each is described by its declaration in `RENDER_TILE`.
+#[non_exhaustive]
 pub enum RenderArg {
     Params,
     Camera,
@@ -180,6 +182,7 @@ pub const RENDER_TILE: [(RenderArg, &str); 24] = [
 /// [`Quality::cone_tile`](crate::quality::Quality::cone_tile)), in order.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 #[allow(missing_docs)] // Each is described by its declaration in `CONE_STARTS`.
+#[non_exhaustive]
 pub enum ConeArg {
     Params,
     Camera,
@@ -211,6 +214,7 @@ impl ConeArg {
 /// [`Quality::brute_step`](crate::quality::Quality::brute_step)).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 #[allow(missing_docs)] // Each is described by its declaration in `BRUTE_DEPTHS`.
+#[non_exhaustive]
 pub enum BruteArg {
     Params,
     Camera,
@@ -264,6 +268,7 @@ impl RenderArg {
 /// The arguments of the point-evaluation kernel `eval_points`, in order.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 #[allow(missing_docs)] // Each is described by its declaration in `EVAL_POINTS`.
+#[non_exhaustive]
 pub enum EvalArg {
     Points,
     Params,
@@ -296,6 +301,7 @@ pub const EVAL_OUT_STRIDE: usize = 8;
 /// at every sample of cubic blocks of a regular grid (meshes, volumes).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 #[allow(missing_docs)] // Each is described by its declaration in `EVAL_GRID`.
+#[non_exhaustive]
 pub enum GridArg {
     Blocks,
     Grid,

@@ -45,6 +45,7 @@ use crate::scene::{BRUTE_MAX_STEPS, DEFAULT_MATERIAL, INSIDE_HUGE, Kind};
 
 /// What the generated program is for.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
+#[non_exhaustive]
 pub enum Target {
     /// The ray-marching renderer (`kernels/march.cl`).
     #[default]
@@ -56,6 +57,7 @@ pub enum Target {
 
 /// Everything that shapes the generated source besides the scene.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
+#[non_exhaustive]
 pub struct Options {
     /// March and sample settings, precision.
     pub quality: Quality,
@@ -65,10 +67,20 @@ pub struct Options {
     pub target: Target,
 }
 
+setters!(Options {
+    /// Sets [`Options::quality`].
+    quality: Quality,
+    /// Sets [`Options::effects`].
+    effects: Effects,
+    /// Sets [`Options::target`].
+    target: Target,
+});
+
 /// A lighting effect that can be compiled into the marcher. Each names an
 /// `#ifdef ENABLE_*` block of `kernels/march.cl`; code generation keeps
 /// the blocks of the effects that are on and removes the others entirely.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[non_exhaustive]
 pub enum Effect {
     /// Ambient occlusion (`ENABLE_AO`).
     AmbientOcclusion,
@@ -121,6 +133,7 @@ impl Effect {
 /// A generated program and what the executor needs to run it: the one
 /// type for a program's source, generated or hand-written.
 #[derive(Debug, Clone, PartialEq)]
+#[non_exhaustive]
 pub struct KernelSource {
     /// The complete OpenCL C source.
     pub source: String,

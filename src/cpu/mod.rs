@@ -11,7 +11,7 @@ pub mod shade;
 use glam::DVec3;
 
 use crate::math::{DEFAULT_COLOR, integer_power, normalize, rotation_rows};
-pub use crate::math::{Real, V3, v3};
+use crate::math::{Real, V3, v3};
 use sdf::Estimate;
 
 use crate::error::Result;
@@ -28,6 +28,7 @@ use crate::scene::{
 
 /// What the scene is like at one point.
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[non_exhaustive]
 pub struct Sample<T> {
     /// Signed distance (or a bound) to the nearest surface.
     pub distance: T,
@@ -44,6 +45,7 @@ pub struct Sample<T> {
 ///
 /// ```
 /// use fractal_sdf::prelude::*;
+/// use fractal_sdf::cpu;
 /// let eval = cpu::Evaluator::new(&sphere(1.0))?;
 /// assert!((eval.distance(dvec3(3.0, 0.0, 0.0)) - 2.0).abs() < 1e-12);
 /// # Ok::<(), fractal_sdf::Error>(())
@@ -465,6 +467,7 @@ fn combine<T: Real>(op: CsgOp, k: Option<T>, a: Sample<T>, b: Sample<T>) -> Samp
 
 /// A ray: origin and unit direction.
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[non_exhaustive]
 pub struct Ray {
     /// Where the ray starts.
     pub origin: DVec3,
@@ -483,6 +486,7 @@ pub struct Ray {
 /// `render::Viewport::march_settings` (feature `opencl`) gives the
 /// settings of a rendered image.
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[non_exhaustive]
 pub struct MarchSettings {
     /// Give up after this many steps (`MAX_STEPS`).
     pub max_steps: u32,
@@ -527,8 +531,34 @@ impl Default for MarchSettings {
     }
 }
 
+setters!(MarchSettings {
+    /// Sets [`MarchSettings::max_steps`].
+    max_steps: u32,
+    /// Sets [`MarchSettings::max_distance`].
+    max_distance: f64,
+    /// Sets [`MarchSettings::footprint_base`].
+    footprint_base: f64,
+    /// Sets [`MarchSettings::footprint_per_unit`].
+    footprint_per_unit: f64,
+    /// Sets [`MarchSettings::detail`].
+    detail: f64,
+    /// Sets [`MarchSettings::hit_epsilon`].
+    hit_epsilon: f64,
+    /// Sets [`MarchSettings::over_relaxation`].
+    over_relaxation: f64,
+});
+
+impl Ray {
+    /// A ray from `origin` along the unit vector `direction`.
+    #[must_use]
+    pub fn new(origin: DVec3, direction: DVec3) -> Ray {
+        Ray { origin, direction }
+    }
+}
+
 /// The result of tracing one ray (the kernel's `MarchResult`).
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[non_exhaustive]
 pub struct Hit {
     /// Whether a surface was reached.
     pub hit: bool,
@@ -558,6 +588,7 @@ pub fn march(eval: &Evaluator, ray: Ray, settings: &MarchSettings) -> Hit {
 /// that starts `phase` of a step past where the ray enters it, or the
 /// sphere tracer's step where that is shorter.
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[non_exhaustive]
 pub struct Brute {
     /// The step within the region, in footprints
     /// ([`Quality::brute_step`](crate::quality::Quality::brute_step)).

@@ -16,8 +16,10 @@
 //! kaleidoscopic IFS (Menger, Sierpinski).
 
 use crate::expr::Step;
-pub use crate::math::{JULIA_FAR_FIELD, JULIA_FAR_FIELD_SLOPE, julia_radius};
-use crate::math::{Num, Real, V3, escape_radius, mandelbulb_radius, v3};
+use crate::math::{
+    JULIA_FAR_FIELD, JULIA_FAR_FIELD_SLOPE, Num, Real, V3, escape_radius, julia_radius,
+    mandelbulb_radius, v3,
+};
 use crate::scene::CsgOp;
 
 /// Exact distance to a sphere of radius `r` at the origin.
@@ -142,6 +144,7 @@ pub fn ellipsoid<T: Num>(p: V3<T>, r: V3<T>) -> T {
 
 /// A distance estimate with its orbit trap in `[0, 1]`.
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[non_exhaustive]
 pub struct Estimate<T> {
     /// The distance estimate (a bound).
     pub distance: T,
@@ -810,6 +813,7 @@ pub fn onion<T: Num>(d: T, thickness: T) -> T {
 
 /// A boolean of two distances (see [`csg`]).
 #[derive(Clone, Copy)]
+#[non_exhaustive]
 pub struct Boolean<T: Num> {
     /// The combined distance.
     pub distance: T,

@@ -15,11 +15,20 @@ use crate::scene::{Light, LightSource, Material};
 /// ([`Effects::sky_bottom`](crate::quality::Effects::sky_bottom) and
 /// [`Effects::sky_top`](crate::quality::Effects::sky_top)).
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[non_exhaustive]
 pub struct Sky {
     /// Linear RGB below the horizon.
     pub bottom: DVec3,
     /// Linear RGB overhead.
     pub top: DVec3,
+}
+
+impl Sky {
+    /// A sky from its colour overhead and below the horizon.
+    #[must_use]
+    pub fn new(top: DVec3, bottom: DVec3) -> Sky {
+        Sky { bottom, top }
+    }
 }
 
 /// The kernels' strength of the sky's hemisphere light
@@ -38,13 +47,14 @@ pub const SCATTER_SAMPLES: u32 = 4;
 ///
 /// ```
 /// use fractal_sdf::prelude::*;
+/// use fractal_sdf::cpu;
 /// use fractal_sdf::cpu::shade;
 ///
 /// let eval = cpu::Evaluator::new(&sphere(1.0).material(Material::oren_nayar(0.5)))?;
 /// let lights = [Light::directional(dvec3(0.0, 0.0, 1.0))];
 /// let p = dvec3(0.0, 0.0, 1.0);
 /// let effects = Effects::default();
-/// let sky = shade::Sky { bottom: effects.sky_bottom, top: effects.sky_top };
+/// let sky = shade::Sky::new(effects.sky_top, effects.sky_bottom);
 /// let lit = shade::shade(&eval, p, p, -p, &lights, sky);
 /// assert!(lit.x > 0.5);
 /// # Ok::<(), fractal_sdf::Error>(())

@@ -16,6 +16,7 @@ use super::program::Step;
 
 /// A closed interval `[lo, hi]` of `f64`, possibly unbounded.
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[non_exhaustive]
 pub struct Interval {
     /// The lower end.
     pub lo: f64,
@@ -26,6 +27,7 @@ pub struct Interval {
 /// A truth value over a box: whether it can be true and whether it can be
 /// false somewhere in it.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[non_exhaustive]
 pub struct Maybe {
     /// True somewhere.
     pub can_be_true: bool,

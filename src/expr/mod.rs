@@ -31,7 +31,7 @@
 //! // and as OpenCL C.
 //! let program = trace(4, |a| vec![rounded_sphere(v3(a[0], a[1], a[2]), a[3])]);
 //! let params = [("p", Shape::Vec3), ("r", Shape::Scalar)];
-//! let signature = Signature { name: "sd_ball", params: &params, result: Shape::Scalar };
+//! let signature = Signature::new("sd_ball", &params, Shape::Scalar);
 //! let source = OpenCl.function(&signature, &program).unwrap();
 //! assert!(source.contains("return length(p) - r;"), "{source}");
 //! ```

@@ -14,6 +14,7 @@ use super::program::{Binary, Loop, Op, Program, Unary, ValueId};
 /// The shape of a parameter or result: how many scalar inputs or outputs
 /// it stands for.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[non_exhaustive]
 pub enum Shape {
     /// One number.
     Scalar,
@@ -38,6 +39,7 @@ impl Shape {
 /// A function's name, parameters and result: the program's inputs are the
 /// parameters' components in order, and its outputs the result's.
 #[derive(Debug, Clone, Copy)]
+#[non_exhaustive]
 pub struct Signature<'a> {
     /// The function's name (an identifier the caller chose).
     pub name: &'a str,
@@ -47,7 +49,17 @@ pub struct Signature<'a> {
     pub result: Shape,
 }
 
-impl Signature<'_> {
+impl<'a> Signature<'a> {
+    /// A function `name(params) -> result`.
+    #[must_use]
+    pub fn new(name: &'a str, params: &'a [(&'a str, Shape)], result: Shape) -> Self {
+        Signature {
+            name,
+            params,
+            result,
+        }
+    }
+
     /// How many scalar inputs the parameters stand for.
     #[must_use]
     pub fn inputs(&self) -> u32 {
@@ -57,6 +69,7 @@ impl Signature<'_> {
 
 /// A program a printer cannot write.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[non_exhaustive]
 pub enum Unprintable {
     /// A literal that is NaN or infinite.
     #[error("the non-finite literal {0} cannot be written")]
@@ -105,6 +118,7 @@ pub trait Printer {
 
 /// A program written inside another function (see [`Printer::inline`]).
 #[derive(Debug, Clone, PartialEq, Eq)]
+#[non_exhaustive]
 pub struct Inline {
     /// The statements, one per line, to write before the results are read.
     pub statements: String,

@@ -27,6 +27,7 @@ impl ValueId {
 
 /// An operation of one operand.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[non_exhaustive]
 pub enum Unary {
     /// `-x`
     Neg,
@@ -56,6 +57,7 @@ pub enum Unary {
 
 /// An operation of two operands.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[non_exhaustive]
 pub enum Binary {
     /// `a + b`
     Add,
@@ -95,6 +97,7 @@ impl Binary {
 
 /// One operation of a [`Program`].
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[non_exhaustive]
 pub enum Op {
     /// A literal.
     Const(f64),
@@ -132,6 +135,7 @@ pub enum Op {
 /// on the state, which starts as `init`; it stops early where the body says
 /// so. Every loop terminates: `count` is a value, not a condition.
 #[derive(Debug, Clone, PartialEq)]
+#[non_exhaustive]
 pub struct Loop {
     /// How many times the body may run (in the enclosing program).
     pub count: ValueId,
@@ -255,6 +259,7 @@ type Key = (u8, u64, [u32; 3]);
 /// A recorded formula: operations in order, how many scalar inputs it
 /// reads, and which values it returns.
 #[derive(Debug, Clone, PartialEq)]
+#[non_exhaustive]
 pub struct Program {
     /// The operations; each names only earlier ones.
     pub ops: Vec<Op>,

@@ -59,7 +59,7 @@
 //!
 //! ```
 //! use fractal_sdf::prelude::*;
-//! use fractal_sdf::SceneFile;
+//! use fractal_sdf::file::SceneFile;
 //!
 //! let file = SceneFile::parse("(version: 1, geometry: Sphere(radius: 1))")?;
 //! assert_eq!(file.scene.geometry, Some(sphere(1.0)));
@@ -106,6 +106,7 @@ const TEXT: &str = "<scene>";
 /// A scene and how to render it, as read from or written to a scene file
 /// (see the [module documentation](self) for the format).
 #[derive(Debug, Clone, PartialEq)]
+#[non_exhaustive]
 pub struct SceneFile {
     /// Geometry, camera and lights.
     pub scene: Scene,

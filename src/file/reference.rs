@@ -227,7 +227,9 @@ mod tests {
             "(version: 1, geometry: {material},\n\
              motions: [Oscillate(name: \"power\", center: 8, amplitude: 2, period: 4)])"
         );
-        let err = crate::SceneFile::parse(&text).unwrap_err().to_string();
+        let err = crate::file::SceneFile::parse(&text)
+            .unwrap_err()
+            .to_string();
         // The motion names a parameter this scene does not have: all else read.
         assert!(err.contains("no dynamic parameter named `power`"), "{err}");
     }

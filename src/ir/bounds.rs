@@ -34,6 +34,7 @@ use crate::scene::{Axis, CsgOp, Kind};
 /// distance estimate at `p` is at least that value. Pruning reads it as
 /// [`Bound::distance`], a little lower still.
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[non_exhaustive]
 pub struct Bound {
     /// The sphere's centre.
     pub centre: DVec3,

@@ -6,7 +6,7 @@
 //! against its [`Rule`](crate::scene::Rule), rules that relate parameters
 //! are checked (and kept, when they read dynamic ones, for
 //! [`ParamValues::set`]), and dynamic parameters are given slots.
-//! [`Scene::compile`](crate::Scene::compile) lowers the geometry and checks
+//! [`Scene::compile`](crate::scene::Scene::compile) lowers the geometry and checks
 //! the camera and lights into a [`CompiledScene`], the value every later
 //! stage receives: the CPU reference ([`crate::cpu`]), code generation
 //! ([`crate::codegen`]) and the renderer read it, never the scene tree.
@@ -52,6 +52,7 @@ impl NodeId {
 
 /// A lowered scalar parameter.
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[non_exhaustive]
 pub enum Scalar {
     /// A constant, emitted as a literal.
     Baked(f64),
@@ -93,7 +94,7 @@ static LOWERINGS: AtomicU64 = AtomicU64::new(0);
 
 /// How many times geometry has been lowered in this process. Building a
 /// renderer, an evaluator or a program from a [`CompiledScene`] lowers
-/// nothing; each [`Scene::compile`](crate::Scene::compile) lowers once.
+/// nothing; each [`Scene::compile`](crate::scene::Scene::compile) lowers once.
 #[must_use]
 pub fn lowerings() -> u64 {
     LOWERINGS.load(Ordering::Relaxed)

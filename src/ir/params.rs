@@ -11,6 +11,7 @@ use crate::scene::Rule;
 
 /// One slot of the parameter buffer.
 #[derive(Debug, Clone, PartialEq)]
+#[non_exhaustive]
 pub struct ParamSlot {
     /// The dynamic parameter's name.
     pub name: String,
@@ -24,6 +25,7 @@ pub struct ParamSlot {
 
 /// A rule that relates several parameters of one node.
 #[derive(Debug, Clone, PartialEq)]
+#[non_exhaustive]
 pub enum Relation {
     /// `value` is at most the smallest component of `bound` (a round box's
     /// edge radius and its half extents).
@@ -44,6 +46,7 @@ pub enum Relation {
 
 /// A [`Relation`] at one node, with the parameter it is reported against.
 #[derive(Debug, Clone, PartialEq)]
+#[non_exhaustive]
 pub struct Constraint {
     /// The node's path, as in every validation error.
     pub node: String,

@@ -36,6 +36,7 @@ use std::f64::consts::TAU;
 
 /// The magnitudes a value may take in one kernel precision.
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[non_exhaustive]
 pub struct Limits {
     /// The precision's name, as messages say it: `"F32"` or `"F64"`.
     pub precision: &'static str,
@@ -67,6 +68,7 @@ pub const F64_LIMITS: Limits = Limits {
 
 /// How the kernel uses a value, which decides the limits it keeps.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[non_exhaustive]
 pub enum Magnitude {
     /// Only added and multiplied (a coordinate, an offset, a rate): its
     /// magnitude is at most `max`.

@@ -12,7 +12,8 @@ mod real;
 use glam::DVec3;
 
 pub use limits::{F32_LIMITS, F64_LIMITS, Limits, Magnitude, reduce_angle};
-pub use real::{Num, Real, V3, v3};
+pub(crate) use real::Num;
+pub use real::{Real, V3, v3};
 
 /// The smallest magnitude used to guard divisions and logarithms, in both
 /// twins (`REAL_TINY` in the kernels; a normal `f32`).
@@ -118,7 +119,7 @@ pub fn rotation_rows(axis: DVec3, angle: f64) -> [V3<f64>; 3] {
 /// point whose orbit ever leaves it is not in the set.
 ///
 /// ```
-/// use fractal_sdf::cpu::sdf::julia_radius;
+/// use fractal_sdf::math::julia_radius;
 /// assert_eq!(julia_radius([-2.0_f64, 0.0, 0.0, 0.0]), 2.0);
 /// assert_eq!(julia_radius([0.0_f64, 0.0, 0.0, 0.0]), 1.0);
 /// ```

@@ -31,6 +31,7 @@ impl Real for f64 {
 
 /// A 3-vector in either precision.
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[non_exhaustive]
 pub struct V3<T> {
     /// x
     pub x: T,

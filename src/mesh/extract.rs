@@ -27,6 +27,7 @@ const GAMMA: f64 = 2.2;
 
 /// A triangle mesh in the scene's coordinates.
 #[derive(Debug, Clone, PartialEq, Default)]
+#[non_exhaustive]
 pub struct Mesh {
     /// Vertex positions.
     pub positions: Vec<Vec3>,
@@ -46,6 +47,7 @@ pub struct Mesh {
 
 /// What an extraction cost.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[non_exhaustive]
 pub struct MeshStats {
     /// Cells along each axis of the grid.
     pub cells: [u32; 3],
@@ -62,6 +64,7 @@ pub struct MeshStats {
 /// every edge between exactly two triangles that traverse it in opposite
 /// directions.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[non_exhaustive]
 pub struct Topology {
     /// Distinct edges.
     pub edges: usize,

@@ -20,6 +20,7 @@ const MARGIN_VOXELS: f64 = 2.0;
 
 /// An axis-aligned box.
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[non_exhaustive]
 pub struct Aabb {
     /// The corner with the smallest coordinates.
     pub min: DVec3,
@@ -94,6 +95,7 @@ const MIN_RELATIVE_SIDE: f64 = 1e-5;
 
 /// Where and how finely a scene is sampled for a mesh or a volume.
 #[derive(Debug, Clone, PartialEq)]
+#[non_exhaustive]
 pub struct GridOptions {
     /// The box to sample; `None`: the scene's bound, tightened to its
     /// surface, plus two voxels on every side.
@@ -196,6 +198,7 @@ impl GridOptions {
 
 /// What a long extraction is doing, for progress bars.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[non_exhaustive]
 pub enum Stage {
     /// Finding the box from the scene's bound (coarse culling).
     Bounds,
@@ -211,6 +214,7 @@ pub enum Stage {
 
 /// One progress report: `done` of `total` units of `stage`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[non_exhaustive]
 pub struct Progress {
     /// What is being done.
     pub stage: Stage,

@@ -12,6 +12,7 @@ use crate::render::{DeviceSelector, PointEvaluator};
 
 /// Where a mesh's or a volume's distances are computed.
 #[derive(Debug, Clone, PartialEq)]
+#[non_exhaustive]
 pub enum Sampler {
     /// The generated `DE` on an OpenCL device (the default with the
     /// `opencl` feature, on the automatically chosen device).

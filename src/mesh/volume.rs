@@ -38,6 +38,7 @@ pub const BAND_VOXELS: f64 = 3.0;
 /// Signed distances at every sample of a regular grid: negative inside,
 /// clamped to ±[`BAND_VOXELS`] spacings (see [`Volume::band`]).
 #[derive(Debug, Clone, PartialEq)]
+#[non_exhaustive]
 pub struct Volume {
     /// The position of sample `(0, 0, 0)`.
     pub origin: DVec3,

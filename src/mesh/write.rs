@@ -13,6 +13,7 @@ use crate::output::write_atomic;
 
 /// A mesh file format.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[non_exhaustive]
 pub enum MeshFormat {
     /// Binary STL: triangles with face normals, what 3D printers take.
     Stl,

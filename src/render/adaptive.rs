@@ -8,6 +8,7 @@ use super::aov::Frame;
 /// What an adaptive frame found and drew (see
 /// [`Renderer::render_adaptive`](super::Renderer::render_adaptive)).
 #[derive(Debug, Clone, PartialEq)]
+#[non_exhaustive]
 pub struct AdaptiveFrame {
     /// The image: the mean of every pass's samples where a pixel was
     /// refined, the first pass's elsewhere.
@@ -66,6 +67,7 @@ impl AdaptiveFrame {
 /// How far apart two neighbouring pixels' first samples may be before
 /// both are refined.
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[non_exhaustive]
 pub struct EdgeThresholds {
     /// The largest difference in any colour channel, in 8-bit levels.
     pub color: u8,

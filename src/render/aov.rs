@@ -7,6 +7,7 @@ use image::RgbaImage;
 /// Every vector is row-major with `width × height` entries, index
 /// `y * width + x` (see [`Frame::index`]).
 #[derive(Debug, Clone, PartialEq)]
+#[non_exhaustive]
 pub struct Frame {
     /// The shaded image.
     pub image: RgbaImage,

@@ -26,11 +26,9 @@ use std::sync::atomic::{AtomicBool, Ordering};
 /// use fractal_sdf::render::{CancelToken, RenderOptions, Renderer};
 ///
 /// let token = CancelToken::new();
-/// let options = RenderOptions {
-///     cancel: Some(token.clone()),
-///     tile_size: 64,
-///     ..RenderOptions::default()
-/// };
+/// let options = RenderOptions::default()
+///     .cancel(Some(token.clone()))
+///     .tile_size(64);
 /// let mut renderer = Renderer::with_options(&Scene::new(sphere(1.0)), &options)?;
 /// let stopper = std::thread::spawn(move || token.cancel());
 /// match renderer.render(1920, 1080) {

@@ -15,6 +15,7 @@ pub const DEVICE_ENV: &str = "FRACTAL_SDF_DEVICE";
 
 /// What kind of processor a device is.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[non_exhaustive]
 pub enum DeviceKind {
     /// A graphics processor.
     Gpu,
@@ -95,6 +96,7 @@ fn parse_version(text: &str) -> Option<(u32, u32)> {
 /// Names match as case-insensitive substrings; among matches a GPU is
 /// preferred.
 #[derive(Debug, Clone, Default, PartialEq, Eq)]
+#[non_exhaustive]
 pub struct DeviceSelector {
     /// A substring of the platform's name, such as `"nvidia"` or
     /// `"portable"` (PoCL).

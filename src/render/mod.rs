@@ -79,5 +79,3 @@ pub use renderer::{RenderOptions, Renderer};
 pub use sampling::{SamplePoint, brute_phase, sample_point};
 pub use stereo::compose;
 pub use viewport::Viewport;
-
-pub use crate::view::FrameTiming;

@@ -20,6 +20,7 @@ use crate::scene::Node;
 
 /// What the device computed at one point.
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[non_exhaustive]
 pub struct PointSample {
     /// `DE(p)`.
     pub distance: f64,
@@ -35,6 +36,8 @@ pub struct PointSample {
 ///
 /// ```no_run
 /// use fractal_sdf::prelude::*;
+/// use fractal_sdf::cpu;
+/// use fractal_sdf::quality::Precision;
 /// use fractal_sdf::render::{DeviceSelector, PointEvaluator};
 ///
 /// let node = mandelbulb(8.0);

@@ -24,6 +24,7 @@ use crate::quality::Precision;
 
 /// How a renderer's program was obtained.
 #[derive(Debug, Clone, PartialEq, Eq)]
+#[non_exhaustive]
 pub struct BuildInfo {
     /// The device it was built for, as `"platform / device"`.
     pub device: String,

@@ -30,6 +30,7 @@ use crate::view::FrameTiming;
 
 /// Everything that decides how a scene is rendered, apart from the scene.
 #[derive(Debug, Clone, PartialEq)]
+#[non_exhaustive]
 pub struct RenderOptions {
     /// Accuracy knobs (compiled into the program).
     pub quality: Quality,
@@ -69,6 +70,21 @@ impl Default for RenderOptions {
         }
     }
 }
+
+setters!(RenderOptions {
+    /// Sets [`RenderOptions::quality`].
+    quality: Quality,
+    /// Sets [`RenderOptions::effects`].
+    effects: Effects,
+    /// Sets [`RenderOptions::device`].
+    device: DeviceSelector,
+    /// Sets [`RenderOptions::tile_size`].
+    tile_size: u32,
+    /// Sets [`RenderOptions::deadline`].
+    deadline: Option<Duration>,
+    /// Sets [`RenderOptions::cancel`].
+    cancel: Option<CancelToken>,
+});
 
 /// Tiles in flight at once: the next tile is launched when the one before
 /// the last has finished, so the device stays busy while the renderer

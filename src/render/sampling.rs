@@ -6,6 +6,7 @@ use glam::DVec2;
 
 /// Sample `j` of a pixel: its position in the pixel and on the lens.
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[non_exhaustive]
 pub struct SamplePoint {
     /// The position in the pixel, each coordinate in `[0, 1)`; add the
     /// pixel's corner to get an image position for

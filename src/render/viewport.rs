@@ -24,6 +24,7 @@ use crate::scene::{Camera, Light, LightSource, Projection};
 ///
 /// ```
 /// use fractal_sdf::prelude::*;
+/// use fractal_sdf::quality::Precision;
 /// use fractal_sdf::render::Viewport;
 /// let view = Viewport::new(&Camera::look_at(dvec3(0.0, 0.0, 5.0), DVec3::ZERO), 64, 64, Precision::F32)?;
 /// // The centre of the image looks straight ahead.
@@ -134,6 +135,7 @@ impl Viewport {
     ///
     /// ```
     /// use fractal_sdf::prelude::*;
+    /// use fractal_sdf::quality::Precision;
     /// use fractal_sdf::render::Viewport;
     /// assert_eq!(Viewport::relative_floor(Precision::F32), 8.0 * f64::from(f32::EPSILON));
     /// assert_eq!(Viewport::relative_floor(Precision::F64), 8.0 * f64::EPSILON);

@@ -3,6 +3,7 @@
 //!
 //! ```
 //! use fractal_sdf::prelude::*;
+//! use fractal_sdf::cpu;
 //! use fractal_sdf::scene::{CustomShape, Rule};
 //!
 //! // A gyroid shell, |sin x cos y + sin y cos z + sin z cos x| / 1.5 - t, a
@@ -76,6 +77,7 @@ enum Form {
 /// set is clipped to it, code generation marches by brute force only
 /// within it, and it is the shape's bound for pruning.
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[non_exhaustive]
 pub enum InsideBounds {
     /// A ball.
     Sphere {
@@ -329,6 +331,7 @@ impl CustomShape {
     /// use fractal_sdf::expr::{Distance, Num};
     /// use fractal_sdf::math::V3;
     /// use fractal_sdf::prelude::*;
+    /// use fractal_sdf::cpu;
     /// use fractal_sdf::scene::{CustomShape, Rule};
     ///
     /// /// A box with rounded edges: half extents `b`, rounding `r`.
@@ -364,6 +367,7 @@ impl CustomShape {
     ///
     /// ```
     /// use fractal_sdf::prelude::*;
+    /// use fractal_sdf::cpu;
     /// use fractal_sdf::scene::{CustomShape, Rule};
     ///
     /// let shape = CustomShape::parse("ball", &[("r", Rule::Positive)], "length(p) - r")?;

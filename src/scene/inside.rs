@@ -15,6 +15,7 @@ use crate::error::Result;
 ///
 /// ```
 /// use fractal_sdf::prelude::*;
+/// use fractal_sdf::cpu;
 /// use fractal_sdf::scene::{InsideBounds, InsideShape, Rule};
 ///
 /// // A ball of radius r, known only by |p| < r.

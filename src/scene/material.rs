@@ -43,6 +43,7 @@ use super::param::Param;
 /// Lambert diffuse with a Blinn–Phong highlight of strength 0.25 and
 /// shininess 32, nothing reflected or transmitted.
 #[derive(Debug, Clone, PartialEq)]
+#[non_exhaustive]
 pub struct Material<S = Param> {
     /// Oren–Nayar roughness σ, the spread of the microfacets' slopes in
     /// radians (at least 0; 0 is Lambert, 0.3 chalky, 1 very rough): rough

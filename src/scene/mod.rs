@@ -4,7 +4,7 @@
 //! once, reporting the first bad value as a typed [`Error`] naming the
 //! node's path and the parameter.
 
-pub mod build;
+mod build;
 mod custom;
 mod inside;
 mod material;
@@ -42,6 +42,7 @@ use crate::math::{F64_LIMITS, Magnitude, normalize};
 /// How the camera projects the scene.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
+#[non_exhaustive]
 pub enum Projection {
     /// Perspective with a vertical field of view in degrees, in (0, 180).
     Perspective {
@@ -58,6 +59,7 @@ pub enum Projection {
 /// A look-at camera.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
+#[non_exhaustive]
 pub struct Camera {
     /// Where the camera is.
     pub position: DVec3,
@@ -341,6 +343,7 @@ impl Default for Camera {
 /// Where light comes from.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
+#[non_exhaustive]
 pub enum LightSource {
     /// Parallel light, like the sun; `direction` points from the scene
     /// towards the light.
@@ -358,6 +361,7 @@ pub enum LightSource {
 /// A light with colour, intensity and shadow softness.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
+#[non_exhaustive]
 pub struct Light {
     /// Directional or point.
     pub source: LightSource,
@@ -516,6 +520,7 @@ fn within(node: &str, param: &str, v: DVec3, magnitude: Magnitude) -> Result<()>
 
 /// Geometry, lights and a camera: everything needed to render a picture.
 #[derive(Debug, Clone, PartialEq)]
+#[non_exhaustive]
 pub struct Scene {
     /// The geometry, or `None` for an empty scene (which does not validate).
     pub geometry: Option<Node>,

@@ -23,6 +23,7 @@ pub const MAX_FOLD_ITERATIONS: u32 = 20;
 
 /// A coordinate axis.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize)]
+#[non_exhaustive]
 pub enum Axis {
     /// The x axis.
     X,
@@ -52,6 +53,7 @@ const WARP_RATE: Rule = Rule::Range(-MAX_WARP_RATE, MAX_WARP_RATE);
 
 /// The boolean operation of a [`Kind::Csg`] node.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[non_exhaustive]
 pub enum CsgOp {
     /// Everything in `a` or `b`: `min(a, b)`.
     Union,
@@ -76,6 +78,7 @@ pub enum CsgOp {
 /// `dr`, a bound (it does not overestimate within the sampled tests). The
 /// orbit trap is the smallest `|z|` the orbit reaches, mapped to `[0, 1]`.
 #[derive(Debug, Clone, PartialEq)]
+#[non_exhaustive]
 pub struct Mandelbulb<S = Param> {
     /// The power of the map; at least 2. An integer 8 is the classic bulb.
     pub power: S,
@@ -92,6 +95,7 @@ pub struct Mandelbulb<S = Param> {
 /// scales in `[2, 4]` give related sponges. Distance: the exact box distance of the folded point divided by
 /// `scale^iterations`, a bound. Iterations 0 is the solid cube.
 #[derive(Debug, Clone, PartialEq)]
+#[non_exhaustive]
 pub struct Menger<S = Param> {
     /// Folding levels, 0 to [`MAX_FOLD_ITERATIONS`].
     pub iterations: u32,
@@ -131,6 +135,7 @@ pub struct Menger<S = Param> {
 ///   smaller than the escape-time estimate, most of all near the set, so
 ///   such sets take more steps and are drawn a little fatter.
 #[derive(Debug, Clone, PartialEq)]
+#[non_exhaustive]
 pub struct QuaternionJulia<S = Param> {
     /// The constant `c` as (x, y, z, w).
     pub c: [S; 4],
@@ -151,6 +156,7 @@ pub struct QuaternionJulia<S = Param> {
 /// sets. Distance: a tetrahedron bound of the folded point divided by
 /// `scale^iterations`, a bound. Iterations 0 is the solid tetrahedron.
 #[derive(Debug, Clone, PartialEq)]
+#[non_exhaustive]
 pub struct Sierpinski<S = Param> {
     /// Folding levels, 0 to [`MAX_FOLD_ITERATIONS`].
     pub iterations: u32,
@@ -166,6 +172,7 @@ pub struct Sierpinski<S = Param> {
 /// radians. "Exact" means the value is the Euclidean distance; "bound" means
 /// it never exceeds it (so rays never skip a surface).
 #[derive(Debug, Clone, PartialEq)]
+#[non_exhaustive]
 pub enum Kind<S, V, C> {
     /// A sphere at the origin. Exact.
     Sphere {
@@ -397,6 +404,7 @@ pub enum Kind<S, V, C> {
 /// within the magnitudes the kernels can compute with (see
 /// [`Rule::magnitude`] and [`math::Limits`](crate::math::Limits)).
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[non_exhaustive]
 pub enum Rule {
     /// Any finite value: a coordinate, an offset or a rate (at most the
     /// largest magnitude of the precision).
@@ -463,6 +471,7 @@ impl Rule {
 
 /// A parameter's name within its node and the rule it must satisfy.
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[non_exhaustive]
 pub struct ParamSpec<'a> {
     /// The field name, such as `"radius"`.
     pub name: &'a str,

@@ -8,6 +8,7 @@ use glam::{DVec3, Vec3};
 /// Every plain number converts into a `Param` (`1.0`, `2.5f32`, `3`), so most
 /// code never names this type. Use [`param`] to make a number dynamic.
 #[derive(Debug, Clone, PartialEq)]
+#[non_exhaustive]
 pub enum Param {
     /// A constant, emitted as a literal in generated code (fastest; changing
     /// it changes the kernel source).
@@ -82,6 +83,7 @@ impl From<i32> for Param {
 /// A three-component parameter (an offset, a size, a colour), each
 /// component a [`Param`].
 #[derive(Debug, Clone, PartialEq)]
+#[non_exhaustive]
 pub struct Param3 {
     /// The x component.
     pub x: Param,
@@ -114,6 +116,7 @@ impl Param3 {
 ///
 /// ```
 /// use fractal_sdf::prelude::*;
+/// use fractal_sdf::scene::param3;
 /// let moving = sphere(0.5).translate(param3("orbit", dvec3(1.0, 0.0, 0.0)));
 /// # let _ = moving;
 /// ```

@@ -10,6 +10,7 @@ use crate::error::Result;
 
 /// How the two eyes' images share one picture.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[non_exhaustive]
 pub enum StereoLayout {
     /// Red–cyan glasses: the left eye's brightness in red, the right
     /// eye's green and blue (a half-colour anaglyph, which keeps most
@@ -73,6 +74,7 @@ impl StereoLayout {
 /// ```
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
+#[non_exhaustive]
 pub struct Stereo {
     /// How the eyes share the picture.
     pub layout: StereoLayout,
@@ -84,6 +86,11 @@ pub struct Stereo {
     /// ([`Camera::focus_distance`]), its target unless set.
     pub convergence: Option<f64>,
 }
+
+setters!(Stereo {
+    /// Sets [`Stereo::layout`].
+    layout: StereoLayout,
+});
 
 impl Stereo {
     /// The default eye separation over the convergence distance.

@@ -35,6 +35,7 @@ pub const MIN_BALL_FRACTION: f64 = 0.125;
 /// least one input; for [`check_never_overestimates`], balls around at
 /// least [`MIN_BALL_FRACTION`] of the points).
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
+#[non_exhaustive]
 pub struct Tested {
     /// Inputs examined: points, or pairs for [`check_lipschitz`].
     pub inputs: usize,
@@ -114,6 +115,7 @@ pub enum Check {
 /// (and saves it to a file it names), so a failure can be read against the
 /// code that produced it.
 #[derive(Debug, Clone, PartialEq)]
+#[non_exhaustive]
 pub struct Failure {
     /// Which invariant broke.
     pub check: Check,
@@ -141,6 +143,7 @@ pub struct Failure {
 
 /// The generated OpenCL program a device check ran, or failed to build.
 #[derive(Debug, Clone, PartialEq, Eq)]
+#[non_exhaustive]
 pub struct GeneratedProgram {
     /// The complete source.
     pub source: String,

@@ -76,6 +76,7 @@ pub fn spicy_points() -> Vec<DVec3> {
 ///
 /// ```no_run
 /// use fractal_sdf::prelude::*;
+/// use fractal_sdf::quality::Precision;
 /// use fractal_sdf::render::DeviceSelector;
 /// use fractal_sdf::testing::{check_device_matches_cpu, random_points};
 ///
@@ -166,6 +167,8 @@ pub fn check_device_matches_cpu(
 ///
 /// ```no_run
 /// use fractal_sdf::prelude::*;
+/// use fractal_sdf::quality::Precision;
+/// use fractal_sdf::scene::InsideShape;
 /// use fractal_sdf::render::DeviceSelector;
 /// use fractal_sdf::testing::{check_inside_matches_device, random_points};
 ///

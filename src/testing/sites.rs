@@ -9,6 +9,7 @@ use crate::scene::{Mapper, Node, NodeKind, Param, Param3, ParamSpec, Rule};
 /// One scalar parameter of a node: its name as errors give it (`radius`,
 /// `half_extents.x`, `c.w`) and its rule.
 #[derive(Debug, Clone, PartialEq)]
+#[non_exhaustive]
 pub struct Site {
     /// The parameter's name, with `.x`/`.y`/`.z` for a vector component.
     pub name: String,

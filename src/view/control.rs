@@ -18,6 +18,7 @@ use crate::scene::{Camera, StereoLayout};
 /// Yaw 0 looks down −z; positive yaw turns right. Pitch is kept inside
 /// ±[`FlyCamera::MAX_PITCH`] so the view never flips over the pole.
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[non_exhaustive]
 pub struct FlyCamera {
     /// Where the camera is.
     pub position: DVec3,
@@ -133,6 +134,7 @@ impl FlyCamera {
 /// and back, A/D (or the left and right arrows) left and right, E/Q up and
 /// down.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[non_exhaustive]
 pub struct Movement {
     /// W or the up arrow.
     pub forward: bool,
@@ -209,6 +211,7 @@ impl Movement {
 /// settings file rebinds it ([`KeyBindings`]); the keys without one are
 /// free for the window's own use.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[non_exhaustive]
 pub enum Action {
     /// `o`: ambient occlusion on or off.
     ToggleAmbientOcclusion,
@@ -469,6 +472,7 @@ impl KeyBindings {
 
 /// The quality preset and effect switches of an interactive view.
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[non_exhaustive]
 pub struct ViewSettings {
     /// The quality preset.
     pub preset: Preset,

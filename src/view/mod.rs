@@ -23,6 +23,7 @@
 //! ```
 //! use std::time::Duration;
 //! use fractal_sdf::prelude::*;
+//! use fractal_sdf::image::RgbaImage;
 //! use fractal_sdf::view::{
 //!     Action, FlyCamera, Key, Movement, ResolutionScaler, ViewSettings, blit_scaled, reduced_size,
 //! };

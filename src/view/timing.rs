@@ -7,6 +7,7 @@ use std::time::Duration;
 /// What one rendered frame cost, as the renderer reports it
 /// (`render::Renderer::last_timing`, feature `opencl`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[non_exhaustive]
 pub struct FrameTiming {
     /// Time the device spent running the ray-marching kernel, summed over
     /// the frame's tiles. From OpenCL profiling events where the device
@@ -138,6 +139,7 @@ pub fn fps(frame: Duration) -> Option<f64> {
 /// assert_eq!(s.next(false), None); // ...then nothing to do
 /// ```
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[non_exhaustive]
 pub struct ResolutionScaler {
     /// The wanted duration of a reduced frame.
     pub target: Duration,

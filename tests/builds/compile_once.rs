@@ -6,6 +6,7 @@
 use crate::gpu;
 
 use fractal_sdf::codegen;
+use fractal_sdf::cpu;
 use fractal_sdf::ir;
 use fractal_sdf::prelude::*;
 use fractal_sdf::render::{RenderOptions, Renderer};

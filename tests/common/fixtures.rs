@@ -2,6 +2,12 @@
 //! is for tests, golden renders and benchmarks alike.
 
 use fractal_sdf::prelude::*;
+use fractal_sdf::scene::Axis;
+use fractal_sdf::scene::Mandelbulb;
+use fractal_sdf::scene::capped_cone;
+use fractal_sdf::scene::ellipsoid;
+use fractal_sdf::scene::octahedron;
+use fractal_sdf::scene::param3;
 
 /// The classic power-8 Mandelbulb (12 iterations, bailout 2; the power is
 /// a baked integer, so it uses the trig-free form).

@@ -12,7 +12,14 @@
 use crate::gpu;
 
 use fractal_sdf::prelude::*;
+use fractal_sdf::quality::Precision;
 use fractal_sdf::render::{DeviceInfo, DeviceKind, DeviceSelector, PointEvaluator};
+use fractal_sdf::scene::Axis;
+use fractal_sdf::scene::QuaternionJulia;
+use fractal_sdf::scene::capped_cone;
+use fractal_sdf::scene::ellipsoid;
+use fractal_sdf::scene::octahedron;
+use fractal_sdf::scene::param3;
 use fractal_sdf::scene::{CustomShape, Rule};
 use fractal_sdf::testing::{check_device_matches_cpu, random_points, spicy_points};
 
@@ -148,8 +155,8 @@ fn tolerance(precision: Precision, device: &DeviceInfo) -> f64 {
     match (precision, device.kind) {
         (Precision::F32, DeviceKind::Cpu) => 2e-5,
         (Precision::F64, DeviceKind::Cpu) => 1e-14,
-        (Precision::F32, _) => 1e-4,
         (Precision::F64, _) => 1e-10,
+        _ => 1e-4,
     }
 }
 

@@ -5,6 +5,7 @@
 use crate::gpu;
 
 use fractal_sdf::codegen::{self, Options};
+use fractal_sdf::cpu;
 use fractal_sdf::prelude::*;
 use fractal_sdf::render::Renderer;
 

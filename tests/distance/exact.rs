@@ -5,7 +5,10 @@
 //! polygons for solids of revolution).
 
 use crate::common::analytic::{self, exact_distance};
+use fractal_sdf::cpu;
 use fractal_sdf::prelude::*;
+use fractal_sdf::scene::capped_cone;
+use fractal_sdf::scene::octahedron;
 use fractal_sdf::testing::{self, Failure, check_exact, point};
 use proptest::prelude::*;
 
@@ -75,11 +78,7 @@ proptest! {
         // Walk each ray to its surface crossing, then probe both sides.
         let mut points = Vec::new();
         for ray in rays {
-            let hit = cpu::march(&eval, ray, &cpu::MarchSettings {
-                footprint_base: 1e-7,
-                max_distance: 20.0,
-                ..Default::default()
-            });
+            let hit = cpu::march(&eval, ray, &cpu::MarchSettings::default().footprint_base(1e-7).max_distance(20.0));
             if hit.hit {
                 let p = ray.origin + ray.direction * hit.depth;
                 for s in [-1e-3, -1e-6, 0.0, 1e-6, 1e-3] {

@@ -12,9 +12,13 @@ use crate::gpu;
 use fractal_sdf::cpu::{self, Evaluator, MarchSettings, Ray};
 use fractal_sdf::metrics::psnr;
 use fractal_sdf::prelude::*;
+use fractal_sdf::quality::Precision;
 use fractal_sdf::render::{
     DeviceInfo, DeviceKind, DeviceSelector, Frame, PointEvaluator, RenderOptions, Renderer,
 };
+use fractal_sdf::scene::Mandelbulb;
+use fractal_sdf::scene::Param;
+use fractal_sdf::scene::QuaternionJulia;
 
 /// A case: a name, its geometry, and its size (cameras scale with it).
 struct Case {
@@ -92,19 +96,14 @@ fn directions() -> Vec<DVec3> {
 /// Where rays from `3 size` along each direction towards the origin first
 /// reach the surface (to 1e-13 of the case's size), with the direction.
 fn surface_points(eval: &Evaluator, size: f64) -> Vec<(DVec3, DVec3)> {
-    let settings = MarchSettings {
-        max_steps: 20_000,
-        max_distance: 10.0 * size,
-        footprint_base: 1e-13 * size,
-        ..MarchSettings::default()
-    };
+    let settings = MarchSettings::default()
+        .max_steps(20_000)
+        .max_distance(10.0 * size)
+        .footprint_base(1e-13 * size);
     directions()
         .into_iter()
         .filter_map(|u| {
-            let ray = Ray {
-                origin: u * (3.0 * size),
-                direction: -u,
-            };
+            let ray = Ray::new(u * (3.0 * size), -u);
             let hit = cpu::march(eval, ray, &settings);
             hit.hit
                 .then(|| (ray.origin + ray.direction * hit.depth, ray.direction))
@@ -254,17 +253,13 @@ fn scaling_scales_distances_exactly() {
 }
 
 fn render(scene: &Scene, precision: Precision, reach: f64) -> Frame {
-    let quality = Quality {
-        precision,
-        max_steps: 512,
-        max_distance: reach,
-        ..Quality::production()
-    };
-    let options = RenderOptions {
-        quality,
-        effects: Effects::none(),
-        ..RenderOptions::default()
-    };
+    let quality = Quality::production()
+        .precision(precision)
+        .max_steps(512)
+        .max_distance(reach);
+    let options = RenderOptions::default()
+        .quality(quality)
+        .effects(Effects::none());
     Renderer::with_options(scene, &options)
         .unwrap()
         .render_with_aovs(48, 32)
@@ -309,24 +304,15 @@ fn renders_have_no_nan_near_far_and_on_the_surface() {
 /// scaled by `s`.
 fn scaled_mandelbulb(s: f64) -> (Scene, Quality, Effects) {
     let unit = fractal_sdf::gallery::mandelbulb();
-    let camera = Camera {
-        position: unit.camera.position * s,
-        target: unit.camera.target * s,
-        ..unit.camera
-    };
+    let mut camera = unit.camera;
+    camera.position = unit.camera.position * s;
+    camera.target = unit.camera.target * s;
     let scene = Scene::new(unit.geometry.clone().unwrap().scale(s))
         .with_camera(camera)
         .with_lights(unit.lights.clone());
     let q = Quality::production();
-    let quality = Quality {
-        precision: Precision::F64,
-        max_distance: q.max_distance * s,
-        ..q
-    };
-    let effects = Effects {
-        ao_distance: Effects::default().ao_distance * s,
-        ..Effects::default()
-    };
+    let quality = q.precision(Precision::F64).max_distance(q.max_distance * s);
+    let effects = Effects::default().ao_distance(Effects::default().ao_distance * s);
     (scene, quality, effects)
 }
 
@@ -376,11 +362,9 @@ fn assert_same_image(unit: &Frame, other: &Frame, what: &str, device: &DeviceInf
 /// `painted` puts the translation under a colour, which does not move it.
 fn moved_mandelbulb(offset: DVec3, painted: bool) -> Scene {
     let unit = fractal_sdf::gallery::mandelbulb();
-    let camera = Camera {
-        position: unit.camera.position + offset,
-        target: unit.camera.target + offset,
-        ..unit.camera
-    };
+    let mut camera = unit.camera;
+    camera.position = unit.camera.position + offset;
+    camera.target = unit.camera.target + offset;
     let mut geometry = unit.geometry.clone().unwrap().translate(offset);
     if painted {
         geometry = geometry.color(dvec3(0.9, 0.6, 0.35));
@@ -397,10 +381,7 @@ fn a_scene_ten_million_units_away_renders_the_unit_image_in_f32() {
     // coordinates would be useless. The renderer works relative to the
     // scene's outermost translation, moving the camera there in f64.
     let frame = |offset: DVec3, painted: bool| {
-        let quality = Quality {
-            precision: Precision::F32,
-            ..Quality::production()
-        };
+        let quality = Quality::production().precision(Precision::F32);
         Renderer::with_options(
             &moved_mandelbulb(offset, painted),
             &gpu::options(quality, Effects::default()),

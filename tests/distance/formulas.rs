@@ -9,7 +9,9 @@ use fractal_sdf::expr::{Distance, Formula, Interval, Num, Program};
 use fractal_sdf::math::V3;
 use fractal_sdf::mesh::{GridOptions, Sampler, extract};
 use fractal_sdf::prelude::*;
+use fractal_sdf::quality::Precision;
 use fractal_sdf::render::{DeviceSelector, PointEvaluator};
+use fractal_sdf::scene::Param;
 use fractal_sdf::scene::{CustomShape, Rule};
 use fractal_sdf::testing::{check_lipschitz, check_never_overestimates, random_points};
 use proptest::prelude::*;
@@ -256,13 +258,13 @@ fn a_shape_written_once_renders_on_the_device() {
 
 #[test]
 fn a_text_formula_in_a_scene_file_has_bounds_and_reads_back() {
-    let file = fractal_sdf::SceneFile::load(
+    let file = fractal_sdf::file::SceneFile::load(
         std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/custom_formula.ron"),
     )
     .unwrap();
     let text = file.to_text().unwrap();
     assert!(text.contains("formulas:"), "{text}");
-    let back = fractal_sdf::SceneFile::parse(&text).unwrap();
+    let back = fractal_sdf::file::SceneFile::parse(&text).unwrap();
     assert_eq!(
         back.scene.geometry.as_ref().map(|g| format!("{g:?}")),
         file.scene.geometry.as_ref().map(|g| format!("{g:?}"))
@@ -316,7 +318,9 @@ fn formula_errors_name_line_column_and_what_was_expected() {
     }
     // In a scene file, the error also names the file's line.
     let file = "(version: 1, formulas: [(name: \"f\", distance: \"length(p) - q\")], geometry: Custom(name: \"f\", args: []))";
-    let e = fractal_sdf::SceneFile::parse(file).unwrap_err().to_string();
+    let e = fractal_sdf::file::SceneFile::parse(file)
+        .unwrap_err()
+        .to_string();
     assert!(
         e.contains("unknown variable `q`") && e.contains("line 1, column 13"),
         "{e}"

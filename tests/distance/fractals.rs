@@ -28,9 +28,13 @@
 
 use crate::common::fixtures::{self, JULIA_C};
 use approx::relative_eq;
+use fractal_sdf::cpu;
 use fractal_sdf::cpu::sdf;
 use fractal_sdf::prelude::*;
 use fractal_sdf::scene::Kind;
+use fractal_sdf::scene::Mandelbulb;
+use fractal_sdf::scene::Param;
+use fractal_sdf::scene::QuaternionJulia;
 use fractal_sdf::testing::{
     self, check_never_overestimates, fractal_node, julia_inside, mandelbulb_inside, menger_inside,
     point, sierpinski_inside, unit_vector,
@@ -467,14 +471,8 @@ fn mandelbulb_far_field_never_overestimates() {
     assert!((far - (1e6 - ball)).abs() < 1e-9, "{far}");
     // A ray from r = 10 towards the origin reaches the surface where a ray
     // from r = 3 does (it used to jump past the bulb).
-    let settings = cpu::MarchSettings {
-        footprint_base: 1e-6,
-        ..cpu::MarchSettings::default()
-    };
-    let ray = |z: f64| cpu::Ray {
-        origin: dvec3(0.1, 0.05, z),
-        direction: dvec3(0.0, 0.0, -1.0),
-    };
+    let settings = cpu::MarchSettings::default().footprint_base(1e-6);
+    let ray = |z: f64| cpu::Ray::new(dvec3(0.1, 0.05, z), dvec3(0.0, 0.0, -1.0));
     let (from_far, from_near) = (
         cpu::march(&eval, ray(10.0), &settings),
         cpu::march(&eval, ray(3.0), &settings),
@@ -614,7 +612,7 @@ fn julia_far_field_never_overestimates() {
         .filter(|&x| inside(dvec3(x, 0.0, 0.0)))
         .fold(0.0, f64::max);
     assert!(tip > 0.5, "{tip}");
-    let ball = sdf::julia_radius(JULIA_C);
+    let ball = fractal_sdf::math::julia_radius(JULIA_C);
     for r in [5.0, 10.0, 1e6] {
         let d = eval.distance(dvec3(r, 0.0, 0.0));
         assert!(d <= r - tip, "at r = {r}: {d}");
@@ -625,14 +623,8 @@ fn julia_far_field_never_overestimates() {
     }
     // A ray from 10 units reaches the surface where a ray from 2 does (it
     // used to step past the set).
-    let settings = cpu::MarchSettings {
-        footprint_base: 1e-6,
-        ..cpu::MarchSettings::default()
-    };
-    let ray = |z: f64| cpu::Ray {
-        origin: dvec3(0.1, 0.05, z),
-        direction: dvec3(0.0, 0.0, -1.0),
-    };
+    let settings = cpu::MarchSettings::default().footprint_base(1e-6);
+    let ray = |z: f64| cpu::Ray::new(dvec3(0.1, 0.05, z), dvec3(0.0, 0.0, -1.0));
     let (from_far, from_near) = (
         cpu::march(&eval, ray(10.0), &settings),
         cpu::march(&eval, ray(2.0), &settings),
@@ -866,7 +858,7 @@ impl JuliaCase {
     /// times that ball.
     fn points(&self) -> Vec<DVec3> {
         let mut rng = SplitMix(self.seed);
-        let radius = sdf::julia_radius(self.c).min(self.bailout);
+        let radius = fractal_sdf::math::julia_radius(self.c).min(self.bailout);
         let mut points = Vec::new();
         let mut bounded = Vec::new();
         for _ in 0..1500 {
@@ -1081,7 +1073,7 @@ fn julia_worst_ratio_is_measured() {
     for _ in 0..cases {
         let case = strategy.new_tree(&mut runner).unwrap().current();
         let connected = julia_inside(DVec3::ZERO, case.c, 0.0, 1000, 2.0);
-        let escape_time = case.bailout >= 2.5 * sdf::julia_radius(case.c)
+        let escape_time = case.bailout >= 2.5 * fractal_sdf::math::julia_radius(case.c)
             && !sdf::julia_critical_leaves(case.c, case.iterations + 2, 0.81);
         let set = if connected { "connected" } else { "dust" };
         let bailout = if case.bailout <= 16.0 {
@@ -1096,7 +1088,7 @@ fn julia_worst_ratio_is_measured() {
         for group in &groups {
             *counts.entry(group.clone()).or_default() += 1;
         }
-        let radius = sdf::julia_radius(case.c).min(case.bailout);
+        let radius = fractal_sdf::math::julia_radius(case.c).min(case.bailout);
         for (ratio, p, q, escapes) in julia_ratios(&case) {
             let which = if escapes { "escaping" } else { "band" };
             let near = p.extend(case.slice()).length() <= 1.5 * radius;

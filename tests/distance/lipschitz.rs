@@ -5,7 +5,10 @@
 //! distance.
 
 use crate::common::analytic::ellipsoid_distance;
+use fractal_sdf::cpu;
 use fractal_sdf::prelude::*;
+use fractal_sdf::scene::Axis;
+use fractal_sdf::scene::ellipsoid;
 use fractal_sdf::testing::{
     self, Check, bounded_node, check_lipschitz, check_never_overestimates, exact_node, point,
     point_pair,

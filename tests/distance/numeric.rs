@@ -8,7 +8,13 @@ use crate::gpu;
 use fractal_sdf::codegen;
 use fractal_sdf::cpu::{self, Evaluator};
 use fractal_sdf::prelude::*;
+use fractal_sdf::quality::Glow;
+use fractal_sdf::quality::Precision;
 use fractal_sdf::render::{DeviceSelector, Frame, PointEvaluator, RenderOptions, Renderer};
+use fractal_sdf::scene::Param;
+use fractal_sdf::scene::ellipsoid;
+use fractal_sdf::scene::param3;
+use glam::EulerRot;
 
 const SAFELY: &str = "cannot be represented safely in";
 
@@ -109,18 +115,13 @@ fn values_beyond_f32_are_refused_before_the_build() {
         );
     }
     let plain = scene(sphere(1.0));
-    let quality = RenderOptions {
-        quality: gpu::plain(Quality::draft()).max_distance(big),
-        ..f32_options.clone()
-    };
-    let fog = RenderOptions {
-        effects: Effects::none().fog_density(big),
-        ..f32_options.clone()
-    };
-    let glow = RenderOptions {
-        effects: Effects::none().glow(Glow::new(dvec3(1.0, 1.0, 1.0), big)),
-        ..f32_options
-    };
+    let quality = f32_options
+        .clone()
+        .quality(gpu::plain(Quality::draft()).max_distance(big));
+    let fog = f32_options
+        .clone()
+        .effects(Effects::none().fog_density(big));
+    let glow = f32_options.effects(Effects::none().glow(Glow::new(dvec3(1.0, 1.0, 1.0), big)));
     for (what, options) in [("max_distance", quality), ("fog", fog), ("glow", glow)] {
         let err = Renderer::with_options(&plain, &options).unwrap_err();
         let text = err.to_string();
@@ -331,10 +332,7 @@ fn the_cpu_reference_is_finite_for_every_accepted_value() {
         };
         let eval = Evaluator::from_compiled(&compiled);
         // The f32 reference, for what an F32 program accepts.
-        let f32_program = codegen::Options {
-            quality: gpu::plain(Quality::draft()),
-            ..codegen::Options::default()
-        };
+        let f32_program = codegen::Options::default().quality(gpu::plain(Quality::draft()));
         let in_f32 = codegen::emit(&compiled, &f32_program).is_ok();
         for p in points {
             let s = eval.sample::<f64>(p.into());

@@ -15,7 +15,9 @@
 //! the golden images.
 use crate::gpu;
 
+use fractal_sdf::cpu;
 use fractal_sdf::prelude::*;
+use fractal_sdf::quality::Precision;
 use fractal_sdf::render::{DeviceSelector, PointEvaluator};
 
 const RED: DVec3 = DVec3::new(1.0, 0.0, 0.0);
@@ -81,7 +83,7 @@ fn points(k: f64) -> Vec<DVec3> {
 fn tolerance(precision: Precision) -> f64 {
     match precision {
         Precision::F64 => 1e-14,
-        Precision::F32 => 1e-6,
+        _ => 1e-6,
     }
 }
 

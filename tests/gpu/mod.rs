@@ -95,22 +95,18 @@ pub fn sun(softness: f64) -> Light {
 
 /// Options on the first device with the given quality and effects.
 pub fn options(quality: Quality, effects: Effects) -> RenderOptions {
-    RenderOptions {
-        quality,
-        effects,
-        ..RenderOptions::default()
-    }
+    RenderOptions::default().quality(quality).effects(effects)
 }
 
 /// A quick quality: production thresholds, fewer steps, and every ray
 /// marched from the camera ([`plain`]).
 pub fn quick() -> Quality {
-    plain(Quality {
-        max_steps: 192,
-        ao_samples: 5,
-        shadow_steps: 96,
-        ..Quality::production()
-    })
+    plain(
+        Quality::production()
+            .max_steps(192)
+            .ao_samples(5)
+            .shadow_steps(96),
+    )
 }
 
 /// Mean luminance (0–255) of the pixels in a square of half side `r`
@@ -149,7 +145,7 @@ pub fn project(view: &fractal_sdf::render::Viewport, p: DVec3) -> (u32, u32) {
 pub fn direction_of(light: &Light) -> Option<DVec3> {
     match light.source {
         LightSource::Directional { direction } => Some(direction.normalize()),
-        LightSource::Point { .. } => None,
+        _ => None,
     }
 }
 

@@ -2,8 +2,11 @@
 //! parameters, folding, and safe identifiers.
 
 use fractal_sdf::codegen::{self, Options};
+use fractal_sdf::cpu;
 use fractal_sdf::ir::Ir;
 use fractal_sdf::prelude::*;
+use fractal_sdf::quality::Glow;
+use fractal_sdf::quality::Precision;
 
 fn source(geometry: Node, options: &Options) -> String {
     codegen::emit(&Scene::new(geometry).compile().unwrap(), options)
@@ -13,10 +16,7 @@ fn source(geometry: Node, options: &Options) -> String {
 
 #[test]
 fn sphere_scene_contains_no_fractal_helper_and_no_disabled_effect() {
-    let options = Options {
-        effects: Effects::none(),
-        ..Options::default()
-    };
+    let options = Options::default().effects(Effects::none());
     let src = source(sphere(1.0), &options);
     for absent in [
         "mandelbulb",
@@ -42,17 +42,11 @@ fn sphere_scene_contains_no_fractal_helper_and_no_disabled_effect() {
 
 #[test]
 fn effects_that_are_on_are_defined() {
-    let options = Options {
-        effects: Effects {
-            glow: Some(Glow {
-                color: dvec3(1.0, 0.5, 0.2),
-                strength: 1.0,
-            }),
-            fog_density: 0.1,
-            ..Effects::default()
-        },
-        ..Options::default()
-    };
+    let options = Options::default().effects(
+        Effects::default()
+            .glow(Some(Glow::new(dvec3(1.0, 0.5, 0.2), 1.0)))
+            .fog_density(0.1),
+    );
     let src = source(sphere(1.0), &options);
     for present in ["AO_SAMPLES", "SHADOW_STEPS", "GLOW_STRENGTH", "FOG_DENSITY"] {
         assert!(
@@ -153,13 +147,7 @@ fn baked_iteration_counts_are_constant_loop_bounds_and_can_be_overridden() {
 
 #[test]
 fn f64_source_declares_double_precision() {
-    let options = Options {
-        quality: Quality {
-            precision: Precision::F64,
-            ..Quality::default()
-        },
-        ..Options::default()
-    };
+    let options = Options::default().quality(Quality::default().precision(Precision::F64));
     let src = source(sphere(0.1), &options);
     assert!(src.contains("#pragma OPENCL EXTENSION cl_khr_fp64 : enable"));
     assert!(src.contains("typedef double real;"));
@@ -344,24 +332,15 @@ fn wide_unions_become_one_loop_over_a_table() {
 fn effects_that_cost_nothing_leave_no_code() {
     // Each effect switched on but given nothing to do: no samples, no
     // steps, no strength, no density.
-    let options = Options {
-        quality: Quality {
-            ao_samples: 0,
-            shadow_steps: 0,
-            ..Quality::default()
-        },
-        effects: Effects {
-            ambient_occlusion: true,
-            shadows: true,
-            glow: Some(Glow {
-                color: dvec3(1.0, 0.5, 0.2),
-                strength: 0.0,
-            }),
-            fog_density: 0.0,
-            ..Effects::default()
-        },
-        ..Options::default()
-    };
+    let options = Options::default()
+        .quality(Quality::default().ao_samples(0).shadow_steps(0))
+        .effects(
+            Effects::default()
+                .ambient_occlusion(true)
+                .shadows(true)
+                .glow(Some(Glow::new(dvec3(1.0, 0.5, 0.2), 0.0)))
+                .fog_density(0.0),
+        );
     assert!(codegen::Effect::enabled(&options).is_empty());
     let src = source(sphere(1.0), &options);
     for absent in ["AO_SAMPLES", "SHADOW_STEPS", "GLOW_", "FOG_"] {

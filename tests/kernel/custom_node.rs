@@ -9,8 +9,15 @@ use crate::gpu;
 mod hex_prism;
 
 use fractal_sdf::codegen::{self, Options, Target};
+use fractal_sdf::cpu;
 use fractal_sdf::prelude::*;
+use fractal_sdf::quality::Glow;
+use fractal_sdf::quality::Precision;
 use fractal_sdf::render::{DeviceInfo, DeviceKind, DeviceSelector};
+use fractal_sdf::scene::Param;
+use fractal_sdf::scene::capped_cone;
+use fractal_sdf::scene::ellipsoid;
+use fractal_sdf::scene::octahedron;
 use fractal_sdf::scene::{CustomShape, Rule};
 use fractal_sdf::testing::{
     Check, check_device_matches_cpu, check_lipschitz, check_never_overestimates, point, point_pair,
@@ -59,8 +66,8 @@ fn device_tolerance(precision: Precision, device: &DeviceInfo) -> f64 {
     match (precision, device.kind) {
         (Precision::F32, DeviceKind::Cpu) => 1e-5,
         (Precision::F64, DeviceKind::Cpu) => 1e-14,
-        (Precision::F32, _) => 1e-4,
         (Precision::F64, _) => 1e-10,
+        _ => 1e-4,
     }
 }
 
@@ -487,24 +494,18 @@ fn every_name_the_code_generator_defines_is_refused() {
         .union(menger(3).union(julia([-0.2, 0.6, 0.2, 0.2])))
         .union(sierpinski(4));
     let scene = Scene::new(every_helper).compile().unwrap();
-    let effects = Effects {
-        ambient_occlusion: true,
-        shadows: true,
-        glow: Some(Glow::new(DVec3::ONE, 1.0)),
-        fog_density: 0.5,
-        ..Effects::default()
-    };
+    let effects = Effects::default()
+        .ambient_occlusion(true)
+        .shadows(true)
+        .glow(Some(Glow::new(DVec3::ONE, 1.0)))
+        .fog_density(0.5);
     let mut checked = 0;
     for precision in [Precision::F32, Precision::F64] {
         for target in [Target::Render, Target::Evaluate] {
-            let options = Options {
-                quality: Quality {
-                    precision,
-                    ..Quality::default()
-                },
-                effects,
-                target,
-            };
+            let options = Options::default()
+                .quality(Quality::default().precision(precision))
+                .effects(effects)
+                .target(target);
             let source = codegen::emit(&scene, &options).unwrap().source;
             let names = defined_names(&source);
             for must in [

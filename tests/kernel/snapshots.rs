@@ -47,10 +47,7 @@ fn generated_sources_match_the_committed_snapshots() {
         .into_iter()
         .map(|(name, scene)| (name.to_string(), scene, Options::default()))
         .collect();
-    let f64_options = Options {
-        quality: Quality::reference(),
-        ..Options::default()
-    };
+    let f64_options = Options::default().quality(Quality::reference());
     cases.push(("mandelbulb_f64".into(), gallery::mandelbulb(), f64_options));
     let mut kernels = BTreeMap::new();
     let mut failures = Vec::new();

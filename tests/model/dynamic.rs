@@ -4,6 +4,7 @@
 
 use crate::common::fixtures;
 use approx::relative_eq;
+use fractal_sdf::cpu;
 use fractal_sdf::ir::{Ir, Scalar};
 use fractal_sdf::prelude::*;
 use fractal_sdf::scene::Kind;

@@ -7,6 +7,11 @@
 
 use fractal_sdf::cpu::Evaluator;
 use fractal_sdf::prelude::*;
+use fractal_sdf::scene::Mandelbulb;
+use fractal_sdf::scene::Menger;
+use fractal_sdf::scene::Param;
+use fractal_sdf::scene::QuaternionJulia;
+use fractal_sdf::scene::Sierpinski;
 use fractal_sdf::testing::{julia_inside, mandelbulb_inside};
 
 /// `n` directions spread over the sphere (a Fibonacci lattice), plus the

@@ -8,7 +8,12 @@
 use crate::gpu;
 
 use fractal_sdf::prelude::*;
+use fractal_sdf::quality::Glow;
 use fractal_sdf::render::Renderer;
+use fractal_sdf::scene::Mandelbulb;
+use fractal_sdf::scene::Menger;
+use fractal_sdf::scene::QuaternionJulia;
+use fractal_sdf::scene::Sierpinski;
 use fractal_sdf::testing::scene_node;
 use proptest::prelude::*;
 use proptest::test_runner::{Config, FileFailurePersistence, TestRunner};
@@ -34,19 +39,12 @@ fn random_scenes_build_and_render_without_nan() {
         source_file: Some(file!()),
         ..Config::default()
     });
-    let effects = Effects {
-        glow: Some(Glow {
-            color: dvec3(1.0, 0.8, 0.5),
-            strength: 1.0,
-        }),
-        fog_density: 0.05,
-        ..Effects::default()
-    };
-    let options = fractal_sdf::render::RenderOptions {
-        quality: Quality::draft(),
-        effects,
-        ..Default::default()
-    };
+    let effects = Effects::default()
+        .glow(Some(Glow::new(dvec3(1.0, 0.8, 0.5), 1.0)))
+        .fog_density(0.05);
+    let options = fractal_sdf::render::RenderOptions::default()
+        .quality(Quality::draft())
+        .effects(effects);
     runner
         .run(&scene_node(3), |node| {
             let scene = Scene::new(node)

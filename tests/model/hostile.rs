@@ -25,9 +25,21 @@ use fractal_sdf::codegen::{self, Options};
 use fractal_sdf::cpu::{self, Evaluator};
 use fractal_sdf::math::F32_LIMITS;
 use fractal_sdf::prelude::*;
+use fractal_sdf::quality::Glow;
+use fractal_sdf::quality::Precision;
 use fractal_sdf::render::{RenderOptions, Renderer};
+use fractal_sdf::scene::Axis;
+use fractal_sdf::scene::Mandelbulb;
+use fractal_sdf::scene::Menger;
+use fractal_sdf::scene::Param;
+use fractal_sdf::scene::QuaternionJulia;
+use fractal_sdf::scene::Sierpinski;
+use fractal_sdf::scene::capped_cone;
+use fractal_sdf::scene::ellipsoid;
+use fractal_sdf::scene::octahedron;
 use fractal_sdf::scene::{CustomShape, Rule};
 use fractal_sdf::testing::{parameter_sites, substitute};
+use glam::Vec3;
 
 /// The hostile values.
 const VALUES: [f64; 11] = [
@@ -197,10 +209,7 @@ fn finite_reference(eval: &Evaluator, f32_too: bool) -> Result<(), String> {
 }
 
 fn program(precision: Precision) -> Options {
-    Options {
-        quality: gpu::plain(Quality::draft()).precision(precision),
-        ..Options::default()
-    }
+    Options::default().quality(gpu::plain(Quality::draft()).precision(precision))
 }
 
 /// One node parameter case: compile, set, check the reference and the
@@ -593,10 +602,7 @@ fn setting_cases(t: &mut Tally) {
                         Err(e) => t.refused(&what, &e, name, &[name]),
                         Ok(()) => {
                             t.accepted += 1;
-                            let options = Options {
-                                quality: q,
-                                ..Options::default()
-                            };
+                            let options = Options::default().quality(q);
                             if let Err(e) = codegen::emit(&base.compile().unwrap(), &options) {
                                 t.fail(&what, format!("valid, but code generation fails: {e}"));
                             }
@@ -613,11 +619,9 @@ fn setting_cases(t: &mut Tally) {
                         Err(err) => t.refused(&what, &err, name, &[name]),
                         Ok(()) => {
                             t.accepted += 1;
-                            let options = Options {
-                                quality: gpu::plain(Quality::preview()).precision(precision),
-                                effects: e,
-                                ..Options::default()
-                            };
+                            let options = Options::default()
+                                .quality(gpu::plain(Quality::preview()).precision(precision))
+                                .effects(e);
                             if let Err(err) = codegen::emit(&base.compile().unwrap(), &options) {
                                 t.fail(&what, format!("valid, but code generation fails: {err}"));
                             }

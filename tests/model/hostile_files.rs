@@ -10,12 +10,12 @@ use std::fs::{self, File};
 use std::path::{Path, PathBuf};
 use std::time::{Duration, SystemTime};
 
-use fractal_sdf::SceneFile;
 use fractal_sdf::animation::{CameraPath, Keyframe};
-use fractal_sdf::error::fmt_value;
+use fractal_sdf::file::SceneFile;
 use fractal_sdf::image::{self, Rgba, RgbaImage};
 use fractal_sdf::output::{STALE_TEMPORARY_AGE, save_png, verify_png};
 use fractal_sdf::prelude::*;
+use fractal_sdf::quality::Glow;
 use fractal_sdf::sequence::{Sequence, parse_range};
 use fractal_sdf::view::{FrameStats, KeyScript};
 
@@ -437,8 +437,6 @@ fn numbers_in_messages_are_readable() {
             "{text}"
         );
     }
-    assert_eq!(fmt_value(1e300).to_string(), "1e300");
-    assert_eq!(fmt_value(0.5).to_string(), "0.5");
 }
 
 #[test]

@@ -3,7 +3,13 @@
 
 use fractal_sdf::cpu::{self, Brute, Ray};
 use fractal_sdf::prelude::*;
+use fractal_sdf::quality::Precision;
+use fractal_sdf::quality::ScreenNormals;
 use fractal_sdf::render::{DeviceSelector, Frame, RenderOptions, Renderer};
+use fractal_sdf::scene::Axis;
+use fractal_sdf::scene::InsideBounds;
+use fractal_sdf::scene::InsideShape;
+use fractal_sdf::scene::param3;
 use fractal_sdf::scene::{INSIDE_HUGE, Rule};
 use fractal_sdf::testing::{
     check_inside_agrees_with_de, check_inside_matches_device, random_points,
@@ -34,10 +40,7 @@ fn camera() -> Camera {
 }
 
 fn options(quality: Quality) -> RenderOptions {
-    let mut options = RenderOptions {
-        quality,
-        ..RenderOptions::default()
-    };
+    let mut options = RenderOptions::default().quality(quality);
     options.effects.shadows = false;
     options
 }
@@ -126,14 +129,12 @@ fn bisection_locates_the_crossing_to_hit_epsilon() {
     let node = ball().node([RADIUS]);
     let eval = cpu::Evaluator::new(&node).unwrap();
     for hit_epsilon in [0.05, 0.001] {
-        let settings = cpu::MarchSettings {
-            footprint_base: 0.0,
-            footprint_per_unit: 0.004,
-            detail: 0.5,
-            hit_epsilon,
-            max_steps: 512,
-            ..cpu::MarchSettings::default()
-        };
+        let settings = cpu::MarchSettings::default()
+            .footprint_base(0.0)
+            .footprint_per_unit(0.004)
+            .detail(0.5)
+            .hit_epsilon(hit_epsilon)
+            .max_steps(512);
         let mut worst = 0.0f64;
         let mut rays = 0;
         for k in 0..200 {
@@ -144,10 +145,7 @@ fn bisection_locates_the_crossing_to_hit_epsilon() {
                 0.0,
             );
             let origin = dvec3(0.0, 0.4, 3.2);
-            let ray = Ray {
-                origin,
-                direction: (target - origin).normalize(),
-            };
+            let ray = Ray::new(origin, (target - origin).normalize());
             let brute = Brute::of(&eval, 4.0, phase).expect("a scene with an inside shape");
             let hit = cpu::march_brute(&eval, ray, &settings, &brute);
             let t = sphere_hit(ray, DVec3::ZERO, RADIUS).unwrap();

@@ -9,9 +9,11 @@
 //! comment says.
 
 use approx::relative_eq;
-use fractal_sdf::cpu::{Evaluator, V3};
+use fractal_sdf::cpu::Evaluator;
 use fractal_sdf::math::DEFAULT_COLOR;
+use fractal_sdf::math::V3;
 use fractal_sdf::prelude::*;
+use fractal_sdf::scene::Axis;
 use fractal_sdf::testing::{bounded_node, point, rotation, scene_node};
 use proptest::prelude::*;
 

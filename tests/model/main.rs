@@ -29,6 +29,7 @@ mod inside;
 mod laws;
 #[cfg(feature = "proptest")]
 mod pruning;
+mod public_api;
 #[cfg(feature = "proptest")]
 mod scene_files;
 #[cfg(feature = "proptest")]

@@ -6,6 +6,7 @@
 use fractal_sdf::cpu::{Evaluator, Sample};
 use fractal_sdf::ir::Ir;
 use fractal_sdf::prelude::*;
+use fractal_sdf::scene::param3;
 use fractal_sdf::testing::{fractal_node, point, scene_node};
 use proptest::prelude::*;
 

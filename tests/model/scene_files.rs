@@ -9,8 +9,8 @@ use crate::gpu;
 
 use std::path::{Path, PathBuf};
 
-use fractal_sdf::SceneFile;
 use fractal_sdf::file::MAX_NESTING;
+use fractal_sdf::file::SceneFile;
 use fractal_sdf::gallery;
 use fractal_sdf::prelude::*;
 use fractal_sdf::scene::{CustomShape, Rule};
@@ -58,11 +58,9 @@ fn a_round_trip_renders_the_identical_image() {
         let file = gallery::file(name).unwrap();
         let back = SceneFile::parse(&file.to_text().unwrap()).unwrap();
         let render = |f: &SceneFile| {
-            let options = fractal_sdf::render::RenderOptions {
-                quality: Quality::draft(),
-                effects: f.effects,
-                ..Default::default()
-            };
+            let options = fractal_sdf::render::RenderOptions::default()
+                .quality(Quality::draft())
+                .effects(f.effects);
             fractal_sdf::render::Renderer::with_options(&f.scene, &options)
                 .and_then(|mut r| r.render(40, 30))
                 .unwrap_or_else(|e| panic!("{name}: {e}"))
@@ -385,7 +383,7 @@ fn the_readme_example_file_reads() {
 }
 
 mod properties {
-    use fractal_sdf::SceneFile;
+    use fractal_sdf::file::SceneFile;
     use fractal_sdf::prelude::*;
     use fractal_sdf::testing::scene_node;
     use proptest::prelude::*;

@@ -265,6 +265,15 @@ fn iteration_counts_outside_their_range_are_rejected() {
     }
 }
 
+use fractal_sdf::cpu;
+use fractal_sdf::scene::Mandelbulb;
+use fractal_sdf::scene::Menger;
+use fractal_sdf::scene::QuaternionJulia;
+use fractal_sdf::scene::Sierpinski;
+use fractal_sdf::scene::capped_cone;
+use fractal_sdf::scene::ellipsoid;
+use fractal_sdf::scene::octahedron;
+use fractal_sdf::scene::param3;
 use fractal_sdf::scene::{MAX_ESCAPE_ITERATIONS, MAX_FOLD_ITERATIONS};
 
 #[test]

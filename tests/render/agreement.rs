@@ -4,6 +4,7 @@ use crate::gpu;
 
 use fractal_sdf::cpu::{self, Evaluator, Ray};
 use fractal_sdf::prelude::*;
+use fractal_sdf::quality::Precision;
 use fractal_sdf::render::{Frame, Renderer};
 use fractal_sdf::scene::Projection;
 
@@ -21,17 +22,16 @@ fn pixel_ray(camera: &Camera, w: u32, h: u32, x: u32, y: u32) -> Ray {
     match camera.projection {
         Projection::Perspective { fov_y_degrees } => {
             let half = (fov_y_degrees.to_radians() / 2.0).tan();
-            Ray {
-                origin: camera.position,
-                direction: (forward + right * (sx * half * aspect) + up * (sy * half)).normalize(),
-            }
+            Ray::new(
+                camera.position,
+                (forward + right * (sx * half * aspect) + up * (sy * half)).normalize(),
+            )
         }
-        Projection::Orthographic { height } => Ray {
-            origin: camera.position
-                + right * (sx * height / 2.0 * aspect)
-                + up * (sy * height / 2.0),
-            direction: forward,
-        },
+        Projection::Orthographic { height } => Ray::new(
+            camera.position + right * (sx * height / 2.0 * aspect) + up * (sy * height / 2.0),
+            forward,
+        ),
+        other => panic!("no reference ray for {other:?}"),
     }
 }
 
@@ -151,10 +151,7 @@ fn over_relaxation_finds_the_same_surface_in_fewer_steps() {
     let Some(_) = gpu::device() else { return };
     let scene = gpu::sphere_box_floor();
     let frame = |over_relaxation: f64| {
-        let quality = Quality {
-            over_relaxation,
-            ..Quality::production()
-        };
+        let quality = Quality::production().over_relaxation(over_relaxation);
         let mut r =
             Renderer::with_options(&scene, &gpu::options(quality, Effects::none())).unwrap();
         let f = r.render_with_aovs(96, 64).unwrap();
@@ -220,10 +217,7 @@ fn supersampled_aovs_trace_the_pixel_centre() {
     let Some(_) = gpu::device() else { return };
     let scene = gpu::sphere_box_floor();
     let frame = |supersampling: u32| {
-        let quality = Quality {
-            supersampling,
-            ..Quality::production()
-        };
+        let quality = Quality::production().supersampling(supersampling);
         let mut r =
             Renderer::with_options(&scene, &gpu::options(quality, Effects::none())).unwrap();
         r.render_with_aovs(48, 32).unwrap()

@@ -27,12 +27,10 @@ fn slow_sphere(work: u32) -> Scene {
 }
 
 fn options(token: Option<CancelToken>, deadline: Option<Duration>) -> RenderOptions {
-    RenderOptions {
-        tile_size: 4,
-        cancel: token,
-        deadline,
-        ..gpu::options(gpu::plain(Quality::draft()), Effects::none())
-    }
+    gpu::options(gpu::plain(Quality::draft()), Effects::none())
+        .tile_size(4)
+        .cancel(token)
+        .deadline(deadline)
 }
 
 #[test]

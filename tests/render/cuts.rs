@@ -5,6 +5,7 @@ use crate::gpu;
 
 use fractal_sdf::prelude::*;
 use fractal_sdf::render::Renderer;
+use fractal_sdf::scene::param3;
 use image::RgbaImage;
 
 const SIDE: u32 = 64;

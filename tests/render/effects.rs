@@ -5,6 +5,7 @@ use crate::gpu;
 use fractal_sdf::cpu::{self, Evaluator, MarchSettings, Ray};
 use fractal_sdf::prelude::*;
 use fractal_sdf::quality::Glow;
+use fractal_sdf::quality::Precision;
 use fractal_sdf::render::{Frame, Renderer};
 
 const W: u32 = 96;
@@ -34,11 +35,7 @@ fn ambient_occlusion_darkens_the_crease_where_a_box_meets_the_floor() {
     let scene = gpu::sphere_box_floor().with_lights([]);
     // Occlusion reaching 0.5 from the surface: the crease spans a few
     // pixels.
-    let with = Effects {
-        shadows: false,
-        ao_distance: 0.5,
-        ..Effects::default()
-    };
+    let with = Effects::default().shadows(false).ao_distance(0.5);
     let without = Effects::none();
     let quality = gpu::quick();
     let on = render(&scene, quality, with);
@@ -88,22 +85,17 @@ fn classify_shadows(scene: &Scene, frame: &Frame, light_dir: DVec3) -> (Vec<usiz
         .unwrap()
         .viewport(W, H)
         .unwrap();
-    let settings = MarchSettings {
-        max_steps: 512,
-        max_distance: 50.0,
-        footprint_base: 1e-4,
-        ..MarchSettings::default()
-    };
+    let settings = MarchSettings::default()
+        .max_steps(512)
+        .max_distance(50.0)
+        .footprint_base(1e-4);
     // Where the ray through image position (x, y) meets the floor y = 0.
     let floor_point = |x: f64, y: f64| {
         let ray = view.ray(x, y);
         ray.origin - ray.direction * (ray.origin.y / ray.direction.y)
     };
     let blocked = |p: DVec3| {
-        let ray = Ray {
-            origin: p + dvec3(0.0, 1e-3, 0.0),
-            direction: light_dir,
-        };
+        let ray = Ray::new(p + dvec3(0.0, 1e-3, 0.0), light_dir);
         cpu::march(&eval, ray, &settings).hit
     };
     let (mut dark, mut lit) = (Vec::new(), Vec::new());
@@ -136,10 +128,7 @@ fn a_shadowed_floor_point_is_darker_than_a_lit_one() {
     let Some(_) = gpu::device() else { return };
     let sun = gpu::sun(0.0);
     let scene = gpu::sphere_box_floor().with_lights([sun]);
-    let effects = Effects {
-        ambient_occlusion: false,
-        ..Effects::default()
-    };
+    let effects = Effects::default().ambient_occlusion(false);
     let frame = render(&scene, gpu::quick(), effects);
     gpu::save("effects_hard_shadow", &frame.image);
     let (dark, lit) = classify_shadows(&scene, &frame, gpu::direction_of(&sun).unwrap());
@@ -180,10 +169,7 @@ fn linear(frame: &Frame, i: usize) -> f64 {
 /// Per floor pixel, the fraction of the light that reaches it: the shadowed
 /// render's light above ambient over the unshadowed render's.
 fn visibility(scene: &Scene, quality: Quality) -> (Vec<f64>, Frame) {
-    let effects = Effects {
-        ambient_occlusion: false,
-        ..Effects::default()
-    };
+    let effects = Effects::default().ambient_occlusion(false);
     let shadowed = render(scene, quality, effects);
     let unshadowed = render(scene, quality, Effects::none());
     let ambient = render(&scene.clone().with_lights([]), quality, Effects::none());
@@ -240,10 +226,7 @@ fn soft_shadows_from_straight_above_light_an_open_floor() {
     let Some(_) = gpu::device() else { return };
     let overhead = Light::directional(dvec3(0.0, 1.0, 0.0)).softness(0.05);
     let scene = gpu::sphere_box_floor().with_lights([overhead]);
-    let effects = Effects {
-        ambient_occlusion: false,
-        ..Effects::default()
-    };
+    let effects = Effects::default().ambient_occlusion(false);
     let shadowed = render(&scene, gpu::quick(), effects);
     let unshadowed = render(&scene, gpu::quick(), Effects::none());
     let view = Renderer::with_options(&scene, &gpu::options(gpu::quick(), effects))
@@ -268,13 +251,7 @@ fn glow_brightens_missed_rays_near_the_surface_only() {
     let Some(_) = gpu::device() else { return };
     let scene = Scene::new(sphere(0.5))
         .with_camera(Camera::look_at(dvec3(0.0, 0.0, 4.0), DVec3::ZERO).fov(40.0));
-    let glow = Effects {
-        glow: Some(Glow {
-            color: dvec3(1.0, 0.6, 0.2),
-            strength: 1.0,
-        }),
-        ..Effects::none()
-    };
+    let glow = Effects::none().glow(Some(Glow::new(dvec3(1.0, 0.6, 0.2), 1.0)));
     let on = render(&scene, gpu::quick(), glow);
     let off = render(&scene, gpu::quick(), Effects::none());
     gpu::save("effects_glow", &on.image);
@@ -308,10 +285,7 @@ fn glow_brightens_missed_rays_near_the_surface_only() {
 fn fog_fades_distant_surfaces_into_the_background() {
     let Some(_) = gpu::device() else { return };
     let scene = gpu::sphere_box_floor().with_lights([gpu::sun(0.0)]);
-    let fog = Effects {
-        fog_density: 0.3,
-        ..Effects::none()
-    };
+    let fog = Effects::none().fog_density(0.3);
     let on = render(&scene, gpu::quick(), fog);
     let off = render(&scene, gpu::quick(), Effects::none());
     // The farthest floor pixel is closer to the background colour with fog.
@@ -338,11 +312,9 @@ fn fog_fades_distant_surfaces_into_the_background() {
 /// so that occlusion is all that varies: for `s` below 1 the same view
 /// magnified `1 / s` times.
 fn shrunk(unit: &Scene, s: f64) -> Scene {
-    let camera = Camera {
-        position: unit.camera.position * s,
-        target: unit.camera.target * s,
-        ..unit.camera
-    };
+    let mut camera = unit.camera;
+    camera.position = unit.camera.position * s;
+    camera.target = unit.camera.target * s;
     Scene::new(unit.geometry.clone().unwrap().scale(s))
         .with_camera(camera)
         .with_lights([])
@@ -389,21 +361,16 @@ fn occlusion_does_not_darken_a_magnified_view() {
             0.06,
         ),
     ];
-    let effects = Effects {
-        shadows: false,
-        ..Effects::default()
-    };
+    let effects = Effects::default().shadows(false);
     let mut cases = vec![(1e-3, Precision::F32)];
     if gpu::fp64(&device) {
         cases.push((1e-6, Precision::F64));
     }
     for (name, scene, tolerance) in scenes {
         let frame = |s: f64, precision: Precision| {
-            let quality = Quality {
-                precision,
-                max_distance: gpu::quick().max_distance * s,
-                ..gpu::quick()
-            };
+            let quality = gpu::quick()
+                .precision(precision)
+                .max_distance(gpu::quick().max_distance * s);
             render(&shrunk(&scene, s), quality, effects)
         };
         let unit = frame(1.0, Precision::F32);
@@ -436,10 +403,7 @@ fn occlusion_seen_from_inside_a_solid_keeps_its_reach() {
     let bulb = fractal_sdf::gallery::mandelbulb().geometry.unwrap();
     let camera = Camera::look_at(dvec3(0.41, 0.29, 0.56), dvec3(0.0, -0.12, 0.0)).fov(40.0);
     let scene = Scene::new(bulb).with_camera(camera).with_lights([]);
-    let effects = Effects {
-        shadows: false,
-        ..Effects::default()
-    };
+    let effects = Effects::default().shadows(false);
     let on = render(&scene, gpu::quick(), effects);
     let off = render(&scene, gpu::quick(), Effects::none());
     assert!(on.depth.iter().all(|&d| d == 0.0), "the camera is inside");
@@ -457,13 +421,7 @@ fn glow_comes_from_the_shapes_not_from_a_floor_at_the_horizon() {
     // Looking level over the floor: the horizon crosses the image.
     let scene = Scene::new(gpu::floor().union(sphere(0.5).translate(dvec3(0.0, 0.5, 0.0))))
         .with_camera(Camera::look_at(dvec3(0.0, 0.6, 4.0), dvec3(0.0, 0.6, 0.0)).fov(50.0));
-    let glow = Effects {
-        glow: Some(Glow {
-            color: dvec3(1.0, 0.6, 0.2),
-            strength: 1.0,
-        }),
-        ..Effects::none()
-    };
+    let glow = Effects::none().glow(Some(Glow::new(dvec3(1.0, 0.6, 0.2), 1.0)));
     let on = render(&scene, gpu::quick(), glow);
     let off = render(&scene, gpu::quick(), Effects::none());
     gpu::save("effects_glow_floor", &on.image);
@@ -508,10 +466,7 @@ fn a_twist_darkens_nothing_far_from_its_shape() {
         .with_camera(Camera::look_at(dvec3(0.0, 1.4, 3.2), dvec3(0.0, 0.35, 0.0)).fov(40.0))
         .with_lights([gpu::sun(0.1)])
     };
-    let effects = Effects {
-        ambient_occlusion: false,
-        ..Effects::default()
-    };
+    let effects = Effects::default().ambient_occlusion(false);
     let twisted = render(&scene(sphere(0.5).twist(2.5)), gpu::quick(), effects);
     let plain = render(&scene(sphere(0.5)), gpu::quick(), effects);
     gpu::save("effects_twist", &twisted.image);

@@ -38,13 +38,7 @@ fn a_build_failure_carries_the_log_and_the_source() {
 #[test]
 fn invalid_settings_are_refused_before_anything_runs() {
     let scene = gpu::sphere_box_floor();
-    let bad_quality = RenderOptions {
-        quality: Quality {
-            max_steps: 0,
-            ..Quality::draft()
-        },
-        ..RenderOptions::default()
-    };
+    let bad_quality = RenderOptions::default().quality(Quality::draft().max_steps(0));
     let err = Renderer::with_options(&scene, &bad_quality).unwrap_err();
     assert!(
         matches!(
@@ -57,13 +51,7 @@ fn invalid_settings_are_refused_before_anything_runs() {
         "{err}"
     );
 
-    let bad_effects = RenderOptions {
-        effects: Effects {
-            gamma: 0.0,
-            ..Effects::default()
-        },
-        ..RenderOptions::default()
-    };
+    let bad_effects = RenderOptions::default().effects(Effects::default().gamma(0.0));
     let err = Renderer::with_options(&scene, &bad_effects).unwrap_err();
     assert!(
         matches!(
@@ -76,10 +64,7 @@ fn invalid_settings_are_refused_before_anything_runs() {
         "{err}"
     );
 
-    let no_tiles = RenderOptions {
-        tile_size: 0,
-        ..RenderOptions::default()
-    };
+    let no_tiles = RenderOptions::default().tile_size(0);
     let err = Renderer::with_options(&scene, &no_tiles).unwrap_err();
     assert!(matches!(err, Error::TileSize { value: 0 }), "{err}");
     assert_eq!(err.to_string(), "tile size must be at least 1 pixel, got 0");
@@ -91,22 +76,17 @@ fn invalid_settings_are_refused_before_anything_runs() {
 #[test]
 fn an_unmatched_device_selector_lists_the_devices() {
     let Some(device) = gpu::device() else { return };
-    let options = RenderOptions {
-        device: DeviceSelector::device("no such device anywhere"),
-        ..RenderOptions::default()
-    };
+    let options =
+        RenderOptions::default().device(DeviceSelector::device("no such device anywhere"));
     let err = Renderer::with_options(&gpu::sphere_box_floor(), &options).unwrap_err();
     assert!(matches!(err, Error::NoDevice { .. }), "{err}");
     assert!(err.to_string().contains(&device.name), "{err}");
     // Selecting the device by its own names works.
-    let options = RenderOptions {
-        device: DeviceSelector {
-            platform: Some(device.platform.to_uppercase()),
-            device: Some(device.name.clone()),
-            index: None,
-        },
-        ..RenderOptions::default()
-    };
+    let options = RenderOptions::default().device({
+        let mut selector = DeviceSelector::device(device.name.clone());
+        selector.platform = Some(device.platform.to_uppercase());
+        selector
+    });
     let r = Renderer::with_options(&gpu::sphere_box_floor(), &options).unwrap();
     assert_eq!(r.device(), &device);
     // And by its place in the list, which tells apart devices of one name.

@@ -6,6 +6,7 @@ use crate::gpu;
 
 use fractal_sdf::gallery;
 use fractal_sdf::prelude::*;
+use fractal_sdf::quality::Glow;
 use fractal_sdf::render::{Frame, Renderer};
 
 /// The scene with a plane far below it, beyond the largest distance a ray

@@ -82,10 +82,7 @@ fn each_shading_model_matches_its_cpu_reference() {
     ];
     let quality = gpu::quick();
     let effects = Effects::none();
-    let sky = shade::Sky {
-        bottom: effects.sky_bottom,
-        top: effects.sky_top,
-    };
+    let sky = shade::Sky::new(effects.sky_top, effects.sky_bottom);
     let mut images = Vec::new();
     for (name, node) in models {
         let scene = lit(node.clone());

@@ -12,12 +12,10 @@ fn two_shares_of_one_device_render_the_image_of_one() {
         return;
     };
     let scene = fractal_sdf::gallery::benchmark();
-    let options = RenderOptions {
-        quality: Quality::draft(),
-        // Small tiles, so that each share has many, in both directions.
-        tile_size: 16,
-        ..RenderOptions::default()
-    };
+    // Small tiles, so that each share has many, in both directions.
+    let options = RenderOptions::default()
+        .quality(Quality::draft())
+        .tile_size(16);
     let twice = [DeviceSelector::exactly(&device), DeviceSelector::auto()];
     let mut one = Renderer::with_options(&scene, &options).unwrap();
     let mut two = Renderer::with_devices(&scene, &options, &twice).unwrap();

@@ -7,10 +7,12 @@ use crate::gpu;
 
 use fractal_sdf::cpu::{self, Evaluator};
 use fractal_sdf::prelude::*;
+use fractal_sdf::quality::Precision;
 use fractal_sdf::render::{
     DeviceSelector, EdgeThresholds, Renderer, Viewport, compose, sample_point,
 };
 use fractal_sdf::scene::{Stereo, StereoLayout};
+use glam::dvec2;
 use image::RgbaImage;
 
 /// A pure red sphere: only its pixels have no green (the sky has some), so
@@ -398,14 +400,7 @@ fn stereo_pictures_lay_out_the_eyes() {
     );
     r.set_camera(scene.camera).unwrap();
     let over = r
-        .render_stereo(
-            40,
-            30,
-            &Stereo {
-                layout: StereoLayout::OverUnder,
-                ..stereo
-            },
-        )
+        .render_stereo(40, 30, &stereo.layout(StereoLayout::OverUnder))
         .unwrap();
     assert_eq!(over.dimensions(), (40, 60));
     assert_eq!(
@@ -413,14 +408,7 @@ fn stereo_pictures_lay_out_the_eyes() {
         seen_left
     );
     let anaglyph = r
-        .render_stereo(
-            40,
-            30,
-            &Stereo {
-                layout: StereoLayout::Anaglyph,
-                ..stereo
-            },
-        )
+        .render_stereo(40, 30, &stereo.layout(StereoLayout::Anaglyph))
         .unwrap();
     for (x, y, p) in anaglyph.enumerate_pixels() {
         let (l, rr) = (seen_left.get_pixel(x, y).0, seen_right.get_pixel(x, y).0);

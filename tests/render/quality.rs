@@ -6,6 +6,7 @@ use crate::gpu;
 use fractal_sdf::cpu::Evaluator;
 use fractal_sdf::prelude::*;
 use fractal_sdf::render::{Frame, Renderer};
+use fractal_sdf::scene::Mandelbulb;
 
 const W: u32 = 96;
 const H: u32 = 64;
@@ -19,11 +20,7 @@ fn frame(scene: &Scene, quality: Quality, effects: Effects) -> Frame {
 
 /// Plain sphere tracing, no effects: the baseline the cases vary.
 fn plain() -> Quality {
-    Quality {
-        ao_samples: 0,
-        shadow_steps: 0,
-        ..Quality::production()
-    }
+    Quality::production().ao_samples(0).shadow_steps(0)
 }
 
 fn hits(f: &Frame) -> usize {
@@ -44,18 +41,8 @@ fn evaluations_count_every_distance_call() {
         assert_eq!(f.evaluations[i], f.steps[i] + extra, "pixel {i}");
     }
     // Occlusion adds its samples.
-    let ao = Effects {
-        shadows: false,
-        ..Effects::default()
-    };
-    let f = frame(
-        &scene,
-        Quality {
-            ao_samples: 3,
-            ..plain()
-        },
-        ao,
-    );
+    let ao = Effects::default().shadows(false);
+    let f = frame(&scene, plain().ao_samples(3), ao);
     for i in 0..f.hit.len() {
         let extra = if f.hit[i] { 8 } else { 0 };
         assert_eq!(f.evaluations[i], f.steps[i] + extra, "pixel {i}");
@@ -63,18 +50,8 @@ fn evaluations_count_every_distance_call() {
     // Shadow rays add at most `shadow_steps` per light, and some add many.
     let shadow_steps = 40;
     let scene = scene.with_lights([gpu::sun(0.0)]);
-    let shadows = Effects {
-        ambient_occlusion: false,
-        ..Effects::default()
-    };
-    let f = frame(
-        &scene,
-        Quality {
-            shadow_steps,
-            ..plain()
-        },
-        shadows,
-    );
+    let shadows = Effects::default().ambient_occlusion(false);
+    let f = frame(&scene, plain().shadow_steps(shadow_steps), shadows);
     let mut longest = 0;
     for i in 0..f.hit.len() {
         if f.hit[i] {
@@ -95,14 +72,7 @@ fn max_steps_and_max_distance_end_rays() {
     let Some(_) = gpu::device() else { return };
     let scene = gpu::sphere_box_floor();
     let base = frame(&scene, plain(), Effects::none());
-    let few = frame(
-        &scene,
-        Quality {
-            max_steps: 3,
-            ..plain()
-        },
-        Effects::none(),
-    );
+    let few = frame(&scene, plain().max_steps(3), Effects::none());
     // Measured: no pixel hits within 3 steps (5,760 without the limit),
     // and 460 within 2.5 units.
     assert!(few.steps.iter().all(|&s| s <= 3));
@@ -114,14 +84,7 @@ fn max_steps_and_max_distance_end_rays() {
     );
     // The camera is about 3.3 from the objects: a shorter reach sees only
     // the nearest floor.
-    let near = frame(
-        &scene,
-        Quality {
-            max_distance: 2.5,
-            ..plain()
-        },
-        Effects::none(),
-    );
+    let near = frame(&scene, plain().max_distance(2.5), Effects::none());
     assert!(hits(&near) < hits(&base));
     for i in 0..near.hit.len() {
         if near.hit[i] {
@@ -165,11 +128,7 @@ fn detail_sets_the_surface_and_hit_epsilon_how_closely_hits_find_it() {
     // distance moved).
     let scene = gpu::sphere_box_floor();
     for (detail, hit_epsilon) in [(0.5, 0.01), (0.5, 0.4), (6.0, 0.05), (6.0, 3.0)] {
-        let quality = Quality {
-            detail,
-            hit_epsilon,
-            ..plain()
-        };
+        let quality = plain().detail(detail).hit_epsilon(hit_epsilon);
         let (frame, offsets, per_unit) = hit_offsets(&scene, quality);
         let lipschitz = 1.0 + detail * per_unit;
         assert!(offsets.len() > 3000, "{} hits", offsets.len());
@@ -203,22 +162,8 @@ fn detail_sets_the_surface_and_hit_epsilon_how_closely_hits_find_it() {
 fn a_coarser_hit_epsilon_takes_fewer_steps_to_the_same_surface() {
     let Some(_) = gpu::device() else { return };
     let scene = gpu::sphere_box_floor();
-    let fine = frame(
-        &scene,
-        Quality {
-            hit_epsilon: 0.001,
-            ..plain()
-        },
-        Effects::none(),
-    );
-    let coarse = frame(
-        &scene,
-        Quality {
-            hit_epsilon: 0.5,
-            ..plain()
-        },
-        Effects::none(),
-    );
+    let fine = frame(&scene, plain().hit_epsilon(0.001), Effects::none());
+    let coarse = frame(&scene, plain().hit_epsilon(0.5), Effects::none());
     assert_eq!(fine.hit, coarse.hit);
     // Measured: the coarse march takes 0.45 of the fine one's steps.
     assert!(
@@ -234,14 +179,7 @@ fn normal_epsilon_blurs_edges() {
     let Some(_) = gpu::device() else { return };
     let scene = gpu::sphere_box_floor();
     let sharp = frame(&scene, plain(), Effects::none());
-    let blurred = frame(
-        &scene,
-        Quality {
-            normal_epsilon: 30.0,
-            ..plain()
-        },
-        Effects::none(),
-    );
+    let blurred = frame(&scene, plain().normal_epsilon(30.0), Effects::none());
     let mut changed = 0;
     for i in 0..sharp.hit.len() {
         if sharp.hit[i] && blurred.hit[i] {
@@ -262,10 +200,7 @@ fn fractal_iterations_override_every_fractal() {
     let Some(_) = gpu::device() else { return };
     let camera = Camera::look_at(dvec3(2.2, 1.6, 2.8), DVec3::ZERO).fov(40.0);
     let scene = |node: Node| Scene::new(node).with_camera(camera);
-    let override_to = |n| Quality {
-        fractal_iterations: Some(n),
-        ..plain()
-    };
+    let override_to = |n| plain().fractal_iterations(Some(n));
     let bulb = |n| Node::from(Mandelbulb::new(8.0).iterations(n));
     let both = |n| menger(n).union(bulb(n).translate(dvec3(0.0, 1.2, 0.0)));
     let overridden = frame(&scene(both(4)), override_to(2), Effects::none());
@@ -280,14 +215,7 @@ fn supersampling_traces_n_by_n_samples() {
     let Some(_) = gpu::device() else { return };
     let scene = gpu::sphere_box_floor();
     let one = frame(&scene, plain(), Effects::none());
-    let three = frame(
-        &scene,
-        Quality {
-            supersampling: 3,
-            ..plain()
-        },
-        Effects::none(),
-    );
+    let three = frame(&scene, plain().supersampling(3), Effects::none());
     // Nine samples a pixel: measured 9.09 times the steps.
     let ratio = three.mean_steps() / one.mean_steps();
     assert!((8.0..10.0).contains(&ratio), "{ratio}");

@@ -3,7 +3,8 @@
 use crate::gpu;
 
 use fractal_sdf::prelude::*;
-use fractal_sdf::render::{Frame, RenderOptions, Renderer};
+use fractal_sdf::quality::Preset;
+use fractal_sdf::render::{Frame, Renderer};
 
 /// No NaN in the frame (see `gpu::assert_no_nan`), and every pixel opaque.
 fn assert_no_nan(frame: &Frame, what: &str) {
@@ -37,15 +38,9 @@ fn odd_sizes_render_with_every_pixel_written() {
 fn tiled_images_equal_untiled_ones() {
     let Some(_) = gpu::device() else { return };
     let scene = gpu::sphere_box_floor();
-    let quality = Quality {
-        supersampling: 2,
-        ..gpu::quick()
-    };
+    let quality = gpu::quick().supersampling(2);
     let frame = |tile_size: u32| {
-        let options = RenderOptions {
-            tile_size,
-            ..gpu::options(quality, Effects::default())
-        };
+        let options = gpu::options(quality, Effects::default()).tile_size(tile_size);
         Renderer::with_options(&scene, &options)
             .unwrap()
             .render_with_aovs(97, 61)
@@ -100,14 +95,12 @@ fn awkward_cameras_and_lights_give_no_nan() {
             ),
         ),
     ];
-    let effects = Effects {
-        fog_density: 0.05,
-        glow: Some(fractal_sdf::quality::Glow {
-            color: dvec3(0.2, 0.5, 1.0),
-            strength: 2.0,
-        }),
-        ..Effects::default()
-    };
+    let effects = Effects::default()
+        .fog_density(0.05)
+        .glow(Some(fractal_sdf::quality::Glow::new(
+            dvec3(0.2, 0.5, 1.0),
+            2.0,
+        )));
     let mut r = Renderer::with_options(&base, &gpu::options(gpu::quick(), effects)).unwrap();
     for (what, scene) in cases {
         r.set_camera(scene.camera).unwrap();
@@ -191,11 +184,7 @@ fn a_stereo_picture_past_the_largest_side_is_refused() {
     let Some(_) = gpu::device() else { return };
     use fractal_sdf::scene::{Stereo, StereoLayout};
     let mut r = Renderer::new(&gpu::sphere_box_floor(), gpu::quick()).unwrap();
-    let stereo = Stereo {
-        layout: StereoLayout::SideBySide,
-        eye_separation: None,
-        convergence: None,
-    };
+    let stereo = Stereo::new(StereoLayout::SideBySide);
     let side = fractal_sdf::render::MAX_IMAGE_SIDE;
     let err = r.render_stereo(side, 8, &stereo).unwrap_err();
     assert!(matches!(err, Error::Resolution { .. }), "{err}");

@@ -4,6 +4,7 @@
 use crate::gpu;
 
 use fractal_sdf::prelude::*;
+use fractal_sdf::quality::Precision;
 use fractal_sdf::render::{RenderOptions, Renderer};
 
 #[test]
@@ -86,10 +87,7 @@ fn quality_and_effects_changes_rebuild_once_then_hit_the_cache() {
     let Some(_) = gpu::device() else { return };
     let scene = gpu::sphere_box_floor();
     // A quality no other test uses, so this test's first build is its own.
-    let quality = Quality {
-        max_steps: 177,
-        ..gpu::quick()
-    };
+    let quality = gpu::quick().max_steps(177);
     let mut r = Renderer::new(&scene, quality).unwrap();
     assert_eq!(r.builds(), 1);
     assert!(!r.build_info().cached);
@@ -117,11 +115,7 @@ fn quality_and_effects_changes_rebuild_once_then_hit_the_cache() {
     assert_eq!(twin.build_info().source_hash, first.source_hash);
 
     // Quality is compiled in.
-    r.set_quality(Quality {
-        supersampling: 2,
-        ..quality
-    })
-    .unwrap();
+    r.set_quality(quality.supersampling(2)).unwrap();
     assert_eq!(r.builds(), 3);
     assert!(r.source().source.contains("#define SUPERSAMPLING 2"));
 }
@@ -129,10 +123,7 @@ fn quality_and_effects_changes_rebuild_once_then_hit_the_cache() {
 #[test]
 fn f64_renders_where_the_device_supports_it() {
     let Some(device) = gpu::device() else { return };
-    let quality = Quality {
-        precision: Precision::F64,
-        ..gpu::quick()
-    };
+    let quality = gpu::quick().precision(Precision::F64);
     let result = Renderer::new(&gpu::sphere_box_floor(), quality);
     if !gpu::fp64(&device) {
         assert!(matches!(result, Err(Error::Fp64Unsupported { .. })));

@@ -9,12 +9,13 @@ use std::process::ExitCode;
 use std::time::{Duration, Instant};
 
 use clap::{Args, Parser, Subcommand};
-use fractal_sdf::SceneFile;
 use fractal_sdf::animation::CameraPath;
 use fractal_sdf::codegen::{self, Options};
+use fractal_sdf::file::SceneFile;
 use fractal_sdf::gallery;
 use fractal_sdf::output::{image_extension, save_image, verify_png};
 use fractal_sdf::prelude::*;
+use fractal_sdf::quality::Preset;
 use fractal_sdf::render::{
     DeviceKind, DeviceSelector, EdgeThresholds, RenderOptions, Renderer, devices,
 };
@@ -193,11 +194,10 @@ impl RenderArgs {
                 names.join(", ")
             ))
         })?;
-        Ok(Some(Stereo {
-            layout,
-            eye_separation: self.eye_separation,
-            convergence: self.convergence,
-        }))
+        let mut stereo = Stereo::new(layout);
+        stereo.eye_separation = self.eye_separation;
+        stereo.convergence = self.convergence;
+        Ok(Some(stereo))
     }
 }
 
@@ -389,13 +389,11 @@ impl Job {
                     .collect::<Outcome<_>>()?,
             ),
         };
-        let options = RenderOptions {
-            quality: quality(preset, &file, settings),
-            effects: file.effects,
-            device: device.map_or_else(DeviceSelector::auto, DeviceSelector::device),
-            deadline: args.deadline,
-            ..RenderOptions::default()
-        };
+        let options = RenderOptions::default()
+            .quality(quality(preset, &file, settings))
+            .effects(file.effects)
+            .device(device.map_or_else(DeviceSelector::auto, DeviceSelector::device))
+            .deadline(args.deadline);
         Ok(Job {
             file,
             devices,
@@ -704,11 +702,9 @@ fn emit(args: &EmitArgs, settings: &Settings) -> Outcome {
         Some(name) => Some(parse_preset(name).map_err(|e| usage(e.to_string()))?),
         None => None,
     };
-    let options = Options {
-        quality: quality(preset, &file, settings),
-        effects: file.effects,
-        ..Options::default()
-    };
+    let options = Options::default()
+        .quality(quality(preset, &file, settings))
+        .effects(file.effects);
     let compiled = file.scene.compile()?;
     let kernel = codegen::emit(&compiled, &options)?;
     print!("{}", kernel.source);

@@ -11,6 +11,8 @@ use fractal_sdf::render::DeviceSelector;
 use indicatif::{ProgressBar, ProgressStyle};
 
 use super::{Outcome, load_scene, parse_sets, usage};
+use fractal_sdf::ir::CompiledScene;
+use fractal_sdf::quality::Precision;
 
 /// What `mesh` and `volume` take: the scene and the grid.
 #[derive(Args)]
@@ -99,6 +101,7 @@ impl GridArgs {
         let on = match &sampler {
             Sampler::Cpu => "the CPU".to_string(),
             Sampler::Device(selector) => selector.resolve()?.label(),
+            other => format!("{other:?}"),
         };
         let mut options = GridOptions::default()
             .resolution(self.resolution)
@@ -134,6 +137,7 @@ fn bar() -> (ProgressBar, impl FnMut(Progress)) {
             Stage::Sampling => "sampling",
             Stage::Sharpening => "fitting",
             Stage::Shading => "colouring",
+            _ => "meshing",
         });
         handle.set_length(p.total);
         handle.set_position(p.done);

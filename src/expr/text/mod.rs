@@ -80,6 +80,7 @@ pub const FUNCTIONS: &[(&str, usize)] = &[
 
 /// A formula's syntax or meaning error, located.
 #[derive(Debug, Clone, PartialEq, Eq)]
+#[non_exhaustive]
 pub struct FormulaError {
     /// The line, from 1.
     pub line: usize,

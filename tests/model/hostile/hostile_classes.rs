@@ -12,8 +12,10 @@
 use std::panic::{AssertUnwindSafe, catch_unwind};
 
 use fractal_sdf::codegen::{self, Options};
+use fractal_sdf::cpu;
 use fractal_sdf::mesh::{self, Aabb, GridOptions, Sampler};
 use fractal_sdf::prelude::*;
+use fractal_sdf::quality::Precision;
 use fractal_sdf::scene::{CustomShape, InsideBounds, InsideShape, Stereo, StereoLayout};
 
 /// How one case ended.
@@ -60,10 +62,7 @@ fn sweep(n: usize) -> Vec<f64> {
 }
 
 fn program(precision: Precision) -> Options {
-    Options {
-        quality: Quality::draft().precision(precision),
-        ..Options::default()
-    }
+    Options::default().quality(Quality::draft().precision(precision))
 }
 
 /// A typed error whose text mentions `says`.
@@ -238,11 +237,7 @@ fn stereo_sizes(row: &mut Row) {
     let side = fractal_sdf::render::MAX_IMAGE_SIDE;
     for layout in StereoLayout::ALL {
         for width in [0, 1, 3, side / 2, side / 2 + 1, side, side + 1, u32::MAX] {
-            let stereo = Stereo {
-                layout,
-                eye_separation: None,
-                convergence: None,
-            };
+            let stereo = Stereo::new(layout);
             row.case(
                 &format!("{} eyes {width}x1", layout.name()),
                 || match renderer.render_stereo(width, 1, &stereo) {
