@@ -65,7 +65,8 @@ say "$name-$version.crate: $files files, $bytes bytes"
 # What a user needs is in; what only the repository needs is out.
 listing=$(tar tzf "$crate_file")
 for needed in Cargo.toml Cargo.lock README.md CHANGELOG.md LICENSE-MIT LICENSE-APACHE \
-    src/lib.rs src/guide.rs docs/guide/getting_started.md kernels/march.cl kernels/eval.cl \
+    src/lib.rs src/guide.rs docs/guide/getting_started.md kernels/march.cl kernels/shade.cl \
+    kernels/optics.cl kernels/render.cl kernels/eval.cl \
     examples/gallery.rs; do
     grep -qx "$name-$version/$needed" <<<"$listing" || fail "the package lacks $needed"
 done

@@ -47,7 +47,8 @@ use crate::scene::{BRUTE_MAX_STEPS, DEFAULT_MATERIAL, INSIDE_HUGE, Kind};
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
 #[non_exhaustive]
 pub enum Target {
-    /// The ray-marching renderer (`kernels/march.cl`).
+    /// The ray-marching renderer (`kernels/march.cl`, `shade.cl`,
+    /// `optics.cl` and `render.cl`).
     #[default]
     Render,
     /// A kernel `eval_points` that writes `DE` (and colour/trap) for a
@@ -77,7 +78,7 @@ setters!(Options {
 });
 
 /// A lighting effect that can be compiled into the marcher. Each names an
-/// `#ifdef ENABLE_*` block of `kernels/march.cl`; code generation keeps
+/// `#ifdef ENABLE_*` block of the render kernel (`kernels/*.cl`); code generation keeps
 /// the blocks of the effects that are on and removes the others entirely.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 #[non_exhaustive]
@@ -160,7 +161,8 @@ pub struct KernelSource {
     /// [`Ir::local_frame`]), zero otherwise. The renderer moves the camera
     /// and the lights by it, in `f64`, before they reach the device.
     pub origin: DVec3,
-    /// Where the target kernel (`kernels/march.cl` or `kernels/eval.cl`,
+    /// Where the target kernel (the render files `kernels/march.cl` to
+    /// `render.cl`, or `kernels/eval.cl`,
     /// after effect selection) starts in `source`.
     pub kernel_start: usize,
     /// Where each custom shape's function lies in `source`, in order, so
@@ -463,9 +465,18 @@ pub fn target_kernel(options: &Options) -> String {
     kernel_with(options, false, &Features::default())
 }
 
+/// The render program's kernel source: its four files, in order (see the
+/// header of `kernels/march.cl`).
+pub(crate) const RENDER_KERNEL: &str = concat!(
+    include_str!("../../kernels/march.cl"),
+    include_str!("../../kernels/shade.cl"),
+    include_str!("../../kernels/optics.cl"),
+    include_str!("../../kernels/render.cl"),
+);
+
 fn kernel_with(options: &Options, bounded: bool, features: &Features) -> String {
     let kernel = match options.target {
-        Target::Render => include_str!("../../kernels/march.cl"),
+        Target::Render => RENDER_KERNEL,
         Target::Evaluate => include_str!("../../kernels/eval.cl"),
     };
     let mut on: Vec<&str> = Effect::enabled(options)
@@ -594,7 +605,7 @@ fn finish(
     w.line(format!(
         "/* ---- kernel: {} ---- */",
         match options.target {
-            Target::Render => "march.cl",
+            Target::Render => "march.cl, shade.cl, optics.cl, render.cl",
             Target::Evaluate => "eval.cl",
         }
     ));

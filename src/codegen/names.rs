@@ -148,7 +148,7 @@ fn library_texts() -> Vec<String> {
     }
     texts.extend(Helper::ALL.iter().filter_map(|h| h.source().ok()));
     texts.extend(power::mandelbulb_helper(8).ok());
-    texts.push(include_str!("../../kernels/march.cl").into());
+    texts.push(super::RENDER_KERNEL.into());
     texts.push(include_str!("../../kernels/eval.cl").into());
     texts
 }

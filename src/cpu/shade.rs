@@ -1,5 +1,5 @@
 //! The CPU reference of the kernels' surface shading (`march_shade` in
-//! `kernels/march.cl`): the sky's ambient light and every light's diffuse
+//! `kernels/shade.cl`): the sky's ambient light and every light's diffuse
 //! (Lambert or Oren–Nayar), Blinn–Phong highlight and subsurface terms,
 //! with the same formulas, in `f64`. It leaves out what needs more than
 //! the surface point: ambient occlusion and shadows (render with those

@@ -20,8 +20,9 @@
 //!
 //! A program is one OpenCL C 1.2 source
 //! ([`KernelSource`](crate::codegen::KernelSource)): a header, the scene's
-//! distance functions, then `kernels/march.cl` (the marcher and shading,
-//! kernel `render_tile`). The header defines:
+//! distance functions, then the render kernel: `kernels/march.cl` (the
+//! marcher), `shade.cl`, `optics.cl` and `render.cl` (kernel
+//! `render_tile`). The header defines:
 //!
 //! - `real`, `real2`, `real3`, `real4` (`float*` or `double*`, the latter
 //!   with `#pragma OPENCL EXTENSION cl_khr_fp64 : enable`), and `R(x)`, which

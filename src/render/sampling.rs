@@ -1,5 +1,5 @@
 //! Where each sample of a pixel lies, in the pixel and on the lens: the
-//! CPU twin of `march_sample_point` in `kernels/march.cl`, so a test can
+//! CPU twin of `march_sample_point` in `kernels/optics.cl`, so a test can
 //! trace the rays the kernel traces.
 
 use glam::DVec2;

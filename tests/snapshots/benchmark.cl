@@ -405,4 +405,4 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     return u11;
 }
 
-/* ---- kernel: march.cl ---- */
+/* ---- kernel: march.cl, shade.cl, optics.cl, render.cl ---- */

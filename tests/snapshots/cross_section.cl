@@ -201,4 +201,4 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     return u7;
 }
 
-/* ---- kernel: march.cl ---- */
+/* ---- kernel: march.cl, shade.cl, optics.cl, render.cl ---- */

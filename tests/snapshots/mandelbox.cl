@@ -178,4 +178,4 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
 /* The sphere inside shapes lie in: marched by brute force. */
 #define BRUTE_CENTRE (real3)(0.0f, 0.0f, 0.0f)
 #define BRUTE_RADIUS 1.9485571f
-/* ---- kernel: march.cl ---- */
+/* ---- kernel: march.cl, shade.cl, optics.cl, render.cl ---- */

@@ -159,4 +159,4 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
 #define SCENE_BOUND_CENTRE (real3)(0.0f, 0.0f, 0.0f)
 #define SCENE_BOUND_RADIUS 1.1040895f
 #define SCENE_BOUND_SLOPE 1.0f
-/* ---- kernel: march.cl ---- */
+/* ---- kernel: march.cl, shade.cl, optics.cl, render.cl ---- */

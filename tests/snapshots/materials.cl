@@ -486,4 +486,4 @@ real DE_material(real3 p0, __global const real* params, real8* material) {
     return u8;
 }
 
-/* ---- kernel: march.cl ---- */
+/* ---- kernel: march.cl, shade.cl, optics.cl, render.cl ---- */

@@ -1,7 +1,9 @@
-// march.cl — the reusable sphere tracer and shading.
+// march.cl — the reusable sphere tracer: camera rays, the march, the stop
+// at the scene's bound and the brute-force steps of inside shapes.
 //
-// Appended after the generated header and the scene's distance functions.
-// It uses only:
+// The render program is march.cl, shade.cl, optics.cl and render.cl, in
+// that order, appended after the generated header and the scene's distance
+// functions. They use only:
 //   types   real, real2, real3, real4 and the literal macro R(x)
 //   consts  REAL_TINY MAX_STEPS MAX_DISTANCE DETAIL HIT_EPSILON
 //           NORMAL_EPSILON OVER_RELAXATION SUPERSAMPLING GAMMA SKY_TOP
@@ -18,7 +20,7 @@
 //           CONE_TILE, the cone_starts kernel and the starts it leaves).
 //           Code generation resolves these blocks
 //           itself and leaves out every one that is off, so they are the
-//           only preprocessor conditionals allowed in this file.
+//           only preprocessor conditionals allowed in these files.
 //
 // Everything else arrives at run time, so moving the camera or the lights
 // and changing dynamic parameters never rebuilds the program. The header
@@ -303,6 +305,13 @@ MarchResult march_ray(real3 ro, real3 rd, real start, const MarchCamera* cam, re
     }
     return r;
 }
+// shade.cl — normals, occlusion, shadows and the shading of a hit.
+//
+// Follows march.cl in every render program (see its header for what the
+// files may use): the tetrahedral normal, ambient occlusion (ENABLE_AO),
+// soft shadows (ENABLE_SHADOWS), the orbit-trap tint, the background, the
+// materials' shading models (ENABLE_MATERIALS) and march_shade, which
+// lights a hit with every light.
 
 // Unit normal by tetrahedral differences (MARCH_NORMAL_EVALUATIONS
 // evaluations) with step h.
@@ -471,6 +480,13 @@ real3 march_shade(real3 p, real3 n, real3 rd, real eps, real occlusion,
     albedo *= march_trap_tint(trap);
     real specular_strength = MARCH_SPECULAR;
     real shininess = MARCH_SHININESS;
+// optics.cl — reflections and transparency, and where each sample looks.
+//
+// Follows shade.cl: the branching paths of reflective and transparent
+// materials (ENABLE_MATERIALS), the per-sample jitter, the pixel and lens
+// points of supersampling and depth of field, and the camera ray of a
+// sample.
+
 
     real3 sky = mix(SKY_BOTTOM, SKY_TOP, R(0.5) + R(0.5) * n.y);
     real3 color = albedo * sky * (MARCH_AMBIENT * occlusion);
@@ -615,6 +631,12 @@ void march_sample_ray(const MarchCamera* cam, int x, int y, uint pixel, uint j, 
     *py = ((real)y + jy) * cam->pixel_scale;
     march_lens_ray(cam, px, *py, lens, ro, rd);
 }
+// render.cl — the kernels a render program runs.
+//
+// Follows optics.cl: the brute-force depth pass of inside shapes
+// (ENABLE_BRUTE), the screen-space normals and occlusion of stored depths,
+// render_tile (one tile of pixels: march, shade, fog and glow) and the
+// coarse pass (ENABLE_CONE: cone_starts).
 
 
 // One launch shades the tile [x0, x0 + tile_w) x [y0, y0 + tile_h) of a

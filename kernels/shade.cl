@@ -1,0 +1,256 @@
+// shade.cl — normals, occlusion, shadows and the shading of a hit.
+//
+// Follows march.cl in every render program (see its header for what the
+// files may use): the tetrahedral normal, ambient occlusion (ENABLE_AO),
+// soft shadows (ENABLE_SHADOWS), the orbit-trap tint, the background, the
+// materials' shading models (ENABLE_MATERIALS) and march_shade, which
+// lights a hit with every light.
+
+// Unit normal by tetrahedral differences (MARCH_NORMAL_EVALUATIONS
+// evaluations) with step h.
+real3 march_normal(real3 p, real h, real3 rd, __global const real* params) {
+    const real2 k = (real2)(R(1.0), R(-1.0));
+    real3 g = k.xyy * DE(p + k.xyy * h, params) + k.yyx * DE(p + k.yyx * h, params)
+            + k.yxy * DE(p + k.yxy * h, params) + k.xxx * DE(p + k.xxx * h, params);
+    real len = length(g);
+    // A flat gradient (inside a thin feature, or at a cusp): face the viewer.
+    return len > REAL_TINY ? g / len : -rd;
+}
+
+// The normal n of a surface that a ray along rd reached from outside,
+// which faces the ray. Differences over a step wider than the detail
+// beneath it (a fractal's dust) can point away; mirrored towards the
+// viewer, occlusion and shadow rays leave the surface instead of starting
+// inside it and darkening a lit pixel to black.
+real3 march_facing(real3 n, real3 rd) {
+    real away = dot(n, rd);
+    return away > R(0.0) ? normalize(n - R(2.0) * away * rd) : n;
+}
+
+#ifdef ENABLE_AO
+// Ambient occlusion: how much closer the surface is than expected along
+// the normal out to a reach r, nearer points weighing more:
+//   1 - integral of w(h) clamp(h - DE(p + n h), 0, h) dh
+//     / integral of w(h) h dh,   w(h) = exp(-AO_FALLOFF h / r),
+// by the midpoint rule with AO_SAMPLES points. The integral is fixed, so
+// more samples converge on the same value rather than reaching further.
+// 1 on an open face, towards 0 in a crease. Evaluates DE AO_SAMPLES times.
+//
+// The reach r is AO_DISTANCE, or AO_VIEW_FRACTION of view_height (the
+// height the image covers at p's distance: 2 tan(fov / 2) t in
+// perspective, the visible height in orthographic) where that is shorter.
+// The second is an angle, the same at every resolution, so a view
+// magnified any number of times is occluded like the view unmagnified
+// rather than by structure far outside it. With the default AO_DISTANCE
+// (0.25), a scene of unit size seen from a few units (view_height above
+// 1.25) keeps AO_DISTANCE.
+#define AO_FALLOFF R(1.5)
+// Occlusion never goes below this: where every sample lands inside the
+// shape (dust finer than the normal's step, a crevice narrower than the
+// first sample) the estimate knows no more than "dark", and a surface
+// under the sky keeps a trace of its light instead of reading as a hole.
+#define AO_FLOOR R(0.015625) // 2^-6
+#define AO_VIEW_FRACTION R(0.2)
+real march_ambient_occlusion(real3 p, real3 n, real view_height, real offset,
+                             __global const real* params) {
+    real reach = fmax(fmin(AO_DISTANCE, AO_VIEW_FRACTION * view_height), REAL_TINY);
+    real missing = R(0.0);
+    real expected = R(0.0);
+    for (int i = 0; i < AO_SAMPLES; ++i) {
+        real h = reach * ((real)i + offset) / (real)AO_SAMPLES;
+        real weight = exp(-AO_FALLOFF * h / reach);
+        real d = DE(p + n * h, params);
+        missing += weight * clamp(h - d, R(0.0), h);
+        expected += weight * h;
+    }
+    return clamp(R(1.0) - missing / expected, AO_FLOOR, R(1.0));
+}
+#endif
+
+#ifdef ENABLE_SHADOWS
+// Visibility of a light from ro along rd, from distance start to max_t: 0
+// in full shadow, 1 fully lit. softness 0 gives a hard shadow; above 0,
+// Quilez's improved soft shadow (2018) with a penumbra that grows with
+// softness. The ray is blocked where it comes within eps of a surface;
+// callers pass a fraction of the surface hit threshold so shadows are not
+// fattened by a pixel where objects nearly touch. Adds its DE evaluations
+// to *evals.
+//
+// The ray stops early where the rest cannot change the pixel: once the
+// light it could still let through is below half a step of an 8-bit pixel
+// (`weight` is the most light a fully visible light adds to the pixel in
+// any channel, and the smoothstep below is at most 3 v^2), and, for a
+// hard shadow, once it has passed the scene's bounding sphere (nothing
+// beyond can block it).
+real march_shadow(real3 ro, real3 rd, real max_t, real eps, real start, real softness,
+                  real weight, __global const real* params, uint* evals) {
+    real visible = R(1.0);
+    real prev_h = R(1e20);
+    real t = start;
+    real faint = sqrt(R(0.5) / (R(255.0) * R(3.0) * fmax(weight, REAL_TINY)));
+#ifdef ENABLE_SCENE_BOUND
+    real3 oc = ro - SCENE_BOUND_CENTRE;
+    real b = dot(oc, rd);
+    real widened = SCENE_BOUND_RADIUS + eps / SCENE_BOUND_SLOPE;
+    real disc = b * b - (dot(oc, oc) - widened * widened);
+    // Where the ray leaves the sphere widened until the estimate outside it
+    // exceeds eps (negative: it misses it).
+    real t_exit = disc < R(0.0) ? R(-1.0) : -b + sqrt(disc);
+    if (softness <= R(0.0)) {
+        max_t = fmin(max_t, t_exit);
+    }
+#endif
+#ifdef ENABLE_BRUTE
+    // Inside shapes block the ray where a sample lands in them: samples
+    // BRUTE_STEP times 4 of the shaded pixel's footprints apart (start is
+    // DETAIL footprints), beyond SHADOW_STEPS. They begin two samples out:
+    // a set's surface is rough at the scale of a step, and the sub-pixel
+    // dust next to a hit would otherwise shadow every point of it.
+    const real lattice = R(4.0) * BRUTE_STEP * start / DETAIL;
+    real2 span = march_brute_span(ro, rd);
+    span.x = fmax(span.x, R(2.0) * lattice);
+    real next_sample = R(-1.0);
+    int brute_steps = 0;
+#endif
+    for (int i = 0; i < SHADOW_STEPS && t < max_t; ++i) {
+        real h = DE(ro + rd * t, params);
+        *evals += 1u;
+#ifdef ENABLE_BRUTE
+        if (h <= R(-0.5) * INSIDE_HUGE && t < span.x) {
+            // The dust next to the start: no information.
+            h = INSIDE_HUGE;
+        }
+#endif
+        if (h < eps) {
+            return R(0.0);
+        }
+
+        if (softness > R(0.0)) {
+            // The closest point to the surface between this sample and the
+            // previous one, estimated from the two distance spheres. They
+            // cross only if h < 2 prev_h, always true of an exact distance
+            // but not of every estimator (or after a minimum-length step);
+            // otherwise use this sample's own distance.
+            real y = h < R(2.0) * prev_h ? h * h / (R(2.0) * prev_h) : R(0.0);
+            real side = sqrt(fmax(h * h - y * y, R(0.0)));
+            visible = fmin(visible, side / (softness * fmax(t - y, REAL_TINY)));
+            prev_h = h;
+            if (visible < faint) {
+                return R(0.0);
+            }
+        }
+        real step = fmax(h, eps);
+#ifdef ENABLE_BRUTE
+        real brute = march_brute_step(t, step, span, lattice, R(0.5), &next_sample);
+        if (brute < step) {
+            step = brute;
+            if (brute_steps < BRUTE_MAX_STEPS) {
+                brute_steps += 1;
+                i -= 1;
+            }
+        }
+#endif
+        t += step;
+    }
+    visible = clamp(visible, R(0.0), R(1.0));
+    return visible * visible * (R(3.0) - R(2.0) * visible);
+}
+#endif
+
+// Orbit-trap tint: a cosine palette that fades to white as the trap reaches
+// 1, so non-fractal surfaces (trap 1) keep their colour exactly.
+real3 march_trap_tint(real trap) {
+    real t = clamp(trap, R(0.0), R(1.0));
+    real3 phase = (real3)(R(0.0), R(0.1), R(0.2)) + t;
+    real3 palette = R(0.5) + R(0.5) * cos(R(6.28318530717958648) * phase);
+    return mix(palette, (real3)(R(1.0)), t);
+}
+
+// Background at image row py: SKY_BOTTOM at the bottom, SKY_TOP at the top.
+real3 march_background(const MarchCamera* cam, real py) {
+    real v = clamp(R(1.0) - py / cam->image_h, R(0.0), R(1.0));
+    return mix(SKY_BOTTOM, SKY_TOP, v);
+}
+
+#ifdef ENABLE_MATERIALS
+#define MARCH_SCATTER_SAMPLES 4 // DE calls of march_thinness
+
+// Oren-Nayar's qualitative model: the diffuse light of a surface of
+// microfacets whose slopes spread by sigma radians, relative to Lambert's
+// (so 1 at sigma 0), for unit normal n, light direction l and view
+// direction v, with ndl = n.l > 0:
+//   A + B max(0, cos(phi_l - phi_v)) sin(alpha) tan(beta),
+//   A = 1 - sigma^2 / (2 (sigma^2 + 0.33)),  B = 0.45 sigma^2 / (sigma^2 + 0.09),
+// alpha and beta the larger and smaller of the angles of l and v from n.
+real march_oren_nayar(real sigma, real3 n, real3 l, real3 v, real ndl) {
+    if (sigma <= R(0.0)) {
+        return R(1.0);
+    }
+    real s2 = sigma * sigma;
+    real a = R(1.0) - R(0.5) * s2 / (s2 + R(0.33));
+    real b = R(0.45) * s2 / (s2 + R(0.09));
+    // The view can sit just behind a normal taken by differences.
+    real ndv = clamp(dot(n, v), R(1e-4), R(1.0));
+    real3 lt = l - n * ndl;
+    real3 vt = v - n * ndv;
+    real norms = length(lt) * length(vt);
+    real cos_phi = norms > REAL_TINY ? fmax(dot(lt, vt) / norms, R(0.0)) : R(0.0);
+    real cos_alpha = fmin(ndl, ndv);
+    real cos_beta = fmax(ndl, ndv);
+    real sin_alpha = sqrt(fmax(R(1.0) - cos_alpha * cos_alpha, R(0.0)));
+    real tan_beta = sqrt(fmax(R(1.0) - cos_beta * cos_beta, R(0.0))) / cos_beta;
+    return a + b * cos_phi * sin_alpha * tan_beta;
+}
+
+// How thin the shape is below p, with outward normal n, down to depth:
+// 0 where it is solid that deep, towards 1 where it ends sooner. Samples
+// MARCH_SCATTER_SAMPLES points along the inward normal; at h below a
+// solid face the distance is -h, so each sample adds how far its depth
+// inside falls short of h.
+real march_thinness(real3 p, real3 n, real depth, __global const real* params, uint* evals) {
+    real solid = R(0.0);
+    for (int i = 1; i <= MARCH_SCATTER_SAMPLES; ++i) {
+        real h = depth * (real)i / (real)MARCH_SCATTER_SAMPLES;
+        solid += clamp(-DE(p - n * h, params) / h, R(0.0), R(1.0));
+    }
+    *evals += (uint)MARCH_SCATTER_SAMPLES;
+    return R(1.0) - solid / (real)MARCH_SCATTER_SAMPLES;
+}
+#endif
+
+// Ambient occlusion at p from the distance estimate (see
+// march_ambient_occlusion), or 1 without it; the image is view_height
+// scene units high at p's distance. The samples lie at offset (0.5: the
+// midpoints) of their intervals along the normal. Adds its evaluations to
+// *evals.
+real march_occlusion(real3 p, real3 n, real view_height, real offset,
+                     __global const real* params, uint* evals) {
+    real occlusion = R(1.0);
+#ifdef ENABLE_AO
+    occlusion = march_ambient_occlusion(p, n, view_height, offset, params);
+    *evals += (uint)AO_SAMPLES;
+#endif
+    return occlusion;
+}
+
+// Lit colour of the surface point p with normal n, seen along rd, with the
+// sky's light scaled by occlusion (1: open). Adds its distance evaluations
+// (DE_shade, DE_material, shadow rays, thickness) to *evals.
+//
+// Every light adds albedo * diffuse * n.l plus the Blinn-Phong highlight
+// specular * (n.h)^shininess * n.l, the diffuse term being Lambert's (1)
+// or, with a material's roughness, Oren-Nayar's. With a material's
+// subsurface strength s, a light behind the surface (n.l < 0) adds
+// albedo * s * thinness * -n.l: it shows through thin parts, unshadowed
+// (the shape itself stands between). Without materials the highlight is
+// MARCH_SPECULAR and MARCH_SHININESS, the default material's.
+real3 march_shade(real3 p, real3 n, real3 rd, real eps, real occlusion,
+                  __global const real* params, __global const real* lights, int light_count,
+                  uint* evals) {
+    real3 albedo;
+    real trap;
+    DE_shade(p, params, &albedo, &trap);
+    *evals += 1u;
+    albedo *= march_trap_tint(trap);
+    real specular_strength = MARCH_SPECULAR;
+    real shininess = MARCH_SHININESS;
