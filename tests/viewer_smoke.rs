@@ -77,7 +77,7 @@ fn viewer_binary() -> PathBuf {
     let built = std::fs::metadata(&path).and_then(|m| m.modified());
     let built = built.unwrap_or_else(|_| panic!("{} is missing: run `{BUILD}`", path.display()));
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
-    let sources = ["src", "kernels", "examples/viewer.rs", "examples/common"]
+    let sources = ["src", "kernels", "examples/viewer", "examples/common"]
         .map(|d| newest(&root.join(d)))
         .into_iter()
         .max()

@@ -538,7 +538,7 @@ fn square_plus<T: Num>(z0: T, z1: T, z2: T, z3: T, c: [T; 4]) -> [T; 4] {
 ///    and the critical orbit (see [`julia_critical_leaves`]) stays within
 ///    [`JULIA_CRITICAL_RADIUS`] for the point's iterations and
 ///    [`JULIA_CRITICAL_MARGIN`] more. Not proven; measured (see
-///    `tests/distance/fractals.rs`): within 0.98 of the distance at points that
+///    `tests/distance/julia.rs`): within 0.98 of the distance at points that
 ///    escape, and at most a thin band above it at points that do not.
 /// 3. Otherwise the smaller of that estimate and [`julia_bound`]: a proven
 ///    bound where the orbit proves escape within [`JULIA_BOUND_EXTRA`]

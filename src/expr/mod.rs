@@ -42,6 +42,7 @@ mod num;
 mod print;
 mod program;
 mod text;
+mod trace;
 
 pub use bound::surface_box;
 
@@ -68,7 +69,8 @@ impl Distance for Formula {
 pub use interval::{Interval, Maybe};
 pub use num::{Logic, MAX_LOOP_STEPS, Num};
 pub use print::{Inline, OpenCl, Printer, Shape, Signature, Unprintable};
-pub use program::{Binary, Loop, Op, Program, Step, Unary, ValueId, Var, VarBool, trace};
+pub use program::{Binary, Loop, Op, Program, Step, Unary, ValueId};
 pub use text::{
     FUNCTIONS, Formula, FormulaError, MAX_DEPTH, MAX_ITERATIONS, MAX_LENGTH, MAX_NESTING,
 };
+pub use trace::{Var, VarBool, trace};

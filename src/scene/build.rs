@@ -9,8 +9,9 @@
 
 use glam::{DQuat, DVec3, DVec4, EulerRot};
 
+use super::fractal::{Mandelbulb, Menger, QuaternionJulia, Sierpinski};
 use super::material::Material;
-use super::node::{Axis, CsgOp, Kind, Mandelbulb, Menger, Node, QuaternionJulia, Sierpinski};
+use super::node::{Axis, CsgOp, Kind, Node};
 use super::param::{Param, Param3};
 
 /// A sphere of `radius` at the origin.

@@ -6,6 +6,7 @@
 
 mod build;
 mod custom;
+mod fractal;
 mod inside;
 mod material;
 pub(crate) mod names;
@@ -23,6 +24,7 @@ pub use build::{
 pub use custom::{
     CpuDistance, CpuInside, CustomShape, INSIDE_HUGE, InsideBounds, MAX_INSIDE_REACH,
 };
+pub use fractal::{Mandelbulb, Menger, QuaternionJulia, Sierpinski};
 pub use inside::{
     BRUTE_MAX_STEPS, InsideShape, MANDELBOX_BAILOUT, MANDELBOX_HALF_SIDE, MANDELBULB_BAILOUT,
     mandelbox_contains, mandelbulb_contains,
@@ -30,8 +32,8 @@ pub use inside::{
 pub use material::{DEFAULT_MATERIAL, MATERIAL_LEN, Material};
 pub(crate) use node::Mapper;
 pub use node::{
-    Axis, CsgOp, Kind, MAX_ESCAPE_ITERATIONS, MAX_FOLD_ITERATIONS, MAX_WARP_RATE, Mandelbulb,
-    Menger, Node, NodeKind, ParamSpec, QuaternionJulia, Rule, Sierpinski,
+    Axis, CsgOp, Kind, MAX_ESCAPE_ITERATIONS, MAX_FOLD_ITERATIONS, MAX_WARP_RATE, Node, NodeKind,
+    ParamSpec, Rule,
 };
 pub use param::{Param, Param3, param, param3};
 pub use stereo::{Stereo, StereoLayout};

@@ -8,6 +8,7 @@ use std::sync::{Arc, OnceLock};
 use glam::DVec3;
 
 use super::custom::CustomShape;
+use super::fractal::{Mandelbulb, Menger, QuaternionJulia, Sierpinski};
 use super::material::Material;
 use super::param::{Param, Param3};
 use crate::math::Magnitude;
@@ -65,103 +66,6 @@ pub enum CsgOp {
     /// showing `a`'s colour and orbit trap everywhere, the face `b` cuts
     /// included: a cross-section (see [`Node::cut`]).
     Cut,
-}
-
-/// The Mandelbulb: the escape-time fractal of the "triplex" power map
-/// `z -> z^power + p` in spherical coordinates (White and Nylander).
-///
-/// Extent: the set lies in the ball of radius `2^(1/(power - 1))` about the
-/// origin, for any iterations and bailout (beyond it every orbit grows);
-/// that is about 1.104 for power 8, which reaches it, and 2 for power 2.
-///
-/// Distance estimate: `0.5 * ln(r) * r / dr` with the running derivative
-/// `dr`, a bound (it does not overestimate within the sampled tests). The
-/// orbit trap is the smallest `|z|` the orbit reaches, mapped to `[0, 1]`.
-#[derive(Debug, Clone, PartialEq)]
-#[non_exhaustive]
-pub struct Mandelbulb<S = Param> {
-    /// The power of the map; at least 2. An integer 8 is the classic bulb.
-    pub power: S,
-    /// Escape-time iterations, 1 to [`MAX_ESCAPE_ITERATIONS`].
-    pub iterations: u32,
-    /// The escape radius; at least 1 (2 is usual).
-    pub bailout: S,
-}
-
-/// The Menger sponge as a folding (KIFS) fractal in the cube `[-1, 1]^3`.
-///
-/// Extent: for every scale and level the sponge fills that cube: it lies in
-/// it and keeps its eight corners. Scale 3 is the classic sponge; other
-/// scales in `[2, 4]` give related sponges. Distance: the exact box distance of the folded point divided by
-/// `scale^iterations`, a bound. Iterations 0 is the solid cube.
-#[derive(Debug, Clone, PartialEq)]
-#[non_exhaustive]
-pub struct Menger<S = Param> {
-    /// Folding levels, 0 to [`MAX_FOLD_ITERATIONS`].
-    pub iterations: u32,
-    /// The scale factor of each level, in `[2, 4]`; 3 is the classic sponge.
-    pub scale: S,
-}
-
-/// A quaternion Julia set `z -> z^2 + c`, sliced at `w = slice_w`: the
-/// points whose orbits stay within the bailout (for a bailout of at least
-/// `1/2 + sqrt(1/4 + |c|)`, the radius of the ball that holds the set, the
-/// whole filled Julia set).
-///
-/// Extent: the 4D set lies in the ball of radius
-/// `R = (1 + sqrt(1 + 4|c|)) / 2` about the origin (beyond it every orbit
-/// grows), so the slice lies in the 3D ball of radius `sqrt(R^2 - w^2)`
-/// and is empty for `|w| > R`. `R` is 1 for `c = 0` (the unit ball) and 2
-/// for `|c| = 2`.
-///
-/// Distance: a bound for every valid `c`, whether the set is connected or
-/// dust and `c` baked or dynamic (proven, or measured where said so);
-/// [`cpu::sdf::julia`](crate::cpu::sdf::julia) has the details.
-///
-/// - Far away (beyond 1.5 ball radii): 0.9 times the distance to the ball.
-/// - Where it is safe, the escape-time estimate `0.5 |z| ln|z| / |dz|`:
-///   the bailout is at least 2.5 ball radii and the critical orbit `0, c,
-///   c^2 + c, ...` stays within 0.9 for the iterations used and 2 more.
-///   Measured, not proven: below the distance at points that escape within
-///   the iterations; at points that do not, at most a thin band above 0
-///   (about 0.06 with 4 iterations, 0.016 with 8, 0.009 with 12).
-/// - Elsewhere, no more than a proven bound: positive only where the orbit
-///   proves escape, 0 or less where it stays within the bailout. That is
-///   the case when `c' = c.x + i |(c.y, c.z, c.w)|` is outside the
-///   Mandelbrot set (its complex Julia set is then dust, and the
-///   escape-time estimate overestimates by any factor near the set) or the
-///   critical orbit reaches beyond the unit ball (as for a cycle out there,
-///   which makes that estimate positive inside the set). The bound is
-///   smaller than the escape-time estimate, most of all near the set, so
-///   such sets take more steps and are drawn a little fatter.
-#[derive(Debug, Clone, PartialEq)]
-#[non_exhaustive]
-pub struct QuaternionJulia<S = Param> {
-    /// The constant `c` as (x, y, z, w).
-    pub c: [S; 4],
-    /// Escape-time iterations, 1 to [`MAX_ESCAPE_ITERATIONS`].
-    pub iterations: u32,
-    /// The escape radius; at least 1 (4 is usual).
-    pub bailout: S,
-    /// The w coordinate of the 3D slice through the 4D set.
-    pub slice_w: S,
-}
-
-/// The Sierpinski tetrahedron as a folding (KIFS) fractal, with vertices at
-/// `(1,1,1)`, `(-1,-1,1)`, `(1,-1,-1)` and `(-1,1,-1)`.
-///
-/// Extent: for every scale and level it lies in the solid tetrahedron of
-/// those vertices (inside the cube `[-1, 1]^3`) and keeps the four
-/// vertices. Scale 2 is the classic gasket; other scales in `[1.5, 4]` give related
-/// sets. Distance: a tetrahedron bound of the folded point divided by
-/// `scale^iterations`, a bound. Iterations 0 is the solid tetrahedron.
-#[derive(Debug, Clone, PartialEq)]
-#[non_exhaustive]
-pub struct Sierpinski<S = Param> {
-    /// Folding levels, 0 to [`MAX_FOLD_ITERATIONS`].
-    pub iterations: u32,
-    /// The scale factor of each level, in `[1.5, 4]`; 2 is the classic.
-    pub scale: S,
 }
 
 /// Every node type, generic over how a scalar (`S`), a vector (`V`) and a
@@ -936,29 +840,5 @@ impl fmt::Debug for Node {
                 .finish_non_exhaustive();
         }
         fmt::Debug::fmt(self.kind(), f)
-    }
-}
-
-impl From<Mandelbulb> for Node {
-    fn from(f: Mandelbulb) -> Self {
-        Kind::Mandelbulb(f).into()
-    }
-}
-
-impl From<Menger> for Node {
-    fn from(f: Menger) -> Self {
-        Kind::Menger(f).into()
-    }
-}
-
-impl From<QuaternionJulia> for Node {
-    fn from(f: QuaternionJulia) -> Self {
-        Kind::Julia(f).into()
-    }
-}
-
-impl From<Sierpinski> for Node {
-    fn from(f: Sierpinski) -> Self {
-        Kind::Sierpinski(f).into()
     }
 }

@@ -17,7 +17,7 @@
 //!
 //! [`KeyScript`] schedules key presses by frame, for unattended runs.
 //! [`FrameTiming`] (what a frame cost, from the renderer) and
-//! [`FrameStats`] measure frames in benchmarks too. `examples/viewer.rs`
+//! [`FrameStats`] measure frames in benchmarks too. `examples/viewer/`
 //! connects all of it to a `winit` window.
 //!
 //! ```
@@ -63,14 +63,18 @@
 //! blit_scaled(&image, 640, 480, &mut pixels);
 //! ```
 
+mod bindings;
 mod blit;
 mod control;
 mod key;
 mod script;
+mod settings;
 mod timing;
 
+pub use bindings::{Action, KeyBindings};
 pub use blit::blit_scaled;
-pub use control::{Action, FlyCamera, KeyBindings, Movement, ViewSettings};
+pub use control::{FlyCamera, Movement};
 pub use key::Key;
 pub use script::KeyScript;
+pub use settings::ViewSettings;
 pub use timing::{FrameStats, FrameTiming, ResolutionScaler, fps, reduced_size};

@@ -21,6 +21,8 @@ mod formulas;
 #[cfg(feature = "proptest")]
 mod fractals;
 #[cfg(feature = "proptest")]
+mod julia;
+#[cfg(feature = "proptest")]
 mod lipschitz;
 mod numeric;
 mod smooth_oracle;

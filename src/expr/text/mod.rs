@@ -33,7 +33,8 @@ use std::collections::HashMap;
 use std::fmt;
 
 use super::num::Num;
-use super::program::{Program, Var, trace};
+use super::program::Program;
+use super::trace::{Var, trace};
 use crate::math::{V3, v3};
 use eval::{Eval, Run, Value};
 use parse::{Block, KEYWORDS, Parser, Tok, lex, start};

@@ -1,0 +1,244 @@
+//! Lighting effects: ambient occlusion, shadows, glow, fog, the sky and
+//! gamma, each compiled into the program only when it is on.
+
+use super::*;
+
+/// Glow around surfaces, from how closely a ray passed them.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+#[non_exhaustive]
+pub struct Glow {
+    /// Linear RGB colour of the glow.
+    pub color: DVec3,
+    /// Strength; 0.5 is subtle, 2 is strong.
+    pub strength: f64,
+}
+
+impl Glow {
+    /// A glow of `color` (linear RGB) and `strength`.
+    #[must_use]
+    pub fn new(color: DVec3, strength: f64) -> Self {
+        Glow { color, strength }
+    }
+}
+
+/// Lighting effects. Each one that is off is left out of the kernel.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+#[non_exhaustive]
+pub struct Effects {
+    /// Ambient occlusion (needs [`Quality::ao_samples`] > 0).
+    pub ambient_occlusion: bool,
+    /// Reach of ambient occlusion along the normal, in scene units:
+    /// surfaces closer than this darken a crease. Where a fifth of the
+    /// image's height at the surface's distance is shorter, occlusion
+    /// reaches that far instead (in perspective, `0.4 tan(fov / 2)` times
+    /// the distance along the ray; orthographic, a fifth of the visible
+    /// height), so a magnified view is shaded like the view unmagnified
+    /// and the image does not change with the resolution. The default 0.25
+    /// is kept wherever the image is more than 1.25 units high at the
+    /// surface (a scene of unit size seen from a few units away), and by a
+    /// camera inside a solid, which sees the surface from no distance.
+    pub ao_distance: f64,
+    /// Shadows from every light (needs [`Quality::shadow_steps`] > 0);
+    /// soft where the light's softness is above 0.
+    pub shadows: bool,
+    /// Glow on rays that pass close to a surface.
+    pub glow: Option<Glow>,
+    /// Distance fog: the fraction of light lost per unit, 0 for none.
+    pub fog_density: f64,
+    /// Colour of the background at the top of the image (linear RGB).
+    pub sky_top: DVec3,
+    /// Colour of the background at the bottom of the image (linear RGB).
+    pub sky_bottom: DVec3,
+    /// Output gamma (2.2 for sRGB-like output; 1 for linear).
+    pub gamma: f64,
+}
+
+impl Default for Effects {
+    /// Ambient occlusion and shadows on, no glow, no fog, a blue-grey
+    /// gradient background.
+    fn default() -> Self {
+        Effects {
+            ambient_occlusion: true,
+            ao_distance: 0.25,
+            shadows: true,
+            glow: None,
+            fog_density: 0.0,
+            sky_top: DVec3::new(0.32, 0.42, 0.58),
+            sky_bottom: DVec3::new(0.06, 0.07, 0.09),
+            gamma: 2.2,
+        }
+    }
+}
+
+impl Effects {
+    /// Everything off: plain diffuse shading on the background.
+    #[must_use]
+    pub fn none() -> Self {
+        Effects {
+            ambient_occlusion: false,
+            shadows: false,
+            glow: None,
+            fog_density: 0.0,
+            ..Self::default()
+        }
+    }
+
+    /// Checks every value, for its own range and for the `F64` limits
+    /// (the widest; a renderer checks its own precision's with
+    /// [`Effects::validate_for`]).
+    ///
+    /// # Errors
+    /// As [`Effects::validate_for`].
+    pub fn validate(&self) -> Result<()> {
+        self.validate_for(Precision::F64)
+    }
+
+    /// Checks every value, for its own range and for what a kernel of
+    /// `precision` can compute with: each is a size within
+    /// [`Precision::limits`].
+    ///
+    /// # Errors
+    /// [`Error::Effects`] naming the first setting outside its own range;
+    /// [`Error::Precision`] for one the precision cannot compute with.
+    pub fn validate_for(&self, precision: Precision) -> Result<()> {
+        self.check_ranges()?;
+        let limits = precision.limits();
+        let size =
+            |setting: &str, value: f64| within("effects", setting, value, Magnitude::Size, limits);
+        let rgb = |setting: &str, c: DVec3| -> Result<()> {
+            for (value, axis) in c.to_array().into_iter().zip(["x", "y", "z"]) {
+                size(&format!("{setting}.{axis}"), value)?;
+            }
+            Ok(())
+        };
+        if let Some(g) = self.glow {
+            rgb("glow.color", g.color)?;
+            size("glow.strength", g.strength)?;
+        }
+        size("ao_distance", self.ao_distance)?;
+        size("fog_density", self.fog_density)?;
+        rgb("sky_top", self.sky_top)?;
+        rgb("sky_bottom", self.sky_bottom)?;
+        size("gamma", self.gamma)
+    }
+
+    /// Each value's own range.
+    fn check_ranges(&self) -> Result<()> {
+        let bad = |setting: &'static str, value: f64, expected: &str| Error::Effects {
+            setting,
+            value,
+            expected: expected.into(),
+        };
+        // The first component that is NaN, infinite or negative (a
+        // minimum would hide a NaN).
+        let wrong = |c: DVec3| {
+            c.to_array()
+                .into_iter()
+                .find(|v| !(v.is_finite() && *v >= 0.0))
+        };
+        if let Some(g) = self.glow {
+            if let Some(v) = wrong(g.color) {
+                return Err(bad("glow.color", v, "finite and >= 0"));
+            }
+            if !(g.strength.is_finite() && g.strength >= 0.0) {
+                return Err(bad("glow.strength", g.strength, "finite and >= 0"));
+            }
+        }
+        if !(self.ao_distance.is_finite() && self.ao_distance > 0.0) {
+            return Err(bad("ao_distance", self.ao_distance, "finite and > 0"));
+        }
+        if !(self.fog_density.is_finite() && self.fog_density >= 0.0) {
+            return Err(bad("fog_density", self.fog_density, "finite and >= 0"));
+        }
+        for (name, c) in [("sky_top", self.sky_top), ("sky_bottom", self.sky_bottom)] {
+            if let Some(v) = wrong(c) {
+                return Err(bad(name, v, "finite and >= 0"));
+            }
+        }
+        if !(self.gamma.is_finite() && self.gamma > 0.0) {
+            return Err(bad("gamma", self.gamma, "> 0"));
+        }
+        Ok(())
+    }
+}
+
+/// Builder methods, one per setting, as for [`Quality`]: each returns the
+/// effects with that setting changed; [`Effects::validate`] checks them.
+///
+/// ```
+/// use fractal_sdf::prelude::*;
+/// use fractal_sdf::quality::Glow;
+///
+/// let effects = Effects::default()
+///     .shadows(false)
+///     .glow(Glow::new(dvec3(0.6, 0.75, 1.0), 0.6))
+///     .fog_density(0.05);
+/// assert!(effects.ambient_occlusion && !effects.shadows);
+/// assert_eq!(effects.glow.map(|g| g.strength), Some(0.6));
+/// assert_eq!(effects.glow(None).glow, None);
+/// effects.validate()?;
+/// # Ok::<(), fractal_sdf::Error>(())
+/// ```
+impl Effects {
+    /// Turns ambient occlusion on or off (on needs
+    /// [`Quality::ao_samples`] > 0).
+    #[must_use]
+    pub fn ambient_occlusion(mut self, on: bool) -> Self {
+        self.ambient_occlusion = on;
+        self
+    }
+
+    /// Sets the reach of ambient occlusion along the normal, in scene
+    /// units (> 0).
+    #[must_use]
+    pub fn ao_distance(mut self, distance: f64) -> Self {
+        self.ao_distance = distance;
+        self
+    }
+
+    /// Turns shadows on or off (on needs [`Quality::shadow_steps`] > 0).
+    #[must_use]
+    pub fn shadows(mut self, on: bool) -> Self {
+        self.shadows = on;
+        self
+    }
+
+    /// Sets the glow, or turns it off with `None`.
+    #[must_use]
+    pub fn glow(mut self, glow: impl Into<Option<Glow>>) -> Self {
+        self.glow = glow.into();
+        self
+    }
+
+    /// Sets the fog: the fraction of light lost per unit of distance
+    /// (>= 0; 0: no fog).
+    #[must_use]
+    pub fn fog_density(mut self, density: f64) -> Self {
+        self.fog_density = density;
+        self
+    }
+
+    /// Sets the background colour at the top of the image (linear RGB).
+    #[must_use]
+    pub fn sky_top(mut self, color: DVec3) -> Self {
+        self.sky_top = color;
+        self
+    }
+
+    /// Sets the background colour at the bottom of the image (linear RGB).
+    #[must_use]
+    pub fn sky_bottom(mut self, color: DVec3) -> Self {
+        self.sky_bottom = color;
+        self
+    }
+
+    /// Sets the output gamma (> 0; 2.2 for sRGB-like output, 1 for
+    /// linear).
+    #[must_use]
+    pub fn gamma(mut self, gamma: f64) -> Self {
+        self.gamma = gamma;
+        self
+    }
+}
