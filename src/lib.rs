@@ -17,9 +17,9 @@
 //!
 //! Each stage is a module and a function of the previous stage's output:
 //!
-//! 1. [`scene`]: the typed scene ([`Node`], [`Scene`]) and its builder API.
-//! 2. [`ir`]: [`Scene::compile`] validates and lowers a scene, once, into a
-//!    [`CompiledScene`]: a flat arena whose parameters are baked constants or
+//! 1. [`scene`]: the typed scene ([`Node`](scene::Node), [`Scene`](scene::Scene)) and its builder API.
+//! 2. [`ir`]: [`Scene::compile`](scene::Scene::compile) validates and lowers a scene, once, into a
+//!    [`CompiledScene`](ir::CompiledScene): a flat arena whose parameters are baked constants or
 //!    dynamic slots, with every parameter rule, the camera and the lights.
 //!    Every later stage takes the compiled scene.
 //! 3. [`cpu`]: the reference evaluator (distance, colour, normal, sphere

@@ -1,8 +1,8 @@
 //! The custom shape of `examples/custom_node.rs`, shared with
 //! `tests/kernel/custom_node.rs`.
 
+use fractal_sdf::expr::V3;
 use fractal_sdf::expr::{Distance, Num};
-use fractal_sdf::math::V3;
 use fractal_sdf::prelude::*;
 use fractal_sdf::scene::{CustomShape, Rule};
 

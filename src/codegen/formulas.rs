@@ -133,10 +133,20 @@ pub(crate) fn mandelbulb() -> Result<String, Unprintable> {
     )
 }
 
-/// The Mandelbulb of the integer power `n`, trig-free.
+/// The name of the Mandelbulb's helper for the baked integer power `n`.
+pub(crate) fn power_helper_name(n: u32) -> String {
+    format!("mandelbulb_p{n}")
+}
+
+/// Structure specialisation: for a baked integer power `n`, a helper
+/// `mandelbulb_pN` printed from the one Mandelbulb formula
+/// ([`cpu::sdf::mandelbulb_estimate`](crate::cpu::sdf::mandelbulb_estimate))
+/// traced with the power fixed: its binary exponentiation and angle powers
+/// unroll into straight-line multiplications (no loop over the bits of
+/// `n`, no trigonometry).
 pub(crate) fn mandelbulb_power(n: u32) -> Result<String, Unprintable> {
     print(
-        &super::power::helper_name(n),
+        &power_helper_name(n),
         &[
             ("p", Vec3),
             ("iterations", Scalar),
@@ -198,4 +208,28 @@ pub(crate) fn julia() -> Result<String, Unprintable> {
             pair(sdf::julia_estimate(vector(a, 0), c, a[7], a[8], a[9]))
         },
     )
+}
+
+#[cfg(test)]
+mod power_tests {
+    use super::*;
+
+    #[test]
+    fn power_eight_needs_no_trigonometry_and_three_squarings() {
+        let src = mandelbulb_power(8).unwrap();
+        assert!(src.contains("real2 mandelbulb_p8("), "{src}");
+        for f in ["sin(", "cos(", "acos(", "atan2(", "pow("] {
+            assert!(!src.contains(f), "{f} in {src}");
+        }
+        // r^7 = r * r^2 * r^4: r is squared, and squared again.
+        assert!(src.contains("R(2.0) *"), "{src}");
+    }
+
+    #[test]
+    fn a_real_power_uses_the_trigonometric_form() {
+        let src = mandelbulb().unwrap();
+        for f in ["acos(", "atan2(", "pow("] {
+            assert!(src.contains(f), "{f} missing from {src}");
+        }
+    }
 }

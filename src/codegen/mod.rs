@@ -26,7 +26,6 @@ mod formulas;
 mod helpers;
 pub mod interface;
 pub(crate) mod names;
-mod power;
 mod scene;
 mod writer;
 
@@ -345,8 +344,11 @@ pub fn emit_ir(ir: &Ir, options: &Options) -> Result<KernelSource> {
         w.line("");
     }
     for n in powers {
-        w.line(format!("/* ---- {} ---- */", power::helper_name(n)));
-        w.raw(&power::mandelbulb_helper(n).map_err(|e| Error::Invalid {
+        w.line(format!(
+            "/* ---- {} ---- */",
+            formulas::power_helper_name(n)
+        ));
+        w.raw(&formulas::mandelbulb_power(n).map_err(|e| Error::Invalid {
             what: "formula",
             reason: e.to_string(),
         })?);

@@ -8,7 +8,7 @@ use std::sync::OnceLock;
 
 use glam::DVec3;
 
-use super::{Options, Target, header, helpers::Helper, power, writer::Writer};
+use super::{Options, Target, formulas, header, helpers::Helper, writer::Writer};
 use crate::error::{Error, Result};
 use crate::quality::{Effects, Glow, Precision, Quality};
 use crate::scene::CustomShape;
@@ -147,7 +147,7 @@ fn library_texts() -> Vec<String> {
         }
     }
     texts.extend(Helper::ALL.iter().filter_map(|h| h.source().ok()));
-    texts.extend(power::mandelbulb_helper(8).ok());
+    texts.extend(formulas::mandelbulb_power(8).ok());
     texts.push(super::RENDER_KERNEL.into());
     texts.push(include_str!("../../kernels/eval.cl").into());
     texts

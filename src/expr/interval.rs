@@ -11,8 +11,8 @@
 
 use std::ops::{Add, BitAnd, BitOr, Div, Mul, Neg, Not, Sub};
 
+use super::num::Step;
 use super::num::{Logic, MAX_LOOP_STEPS, Num};
-use super::program::Step;
 
 /// A closed interval `[lo, hi]` of `f64`, possibly unbounded.
 #[derive(Debug, Clone, Copy, PartialEq)]

@@ -39,14 +39,14 @@
 mod bound;
 mod interval;
 mod num;
+mod ops;
 mod print;
 mod program;
 mod text;
 mod trace;
+mod vector;
 
 pub use bound::surface_box;
-
-use crate::math::V3;
 
 /// A distance formula written once, for custom shapes
 /// ([`CustomShape::formula`](crate::scene::CustomShape::formula)): one
@@ -67,10 +67,12 @@ impl Distance for Formula {
     }
 }
 pub use interval::{Interval, Maybe};
-pub use num::{Logic, MAX_LOOP_STEPS, Num};
+pub use num::{DERIVATIVE_CAP, Logic, MAGNITUDE_CAP, MAX_LOOP_STEPS, Num, REAL_TINY, Step};
+pub use ops::{Binary, Unary};
 pub use print::{Inline, OpenCl, Printer, Shape, Signature, Unprintable};
-pub use program::{Binary, Loop, Op, Program, Step, Unary, ValueId};
+pub use program::{Loop, Op, Program, ValueId};
 pub use text::{
     FUNCTIONS, Formula, FormulaError, MAX_DEPTH, MAX_ITERATIONS, MAX_LENGTH, MAX_NESTING,
 };
 pub use trace::{Var, VarBool, trace};
+pub use vector::{V3, v3};

@@ -13,7 +13,21 @@
 use std::fmt::Debug;
 use std::ops::{Add, BitAnd, BitOr, Div, Mul, Neg, Not, Sub};
 
-use super::program::{Binary, Step, Unary, binary, unary};
+use super::ops::{Binary, Unary};
+
+/// The smallest magnitude used to guard divisions and logarithms, in both
+/// twins (`REAL_TINY` in the kernels; a normal `f32`).
+pub const REAL_TINY: f64 = 1e-30;
+
+/// The cap on fractal running derivatives, so they never overflow to
+/// infinity (`DERIVATIVE_CAP` in the kernels).
+pub const DERIVATIVE_CAP: f64 = 1e30;
+
+/// The largest magnitude an escape-time iteration may produce
+/// (`MAGNITUDE_CAP` in the kernels): the squared length of a vector this
+/// long stays below `f32::MAX`, and dividing it by a capped derivative
+/// stays tiny.
+pub const MAGNITUDE_CAP: f64 = 1e18;
 
 /// The most steps a loop takes in plain numbers, whatever its count: a
 /// count of infinity still ends.
@@ -65,19 +79,19 @@ pub trait Num:
     /// (`1e-30`, a normal `f32`).
     #[must_use]
     fn tiny() -> Self {
-        Self::of(crate::math::REAL_TINY)
+        Self::of(REAL_TINY)
     }
 
     /// The cap on fractal running derivatives (`1e30`).
     #[must_use]
     fn derivative_cap() -> Self {
-        Self::of(crate::math::DERIVATIVE_CAP)
+        Self::of(DERIVATIVE_CAP)
     }
 
     /// The largest magnitude an escape-time iteration may produce (`1e18`).
     #[must_use]
     fn magnitude_cap() -> Self {
-        Self::of(crate::math::MAGNITUDE_CAP)
+        Self::of(MAGNITUDE_CAP)
     }
 
     /// Square root.
@@ -332,3 +346,50 @@ macro_rules! plain {
 
 plain!(f32);
 plain!(f64);
+
+/// Applies a numeric [`Unary`] operation.
+#[inline]
+pub(crate) fn unary<N: Num>(u: Unary, a: N) -> N {
+    match u {
+        Unary::Neg => -a,
+        Unary::Sqrt => a.sqrt(),
+        Unary::Abs => a.abs(),
+        Unary::Sin => a.sin(),
+        Unary::Cos => a.cos(),
+        Unary::Acos => a.acos(),
+        Unary::Exp => a.exp(),
+        Unary::Ln => a.ln(),
+        Unary::Floor => a.floor(),
+        Unary::Round => a.round(),
+        Unary::Finite | Unary::Not => N::of(f64::NAN),
+    }
+}
+
+/// Applies a numeric [`Binary`] operation.
+#[inline]
+pub(crate) fn binary<N: Num>(op: Binary, a: N, b: N) -> N {
+    match op {
+        Binary::Add => a + b,
+        Binary::Sub => a - b,
+        Binary::Mul => a * b,
+        Binary::Div => a / b,
+        Binary::Min => a.min(b),
+        Binary::Max => a.max(b),
+        Binary::Atan2 => a.atan2(b),
+        Binary::Pow => a.powf(b),
+        Binary::Hypot => a.hypot(b),
+        Binary::Lt | Binary::Le | Binary::And | Binary::Or => N::of(f64::NAN),
+    }
+}
+
+/// One step of a loop (see [`Num::iterate`]).
+#[derive(Debug, Clone)]
+pub struct Step<N: Num, S = Vec<N>> {
+    /// Where this holds, the loop ends before the step: the state stays
+    /// as it was.
+    pub stop_before: Option<N::Bool>,
+    /// The next state.
+    pub next: S,
+    /// Where this holds, the loop ends after the step.
+    pub stop_after: Option<N::Bool>,
+}

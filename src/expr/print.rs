@@ -9,7 +9,8 @@
 use std::collections::HashMap;
 
 use super::num::MAX_LOOP_STEPS;
-use super::program::{Binary, Loop, Op, Program, Unary, ValueId};
+use super::ops::{Binary, Unary};
+use super::program::{Loop, Op, Program, ValueId};
 
 /// The shape of a parameter or result: how many scalar inputs or outputs
 /// it stands for.

@@ -7,7 +7,8 @@
 //! common subexpressions), so a printer gets each value once and decides
 //! which to name.
 
-use super::num::Num;
+use super::num::{Num, Step, binary, unary};
+use super::ops::{Binary, Unary};
 
 /// A value's place in a [`Program`]: operations only name earlier places.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
@@ -18,76 +19,6 @@ impl ValueId {
     #[must_use]
     pub fn index(self) -> usize {
         self.0 as usize
-    }
-}
-
-/// An operation of one operand.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
-#[non_exhaustive]
-pub enum Unary {
-    /// `-x`
-    Neg,
-    /// `sqrt(x)`
-    Sqrt,
-    /// `|x|`
-    Abs,
-    /// `sin(x)`
-    Sin,
-    /// `cos(x)`
-    Cos,
-    /// `acos(x)`
-    Acos,
-    /// `e^x`
-    Exp,
-    /// `ln(x)`
-    Ln,
-    /// `floor(x)`
-    Floor,
-    /// The nearest integer, halves away from zero (`round(x)`).
-    Round,
-    /// Whether `x` is finite (a truth value).
-    Finite,
-    /// Logical not of a truth value.
-    Not,
-}
-
-/// An operation of two operands.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
-#[non_exhaustive]
-pub enum Binary {
-    /// `a + b`
-    Add,
-    /// `a - b`
-    Sub,
-    /// `a * b`
-    Mul,
-    /// `a / b`
-    Div,
-    /// The smaller (the other where one is NaN).
-    Min,
-    /// The larger (the other where one is NaN).
-    Max,
-    /// `atan2(a, b)`: the angle of `(b, a)`.
-    Atan2,
-    /// `a^b`
-    Pow,
-    /// `sqrt(a^2 + b^2)`
-    Hypot,
-    /// `a < b` (a truth value).
-    Lt,
-    /// `a <= b` (a truth value).
-    Le,
-    /// Both truth values.
-    And,
-    /// Either truth value.
-    Or,
-}
-
-impl Binary {
-    /// Whether the result is a truth value.
-    #[must_use]
-    pub fn is_logic(self) -> bool {
-        matches!(self, Binary::Lt | Binary::Le | Binary::And | Binary::Or)
     }
 }
 
@@ -304,7 +235,7 @@ impl<N: Num> Slot<N> {
 
 impl Program {
     /// Runs the program on `inputs` in any number type: `f64` or `f32`
-    /// for values, intervals for bounds, [`Var`] to record it again.
+    /// for values, intervals for bounds, [`Var`](super::Var) to record it again.
     /// Missing inputs read as NaN.
     #[must_use]
     pub fn run<N: Num>(&self, inputs: &[N]) -> Vec<N> {
@@ -427,51 +358,4 @@ fn run_loop<N: Num>(l: &Loop, count: N, init: Vec<N>, outer: &[&[Slot<N>]]) -> V
             stop_after: truth(l.stop_after_output()),
         }
     })
-}
-
-/// One step of a loop (see [`Num::iterate`]).
-#[derive(Debug, Clone)]
-pub struct Step<N: Num, S = Vec<N>> {
-    /// Where this holds, the loop ends before the step: the state stays
-    /// as it was.
-    pub stop_before: Option<N::Bool>,
-    /// The next state.
-    pub next: S,
-    /// Where this holds, the loop ends after the step.
-    pub stop_after: Option<N::Bool>,
-}
-
-/// Applies a numeric [`Unary`] operation.
-#[inline]
-pub(crate) fn unary<N: Num>(u: Unary, a: N) -> N {
-    match u {
-        Unary::Neg => -a,
-        Unary::Sqrt => a.sqrt(),
-        Unary::Abs => a.abs(),
-        Unary::Sin => a.sin(),
-        Unary::Cos => a.cos(),
-        Unary::Acos => a.acos(),
-        Unary::Exp => a.exp(),
-        Unary::Ln => a.ln(),
-        Unary::Floor => a.floor(),
-        Unary::Round => a.round(),
-        Unary::Finite | Unary::Not => N::of(f64::NAN),
-    }
-}
-
-/// Applies a numeric [`Binary`] operation.
-#[inline]
-pub(crate) fn binary<N: Num>(op: Binary, a: N, b: N) -> N {
-    match op {
-        Binary::Add => a + b,
-        Binary::Sub => a - b,
-        Binary::Mul => a * b,
-        Binary::Div => a / b,
-        Binary::Min => a.min(b),
-        Binary::Max => a.max(b),
-        Binary::Atan2 => a.atan2(b),
-        Binary::Pow => a.powf(b),
-        Binary::Hypot => a.hypot(b),
-        Binary::Lt | Binary::Le | Binary::And | Binary::Or => N::of(f64::NAN),
-    }
 }

@@ -6,7 +6,8 @@ use std::cell::RefCell;
 use std::collections::HashMap;
 use std::ops::{Add, BitAnd, BitOr, Div, Mul, Neg, Not, Sub};
 
-use super::num::{Logic, Num};
+use super::num::{Logic, Num, Step, binary, unary};
+use super::ops::{Binary, Unary};
 use super::program::*;
 
 /// The operations recorded so far, with one place per distinct operation.

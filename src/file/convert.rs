@@ -7,8 +7,9 @@ use crate::scene::{
 };
 
 use super::MAX_NESTING;
-use super::locate::{Located, SiteMap};
+use super::locate::SiteMap;
 use super::schema::{Child, MaterialRepr, NodeRepr};
+use super::sites::Located;
 
 /// How deep `node` nests in a file: a chain of hard unions down their
 /// first operands is one `Union([...])`, one level. Counted without

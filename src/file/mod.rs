@@ -79,12 +79,14 @@ mod layout;
 mod locate;
 pub mod reference;
 mod schema;
+mod sites;
 mod values;
 
 use convert::nesting;
 use layout::layout;
-use locate::{Located, SiteMap, Sites, line_and_column, locate, unknown_name};
+use locate::{SiteMap, line_and_column, locate, unknown_name};
 use schema::{FileRepr, FormulaParam, FormulaRepr, NodeRepr, QualityRepr};
+use sites::{Located, Sites};
 
 use crate::animation::{CameraPath, Motion};
 use crate::error::{Error, Result};

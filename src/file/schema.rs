@@ -7,7 +7,7 @@ use crate::animation::{Keyframe, Motion};
 use crate::quality::{Effects, Precision, Preset, Quality, ScreenNormals};
 use crate::scene::{Axis, Camera, Light, Material, Param, Param3, Rule, Scene};
 
-use super::locate::Located;
+use super::sites::Located;
 use super::values::count;
 
 // ---------------------------------------------------------------------------

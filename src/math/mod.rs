@@ -11,23 +11,10 @@ mod real;
 
 use glam::DVec3;
 
+pub(crate) use crate::expr::{DERIVATIVE_CAP, MAGNITUDE_CAP, REAL_TINY, V3, v3};
 pub use limits::{F32_LIMITS, F64_LIMITS, Limits, Magnitude, reduce_angle};
 pub(crate) use real::Num;
-pub use real::{Real, V3, v3};
-
-/// The smallest magnitude used to guard divisions and logarithms, in both
-/// twins (`REAL_TINY` in the kernels; a normal `f32`).
-pub const REAL_TINY: f64 = 1e-30;
-
-/// The cap on fractal running derivatives, so they never overflow to
-/// infinity (`DERIVATIVE_CAP` in the kernels).
-pub const DERIVATIVE_CAP: f64 = 1e30;
-
-/// The largest magnitude an escape-time iteration may produce
-/// (`MAGNITUDE_CAP` in the kernels): the squared length of a vector this
-/// long stays below `f32::MAX`, and dividing it by a capped derivative
-/// stays tiny.
-pub const MAGNITUDE_CAP: f64 = 1e18;
+pub use real::Real;
 
 /// The linear RGB colour of surfaces that no `color` node paints
 /// (`DEFAULT_COLOR` in the kernels).

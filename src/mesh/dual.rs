@@ -9,9 +9,9 @@ use std::collections::HashMap;
 use glam::{DVec3, Vec3};
 
 use super::cases::{EDGES, NONE, case, corner, edge};
-use super::extract::{CHUNK, Mesh};
-use super::grid::Grid;
+use super::grid::{CHUNK, Grid};
 use super::sharpen::Crossings;
+use super::triangles::Mesh;
 
 /// Samples along a sampled block's edge: the block's `CHUNK + 1` corners
 /// and one more, so that the cells on its far faces are whole (they are

@@ -8,6 +8,9 @@ use crate::error::{Error, Result, fmt_value};
 use crate::ir::{Bound, CompiledScene, union_chain};
 use crate::quality::Precision;
 
+/// Cells along a block's edge: the unit the octree drops or keeps.
+pub const CHUNK: u32 = 16;
+
 /// The most cells along a grid's longest side.
 pub const MAX_RESOLUTION: u32 = 4096;
 

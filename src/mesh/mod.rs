@@ -89,12 +89,14 @@ mod manifold;
 use sample::Sampling;
 mod sample;
 mod sharpen;
+mod triangles;
 mod volume;
 mod write;
 
-pub use extract::{CHUNK, Mesh, MeshStats, Topology, extract, extract_with_progress};
-pub use grid::{Aabb, GridOptions, MAX_RESOLUTION, Progress, Stage};
+pub use extract::{extract, extract_with_progress};
+pub use grid::{Aabb, CHUNK, GridOptions, MAX_RESOLUTION, Progress, Stage};
 pub use sample::Sampler;
+pub use triangles::{Mesh, MeshStats, Topology};
 pub use volume::{
     BAND_VOXELS, MAX_VOLUME_SAMPLES, Volume, sample_volume, sample_volume_with_progress,
 };

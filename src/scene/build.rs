@@ -9,6 +9,7 @@
 
 use glam::{DQuat, DVec3, DVec4, EulerRot};
 
+use super::custom::CustomShape;
 use super::fractal::{Mandelbulb, Menger, QuaternionJulia, Sierpinski};
 use super::material::Material;
 use super::node::{Axis, CsgOp, Kind, Node};
@@ -486,5 +487,19 @@ impl Node {
     #[must_use]
     pub fn smooth_intersect(self, other: impl Into<Node>, k: impl Into<Param>) -> Node {
         self.csg(CsgOp::Intersect, Some(k.into()), other)
+    }
+}
+
+impl CustomShape {
+    /// A node of this shape with the given parameter values (plain numbers
+    /// or [`param`](super::param) for dynamic ones). A wrong number of
+    /// values is reported by validation.
+    #[must_use]
+    pub fn node<P: Into<Param>>(&self, args: impl IntoIterator<Item = P>) -> Node {
+        Kind::Custom {
+            shape: self.clone(),
+            args: args.into_iter().map(Into::into).collect(),
+        }
+        .into()
     }
 }

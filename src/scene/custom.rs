@@ -31,8 +31,7 @@ use std::sync::Arc;
 use glam::DVec3;
 
 use super::names;
-use super::node::{Kind, Node, Rule};
-use super::param::Param;
+use super::rule::Rule;
 use crate::error::{Error, Result, fmt_value};
 use crate::expr::{Distance, Formula, OpenCl, Printer, Program, Shape, Signature, trace};
 use crate::math::{V3, v3};
@@ -630,18 +629,6 @@ impl CustomShape {
             .iter()
             .map(|(n, _)| format!(", real {n}"))
             .collect()
-    }
-
-    /// A node of this shape with the given parameter values (plain numbers
-    /// or [`param`](super::param) for dynamic ones). A wrong number of
-    /// values is reported by validation.
-    #[must_use]
-    pub fn node<P: Into<Param>>(&self, args: impl IntoIterator<Item = P>) -> Node {
-        Kind::Custom {
-            shape: self.clone(),
-            args: args.into_iter().map(Into::into).collect(),
-        }
-        .into()
     }
 
     /// What tells `other` apart from this shape, or `None` if the two are

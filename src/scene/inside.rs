@@ -4,8 +4,9 @@
 use glam::DVec3;
 
 use super::custom::{CustomShape, InsideBounds};
-use super::node::{Node, Rule};
+use super::node::Node;
 use super::param::Param;
+use super::rule::Rule;
 use crate::error::Result;
 
 /// A user-defined shape given by a membership test: a Rust function (the

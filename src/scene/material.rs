@@ -31,8 +31,8 @@
 //! # let _ = (chrome, glass, clay, wax);
 //! ```
 
-use super::node::{ParamSpec, Rule};
 use super::param::Param;
+use super::rule::{ParamSpec, Rule, spec};
 
 /// How a surface answers light: the values that the renderer's one
 /// shading formula reads (Oren–Nayar diffuse, a Blinn–Phong highlight,
@@ -189,10 +189,6 @@ pub(crate) const MATERIAL_SPECS: [ParamSpec<'static>; MATERIAL_LEN] = [
     spec("transparency", Rule::Range(0.0, 1.0)),
     spec("ior", Rule::Positive),
 ];
-
-const fn spec(name: &'static str, rule: Rule) -> ParamSpec<'static> {
-    ParamSpec { name, rule }
-}
 
 impl<S> Material<S> {
     /// The values in a fixed order: roughness, specular, shininess,

@@ -12,6 +12,7 @@ mod material;
 pub(crate) mod names;
 mod node;
 mod param;
+mod rule;
 mod stereo;
 
 use glam::{DVec2, DVec3};
@@ -33,9 +34,9 @@ pub use material::{DEFAULT_MATERIAL, MATERIAL_LEN, Material};
 pub(crate) use node::Mapper;
 pub use node::{
     Axis, CsgOp, Kind, MAX_ESCAPE_ITERATIONS, MAX_FOLD_ITERATIONS, MAX_WARP_RATE, Node, NodeKind,
-    ParamSpec, Rule,
 };
 pub use param::{Param, Param3, param, param3};
+pub use rule::{ParamSpec, Rule};
 pub use stereo::{Stereo, StereoLayout};
 
 use crate::error::{Error, Result, fmt_value};

@@ -11,7 +11,7 @@ use super::custom::CustomShape;
 use super::fractal::{Mandelbulb, Menger, QuaternionJulia, Sierpinski};
 use super::material::Material;
 use super::param::{Param, Param3};
-use crate::math::Magnitude;
+use super::rule::{ParamSpec, Rule, spec};
 
 /// The largest iteration count accepted by the escape-time fractals
 /// (Mandelbulb, quaternion Julia).
@@ -302,89 +302,6 @@ pub enum Kind<S, V, C> {
         /// The node it covers.
         child: C,
     },
-}
-
-/// What a parameter must satisfy. Every rule also requires a finite value,
-/// within the magnitudes the kernels can compute with (see
-/// [`Rule::magnitude`] and [`math::Limits`](crate::math::Limits)).
-#[derive(Debug, Clone, Copy, PartialEq)]
-#[non_exhaustive]
-pub enum Rule {
-    /// Any finite value: a coordinate, an offset or a rate (at most the
-    /// largest magnitude of the precision).
-    Finite,
-    /// At least 0: a size (0, or between the smallest and the largest
-    /// magnitude of the precision).
-    NonNegative,
-    /// Greater than 0: a size, as for `NonNegative`.
-    Positive,
-    /// Within `[min, max]`.
-    Range(f64, f64),
-    /// Any finite angle in radians. Angles are reduced modulo a full turn
-    /// (see [`math::reduce_angle`](crate::math::reduce_angle)) before the
-    /// CPU reference or a kernel uses them, so no magnitude limit applies.
-    Angle,
-    /// A component of a direction, which is normalised: any finite value.
-    /// A baked direction is normalised in `f64` when the scene is compiled,
-    /// so no magnitude limit applies to it; the components of a dynamic one
-    /// reach the kernel as they are, and are held to the limits of a size.
-    Direction,
-}
-
-impl Rule {
-    /// Whether `v` satisfies the rule.
-    #[must_use]
-    pub fn accepts(self, v: f64) -> bool {
-        v.is_finite()
-            && match self {
-                Rule::Finite | Rule::Angle | Rule::Direction => true,
-                Rule::NonNegative => v >= 0.0,
-                Rule::Positive => v > 0.0,
-                Rule::Range(lo, hi) => (lo..=hi).contains(&v),
-            }
-    }
-
-    /// A short human description, such as `">= 0"`.
-    #[must_use]
-    pub fn describe(self) -> String {
-        match self {
-            Rule::Finite | Rule::Angle | Rule::Direction => "finite".into(),
-            Rule::NonNegative => ">= 0".into(),
-            Rule::Positive => "> 0".into(),
-            Rule::Range(lo, hi) => format!("in [{lo}, {hi}]"),
-        }
-    }
-
-    /// How the kernels use a value under this rule, which decides the
-    /// magnitude limits it keeps: sizes (`NonNegative`, `Positive`) are
-    /// squared and divided by, so they are 0 or at least the precision's
-    /// smallest size; coordinates (`Finite`, `Range`) are only added and
-    /// multiplied; angles and baked directions are reduced or normalised
-    /// in `f64` first, and keep none.
-    #[must_use]
-    pub fn magnitude(self, baked: bool) -> Magnitude {
-        match self {
-            Rule::Finite | Rule::Range(..) => Magnitude::Coordinate,
-            Rule::NonNegative | Rule::Positive => Magnitude::Size,
-            Rule::Angle => Magnitude::Free,
-            Rule::Direction if baked => Magnitude::Free,
-            Rule::Direction => Magnitude::Size,
-        }
-    }
-}
-
-/// A parameter's name within its node and the rule it must satisfy.
-#[derive(Debug, Clone, Copy, PartialEq)]
-#[non_exhaustive]
-pub struct ParamSpec<'a> {
-    /// The field name, such as `"radius"`.
-    pub name: &'a str,
-    /// What the value must satisfy.
-    pub rule: Rule,
-}
-
-const fn spec(name: &str, rule: Rule) -> ParamSpec<'_> {
-    ParamSpec { name, rule }
 }
 
 /// Converts the scalars, vectors and children of a [`Kind`] into another
@@ -712,7 +629,7 @@ pub type NodeKind = Kind<Param, Param3, Node>;
 ///
 /// Build nodes with the free functions ([`sphere`](super::sphere),
 /// [`mandelbulb`](super::mandelbulb), ...) and combine them with the methods
-/// in [`build`](super::build). A `Node` is a plain value: clone it (cheaply:
+/// of [`Node`]. A `Node` is a plain value: clone it (cheaply:
 /// subtrees are shared), compare it, keep it in a `Vec`. Nothing about a
 /// node recurses on its depth: dropping, comparing, printing and compiling
 /// a chain of a million nodes needs no deeper stack than one node.

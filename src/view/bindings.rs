@@ -19,7 +19,7 @@ pub enum Action {
     ToggleShadows,
     /// `g`: glow on or off.
     ToggleGlow,
-    /// `v`: stereo off, then each [`StereoLayout`] in turn.
+    /// `v`: stereo off, then each [`StereoLayout`](crate::scene::StereoLayout) in turn.
     CycleStereo,
     /// `1`–`4`: draft, preview, production, reference quality.
     Quality(Preset),

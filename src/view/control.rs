@@ -165,7 +165,7 @@ impl Movement {
     }
 
     /// The keys that move the camera: `w`, `a`, `s`, `d`, `e`, `q` and the
-    /// arrows. No [`Action`] may be bound to one.
+    /// arrows. No [`Action`](super::Action) may be bound to one.
     pub const KEYS: [Key; 10] = [
         Key::W,
         Key::A,

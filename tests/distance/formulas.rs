@@ -5,8 +5,8 @@
 
 use crate::gpu;
 
+use fractal_sdf::expr::V3;
 use fractal_sdf::expr::{Distance, Formula, Interval, Num, Program};
-use fractal_sdf::math::V3;
 use fractal_sdf::mesh::{GridOptions, Sampler, extract};
 use fractal_sdf::prelude::*;
 use fractal_sdf::quality::Precision;

@@ -3,7 +3,7 @@
 //! `crate::module` a pipeline module's code names (doc comments aside)
 //! against the stages before it.
 
-use std::collections::BTreeSet;
+use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
 
 /// Each pipeline module and the modules its code may name. Modules beside
@@ -12,10 +12,10 @@ use std::path::{Path, PathBuf};
 /// `FrameTiming` the renderer reports.
 const STAGES: &[(&str, &[&str])] = &[
     ("error", &[]),
-    // The foundation: `math`'s vectors are generic over `expr`'s numbers,
-    // and `expr`'s formulas use `math`'s vectors and guards.
+    // The foundation: `expr`'s numbers, vectors and guards, over which
+    // `math`'s helpers and every later stage's formulas are written.
+    ("expr", &[]),
     ("math", &["expr"]),
-    ("expr", &["math"]),
     ("quality", &["error", "math"]),
     ("scene", &["error", "math", "expr"]),
     ("ir", &["error", "math", "expr", "scene"]),
@@ -120,4 +120,193 @@ fn the_reader_finds_plain_grouped_and_nested_names() {
                 let x = crate::cpu::f(); // crate::render in a comment\n/// [`x`](crate::codegen)";
     let names: Vec<String> = named_modules(text).into_iter().collect();
     assert_eq!(names, ["cpu", "error", "ir", "scene"]);
+}
+
+/// The modules directly inside `dir` (files and folders), by name.
+fn children(dir: &Path) -> Vec<(String, PathBuf)> {
+    let mut out = Vec::new();
+    for entry in std::fs::read_dir(dir).unwrap() {
+        let path = entry.unwrap().path();
+        let name = path.file_stem().unwrap().to_string_lossy().to_string();
+        if path.is_dir() || (path.extension().is_some_and(|e| e == "rs") && name != "mod") {
+            out.push((name, path));
+        }
+    }
+    out.sort();
+    out
+}
+
+/// The sibling a name in `dir`'s module refers to: a sibling module of
+/// that name, or the sibling an item of that name is re-exported from
+/// (`use sibling::{Item, ..}` in the module's own file).
+fn resolve(
+    name: &str,
+    siblings: &BTreeSet<String>,
+    reexports: &[(String, String)],
+) -> Option<String> {
+    if siblings.contains(name) {
+        return Some(name.to_string());
+    }
+    reexports
+        .iter()
+        .find(|(item, _)| item == name)
+        .map(|(_, from)| from.clone())
+}
+
+/// `(item, sibling)` for each `use sibling::...` in a module's own file.
+fn reexports(text: &str, siblings: &BTreeSet<String>) -> Vec<(String, String)> {
+    let mut out = Vec::new();
+    let code: String = text
+        .lines()
+        .map(|l| l.split("//").next().unwrap_or(""))
+        .collect::<Vec<_>>()
+        .join(" ");
+    for part in code.split("use ").skip(1) {
+        let statement = part.split(';').next().unwrap_or("");
+        let statement = statement.trim().trim_start_matches("self::");
+        let Some((from, rest)) = statement.split_once("::") else {
+            continue;
+        };
+        if !siblings.contains(from) {
+            continue;
+        }
+        let rest = rest.trim().trim_start_matches('{').trim_end_matches('}');
+        for item in rest.split(',') {
+            let item = item.split(" as ").last().unwrap_or("").trim();
+            let item = item.rsplit("::").next().unwrap_or("").trim();
+            if !item.is_empty() {
+                out.push((item.to_string(), from.to_string()));
+            }
+        }
+    }
+    out
+}
+
+/// The names after `prefix` (`super::` or `crate::a::b::`) outside comments.
+fn names_after(text: &str, prefix: &str) -> BTreeSet<String> {
+    let mut names = BTreeSet::new();
+    for line in text.lines() {
+        let code = line.split("//").next().unwrap_or("");
+        let mut rest = code;
+        while let Some(at) = rest.find(prefix) {
+            rest = &rest[at + prefix.len()..];
+            // `super::super::` names the module above: not a sibling.
+            if prefix == "super::" && rest.starts_with("super::") {
+                rest = &rest["super::".len()..];
+                continue;
+            }
+            let group = if let Some(g) = rest.strip_prefix('{') {
+                g.split('}').next().unwrap_or("").to_string()
+            } else {
+                rest.chars()
+                    .take_while(|c| c.is_ascii_alphanumeric() || *c == '_')
+                    .collect()
+            };
+            for item in group.split(',') {
+                let first = item.trim().split("::").next().unwrap_or("").trim();
+                if !first.is_empty() && first != "*" {
+                    names.insert(first.to_string());
+                }
+            }
+        }
+    }
+    names
+}
+
+/// Every import circle among the modules inside `dir` (named `path`), and
+/// recursively inside each of them.
+fn circles_in(dir: &Path, path: &str, out: &mut Vec<String>) {
+    let kids = children(dir);
+    let siblings: BTreeSet<String> = kids.iter().map(|(n, _)| n.clone()).collect();
+    let own = if path.is_empty() {
+        dir.join("lib.rs")
+    } else {
+        dir.join("mod.rs")
+    };
+    let own_text = std::fs::read_to_string(&own).unwrap_or_default();
+    let exports = reexports(&own_text, &siblings);
+    let crate_prefix = format!("crate::{path}{}", if path.is_empty() { "" } else { "::" });
+    let mut edges: BTreeMap<String, BTreeSet<String>> = BTreeMap::new();
+    for (name, at) in &kids {
+        if name == "bin" || name == "lib" {
+            continue;
+        }
+        let mut files = Vec::new();
+        sources(at, &mut files);
+        for file in files {
+            let text = std::fs::read_to_string(&file).unwrap();
+            // Unit tests may name any sibling: the circle is in the code.
+            let text = text.split("#[cfg(test)]\nmod tests").next().unwrap_or("");
+            // `super::` means this module only in the sibling's own file.
+            let direct = file == *at || file == at.join("mod.rs");
+            let mut named = names_after(text, &crate_prefix);
+            if direct && !path.is_empty() {
+                named.extend(names_after(text, "super::"));
+            }
+            for n in named {
+                if let Some(to) = resolve(&n, &siblings, &exports)
+                    && to != *name
+                {
+                    edges.entry(name.clone()).or_default().insert(to);
+                }
+            }
+        }
+        if at.is_dir() {
+            let inner = if path.is_empty() {
+                name.clone()
+            } else {
+                format!("{path}::{name}")
+            };
+            circles_in(at, &inner, out);
+        }
+    }
+    // A circle: a path from a module back to itself.
+    for start in edges.keys() {
+        let mut stack = vec![(start.clone(), vec![start.clone()])];
+        let mut seen = BTreeSet::new();
+        while let Some((at, trail)) = stack.pop() {
+            for next in edges.get(&at).into_iter().flatten() {
+                if next == start {
+                    let mut trail = trail.clone();
+                    trail.push(start.clone());
+                    // Report each circle once, from its smallest member.
+                    if trail.iter().all(|m| m >= start) {
+                        out.push(format!("{path}: {}", trail.join(" -> ")));
+                    }
+                } else if seen.insert(next.clone()) {
+                    let mut trail = trail.clone();
+                    trail.push(next.clone());
+                    stack.push((next.clone(), trail));
+                }
+            }
+        }
+    }
+}
+
+/// No two modules name each other, directly or round a circle: among the
+/// top-level modules and among the modules inside each one. A module's own
+/// file (`mod.rs`) is its facade and may re-export its children; a child
+/// naming `super::Item` is held to the sibling that item comes from. Unit
+/// test modules are left out.
+#[test]
+fn no_import_circles() {
+    let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("src");
+    let mut circles = Vec::new();
+    circles_in(&src, "", &mut circles);
+    assert!(
+        circles.is_empty(),
+        "import circles:\n{}",
+        circles.join("\n")
+    );
+}
+
+#[test]
+fn the_circle_finder_finds_a_circle() {
+    let siblings: BTreeSet<String> = ["a", "b"].map(String::from).into();
+    let exports = reexports("pub use a::{Thing, Other};\nuse b::More;", &siblings);
+    assert_eq!(resolve("Thing", &siblings, &exports).as_deref(), Some("a"));
+    assert_eq!(resolve("More", &siblings, &exports).as_deref(), Some("b"));
+    assert_eq!(resolve("b", &siblings, &exports).as_deref(), Some("b"));
+    let named = names_after("use super::{Thing, b::x};\nsuper::super::c", "super::");
+    assert_eq!(named.into_iter().collect::<Vec<_>>(), ["Thing", "b"]);
 }

@@ -10,8 +10,8 @@
 
 use approx::relative_eq;
 use fractal_sdf::cpu::Evaluator;
+use fractal_sdf::expr::V3;
 use fractal_sdf::math::DEFAULT_COLOR;
-use fractal_sdf::math::V3;
 use fractal_sdf::prelude::*;
 use fractal_sdf::scene::Axis;
 use fractal_sdf::testing::{bounded_node, point, rotation, scene_node};

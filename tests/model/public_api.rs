@@ -441,9 +441,9 @@ fn listing(s: &Surface) -> (String, [usize; 3]) {
             lines.insert(format!("{canonical}{m}"));
         }
         for (module, ty, line) in &s.krate.impls {
-            // A method belongs to the type of that name defined in the same
-            // module tree (the impl's module or an ancestor of it).
-            if ty == &def.name && top(module) == top(&def.module) {
+            // A method belongs to the type of that name in the impl's
+            // top-level module, else to the one type of that name.
+            if ty == &def.name && owner(s, module, ty).is_some_and(|o| std::ptr::eq(o, def)) {
                 if line.starts_with("::") {
                     methods += 1;
                     lines.insert(format!("{canonical}{line}"));
@@ -471,6 +471,16 @@ fn listing(s: &Surface) -> (String, [usize; 3]) {
         writeln!(out, "{line}").unwrap();
     }
     (out, [items, methods, fields])
+}
+
+/// The definition an `impl ty` in `module` is for.
+fn owner<'a>(s: &'a Surface, module: &str, ty: &str) -> Option<&'a Def> {
+    let named: Vec<&Def> = s.krate.defs.iter().filter(|d| d.name == ty).collect();
+    named
+        .iter()
+        .find(|d| top(&d.module) == top(module))
+        .or_else(|| (named.len() == 1).then(|| &named[0]))
+        .copied()
 }
 
 /// The crate's top-level module a path is in (`fractal_sdf::scene`).

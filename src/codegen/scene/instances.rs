@@ -138,7 +138,7 @@ impl<'a> SceneEmitter<'a> {
 
 /// The fewest operands of one tree of hard unions, alike but for their
 /// baked values, that code generation emits as one loop over a table of
-/// those values (see [`KernelSource::constants`](super::KernelSource)).
+/// those values (see [`KernelSource::constants`](crate::codegen::KernelSource)).
 pub const MIN_INSTANCES: usize = 16;
 
 /// Rewrites a node's baked values as entries of an instance's table row,

@@ -548,7 +548,11 @@ impl<'a> SceneEmitter<'a> {
                     Some(power) => {
                         self.powers.insert(power);
                         let args = format!("{p}, {n}, {escape}, {ball}");
-                        Step::Done(self.fractal_call(id, &super::power::helper_name(power), &args))
+                        Step::Done(self.fractal_call(
+                            id,
+                            &super::formulas::power_helper_name(power),
+                            &args,
+                        ))
                     }
                     None => {
                         let args = format!("{p}, {}, {n}, {escape}, {ball}", w(self, f.power));

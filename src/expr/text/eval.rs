@@ -7,8 +7,8 @@ use super::Formula;
 use super::parse::{Block, Expr, Stmt, start};
 use super::{FUNCTIONS, MAX_ITERATIONS};
 use crate::expr::num::Num;
-use crate::expr::program::Step;
-use crate::math::{V3, v3};
+use crate::expr::num::Step;
+use crate::expr::{V3, v3};
 
 /// A value while a formula runs.
 #[derive(Debug, Clone, Copy)]

@@ -35,7 +35,7 @@ use std::fmt;
 use super::num::Num;
 use super::program::Program;
 use super::trace::{Var, trace};
-use crate::math::{V3, v3};
+use crate::expr::{V3, v3};
 use eval::{Eval, Run, Value};
 use parse::{Block, KEYWORDS, Parser, Tok, lex, start};
 
