@@ -11,6 +11,9 @@
 //   scene   real DE(real3 p, __global const real* params)
 //           real DE_shade(real3 p, __global const real* params,
 //                         real3* color, real* trap)
+//           and, with materials (ENABLE_MATERIALS), void DE_material(real3 p,
+//           __global const real* params, real8* material), whose fields the
+//           header names MATERIAL_<value> (material.MATERIAL_IOR)
 //   effects: the code of each effect (ambient occlusion, shadows, glow,
 //           fog) sits in a conditional block named ENABLE_<effect>, with
 //           its constants defined by the header only when it is on, and so

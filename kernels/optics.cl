@@ -6,70 +6,6 @@
 // sample.
 
 #ifdef ENABLE_MATERIALS
-    real8 material;
-    DE_material(p, params, &material);
-    *evals += 1u;
-    specular_strength = material.s1;
-    shininess = material.s2;
-    real through = R(0.0);
-    if (material.s3 > R(0.0) && material.s4 > R(0.0)) {
-        through = material.s3 * march_thinness(p, n, material.s4, params, evals);
-    }
-#endif
-
-    real3 sky = mix(SKY_BOTTOM, SKY_TOP, R(0.5) + R(0.5) * n.y);
-    real3 color = albedo * sky * (MARCH_AMBIENT * occlusion);
-
-#ifdef ENABLE_SHADOWS
-    // Shadow rays start one hit threshold off the surface and are blocked
-    // within a quarter of it, so a surface does not shadow itself.
-    real3 lifted = p + n * eps;
-#endif
-    for (int i = 0; i < light_count; ++i) {
-        __global const real* l = lights + LIGHT_STRIDE * i;
-        real3 v = vload3(0, l + LIGHT_POSITION);
-        real3 radiance = vload3(0, l + LIGHT_RADIANCE);
-        real3 to_light = v;
-        real light_distance = MAX_DISTANCE;
-        if (l[LIGHT_KIND] > R(0.5)) {
-            real3 delta = v - p;
-            real dist2 = fmax(dot(delta, delta), REAL_TINY);
-            light_distance = sqrt(dist2);
-            to_light = delta / light_distance;
-            radiance /= dist2;
-        }
-        real ndl = dot(n, to_light);
-#ifdef ENABLE_MATERIALS
-        if (ndl < R(0.0)) {
-            color += radiance * albedo * (through * -ndl);
-        }
-#endif
-        if (ndl <= R(0.0)) {
-            continue;
-        }
-        real diffuse = R(1.0);
-#ifdef ENABLE_MATERIALS
-        diffuse = march_oren_nayar(material.s0, n, to_light, -rd, ndl);
-#endif
-#ifdef ENABLE_SHADOWS
-        // The most this light adds to the pixel in any channel.
-        real3 most = radiance * ((albedo * diffuse + specular_strength) * ndl);
-        real visible = march_shadow(lifted, to_light, light_distance, R(0.25) * eps, eps,
-                                    l[LIGHT_SOFTNESS], fmax(most.x, fmax(most.y, most.z)),
-                                    params, evals);
-        if (visible <= R(0.0)) {
-            continue;
-        }
-        radiance *= visible;
-#endif
-        real3 half_vector = normalize(to_light - rd);
-        real specular = specular_strength * pow(fmax(dot(n, half_vector), R(0.0)), shininess);
-        color += radiance * (albedo * (diffuse * ndl) + specular * ndl);
-    }
-    return color;
-}
-
-#ifdef ENABLE_MATERIALS
 // A branch carrying less than this share of a pixel cannot change its
 // 8-bit value: it is not traced.
 #define MARCH_FAINT R(0.001953125) // 2^-9
@@ -140,9 +76,9 @@ real3 march_split(real3 p, real3 n, real3 rd, real eps, real t, real3 weight, in
     real8 material;
     DE_material(p, params, &material);
     *evals += 1u;
-    real r = material.s5;
-    real tau = material.s6;
-    real ior = material.s7;
+    real r = material.MATERIAL_REFLECTIVITY;
+    real tau = material.MATERIAL_TRANSPARENCY;
+    real ior = material.MATERIAL_IOR;
     real3 color = weight * ((R(1.0) - r) * (R(1.0) - tau)) * own;
     real reflected = r;
     if (tau > R(0.0)) {
@@ -204,7 +140,7 @@ real3 march_paths(real3 p, real3 n, real3 rd, real eps, real t, const MarchCamer
             real8 material;
             DE_material(q, params, &material);
             *evals += 1u;
-            real3 out = march_refract(b.rd, -nq, material.s7);
+            real3 out = march_refract(b.rd, -nq, material.MATERIAL_IOR);
             MarchBranch next = {q + nq * (R(2.0) * eq), normalize(out), b.weight, travelled,
                                 b.depth + 1, 0};
             if (dot(out, out) <= R(0.0)) {

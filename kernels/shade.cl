@@ -254,3 +254,66 @@ real3 march_shade(real3 p, real3 n, real3 rd, real eps, real occlusion,
     albedo *= march_trap_tint(trap);
     real specular_strength = MARCH_SPECULAR;
     real shininess = MARCH_SHININESS;
+#ifdef ENABLE_MATERIALS
+    real8 material;
+    DE_material(p, params, &material);
+    *evals += 1u;
+    specular_strength = material.MATERIAL_SPECULAR;
+    shininess = material.MATERIAL_SHININESS;
+    real through = R(0.0);
+    if (material.MATERIAL_SUBSURFACE > R(0.0) && material.MATERIAL_SCATTER_DEPTH > R(0.0)) {
+        through = material.MATERIAL_SUBSURFACE * march_thinness(p, n, material.MATERIAL_SCATTER_DEPTH, params, evals);
+    }
+#endif
+
+    real3 sky = mix(SKY_BOTTOM, SKY_TOP, R(0.5) + R(0.5) * n.y);
+    real3 color = albedo * sky * (MARCH_AMBIENT * occlusion);
+
+#ifdef ENABLE_SHADOWS
+    // Shadow rays start one hit threshold off the surface and are blocked
+    // within a quarter of it, so a surface does not shadow itself.
+    real3 lifted = p + n * eps;
+#endif
+    for (int i = 0; i < light_count; ++i) {
+        __global const real* l = lights + LIGHT_STRIDE * i;
+        real3 v = vload3(0, l + LIGHT_POSITION);
+        real3 radiance = vload3(0, l + LIGHT_RADIANCE);
+        real3 to_light = v;
+        real light_distance = MAX_DISTANCE;
+        if (l[LIGHT_KIND] > R(0.5)) {
+            real3 delta = v - p;
+            real dist2 = fmax(dot(delta, delta), REAL_TINY);
+            light_distance = sqrt(dist2);
+            to_light = delta / light_distance;
+            radiance /= dist2;
+        }
+        real ndl = dot(n, to_light);
+#ifdef ENABLE_MATERIALS
+        if (ndl < R(0.0)) {
+            color += radiance * albedo * (through * -ndl);
+        }
+#endif
+        if (ndl <= R(0.0)) {
+            continue;
+        }
+        real diffuse = R(1.0);
+#ifdef ENABLE_MATERIALS
+        diffuse = march_oren_nayar(material.MATERIAL_ROUGHNESS, n, to_light, -rd, ndl);
+#endif
+#ifdef ENABLE_SHADOWS
+        // The most this light adds to the pixel in any channel.
+        real3 most = radiance * ((albedo * diffuse + specular_strength) * ndl);
+        real visible = march_shadow(lifted, to_light, light_distance, R(0.25) * eps, eps,
+                                    l[LIGHT_SOFTNESS], fmax(most.x, fmax(most.y, most.z)),
+                                    params, evals);
+        if (visible <= R(0.0)) {
+            continue;
+        }
+        radiance *= visible;
+#endif
+        real3 half_vector = normalize(to_light - rd);
+        real specular = specular_strength * pow(fmax(dot(n, half_vector), R(0.0)), shininess);
+        color += radiance * (albedo * (diffuse * ndl) + specular * ndl);
+    }
+    return color;
+}

@@ -40,7 +40,7 @@ use crate::error::{Error, Result};
 use crate::ir::{Bound, CompiledScene, Ir, union_chain};
 use crate::math::{DEFAULT_COLOR, DERIVATIVE_CAP, MAGNITUDE_CAP, REAL_TINY};
 use crate::quality::{Effects, Precision, Quality, ScreenNormals};
-use crate::scene::{BRUTE_MAX_STEPS, DEFAULT_MATERIAL, INSIDE_HUGE, Kind};
+use crate::scene::{BRUTE_MAX_STEPS, DEFAULT_MATERIAL, INSIDE_HUGE, Kind, MATERIAL_SPECS};
 
 /// What the generated program is for.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
@@ -65,6 +65,17 @@ pub struct Options {
     pub effects: Effects,
     /// Which kernel to append.
     pub target: Target,
+}
+
+impl Options {
+    /// The one check of the quality and the effects on their way to a
+    /// program: every path to the kernel (the renderer, the mesher, the
+    /// command) passes through code generation, and code generation checks
+    /// them here, before it writes anything.
+    fn validate(&self) -> Result<()> {
+        self.quality.validate()?;
+        self.effects.validate_for(self.quality.precision)
+    }
 }
 
 setters!(Options {
@@ -283,8 +294,7 @@ pub fn emit(scene: &CompiledScene, options: &Options) -> Result<KernelSource> {
 /// [`Error::Precision`] for a baked value beyond
 /// the precision's limits, with its node's path.
 pub fn emit_ir(ir: &Ir, options: &Options) -> Result<KernelSource> {
-    options.quality.validate()?;
-    options.effects.validate_for(options.quality.precision)?;
+    options.validate()?;
     let precision = options.quality.precision;
     ir.check_limits(precision.limits())?;
 
@@ -397,8 +407,7 @@ pub fn emit_ir(ir: &Ir, options: &Options) -> Result<KernelSource> {
 /// # Errors
 /// A validation error of the quality or effects.
 pub fn emit_handwritten(scene_functions: &str, options: &Options) -> Result<KernelSource> {
-    options.quality.validate()?;
-    options.effects.validate_for(options.quality.precision)?;
+    options.validate()?;
     let mut w = writer::Writer::new(options.quality.precision);
     header(&mut w, options, &Features::default());
     w.line("/* ---- scene (hand-written) ---- */");
@@ -721,6 +730,13 @@ fn header(w: &mut writer::Writer, options: &Options, features: &Features) {
     }
     for (name, value) in defines {
         w.line(format!("#define {name} {value}"));
+    }
+    if materials {
+        // A material is a `real8` of its values in `MATERIAL_SPECS` order:
+        // the kernel reads each by name (`material.MATERIAL_IOR`).
+        for (i, spec) in MATERIAL_SPECS.iter().enumerate() {
+            w.line(format!("#define MATERIAL_{} s{i}", spec.name.to_uppercase()));
+        }
     }
     for effect in on {
         w.line(format!("#define {}", effect.switch()));

@@ -118,7 +118,17 @@ impl Scene {
     }
 }
 
+/// The most lights a scene holds: their count is an `int` kernel argument.
+pub const MAX_LIGHTS: usize = i32::MAX as usize;
+
+/// The one check of a scene's lights: each light's values, and their count.
 fn validate_lights(lights: &[Light]) -> Result<()> {
+    if lights.len() > MAX_LIGHTS {
+        return Err(Error::TooManyLights {
+            count: lights.len(),
+            max: MAX_LIGHTS,
+        });
+    }
     lights
         .iter()
         .enumerate()

@@ -26,7 +26,7 @@ pub use bounds::{Bound, SHRINK};
 pub(crate) use bounds::{
     Reach, UnionChain, constant, costs, is_hard_union, reach, swaps, union_chain,
 };
-pub use compiled::CompiledScene;
+pub use compiled::{CompiledScene, MAX_LIGHTS};
 pub use params::{Constraint, ParamLayout, ParamSlot, ParamValues, Relation};
 
 use crate::error::Result;

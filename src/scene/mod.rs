@@ -30,6 +30,7 @@ pub use inside::{
     BRUTE_MAX_STEPS, InsideShape, MANDELBOX_BAILOUT, MANDELBOX_HALF_SIDE, MANDELBULB_BAILOUT,
     mandelbox_contains, mandelbulb_contains,
 };
+pub(crate) use material::MATERIAL_SPECS;
 pub use material::{DEFAULT_MATERIAL, MATERIAL_LEN, Material};
 pub(crate) use node::Mapper;
 pub use node::{

@@ -26,6 +26,14 @@ typedef float8 real8;
 #define CONE_TILE 8
 #define DEFAULT_MATERIAL (real8)(0.0f, 0.25f, 32.0f, 0.0f, 0.0f, 0.0f, 0.0f, 1.0f)
 #define BOUNCES 4
+#define MATERIAL_ROUGHNESS s0
+#define MATERIAL_SPECULAR s1
+#define MATERIAL_SHININESS s2
+#define MATERIAL_SUBSURFACE s3
+#define MATERIAL_SCATTER_DEPTH s4
+#define MATERIAL_REFLECTIVITY s5
+#define MATERIAL_TRANSPARENCY s6
+#define MATERIAL_IOR s7
 #define ENABLE_AO
 #define ENABLE_SHADOWS
 #define ENABLE_MATERIALS

@@ -82,24 +82,12 @@ pub(super) fn check_inputs(
     check_frame_inputs(&view, scene.lights(), source.origin, limits)
 }
 
+/// The options code generation does not check (it checks the quality and
+/// the effects, once, when it generates the program).
 pub(super) fn validate(options: &RenderOptions) -> Result<()> {
-    options.quality.validate()?;
-    options.effects.validate_for(options.quality.precision)?;
     if options.tile_size == 0 {
         return Err(Error::TileSize {
             value: options.tile_size,
-        });
-    }
-    Ok(())
-}
-
-/// The light count is an `int` kernel argument.
-pub(super) fn check_light_count(lights: &[Light]) -> Result<()> {
-    const MAX: usize = i32::MAX as usize;
-    if lights.len() > MAX {
-        return Err(Error::TooManyLights {
-            count: lights.len(),
-            max: MAX,
         });
     }
     Ok(())
@@ -456,8 +444,8 @@ impl Inputs {
         self.params.set_arg(kernel, RenderArg::Params.index())?;
         self.camera.set_arg(kernel, RenderArg::Camera.index())?;
         self.lights.set_arg(kernel, RenderArg::Lights.index())?;
-        check_light_count(lights)?;
-        #[allow(clippy::cast_possible_truncation, clippy::cast_possible_wrap)] // checked above
+        // A compiled scene holds at most `MAX_LIGHTS` (`i32::MAX`) lights.
+        #[allow(clippy::cast_possible_truncation, clippy::cast_possible_wrap)]
         let count = lights.len() as i32;
         kernel
             .set_arg(RenderArg::LightCount.index(), count)

@@ -286,7 +286,6 @@ impl Renderer {
         functions: SceneFunctions,
     ) -> Result<Self> {
         validate(options)?;
-        check_light_count(scene.lights())?;
         let source = generate(&scene, &functions, options)?;
         let values = scene.default_values();
         check_inputs(&scene, &values, &source)?;
@@ -470,7 +469,6 @@ impl Renderer {
     /// program's precision cannot compute with.
     pub fn set_lights(&mut self, lights: impl IntoIterator<Item = Light>) -> Result<()> {
         let lights: Vec<Light> = lights.into_iter().collect();
-        check_light_count(&lights)?;
         let mut scene = self.scene.clone();
         scene.set_lights(lights.clone())?;
         check_inputs(&scene, &self.values, &self.source)?;

@@ -11,6 +11,9 @@
 //   scene   real DE(real3 p, __global const real* params)
 //           real DE_shade(real3 p, __global const real* params,
 //                         real3* color, real* trap)
+//           and, with materials (ENABLE_MATERIALS), void DE_material(real3 p,
+//           __global const real* params, real8* material), whose fields the
+//           header names MATERIAL_<value> (material.MATERIAL_IOR)
 //   effects: the code of each effect (ambient occlusion, shadows, glow,
 //           fog) sits in a conditional block named ENABLE_<effect>, with
 //           its constants defined by the header only when it is on, and so
@@ -480,13 +483,6 @@ real3 march_shade(real3 p, real3 n, real3 rd, real eps, real occlusion,
     albedo *= march_trap_tint(trap);
     real specular_strength = MARCH_SPECULAR;
     real shininess = MARCH_SHININESS;
-// optics.cl — reflections and transparency, and where each sample looks.
-//
-// Follows shade.cl: the branching paths of reflective and transparent
-// materials (ENABLE_MATERIALS), the per-sample jitter, the pixel and lens
-// points of supersampling and depth of field, and the camera ray of a
-// sample.
-
 
     real3 sky = mix(SKY_BOTTOM, SKY_TOP, R(0.5) + R(0.5) * n.y);
     real3 color = albedo * sky * (MARCH_AMBIENT * occlusion);
@@ -527,6 +523,12 @@ real3 march_shade(real3 p, real3 n, real3 rd, real eps, real occlusion,
     }
     return color;
 }
+// optics.cl — reflections and transparency, and where each sample looks.
+//
+// Follows shade.cl: the branching paths of reflective and transparent
+// materials (ENABLE_MATERIALS), the per-sample jitter, the pixel and lens
+// points of supersampling and depth of field, and the camera ray of a
+// sample.
 
 
 // Deterministic per-sample jitter in [0, 1): the same image every run.
