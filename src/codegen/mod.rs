@@ -735,7 +735,10 @@ fn header(w: &mut writer::Writer, options: &Options, features: &Features) {
         // A material is a `real8` of its values in `MATERIAL_SPECS` order:
         // the kernel reads each by name (`material.MATERIAL_IOR`).
         for (i, spec) in MATERIAL_SPECS.iter().enumerate() {
-            w.line(format!("#define MATERIAL_{} s{i}", spec.name.to_uppercase()));
+            w.line(format!(
+                "#define MATERIAL_{} s{i}",
+                spec.name.to_uppercase()
+            ));
         }
     }
     for effect in on {

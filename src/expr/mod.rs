@@ -15,7 +15,7 @@
 //!
 //! ```
 //! use fractal_sdf::expr::{Interval, Num, OpenCl, Printer, Shape, Signature, trace};
-//! use fractal_sdf::math::{V3, v3};
+//! use fractal_sdf::expr::{V3, v3};
 //!
 //! // One formula...
 //! fn rounded_sphere<N: Num>(p: V3<N>, r: N) -> N {

@@ -328,7 +328,7 @@ impl CustomShape {
     ///
     /// ```
     /// use fractal_sdf::expr::{Distance, Num};
-    /// use fractal_sdf::math::V3;
+    /// use fractal_sdf::expr::V3;
     /// use fractal_sdf::prelude::*;
     /// use fractal_sdf::cpu;
     /// use fractal_sdf::scene::{CustomShape, Rule};
