@@ -36,7 +36,7 @@
 //!   `AO_DISTANCE`; `ENABLE_SHADOWS` with `SHADOW_STEPS`; `ENABLE_GLOW` with
 //!   `GLOW_COLOR` and `GLOW_STRENGTH`; `ENABLE_FOG` with `FOG_DENSITY`;
 //! - the kernel interface from
-//!   [`codegen::interface`](crate::codegen::interface): the argument lists
+//!   `src/codegen/interface.rs` (internal): the argument lists
 //!   `RENDER_TILE_ARGS` and `EVAL_POINTS_ARGS`, the camera buffer's field
 //!   offsets `CAMERA_*` and the light buffer's `LIGHT_*` and
 //!   `LIGHT_STRIDE`.

@@ -2,7 +2,7 @@
 //! size of a pixel at each distance, plus the packed light list.
 //!
 //! Nothing here touches OpenCL; the buffers are packed from the layouts in
-//! [`codegen::interface`](crate::codegen::interface), which the kernel
+//! `src/codegen/interface.rs`, which the kernel
 //! reads through the header's `#define`s.
 
 use glam::{DVec2, DVec3};
