@@ -1,7 +1,8 @@
 //! Compiles a scene to OpenCL C.
 //!
 //! The program is, in a fixed order: a header (precision typedefs, the
-//! quality constants, the kernel interface (the argument lists and buffer layouts the renderer packs, `src/codegen/interface.rs`) and one
+//! quality constants, the kernel interface (the argument lists and buffer
+//! layouts the renderer packs, `src/codegen/interface.rs`) and one
 //! `#define` per effect that is on), the helper functions the scene uses
 //! and nothing else (each printed from its formula's expression IR, see
 //! [`crate::expr`]), the

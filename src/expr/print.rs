@@ -127,6 +127,18 @@ pub struct Inline {
     pub results: Vec<String>,
 }
 
+impl Inline {
+    /// Statements and the expressions of the results they compute: what a
+    /// [`Printer::inline`] returns.
+    #[must_use]
+    pub fn new(statements: String, results: Vec<String>) -> Self {
+        Inline {
+            statements,
+            results,
+        }
+    }
+}
+
 /// The OpenCL C printer: `real` is the precision's type, literals are
 /// `R(...)` (the kernel header's literal macro).
 #[derive(Debug, Clone, Copy, Default)]

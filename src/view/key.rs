@@ -26,6 +26,7 @@ macro_rules! keys {
         /// # Ok::<(), fractal_sdf::Error>(())
         /// ```
         #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+        #[non_exhaustive]
         pub enum Key {
             $(
                 #[doc = concat!("The key named `", $name, "`.")]

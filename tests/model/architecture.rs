@@ -184,33 +184,60 @@ fn reexports(text: &str, siblings: &BTreeSet<String>) -> Vec<(String, String)> {
 
 /// The names after `prefix` (`super::` or `crate::a::b::`) outside comments.
 fn names_after(text: &str, prefix: &str) -> BTreeSet<String> {
+    // Comments out, lines joined: a `use` group may span lines.
+    let code: String = text
+        .lines()
+        .map(|l| l.split("//").next().unwrap_or(""))
+        .collect::<Vec<_>>()
+        .join(" ");
     let mut names = BTreeSet::new();
-    for line in text.lines() {
-        let code = line.split("//").next().unwrap_or("");
-        let mut rest = code;
-        while let Some(at) = rest.find(prefix) {
-            rest = &rest[at + prefix.len()..];
-            // `super::super::` names the module above: not a sibling.
-            if prefix == "super::" && rest.starts_with("super::") {
-                rest = &rest["super::".len()..];
-                continue;
-            }
-            let group = if let Some(g) = rest.strip_prefix('{') {
-                g.split('}').next().unwrap_or("").to_string()
-            } else {
-                rest.chars()
-                    .take_while(|c| c.is_ascii_alphanumeric() || *c == '_')
-                    .collect()
-            };
-            for item in group.split(',') {
-                let first = item.trim().split("::").next().unwrap_or("").trim();
-                if !first.is_empty() && first != "*" {
-                    names.insert(first.to_string());
-                }
+    let mut rest = code.as_str();
+    while let Some(at) = rest.find(prefix) {
+        rest = &rest[at + prefix.len()..];
+        // `super::super::` names the module above: not a sibling.
+        if prefix == "super::" && rest.starts_with("super::") {
+            rest = &rest["super::".len()..];
+            continue;
+        }
+        let items = match rest.strip_prefix('{') {
+            Some(group) => top_level(group),
+            None => vec![rest],
+        };
+        for item in items {
+            let first: String = item
+                .trim_start()
+                .chars()
+                .take_while(|c| c.is_ascii_alphanumeric() || *c == '_')
+                .collect();
+            if !first.is_empty() {
+                names.insert(first);
             }
         }
     }
     names
+}
+
+/// The items of a `{...}` group (`group` starts after its `{`), split at
+/// its own commas, not those of nested groups.
+fn top_level(group: &str) -> Vec<&str> {
+    let (mut depth, mut start, mut items) = (0, 0, Vec::new());
+    for (i, c) in group.char_indices() {
+        match c {
+            '{' => depth += 1,
+            '}' if depth == 0 => {
+                items.push(&group[start..i]);
+                return items;
+            }
+            '}' => depth -= 1,
+            ',' if depth == 0 => {
+                items.push(&group[start..i]);
+                start = i + 1;
+            }
+            _ => {}
+        }
+    }
+    items.push(&group[start..]);
+    items
 }
 
 /// Every import circle among the modules inside `dir` (named `path`), and
@@ -300,6 +327,32 @@ fn no_import_circles() {
     );
 }
 
+/// A module tree written to a temporary folder: `a` names `b` through a
+/// group over two lines, `b` names `a` through an item `a` exports.
+#[test]
+fn the_circle_finder_finds_a_circle_in_a_tree() {
+    let root = std::env::temp_dir().join(format!("fractal-sdf-circles-{}", std::process::id()));
+    let top = root.join("top");
+    std::fs::create_dir_all(&top).unwrap();
+    std::fs::write(top.join("mod.rs"), "mod a;\nmod b;\npub use a::Thing;\n").unwrap();
+    std::fs::write(
+        top.join("a.rs"),
+        "use crate::top::{\n    b::More,\n};\npub struct Thing;\n",
+    )
+    .unwrap();
+    std::fs::write(
+        top.join("b.rs"),
+        "use super::Thing; // from a\npub struct More;\n",
+    )
+    .unwrap();
+    std::fs::write(top.join("c.rs"), "use super::b::More;\n").unwrap();
+    std::fs::write(root.join("lib.rs"), "mod top;\n").unwrap();
+    let mut circles = Vec::new();
+    circles_in(&root, "", &mut circles);
+    std::fs::remove_dir_all(&root).unwrap();
+    assert_eq!(circles, ["top: a -> b -> a"]);
+}
+
 #[test]
 fn the_circle_finder_finds_a_circle() {
     let siblings: BTreeSet<String> = ["a", "b"].map(String::from).into();
@@ -307,6 +360,9 @@ fn the_circle_finder_finds_a_circle() {
     assert_eq!(resolve("Thing", &siblings, &exports).as_deref(), Some("a"));
     assert_eq!(resolve("More", &siblings, &exports).as_deref(), Some("b"));
     assert_eq!(resolve("b", &siblings, &exports).as_deref(), Some("b"));
-    let named = names_after("use super::{Thing, b::x};\nsuper::super::c", "super::");
-    assert_eq!(named.into_iter().collect::<Vec<_>>(), ["Thing", "b"]);
+    let named = names_after(
+        "use super::{Thing, b::{x, y}, d};\nsuper::super::c",
+        "super::",
+    );
+    assert_eq!(named.into_iter().collect::<Vec<_>>(), ["Thing", "b", "d"]);
 }

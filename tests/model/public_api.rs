@@ -250,6 +250,52 @@ fn walk_items(items: &[Item], dir: &Path, path: &str, public: bool, c: &mut Crat
                 let name = m.ident.as_ref().map(|i| i.to_string()).unwrap_or_default();
                 c.macros.push(format!("macro fractal_sdf::{name}!"));
             }
+            // A local `macro_rules!` that defines a public type (`keys!`
+            // makes `Key`): the type, as the macro writes it.
+            Item::Macro(m) if m.ident.is_some() && !has_attr(&m.attrs, "macro_export") => {
+                let body = tokens(&m.mac.tokens);
+                for kind in ["enum", "struct"] {
+                    let marker = format!("pub {kind} ");
+                    for (at, _) in body.match_indices(&marker) {
+                        let name: String = body[at + marker.len()..]
+                            .chars()
+                            .take_while(|c| c.is_alphanumeric() || *c == '_')
+                            .collect();
+                        let ne = body[..at].trim_end().ends_with("# [non_exhaustive]");
+                        let head = format!(
+                            "{}{kind} (made by {}!)",
+                            if ne { "#[non_exhaustive] " } else { "" },
+                            m.ident.as_ref().unwrap()
+                        );
+                        let kind = if kind == "enum" {
+                            Kind::Enum
+                        } else {
+                            Kind::Other
+                        };
+                        def(c, name, head, vec![], kind, ne);
+                    }
+                }
+            }
+            // `setters!(Type { field: Ty, .. })`: a setter per field.
+            Item::Macro(m) if m.mac.path.is_ident("setters") => {
+                let (ty, fields) = m
+                    .mac
+                    .parse_body_with(parse_setters)
+                    .unwrap_or_else(|e| panic!("setters! in {path}: {e}"));
+                for (field, t) in fields {
+                    let line = format!("::fn {field} (mut self, {field} : {t}) -> Self [setters!]");
+                    c.impls.push((path.to_string(), ty.clone(), line));
+                }
+            }
+            // Any other macro that makes items (`keys!`): listed whole, so
+            // a change to what it makes shows here too.
+            Item::Macro(m) if m.ident.is_none() && !m.mac.path.is_ident("thread_local") => {
+                c.macros.push(format!(
+                    "{path}: {}! {}",
+                    tokens(&m.mac.path),
+                    tokens(&m.mac.tokens)
+                ));
+            }
             _ => {}
         }
     }
@@ -272,6 +318,25 @@ fn fields_sig(fields: &Fields) -> String {
         Fields::Unnamed(_) => format!("({})", list(false)),
         Fields::Unit => String::new(),
     }
+}
+
+/// The type and the `(field, type)` pairs of a `setters!` invocation.
+fn parse_setters(input: syn::parse::ParseStream) -> syn::Result<(String, Vec<(String, String)>)> {
+    let ty: syn::Ident = input.parse()?;
+    let body;
+    syn::braced!(body in input);
+    let mut fields = Vec::new();
+    while !body.is_empty() {
+        let _docs = body.call(Attribute::parse_outer)?;
+        let field: syn::Ident = body.parse()?;
+        body.parse::<syn::Token![:]>()?;
+        let t: syn::Type = body.parse()?;
+        fields.push((field.to_string(), tokens(&t)));
+        if !body.is_empty() {
+            body.parse::<syn::Token![,]>()?;
+        }
+    }
+    Ok((ty.to_string(), fields))
 }
 
 fn has_test_cfg(attrs: &[Attribute]) -> bool {
@@ -384,6 +449,11 @@ impl Surface {
                         .strip_prefix(&format!("{module}::"))
                         .unwrap_or(target);
                     foreign.insert(format!("use {module}::{name} = {written}"));
+                } else if reachable && from == *module && !krate.modules.contains_key(target) {
+                    // A whole crate (`pub use glam;`).
+                    foreign.insert(format!("use {module}::{name} = {item}"));
+                } else if reachable && !by_place.contains_key(&(module.clone(), name.clone())) {
+                    panic!("`pub use {target}` in {module} names nothing the listing knows");
                 }
             }
             if !changed {
@@ -546,6 +616,20 @@ fn enums_and_options_structs_are_non_exhaustive() {
         share >= 0.9,
         "{:.0}% non_exhaustive; exhaustive: {closed:#?}",
         share * 100.0
+    );
+    // The exceptions, each plain data written as a literal: a loop step
+    // returned by users' formulas, and a region of generated source.
+    let allowed = [
+        "fractal_sdf::expr::Step",
+        "fractal_sdf::codegen::CustomRegion",
+    ];
+    let unexpected: Vec<&&String> = closed
+        .iter()
+        .filter(|n| !allowed.contains(&n.as_str()))
+        .collect();
+    assert!(
+        unexpected.is_empty(),
+        "exhaustive without a reason: {unexpected:#?}"
     );
 }
 
