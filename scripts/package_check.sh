@@ -102,6 +102,7 @@ $name = { path = "../$name-$version" }
 # from the unpacked copy) unoptimised, as \`cargo package\` builds it.
 [profile.dev.package."*"]
 opt-level = 2
+debug = false
 
 [profile.dev.package.$name]
 opt-level = 0
