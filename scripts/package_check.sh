@@ -84,6 +84,8 @@ rm -rf "$work"
 mkdir -p "$work/readme-program/src/bin"
 tar xzf "$crate_file" -C "$work"
 cp "$work/$name-$version/Cargo.lock" "$work/readme-program/Cargo.lock"
+dependency_profile=$(awk '/^\[profile\.dev\.package\."\*"\]/ { on = 1; print; next } /^\[/ { on = 0 } on && NF' Cargo.toml)
+[ -n "$dependency_profile" ] || fail "Cargo.toml declares no [profile.dev.package.\"*\"]"
 cat >"$work/readme-program/Cargo.toml" <<EOF
 [package]
 name = "readme-program"
@@ -97,12 +99,11 @@ $name = { path = "../$name-$version" }
 # Its own workspace, whatever directory it sits in.
 [workspace]
 
-# The profile the package declares for its dependencies, so the ones
-# \`cargo package\` compiled are reused; the library itself (compiled again,
-# from the unpacked copy) unoptimised, as \`cargo package\` builds it.
-[profile.dev.package."*"]
-opt-level = 2
-debug = false
+# The profile the package declares for its dependencies (copied from its
+# Cargo.toml), so the ones \`cargo package\` compiled are reused; the library
+# itself (compiled again, from the unpacked copy) unoptimised, as
+# \`cargo package\` builds it.
+$dependency_profile
 
 [profile.dev.package.$name]
 opt-level = 0
