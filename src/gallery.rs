@@ -291,19 +291,16 @@ pub fn mandelbulb_escape() -> Scene {
         .with_lights(reference.lights)
 }
 
-/// A Mandelbox of scale −1.5 and 12 iterations standing on a floor: a set
-/// the library has no distance estimate for, drawn from its escape-time
-/// test ([`InsideShape::mandelbox`]) by brute force, beside a floor that
-/// is still sphere-traced.
+/// The classic Mandelbox (scale 2, 16 iterations) standing on a floor,
+/// drawn from its distance estimate. Scale 2 fills the cube `[-6, 6]^3`;
+/// the scene shrinks it to the cube `[-1, 1]^3`.
 #[must_use]
 pub fn mandelbox() -> Scene {
-    let scale = 0.5;
-    let boxed = InsideShape::mandelbox()
-        .node([-1.5, 12.0])
+    let boxed = crate::scene::mandelbox(2.0)
         .rotate(DVec3::Y, 0.6)
-        .scale(scale)
+        .scale(1.0 / 6.0)
         .color(dvec3(0.5, 0.62, 0.85));
-    Scene::new(boxed.union(floor(2.0 * scale)))
+    Scene::new(boxed.union(floor(1.0)))
         .with_camera(Camera::look_at(dvec3(2.9, 2.0, 3.8), dvec3(0.0, -0.2, 0.0)).fov(40.0))
         .with_lights(key_and_fill())
 }

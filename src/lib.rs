@@ -219,7 +219,7 @@ pub use image;
 /// quaternions every scene is written in.
 pub use glam;
 
-/// What a first scene needs, in 24 names: `use fractal_sdf::prelude::*;`.
+/// What a first scene needs, in 25 names: `use fractal_sdf::prelude::*;`.
 ///
 /// The scene and its parts, the quality, the common shapes and fractals,
 /// dynamic parameters, the crate's error, and glam's `DVec3`, `dvec3` and
@@ -230,8 +230,8 @@ pub mod prelude {
     pub use crate::error::{Error, Result};
     pub use crate::quality::{Effects, Quality};
     pub use crate::scene::{
-        Camera, Light, Material, Node, Scene, capsule, cuboid, cylinder, julia, mandelbulb, menger,
-        param, plane, round_box, sierpinski, sphere, torus,
+        Camera, Light, Material, Node, Scene, capsule, cuboid, cylinder, julia, mandelbox,
+        mandelbulb, menger, param, plane, round_box, sierpinski, sphere, torus,
     };
     pub use glam::{DQuat, DVec3, dvec3};
 }

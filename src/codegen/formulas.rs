@@ -188,6 +188,30 @@ pub(crate) fn sierpinski() -> Result<String, Unprintable> {
     )
 }
 
+/// The Mandelbox, in Mandelbrot mode or (`julia`) with a constant.
+pub(crate) fn mandelbox(julia: bool) -> Result<String, Unprintable> {
+    let mut params = vec![
+        ("p", Vec3),
+        ("iterations", Scalar),
+        ("scale", Scalar),
+        ("min_radius", Scalar),
+        ("fixed_radius", Scalar),
+        ("fold_limit", Scalar),
+    ];
+    if julia {
+        params.push(("c", Vec3));
+    }
+    let name = if julia {
+        "mandelbox_julia"
+    } else {
+        "mandelbox"
+    };
+    print(name, &params, Pair, |a| {
+        let m = sdf::MandelboxParams::new(a[4], a[5], a[6], a[7], julia.then(|| vector(a, 8)));
+        pair(sdf::mandelbox_estimate(vector(a, 0), a[3], &m))
+    })
+}
+
 /// The quaternion Julia set, `c` as four numbers.
 pub(crate) fn julia() -> Result<String, Unprintable> {
     print(

@@ -23,11 +23,13 @@ pub(crate) enum Helper {
     Menger,
     Sierpinski,
     Julia,
+    Mandelbox,
+    MandelboxJulia,
 }
 
 impl Helper {
     /// Every helper, in the order they are emitted.
-    pub(crate) const ALL: [Helper; 14] = [
+    pub(crate) const ALL: [Helper; 16] = [
         Helper::Sphere,
         Helper::Cuboid,
         Helper::RoundBox,
@@ -42,6 +44,8 @@ impl Helper {
         Helper::Menger,
         Helper::Sierpinski,
         Helper::Julia,
+        Helper::Mandelbox,
+        Helper::MandelboxJulia,
     ];
 
     /// The helper's name, in the program's section comments.
@@ -61,6 +65,8 @@ impl Helper {
             Helper::Menger => "menger",
             Helper::Sierpinski => "sierpinski",
             Helper::Julia => "julia",
+            Helper::Mandelbox => "mandelbox",
+            Helper::MandelboxJulia => "mandelbox_julia",
         }
     }
 
@@ -81,6 +87,8 @@ impl Helper {
             Helper::Menger => formulas::menger(),
             Helper::Sierpinski => formulas::sierpinski(),
             Helper::Julia => formulas::julia(),
+            Helper::Mandelbox => formulas::mandelbox(false),
+            Helper::MandelboxJulia => formulas::mandelbox(true),
         }
     }
 }

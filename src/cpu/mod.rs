@@ -376,6 +376,17 @@ impl Evaluator {
                 s(f.bailout),
             )),
             Kind::Sierpinski(f) => Self::fractal(sdf::sierpinski(p, f.iterations, s(f.scale))),
+            Kind::Mandelbox(f) => Self::fractal(sdf::mandelbox(
+                p,
+                f.iterations,
+                &sdf::MandelboxParams::new(
+                    s(f.scale),
+                    s(f.min_radius),
+                    s(f.fixed_radius),
+                    s(f.fold_limit),
+                    f.julia.map(|[x, y, z]| v3(s(x), s(y), s(z))),
+                ),
+            )),
             Kind::Translate { child, .. }
             | Kind::Rotate { child, .. }
             | Kind::Mirror { child, .. }

@@ -2,8 +2,8 @@
 
 use crate::error::Error;
 use crate::scene::{
-    CsgOp, CustomShape, InsideShape, Kind, Mandelbulb, Menger, Node, Param, QuaternionJulia,
-    Sierpinski,
+    CsgOp, CustomShape, InsideShape, Kind, Mandelbox, Mandelbulb, Menger, Node, Param,
+    QuaternionJulia, Sierpinski,
 };
 
 use super::MAX_NESTING;
@@ -131,6 +131,21 @@ impl NodeRepr {
             Kind::Sierpinski(Sierpinski { iterations, scale }) => {
                 NodeRepr::Sierpinski { iterations, scale }
             }
+            Kind::Mandelbox(Mandelbox {
+                scale,
+                min_radius,
+                fixed_radius,
+                fold_limit,
+                iterations,
+                julia,
+            }) => NodeRepr::Mandelbox {
+                scale,
+                min_radius,
+                fixed_radius,
+                fold_limit,
+                iterations,
+                julia,
+            },
             Kind::Translate { offset, child: c } => NodeRepr::Translate {
                 offset,
                 child: child(&c),
@@ -358,6 +373,22 @@ impl Located<NodeRepr> {
                 scale: scale.clone(),
             }
             .into(),
+            NodeRepr::Mandelbox {
+                scale,
+                min_radius,
+                fixed_radius,
+                fold_limit,
+                iterations,
+                julia,
+            } => {
+                let mut b = Mandelbox::new(scale.clone())
+                    .min_radius(min_radius.clone())
+                    .fixed_radius(fixed_radius.clone())
+                    .fold_limit(fold_limit.clone())
+                    .iterations(*iterations);
+                b.julia.clone_from(julia);
+                b.into()
+            }
             NodeRepr::Translate { offset, child: c } => Kind::Translate {
                 offset: offset.clone(),
                 child: child(c)?,

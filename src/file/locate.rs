@@ -38,6 +38,7 @@ pub(super) const NAMES: &[&str] = &[
     "Menger",
     "Julia",
     "Sierpinski",
+    "Mandelbox",
     "Translate",
     "Rotate",
     "Scale",

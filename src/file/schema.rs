@@ -77,6 +77,9 @@ impl FormulaParam {
                 (lo > -f64::MAX).then_some(lo),
                 (hi < f64::MAX).then_some(hi),
             ),
+            // A formula's bounds state only the rules above; a magnitude
+            // rule is written as its outer interval.
+            Rule::Magnitude(_, hi) => (Some(-hi), Some(hi)),
             Rule::Finite | Rule::Angle | Rule::Direction => (None, None),
         };
         FormulaParam {
@@ -280,6 +283,15 @@ pub(super) fn four() -> Param {
 pub(super) fn zero() -> Param {
     Param::Value(0.0)
 }
+pub(super) fn half() -> Param {
+    Param::Value(0.5)
+}
+pub(super) fn one() -> Param {
+    Param::Value(1.0)
+}
+pub(super) fn sixteen_steps() -> u32 {
+    16
+}
 
 /// A material as written in a file: only the values that differ from
 /// [`Material::default`] need be named.
@@ -412,6 +424,19 @@ pub(super) enum NodeRepr {
         iterations: u32,
         #[serde(default = "two")]
         scale: Param,
+    },
+    Mandelbox {
+        scale: Param,
+        #[serde(default = "half")]
+        min_radius: Param,
+        #[serde(default = "one")]
+        fixed_radius: Param,
+        #[serde(default = "one")]
+        fold_limit: Param,
+        #[serde(default = "sixteen_steps", deserialize_with = "count::iterations")]
+        iterations: u32,
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        julia: Option<[Param; 3]>,
     },
     Translate {
         offset: Param3,

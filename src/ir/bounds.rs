@@ -24,8 +24,8 @@ use glam::DVec3;
 
 use super::{Ir, IrNode, NodeId, Scalar, baked3};
 use crate::math::{
-    JULIA_FAR_FIELD, JULIA_FAR_FIELD_SLOPE, Limits, Num, V3, julia_radius, mandelbulb_radius,
-    rotation_rows,
+    JULIA_FAR_FIELD, JULIA_FAR_FIELD_SLOPE, Limits, Num, V3, julia_radius, mandelbox_extent,
+    mandelbulb_radius, rotation_rows,
 };
 use crate::scene::{Axis, CsgOp, Kind};
 
@@ -203,6 +203,19 @@ pub(super) fn bound(node: &IrNode, done: &[Option<Bound>]) -> Option<Bound> {
         // scale (at least 1.5) and iteration count.
         Kind::Menger(_) => Bound::sphere(origin, SQRT_3),
         Kind::Sierpinski(_) => Bound::sphere(origin, SQRT_3).with_slope(1.0 / 3.0),
+        // The estimate is at least the exact distance to the cube of the
+        // set's extent, so at least `|p| − √3 half_side`.
+        Kind::Mandelbox(f) => {
+            let julia = match f.julia {
+                Some(c) => {
+                    let [x, y, z] = c.map(baked);
+                    Some([x?, y?, z?])
+                }
+                None => None,
+            };
+            let (half_side, _) = mandelbox_extent(baked(f.scale)?, baked(f.fold_limit)?, julia);
+            Bound::sphere(origin, half_side * SQRT_3)
+        }
         // Beyond `JULIA_FAR_FIELD · edge` the estimate is exactly
         // `JULIA_FAR_FIELD_SLOPE (|(p, w)| − edge)`; the bound is that
         // slope beyond that radius (the largest edge of any constant in
@@ -523,6 +536,7 @@ pub(crate) fn costs(ir: &Ir) -> Vec<f64> {
             Kind::Julia(f) => 6.0 * f64::from(f.iterations),
             Kind::Menger(f) => 4.0 * f64::from(f.iterations),
             Kind::Sierpinski(f) => 3.0 * f64::from(f.iterations),
+            Kind::Mandelbox(f) => 6.0 * f64::from(f.iterations),
             Kind::Custom { .. } => 10.0,
             _ => 1.0,
         };

@@ -51,6 +51,50 @@ pub fn mandelbulb_radius<T: Num>(power: T) -> T {
     T::of(2.0).powf(T::one() / (power - T::one()))
 }
 
+/// `(half_side, escape)` for the Mandelbox of `scale` (magnitude above 1)
+/// and `fold_limit`, in Mandelbrot mode or with the Julia constant
+/// `julia`: the set lies in the cube `[-half_side, half_side]^3`, and an
+/// orbit whose largest coordinate passes `escape` grows without bound.
+///
+/// Proof. Each step lowers the largest coordinate's magnitude `a` by at
+/// most `2L` (the box fold reflects a coordinate beyond `±L` in that
+/// plane), never shrinks it (the sphere fold scales by at least 1),
+/// multiplies it by `|s|` and adds at most `|c|∞`, so `a' >= |s| (a − 2L)
+/// − |c|∞`, which is more than `a` once `a > (2L|s| + |c|∞) / (|s| − 1)`:
+/// the escape threshold, and from there each step adds more than the
+/// last. In Julia mode that is also the half side. In Mandelbrot mode
+/// (`c = p`), follow one coordinate `x > L` of `p` alone (the sphere fold
+/// only scales it further): with a negative scale `x' = |s| (x − 2L) + x
+/// > x` once `x > 2L`; with a positive one the sign alternates and two
+/// steps give `|x''| > x` once `x > 2L (s + 1) / (s − 1)`. Either way the
+/// orbit then grows without bound, so those are the half sides, and
+/// inside the cube `|c|∞` is at most the half side.
+///
+/// ```
+/// use fractal_sdf::math::mandelbox_extent;
+/// assert_eq!(mandelbox_extent(2.0_f64, 1.0, None), (6.0, 10.0));
+/// assert_eq!(mandelbox_extent(-1.5_f64, 1.0, None), (2.0, 10.0));
+/// ```
+#[must_use]
+pub fn mandelbox_extent<T: Num>(scale: T, fold_limit: T, julia: Option<[T; 3]>) -> (T, T) {
+    let s = scale.abs();
+    let two_l = T::of(2.0) * fold_limit;
+    // The largest |c|∞ in the cube: the constant's, or the half side.
+    let c_max = match julia {
+        Some([x, y, z]) => x.abs().max(y.abs()).max(z.abs()),
+        None => T::select(
+            scale.lt(T::zero()),
+            two_l,
+            two_l * (s + T::one()) / (s - T::one()),
+        ),
+    };
+    let escape = (two_l * s + c_max) / (s - T::one());
+    match julia {
+        Some(_) => (escape, escape),
+        None => (c_max, escape),
+    }
+}
+
 /// The Mandelbulb power as an integer, when the trig-free integer form
 /// applies to a baked `power`: an integer in `[2, 64]`. The CPU reference
 /// and code generation make the same choice through it.

@@ -10,7 +10,7 @@
 use glam::{DQuat, DVec3, DVec4, EulerRot};
 
 use super::custom::CustomShape;
-use super::fractal::{Mandelbulb, Menger, QuaternionJulia, Sierpinski};
+use super::fractal::{Mandelbox, Mandelbulb, Menger, QuaternionJulia, Sierpinski};
 use super::material::Material;
 use super::node::{Axis, CsgOp, Kind, Node};
 use super::param::{Param, Param3};
@@ -151,6 +151,67 @@ pub fn julia(c: [f64; 4]) -> Node {
 #[must_use]
 pub fn sierpinski(iterations: u32) -> Node {
     Sierpinski::new(iterations).into()
+}
+
+/// A Mandelbox of `scale` (2 and −1.5 are classic; its magnitude in `[1.1,
+/// 4]`) with fold limit 1, radii 0.5 and 1 and 16 iterations, centred on
+/// the origin. Scale 2 lies in the cube `[-6, 6]^3`, scale −1.5 in `[-2,
+/// 2]^3`. Build a [`Mandelbox`] for other settings.
+#[must_use]
+pub fn mandelbox(scale: impl Into<Param>) -> Node {
+    Mandelbox::new(scale).into()
+}
+
+impl Mandelbox {
+    /// A Mandelbox of `scale` with the usual folds: fold limit 1, minimum
+    /// radius 0.5, fixed radius 1; 16 iterations.
+    #[must_use]
+    pub fn new(scale: impl Into<Param>) -> Self {
+        Mandelbox {
+            scale: scale.into(),
+            min_radius: 0.5.into(),
+            fixed_radius: 1.0.into(),
+            fold_limit: 1.0.into(),
+            iterations: 16,
+            julia: None,
+        }
+    }
+
+    /// Sets the sphere fold's inner radius.
+    #[must_use]
+    pub fn min_radius(mut self, radius: impl Into<Param>) -> Self {
+        self.min_radius = radius.into();
+        self
+    }
+
+    /// Sets the sphere fold's outer radius.
+    #[must_use]
+    pub fn fixed_radius(mut self, radius: impl Into<Param>) -> Self {
+        self.fixed_radius = radius.into();
+        self
+    }
+
+    /// Sets the box fold's half side.
+    #[must_use]
+    pub fn fold_limit(mut self, limit: impl Into<Param>) -> Self {
+        self.fold_limit = limit.into();
+        self
+    }
+
+    /// Sets the iteration count.
+    #[must_use]
+    pub fn iterations(mut self, iterations: u32) -> Self {
+        self.iterations = iterations;
+        self
+    }
+
+    /// Julia mode: adds the constant `c` in each iteration instead of the
+    /// point.
+    #[must_use]
+    pub fn julia(mut self, c: [impl Into<Param>; 3]) -> Self {
+        self.julia = Some(c.map(Into::into));
+        self
+    }
 }
 
 impl Mandelbulb {

@@ -1,5 +1,6 @@
 //! The fractals' parameters: the Mandelbulb, the Menger sponge, the
-//! quaternion Julia set and the Sierpinski tetrahedron, each a node of the
+//! quaternion Julia set, the Sierpinski tetrahedron and the Mandelbox, each
+//! a node of the
 //! scene through `From` and validated with the rest of its node.
 
 use super::param::Param;
@@ -100,6 +101,52 @@ pub struct Sierpinski<S = Param> {
     pub iterations: u32,
     /// The scale factor of each level, in `[1.5, 4]`; 2 is the classic.
     pub scale: S,
+}
+
+/// The Mandelbox (Tom Lowe): each iteration folds the point into the box
+/// `[-fold_limit, fold_limit]^3` (a box fold), scales it up by
+/// `(fixed_radius / min_radius)^2` inside `min_radius` or inverts it in the
+/// sphere of `fixed_radius` between the two radii (a sphere fold),
+/// multiplies it by `scale` and adds `p` (or, in Julia mode, a constant).
+///
+/// Extent: the set lies in a cube centred on the origin, of half side
+/// `2 L (s + 1) / (s − 1)` for a positive scale `s` and `2 L` for a
+/// negative one with the fold limit `L` (6 and 2 for the classic 2 and
+/// −1.5), and `(2 L |s| + |c|∞) / (|s| − 1)` in Julia mode
+/// ([`math::mandelbox_extent`](crate::math::mandelbox_extent)
+/// has the proof). An orbit past a threshold of the same kind never
+/// returns, so the drawn set (the points whose orbit is still within it
+/// after `iterations` steps) shrinks towards the Mandelbox as the count
+/// grows.
+///
+/// Distance estimate: the orbit's distance past that threshold over the
+/// running derivative, times a measured safety factor
+/// ([`cpu::sdf::MANDELBOX_SAFETY`](crate::cpu::sdf::MANDELBOX_SAFETY)),
+/// since this estimate is not a proven bound; continuous, and negative
+/// inside. The trap is the orbit's smallest radius over `fixed_radius`.
+#[derive(Debug, Clone, PartialEq)]
+#[non_exhaustive]
+pub struct Mandelbox<S = Param> {
+    /// The scale of each iteration, of magnitude in `[1.1, 4]`; 2 and −1.5
+    /// are classic.
+    pub scale: S,
+    /// The sphere fold's inner radius, greater than 0 (0.5 is usual); taken
+    /// as `fixed_radius` where it is larger.
+    pub min_radius: S,
+    /// The sphere fold's outer radius, greater than 0 (1 is usual).
+    pub fixed_radius: S,
+    /// The box fold's half side, greater than 0 (1 is usual).
+    pub fold_limit: S,
+    /// Iterations, 1 to [`MAX_ESCAPE_ITERATIONS`].
+    pub iterations: u32,
+    /// Julia mode: the constant added in each iteration instead of `p`.
+    pub julia: Option<[S; 3]>,
+}
+
+impl From<Mandelbox> for Node {
+    fn from(f: Mandelbox) -> Self {
+        Kind::Mandelbox(f).into()
+    }
 }
 
 impl From<Mandelbulb> for Node {

@@ -8,7 +8,7 @@ use std::sync::{Arc, OnceLock};
 use glam::DVec3;
 
 use super::custom::CustomShape;
-use super::fractal::{Mandelbulb, Menger, QuaternionJulia, Sierpinski};
+use super::fractal::{Mandelbox, Mandelbulb, Menger, QuaternionJulia, Sierpinski};
 use super::material::Material;
 use super::param::{Param, Param3};
 use super::rule::{ParamSpec, Rule, spec};
@@ -160,6 +160,8 @@ pub enum Kind<S, V, C> {
     Julia(QuaternionJulia<S>),
     /// See [`Sierpinski`].
     Sierpinski(Sierpinski<S>),
+    /// See [`Mandelbox`].
+    Mandelbox(Mandelbox<S>),
     /// Moves the child by `offset`. Preserves exactness.
     Translate {
         /// The translation.
@@ -339,6 +341,7 @@ impl<S, V, C> Kind<S, V, C> {
             Kind::Menger(_) => "menger",
             Kind::Julia(_) => "julia",
             Kind::Sierpinski(_) => "sierpinski",
+            Kind::Mandelbox(_) => "mandelbox",
             Kind::Translate { .. } => "translate",
             Kind::Rotate { .. } => "rotate",
             Kind::Scale { .. } => "scale",
@@ -405,6 +408,7 @@ impl<S, V, C> Kind<S, V, C> {
             | Kind::Menger(_)
             | Kind::Julia(_)
             | Kind::Sierpinski(_)
+            | Kind::Mandelbox(_)
             | Kind::Custom { .. } => vec![],
             Kind::Translate { child, .. }
             | Kind::Rotate { child, .. }
@@ -428,7 +432,11 @@ impl<S, V, C> Kind<S, V, C> {
     pub fn is_fractal(&self) -> bool {
         matches!(
             self,
-            Kind::Mandelbulb(_) | Kind::Menger(_) | Kind::Julia(_) | Kind::Sierpinski(_)
+            Kind::Mandelbulb(_)
+                | Kind::Menger(_)
+                | Kind::Julia(_)
+                | Kind::Sierpinski(_)
+                | Kind::Mandelbox(_)
         )
     }
 
@@ -440,6 +448,7 @@ impl<S, V, C> Kind<S, V, C> {
             Kind::Menger(m) => Some(m.iterations),
             Kind::Julia(j) => Some(j.iterations),
             Kind::Sierpinski(s) => Some(s.iterations),
+            Kind::Mandelbox(b) => Some(b.iterations),
             _ => None,
         }
     }
@@ -448,7 +457,9 @@ impl<S, V, C> Kind<S, V, C> {
     #[must_use]
     pub fn iteration_range(&self) -> Option<(u32, u32)> {
         match self {
-            Kind::Mandelbulb(_) | Kind::Julia(_) => Some((1, MAX_ESCAPE_ITERATIONS)),
+            Kind::Mandelbulb(_) | Kind::Julia(_) | Kind::Mandelbox(_) => {
+                Some((1, MAX_ESCAPE_ITERATIONS))
+            }
             Kind::Menger(_) | Kind::Sierpinski(_) => Some((0, MAX_FOLD_ITERATIONS)),
             _ => None,
         }
@@ -461,7 +472,7 @@ impl<S, V, C> Kind<S, V, C> {
     where
         M: Mapper<S, V, C>,
     {
-        use Rule::{Angle, Direction, Finite, NonNegative, Positive, Range};
+        use Rule::{Angle, Direction, Finite, Magnitude, NonNegative, Positive, Range};
         Ok(match self {
             Kind::Sphere { radius } => Kind::Sphere {
                 radius: m.scalar(radius, spec("radius", NonNegative))?,
@@ -537,6 +548,21 @@ impl<S, V, C> Kind<S, V, C> {
             Kind::Sierpinski(f) => Kind::Sierpinski(Sierpinski {
                 iterations: f.iterations,
                 scale: m.scalar(&f.scale, spec("scale", Range(1.5, 4.0)))?,
+            }),
+            Kind::Mandelbox(f) => Kind::Mandelbox(Mandelbox {
+                scale: m.scalar(&f.scale, spec("scale", Magnitude(1.1, 4.0)))?,
+                min_radius: m.scalar(&f.min_radius, spec("min_radius", Positive))?,
+                fixed_radius: m.scalar(&f.fixed_radius, spec("fixed_radius", Positive))?,
+                fold_limit: m.scalar(&f.fold_limit, spec("fold_limit", Positive))?,
+                iterations: f.iterations,
+                julia: match &f.julia {
+                    Some([x, y, z]) => Some([
+                        m.scalar(x, spec("julia.x", Finite))?,
+                        m.scalar(y, spec("julia.y", Finite))?,
+                        m.scalar(z, spec("julia.z", Finite))?,
+                    ]),
+                    None => None,
+                },
             }),
             Kind::Translate { offset, child } => Kind::Translate {
                 offset: m.vector(offset, spec("offset", Finite))?,

@@ -20,6 +20,9 @@ pub enum Rule {
     Positive,
     /// Within `[min, max]`.
     Range(f64, f64),
+    /// Of magnitude within `[min, max]`, either sign: a scale that must
+    /// grow, such as the Mandelbox's.
+    Magnitude(f64, f64),
     /// Any finite angle in radians. Angles are reduced modulo a full turn
     /// (see [`math::reduce_angle`](crate::math::reduce_angle)) before the
     /// CPU reference or a kernel uses them, so no magnitude limit applies.
@@ -41,6 +44,7 @@ impl Rule {
                 Rule::NonNegative => v >= 0.0,
                 Rule::Positive => v > 0.0,
                 Rule::Range(lo, hi) => (lo..=hi).contains(&v),
+                Rule::Magnitude(lo, hi) => (lo..=hi).contains(&v.abs()),
             }
     }
 
@@ -52,6 +56,7 @@ impl Rule {
             Rule::NonNegative => ">= 0".into(),
             Rule::Positive => "> 0".into(),
             Rule::Range(lo, hi) => format!("in [{lo}, {hi}]"),
+            Rule::Magnitude(lo, hi) => format!("in [-{hi}, -{lo}] or [{lo}, {hi}]"),
         }
     }
 
@@ -64,7 +69,7 @@ impl Rule {
     #[must_use]
     pub fn magnitude(self, baked: bool) -> Magnitude {
         match self {
-            Rule::Finite | Rule::Range(..) => Magnitude::Coordinate,
+            Rule::Finite | Rule::Range(..) | Rule::Magnitude(..) => Magnitude::Coordinate,
             Rule::NonNegative | Rule::Positive => Magnitude::Size,
             Rule::Angle => Magnitude::Free,
             Rule::Direction if baked => Magnitude::Free,

@@ -130,3 +130,71 @@ pub fn sierpinski_inside(p: DVec3, iterations: u32) -> bool {
     }
     true
 }
+
+/// Whether `p` is in the Mandelbox `m` as drawn (its parameters' default
+/// values), from the definition in [`Mandelbox`](crate::scene::Mandelbox):
+/// `p` lies in the cube of half side `h` and, for `iterations` steps of
+/// box fold, sphere fold, scale and add, no coordinate of the orbit's
+/// point passes the escape threshold `(2 L |s| + c) / (|s| − 1)`, where
+/// `c` is `h` (or the largest coordinate of the Julia constant) and `h`
+/// is `2 L (s + 1) / (s − 1)` for a positive scale, `2 L` for a negative
+/// one, the threshold itself in Julia mode.
+///
+/// ```
+/// use fractal_sdf::prelude::*;
+/// use fractal_sdf::scene::Mandelbox;
+/// use fractal_sdf::testing::mandelbox_inside;
+/// let m = Mandelbox::new(-1.5).iterations(12);
+/// assert!(mandelbox_inside(DVec3::ZERO, &m));
+/// assert!(!mandelbox_inside(dvec3(2.1, 0.0, 0.0), &m));
+/// ```
+#[must_use]
+pub fn mandelbox_inside(p: DVec3, m: &crate::scene::Mandelbox) -> bool {
+    let s = m.scale.default_value();
+    let l = m.fold_limit.default_value();
+    let fixed = m.fixed_radius.default_value();
+    let min = m.min_radius.default_value().min(fixed);
+    let julia = m.julia.as_ref().map(|c| {
+        DVec3::new(
+            c[0].default_value(),
+            c[1].default_value(),
+            c[2].default_value(),
+        )
+    });
+    let grow = |c: f64| (2.0 * l * s.abs() + c) / (s.abs() - 1.0);
+    let (half_side, threshold) = match julia {
+        Some(c) => (grow(c.abs().max_element()), grow(c.abs().max_element())),
+        None if s < 0.0 => (2.0 * l, grow(2.0 * l)),
+        None => {
+            let h = 2.0 * l * (s + 1.0) / (s - 1.0);
+            (h, grow(h))
+        }
+    };
+    if p.abs().max_element() > half_side {
+        return false;
+    }
+    let c = julia.unwrap_or(p);
+    let mut z = p;
+    for _ in 0..m.iterations {
+        // The box fold: each coordinate beyond ±L reflected in that plane.
+        for i in 0..3 {
+            if z[i] > l {
+                z[i] = 2.0 * l - z[i];
+            } else if z[i] < -l {
+                z[i] = -2.0 * l - z[i];
+            }
+        }
+        // The sphere fold.
+        let r = z.length();
+        if r < min {
+            z *= (fixed / min).powi(2);
+        } else if r < fixed {
+            z *= (fixed / r).powi(2);
+        }
+        z = s * z + c;
+        if z.abs().max_element() > threshold {
+            return false;
+        }
+    }
+    true
+}

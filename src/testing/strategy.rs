@@ -9,9 +9,9 @@ use proptest::prelude::*;
 
 use crate::cpu::Ray;
 use crate::scene::{
-    Axis, CsgOp, Kind, MAX_ESCAPE_ITERATIONS, MAX_FOLD_ITERATIONS, Mandelbulb, Menger, Node, Param,
-    Param3, QuaternionJulia, Sierpinski, capped_cone, capsule, cuboid, cylinder, ellipsoid,
-    octahedron, param, plane, round_box, sphere, torus,
+    Axis, CsgOp, Kind, MAX_ESCAPE_ITERATIONS, MAX_FOLD_ITERATIONS, Mandelbox, Mandelbulb, Menger,
+    Node, Param, Param3, QuaternionJulia, Sierpinski, capped_cone, capsule, cuboid, cylinder,
+    ellipsoid, octahedron, param, plane, round_box, sphere, torus,
 };
 
 /// The largest size (radius, half extent, height) the primitive strategies
@@ -434,13 +434,48 @@ pub fn sierpinski_node() -> impl Strategy<Value = Node> + Clone {
         .boxed()
 }
 
-/// Any of the four fractals with valid parameters.
+/// A Mandelbox: scale often the classic −1.5 or 2, otherwise of magnitude
+/// in `[1.1, 4]` with either sign; radii in `[0.1, 1]` and `[0.5, 1.5]`,
+/// fold limit in `[0.5, 1.5]`, iterations in `1..=256`, and a Julia
+/// constant in `[-1.5, 1.5]^3` one time in four.
+pub fn mandelbox_node() -> impl Strategy<Value = Node> + Clone {
+    let scale = prop_oneof![
+        1 => Just(-1.5),
+        1 => Just(2.0),
+        2 => (1.1..=4.0f64, any::<bool>()).prop_map(|(s, neg)| if neg { -s } else { s }),
+    ];
+    let component = || scalar("mandelbox.julia", -1.5..=1.5f64);
+    let julia = prop::option::weighted(0.25, [component(), component(), component()]);
+    (
+        scalar("mandelbox.scale", scale),
+        scalar("mandelbox.min_radius", 0.1..=1.0f64),
+        scalar("mandelbox.fixed_radius", 0.5..=1.5f64),
+        scalar("mandelbox.fold_limit", 0.5..=1.5f64),
+        iterations(1, MAX_ESCAPE_ITERATIONS, 16),
+        julia,
+    )
+        .prop_map(|(s, min, fixed, limit, n, julia)| {
+            let m = Mandelbox::new(s)
+                .min_radius(min)
+                .fixed_radius(fixed)
+                .fold_limit(limit)
+                .iterations(n);
+            match julia {
+                Some(c) => m.julia(c).into(),
+                None => m.into(),
+            }
+        })
+        .boxed()
+}
+
+/// Any of the five fractals with valid parameters.
 pub fn fractal_node() -> impl Strategy<Value = Node> + Clone {
     prop_oneof![
         mandelbulb_node(),
         menger_node(),
         julia_node(),
         sierpinski_node(),
+        mandelbox_node(),
     ]
 }
 

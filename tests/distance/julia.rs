@@ -227,7 +227,7 @@ impl SplitMix {
         dvec3(rho * phi.cos(), rho * phi.sin(), z)
     }
 
-    fn in_ball(&mut self, radius: f64) -> DVec3 {
+    pub(super) fn in_ball(&mut self, radius: f64) -> DVec3 {
         self.direction() * radius * self.unit().cbrt()
     }
 }

@@ -24,5 +24,7 @@ mod fractals;
 mod julia;
 #[cfg(feature = "proptest")]
 mod lipschitz;
+#[cfg(feature = "proptest")]
+mod mandelbox;
 mod numeric;
 mod smooth_oracle;

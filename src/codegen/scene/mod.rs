@@ -580,6 +580,25 @@ impl<'a> SceneEmitter<'a> {
                 let args = format!("{p}, {n}, {}", w(self, f.scale));
                 Step::Done(self.fractal(id, Helper::Sierpinski, &args))
             }
+            Kind::Mandelbox(f) => {
+                let n = self.iterations(f.iterations, (1, MAX_ESCAPE_ITERATIONS));
+                let mut args = format!(
+                    "{p}, {n}, {}, {}, {}, {}",
+                    w(self, f.scale),
+                    w(self, f.min_radius),
+                    w(self, f.fixed_radius),
+                    w(self, f.fold_limit)
+                );
+                let helper = match f.julia {
+                    Some(c) => {
+                        let [x, y, z] = c.map(|s| w(self, s));
+                        let _ = write!(args, ", (real3)({x}, {y}, {z})");
+                        Helper::MandelboxJulia
+                    }
+                    None => Helper::Mandelbox,
+                };
+                Step::Done(self.fractal(id, helper, &args))
+            }
             Kind::Translate { offset, child } => {
                 let q = self.map_point(p, &[Arg::Vector(*offset)], |p, a| {
                     sdf::translate(p, vector(a, 0))
