@@ -22,13 +22,9 @@ typedef float4 real4;
 #define AO_SAMPLES 5
 #define AO_DISTANCE 0.25f
 #define SHADOW_STEPS 96
-#define INSIDE_HUGE 1000000000000000.0f
-#define BRUTE_STEP 1.0f
-#define BRUTE_MAX_STEPS 16384
-#define SCREEN_NORMALS 1
+#define CONE_TILE 8
 #define ENABLE_AO
 #define ENABLE_SHADOWS
-#define ENABLE_BRUTE
 /* The kernel interface (src/codegen/interface.rs). */
 #define RENDER_TILE_ARGS \
     __global const real* params, \
@@ -100,25 +96,45 @@ real sd_plane(real3 p, real3 n, real offset) {
     return (((p.x * t4.x) + (p.y * t4.y)) + (p.z * t4.z)) + offset;
 }
 
-/* ---- custom shape mandelbox_escape ---- */
-int inside_mandelbox_escape(real3 p, real scale, real iterations) {
-real3 z = p;
-for (int i = 0; i < (int)iterations; ++i) {
-    z = clamp(z, R(-1.0), R(1.0)) * R(2.0) - z;
-    real r2 = dot(z, z);
-    real k = r2 < R(0.25) ? R(4.0) : (r2 < R(1.0) ? R(1.0) / r2 : R(1.0));
-    z = z * (scale * k) + p;
-    if (dot(z, z) > R(16.0)) {
-        return 0;
+/* ---- mandelbox ---- */
+real2 mandelbox(real3 p, real iterations, real scale, real min_radius, real fixed_radius, real fold_limit) {
+    real t0 = fixed_radius * fixed_radius;
+    real t1 = fmin(min_radius * min_radius, t0);
+    real t2 = fabs(scale);
+    real t3 = R(2.0) * fold_limit;
+    real t4 = t2 - R(1.0);
+    real t5 = (scale < R(0.0)) ? t3 : ((t3 * (t2 + R(1.0))) / t4);
+    real t6 = ((t3 * t2) + t5) / t4;
+    real t7 = t6 * R(16.0);
+    real t8 = ((p.x * p.x) + (p.y * p.y)) + (p.z * p.z);
+    real3 ts0_0 = p;
+    real ts0_3 = R(1.0);
+    real ts0_4 = t8;
+    real ts0_5 = R(0.0);
+    int tn0 = (int)clamp(ceil(iterations), R(0.0), R(1048576.0));
+    for (int ti0 = 0; ti0 < tn0; ti0++) {
+        real t9 = -fold_limit;
+        real t10 = (fmin(fmax(ts0_0.x, t9), fold_limit) * R(2.0)) - ts0_0.x;
+        real t11 = (fmin(fmax(ts0_0.y, t9), fold_limit) * R(2.0)) - ts0_0.y;
+        real t12 = (fmin(fmax(ts0_0.z, t9), fold_limit) * R(2.0)) - ts0_0.z;
+        real t13 = ((t10 * t10) + (t11 * t11)) + (t12 * t12);
+        real t14 = (t13 < t1) ? (t0 / t1) : ((t13 < t0) ? (t0 / fmax(t13, R(1e-30))) : R(1.0));
+        real t15 = t14 * scale;
+        real3 t16 = (((real3)(t10, t11, t12)) * t15) + ((real3)(p.x, p.y, p.z));
+        real t17 = fmin(((ts0_3 * t14) * t2) + R(1.0), R(1e30));
+        real t18 = fmin(ts0_4, ((t16.x * t16.x) + (t16.y * t16.y)) + (t16.z * t16.z));
+        real t19 = ts0_5 + R(1.0);
+        bool t20 = t7 < fmax(fmax(fabs(t16.x), fabs(t16.y)), fabs(t16.z));
+        ts0_0 = t16;
+        ts0_3 = t17;
+        ts0_4 = t18;
+        ts0_5 = t19;
+        if (t20) {
+            break;
+        }
     }
-}
-return 1;
-}
-real custom_mandelbox_escape(real3 p, real scale, real iterations) {
-    if (any(isgreater(fabs(p - (real3)(R(0.0), R(0.0), R(0.0))) - (real3)(R(2.25), R(2.25), R(2.25)), (real3)(R(0.0))))) {
-        return INSIDE_HUGE;
-    }
-    return inside_mandelbox_escape(p, scale, iterations) ? -INSIDE_HUGE : INSIDE_HUGE;
+    real3 t21 = fabs(p) - t5;
+    return (real2)(fmax(R(0.8) * ((fmax(fmax(fabs(ts0_0.x), fabs(ts0_0.y)), fabs(ts0_0.z)) - (t6 / exp((iterations - ts0_5) * log(t2)))) / fmax(ts0_3, R(1e-30))), length(fmax(t21, R(0.0))) + fmin(fmax(fmax(t21.x, t21.y), t21.z), R(0.0))), fmin(sqrt(ts0_4) / fmax(fixed_radius, R(1e-30)), R(1.0)));
 }
 
 /* ---- scene ---- */
@@ -128,15 +144,16 @@ real DE(real3 p0, __global const real* params) {
     real d4 = sd_plane(p0, (real3)(0.0f, 1.0f, 0.0f), 1.0f);
     /* union: the second operand only within reach of its bound */
     real u6 = d4;
-    real g6 = (length(p0) * R(0.9999)) - R(1.948557158514987);
+    real g6 = (length(p0) * R(0.9999)) - R(1.7320508075688772);
     if (!(g6 > u6 && g6 > R(0.0))) {
         /* union/a:color/scale */
-        real3 p1 = p0 / R(0.5);
+        real3 p1 = p0 / R(0.16666666666666666);
         /* .../a:color/scale/rotate */
         real3 p2 = (real3)((R(0.8253356149096783) * p1.x) - (R(0.5646424733950354) * p1.z), p1.y, (R(0.5646424733950354) * p1.x) + (R(0.8253356149096783) * p1.z));
-        /* .../scale/rotate/mandelbox_escape */
-        real d0 = custom_mandelbox_escape(p2, (-1.5f), 12.0f);
-        real d2 = d0 * R(0.5);
+        /* .../scale/rotate/mandelbox */
+        real2 f0 = mandelbox(p2, 16, 2.0f, 0.5f, 1.0f, 1.0f);
+        real d0 = f0.x;
+        real d2 = d0 * R(0.16666666666666666);
         real d6 = fmin(d4, d2);
         u6 = d6;
     }
@@ -153,29 +170,29 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     real u6 = d4;
     real3 uc6 = c5;
     real ut6 = R(1.0);
-    real g6 = (length(p0) * R(0.9999)) - R(1.948557158514987);
+    real g6 = (length(p0) * R(0.9999)) - R(1.7320508075688772);
     if (!(g6 > u6 && g6 > R(0.0))) {
         /* union/a:color/scale */
-        real3 p1 = p0 / R(0.5);
+        real3 p1 = p0 / R(0.16666666666666666);
         /* .../a:color/scale/rotate */
         real3 p2 = (real3)((R(0.8253356149096783) * p1.x) - (R(0.5646424733950354) * p1.z), p1.y, (R(0.5646424733950354) * p1.x) + (R(0.8253356149096783) * p1.z));
-        /* .../scale/rotate/mandelbox_escape */
-        real d0 = custom_mandelbox_escape(p2, (-1.5f), 12.0f);
-        real d2 = d0 * R(0.5);
+        /* .../scale/rotate/mandelbox */
+        real2 f0 = mandelbox(p2, 16, 2.0f, 0.5f, 1.0f, 1.0f);
+        real d0 = f0.x;
+        real t0 = f0.y;
+        real d2 = d0 * R(0.16666666666666666);
         /* union/a:color */
         real3 c3 = (real3)(0.5f, 0.62f, 0.85f);
         real d6 = fmin(d4, d2);
         real3 c6 = d4 < d2 ? c5 : c3;
+        real t6 = d4 < d2 ? R(1.0) : t0;
         u6 = d6;
         uc6 = c6;
-        ut6 = R(1.0);
+        ut6 = t6;
     }
     *color = uc6;
     *trap = ut6;
     return u6;
 }
 
-/* The sphere inside shapes lie in: marched by brute force. */
-#define BRUTE_CENTRE (real3)(0.0f, 0.0f, 0.0f)
-#define BRUTE_RADIUS 1.9485571f
 /* ---- kernel: march.cl, shade.cl, optics.cl, render.cl ---- */
