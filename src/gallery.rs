@@ -20,8 +20,8 @@ use crate::file::SceneFile;
 use crate::quality::{Effects, Glow, Quality};
 use crate::scene::{
     Axis, Camera, InsideShape, Light, Mandelbulb, Material, Node, QuaternionJulia, Scene,
-    capped_cone, capsule, cuboid, cylinder, ellipsoid, julia, menger, octahedron, param, param3,
-    plane, round_box, sierpinski, sphere, torus,
+    capped_cone, capsule, cuboid, cylinder, ellipsoid, hex_prism, julia, link, menger, octahedron,
+    param, param3, plane, round_box, round_cone, sierpinski, sphere, torus,
 };
 
 /// Every gallery scene by name.
@@ -343,6 +343,9 @@ pub fn primitives() -> Scene {
         octahedron(0.4),
         capped_cone(0.35, 0.3, 0.1),
         ellipsoid(dvec3(0.35, 0.2, 0.25)),
+        hex_prism(0.28, 0.3),
+        round_cone(0.22, 0.22, 0.1),
+        link(0.14, 0.2, 0.07).rotate(DVec3::Y, 0.5),
     ];
     let count = items.len();
     let row = items
@@ -356,18 +359,15 @@ pub fn primitives() -> Scene {
                 0.45 + 0.35 * (1.0 - (2.0 * t - 1.0).abs()),
                 0.3 + 0.6 * t,
             );
-            // Five in the back row, four in front, 0.95 apart.
-            let (column, z) = if i < 5 {
-                (i as f64 - 2.0, -0.6)
-            } else {
-                (i as f64 - 6.5, 0.6)
-            };
-            node.color(hue).translate(dvec3(column * 0.95, 0.0, z))
+            // Six in the back row, six in front, 0.85 apart.
+            #[allow(clippy::cast_precision_loss)]
+            let (column, z) = ((i % 6) as f64 - 2.5, if i < 6 { -0.6 } else { 0.6 });
+            node.color(hue).translate(dvec3(column * 0.85, 0.0, z))
         })
         .reduce(Node::union)
-        .expect("nine primitives");
+        .expect("twelve primitives");
     Scene::new(row.union(floor(0.4)))
-        .with_camera(Camera::look_at(dvec3(0.0, 2.0, 4.2), dvec3(0.0, -0.15, 0.0)).fov(45.0))
+        .with_camera(Camera::look_at(dvec3(0.0, 2.2, 5.1), dvec3(0.0, -0.15, 0.0)).fov(45.0))
         .with_lights(key_and_fill())
 }
 

@@ -97,6 +97,28 @@ pub(crate) fn capped_cone() -> Result<String, Unprintable> {
     )
 }
 
+pub(crate) fn hex_prism() -> Result<String, Unprintable> {
+    distance("sd_hex_prism", &[("r", Scalar), ("h", Scalar)], |p, a| {
+        sdf::hex_prism(p, a[0], a[1])
+    })
+}
+
+pub(crate) fn round_cone() -> Result<String, Unprintable> {
+    distance(
+        "sd_round_cone",
+        &[("h", Scalar), ("r1", Scalar), ("r2", Scalar)],
+        |p, a| sdf::round_cone(p, a[0], a[1], a[2]),
+    )
+}
+
+pub(crate) fn link() -> Result<String, Unprintable> {
+    distance(
+        "sd_link",
+        &[("le", Scalar), ("r1", Scalar), ("r2", Scalar)],
+        |p, a| sdf::link(p, a[0], a[1], a[2]),
+    )
+}
+
 pub(crate) fn ellipsoid() -> Result<String, Unprintable> {
     distance("sd_ellipsoid", &[("r", Vec3)], |p, a| {
         sdf::ellipsoid(p, vector(a, 0))

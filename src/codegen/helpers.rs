@@ -18,6 +18,9 @@ pub(crate) enum Helper {
     Plane,
     Octahedron,
     CappedCone,
+    HexPrism,
+    RoundCone,
+    Link,
     Ellipsoid,
     Mandelbulb,
     Menger,
@@ -29,7 +32,7 @@ pub(crate) enum Helper {
 
 impl Helper {
     /// Every helper, in the order they are emitted.
-    pub(crate) const ALL: [Helper; 16] = [
+    pub(crate) const ALL: [Helper; 19] = [
         Helper::Sphere,
         Helper::Cuboid,
         Helper::RoundBox,
@@ -39,6 +42,9 @@ impl Helper {
         Helper::Plane,
         Helper::Octahedron,
         Helper::CappedCone,
+        Helper::HexPrism,
+        Helper::RoundCone,
+        Helper::Link,
         Helper::Ellipsoid,
         Helper::Mandelbulb,
         Helper::Menger,
@@ -60,6 +66,9 @@ impl Helper {
             Helper::Plane => "plane",
             Helper::Octahedron => "octahedron",
             Helper::CappedCone => "capped_cone",
+            Helper::HexPrism => "hex_prism",
+            Helper::RoundCone => "round_cone",
+            Helper::Link => "link",
             Helper::Ellipsoid => "ellipsoid",
             Helper::Mandelbulb => "mandelbulb",
             Helper::Menger => "menger",
@@ -82,6 +91,9 @@ impl Helper {
             Helper::Plane => formulas::plane(),
             Helper::Octahedron => formulas::octahedron(),
             Helper::CappedCone => formulas::capped_cone(),
+            Helper::HexPrism => formulas::hex_prism(),
+            Helper::RoundCone => formulas::round_cone(),
+            Helper::Link => formulas::link(),
             Helper::Ellipsoid => formulas::ellipsoid(),
             Helper::Mandelbulb => formulas::mandelbulb(),
             Helper::Menger => formulas::menger(),

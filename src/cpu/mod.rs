@@ -359,6 +359,30 @@ impl Evaluator {
                 s(*bottom_radius),
                 s(*top_radius),
             )),
+            Kind::HexPrism {
+                radius,
+                half_height,
+            } => Self::leaf(sdf::hex_prism(p, s(*radius), s(*half_height))),
+            Kind::RoundCone {
+                half_height,
+                bottom_radius,
+                top_radius,
+            } => Self::leaf(sdf::round_cone(
+                p,
+                s(*half_height),
+                s(*bottom_radius),
+                s(*top_radius),
+            )),
+            Kind::Link {
+                half_length,
+                major_radius,
+                minor_radius,
+            } => Self::leaf(sdf::link(
+                p,
+                s(*half_length),
+                s(*major_radius),
+                s(*minor_radius),
+            )),
             Kind::Ellipsoid { radii } => Self::leaf(sdf::ellipsoid(p, v(*radii))),
             Kind::Mandelbulb(f) => Self::fractal(sdf::mandelbulb(
                 p,

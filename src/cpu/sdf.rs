@@ -118,6 +118,63 @@ pub fn capped_cone<T: Num>(p: V3<T>, h: T, r1: T, r2: T) -> T {
     s * (cax * cax + cay * cay).min(cbx * cbx + cby * cby).sqrt()
 }
 
+/// Exact distance to a hexagonal prism along y: the hexagon in the xz
+/// plane has its flat sides `r` from the axis (two of them facing ±z) and
+/// the prism runs from `-h` to `+h` (Quilez's `sdHexPrism`, its axis
+/// turned to y).
+#[must_use]
+pub fn hex_prism<T: Num>(p: V3<T>, r: T, h: T) -> T {
+    // (-cos 30°, sin 30°) and tan 30°.
+    let (kx, ky, kz) = (
+        T::of(-0.866_025_403_784_438_6),
+        T::of(0.5),
+        T::of(0.577_350_269_189_625_8),
+    );
+    let q = p.abs();
+    // Fold the hexagon's plane (x, z) into the sector of its +z side.
+    let fold = T::of(2.0) * (kx * q.x + ky * q.z).min(T::zero());
+    let (x, z) = (q.x - fold * kx, q.z - fold * ky);
+    let edge = kz * r;
+    let side = z - r;
+    let dx = (x - x.clamp(-edge, edge)).hypot(side);
+    let d = (T::select(side.lt(T::zero()), -dx, dx), q.y - h);
+    d.0.max(d.1).min(T::zero()) + d.0.max(T::zero()).hypot(d.1.max(T::zero()))
+}
+
+/// Exact distance to a round cone along y: the convex hull of the ball of
+/// radius `r1` at `y = -h` and the ball of radius `r2` at `y = +h`
+/// (Quilez's `sdRoundCone`, centred); where one ball holds the other, the
+/// larger ball.
+#[must_use]
+pub fn round_cone<T: Num>(p: V3<T>, h: T, r1: T, r2: T) -> T {
+    let length = T::of(2.0) * h;
+    let (qx, qy) = (p.x.hypot(p.z), p.y + h);
+    let bottom = qx.hypot(qy) - r1;
+    let top = qx.hypot(qy - length) - r2;
+    // The sine and cosine of the side's slope.
+    let b = (r1 - r2) / length.max(T::tiny());
+    let a = (T::one() - b * b).max(T::zero()).sqrt();
+    let k = -b * qx + a * qy;
+    let side = a * qx + b * qy - r1;
+    let hull = T::select(
+        k.lt(T::zero()),
+        bottom,
+        T::select(k.gt(a * length), top, side),
+    );
+    // One ball holds the other: `|r1 - r2| >= 2h`.
+    T::select((r1 - r2).abs().ge(length), bottom.min(top), hull)
+}
+
+/// Exact distance to a chain link in the xy plane: a tube of radius `r2`
+/// around the stadium made of two segments at `x = ±r1` from `y = -le` to
+/// `le` and two half circles of radius `r1` (Quilez's `sdLink`); exact
+/// where `r2 <= r1`.
+#[must_use]
+pub fn link<T: Num>(p: V3<T>, le: T, r1: T, r2: T) -> T {
+    let y = (p.y.abs() - le).max(T::zero());
+    (p.x.hypot(y) - r1).hypot(p.z) - r2
+}
+
 /// A distance bound for an axis-aligned ellipsoid with semi-axes `r`.
 ///
 /// Outside, Quilez's `k0 (k0 - 1) / k1` with `k0 = |p / r|` and

@@ -106,6 +106,31 @@ impl NodeRepr {
                 bottom_radius,
                 top_radius,
             },
+            Kind::HexPrism {
+                radius,
+                half_height,
+            } => NodeRepr::HexPrism {
+                radius,
+                half_height,
+            },
+            Kind::RoundCone {
+                half_height,
+                bottom_radius,
+                top_radius,
+            } => NodeRepr::RoundCone {
+                half_height,
+                bottom_radius,
+                top_radius,
+            },
+            Kind::Link {
+                half_length,
+                major_radius,
+                minor_radius,
+            } => NodeRepr::Link {
+                half_length,
+                major_radius,
+                minor_radius,
+            },
             Kind::Ellipsoid { radii } => NodeRepr::Ellipsoid { radii },
             Kind::Mandelbulb(Mandelbulb {
                 power,
@@ -335,6 +360,34 @@ impl Located<NodeRepr> {
                 half_height: half_height.clone(),
                 bottom_radius: bottom_radius.clone(),
                 top_radius: top_radius.clone(),
+            }
+            .into(),
+            NodeRepr::HexPrism {
+                radius,
+                half_height,
+            } => Kind::HexPrism {
+                radius: radius.clone(),
+                half_height: half_height.clone(),
+            }
+            .into(),
+            NodeRepr::RoundCone {
+                half_height,
+                bottom_radius,
+                top_radius,
+            } => Kind::RoundCone {
+                half_height: half_height.clone(),
+                bottom_radius: bottom_radius.clone(),
+                top_radius: top_radius.clone(),
+            }
+            .into(),
+            NodeRepr::Link {
+                half_length,
+                major_radius,
+                minor_radius,
+            } => Kind::Link {
+                half_length: half_length.clone(),
+                major_radius: major_radius.clone(),
+                minor_radius: minor_radius.clone(),
             }
             .into(),
             NodeRepr::Ellipsoid { radii } => Kind::Ellipsoid {

@@ -394,6 +394,20 @@ pub(super) enum NodeRepr {
         bottom_radius: Param,
         top_radius: Param,
     },
+    HexPrism {
+        radius: Param,
+        half_height: Param,
+    },
+    RoundCone {
+        half_height: Param,
+        bottom_radius: Param,
+        top_radius: Param,
+    },
+    Link {
+        half_length: Param,
+        major_radius: Param,
+        minor_radius: Param,
+    },
     Ellipsoid {
         radii: Param3,
     },

@@ -179,6 +179,33 @@ pub(super) fn bound(node: &IrNode, done: &[Option<Bound>]) -> Option<Bound> {
             let r = baked(*bottom_radius)?.max(baked(*top_radius)?);
             Bound::sphere(origin, r.hypot(baked(*half_height)?))
         }
+        // The hexagon's corners are `2 / sqrt(3)` times its flat sides'
+        // distance from the axis.
+        Kind::HexPrism {
+            radius,
+            half_height,
+        } => Bound::sphere(
+            origin,
+            (baked(*radius)? * 2.0 / 3f64.sqrt()).hypot(baked(*half_height)?),
+        ),
+        // The hull of two balls lies in the ball around the origin that
+        // holds both.
+        Kind::RoundCone {
+            half_height,
+            bottom_radius,
+            top_radius,
+        } => {
+            let r = baked(*bottom_radius)?.max(baked(*top_radius)?);
+            Bound::sphere(origin, baked(*half_height)? + r)
+        }
+        Kind::Link {
+            half_length,
+            major_radius,
+            minor_radius,
+        } => Bound::sphere(
+            origin,
+            baked(*half_length)? + baked(*major_radius)? + baked(*minor_radius)?,
+        ),
         // The estimate is `(k0 − 1) / |u / r|` with `k0 = |p / r|` and `u`
         // a unit vector, so it is at least `(k0 − 1) min(r)`, and
         // `k0 >= |p| / max(r)`: at least `min(r) / max(r) · (|p| − max(r))`,

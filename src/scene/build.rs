@@ -90,6 +90,51 @@ pub fn octahedron(size: impl Into<Param>) -> Node {
     Kind::Octahedron { size: size.into() }.into()
 }
 
+/// A hexagonal prism along y from `-half_height` to `+half_height`, its
+/// flat sides `radius` from the axis (two of them facing ±z).
+#[must_use]
+pub fn hex_prism(radius: impl Into<Param>, half_height: impl Into<Param>) -> Node {
+    Kind::HexPrism {
+        radius: radius.into(),
+        half_height: half_height.into(),
+    }
+    .into()
+}
+
+/// A round cone along y: the convex hull of the ball of `bottom_radius`
+/// centred at `-half_height` and the ball of `top_radius` at
+/// `+half_height`.
+#[must_use]
+pub fn round_cone(
+    half_height: impl Into<Param>,
+    bottom_radius: impl Into<Param>,
+    top_radius: impl Into<Param>,
+) -> Node {
+    Kind::RoundCone {
+        half_height: half_height.into(),
+        bottom_radius: bottom_radius.into(),
+        top_radius: top_radius.into(),
+    }
+    .into()
+}
+
+/// A chain link in the xy plane, centred on the origin and long along y:
+/// a tube of `minor_radius` around two straight sides of `2 half_length`
+/// at `x = ±major_radius`, joined by half circles of `major_radius`.
+#[must_use]
+pub fn link(
+    half_length: impl Into<Param>,
+    major_radius: impl Into<Param>,
+    minor_radius: impl Into<Param>,
+) -> Node {
+    Kind::Link {
+        half_length: half_length.into(),
+        major_radius: major_radius.into(),
+        minor_radius: minor_radius.into(),
+    }
+    .into()
+}
+
 /// A capped cone along y from radius `bottom_radius` at `-half_height` to
 /// `top_radius` at `+half_height`.
 #[must_use]

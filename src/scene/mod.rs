@@ -19,8 +19,8 @@ use glam::{DVec2, DVec3};
 use serde::{Deserialize, Serialize};
 
 pub use build::{
-    capped_cone, capsule, cuboid, cylinder, ellipsoid, julia, mandelbox, mandelbulb, menger,
-    octahedron, plane, round_box, sierpinski, sphere, torus,
+    capped_cone, capsule, cuboid, cylinder, ellipsoid, hex_prism, julia, link, mandelbox,
+    mandelbulb, menger, octahedron, plane, round_box, round_cone, sierpinski, sphere, torus,
 };
 pub use custom::{
     CpuDistance, CpuInside, CustomShape, INSIDE_HUGE, InsideBounds, MAX_INSIDE_REACH,

@@ -144,6 +144,33 @@ pub enum Kind<S, V, C> {
         /// Radius at the top cap, at least 0.
         top_radius: S,
     },
+    /// A hexagonal prism along y, two flat sides facing ±z. Exact.
+    HexPrism {
+        /// The distance from the axis to each flat side, at least 0.
+        radius: S,
+        /// Half the height, at least 0.
+        half_height: S,
+    },
+    /// A round cone along y: the convex hull of a ball at each end. Exact.
+    RoundCone {
+        /// Half the distance between the balls' centres, at least 0.
+        half_height: S,
+        /// Radius of the ball at `-half_height`, at least 0.
+        bottom_radius: S,
+        /// Radius of the ball at `+half_height`, at least 0.
+        top_radius: S,
+    },
+    /// A chain link in the xy plane, long along y: a tube around two
+    /// straight sides joined by half circles. Exact where `minor_radius <=
+    /// major_radius` (a thicker tube overlaps itself inside).
+    Link {
+        /// Half the length of the straight sides, at least 0.
+        half_length: S,
+        /// Radius of the half circles (half the link's width), at least 0.
+        major_radius: S,
+        /// Radius of the tube, at least 0.
+        minor_radius: S,
+    },
     /// An axis-aligned ellipsoid. A bound, not exact: outside, the distance
     /// is underestimated away from the axes (Quilez's `k0 (k0 - 1) / k1`,
     /// which is not 1-Lipschitz near thin ellipsoids); inside, the depth is
@@ -336,6 +363,9 @@ impl<S, V, C> Kind<S, V, C> {
             Kind::Plane { .. } => "plane",
             Kind::Octahedron { .. } => "octahedron",
             Kind::CappedCone { .. } => "capped_cone",
+            Kind::HexPrism { .. } => "hex_prism",
+            Kind::RoundCone { .. } => "round_cone",
+            Kind::Link { .. } => "link",
             Kind::Ellipsoid { .. } => "ellipsoid",
             Kind::Mandelbulb(_) => "mandelbulb",
             Kind::Menger(_) => "menger",
@@ -403,6 +433,9 @@ impl<S, V, C> Kind<S, V, C> {
             | Kind::Plane { .. }
             | Kind::Octahedron { .. }
             | Kind::CappedCone { .. }
+            | Kind::HexPrism { .. }
+            | Kind::RoundCone { .. }
+            | Kind::Link { .. }
             | Kind::Ellipsoid { .. }
             | Kind::Mandelbulb(_)
             | Kind::Menger(_)
@@ -521,6 +554,31 @@ impl<S, V, C> Kind<S, V, C> {
                 half_height: m.scalar(half_height, spec("half_height", NonNegative))?,
                 bottom_radius: m.scalar(bottom_radius, spec("bottom_radius", NonNegative))?,
                 top_radius: m.scalar(top_radius, spec("top_radius", NonNegative))?,
+            },
+            Kind::HexPrism {
+                radius,
+                half_height,
+            } => Kind::HexPrism {
+                radius: m.scalar(radius, spec("radius", NonNegative))?,
+                half_height: m.scalar(half_height, spec("half_height", NonNegative))?,
+            },
+            Kind::RoundCone {
+                half_height,
+                bottom_radius,
+                top_radius,
+            } => Kind::RoundCone {
+                half_height: m.scalar(half_height, spec("half_height", NonNegative))?,
+                bottom_radius: m.scalar(bottom_radius, spec("bottom_radius", NonNegative))?,
+                top_radius: m.scalar(top_radius, spec("top_radius", NonNegative))?,
+            },
+            Kind::Link {
+                half_length,
+                major_radius,
+                minor_radius,
+            } => Kind::Link {
+                half_length: m.scalar(half_length, spec("half_length", NonNegative))?,
+                major_radius: m.scalar(major_radius, spec("major_radius", NonNegative))?,
+                minor_radius: m.scalar(minor_radius, spec("minor_radius", NonNegative))?,
             },
             Kind::Ellipsoid { radii } => Kind::Ellipsoid {
                 radii: m.vector(radii, spec("radii", Positive))?,

@@ -11,7 +11,7 @@ use crate::cpu::Ray;
 use crate::scene::{
     Axis, CsgOp, Kind, MAX_ESCAPE_ITERATIONS, MAX_FOLD_ITERATIONS, Mandelbox, Mandelbulb, Menger,
     Node, Param, Param3, QuaternionJulia, Sierpinski, capped_cone, capsule, cuboid, cylinder,
-    ellipsoid, octahedron, param, plane, round_box, sphere, torus,
+    ellipsoid, hex_prism, link, octahedron, param, plane, round_box, round_cone, sphere, torus,
 };
 
 /// The largest size (radius, half extent, height) the primitive strategies
@@ -184,6 +184,41 @@ pub fn capped_cone_node() -> impl Strategy<Value = Node> + Clone {
         .prop_map(|(h, r1, r2)| capped_cone(h, r1, r2))
 }
 
+/// A hexagonal prism: radius (to the flat sides) and half height in
+/// `[0, 1.5]`.
+pub fn hex_prism_node() -> impl Strategy<Value = Node> + Clone {
+    (
+        scalar("hex_prism.radius", size(MAX_SIZE)),
+        scalar("hex_prism.half_height", size(MAX_SIZE)),
+    )
+        .prop_map(|(r, h)| hex_prism(r, h))
+}
+
+/// A round cone: half height and both radii in `[0, 1.5]` (so sometimes
+/// one ball holds the other).
+pub fn round_cone_node() -> impl Strategy<Value = Node> + Clone {
+    (
+        scalar("round_cone.half_height", size(MAX_SIZE)),
+        scalar("round_cone.bottom_radius", size(MAX_SIZE)),
+        scalar("round_cone.top_radius", size(MAX_SIZE)),
+    )
+        .prop_map(|(h, r1, r2)| round_cone(h, r1, r2))
+}
+
+/// A chain link: half length and major radius in `[0, 1.5]`, the tube's
+/// radius at most the major radius (where the link is exact).
+pub fn link_node() -> impl Strategy<Value = Node> + Clone {
+    (size(MAX_SIZE), size(MAX_SIZE), 0.0..=1.0f64)
+        .prop_flat_map(|(le, r1, t)| {
+            (
+                scalar("link.half_length", Just(le)),
+                scalar("link.major_radius", Just(r1)),
+                scalar("link.minor_radius", Just(r1 * t)),
+            )
+        })
+        .prop_map(|(le, r1, r2)| link(le, r1, r2))
+}
+
 /// An ellipsoid (a distance bound, not exact) with semi-axes in
 /// `[0.05, 1.5]`.
 pub fn ellipsoid_node() -> impl Strategy<Value = Node> + Clone {
@@ -202,6 +237,9 @@ pub fn exact_primitive() -> impl Strategy<Value = Node> + Clone {
         plane_node(),
         octahedron_node(),
         capped_cone_node(),
+        hex_prism_node(),
+        round_cone_node(),
+        link_node(),
     ]
 }
 

@@ -51,6 +51,28 @@ pub fn exact_distance(node: &Node, p: DVec3) -> Option<f64> {
             bottom_radius.default_value(),
             top_radius.default_value(),
         ),
+        Kind::HexPrism {
+            radius,
+            half_height,
+        } => hex_prism_distance(p, radius.default_value(), half_height.default_value()),
+        Kind::RoundCone {
+            half_height,
+            bottom_radius,
+            top_radius,
+        } => round_cone_distance(
+            p,
+            half_height.default_value(),
+            bottom_radius.default_value(),
+            top_radius.default_value(),
+        ),
+        Kind::Link {
+            half_length,
+            major_radius,
+            minor_radius,
+        } => {
+            link_curve_distance(p, half_length.default_value(), major_radius.default_value())
+                - minor_radius.default_value()
+        }
         Kind::Translate { offset, child } => exact_distance(child, p - offset.default_value())?,
         Kind::Rotate { axis, angle, child } => {
             let rotation = DQuat::from_axis_angle(*axis, angle.default_value());
@@ -186,6 +208,76 @@ pub fn revolved_trapezoid(p: DVec3, h: f64, r1: f64, r2: f64) -> f64 {
         DVec2::new(-r2, h),
     ];
     convex_polygon_distance(q, &section)
+}
+
+/// Signed distance to the prism over the regular hexagon in the xz plane
+/// whose corners lie `2r / sqrt(3)` from the axis at 0°, 60°, ... from +x
+/// (so its flat sides are `r` from the axis, two facing ±z), from `y = -h`
+/// to `h`: the hexagon's 2D distance `a` and the caps' `b = |y| - h`
+/// combine as for any extrusion, `|max(a, b, 0)|` outside and `max(a, b)`
+/// inside.
+pub fn hex_prism_distance(p: DVec3, r: f64, h: f64) -> f64 {
+    let corner = 2.0 * r / 3f64.sqrt();
+    let hexagon: Vec<DVec2> = (0..6)
+        .map(|k| {
+            let angle = std::f64::consts::FRAC_PI_3 * f64::from(k);
+            DVec2::new(angle.cos(), angle.sin()) * corner
+        })
+        .collect();
+    // Counter-clockwise in (x, z).
+    let a = convex_polygon_distance(DVec2::new(p.x, p.z), &hexagon);
+    let b = p.y.abs() - h;
+    if a > 0.0 || b > 0.0 {
+        DVec2::new(a.max(0.0), b.max(0.0)).length()
+    } else {
+        a.max(b)
+    }
+}
+
+/// Signed distance to the convex hull of the balls of radius `r1` at
+/// `(0, -h, 0)` and `r2` at `(0, h, 0)`: the hull is the union of the balls
+/// `c(t) = (0, (2t - 1) h, 0)`, `r(t) = r1 + t (r2 - r1)` for `t` in
+/// `[0, 1]`, whose boundary touches each ball it passes on a normal
+/// through that ball's centre, so the distance is `min_t |p - c(t)| -
+/// r(t)`, inside too. That function of `t` is convex; golden-section
+/// search finds its minimum.
+pub fn round_cone_distance(p: DVec3, h: f64, r1: f64, r2: f64) -> f64 {
+    let f = |t: f64| p.distance(DVec3::new(0.0, (2.0 * t - 1.0) * h, 0.0)) - (r1 + t * (r2 - r1));
+    let ratio = (5f64.sqrt() - 1.0) / 2.0;
+    let (mut lo, mut hi) = (0.0f64, 1.0f64);
+    for _ in 0..200 {
+        let (x1, x2) = (hi - ratio * (hi - lo), lo + ratio * (hi - lo));
+        if f(x1) <= f(x2) {
+            hi = x2;
+        } else {
+            lo = x1;
+        }
+    }
+    f(0.5 * (lo + hi)).min(f(0.0)).min(f(1.0))
+}
+
+/// Unsigned distance to the stadium curve in the xy plane: the segments
+/// `x = ±r1`, `y` in `[-le, le]`, and the half circles of radius `r1`
+/// around `(0, ±le, 0)` on the far sides (`|y| >= le`), each through its
+/// nearest point.
+pub fn link_curve_distance(p: DVec3, le: f64, r1: f64) -> f64 {
+    let sides =
+        [-r1, r1].map(|x| segment_distance(p, DVec3::new(x, -le, 0.0), DVec3::new(x, le, 0.0)));
+    let arcs = [-le, le].map(|cy| {
+        let q = DVec2::new(p.x, p.y - cy);
+        // The nearest point of the whole circle, kept if on the half.
+        let nearest = if q == DVec2::ZERO {
+            DVec2::new(0.0, cy.signum() * r1)
+        } else {
+            q.normalize() * r1
+        };
+        if nearest.y * cy.signum() >= 0.0 {
+            p.distance(DVec3::new(nearest.x, nearest.y + cy, 0.0))
+        } else {
+            f64::INFINITY
+        }
+    });
+    sides.into_iter().chain(arcs).fold(f64::INFINITY, f64::min)
 }
 
 /// The true signed distance to the ellipsoid with semi-axes `radii`,

@@ -16,11 +16,11 @@ use fractal_sdf::quality::Precision;
 use fractal_sdf::render::{DeviceInfo, DeviceKind, DeviceSelector, PointEvaluator};
 use fractal_sdf::scene::Axis;
 use fractal_sdf::scene::QuaternionJulia;
-use fractal_sdf::scene::capped_cone;
 use fractal_sdf::scene::ellipsoid;
 use fractal_sdf::scene::octahedron;
 use fractal_sdf::scene::param3;
 use fractal_sdf::scene::{CustomShape, Rule};
+use fractal_sdf::scene::{Mandelbox, capped_cone, hex_prism, link, round_cone};
 use fractal_sdf::testing::{check_device_matches_cpu, random_points, spicy_points};
 
 fn gyroid() -> CustomShape {
@@ -83,6 +83,15 @@ fn nodes() -> Vec<(&'static str, Node)> {
         ),
         ("octahedron", octahedron(0.9)),
         ("capped_cone", capped_cone(0.6, 0.5, 0.2)),
+        ("hex_prism", hex_prism(0.5, 0.7)),
+        ("round_cone", round_cone(0.5, 0.4, 0.15)),
+        ("round_cone_ball", round_cone(0.1, 0.6, 0.2)),
+        ("link", link(0.4, 0.35, 0.1)),
+        ("mandelbox", mandelbox(-1.5)),
+        (
+            "mandelbox_julia",
+            Mandelbox::new(2.0).julia([0.4, -0.3, 0.2]).into(),
+        ),
         ("ellipsoid", ellipsoid(dvec3(0.7, 0.4, 0.5))),
         ("mandelbulb_int", mandelbulb(8.0)),
         ("mandelbulb_trig", mandelbulb(7.3)),

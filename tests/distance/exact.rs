@@ -7,8 +7,8 @@
 use crate::common::analytic::{self, exact_distance};
 use fractal_sdf::cpu;
 use fractal_sdf::prelude::*;
-use fractal_sdf::scene::capped_cone;
 use fractal_sdf::scene::octahedron;
+use fractal_sdf::scene::{capped_cone, hex_prism, link, round_cone};
 use fractal_sdf::testing::{self, Failure, check_exact, point};
 use proptest::prelude::*;
 
@@ -63,6 +63,9 @@ exact! {
     plane_is_exact: testing::plane_node();
     octahedron_is_exact: testing::octahedron_node();
     capped_cone_is_exact: testing::capped_cone_node();
+    hex_prism_is_exact: testing::hex_prism_node();
+    round_cone_is_exact: testing::round_cone_node();
+    link_is_exact: testing::link_node();
     transformed_primitives_are_exact: testing::exact_node();
 }
 
@@ -95,7 +98,7 @@ proptest! {
 
 #[test]
 fn known_values() {
-    let cases: [(Node, DVec3, f64); 8] = [
+    let cases: [(Node, DVec3, f64); 13] = [
         (sphere(1.0), dvec3(3.0, 0.0, 0.0), 2.0),
         (cuboid(dvec3(1.0, 2.0, 3.0)), dvec3(4.0, 6.0, 3.0), 5.0),
         (cuboid(dvec3(1.0, 2.0, 3.0)), DVec3::ZERO, -1.0),
@@ -104,6 +107,14 @@ fn known_values() {
         (plane(dvec3(0.0, 2.0, 0.0), 1.0), dvec3(7.0, 2.0, 3.0), 3.0),
         (octahedron(1.0), dvec3(1.0, 1.0, 1.0), 2.0 / 3f64.sqrt()),
         (capped_cone(1.0, 1.0, 0.0), dvec3(0.0, 2.0, 0.0), 1.0),
+        // Beyond a flat side, and beyond a cap.
+        (hex_prism(1.0, 2.0), dvec3(0.0, 0.5, 3.0), 2.0),
+        (hex_prism(1.0, 2.0), dvec3(0.0, 3.0, 0.0), 1.0),
+        // Beyond the top ball, and level with the bottom one.
+        (round_cone(1.0, 1.0, 0.5), dvec3(0.0, 4.0, 0.0), 2.5),
+        (round_cone(1.0, 1.0, 0.5), dvec3(0.0, -1.0, 3.0), 2.0),
+        // Beside a straight side.
+        (link(1.0, 0.5, 0.25), dvec3(2.0, 0.5, 0.0), 1.25),
     ];
     for (node, p, expected) in cases {
         // Distances up to 5, all but one (2 / sqrt(3)) exact in binary:
@@ -139,6 +150,15 @@ fn degenerate_shapes_are_exact() {
         capped_cone(1.0, 0.0, 0.0),
         capped_cone(1.0, 1.0, 1.0),
         capped_cone(1.0, 0.0, 1.0),
+        hex_prism(0.0, 1.0),
+        hex_prism(1.0, 0.0),
+        round_cone(0.0, 1.0, 0.5),
+        round_cone(0.5, 1.0, 0.0),
+        round_cone(0.5, 0.0, 1.0),
+        round_cone(0.2, 1.0, 0.5),
+        link(0.0, 0.5, 0.25),
+        link(1.0, 0.0, 0.25),
+        link(1.0, 0.5, 0.0),
     ];
     let mut grid = Vec::new();
     for i in -4..=4 {

@@ -517,6 +517,32 @@ const NODE_FIELDS: &[(&str, &str)] = &[
         "CappedCone(half_height: 1, bottom_radius: 1, top_radius: @)",
         "top_radius",
     ),
+    ("HexPrism(radius: @, half_height: 1)", "radius"),
+    ("HexPrism(radius: 1, half_height: @)", "half_height"),
+    (
+        "RoundCone(half_height: @, bottom_radius: 1, top_radius: 0.5)",
+        "half_height",
+    ),
+    (
+        "RoundCone(half_height: 1, bottom_radius: @, top_radius: 0.5)",
+        "bottom_radius",
+    ),
+    (
+        "RoundCone(half_height: 1, bottom_radius: 1, top_radius: @)",
+        "top_radius",
+    ),
+    (
+        "Link(half_length: @, major_radius: 0.5, minor_radius: 0.1)",
+        "half_length",
+    ),
+    (
+        "Link(half_length: 1, major_radius: @, minor_radius: 0.1)",
+        "major_radius",
+    ),
+    (
+        "Link(half_length: 1, major_radius: 0.5, minor_radius: @)",
+        "minor_radius",
+    ),
     ("Ellipsoid(radii: @)", "radii"),
     ("Mandelbulb(power: @)", "power"),
     ("Mandelbulb(power: 8, iterations: @)", "iterations"),
@@ -529,6 +555,12 @@ const NODE_FIELDS: &[(&str, &str)] = &[
     ("Julia(c: (0, 0, 0, 0), slice_w: @)", "slice_w"),
     ("Sierpinski(iterations: @)", "iterations"),
     ("Sierpinski(iterations: 3, scale: @)", "scale"),
+    ("Mandelbox(scale: @)", "scale"),
+    ("Mandelbox(scale: 2, min_radius: @)", "min_radius"),
+    ("Mandelbox(scale: 2, fixed_radius: @)", "fixed_radius"),
+    ("Mandelbox(scale: 2, fold_limit: @)", "fold_limit"),
+    ("Mandelbox(scale: 2, iterations: @)", "iterations"),
+    ("Mandelbox(scale: 2, julia: Some((@, 0, 0)))", "julia"),
     ("Translate(offset: @, child: Sphere(radius: 1))", "offset"),
     (
         "Rotate(axis: (0, 1, 0), angle: @, child: Sphere(radius: 1))",

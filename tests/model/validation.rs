@@ -270,11 +270,11 @@ use fractal_sdf::scene::Mandelbulb;
 use fractal_sdf::scene::Menger;
 use fractal_sdf::scene::QuaternionJulia;
 use fractal_sdf::scene::Sierpinski;
-use fractal_sdf::scene::capped_cone;
 use fractal_sdf::scene::ellipsoid;
 use fractal_sdf::scene::octahedron;
 use fractal_sdf::scene::param3;
 use fractal_sdf::scene::{MAX_ESCAPE_ITERATIONS, MAX_FOLD_ITERATIONS};
+use fractal_sdf::scene::{capped_cone, hex_prism, link, round_cone};
 
 #[test]
 fn fractal_settings_outside_their_ranges_are_rejected() {
@@ -560,6 +560,11 @@ fn broken_node() -> impl Strategy<Value = (Node, &'static str)> {
         bad_size().prop_map(|v| (cuboid(dvec3(1.0, v, 1.0)), "cuboid")),
         bad_size().prop_map(|v| (torus(1.0, v), "torus")),
         bad_size().prop_map(|v| (capped_cone(v, 1.0, 0.5), "capped_cone")),
+        bad_size().prop_map(|v| (hex_prism(1.0, v), "hex_prism")),
+        bad_size().prop_map(|v| (round_cone(1.0, v, 0.5), "round_cone")),
+        bad_size().prop_map(|v| (link(1.0, 0.5, v), "link")),
+        outside(-4.0, 4.0).prop_map(|v| (mandelbox(v), "mandelbox")),
+        (-1.0..1.0f64).prop_map(|v| (mandelbox(v), "mandelbox")),
         bad_size().prop_map(|v| (sphere(1.0).onion(v), "onion")),
         bad_size().prop_map(|v| (sphere(1.0).smooth_union(sphere(0.5), v), "smooth_union")),
         bad_size().prop_map(|v| (ellipsoid(dvec3(v, 1.0, 1.0)), "ellipsoid")),

@@ -157,6 +157,38 @@ real sd_capped_cone(real3 p, real h, real r1, real r2) {
     return (((t6 < R(0.0)) && (t4 < R(0.0))) ? (-R(1.0)) : R(1.0)) * sqrt(fmin((t3 * t3) + (t4 * t4), (t6 * t6) + (t7 * t7)));
 }
 
+/* ---- hex_prism ---- */
+real sd_hex_prism(real3 p, real r, real h) {
+    real3 t0 = fabs(p);
+    real t1 = R(2.0) * fmin(((-R(0.8660254037844386)) * t0.x) + (R(0.5) * t0.z), R(0.0));
+    real t2 = t0.x - (t1 * (-R(0.8660254037844386)));
+    real t3 = R(0.5773502691896258) * r;
+    real t4 = (t0.z - (t1 * R(0.5))) - r;
+    real t5 = hypot(t2 - fmin(fmax(t2, -t3), t3), t4);
+    real t6 = (t4 < R(0.0)) ? (-t5) : t5;
+    real t7 = t0.y - h;
+    return fmin(fmax(t6, t7), R(0.0)) + hypot(fmax(t6, R(0.0)), fmax(t7, R(0.0)));
+}
+
+/* ---- round_cone ---- */
+real sd_round_cone(real3 p, real h, real r1, real r2) {
+    real t0 = R(2.0) * h;
+    real t1 = hypot(p.x, p.z);
+    real t2 = p.y + h;
+    real t3 = hypot(t1, t2) - r1;
+    real t4 = hypot(t1, t2 - t0) - r2;
+    real t5 = r1 - r2;
+    real t6 = t5 / fmax(t0, R(1e-30));
+    real t7 = sqrt(fmax(R(1.0) - (t6 * t6), R(0.0)));
+    real t8 = ((-t6) * t1) + (t7 * t2);
+    return (t0 <= fabs(t5)) ? fmin(t3, t4) : ((t8 < R(0.0)) ? t3 : (((t7 * t0) < t8) ? t4 : (((t7 * t1) + (t6 * t2)) - r1)));
+}
+
+/* ---- link ---- */
+real sd_link(real3 p, real le, real r1, real r2) {
+    return hypot(hypot(p.x, fmax(fabs(p.y) - le, R(0.0))) - r1, p.z) - r2;
+}
+
 /* ---- ellipsoid ---- */
 real sd_ellipsoid(real3 p, real3 r) {
     real3 t0 = p / r;
@@ -174,104 +206,139 @@ real sd_ellipsoid(real3 p, real3 r) {
 real DE(real3 p0, __global const real* params) {
     /* union */
     /* union/b:color/plane */
-    real d35 = sd_plane(p0, (real3)(0.0f, 1.0f, 0.0f), 0.4f);
+    real d48 = sd_plane(p0, (real3)(0.0f, 1.0f, 0.0f), 0.4f);
     /* union: the second operand only within reach of its bound */
-    real u37 = d35;
-    real g37 = (length(p0 - ((real3)(-R(1.9), R(0.0), -R(0.6)))) * R(0.9999)) - R(0.35);
-    if (!(g37 > u37 && g37 > R(0.0))) {
+    real u50 = d48;
+    real g50 = (length(p0 - ((real3)(-R(2.125), R(0.0), -R(0.6)))) * R(0.9999)) - R(0.35);
+    if (!(g50 > u50 && g50 > R(0.0))) {
         /* .../a:union/a:union/a:translate */
-        real3 p1 = p0 - ((real3)(-R(1.9), R(0.0), -R(0.6)));
+        real3 p1 = p0 - ((real3)(-R(2.125), R(0.0), -R(0.6)));
         /* .../a:translate/color/sphere */
         real d0 = sd_sphere(p1, 0.35f);
-        real d37 = fmin(d35, d0);
-        u37 = d37;
+        real d50 = fmin(d48, d0);
+        u50 = d50;
     }
     /* union/a:union: the second operand only within reach of its bound */
-    real u34 = u37;
-    real g34 = (length(p0 - ((real3)(-R(0.95), R(0.0), -R(0.6)))) * R(0.9999)) - R(0.5196152422706632);
-    if (!(g34 > u34 && g34 > R(0.0))) {
+    real u47 = u50;
+    real g47 = (length(p0 - ((real3)(-R(1.275), R(0.0), -R(0.6)))) * R(0.9999)) - R(0.5196152422706632);
+    if (!(g47 > u47 && g47 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p2 = p0 - ((real3)(-R(0.95), R(0.0), -R(0.6)));
+        real3 p2 = p0 - ((real3)(-R(1.275), R(0.0), -R(0.6)));
         /* .../b:translate/color/cuboid */
         real d3 = sd_box(p2, (real3)(0.3f));
-        real d34 = fmin(u37, d3);
+        real d47 = fmin(u50, d3);
+        u47 = d47;
+    }
+    /* .../a:union/a:union: the second operand only within reach of its bound */
+    real u42 = u47;
+    real g42 = (length(p0 - ((real3)(-R(0.425), R(0.0), -R(0.6)))) * R(0.9999)) - R(0.5196152422706632);
+    if (!(g42 > u42 && g42 > R(0.0))) {
+        /* .../a:union/a:union/b:translate */
+        real3 p3 = p0 - ((real3)(-R(0.425), R(0.0), -R(0.6)));
+        /* .../b:translate/color/round_box */
+        real d7 = sd_round_box(p3, (real3)(0.3f), 0.08f);
+        real d42 = fmin(u47, d7);
+        u42 = d42;
+    }
+    /* .../a:union/a:union: the second operand only within reach of its bound */
+    real u38 = u42;
+    real g38 = (length(p0 - ((real3)(R(0.425), R(0.0), -R(0.6)))) * R(0.9999)) - R(0.38);
+    if (!(g38 > u38 && g38 > R(0.0))) {
+        /* .../a:union/a:union/b:translate */
+        real3 p4 = p0 - ((real3)(R(0.425), R(0.0), -R(0.6)));
+        /* .../b:translate/color/torus */
+        real d11 = sd_torus(p4, 0.28f, 0.1f);
+        real d38 = fmin(u42, d11);
+        u38 = d38;
+    }
+    /* .../a:union/a:union: the second operand only within reach of its bound */
+    real u34 = u38;
+    real g34 = (length(p0 - ((real3)(R(1.275), R(0.0), -R(0.6)))) * R(0.9999)) - R(0.4301162633521313);
+    if (!(g34 > u34 && g34 > R(0.0))) {
+        /* .../a:union/a:union/b:translate */
+        real3 p5 = p0 - ((real3)(R(1.275), R(0.0), -R(0.6)));
+        /* .../b:translate/color/cylinder */
+        real d15 = sd_cylinder(p5, 0.25f, 0.35f);
+        real d34 = fmin(u38, d15);
         u34 = d34;
     }
     /* .../a:union/a:union: the second operand only within reach of its bound */
     real u30 = u34;
-    real g30 = (length(p0 - ((real3)(R(0.0), R(0.0), -R(0.6)))) * R(0.9999)) - R(0.5196152422706632);
+    real g30 = (length(p0 - ((real3)(R(2.125), R(0.0), -R(0.6)))) * R(0.9999)) - R(0.38);
     if (!(g30 > u30 && g30 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p3 = p0 - ((real3)(R(0.0), R(0.0), -R(0.6)));
-        /* .../b:translate/color/round_box */
-        real d7 = sd_round_box(p3, (real3)(0.3f), 0.08f);
-        real d30 = fmin(u34, d7);
+        real3 p6 = p0 - ((real3)(R(2.125), R(0.0), -R(0.6)));
+        /* .../b:translate/color/capsule */
+        real d19 = sd_capsule(p6, (real3)(0.0f, (-0.2f), 0.0f), (real3)(0.0f, 0.2f, 0.0f), 0.18f);
+        real d30 = fmin(u34, d19);
         u30 = d30;
     }
     /* .../a:union/a:union: the second operand only within reach of its bound */
     real u26 = u30;
-    real g26 = (length(p0 - ((real3)(R(0.95), R(0.0), -R(0.6)))) * R(0.9999)) - R(0.38);
+    real g26 = (length(p0 - ((real3)(-R(2.125), R(0.0), R(0.6)))) * R(0.9999)) - R(0.4);
     if (!(g26 > u26 && g26 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p4 = p0 - ((real3)(R(0.95), R(0.0), -R(0.6)));
-        /* .../b:translate/color/torus */
-        real d11 = sd_torus(p4, 0.28f, 0.1f);
-        real d26 = fmin(u30, d11);
+        real3 p7 = p0 - ((real3)(-R(2.125), R(0.0), R(0.6)));
+        /* .../b:translate/color/octahedron */
+        real d23 = sd_octahedron(p7, 0.4f);
+        real d26 = fmin(u30, d23);
         u26 = d26;
     }
     /* .../a:union/a:union: the second operand only within reach of its bound */
     real u22 = u26;
-    real g22 = (length(p0 - ((real3)(R(1.9), R(0.0), -R(0.6)))) * R(0.9999)) - R(0.4301162633521313);
+    real g22 = (length(p0 - ((real3)(-R(1.275), R(0.0), R(0.6)))) * R(0.9999)) - R(0.4609772228646443);
     if (!(g22 > u22 && g22 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p5 = p0 - ((real3)(R(1.9), R(0.0), -R(0.6)));
-        /* .../b:translate/color/cylinder */
-        real d15 = sd_cylinder(p5, 0.25f, 0.35f);
-        real d22 = fmin(u26, d15);
+        real3 p8 = p0 - ((real3)(-R(1.275), R(0.0), R(0.6)));
+        /* .../b:translate/color/capped_cone */
+        real d27 = sd_capped_cone(p8, 0.35f, 0.3f, 0.1f);
+        real d22 = fmin(u26, d27);
         u22 = d22;
     }
     /* .../a:union/a:union: the second operand only within reach of its bound */
     real u18 = u22;
-    real g18 = (length(p0 - ((real3)(-R(1.4249999999999998), R(0.0), R(0.6)))) * R(0.9999)) - R(0.38);
+    real g18 = R(0.5714285714285715) * ((length(p0 - ((real3)(-R(0.425), R(0.0), R(0.6)))) * R(0.9999)) - R(0.35));
     if (!(g18 > u18 && g18 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p6 = p0 - ((real3)(-R(1.4249999999999998), R(0.0), R(0.6)));
-        /* .../b:translate/color/capsule */
-        real d19 = sd_capsule(p6, (real3)(0.0f, (-0.2f), 0.0f), (real3)(0.0f, 0.2f, 0.0f), 0.18f);
-        real d18 = fmin(u22, d19);
+        real3 p9 = p0 - ((real3)(-R(0.425), R(0.0), R(0.6)));
+        /* .../b:translate/color/ellipsoid */
+        real d31 = sd_ellipsoid(p9, (real3)(0.35f, 0.2f, 0.25f));
+        real d18 = fmin(u22, d31);
         u18 = d18;
     }
     /* .../a:union/a:union: the second operand only within reach of its bound */
     real u14 = u18;
-    real g14 = (length(p0 - ((real3)(-R(0.475), R(0.0), R(0.6)))) * R(0.9999)) - R(0.4);
+    real g14 = (length(p0 - ((real3)(R(0.425), R(0.0), R(0.6)))) * R(0.9999)) - R(0.4410593308539491);
     if (!(g14 > u14 && g14 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p7 = p0 - ((real3)(-R(0.475), R(0.0), R(0.6)));
-        /* .../b:translate/color/octahedron */
-        real d23 = sd_octahedron(p7, 0.4f);
-        real d14 = fmin(u18, d23);
+        real3 p10 = p0 - ((real3)(R(0.425), R(0.0), R(0.6)));
+        /* .../b:translate/color/hex_prism */
+        real d35 = sd_hex_prism(p10, 0.28f, 0.3f);
+        real d14 = fmin(u18, d35);
         u14 = d14;
     }
     /* .../a:union/a:union: the second operand only within reach of its bound */
     real u10 = u14;
-    real g10 = (length(p0 - ((real3)(R(0.475), R(0.0), R(0.6)))) * R(0.9999)) - R(0.4609772228646443);
+    real g10 = (length(p0 - ((real3)(R(1.275), R(0.0), R(0.6)))) * R(0.9999)) - R(0.44);
     if (!(g10 > u10 && g10 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p8 = p0 - ((real3)(R(0.475), R(0.0), R(0.6)));
-        /* .../b:translate/color/capped_cone */
-        real d27 = sd_capped_cone(p8, 0.35f, 0.3f, 0.1f);
-        real d10 = fmin(u14, d27);
+        real3 p11 = p0 - ((real3)(R(1.275), R(0.0), R(0.6)));
+        /* .../b:translate/color/round_cone */
+        real d39 = sd_round_cone(p11, 0.22f, 0.22f, 0.1f);
+        real d10 = fmin(u14, d39);
         u10 = d10;
     }
     /* .../a:union/a:union: the second operand only within reach of its bound */
     real u6 = u10;
-    real g6 = R(0.5714285714285715) * ((length(p0 - ((real3)(R(1.4249999999999998), R(0.0), R(0.6)))) * R(0.9999)) - R(0.35));
+    real g6 = (length(p0 - ((real3)(R(2.125), R(0.0), R(0.6)))) * R(0.9999)) - R(0.41000000000000003);
     if (!(g6 > u6 && g6 > R(0.0))) {
         /* union/a:union/b:translate */
-        real3 p9 = p0 - ((real3)(R(1.4249999999999998), R(0.0), R(0.6)));
-        /* .../b:translate/color/ellipsoid */
-        real d31 = sd_ellipsoid(p9, (real3)(0.35f, 0.2f, 0.25f));
-        real d6 = fmin(u10, d31);
+        real3 p12 = p0 - ((real3)(R(2.125), R(0.0), R(0.6)));
+        /* .../b:translate/color/rotate */
+        real3 p13 = (real3)((R(0.8775825618903728) * p12.x) - (R(0.479425538604203) * p12.z), p12.y, (R(0.479425538604203) * p12.x) + (R(0.8775825618903728) * p12.z));
+        /* .../color/rotate/link */
+        real d43 = sd_link(p13, 0.14f, 0.2f, 0.07f);
+        real d6 = fmin(u10, d43);
         u6 = d6;
     }
     return u6;
@@ -280,42 +347,99 @@ real DE(real3 p0, __global const real* params) {
 real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     /* union */
     /* union/b:color/plane */
-    real d35 = sd_plane(p0, (real3)(0.0f, 1.0f, 0.0f), 0.4f);
+    real d48 = sd_plane(p0, (real3)(0.0f, 1.0f, 0.0f), 0.4f);
     /* union/b:color */
-    real3 c36 = (real3)(0.55f, 0.55f, 0.6f);
+    real3 c49 = (real3)(0.55f, 0.55f, 0.6f);
     /* union: the second operand only within reach of its bound */
-    real u37 = d35;
-    real3 uc37 = c36;
-    real ut37 = R(1.0);
-    real g37 = (length(p0 - ((real3)(-R(1.9), R(0.0), -R(0.6)))) * R(0.9999)) - R(0.35);
-    if (!(g37 > u37 && g37 > R(0.0))) {
+    real u50 = d48;
+    real3 uc50 = c49;
+    real ut50 = R(1.0);
+    real g50 = (length(p0 - ((real3)(-R(2.125), R(0.0), -R(0.6)))) * R(0.9999)) - R(0.35);
+    if (!(g50 > u50 && g50 > R(0.0))) {
         /* .../a:union/a:union/a:translate */
-        real3 p1 = p0 - ((real3)(-R(1.9), R(0.0), -R(0.6)));
+        real3 p1 = p0 - ((real3)(-R(2.125), R(0.0), -R(0.6)));
         /* .../a:translate/color/sphere */
         real d0 = sd_sphere(p1, 0.35f);
         /* .../a:union/a:translate/color */
         real3 c1 = (real3)(0.9f, 0.45f, 0.3f);
-        real d37 = fmin(d35, d0);
-        real3 c37 = d35 < d0 ? c36 : c1;
-        u37 = d37;
-        uc37 = c37;
-        ut37 = R(1.0);
+        real d50 = fmin(d48, d0);
+        real3 c50 = d48 < d0 ? c49 : c1;
+        u50 = d50;
+        uc50 = c50;
+        ut50 = R(1.0);
     }
     /* union/a:union: the second operand only within reach of its bound */
-    real u34 = u37;
-    real3 uc34 = uc37;
-    real ut34 = ut37;
-    real g34 = (length(p0 - ((real3)(-R(0.95), R(0.0), -R(0.6)))) * R(0.9999)) - R(0.5196152422706632);
-    if (!(g34 > u34 && g34 > R(0.0))) {
+    real u47 = u50;
+    real3 uc47 = uc50;
+    real ut47 = ut50;
+    real g47 = (length(p0 - ((real3)(-R(1.275), R(0.0), -R(0.6)))) * R(0.9999)) - R(0.5196152422706632);
+    if (!(g47 > u47 && g47 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p2 = p0 - ((real3)(-R(0.95), R(0.0), -R(0.6)));
+        real3 p2 = p0 - ((real3)(-R(1.275), R(0.0), -R(0.6)));
         /* .../b:translate/color/cuboid */
         real d3 = sd_box(p2, (real3)(0.3f));
         /* .../a:union/b:translate/color */
-        real3 c4 = (real3)(0.825f, 0.5375f, 0.375f);
-        real d34 = fmin(u37, d3);
-        real3 c34 = u37 < d3 ? uc37 : c4;
-        real t34 = u37 < d3 ? ut37 : R(1.0);
+        real3 c4 = (real3)(0.8454546f, 0.51363635f, 0.35454544f);
+        real d47 = fmin(u50, d3);
+        real3 c47 = u50 < d3 ? uc50 : c4;
+        real t47 = u50 < d3 ? ut50 : R(1.0);
+        u47 = d47;
+        uc47 = c47;
+        ut47 = t47;
+    }
+    /* .../a:union/a:union: the second operand only within reach of its bound */
+    real u42 = u47;
+    real3 uc42 = uc47;
+    real ut42 = ut47;
+    real g42 = (length(p0 - ((real3)(-R(0.425), R(0.0), -R(0.6)))) * R(0.9999)) - R(0.5196152422706632);
+    if (!(g42 > u42 && g42 > R(0.0))) {
+        /* .../a:union/a:union/b:translate */
+        real3 p3 = p0 - ((real3)(-R(0.425), R(0.0), -R(0.6)));
+        /* .../b:translate/color/round_box */
+        real d7 = sd_round_box(p3, (real3)(0.3f), 0.08f);
+        /* .../a:union/b:translate/color */
+        real3 c8 = (real3)(0.7909091f, 0.5772727f, 0.4090909f);
+        real d42 = fmin(u47, d7);
+        real3 c42 = u47 < d7 ? uc47 : c8;
+        real t42 = u47 < d7 ? ut47 : R(1.0);
+        u42 = d42;
+        uc42 = c42;
+        ut42 = t42;
+    }
+    /* .../a:union/a:union: the second operand only within reach of its bound */
+    real u38 = u42;
+    real3 uc38 = uc42;
+    real ut38 = ut42;
+    real g38 = (length(p0 - ((real3)(R(0.425), R(0.0), -R(0.6)))) * R(0.9999)) - R(0.38);
+    if (!(g38 > u38 && g38 > R(0.0))) {
+        /* .../a:union/a:union/b:translate */
+        real3 p4 = p0 - ((real3)(R(0.425), R(0.0), -R(0.6)));
+        /* .../b:translate/color/torus */
+        real d11 = sd_torus(p4, 0.28f, 0.1f);
+        /* .../a:union/b:translate/color */
+        real3 c12 = (real3)(0.73636365f, 0.6409091f, 0.46363637f);
+        real d38 = fmin(u42, d11);
+        real3 c38 = u42 < d11 ? uc42 : c12;
+        real t38 = u42 < d11 ? ut42 : R(1.0);
+        u38 = d38;
+        uc38 = c38;
+        ut38 = t38;
+    }
+    /* .../a:union/a:union: the second operand only within reach of its bound */
+    real u34 = u38;
+    real3 uc34 = uc38;
+    real ut34 = ut38;
+    real g34 = (length(p0 - ((real3)(R(1.275), R(0.0), -R(0.6)))) * R(0.9999)) - R(0.4301162633521313);
+    if (!(g34 > u34 && g34 > R(0.0))) {
+        /* .../a:union/a:union/b:translate */
+        real3 p5 = p0 - ((real3)(R(1.275), R(0.0), -R(0.6)));
+        /* .../b:translate/color/cylinder */
+        real d15 = sd_cylinder(p5, 0.25f, 0.35f);
+        /* .../a:union/b:translate/color */
+        real3 c16 = (real3)(0.6818182f, 0.70454544f, 0.5181818f);
+        real d34 = fmin(u38, d15);
+        real3 c34 = u38 < d15 ? uc38 : c16;
+        real t34 = u38 < d15 ? ut38 : R(1.0);
         u34 = d34;
         uc34 = c34;
         ut34 = t34;
@@ -324,17 +448,17 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     real u30 = u34;
     real3 uc30 = uc34;
     real ut30 = ut34;
-    real g30 = (length(p0 - ((real3)(R(0.0), R(0.0), -R(0.6)))) * R(0.9999)) - R(0.5196152422706632);
+    real g30 = (length(p0 - ((real3)(R(2.125), R(0.0), -R(0.6)))) * R(0.9999)) - R(0.38);
     if (!(g30 > u30 && g30 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p3 = p0 - ((real3)(R(0.0), R(0.0), -R(0.6)));
-        /* .../b:translate/color/round_box */
-        real d7 = sd_round_box(p3, (real3)(0.3f), 0.08f);
+        real3 p6 = p0 - ((real3)(R(2.125), R(0.0), -R(0.6)));
+        /* .../b:translate/color/capsule */
+        real d19 = sd_capsule(p6, (real3)(0.0f, (-0.2f), 0.0f), (real3)(0.0f, 0.2f, 0.0f), 0.18f);
         /* .../a:union/b:translate/color */
-        real3 c8 = (real3)(0.75f, 0.625f, 0.45f);
-        real d30 = fmin(u34, d7);
-        real3 c30 = u34 < d7 ? uc34 : c8;
-        real t30 = u34 < d7 ? ut34 : R(1.0);
+        real3 c20 = (real3)(0.6272727f, 0.7681818f, 0.57272726f);
+        real d30 = fmin(u34, d19);
+        real3 c30 = u34 < d19 ? uc34 : c20;
+        real t30 = u34 < d19 ? ut34 : R(1.0);
         u30 = d30;
         uc30 = c30;
         ut30 = t30;
@@ -343,17 +467,17 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     real u26 = u30;
     real3 uc26 = uc30;
     real ut26 = ut30;
-    real g26 = (length(p0 - ((real3)(R(0.95), R(0.0), -R(0.6)))) * R(0.9999)) - R(0.38);
+    real g26 = (length(p0 - ((real3)(-R(2.125), R(0.0), R(0.6)))) * R(0.9999)) - R(0.4);
     if (!(g26 > u26 && g26 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p4 = p0 - ((real3)(R(0.95), R(0.0), -R(0.6)));
-        /* .../b:translate/color/torus */
-        real d11 = sd_torus(p4, 0.28f, 0.1f);
+        real3 p7 = p0 - ((real3)(-R(2.125), R(0.0), R(0.6)));
+        /* .../b:translate/color/octahedron */
+        real d23 = sd_octahedron(p7, 0.4f);
         /* .../a:union/b:translate/color */
-        real3 c12 = (real3)(0.675f, 0.7125f, 0.525f);
-        real d26 = fmin(u30, d11);
-        real3 c26 = u30 < d11 ? uc30 : c12;
-        real t26 = u30 < d11 ? ut30 : R(1.0);
+        real3 c24 = (real3)(0.57272726f, 0.7681818f, 0.6272727f);
+        real d26 = fmin(u30, d23);
+        real3 c26 = u30 < d23 ? uc30 : c24;
+        real t26 = u30 < d23 ? ut30 : R(1.0);
         u26 = d26;
         uc26 = c26;
         ut26 = t26;
@@ -362,17 +486,17 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     real u22 = u26;
     real3 uc22 = uc26;
     real ut22 = ut26;
-    real g22 = (length(p0 - ((real3)(R(1.9), R(0.0), -R(0.6)))) * R(0.9999)) - R(0.4301162633521313);
+    real g22 = (length(p0 - ((real3)(-R(1.275), R(0.0), R(0.6)))) * R(0.9999)) - R(0.4609772228646443);
     if (!(g22 > u22 && g22 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p5 = p0 - ((real3)(R(1.9), R(0.0), -R(0.6)));
-        /* .../b:translate/color/cylinder */
-        real d15 = sd_cylinder(p5, 0.25f, 0.35f);
+        real3 p8 = p0 - ((real3)(-R(1.275), R(0.0), R(0.6)));
+        /* .../b:translate/color/capped_cone */
+        real d27 = sd_capped_cone(p8, 0.35f, 0.3f, 0.1f);
         /* .../a:union/b:translate/color */
-        real3 c16 = (real3)(0.6f, 0.8f, 0.6f);
-        real d22 = fmin(u26, d15);
-        real3 c22 = u26 < d15 ? uc26 : c16;
-        real t22 = u26 < d15 ? ut26 : R(1.0);
+        real3 c28 = (real3)(0.5181818f, 0.70454544f, 0.6818182f);
+        real d22 = fmin(u26, d27);
+        real3 c22 = u26 < d27 ? uc26 : c28;
+        real t22 = u26 < d27 ? ut26 : R(1.0);
         u22 = d22;
         uc22 = c22;
         ut22 = t22;
@@ -381,17 +505,17 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     real u18 = u22;
     real3 uc18 = uc22;
     real ut18 = ut22;
-    real g18 = (length(p0 - ((real3)(-R(1.4249999999999998), R(0.0), R(0.6)))) * R(0.9999)) - R(0.38);
+    real g18 = R(0.5714285714285715) * ((length(p0 - ((real3)(-R(0.425), R(0.0), R(0.6)))) * R(0.9999)) - R(0.35));
     if (!(g18 > u18 && g18 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p6 = p0 - ((real3)(-R(1.4249999999999998), R(0.0), R(0.6)));
-        /* .../b:translate/color/capsule */
-        real d19 = sd_capsule(p6, (real3)(0.0f, (-0.2f), 0.0f), (real3)(0.0f, 0.2f, 0.0f), 0.18f);
+        real3 p9 = p0 - ((real3)(-R(0.425), R(0.0), R(0.6)));
+        /* .../b:translate/color/ellipsoid */
+        real d31 = sd_ellipsoid(p9, (real3)(0.35f, 0.2f, 0.25f));
         /* .../a:union/b:translate/color */
-        real3 c20 = (real3)(0.525f, 0.7125f, 0.675f);
-        real d18 = fmin(u22, d19);
-        real3 c18 = u22 < d19 ? uc22 : c20;
-        real t18 = u22 < d19 ? ut22 : R(1.0);
+        real3 c32 = (real3)(0.46363637f, 0.6409091f, 0.73636365f);
+        real d18 = fmin(u22, d31);
+        real3 c18 = u22 < d31 ? uc22 : c32;
+        real t18 = u22 < d31 ? ut22 : R(1.0);
         u18 = d18;
         uc18 = c18;
         ut18 = t18;
@@ -400,17 +524,17 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     real u14 = u18;
     real3 uc14 = uc18;
     real ut14 = ut18;
-    real g14 = (length(p0 - ((real3)(-R(0.475), R(0.0), R(0.6)))) * R(0.9999)) - R(0.4);
+    real g14 = (length(p0 - ((real3)(R(0.425), R(0.0), R(0.6)))) * R(0.9999)) - R(0.4410593308539491);
     if (!(g14 > u14 && g14 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p7 = p0 - ((real3)(-R(0.475), R(0.0), R(0.6)));
-        /* .../b:translate/color/octahedron */
-        real d23 = sd_octahedron(p7, 0.4f);
+        real3 p10 = p0 - ((real3)(R(0.425), R(0.0), R(0.6)));
+        /* .../b:translate/color/hex_prism */
+        real d35 = sd_hex_prism(p10, 0.28f, 0.3f);
         /* .../a:union/b:translate/color */
-        real3 c24 = (real3)(0.45f, 0.625f, 0.75f);
-        real d14 = fmin(u18, d23);
-        real3 c14 = u18 < d23 ? uc18 : c24;
-        real t14 = u18 < d23 ? ut18 : R(1.0);
+        real3 c36 = (real3)(0.4090909f, 0.5772727f, 0.7909091f);
+        real d14 = fmin(u18, d35);
+        real3 c14 = u18 < d35 ? uc18 : c36;
+        real t14 = u18 < d35 ? ut18 : R(1.0);
         u14 = d14;
         uc14 = c14;
         ut14 = t14;
@@ -419,17 +543,17 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     real u10 = u14;
     real3 uc10 = uc14;
     real ut10 = ut14;
-    real g10 = (length(p0 - ((real3)(R(0.475), R(0.0), R(0.6)))) * R(0.9999)) - R(0.4609772228646443);
+    real g10 = (length(p0 - ((real3)(R(1.275), R(0.0), R(0.6)))) * R(0.9999)) - R(0.44);
     if (!(g10 > u10 && g10 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p8 = p0 - ((real3)(R(0.475), R(0.0), R(0.6)));
-        /* .../b:translate/color/capped_cone */
-        real d27 = sd_capped_cone(p8, 0.35f, 0.3f, 0.1f);
+        real3 p11 = p0 - ((real3)(R(1.275), R(0.0), R(0.6)));
+        /* .../b:translate/color/round_cone */
+        real d39 = sd_round_cone(p11, 0.22f, 0.22f, 0.1f);
         /* .../a:union/b:translate/color */
-        real3 c28 = (real3)(0.375f, 0.5375f, 0.825f);
-        real d10 = fmin(u14, d27);
-        real3 c10 = u14 < d27 ? uc14 : c28;
-        real t10 = u14 < d27 ? ut14 : R(1.0);
+        real3 c40 = (real3)(0.35454544f, 0.51363635f, 0.8454546f);
+        real d10 = fmin(u14, d39);
+        real3 c10 = u14 < d39 ? uc14 : c40;
+        real t10 = u14 < d39 ? ut14 : R(1.0);
         u10 = d10;
         uc10 = c10;
         ut10 = t10;
@@ -438,17 +562,19 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     real u6 = u10;
     real3 uc6 = uc10;
     real ut6 = ut10;
-    real g6 = R(0.5714285714285715) * ((length(p0 - ((real3)(R(1.4249999999999998), R(0.0), R(0.6)))) * R(0.9999)) - R(0.35));
+    real g6 = (length(p0 - ((real3)(R(2.125), R(0.0), R(0.6)))) * R(0.9999)) - R(0.41000000000000003);
     if (!(g6 > u6 && g6 > R(0.0))) {
         /* union/a:union/b:translate */
-        real3 p9 = p0 - ((real3)(R(1.4249999999999998), R(0.0), R(0.6)));
-        /* .../b:translate/color/ellipsoid */
-        real d31 = sd_ellipsoid(p9, (real3)(0.35f, 0.2f, 0.25f));
+        real3 p12 = p0 - ((real3)(R(2.125), R(0.0), R(0.6)));
+        /* .../b:translate/color/rotate */
+        real3 p13 = (real3)((R(0.8775825618903728) * p12.x) - (R(0.479425538604203) * p12.z), p12.y, (R(0.479425538604203) * p12.x) + (R(0.8775825618903728) * p12.z));
+        /* .../color/rotate/link */
+        real d43 = sd_link(p13, 0.14f, 0.2f, 0.07f);
         /* .../a:union/b:translate/color */
-        real3 c32 = (real3)(0.3f, 0.45f, 0.9f);
-        real d6 = fmin(u10, d31);
-        real3 c6 = u10 < d31 ? uc10 : c32;
-        real t6 = u10 < d31 ? ut10 : R(1.0);
+        real3 c45 = (real3)(0.3f, 0.45f, 0.9f);
+        real d6 = fmin(u10, d43);
+        real3 c6 = u10 < d43 ? uc10 : c45;
+        real t6 = u10 < d43 ? ut10 : R(1.0);
         u6 = d6;
         uc6 = c6;
         ut6 = t6;

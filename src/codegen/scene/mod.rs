@@ -90,6 +90,9 @@ fn leaf_function(node: &IrNode) -> Option<(Helper, &'static str)> {
         Kind::Plane { .. } => (Helper::Plane, "sd_plane"),
         Kind::Octahedron { .. } => (Helper::Octahedron, "sd_octahedron"),
         Kind::CappedCone { .. } => (Helper::CappedCone, "sd_capped_cone"),
+        Kind::HexPrism { .. } => (Helper::HexPrism, "sd_hex_prism"),
+        Kind::RoundCone { .. } => (Helper::RoundCone, "sd_round_cone"),
+        Kind::Link { .. } => (Helper::Link, "sd_link"),
         Kind::Ellipsoid { .. } => (Helper::Ellipsoid, "sd_ellipsoid"),
         _ => return None,
     })
