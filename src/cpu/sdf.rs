@@ -42,7 +42,9 @@ pub fn round_box<T: Num>(p: V3<T>, b: V3<T>, r: T) -> T {
     q.max_s(T::zero()).length() + q.max_element().min(T::zero()) - r
 }
 
-/// Exact distance to a torus around the y axis.
+/// Exact distance to a torus around the y axis where `minor <= major`
+/// (the distance to the tube's centre circle minus `minor`); a thicker
+/// torus overlaps itself around the axis, and there this is a bound.
 #[must_use]
 pub fn torus<T: Num>(p: V3<T>, major: T, minor: T) -> T {
     let qx = p.x.hypot(p.z) - major;

@@ -43,7 +43,8 @@ pub fn round_box(half_extents: impl Into<Param3>, radius: impl Into<Param>) -> N
     .into()
 }
 
-/// A torus around the y axis.
+/// A torus around the y axis (exact where `minor_radius <=
+/// major_radius`).
 #[must_use]
 pub fn torus(major_radius: impl Into<Param>, minor_radius: impl Into<Param>) -> Node {
     Kind::Torus {

@@ -95,7 +95,9 @@ pub enum Kind<S, V, C> {
         /// Edge radius, from 0 to the smallest half extent.
         radius: S,
     },
-    /// A torus around the y axis. Exact.
+    /// A torus around the y axis. Exact where `minor_radius <=
+    /// major_radius`; a thicker torus overlaps itself around the axis,
+    /// where the distance is a bound.
     Torus {
         /// Distance from the centre to the middle of the tube.
         major_radius: S,

@@ -130,12 +130,16 @@ pub fn round_box_node() -> impl Strategy<Value = Node> + Clone {
     (vector(size(MAX_SIZE)), 0.0..=1.0f64).prop_map(|(b, f)| round_box(b, f * b.min_element()))
 }
 
-/// A torus: major radius in `[0, 1.5]`, minor radius in `[0, 0.6]`.
+/// A torus: major radius in `[0, 1.5]`, minor radius in `[0, 0.6]` and at
+/// most the major one (where the torus is exact).
 pub fn torus_node() -> impl Strategy<Value = Node> + Clone {
-    (
-        scalar("torus.major_radius", size(MAX_SIZE)),
-        scalar("torus.minor_radius", size(0.6)),
-    )
+    (size(MAX_SIZE), size(0.6))
+        .prop_flat_map(|(major, minor)| {
+            (
+                scalar("torus.major_radius", Just(major)),
+                scalar("torus.minor_radius", Just(minor.min(major))),
+            )
+        })
         .prop_map(|(major, minor)| torus(major, minor))
 }
 

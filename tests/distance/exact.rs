@@ -177,6 +177,25 @@ fn degenerate_shapes_are_exact() {
     }
 }
 
+/// A torus whose tube is thicker than its major radius overlaps itself
+/// around the axis: there the formula is a bound, not the distance (which
+/// is why the exact tests draw `minor <= major`). At the centre of
+/// `torus(0.1, 0.5)` the formula gives `0.1 - 0.5` while the surface is
+/// `sqrt(0.5² - 0.1²)` away along the axis; everywhere it never
+/// overestimates the distance to the points within 0.5 of the circle.
+#[test]
+fn a_self_overlapping_torus_is_a_bound() {
+    let node = torus(0.1, 0.5);
+    let eval = cpu::Evaluator::new(&node).unwrap();
+    let centre = eval.distance(DVec3::ZERO);
+    let depth = (0.5f64 * 0.5 - 0.1 * 0.1).sqrt();
+    assert!((centre + 0.4).abs() < 1e-15, "{centre}");
+    assert!(-centre < depth, "{centre} against the depth {depth}");
+    let inside = |p: DVec3| analytic::circle_distance(p, 0.1) <= 0.5;
+    let points = testing::near_surface_points(inside, 1.0, 0.3, 256, 7);
+    testing::check_never_overestimates(&node, inside, &points, 32).unwrap();
+}
+
 #[test]
 fn the_oracle_agrees_with_brute_force_on_the_ellipsoid_of_a_sphere() {
     // The numerical ellipsoid distance used by the bound tests, checked on
