@@ -65,10 +65,16 @@ pub fn mandelbulb_radius<T: Num>(power: T) -> T {
 /// last. In Julia mode that is also the half side. In Mandelbrot mode
 /// (`c = p`), follow one coordinate `x > L` of `p` alone (the sphere fold
 /// only scales it further): with a negative scale `x' = |s| (x − 2L) + x
-/// > x` once `x > 2L`; with a positive one the sign alternates and two
-/// steps give `|x''| > x` once `x > 2L (s + 1) / (s − 1)`. Either way the
-/// orbit then grows without bound, so those are the half sides, and
-/// inside the cube `|c|∞` is at most the half side.
+/// > x` once `x > 2L`, and the same holds at every later step (the
+/// coordinate stays above `x`, and each step adds at least `|s| (x − 2L)`);
+/// with a positive one the sign alternates: from `m > 2L` on the positive
+/// side, `m' = s (m − 2L) − x` on the negative one, and from there `m'' =
+/// s (m' − 2L) + x`, so `m'' − m = (s² − 1) (m − T)` with `T = 2Ls / (s − 1)
+/// + x / (s + 1)`. Starting at `m = x > 2L (s + 1) / (s − 1)` puts `m`
+/// above `T` and `m' = (s − 1) x − 2Ls` above `2L` (so each fold reflects
+/// as written), and `m` only grows from there, each two steps by more
+/// than the last. Either way the orbit grows without bound, so those are
+/// the half sides, and inside the cube `|c|∞` is at most the half side.
 ///
 /// ```
 /// use fractal_sdf::math::mandelbox_extent;

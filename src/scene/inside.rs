@@ -116,8 +116,10 @@ impl InsideShape {
         InsideShape(shape.expect("the built-in Mandelbulb test is a valid shape"))
     }
 
-    /// Tom Lowe's Mandelbox as an escape-time set, `mandelbox_escape`: a
-    /// set the library has no distance estimate for. Parameters `scale`
+    /// Tom Lowe's Mandelbox as an escape-time set, `mandelbox_escape`,
+    /// drawn by its inside test alone (the [`Mandelbox`](super::Mandelbox)
+    /// node draws a larger set of the same map from a distance estimate).
+    /// Parameters `scale`
     /// (the classic −1.5; from −2 to −1 the set stays within the bounds)
     /// and `iterations` (1 to 256, rounded down). Each iteration folds the
     /// point into the cube `[-1, 1]^3` (a box fold), inverts it in the

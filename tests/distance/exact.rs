@@ -196,6 +196,21 @@ fn a_self_overlapping_torus_is_a_bound() {
     testing::check_never_overestimates(&node, inside, &points, 32).unwrap();
 }
 
+/// A link whose tube is thicker than its half circles overlaps itself:
+/// the formula is then a bound, never above the distance to the points
+/// within the tube's radius of the stadium curve.
+#[test]
+fn a_self_overlapping_link_is_a_bound() {
+    let node = link(0.5, 0.1, 0.4);
+    let inside = |p: DVec3| analytic::link_curve_distance(p, 0.5, 0.1) <= 0.4;
+    let points = testing::near_surface_points(inside, 1.5, 0.3, 256, 11);
+    testing::check_never_overestimates(&node, inside, &points, 32).unwrap();
+    // Between the straight sides the formula gives 0.1 - 0.4; the surface
+    // is sqrt(0.4² - 0.1²) away along z.
+    let centre = cpu::Evaluator::new(&node).unwrap().distance(DVec3::ZERO);
+    assert!(-centre < (0.4f64 * 0.4 - 0.1 * 0.1).sqrt(), "{centre}");
+}
+
 #[test]
 fn the_oracle_agrees_with_brute_force_on_the_ellipsoid_of_a_sphere() {
     // The numerical ellipsoid distance used by the bound tests, checked on

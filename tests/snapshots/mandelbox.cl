@@ -105,7 +105,7 @@ real2 mandelbox(real3 p, real iterations, real scale, real min_radius, real fixe
     real t4 = t2 - R(1.0);
     real t5 = (scale < R(0.0)) ? t3 : ((t3 * (t2 + R(1.0))) / t4);
     real t6 = ((t3 * t2) + t5) / t4;
-    real t7 = t6 * R(16.0);
+    real t7 = fmax(t6 * R(16.0), fixed_radius);
     real t8 = ((p.x * p.x) + (p.y * p.y)) + (p.z * p.z);
     real3 ts0_0 = p;
     real ts0_3 = R(1.0);
@@ -118,7 +118,7 @@ real2 mandelbox(real3 p, real iterations, real scale, real min_radius, real fixe
         real t11 = (fmin(fmax(ts0_0.y, t9), fold_limit) * R(2.0)) - ts0_0.y;
         real t12 = (fmin(fmax(ts0_0.z, t9), fold_limit) * R(2.0)) - ts0_0.z;
         real t13 = ((t10 * t10) + (t11 * t11)) + (t12 * t12);
-        real t14 = (t13 < t1) ? (t0 / t1) : ((t13 < t0) ? (t0 / fmax(t13, R(1e-30))) : R(1.0));
+        real t14 = (t13 < t1) ? fmin(t0 / t1, R(1e30)) : ((t13 < t0) ? (t0 / fmax(t13, R(1e-30))) : R(1.0));
         real t15 = t14 * scale;
         real3 t16 = (((real3)(t10, t11, t12)) * t15) + ((real3)(p.x, p.y, p.z));
         real t17 = fmin(((ts0_3 * t14) * t2) + R(1.0), R(1e30));
@@ -134,7 +134,7 @@ real2 mandelbox(real3 p, real iterations, real scale, real min_radius, real fixe
         }
     }
     real3 t21 = fabs(p) - t5;
-    return (real2)(fmax(R(0.8) * ((fmax(fmax(fabs(ts0_0.x), fabs(ts0_0.y)), fabs(ts0_0.z)) - (t6 / exp((iterations - ts0_5) * log(t2)))) / fmax(ts0_3, R(1e-30))), length(fmax(t21, R(0.0))) + fmin(fmax(fmax(t21.x, t21.y), t21.z), R(0.0))), fmin(sqrt(ts0_4) / fmax(fixed_radius, R(1e-30)), R(1.0)));
+    return (real2)(fmax(R(0.8) * ((fmax(fmax(fabs(ts0_0.x), fabs(ts0_0.y)), fabs(ts0_0.z)) - t6) / fmax(ts0_3 + ((R(1.0) - (R(1.0) / exp((iterations - ts0_5) * log(t2)))) / t4), R(1e-30))), length(fmax(t21, R(0.0))) + fmin(fmax(fmax(t21.x, t21.y), t21.z), R(0.0))), fmin(sqrt(ts0_4) / fmax(fixed_radius, R(1e-30)), R(1.0)));
 }
 
 /* ---- scene ---- */
