@@ -64,8 +64,8 @@ pub fn mandelbulb_radius<T: Num>(power: T) -> T {
 /// the escape threshold, and from there each step adds more than the
 /// last. In Julia mode that is also the half side. In Mandelbrot mode
 /// (`c = p`), follow one coordinate `x > L` of `p` alone (the sphere fold
-/// only scales it further): with a negative scale `x' = |s| (x − 2L) + x
-/// > x` once `x > 2L`, and the same holds at every later step (the
+/// only scales it further): with a negative scale `x' = |s| (x − 2L) + x`,
+/// more than `x` once `x > 2L`, and the same holds at every later step (the
 /// coordinate stays above `x`, and each step adds at least `|s| (x − 2L)`);
 /// with a positive one the sign alternates: from `m > 2L` on the positive
 /// side, `m' = s (m − 2L) − x` on the negative one, and from there `m'' =
