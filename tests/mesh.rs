@@ -291,18 +291,18 @@ fn stl_ply_and_obj_read_back_with_independent_readers() {
     // PLY: positions, normals and colours.
     mesh.write(dir.join("mesh.ply")).unwrap();
     let mut file = std::fs::File::open(dir.join("mesh.ply")).unwrap();
-    let parser = ply_rs::parser::Parser::<ply_rs::ply::DefaultElement>::new();
+    let parser = ply_rs_bw::parser::Parser::<ply_rs_bw::ply::DefaultElement>::new();
     let ply = parser.read_ply(&mut file).unwrap();
     let vertices = &ply.payload["vertex"];
     let faces = &ply.payload["face"];
     assert_eq!(vertices.len(), mesh.positions.len());
     assert_eq!(faces.len(), mesh.triangles.len());
-    use ply_rs::ply::Property;
-    let float = |e: &ply_rs::ply::DefaultElement, k: &str| match e[k] {
+    use ply_rs_bw::ply::Property;
+    let float = |e: &ply_rs_bw::ply::DefaultElement, k: &str| match e[k] {
         Property::Float(v) => v,
         ref other => panic!("{k} is {other:?}"),
     };
-    let byte = |e: &ply_rs::ply::DefaultElement, k: &str| match e[k] {
+    let byte = |e: &ply_rs_bw::ply::DefaultElement, k: &str| match e[k] {
         Property::UChar(v) => v,
         ref other => panic!("{k} is {other:?}"),
     };
@@ -544,13 +544,13 @@ impl FileCounts {
     }
 }
 
-/// Counts a binary PLY file as `ply-rs` reads it (indices as written).
+/// Counts a binary PLY file as `ply-rs-bw` reads it (indices as written).
 fn ply_counts(path: &std::path::Path) -> FileCounts {
-    use ply_rs::ply::Property;
+    use ply_rs_bw::ply::Property;
     let mut file = std::fs::File::open(path).unwrap();
-    let parser = ply_rs::parser::Parser::<ply_rs::ply::DefaultElement>::new();
+    let parser = ply_rs_bw::parser::Parser::<ply_rs_bw::ply::DefaultElement>::new();
     let ply = parser.read_ply(&mut file).unwrap();
-    let float = |e: &ply_rs::ply::DefaultElement, k: &str| match e[k] {
+    let float = |e: &ply_rs_bw::ply::DefaultElement, k: &str| match e[k] {
         Property::Float(v) => v,
         ref other => panic!("{k} is {other:?}"),
     };
