@@ -84,8 +84,8 @@ rm -rf "$work"
 mkdir -p "$work/readme-program/src/bin"
 tar xzf "$crate_file" -C "$work"
 cp "$work/$name-$version/Cargo.lock" "$work/readme-program/Cargo.lock"
-dependency_profile=$(awk '/^\[profile\.dev\.package\."\*"\]/ { on = 1; print; next } /^\[/ { on = 0 } on && NF' Cargo.toml)
-[ -n "$dependency_profile" ] || fail "Cargo.toml declares no [profile.dev.package.\"*\"]"
+dependency_profile=$(awk '/^\[profile\.dev\.package\./ { on = 1; print; next } /^\[/ { on = 0 } on && NF && !/^#/' Cargo.toml)
+[ -n "$dependency_profile" ] || fail "Cargo.toml declares no [profile.dev.package.*] settings"
 cat >"$work/readme-program/Cargo.toml" <<EOF
 [package]
 name = "readme-program"

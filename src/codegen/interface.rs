@@ -7,6 +7,10 @@
 //! `render.cl`) and `kernels/eval.cl` use in place of positions and
 //! offsets of their own, and the executor binds arguments and packs buffers
 //! from the same tables. Neither side can drift from the other.
+//!
+//! Without the `opencl` feature there is no executor: only the kernel's
+//! half (the declarations) is used, and the host's half lies idle.
+#![cfg_attr(not(feature = "opencl"), allow(dead_code))]
 
 use std::fmt::Write as _;
 
