@@ -84,9 +84,38 @@ rm -rf "$work"
 mkdir -p "$work/readme-program/src/bin"
 tar xzf "$crate_file" -C "$work"
 cp "$work/$name-$version/Cargo.lock" "$work/readme-program/Cargo.lock"
-dependency_profile=$(awk '/^\[profile\.dev\.package\./ { on = 1; print; next } /^\[/ { on = 0 } on && NF && !/^#/' Cargo.toml)
-[ -n "$dependency_profile" ] || fail "Cargo.toml declares no [profile.dev.package.*] settings"
-cat >"$work/readme-program/Cargo.toml" <<EOF
+awk '
+    /<!-- readme-program: start -->/ { inside = 1; next }
+    /<!-- readme-program: end -->/ { inside = 0 }
+    inside && /^```/ { fence = !fence; next }
+    inside && fence { print }
+' README.md >"$work/readme-program/src/main.rs"
+lines=$(wc -l <"$work/readme-program/src/main.rs")
+[ "$lines" -gt 0 ] || fail "no program between the readme-program markers in README.md"
+say "the README's program: $lines lines"
+rustfmt --edition 2024 --check "$work/readme-program/src/main.rs" ||
+    fail "the README's program is not formatted as rustfmt would (diff above)"
+
+# The profile the package declares for its dependencies, copied from its
+# Cargo.toml so the ones `cargo package` compiled are reused: the `"*"`
+# section, and each named package's where the program depends on it (cargo
+# warns of a name it does not find).
+profile_section() {
+    awk -v want="$1" '
+        /^\[profile\.dev\.package\./ {
+            name = $0
+            sub(/^\[profile\.dev\.package\./, "", name)
+            sub(/\]$/, "", name)
+            on = (name == want)
+            if (on) print
+            next
+        }
+        /^\[/ { on = 0 }
+        on && NF && !/^#/
+    ' Cargo.toml
+}
+write_manifest() {
+    cat >"$work/readme-program/Cargo.toml" <<EOF
 [package]
 name = "readme-program"
 version = "0.0.0"
@@ -99,27 +128,27 @@ $name = { path = "../$name-$version" }
 # Its own workspace, whatever directory it sits in.
 [workspace]
 
-# The profile the package declares for its dependencies (copied from its
-# Cargo.toml), so the ones \`cargo package\` compiled are reused; the library
-# itself (compiled again, from the unpacked copy) unoptimised, as
-# \`cargo package\` builds it.
-$dependency_profile
+# The package's dependency profile (see the script); the library itself
+# (compiled again, from the unpacked copy) unoptimised, as \`cargo package\`
+# builds it.
+$1
 
 [profile.dev.package.$name]
 opt-level = 0
 EOF
+}
+dependency_profile=$(profile_section '"*"')
+[ -n "$dependency_profile" ] || fail 'Cargo.toml declares no [profile.dev.package."*"]'
+write_manifest "$dependency_profile"
+present=$(cd "$work/readme-program" &&
+    "$CARGO" tree --quiet --prefix none -e normal,build --format '{p}' | cut -d' ' -f1 | sort -u)
+for package in $(sed -n 's/^\[profile\.dev\.package\.\([^"]*\)\]$/\1/p' Cargo.toml); do
+    if grep -qx "$package" <<<"$present"; then
+        dependency_profile+=$'\n'$(profile_section "$package")
+    fi
+done
+write_manifest "$dependency_profile"
 
-awk '
-    /<!-- readme-program: start -->/ { inside = 1; next }
-    /<!-- readme-program: end -->/ { inside = 0 }
-    inside && /^```/ { fence = !fence; next }
-    inside && fence { print }
-' README.md >"$work/readme-program/src/main.rs"
-lines=$(wc -l <"$work/readme-program/src/main.rs")
-[ "$lines" -gt 0 ] || fail "no program between the readme-program markers in README.md"
-say "the README's program: $lines lines"
-rustfmt --edition 2024 --check "$work/readme-program/src/main.rs" ||
-    fail "the README's program is not formatted as rustfmt would (diff above)"
 
 cat >"$work/readme-program/src/bin/check_png.rs" <<'EOF'
 //! Checks that the PNG the README's program wrote is a picture of
