@@ -19,9 +19,9 @@ use crate::error::Result;
 use crate::file::SceneFile;
 use crate::quality::{Effects, Glow, Quality};
 use crate::scene::{
-    Axis, Camera, InsideShape, Light, Mandelbulb, Material, Node, QuaternionJulia, Scene,
-    capped_cone, capsule, cuboid, cylinder, ellipsoid, hex_prism, julia, link, menger, octahedron,
-    param, param3, plane, round_box, round_cone, sierpinski, sphere, torus,
+    Axis, Camera, InsideShape, Kifs, KifsFold, Light, Mandelbulb, Material, Node, QuaternionJulia,
+    Scene, capped_cone, capsule, cuboid, cylinder, ellipsoid, hex_prism, julia, link, menger,
+    octahedron, param, param3, plane, round_box, round_cone, sierpinski, sphere, torus,
 };
 
 /// Every gallery scene by name.
@@ -42,6 +42,7 @@ pub fn all() -> Vec<(&'static str, Scene)> {
         ("materials", materials()),
         ("mandelbulb_escape", mandelbulb_escape()),
         ("mandelbox", mandelbox()),
+        ("kifs", kifs()),
     ]
 }
 
@@ -302,6 +303,44 @@ pub fn mandelbox() -> Scene {
         .color(dvec3(0.5, 0.62, 0.85));
     Scene::new(boxed.union(floor(1.0)))
         .with_camera(Camera::look_at(dvec3(2.9, 2.0, 3.8), dvec3(0.0, -0.2, 0.0)).fov(40.0))
+        .with_lights(key_and_fill())
+}
+
+/// The four kaleidoscopic IFS folds with their classic settings (the
+/// Sierpinski tetrahedron, octahedron and icosahedron, the Menger sponge),
+/// and in front a Menger fold turned before and after its folds.
+#[must_use]
+pub fn kifs() -> Scene {
+    let classic = [
+        (KifsFold::Tetrahedral, 0.33, dvec3(0.9, 0.55, 0.3)),
+        (KifsFold::Octahedral, 0.55, dvec3(0.55, 0.8, 0.4)),
+        (KifsFold::Icosahedral, 0.55, dvec3(0.35, 0.65, 0.9)),
+        (KifsFold::Menger, 0.32, dvec3(0.75, 0.45, 0.85)),
+    ];
+    let row = classic
+        .into_iter()
+        .enumerate()
+        .map(|(i, (fold, size, color))| {
+            #[allow(clippy::cast_precision_loss)]
+            let x = (i as f64 - 1.5) * 1.3;
+            crate::scene::kifs(fold)
+                .scale(size)
+                .rotate(DVec3::Y, 0.4)
+                .color(color)
+                .translate(dvec3(x, 0.0, -0.5))
+        })
+        .reduce(Node::union)
+        .expect("four folds");
+    let turned = Node::from(
+        Kifs::new(KifsFold::Menger)
+            .rotate_before([0.2, 0.1, 0.0])
+            .rotate_after([0.0, 0.0, 0.2]),
+    )
+    .scale(0.3)
+    .color(dvec3(0.95, 0.8, 0.35))
+    .translate(dvec3(0.0, -0.1, 0.9));
+    Scene::new(row.union(turned).union(floor(0.6)))
+        .with_camera(Camera::look_at(dvec3(0.0, 1.4, 3.7), dvec3(0.0, -0.2, 0.0)).fov(45.0))
         .with_lights(key_and_fill())
 }
 

@@ -5,6 +5,7 @@
 use crate::cpu::sdf::{self, Estimate};
 use crate::expr::{Num, OpenCl, Printer, Shape, Signature, Unprintable, Var, trace};
 use crate::math::{V3, v3};
+use crate::scene::KifsFold;
 
 use Shape::{Pair, Scalar, Vec3};
 
@@ -231,6 +232,30 @@ pub(crate) fn mandelbox(julia: bool) -> Result<String, Unprintable> {
     print(name, &params, Pair, |a| {
         let m = sdf::MandelboxParams::new(a[4], a[5], a[6], a[7], julia.then(|| vector(a, 8)));
         pair(sdf::mandelbox_estimate(vector(a, 0), a[3], &m))
+    })
+}
+
+/// A kaleidoscopic IFS of `fold`; with `turned`, the turns before and
+/// after the fold as two vectors of angles (zeros for a turn the node
+/// leaves out: no turn, exactly).
+pub(crate) fn kifs(fold: KifsFold, turned: bool, name: &str) -> Result<String, Unprintable> {
+    let mut params = vec![
+        ("p", Vec3),
+        ("iterations", Scalar),
+        ("scale", Scalar),
+        ("offset", Vec3),
+    ];
+    if turned {
+        params.extend([("before", Vec3), ("after", Vec3)]);
+    }
+    print(name, &params, Pair, |a| {
+        let k = sdf::KifsParams::new(fold, a[4], vector(a, 5));
+        let k = if turned {
+            k.with_turns(Some(vector(a, 8)), Some(vector(a, 11)))
+        } else {
+            k
+        };
+        pair(sdf::kifs_estimate(vector(a, 0), a[3], &k))
     })
 }
 

@@ -4,6 +4,7 @@
 
 use super::formulas;
 use crate::expr::Unprintable;
+use crate::scene::KifsFold;
 
 /// One helper of the library. Code generation records which helpers a
 /// scene calls and emits those and no others.
@@ -28,11 +29,13 @@ pub(crate) enum Helper {
     Julia,
     Mandelbox,
     MandelboxJulia,
+    /// A kaleidoscopic IFS of the fold, with turns (`true`) or without.
+    Kifs(KifsFold, bool),
 }
 
 impl Helper {
     /// Every helper, in the order they are emitted.
-    pub(crate) const ALL: [Helper; 19] = [
+    pub(crate) const ALL: [Helper; 27] = [
         Helper::Sphere,
         Helper::Cuboid,
         Helper::RoundBox,
@@ -52,6 +55,14 @@ impl Helper {
         Helper::Julia,
         Helper::Mandelbox,
         Helper::MandelboxJulia,
+        Helper::Kifs(KifsFold::Tetrahedral, false),
+        Helper::Kifs(KifsFold::Tetrahedral, true),
+        Helper::Kifs(KifsFold::Octahedral, false),
+        Helper::Kifs(KifsFold::Octahedral, true),
+        Helper::Kifs(KifsFold::Icosahedral, false),
+        Helper::Kifs(KifsFold::Icosahedral, true),
+        Helper::Kifs(KifsFold::Menger, false),
+        Helper::Kifs(KifsFold::Menger, true),
     ];
 
     /// The helper's name, in the program's section comments.
@@ -76,6 +87,16 @@ impl Helper {
             Helper::Julia => "julia",
             Helper::Mandelbox => "mandelbox",
             Helper::MandelboxJulia => "mandelbox_julia",
+            Helper::Kifs(fold, turned) => match (fold, turned) {
+                (KifsFold::Tetrahedral, false) => "kifs_tetrahedral",
+                (KifsFold::Tetrahedral, true) => "kifs_tetrahedral_turned",
+                (KifsFold::Octahedral, false) => "kifs_octahedral",
+                (KifsFold::Octahedral, true) => "kifs_octahedral_turned",
+                (KifsFold::Icosahedral, false) => "kifs_icosahedral",
+                (KifsFold::Icosahedral, true) => "kifs_icosahedral_turned",
+                (KifsFold::Menger, false) => "kifs_menger",
+                (KifsFold::Menger, true) => "kifs_menger_turned",
+            },
         }
     }
 
@@ -101,6 +122,7 @@ impl Helper {
             Helper::Julia => formulas::julia(),
             Helper::Mandelbox => formulas::mandelbox(false),
             Helper::MandelboxJulia => formulas::mandelbox(true),
+            Helper::Kifs(fold, turned) => formulas::kifs(fold, turned, self.name()),
         }
     }
 }

@@ -400,6 +400,12 @@ impl Evaluator {
                 s(f.bailout),
             )),
             Kind::Sierpinski(f) => Self::fractal(sdf::sierpinski(p, f.iterations, s(f.scale))),
+            Kind::Kifs(f) => Self::fractal(sdf::kifs(
+                p,
+                f.iterations,
+                &sdf::KifsParams::new(f.fold, s(f.scale), v(f.offset))
+                    .with_turns(f.rotate_before.map(v), f.rotate_after.map(v)),
+            )),
             Kind::Mandelbox(f) => Self::fractal(sdf::mandelbox(
                 p,
                 f.iterations,

@@ -18,9 +18,9 @@
 use crate::expr::Step;
 use crate::math::{
     JULIA_FAR_FIELD, JULIA_FAR_FIELD_SLOPE, Num, Real, V3, escape_radius, julia_radius,
-    mandelbox_extent, mandelbulb_radius, v3,
+    kifs_radius, mandelbox_extent, mandelbulb_radius, v3,
 };
-use crate::scene::CsgOp;
+use crate::scene::{CsgOp, KifsFold};
 
 /// Exact distance to a sphere of radius `r` at the origin.
 #[must_use]
@@ -439,6 +439,164 @@ pub fn sierpinski_estimate<T: Num>(p: V3<T>, iterations: T, scale: T) -> Estimat
     Estimate {
         distance: tetrahedron(v3(x, y, z)) / s,
         trap,
+    }
+}
+
+/// A kaleidoscopic IFS's parameters as numbers (see
+/// [`scene::Kifs`](crate::scene::Kifs)).
+#[derive(Debug, Clone, Copy)]
+#[non_exhaustive]
+pub struct KifsParams<T> {
+    /// The mirrors of each iteration.
+    pub fold: KifsFold,
+    /// The scale of each iteration, greater than 1.
+    pub scale: T,
+    /// The point each iteration scales about.
+    pub offset: V3<T>,
+    /// Angles in radians about `x`, `y`, `z` of the turn before the fold.
+    pub rotate_before: Option<V3<T>>,
+    /// Angles in radians about `x`, `y`, `z` of the turn after the fold.
+    pub rotate_after: Option<V3<T>>,
+}
+
+impl<T: Num> KifsParams<T> {
+    /// The parameters of `fold` with no turns.
+    #[must_use]
+    pub fn new(fold: KifsFold, scale: T, offset: V3<T>) -> Self {
+        KifsParams {
+            fold,
+            scale,
+            offset,
+            rotate_before: None,
+            rotate_after: None,
+        }
+    }
+
+    /// With turns before and after the fold.
+    #[must_use]
+    pub fn with_turns(mut self, before: Option<V3<T>>, after: Option<V3<T>>) -> Self {
+        self.rotate_before = before;
+        self.rotate_after = after;
+        self
+    }
+}
+
+/// An orbit stops being followed once it passes this many times the radius
+/// of [`kifs_radius`]: the estimate is then `(|z_k| − R) / s^k` after the
+/// `k` steps taken, a lower bound of the full one (each later step
+/// multiplies `|z| − R` by at least `s`), within about 1/16 of it.
+pub const KIFS_FOLLOW: f64 = 16.0;
+
+/// A turn by angles about `x`, then `y`, then `z`, as the cosines and
+/// sines of the three angles (computed once, outside the loop).
+fn turn<T: Num>(angles: V3<T>) -> impl Fn(V3<T>) -> V3<T> {
+    let (cx, sx) = (angles.x.cos(), angles.x.sin());
+    let (cy, sy) = (angles.y.cos(), angles.y.sin());
+    let (cz, sz) = (angles.z.cos(), angles.z.sin());
+    move |z: V3<T>| {
+        let z = v3(z.x, cx * z.y - sx * z.z, sx * z.y + cx * z.z);
+        let z = v3(cy * z.x + sy * z.z, z.y, cy * z.z - sy * z.x);
+        v3(cz * z.x - sz * z.y, sz * z.x + cz * z.y, z.z)
+    }
+}
+
+/// The reflection of `z` across the plane through the origin normal to the
+/// unit `n`, where `z` lies on the side `n` points to.
+fn reflect_from<T: Num>(z: V3<T>, n: V3<T>) -> V3<T> {
+    z - n * (T::of(2.0) * z.dot(n).max(T::zero()))
+}
+
+/// `|z|`, then the coordinates sorted, largest first.
+fn octahedral_fold<T: Num>(z: V3<T>) -> V3<T> {
+    let z = z.abs();
+    let z = V3::select(z.x.lt(z.y), v3(z.y, z.x, z.z), z);
+    let z = V3::select(z.x.lt(z.z), v3(z.z, z.y, z.x), z);
+    V3::select(z.y.lt(z.z), v3(z.x, z.z, z.y), z)
+}
+
+/// The fold of [`KifsFold`] (the Menger fold's mirror after the scale is
+/// applied by [`kifs_estimate`]).
+fn kifs_fold<T: Num>(fold: KifsFold, z: V3<T>) -> V3<T> {
+    match fold {
+        KifsFold::Tetrahedral => {
+            let z = V3::select((z.x + z.y).lt(T::zero()), v3(-z.y, -z.x, z.z), z);
+            let z = V3::select((z.x + z.z).lt(T::zero()), v3(-z.z, z.y, -z.x), z);
+            V3::select((z.y + z.z).lt(T::zero()), v3(z.x, -z.z, -z.y), z)
+        }
+        KifsFold::Octahedral | KifsFold::Menger => octahedral_fold(z),
+        KifsFold::Icosahedral => {
+            // Knighty's icosahedral mirrors, with the golden ratio φ.
+            let phi = 0.5 * (1.0 + 5f64.sqrt());
+            let unit = |v: [f64; 3]| {
+                let l = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+                v3(T::of(v[0] / l), T::of(v[1] / l), T::of(v[2] / l))
+            };
+            let n1 = unit([-phi, phi - 1.0, 1.0]);
+            let n2 = unit([1.0, -phi, phi + 1.0]);
+            let mut z = z;
+            for _ in 0..3 {
+                z = reflect_from(reflect_from(z.abs(), n1), n2);
+            }
+            z
+        }
+    }
+}
+
+/// [`kifs_estimate`] with an integer iteration count.
+#[must_use]
+pub fn kifs<T: Num>(p: V3<T>, iterations: u32, k: &KifsParams<T>) -> Estimate<T> {
+    kifs_estimate(p, T::of(f64::from(iterations)), k)
+}
+
+/// A kaleidoscopic IFS (Knighty) distance bound: each step turns the
+/// point, folds it, turns it again and scales it by `s` about the offset
+/// (for the Menger fold with no shift along `z`, then a mirror across
+/// `z = offset.z (s − 1) / 2`). The drawn set is the points whose orbit is
+/// within the radius `R` of [`kifs_radius`] after `iterations` steps, and
+/// `(|z_n| − R) / s^n` never overestimates the distance to it (the proof is
+/// at [`kifs_radius`]). An orbit past [`KIFS_FOLLOW`] `· R` stops early,
+/// with a lower bound of the estimate. The trap is the orbit's smallest
+/// radius over `R`.
+#[must_use]
+pub fn kifs_estimate<T: Num>(p: V3<T>, iterations: T, k: &KifsParams<T>) -> Estimate<T> {
+    let menger = k.fold == KifsFold::Menger;
+    let o = k.offset;
+    let radius = kifs_radius([o.x, o.y, o.z], menger);
+    let follow = (radius * T::of(KIFS_FOLLOW)).max(T::tiny());
+    let follow2 = follow * follow;
+    let grow = k.scale - T::one();
+    let shift = v3(
+        o.x * grow,
+        o.y * grow,
+        if menger { T::zero() } else { o.z * grow },
+    );
+    let height = T::of(0.5) * o.z * grow;
+    let before = k.rotate_before.map(turn);
+    let after = k.rotate_after.map(turn);
+    let start = [p.x, p.y, p.z, T::one(), p.dot(p)];
+    let [x, y, z, s, trap] = T::iterate(iterations, start, |_, [x, y, z, s, trap]| {
+        let mut z = v3(x, y, z);
+        if let Some(turn) = &before {
+            z = turn(z);
+        }
+        z = kifs_fold(k.fold, z);
+        if let Some(turn) = &after {
+            z = turn(z);
+        }
+        let mut w = z * k.scale - shift;
+        if menger {
+            w.z = height - (w.z - height).abs();
+        }
+        let r2 = w.dot(w);
+        Step {
+            stop_before: None,
+            next: [w.x, w.y, w.z, s * k.scale, trap.min(r2)],
+            stop_after: Some(r2.gt(follow2)),
+        }
+    });
+    Estimate {
+        distance: (v3(x, y, z).length() - radius) / s,
+        trap: (trap.sqrt() / radius.max(T::tiny())).min(T::one()),
     }
 }
 

@@ -2,7 +2,7 @@
 
 use crate::error::Error;
 use crate::scene::{
-    CsgOp, CustomShape, InsideShape, Kind, Mandelbox, Mandelbulb, Menger, Node, Param,
+    CsgOp, CustomShape, InsideShape, Kifs, Kind, Mandelbox, Mandelbulb, Menger, Node, Param,
     QuaternionJulia, Sierpinski,
 };
 
@@ -170,6 +170,21 @@ impl NodeRepr {
                 fold_limit,
                 iterations,
                 julia,
+            },
+            Kind::Kifs(Kifs {
+                fold,
+                scale,
+                offset,
+                rotate_before,
+                rotate_after,
+                iterations,
+            }) => NodeRepr::Kifs {
+                fold,
+                scale: Some(scale),
+                offset: Some(offset),
+                rotate_before,
+                rotate_after,
+                iterations: Some(iterations),
             },
             Kind::Translate { offset, child: c } => NodeRepr::Translate {
                 offset,
@@ -441,6 +456,28 @@ impl Located<NodeRepr> {
                     .iterations(*iterations);
                 b.julia.clone_from(julia);
                 b.into()
+            }
+            NodeRepr::Kifs {
+                fold,
+                scale,
+                offset,
+                rotate_before,
+                rotate_after,
+                iterations,
+            } => {
+                let mut k = Kifs::new(*fold);
+                if let Some(scale) = scale {
+                    k.scale = scale.clone();
+                }
+                if let Some(offset) = offset {
+                    k.offset.clone_from(offset);
+                }
+                if let Some(n) = iterations {
+                    k.iterations = *n;
+                }
+                k.rotate_before.clone_from(rotate_before);
+                k.rotate_after.clone_from(rotate_after);
+                k.into()
             }
             NodeRepr::Translate { offset, child: c } => Kind::Translate {
                 offset: offset.clone(),

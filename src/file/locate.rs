@@ -42,6 +42,7 @@ pub(super) const NAMES: &[&str] = &[
     "Julia",
     "Sierpinski",
     "Mandelbox",
+    "Kifs",
     "Translate",
     "Rotate",
     "Scale",

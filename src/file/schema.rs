@@ -5,7 +5,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::animation::{Keyframe, Motion};
 use crate::quality::{Effects, Precision, Preset, Quality, ScreenNormals};
-use crate::scene::{Axis, Camera, Light, Material, Param, Param3, Rule, Scene};
+use crate::scene::{Axis, Camera, KifsFold, Light, Material, Param, Param3, Rule, Scene};
 
 use super::sites::Located;
 use super::values::count;
@@ -451,6 +451,25 @@ pub(super) enum NodeRepr {
         iterations: u32,
         #[serde(default, skip_serializing_if = "Option::is_none")]
         julia: Option<[Param; 3]>,
+    },
+    /// Each setting left out takes the classic one of the fold
+    /// ([`Kifs::new`](crate::scene::Kifs::new)).
+    Kifs {
+        fold: KifsFold,
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        scale: Option<Param>,
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        offset: Option<[Param; 3]>,
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        rotate_before: Option<[Param; 3]>,
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        rotate_after: Option<[Param; 3]>,
+        #[serde(
+            default,
+            skip_serializing_if = "Option::is_none",
+            deserialize_with = "count::optional_iterations"
+        )]
+        iterations: Option<u32>,
     },
     Translate {
         offset: Param3,

@@ -273,6 +273,7 @@ pub(super) mod count {
         ao_samples => "ao_samples",
         shadow_steps => "shadow_steps",
         fractal_iterations => "fractal_iterations",
+        optional_iterations => "iterations",
         supersampling => "supersampling",
         resolution_scale => "resolution_scale",
         cone_tile => "cone_tile",

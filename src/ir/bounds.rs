@@ -24,10 +24,10 @@ use glam::DVec3;
 
 use super::{Ir, IrNode, NodeId, Scalar, baked3};
 use crate::math::{
-    JULIA_FAR_FIELD, JULIA_FAR_FIELD_SLOPE, Limits, Num, V3, julia_radius, mandelbox_extent,
-    mandelbulb_radius, rotation_rows,
+    JULIA_FAR_FIELD, JULIA_FAR_FIELD_SLOPE, Limits, Num, V3, julia_radius, kifs_radius,
+    mandelbox_extent, mandelbulb_radius, rotation_rows,
 };
-use crate::scene::{Axis, CsgOp, Kind};
+use crate::scene::{Axis, CsgOp, KifsFold, Kind};
 
 /// A conservative bounding sphere of a node, in the coordinates the node
 /// sees: wherever `slope · (|p − centre| − radius) > 0`, the node's
@@ -242,6 +242,15 @@ pub(super) fn bound(node: &IrNode, done: &[Option<Bound>]) -> Option<Bound> {
             };
             let (half_side, _) = mandelbox_extent(baked(f.scale)?, baked(f.fold_limit)?, julia);
             Bound::sphere(origin, half_side * SQRT_3)
+        }
+        // Each step keeps `|z| − R` at least `s` times larger, so the
+        // estimate is at least `|p| − R`.
+        Kind::Kifs(f) => {
+            let [x, y, z] = f.offset.map(baked);
+            Bound::sphere(
+                origin,
+                kifs_radius([x?, y?, z?], f.fold == KifsFold::Menger),
+            )
         }
         // Beyond `JULIA_FAR_FIELD · edge` the estimate is exactly
         // `JULIA_FAR_FIELD_SLOPE (|(p, w)| − edge)`; the bound is that
@@ -564,6 +573,18 @@ pub(crate) fn costs(ir: &Ir) -> Vec<f64> {
             Kind::Menger(f) => 4.0 * f64::from(f.iterations),
             Kind::Sierpinski(f) => 3.0 * f64::from(f.iterations),
             Kind::Mandelbox(f) => 6.0 * f64::from(f.iterations),
+            Kind::Kifs(f) => {
+                let fold = if f.fold == KifsFold::Icosahedral {
+                    9.0
+                } else {
+                    3.0
+                };
+                let turns = [&f.rotate_before, &f.rotate_after];
+                let turns = turns.iter().filter(|t| t.is_some()).count();
+                #[allow(clippy::cast_precision_loss)]
+                let per_step = fold + 2.0 * turns as f64;
+                per_step * f64::from(f.iterations)
+            }
             Kind::Custom { .. } => 10.0,
             _ => 1.0,
         };

@@ -151,6 +151,19 @@ impl Lowering {
                     *a = reduce_angle(*a);
                 }
             }
+            // The KIFS turns' baked angles, likewise.
+            Kind::Kifs(f) => {
+                for turn in [&mut f.rotate_before, &mut f.rotate_after]
+                    .into_iter()
+                    .flatten()
+                {
+                    for angle in turn {
+                        if let Scalar::Baked(a) = angle {
+                            *a = reduce_angle(*a);
+                        }
+                    }
+                }
+            }
             // A baked normal is normalised here, in `f64`, whatever its
             // length: both twins receive the same unit vector. A zero one
             // is left for `relate` to refuse.

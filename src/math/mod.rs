@@ -101,6 +101,39 @@ pub fn mandelbox_extent<T: Num>(scale: T, fold_limit: T, julia: Option<[T; 3]>) 
     }
 }
 
+/// The radius `R` of the ball about the origin that holds a kaleidoscopic
+/// IFS ([`scene::Kifs`](crate::scene::Kifs)) of `offset`, for every scale
+/// and turn: `|offset|`, or `|(offset.x, offset.y)| + |offset.z|` for the
+/// Menger fold (`menger`).
+///
+/// Proof. One step is `z → M(s · T(z) − c)`: `T` turns and folds across
+/// planes through the origin, so `|T(z)| = |z|`; `c` is the shift
+/// `offset · (s − 1)` (with no `z` part for the Menger fold); `M` is
+/// nothing, or the Menger fold's mirror across a plane at distance
+/// `h = |offset.z| (s − 1) / 2` from the origin, which moves no point
+/// nearer the origin than `2h` less. So `|z'| ≥ s |z| − |c| − 2h`, and with
+/// `R = (|c| + 2h) / (s − 1)` (the radius above) `|z'| − R ≥ s (|z| − R)`:
+/// past `R` an orbit grows by a factor `s > 1` each step and never returns.
+/// The drawn set after `n` steps (the points whose orbit is then within
+/// `R`) therefore only shrinks as `n` grows, and since each step is
+/// `s`-Lipschitz (turns, folds and mirrors are 1-Lipschitz), a point whose
+/// orbit is at `|z_n|` lies at least `(|z_n| − R) / s^n` from it.
+///
+/// ```
+/// use fractal_sdf::math::kifs_radius;
+/// assert_eq!(kifs_radius([3.0_f64, 0.0, 4.0], false), 5.0);
+/// assert_eq!(kifs_radius([3.0_f64, 4.0, 1.0], true), 6.0);
+/// ```
+#[must_use]
+pub fn kifs_radius<T: Num>(offset: [T; 3], menger: bool) -> T {
+    let [x, y, z] = offset;
+    if menger {
+        x.hypot(y) + z.abs()
+    } else {
+        T::length3(x, y, z)
+    }
+}
+
 /// The Mandelbulb power as an integer, when the trig-free integer form
 /// applies to a baked `power`: an integer in `[2, 64]`. The CPU reference
 /// and code generation make the same choice through it.

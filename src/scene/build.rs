@@ -10,7 +10,7 @@
 use glam::{DQuat, DVec3, DVec4, EulerRot};
 
 use super::custom::CustomShape;
-use super::fractal::{Mandelbox, Mandelbulb, Menger, QuaternionJulia, Sierpinski};
+use super::fractal::{Kifs, KifsFold, Mandelbox, Mandelbulb, Menger, QuaternionJulia, Sierpinski};
 use super::material::Material;
 use super::node::{Axis, CsgOp, Kind, Node};
 use super::param::{Param, Param3};
@@ -256,6 +256,82 @@ impl Mandelbox {
     #[must_use]
     pub fn julia(mut self, c: [impl Into<Param>; 3]) -> Self {
         self.julia = Some(c.map(Into::into));
+        self
+    }
+}
+
+/// A kaleidoscopic IFS with the classic settings of `fold`: offset
+/// `(1, 1, 1)` and scale 2 (the Sierpinski tetrahedron) for
+/// [`KifsFold::Tetrahedral`], `(1, 0, 0)` and 2 (the Sierpinski octahedron)
+/// for [`KifsFold::Octahedral`], the vertex `(0.8507, 0.5257, 0)` and `φ²`
+/// for [`KifsFold::Icosahedral`], `(1, 1, 1)` and 3 (the Menger sponge)
+/// for [`KifsFold::Menger`]; no turns, 12 iterations (8 for the Menger
+/// fold). Build a [`Kifs`] to change them.
+#[must_use]
+pub fn kifs(fold: KifsFold) -> Node {
+    Kifs::new(fold).into()
+}
+
+impl Kifs {
+    /// A kaleidoscopic IFS with the classic settings of `fold` (see
+    /// [`kifs`]).
+    #[must_use]
+    pub fn new(fold: KifsFold) -> Self {
+        let (offset, scale, iterations) = match fold {
+            KifsFold::Tetrahedral => ([1.0, 1.0, 1.0], 2.0, 12),
+            KifsFold::Octahedral => ([1.0, 0.0, 0.0], 2.0, 12),
+            KifsFold::Icosahedral => {
+                // The unit vertex (φ, 1, 0) / |(φ, 1, 0)|, and φ².
+                let phi = 0.5 * (1.0 + 5f64.sqrt());
+                let norm = phi.hypot(1.0);
+                ([phi / norm, 1.0 / norm, 0.0], phi * phi, 12)
+            }
+            KifsFold::Menger => ([1.0, 1.0, 1.0], 3.0, 8),
+        };
+        Kifs {
+            fold,
+            scale: scale.into(),
+            offset: offset.map(Into::into),
+            rotate_before: None,
+            rotate_after: None,
+            iterations,
+        }
+    }
+
+    /// Sets the scale of each iteration.
+    #[must_use]
+    pub fn scale(mut self, scale: impl Into<Param>) -> Self {
+        self.scale = scale.into();
+        self
+    }
+
+    /// Sets the point each iteration scales about.
+    #[must_use]
+    pub fn offset(mut self, offset: [impl Into<Param>; 3]) -> Self {
+        self.offset = offset.map(Into::into);
+        self
+    }
+
+    /// Turns the point before each fold: by `angles[0]` radians about `x`,
+    /// then `angles[1]` about `y`, then `angles[2]` about `z`.
+    #[must_use]
+    pub fn rotate_before(mut self, angles: [impl Into<Param>; 3]) -> Self {
+        self.rotate_before = Some(angles.map(Into::into));
+        self
+    }
+
+    /// Turns the point after each fold, as
+    /// [`rotate_before`](Kifs::rotate_before).
+    #[must_use]
+    pub fn rotate_after(mut self, angles: [impl Into<Param>; 3]) -> Self {
+        self.rotate_after = Some(angles.map(Into::into));
+        self
+    }
+
+    /// Sets the iteration count.
+    #[must_use]
+    pub fn iterations(mut self, iterations: u32) -> Self {
+        self.iterations = iterations;
         self
     }
 }

@@ -1,7 +1,7 @@
 //! The fractals' parameters: the Mandelbulb, the Menger sponge, the
-//! quaternion Julia set, the Sierpinski tetrahedron and the Mandelbox, each
-//! a node of the
-//! scene through `From` and validated with the rest of its node.
+//! quaternion Julia set, the Sierpinski tetrahedron, the Mandelbox and the
+//! kaleidoscopic IFS, each a node of the scene through `From` and validated
+//! with the rest of its node.
 
 use super::param::Param;
 use super::*;
@@ -141,6 +141,72 @@ pub struct Mandelbox<S = Param> {
     pub iterations: u32,
     /// Julia mode: the constant added in each iteration instead of `p`.
     pub julia: Option<[S; 3]>,
+}
+
+/// The mirrors a kaleidoscopic IFS ([`Kifs`]) folds space with in each
+/// iteration: all of them planes through the origin, except the Menger
+/// fold's last.
+#[derive(
+    Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash, serde::Serialize, serde::Deserialize,
+)]
+#[non_exhaustive]
+pub enum KifsFold {
+    /// The three mirrors `x = −y`, `x = −z`, `y = −z` of the regular
+    /// tetrahedron with a vertex at `(1, 1, 1)`: with offset `(1, 1, 1)` and
+    /// scale 2, the Sierpinski tetrahedron.
+    Tetrahedral,
+    /// The cube's mirrors (`|x|`, `|y|`, `|z|`, then the coordinates
+    /// sorted, largest first): with offset `(1, 0, 0)` and scale 2, the
+    /// Sierpinski octahedron.
+    Octahedral,
+    /// The icosahedron's mirrors (Knighty's three rounds of `|·|` and the
+    /// two planes normal to `(−φ, φ − 1, 1)` and `(1, −φ, φ + 1)`): with the
+    /// vertex offset `(0.8507, 0.5257, 0)` and scale `φ² ≈ 2.618`, a
+    /// Sierpinski icosahedron.
+    Icosahedral,
+    /// The octahedral fold, and after the scale a mirror across the plane
+    /// `z = offset.z (scale − 1) / 2`, with no shift along `z`: with offset
+    /// `(1, 1, 1)` and scale 3, the Menger sponge.
+    Menger,
+}
+
+/// A kaleidoscopic iterated function system (Knighty): each iteration
+/// turns the point by `rotate_before`, folds it by the mirrors of
+/// [`fold`](Kifs::fold), turns it by `rotate_after`, and scales it by
+/// `scale` about `offset` (`z → scale · z − offset · (scale − 1)`).
+///
+/// Extent and estimate, both proven
+/// ([`math::kifs_radius`](crate::math::kifs_radius)): an orbit that leaves
+/// the ball of radius `R` (`|offset|`; for the Menger fold
+/// `|(offset.x, offset.y)| + |offset.z|`) never returns, so the drawn set
+/// (the points whose orbit is within `R` after `iterations` steps) shrinks
+/// as the count grows, towards the fractal; each iteration stretches
+/// distances by at most `scale`, so `(|z_n| − R) / scale^n` never
+/// overestimates the distance to it, with no safety factor. The trap is the
+/// orbit's smallest radius over `R`.
+#[derive(Debug, Clone, PartialEq)]
+#[non_exhaustive]
+pub struct Kifs<S = Param> {
+    /// The mirrors of each iteration.
+    pub fold: KifsFold,
+    /// The scale of each iteration, in `[1.1, 4]`.
+    pub scale: S,
+    /// The point each iteration scales about (finite).
+    pub offset: [S; 3],
+    /// A turn before the fold: angles in radians about `x`, then `y`, then
+    /// `z` (any finite values).
+    pub rotate_before: Option<[S; 3]>,
+    /// A turn after the fold, as `rotate_before`.
+    pub rotate_after: Option<[S; 3]>,
+    /// Folding levels, 0 (the ball of radius `R`) to
+    /// [`MAX_FOLD_ITERATIONS`].
+    pub iterations: u32,
+}
+
+impl From<Kifs> for Node {
+    fn from(f: Kifs) -> Self {
+        Kind::Kifs(f).into()
+    }
 }
 
 impl From<Mandelbox> for Node {

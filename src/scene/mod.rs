@@ -19,13 +19,13 @@ use glam::{DVec2, DVec3};
 use serde::{Deserialize, Serialize};
 
 pub use build::{
-    capped_cone, capsule, cuboid, cylinder, ellipsoid, hex_prism, julia, link, mandelbox,
+    capped_cone, capsule, cuboid, cylinder, ellipsoid, hex_prism, julia, kifs, link, mandelbox,
     mandelbulb, menger, octahedron, plane, round_box, round_cone, sierpinski, sphere, torus,
 };
 pub use custom::{
     CpuDistance, CpuInside, CustomShape, INSIDE_HUGE, InsideBounds, MAX_INSIDE_REACH,
 };
-pub use fractal::{Mandelbox, Mandelbulb, Menger, QuaternionJulia, Sierpinski};
+pub use fractal::{Kifs, KifsFold, Mandelbox, Mandelbulb, Menger, QuaternionJulia, Sierpinski};
 pub use inside::{
     BRUTE_MAX_STEPS, InsideShape, MANDELBOX_BAILOUT, MANDELBOX_HALF_SIDE, MANDELBULB_BAILOUT,
     mandelbox_contains, mandelbulb_contains,

@@ -8,7 +8,7 @@ use std::sync::{Arc, OnceLock};
 use glam::DVec3;
 
 use super::custom::CustomShape;
-use super::fractal::{Mandelbox, Mandelbulb, Menger, QuaternionJulia, Sierpinski};
+use super::fractal::{Kifs, Mandelbox, Mandelbulb, Menger, QuaternionJulia, Sierpinski};
 use super::material::Material;
 use super::param::{Param, Param3};
 use super::rule::{ParamSpec, Rule, spec};
@@ -191,6 +191,8 @@ pub enum Kind<S, V, C> {
     Sierpinski(Sierpinski<S>),
     /// See [`Mandelbox`].
     Mandelbox(Mandelbox<S>),
+    /// See [`Kifs`].
+    Kifs(Kifs<S>),
     /// Moves the child by `offset`. Preserves exactness.
     Translate {
         /// The translation.
@@ -374,6 +376,7 @@ impl<S, V, C> Kind<S, V, C> {
             Kind::Julia(_) => "julia",
             Kind::Sierpinski(_) => "sierpinski",
             Kind::Mandelbox(_) => "mandelbox",
+            Kind::Kifs(_) => "kifs",
             Kind::Translate { .. } => "translate",
             Kind::Rotate { .. } => "rotate",
             Kind::Scale { .. } => "scale",
@@ -444,6 +447,7 @@ impl<S, V, C> Kind<S, V, C> {
             | Kind::Julia(_)
             | Kind::Sierpinski(_)
             | Kind::Mandelbox(_)
+            | Kind::Kifs(_)
             | Kind::Custom { .. } => vec![],
             Kind::Translate { child, .. }
             | Kind::Rotate { child, .. }
@@ -472,6 +476,7 @@ impl<S, V, C> Kind<S, V, C> {
                 | Kind::Julia(_)
                 | Kind::Sierpinski(_)
                 | Kind::Mandelbox(_)
+                | Kind::Kifs(_)
         )
     }
 
@@ -484,6 +489,7 @@ impl<S, V, C> Kind<S, V, C> {
             Kind::Julia(j) => Some(j.iterations),
             Kind::Sierpinski(s) => Some(s.iterations),
             Kind::Mandelbox(b) => Some(b.iterations),
+            Kind::Kifs(k) => Some(k.iterations),
             _ => None,
         }
     }
@@ -495,7 +501,7 @@ impl<S, V, C> Kind<S, V, C> {
             Kind::Mandelbulb(_) | Kind::Julia(_) | Kind::Mandelbox(_) => {
                 Some((1, MAX_ESCAPE_ITERATIONS))
             }
-            Kind::Menger(_) | Kind::Sierpinski(_) => Some((0, MAX_FOLD_ITERATIONS)),
+            Kind::Menger(_) | Kind::Sierpinski(_) | Kind::Kifs(_) => Some((0, MAX_FOLD_ITERATIONS)),
             _ => None,
         }
     }
@@ -624,6 +630,33 @@ impl<S, V, C> Kind<S, V, C> {
                     None => None,
                 },
             }),
+            Kind::Kifs(f) => {
+                let scale = m.scalar(&f.scale, spec("scale", Range(1.1, 4.0)))?;
+                let mut three = |v: &[S; 3], names: [&str; 3], rule: Rule| {
+                    let [x, y, z] = v;
+                    Ok([
+                        m.scalar(x, spec(names[0], rule))?,
+                        m.scalar(y, spec(names[1], rule))?,
+                        m.scalar(z, spec(names[2], rule))?,
+                    ])
+                };
+                let before = ["rotate_before.x", "rotate_before.y", "rotate_before.z"];
+                let after = ["rotate_after.x", "rotate_after.y", "rotate_after.z"];
+                Kind::Kifs(Kifs {
+                    fold: f.fold,
+                    scale,
+                    offset: three(&f.offset, ["offset.x", "offset.y", "offset.z"], Finite)?,
+                    rotate_before: match &f.rotate_before {
+                        Some(a) => Some(three(a, before, Angle)?),
+                        None => None,
+                    },
+                    rotate_after: match &f.rotate_after {
+                        Some(a) => Some(three(a, after, Angle)?),
+                        None => None,
+                    },
+                    iterations: f.iterations,
+                })
+            }
             Kind::Translate { offset, child } => Kind::Translate {
                 offset: m.vector(offset, spec("offset", Finite))?,
                 child: m.child(child)?,

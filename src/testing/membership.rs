@@ -198,3 +198,104 @@ pub fn mandelbox_inside(p: DVec3, m: &crate::scene::Mandelbox) -> bool {
     }
     true
 }
+
+/// Whether `p` is in the kaleidoscopic IFS `k` as drawn (its parameters'
+/// default values), from the definition in [`Kifs`](crate::scene::Kifs):
+/// after `iterations` steps the orbit is within the radius `R` (`|offset|`,
+/// or `|(offset.x, offset.y)| + |offset.z|` for the Menger fold). Each
+/// step is written here as the mirrors it is made of, each a reflection
+/// `z − 2 (z·n) n` of the points on the wrong side of a plane, and the
+/// turns as quaternions.
+///
+/// ```
+/// use fractal_sdf::prelude::*;
+/// use fractal_sdf::scene::{Kifs, KifsFold};
+/// use fractal_sdf::testing::kifs_inside;
+/// let k = Kifs::new(KifsFold::Tetrahedral).iterations(6);
+/// assert!(kifs_inside(dvec3(1.0, 1.0, 1.0), &k));
+/// assert!(!kifs_inside(DVec3::ZERO, &k));
+/// ```
+#[must_use]
+pub fn kifs_inside(p: DVec3, k: &crate::scene::Kifs) -> bool {
+    use crate::scene::KifsFold;
+    let three = |v: &[crate::scene::Param; 3]| {
+        DVec3::new(
+            v[0].default_value(),
+            v[1].default_value(),
+            v[2].default_value(),
+        )
+    };
+    let s = k.scale.default_value();
+    let offset = three(&k.offset);
+    let menger = k.fold == KifsFold::Menger;
+    let radius = if menger {
+        offset.truncate().length() + offset.z.abs()
+    } else {
+        offset.length()
+    };
+    let turn = |angles: Option<&[crate::scene::Param; 3]>| {
+        angles.map_or(DQuat::IDENTITY, |a| {
+            let a = three(a);
+            DQuat::from_rotation_z(a.z) * DQuat::from_rotation_y(a.y) * DQuat::from_rotation_x(a.x)
+        })
+    };
+    let (before, after) = (
+        turn(k.rotate_before.as_ref()),
+        turn(k.rotate_after.as_ref()),
+    );
+    // Reflect `z` where `z·n` has the sign `keep` does not want.
+    let mirror = |z: DVec3, n: DVec3, keep_positive: bool| {
+        let n = n.normalize();
+        let d = z.dot(n);
+        if (keep_positive && d < 0.0) || (!keep_positive && d > 0.0) {
+            z - 2.0 * d * n
+        } else {
+            z
+        }
+    };
+    let coordinate_planes = |z: DVec3| {
+        let z = mirror(z, DVec3::X, true);
+        let z = mirror(z, DVec3::Y, true);
+        mirror(z, DVec3::Z, true)
+    };
+    let phi = (1.0 + 5f64.sqrt()) / 2.0;
+    let mut z = p;
+    for _ in 0..k.iterations {
+        z = before * z;
+        z = match k.fold {
+            KifsFold::Tetrahedral => {
+                let z = mirror(z, DVec3::new(1.0, 1.0, 0.0), true);
+                let z = mirror(z, DVec3::new(1.0, 0.0, 1.0), true);
+                mirror(z, DVec3::new(0.0, 1.0, 1.0), true)
+            }
+            KifsFold::Icosahedral => {
+                let mut z = z;
+                for _ in 0..3 {
+                    z = coordinate_planes(z);
+                    z = mirror(z, DVec3::new(-phi, phi - 1.0, 1.0), false);
+                    z = mirror(z, DVec3::new(1.0, -phi, phi + 1.0), false);
+                }
+                z
+            }
+            _ => {
+                // The cube's mirrors: the coordinate planes, then the
+                // planes that order the coordinates, largest first.
+                let z = coordinate_planes(z);
+                let z = mirror(z, DVec3::new(1.0, -1.0, 0.0), true);
+                let z = mirror(z, DVec3::new(1.0, 0.0, -1.0), true);
+                mirror(z, DVec3::new(0.0, 1.0, -1.0), true)
+            }
+        };
+        z = after * z;
+        if menger {
+            z = s * z - (s - 1.0) * DVec3::new(offset.x, offset.y, 0.0);
+            let h = offset.z * (s - 1.0) / 2.0;
+            if z.z > h {
+                z.z = 2.0 * h - z.z;
+            }
+        } else {
+            z = s * z - (s - 1.0) * offset;
+        }
+    }
+    z.length() <= radius
+}

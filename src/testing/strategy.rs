@@ -9,9 +9,10 @@ use proptest::prelude::*;
 
 use crate::cpu::Ray;
 use crate::scene::{
-    Axis, CsgOp, Kind, MAX_ESCAPE_ITERATIONS, MAX_FOLD_ITERATIONS, Mandelbox, Mandelbulb, Menger,
-    Node, Param, Param3, QuaternionJulia, Sierpinski, capped_cone, capsule, cuboid, cylinder,
-    ellipsoid, hex_prism, link, octahedron, param, plane, round_box, round_cone, sphere, torus,
+    Axis, CsgOp, Kifs, KifsFold, Kind, MAX_ESCAPE_ITERATIONS, MAX_FOLD_ITERATIONS, Mandelbox,
+    Mandelbulb, Menger, Node, Param, Param3, QuaternionJulia, Sierpinski, capped_cone, capsule,
+    cuboid, cylinder, ellipsoid, hex_prism, link, octahedron, param, plane, round_box, round_cone,
+    sphere, torus,
 };
 
 /// The largest size (radius, half extent, height) the primitive strategies
@@ -510,7 +511,51 @@ pub fn mandelbox_node() -> impl Strategy<Value = Node> + Clone {
         .boxed()
 }
 
-/// Any of the five fractals with valid parameters.
+/// A kaleidoscopic IFS of any fold: often its classic settings,
+/// otherwise a scale in `[1.1, 4]` and an offset in `[-1.5, 1.5]^3`; each
+/// turn one time in three, with angles in `[-π, π]`; 0 to 20 iterations.
+pub fn kifs_node() -> impl Strategy<Value = Node> + Clone {
+    let fold = prop_oneof![
+        Just(KifsFold::Tetrahedral),
+        Just(KifsFold::Octahedral),
+        Just(KifsFold::Icosahedral),
+        Just(KifsFold::Menger),
+    ];
+    let component = |tag: &'static str| scalar(tag, -1.5..=1.5f64);
+    let offset = prop::option::weighted(
+        0.5,
+        [
+            component("kifs.offset"),
+            component("kifs.offset"),
+            component("kifs.offset"),
+        ],
+    );
+    let angle = || scalar("kifs.angle", -std::f64::consts::PI..=std::f64::consts::PI);
+    let turn = || prop::option::weighted(0.3, [angle(), angle(), angle()]);
+    (
+        fold,
+        prop::option::weighted(0.5, scalar("kifs.scale", 1.1..=4.0f64)),
+        offset,
+        turn(),
+        turn(),
+        iterations(0, MAX_FOLD_ITERATIONS, 8),
+    )
+        .prop_map(|(fold, scale, offset, before, after, n)| {
+            let mut k = Kifs::new(fold).iterations(n);
+            if let Some(s) = scale {
+                k = k.scale(s);
+            }
+            if let Some(o) = offset {
+                k = k.offset(o);
+            }
+            k.rotate_before = before;
+            k.rotate_after = after;
+            k.into()
+        })
+        .boxed()
+}
+
+/// Any of the six fractals with valid parameters.
 pub fn fractal_node() -> impl Strategy<Value = Node> + Clone {
     prop_oneof![
         mandelbulb_node(),
@@ -518,6 +563,7 @@ pub fn fractal_node() -> impl Strategy<Value = Node> + Clone {
         julia_node(),
         sierpinski_node(),
         mandelbox_node(),
+        kifs_node(),
     ]
 }
 

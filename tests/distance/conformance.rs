@@ -20,7 +20,9 @@ use fractal_sdf::scene::ellipsoid;
 use fractal_sdf::scene::octahedron;
 use fractal_sdf::scene::param3;
 use fractal_sdf::scene::{CustomShape, Rule};
-use fractal_sdf::scene::{Mandelbox, capped_cone, hex_prism, link, round_cone};
+use fractal_sdf::scene::{
+    Kifs, KifsFold, Mandelbox, capped_cone, hex_prism, kifs, link, round_cone,
+};
 use fractal_sdf::testing::{check_device_matches_cpu, random_points, spicy_points};
 
 fn gyroid() -> CustomShape {
@@ -91,6 +93,18 @@ fn nodes() -> Vec<(&'static str, Node)> {
         (
             "mandelbox_julia",
             Mandelbox::new(2.0).julia([0.4, -0.3, 0.2]).into(),
+        ),
+        ("kifs_tetrahedral", kifs(KifsFold::Tetrahedral)),
+        ("kifs_octahedral", kifs(KifsFold::Octahedral)),
+        ("kifs_icosahedral", kifs(KifsFold::Icosahedral)),
+        ("kifs_menger", kifs(KifsFold::Menger)),
+        (
+            "kifs_turned_dynamic",
+            Kifs::new(KifsFold::Icosahedral)
+                .scale(param("kifs_scale", 2.4))
+                .rotate_before([0.3.into(), param("kifs_turn", -0.5), 0.1.into()])
+                .iterations(9)
+                .into(),
         ),
         ("ellipsoid", ellipsoid(dvec3(0.7, 0.4, 0.5))),
         ("mandelbulb_int", mandelbulb(8.0)),

@@ -23,6 +23,8 @@ mod fractals;
 #[cfg(feature = "proptest")]
 mod julia;
 #[cfg(feature = "proptest")]
+mod kifs;
+#[cfg(feature = "proptest")]
 mod lipschitz;
 #[cfg(feature = "proptest")]
 mod mandelbox;

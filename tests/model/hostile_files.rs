@@ -561,6 +561,17 @@ const NODE_FIELDS: &[(&str, &str)] = &[
     ("Mandelbox(scale: 2, fold_limit: @)", "fold_limit"),
     ("Mandelbox(scale: 2, iterations: @)", "iterations"),
     ("Mandelbox(scale: 2, julia: Some((@, 0, 0)))", "julia"),
+    ("Kifs(fold: Octahedral, scale: @)", "scale"),
+    ("Kifs(fold: Tetrahedral, offset: (1, @, 1))", "offset"),
+    ("Kifs(fold: Icosahedral, iterations: @)", "iterations"),
+    (
+        "Kifs(fold: Menger, rotate_before: (@, 0, 0))",
+        "rotate_before",
+    ),
+    (
+        "Kifs(fold: Menger, rotate_after: (0, 0, @))",
+        "rotate_after",
+    ),
     ("Translate(offset: @, child: Sphere(radius: 1))", "offset"),
     (
         "Rotate(axis: (0, 1, 0), angle: @, child: Sphere(radius: 1))",

@@ -583,6 +583,23 @@ impl<'a> SceneEmitter<'a> {
                 let args = format!("{p}, {n}, {}", w(self, f.scale));
                 Step::Done(self.fractal(id, Helper::Sierpinski, &args))
             }
+            Kind::Kifs(f) => {
+                let n = self.iterations(f.iterations, (0, MAX_FOLD_ITERATIONS));
+                let [ox, oy, oz] = f.offset.map(|s| w(self, s));
+                let mut args = format!("{p}, {n}, {}, (real3)({ox}, {oy}, {oz})", w(self, f.scale));
+                let turned = f.rotate_before.is_some() || f.rotate_after.is_some();
+                if turned {
+                    // A turn left out is no turn: zero angles.
+                    for turn in [f.rotate_before, f.rotate_after] {
+                        let [x, y, z] = match turn {
+                            Some(a) => a.map(|s| w(self, s)),
+                            None => ["R(0.0)".to_string(), "R(0.0)".into(), "R(0.0)".into()],
+                        };
+                        let _ = write!(args, ", (real3)({x}, {y}, {z})");
+                    }
+                }
+                Step::Done(self.fractal(id, Helper::Kifs(f.fold, turned), &args))
+            }
             Kind::Mandelbox(f) => {
                 let n = self.iterations(f.iterations, (1, MAX_ESCAPE_ITERATIONS));
                 let mut args = format!(
