@@ -12,9 +12,13 @@ set -euo pipefail
 CARGO=${CARGO:-cargo}
 start=$(date +%s)
 
+# Each step's wall time, for the summary at the end.
+timings=()
 step() {
     printf '\n==> %s\n' "$*"
+    local began=$SECONDS
     "$@"
+    timings+=("$(printf '%5ss  %s' "$((SECONDS - began))" "$*")")
 }
 
 # CI builds from a clean clone: incremental compilation's caches would cost
@@ -65,4 +69,6 @@ if [ -s "$skipped" ]; then
     printf '\n==> checks skipped (see above):\n'
     cat "$skipped"
 fi
+printf '\n==> time per step:\n'
+printf '%s\n' "${timings[@]}"
 printf '\n==> make test: all steps passed in %ss\n' "$(($(date +%s) - start))"
