@@ -47,9 +47,11 @@ step "$CARGO" clippy --all-targets --all-features -- -D warnings
 # and none at all: a target that needs a feature without saying so
 # (`required-features`), or code that compiles only with everything on,
 # fails here, and so does a warning that only one of them shows. Checks
-# only: no code generation.
+# only: no code generation. (The library and the command check with exactly
+# the features asked: dev-dependencies add features only to the targets
+# that use them.)
 step "$CARGO" check --all-targets
-step "$CARGO" hack clippy --each-feature --no-dev-deps -- -D warnings
+step "$CARGO" hack clippy --each-feature -- -D warnings
 # The binary tests/viewer_smoke.rs runs (`cargo test` builds examples only as
 # test harnesses); the test profile shares the library build with the tests.
 step "$CARGO" build --profile test --all-features --example viewer
