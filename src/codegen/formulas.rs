@@ -112,6 +112,20 @@ pub(crate) fn round_cone() -> Result<String, Unprintable> {
     )
 }
 
+pub(crate) fn cut_sphere() -> Result<String, Unprintable> {
+    distance("sd_cut_sphere", &[("r", Scalar), ("h", Scalar)], |p, a| {
+        sdf::cut_sphere(p, a[0], a[1])
+    })
+}
+
+pub(crate) fn solid_angle() -> Result<String, Unprintable> {
+    distance(
+        "sd_solid_angle",
+        &[("angle", Scalar), ("r", Scalar)],
+        |p, a| sdf::solid_angle(p, a[0], a[1]),
+    )
+}
+
 pub(crate) fn link() -> Result<String, Unprintable> {
     distance(
         "sd_link",

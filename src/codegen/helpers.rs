@@ -22,6 +22,8 @@ pub(crate) enum Helper {
     HexPrism,
     RoundCone,
     Link,
+    CutSphere,
+    SolidAngle,
     Ellipsoid,
     Mandelbulb,
     Menger,
@@ -35,7 +37,7 @@ pub(crate) enum Helper {
 
 impl Helper {
     /// Every helper, in the order they are emitted.
-    pub(crate) const ALL: [Helper; 27] = [
+    pub(crate) const ALL: [Helper; 29] = [
         Helper::Sphere,
         Helper::Cuboid,
         Helper::RoundBox,
@@ -48,6 +50,8 @@ impl Helper {
         Helper::HexPrism,
         Helper::RoundCone,
         Helper::Link,
+        Helper::CutSphere,
+        Helper::SolidAngle,
         Helper::Ellipsoid,
         Helper::Mandelbulb,
         Helper::Menger,
@@ -80,6 +84,8 @@ impl Helper {
             Helper::HexPrism => "hex_prism",
             Helper::RoundCone => "round_cone",
             Helper::Link => "link",
+            Helper::CutSphere => "cut_sphere",
+            Helper::SolidAngle => "solid_angle",
             Helper::Ellipsoid => "ellipsoid",
             Helper::Mandelbulb => "mandelbulb",
             Helper::Menger => "menger",
@@ -115,6 +121,8 @@ impl Helper {
             Helper::HexPrism => formulas::hex_prism(),
             Helper::RoundCone => formulas::round_cone(),
             Helper::Link => formulas::link(),
+            Helper::CutSphere => formulas::cut_sphere(),
+            Helper::SolidAngle => formulas::solid_angle(),
             Helper::Ellipsoid => formulas::ellipsoid(),
             Helper::Mandelbulb => formulas::mandelbulb(),
             Helper::Menger => formulas::menger(),

@@ -373,6 +373,12 @@ impl Evaluator {
                 s(*bottom_radius),
                 s(*top_radius),
             )),
+            Kind::CutSphere { radius, height } => {
+                Self::leaf(sdf::cut_sphere(p, s(*radius), s(*height)))
+            }
+            Kind::SolidAngle { angle, radius } => {
+                Self::leaf(sdf::solid_angle(p, s(*angle), s(*radius)))
+            }
             Kind::Link {
                 half_length,
                 major_radius,

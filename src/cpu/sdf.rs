@@ -177,6 +177,56 @@ pub fn link<T: Num>(p: V3<T>, le: T, r1: T, r2: T) -> T {
     (p.x.hypot(y) - r1).hypot(p.z) - r2
 }
 
+/// Exact distance to the ball of radius `r` cut by the plane `y = h`
+/// (taken within `[-r, r]`), keeping the part below. Inside, the nearer of
+/// the sphere and the plane (the outside of an intersection is the union of
+/// the outsides); outside, the plane where the point lies over the cut
+/// face, the sphere where its radial projection lies below the plane, and
+/// otherwise the cut face's rim.
+#[must_use]
+pub fn cut_sphere<T: Num>(p: V3<T>, r: T, h: T) -> T {
+    let h = h.max(-r).min(r);
+    let w = (r * r - h * h).max(T::zero()).sqrt();
+    let (rho, y) = (p.x.hypot(p.z), p.y);
+    let len = rho.hypot(y);
+    let sphere = len - r;
+    let plane = y - h;
+    let outside = T::select(
+        y.gt(h) & rho.le(w),
+        plane,
+        T::select(
+            len.ge(r) & (r * y).le(h * len),
+            sphere,
+            (rho - w).hypot(plane),
+        ),
+    );
+    T::select(len.le(r) & y.le(h), sphere.max(plane), outside)
+}
+
+/// Exact distance to the part of the ball of radius `r` within `angle` of
+/// the +y axis. In the plane through the axis the shape is a circular
+/// sector: its boundary is the cone's side (the segment from the origin to
+/// `r (sin angle, cos angle)`) and the arc, which is nearer than the side
+/// only within the cone's directions.
+#[must_use]
+pub fn solid_angle<T: Num>(p: V3<T>, angle: T, r: T) -> T {
+    let (s, c) = (angle.sin(), angle.cos());
+    let (rho, y) = (p.x.hypot(p.z), p.y);
+    let len = rho.hypot(y);
+    let t = (rho * s + y * c).max(T::zero()).min(r);
+    let side = (rho - s * t).hypot(y - c * t);
+    // Within the cone's directions: on the axis's side of the cone's line,
+    // or on the line's own half (the other half meets the axis only where
+    // the cone is a ray, `angle` 0).
+    let cross = c * rho - s * y;
+    let within = cross.lt(T::zero()) | (cross.le(T::zero()) & (rho * s + y * c).ge(T::zero()));
+    T::select(
+        within & len.le(r),
+        -side.min(r - len),
+        T::select(within, side.min(len - r), side),
+    )
+}
+
 /// A distance bound for an axis-aligned ellipsoid with semi-axes `r`.
 ///
 /// Outside, Quilez's `k0 (k0 - 1) / k1` with `k0 = |p / r|` and
@@ -484,8 +534,9 @@ impl<T: Num> KifsParams<T> {
 /// An orbit stops being followed once it passes this many times the radius
 /// of [`kifs_radius`]: the estimate is then `(|z_k| − R) / s^k` after the
 /// `k` steps taken, a lower bound of the full one (each later step
-/// multiplies `|z| − R` by at least `s`), within about 1/16 of it.
-pub const KIFS_FOLLOW: f64 = 16.0;
+/// multiplies `|z| − R` by at least `s`) and at least 31/33 of it (each
+/// multiplies `|z| + R` by at most `s`).
+pub const KIFS_FOLLOW: f64 = 32.0;
 
 /// A turn by angles about `x`, then `y`, then `z`, as the cosines and
 /// sines of the three angles (computed once, outside the loop).

@@ -131,6 +131,8 @@ impl NodeRepr {
                 major_radius,
                 minor_radius,
             },
+            Kind::CutSphere { radius, height } => NodeRepr::CutSphere { radius, height },
+            Kind::SolidAngle { angle, radius } => NodeRepr::SolidAngle { angle, radius },
             Kind::Ellipsoid { radii } => NodeRepr::Ellipsoid { radii },
             Kind::Mandelbulb(Mandelbulb {
                 power,
@@ -403,6 +405,16 @@ impl Located<NodeRepr> {
                 half_length: half_length.clone(),
                 major_radius: major_radius.clone(),
                 minor_radius: minor_radius.clone(),
+            }
+            .into(),
+            NodeRepr::CutSphere { radius, height } => Kind::CutSphere {
+                radius: radius.clone(),
+                height: height.clone(),
+            }
+            .into(),
+            NodeRepr::SolidAngle { angle, radius } => Kind::SolidAngle {
+                angle: angle.clone(),
+                radius: radius.clone(),
             }
             .into(),
             NodeRepr::Ellipsoid { radii } => Kind::Ellipsoid {

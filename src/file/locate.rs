@@ -36,6 +36,8 @@ pub(super) const NAMES: &[&str] = &[
     "HexPrism",
     "RoundCone",
     "Link",
+    "CutSphere",
+    "SolidAngle",
     "Ellipsoid",
     "Mandelbulb",
     "Menger",

@@ -408,6 +408,14 @@ pub(super) enum NodeRepr {
         major_radius: Param,
         minor_radius: Param,
     },
+    CutSphere {
+        radius: Param,
+        height: Param,
+    },
+    SolidAngle {
+        angle: Param,
+        radius: Param,
+    },
     Ellipsoid {
         radii: Param3,
     },

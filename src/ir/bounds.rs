@@ -206,6 +206,10 @@ pub(super) fn bound(node: &IrNode, done: &[Option<Bound>]) -> Option<Bound> {
             origin,
             baked(*half_length)? + baked(*major_radius)? + baked(*minor_radius)?,
         ),
+        // Both lie in their ball.
+        Kind::CutSphere { radius, .. } | Kind::SolidAngle { radius, .. } => {
+            Bound::sphere(origin, baked(*radius)?)
+        }
         // The estimate is `(k0 − 1) / |u / r|` with `k0 = |p / r|` and `u`
         // a unit vector, so it is at least `(k0 − 1) min(r)`, and
         // `k0 >= |p| / max(r)`: at least `min(r) / max(r) · (|p| − max(r))`,

@@ -136,6 +136,30 @@ pub fn link(
     .into()
 }
 
+/// The ball of `radius` about the origin cut by the plane `y = height`,
+/// keeping the part below (a height beyond `±radius` is taken as
+/// `±radius`).
+#[must_use]
+pub fn cut_sphere(radius: impl Into<Param>, height: impl Into<Param>) -> Node {
+    Kind::CutSphere {
+        radius: radius.into(),
+        height: height.into(),
+    }
+    .into()
+}
+
+/// The part of the ball of `radius` about the origin within `angle`
+/// radians (in `[0, MAX_SOLID_ANGLE]`, 3.1) of the +y axis: a cone capped
+/// by the sphere.
+#[must_use]
+pub fn solid_angle(angle: impl Into<Param>, radius: impl Into<Param>) -> Node {
+    Kind::SolidAngle {
+        angle: angle.into(),
+        radius: radius.into(),
+    }
+    .into()
+}
+
 /// A capped cone along y from radius `bottom_radius` at `-half_height` to
 /// `top_radius` at `+half_height`.
 #[must_use]

@@ -19,8 +19,9 @@ use glam::{DVec2, DVec3};
 use serde::{Deserialize, Serialize};
 
 pub use build::{
-    capped_cone, capsule, cuboid, cylinder, ellipsoid, hex_prism, julia, kifs, link, mandelbox,
-    mandelbulb, menger, octahedron, plane, round_box, round_cone, sierpinski, sphere, torus,
+    capped_cone, capsule, cuboid, cut_sphere, cylinder, ellipsoid, hex_prism, julia, kifs, link,
+    mandelbox, mandelbulb, menger, octahedron, plane, round_box, round_cone, sierpinski,
+    solid_angle, sphere, torus,
 };
 pub use custom::{
     CpuDistance, CpuInside, CustomShape, INSIDE_HUGE, InsideBounds, MAX_INSIDE_REACH,
@@ -34,7 +35,8 @@ pub(crate) use material::MATERIAL_SPECS;
 pub use material::{DEFAULT_MATERIAL, MATERIAL_LEN, Material};
 pub(crate) use node::Mapper;
 pub use node::{
-    Axis, CsgOp, Kind, MAX_ESCAPE_ITERATIONS, MAX_FOLD_ITERATIONS, MAX_WARP_RATE, Node, NodeKind,
+    Axis, CsgOp, Kind, MAX_ESCAPE_ITERATIONS, MAX_FOLD_ITERATIONS, MAX_SOLID_ANGLE, MAX_WARP_RATE,
+    Node, NodeKind,
 };
 pub use param::{Param, Param3, param, param3};
 pub use rule::{ParamSpec, Rule};

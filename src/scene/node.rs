@@ -22,6 +22,11 @@ pub const MAX_ESCAPE_ITERATIONS: u32 = 256;
 /// scale, so 20 levels of a scale-3 sponge are already below `f64` precision.
 pub const MAX_FOLD_ITERATIONS: u32 = 20;
 
+/// The largest half-angle of a [`solid_angle`](crate::scene::solid_angle),
+/// in radians: at π the cone's side would shrink to the −y axis inside the
+/// ball, a line that is no part of the shape's surface.
+pub const MAX_SOLID_ANGLE: f64 = 3.1;
+
 /// A coordinate axis.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize)]
 #[non_exhaustive]
@@ -172,6 +177,26 @@ pub enum Kind<S, V, C> {
         major_radius: S,
         /// Radius of the tube, at least 0.
         minor_radius: S,
+    },
+    /// The ball of `radius` about the origin cut by the plane
+    /// `y = height`, keeping the part below. Exact.
+    CutSphere {
+        /// The ball's radius, at least 0.
+        radius: S,
+        /// The cutting plane's height, any finite value: taken as
+        /// `±radius` beyond them (the whole ball above, its lowest point
+        /// below).
+        height: S,
+    },
+    /// The part of the ball of `radius` about the origin within `angle` of
+    /// the +y axis: a cone of half-angle `angle` capped by the sphere.
+    /// Exact.
+    SolidAngle {
+        /// The cone's half-angle in radians, in `[0, MAX_SOLID_ANGLE]`
+        /// (3.1; past π/2 the cone opens downwards).
+        angle: S,
+        /// The ball's radius, at least 0.
+        radius: S,
     },
     /// An axis-aligned ellipsoid. A bound, not exact: outside, the distance
     /// is underestimated away from the axes (Quilez's `k0 (k0 - 1) / k1`,
@@ -370,6 +395,8 @@ impl<S, V, C> Kind<S, V, C> {
             Kind::HexPrism { .. } => "hex_prism",
             Kind::RoundCone { .. } => "round_cone",
             Kind::Link { .. } => "link",
+            Kind::CutSphere { .. } => "cut_sphere",
+            Kind::SolidAngle { .. } => "solid_angle",
             Kind::Ellipsoid { .. } => "ellipsoid",
             Kind::Mandelbulb(_) => "mandelbulb",
             Kind::Menger(_) => "menger",
@@ -441,6 +468,8 @@ impl<S, V, C> Kind<S, V, C> {
             | Kind::HexPrism { .. }
             | Kind::RoundCone { .. }
             | Kind::Link { .. }
+            | Kind::CutSphere { .. }
+            | Kind::SolidAngle { .. }
             | Kind::Ellipsoid { .. }
             | Kind::Mandelbulb(_)
             | Kind::Menger(_)
@@ -587,6 +616,14 @@ impl<S, V, C> Kind<S, V, C> {
                 half_length: m.scalar(half_length, spec("half_length", NonNegative))?,
                 major_radius: m.scalar(major_radius, spec("major_radius", NonNegative))?,
                 minor_radius: m.scalar(minor_radius, spec("minor_radius", NonNegative))?,
+            },
+            Kind::CutSphere { radius, height } => Kind::CutSphere {
+                radius: m.scalar(radius, spec("radius", NonNegative))?,
+                height: m.scalar(height, spec("height", Finite))?,
+            },
+            Kind::SolidAngle { angle, radius } => Kind::SolidAngle {
+                angle: m.scalar(angle, spec("angle", Range(0.0, MAX_SOLID_ANGLE)))?,
+                radius: m.scalar(radius, spec("radius", NonNegative))?,
             },
             Kind::Ellipsoid { radii } => Kind::Ellipsoid {
                 radii: m.vector(radii, spec("radii", Positive))?,

@@ -277,7 +277,7 @@ pub fn kifs_inside(p: DVec3, k: &crate::scene::Kifs) -> bool {
                 }
                 z
             }
-            _ => {
+            KifsFold::Octahedral | KifsFold::Menger => {
                 // The cube's mirrors: the coordinate planes, then the
                 // planes that order the coordinates, largest first.
                 let z = coordinate_planes(z);

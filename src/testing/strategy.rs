@@ -9,10 +9,10 @@ use proptest::prelude::*;
 
 use crate::cpu::Ray;
 use crate::scene::{
-    Axis, CsgOp, Kifs, KifsFold, Kind, MAX_ESCAPE_ITERATIONS, MAX_FOLD_ITERATIONS, Mandelbox,
-    Mandelbulb, Menger, Node, Param, Param3, QuaternionJulia, Sierpinski, capped_cone, capsule,
-    cuboid, cylinder, ellipsoid, hex_prism, link, octahedron, param, plane, round_box, round_cone,
-    sphere, torus,
+    Axis, CsgOp, Kifs, KifsFold, Kind, MAX_ESCAPE_ITERATIONS, MAX_FOLD_ITERATIONS, MAX_SOLID_ANGLE,
+    Mandelbox, Mandelbulb, Menger, Node, Param, Param3, QuaternionJulia, Sierpinski, capped_cone,
+    capsule, cuboid, cut_sphere, cylinder, ellipsoid, hex_prism, link, octahedron, param, plane,
+    round_box, round_cone, solid_angle, sphere, torus,
 };
 
 /// The largest size (radius, half extent, height) the primitive strategies
@@ -224,6 +224,35 @@ pub fn link_node() -> impl Strategy<Value = Node> + Clone {
         .prop_map(|(le, r1, r2)| link(le, r1, r2))
 }
 
+/// A cut sphere: radius in `[0, 1.5]`, the cutting plane's height
+/// anywhere from beyond the bottom to beyond the top.
+pub fn cut_sphere_node() -> impl Strategy<Value = Node> + Clone {
+    (size(MAX_SIZE), -1.2..=1.2f64)
+        .prop_flat_map(|(r, t)| {
+            (
+                scalar("cut_sphere.radius", Just(r)),
+                scalar("cut_sphere.height", Just(r * t)),
+            )
+        })
+        .prop_map(|(r, h)| cut_sphere(r, h))
+}
+
+/// A solid angle: half-angle in `[0, MAX_SOLID_ANGLE]` (often 0, π/2 or
+/// the top of the range), radius in `[0, 1.5]`.
+pub fn solid_angle_node() -> impl Strategy<Value = Node> + Clone {
+    let angle = prop_oneof![
+        3 => 0.0..=MAX_SOLID_ANGLE,
+        1 => Just(0.0),
+        1 => Just(std::f64::consts::FRAC_PI_2),
+        1 => Just(MAX_SOLID_ANGLE),
+    ];
+    (
+        scalar("solid_angle.angle", angle),
+        scalar("solid_angle.radius", size(MAX_SIZE)),
+    )
+        .prop_map(|(a, r)| solid_angle(a, r))
+}
+
 /// An ellipsoid (a distance bound, not exact) with semi-axes in
 /// `[0.05, 1.5]`.
 pub fn ellipsoid_node() -> impl Strategy<Value = Node> + Clone {
@@ -245,6 +274,8 @@ pub fn exact_primitive() -> impl Strategy<Value = Node> + Clone {
         hex_prism_node(),
         round_cone_node(),
         link_node(),
+        cut_sphere_node(),
+        solid_angle_node(),
     ]
 }
 

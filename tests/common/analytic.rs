@@ -73,6 +73,12 @@ pub fn exact_distance(node: &Node, p: DVec3) -> Option<f64> {
             link_curve_distance(p, half_length.default_value(), major_radius.default_value())
                 - minor_radius.default_value()
         }
+        Kind::CutSphere { radius, height } => {
+            cut_sphere_distance(p, radius.default_value(), height.default_value())
+        }
+        Kind::SolidAngle { angle, radius } => {
+            solid_angle_distance(p, angle.default_value(), radius.default_value())
+        }
         Kind::Translate { offset, child } => exact_distance(child, p - offset.default_value())?,
         Kind::Rotate { axis, angle, child } => {
             let rotation = DQuat::from_axis_angle(*axis, angle.default_value());
@@ -318,4 +324,53 @@ pub fn ellipsoid_distance(p: DVec3, radii: DVec3) -> f64 {
     }));
     let distance = y.distance(nearest);
     if t < 0.0 { -distance } else { distance }
+}
+
+/// The point at angle `theta` from +y on the circle of radius `r`, in the
+/// plane through the axis (`x` the distance from the axis).
+fn on_circle(r: f64, theta: f64) -> DVec3 {
+    DVec3::new(r * theta.sin(), r * theta.cos(), 0.0)
+}
+
+/// The point `p` in the plane through the y axis: its distance from the
+/// axis, its height, and its angle from +y in `[0, π]`.
+fn meridian(p: DVec3) -> (DVec3, f64) {
+    let q = DVec3::new(DVec2::new(p.x, p.z).length(), p.y, 0.0);
+    (q, q.x.atan2(q.y))
+}
+
+/// Signed distance to the ball of radius `r` cut by the plane `y = h`
+/// (within `[-r, r]`), keeping the part below, in the plane through the
+/// axis: the nearer of the cut face (a segment) and the arc of the circle
+/// below the plane (the nearest point of the circle by angle, clamped to
+/// the arc's angles), negative inside.
+pub fn cut_sphere_distance(p: DVec3, r: f64, h: f64) -> f64 {
+    let h = h.clamp(-r, r);
+    let (q, theta) = meridian(p);
+    let w = (r * r - h * h).max(0.0).sqrt();
+    let face = segment_distance(q, DVec3::new(0.0, h, 0.0), DVec3::new(w, h, 0.0));
+    let rim = if r > 0.0 {
+        (h / r).clamp(-1.0, 1.0).acos()
+    } else {
+        0.0
+    };
+    let arc = q.distance(on_circle(r, theta.clamp(rim, std::f64::consts::PI)));
+    let d = face.min(arc);
+    if q.length() <= r && q.y <= h { -d } else { d }
+}
+
+/// Signed distance to the part of the ball of radius `r` within `angle` of
+/// +y, in the plane through the axis: the nearer of the cone's side (a
+/// segment from the origin) and the arc (the nearest point of the circle by
+/// angle, clamped to `[0, angle]`), negative inside.
+pub fn solid_angle_distance(p: DVec3, angle: f64, r: f64) -> f64 {
+    let (q, theta) = meridian(p);
+    let side = segment_distance(q, DVec3::ZERO, on_circle(r, angle));
+    let arc = q.distance(on_circle(r, theta.min(angle)));
+    let d = side.min(arc);
+    if q.length() <= r && theta <= angle {
+        -d
+    } else {
+        d
+    }
 }

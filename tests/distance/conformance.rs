@@ -21,7 +21,8 @@ use fractal_sdf::scene::octahedron;
 use fractal_sdf::scene::param3;
 use fractal_sdf::scene::{CustomShape, Rule};
 use fractal_sdf::scene::{
-    Kifs, KifsFold, Mandelbox, capped_cone, hex_prism, kifs, link, round_cone,
+    Kifs, KifsFold, Mandelbox, capped_cone, cut_sphere, hex_prism, kifs, link, round_cone,
+    solid_angle,
 };
 use fractal_sdf::testing::{check_device_matches_cpu, random_points, spicy_points};
 
@@ -89,6 +90,10 @@ fn nodes() -> Vec<(&'static str, Node)> {
         ("round_cone", round_cone(0.5, 0.4, 0.15)),
         ("round_cone_ball", round_cone(0.1, 0.6, 0.2)),
         ("link", link(0.4, 0.35, 0.1)),
+        ("cut_sphere", cut_sphere(0.6, 0.25)),
+        ("cut_sphere_low", cut_sphere(0.6, -0.4)),
+        ("solid_angle", solid_angle(0.7, 0.6)),
+        ("solid_angle_wide", solid_angle(2.4, 0.6)),
         ("mandelbox", mandelbox(-1.5)),
         (
             "mandelbox_julia",

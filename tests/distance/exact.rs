@@ -66,6 +66,8 @@ exact! {
     hex_prism_is_exact: testing::hex_prism_node();
     round_cone_is_exact: testing::round_cone_node();
     link_is_exact: testing::link_node();
+    cut_sphere_is_exact: testing::cut_sphere_node();
+    solid_angle_is_exact: testing::solid_angle_node();
     transformed_primitives_are_exact: testing::exact_node();
 }
 

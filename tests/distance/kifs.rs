@@ -57,8 +57,9 @@ proptest! {
     #![proptest_config(ProptestConfig::with_cases(64))]
 
     /// A point outside the stated ball is outside the drawn set at every
-    /// iteration count, and a point inside after `n + 1` steps is inside
-    /// after `n`: the sets only shrink.
+    /// iteration count, for the membership test and the estimate, and a
+    /// point inside after `n + 1` steps is inside after `n`: the sets only
+    /// shrink.
     #[test]
     fn the_ball_holds_every_drawn_set(
         k in settings(),
@@ -69,7 +70,10 @@ proptest! {
         let r = radius(&k);
         let outside = direction * beyond * r;
         for n in 0..=12 {
-            prop_assert!(!kifs_inside(outside, &k.clone().iterations(n)), "{outside} at {n}");
+            let k = k.clone().iterations(n);
+            prop_assert!(!kifs_inside(outside, &k), "{outside} at {n}");
+            let d = cpu::Evaluator::new(&k.into())?.distance(outside);
+            prop_assert!(d > 0.0, "{outside} at {n}: estimate {d}");
         }
         let p = start * r;
         for n in 0..12 {

@@ -273,6 +273,7 @@ use fractal_sdf::scene::Sierpinski;
 use fractal_sdf::scene::ellipsoid;
 use fractal_sdf::scene::octahedron;
 use fractal_sdf::scene::param3;
+use fractal_sdf::scene::{Kifs, KifsFold, MAX_SOLID_ANGLE, cut_sphere, solid_angle};
 use fractal_sdf::scene::{MAX_ESCAPE_ITERATIONS, MAX_FOLD_ITERATIONS};
 use fractal_sdf::scene::{capped_cone, hex_prism, link, round_cone};
 
@@ -574,6 +575,11 @@ fn broken_node() -> impl Strategy<Value = (Node, &'static str)> {
         outside(-4.0, 4.0).prop_map(|v| (julia([0.0, 0.0, v, 0.0]), "julia")),
         outside(2.0, 4.0).prop_map(|v| (Menger::new(2).scale(v).into(), "menger")),
         outside(1.5, 4.0).prop_map(|v| (Sierpinski::new(2).scale(v).into(), "sierpinski")),
+        outside(1.1, 4.0).prop_map(|v| (Kifs::new(KifsFold::Octahedral).scale(v).into(), "kifs")),
+        (21..=u32::MAX).prop_map(|n| (Kifs::new(KifsFold::Menger).iterations(n).into(), "kifs")),
+        bad_size().prop_map(|v| (cut_sphere(v, 0.5), "cut_sphere")),
+        bad_size().prop_map(|v| (solid_angle(0.5, v), "solid_angle")),
+        outside(0.0, MAX_SOLID_ANGLE).prop_map(|v| (solid_angle(v, 1.0), "solid_angle")),
         prop_oneof![Just(0u32), 257..=u32::MAX]
             .prop_map(|n| (Mandelbulb::new(8.0).iterations(n).into(), "mandelbulb")),
         (21..=u32::MAX).prop_map(|n| (menger(n), "menger")),

@@ -99,7 +99,7 @@ real sd_plane(real3 p, real3 n, real offset) {
 /* ---- kifs_tetrahedral ---- */
 real2 kifs_tetrahedral(real3 p, real iterations, real scale, real3 offset) {
     real t0 = length(offset);
-    real t1 = fmax(t0 * R(16.0), R(1e-30));
+    real t1 = fmax(t0 * R(32.0), R(1e-30));
     real t2 = t1 * t1;
     real t3 = scale - R(1.0);
     real t4 = offset.x * t3;
@@ -131,7 +131,7 @@ real2 kifs_tetrahedral(real3 p, real iterations, real scale, real3 offset) {
 /* ---- kifs_octahedral ---- */
 real2 kifs_octahedral(real3 p, real iterations, real scale, real3 offset) {
     real t0 = length(offset);
-    real t1 = fmax(t0 * R(16.0), R(1e-30));
+    real t1 = fmax(t0 * R(32.0), R(1e-30));
     real t2 = t1 * t1;
     real t3 = scale - R(1.0);
     real t4 = offset.x * t3;
@@ -164,7 +164,7 @@ real2 kifs_octahedral(real3 p, real iterations, real scale, real3 offset) {
 /* ---- kifs_icosahedral ---- */
 real2 kifs_icosahedral(real3 p, real iterations, real scale, real3 offset) {
     real t0 = length(offset);
-    real t1 = fmax(t0 * R(16.0), R(1e-30));
+    real t1 = fmax(t0 * R(32.0), R(1e-30));
     real t2 = t1 * t1;
     real t3 = scale - R(1.0);
     real t4 = offset.x * t3;
@@ -208,7 +208,7 @@ real2 kifs_icosahedral(real3 p, real iterations, real scale, real3 offset) {
 /* ---- kifs_menger ---- */
 real2 kifs_menger(real3 p, real iterations, real scale, real3 offset) {
     real t0 = hypot(offset.x, offset.y) + fabs(offset.z);
-    real t1 = fmax(t0 * R(16.0), R(1e-30));
+    real t1 = fmax(t0 * R(32.0), R(1e-30));
     real t2 = t1 * t1;
     real t3 = scale - R(1.0);
     real t4 = offset.x * t3;
@@ -246,7 +246,7 @@ real2 kifs_menger(real3 p, real iterations, real scale, real3 offset) {
 /* ---- kifs_menger_turned ---- */
 real2 kifs_menger_turned(real3 p, real iterations, real scale, real3 offset, real3 before, real3 after) {
     real t0 = hypot(offset.x, offset.y) + fabs(offset.z);
-    real t1 = fmax(t0 * R(16.0), R(1e-30));
+    real t1 = fmax(t0 * R(32.0), R(1e-30));
     real t2 = t1 * t1;
     real t3 = scale - R(1.0);
     real t4 = offset.x * t3;

@@ -189,6 +189,31 @@ real sd_link(real3 p, real le, real r1, real r2) {
     return hypot(hypot(p.x, fmax(fabs(p.y) - le, R(0.0))) - r1, p.z) - r2;
 }
 
+/* ---- cut_sphere ---- */
+real sd_cut_sphere(real3 p, real r, real h) {
+    real t0 = fmin(fmax(h, -r), r);
+    real t1 = sqrt(fmax((r * r) - (t0 * t0), R(0.0)));
+    real t2 = hypot(p.x, p.z);
+    real t3 = hypot(t2, p.y);
+    real t4 = t3 - r;
+    real t5 = p.y - t0;
+    return ((t3 <= r) && (p.y <= t0)) ? fmax(t4, t5) : (((t0 < p.y) && (t2 <= t1)) ? t5 : (((r <= t3) && ((r * p.y) <= (t0 * t3))) ? t4 : hypot(t2 - t1, t5)));
+}
+
+/* ---- solid_angle ---- */
+real sd_solid_angle(real3 p, real angle, real r) {
+    real t0 = sin(angle);
+    real t1 = cos(angle);
+    real t2 = hypot(p.x, p.z);
+    real t3 = hypot(t2, p.y);
+    real t4 = (t2 * t0) + (p.y * t1);
+    real t5 = fmin(fmax(t4, R(0.0)), r);
+    real t6 = hypot(t2 - (t0 * t5), p.y - (t1 * t5));
+    real t7 = (t1 * t2) - (t0 * p.y);
+    bool t8 = (t7 < R(0.0)) || ((t7 <= R(0.0)) && (R(0.0) <= t4));
+    return (t8 && (t3 <= r)) ? (-fmin(t6, r - t3)) : (t8 ? fmin(t6, t3 - r) : t6);
+}
+
 /* ---- ellipsoid ---- */
 real sd_ellipsoid(real3 p, real3 r) {
     real3 t0 = p / r;
@@ -206,139 +231,165 @@ real sd_ellipsoid(real3 p, real3 r) {
 real DE(real3 p0, __global const real* params) {
     /* union */
     /* union/b:color/plane */
-    real d48 = sd_plane(p0, (real3)(0.0f, 1.0f, 0.0f), 0.4f);
+    real d58 = sd_plane(p0, (real3)(0.0f, 1.0f, 0.0f), 0.4f);
     /* union: the second operand only within reach of its bound */
-    real u50 = d48;
-    real g50 = (length(p0 - ((real3)(-R(2.125), R(0.0), -R(0.6)))) * R(0.9999)) - R(0.35);
-    if (!(g50 > u50 && g50 > R(0.0))) {
+    real u60 = d58;
+    real g60 = (length(p0 - ((real3)(-R(2.25), R(0.0), -R(0.6)))) * R(0.9999)) - R(0.35);
+    if (!(g60 > u60 && g60 > R(0.0))) {
         /* .../a:union/a:union/a:translate */
-        real3 p1 = p0 - ((real3)(-R(2.125), R(0.0), -R(0.6)));
+        real3 p1 = p0 - ((real3)(-R(2.25), R(0.0), -R(0.6)));
         /* .../a:translate/color/sphere */
         real d0 = sd_sphere(p1, 0.35f);
-        real d50 = fmin(d48, d0);
-        u50 = d50;
+        real d60 = fmin(d58, d0);
+        u60 = d60;
     }
     /* union/a:union: the second operand only within reach of its bound */
-    real u47 = u50;
-    real g47 = (length(p0 - ((real3)(-R(1.275), R(0.0), -R(0.6)))) * R(0.9999)) - R(0.5196152422706632);
-    if (!(g47 > u47 && g47 > R(0.0))) {
+    real u57 = u60;
+    real g57 = (length(p0 - ((real3)(-R(1.5), R(0.0), -R(0.6)))) * R(0.9999)) - R(0.5196152422706632);
+    if (!(g57 > u57 && g57 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p2 = p0 - ((real3)(-R(1.275), R(0.0), -R(0.6)));
+        real3 p2 = p0 - ((real3)(-R(1.5), R(0.0), -R(0.6)));
         /* .../b:translate/color/cuboid */
         real d3 = sd_box(p2, (real3)(0.3f));
-        real d47 = fmin(u50, d3);
+        real d57 = fmin(u60, d3);
+        u57 = d57;
+    }
+    /* .../a:union/a:union: the second operand only within reach of its bound */
+    real u52 = u57;
+    real g52 = (length(p0 - ((real3)(-R(0.75), R(0.0), -R(0.6)))) * R(0.9999)) - R(0.5196152422706632);
+    if (!(g52 > u52 && g52 > R(0.0))) {
+        /* .../a:union/a:union/b:translate */
+        real3 p3 = p0 - ((real3)(-R(0.75), R(0.0), -R(0.6)));
+        /* .../b:translate/color/round_box */
+        real d7 = sd_round_box(p3, (real3)(0.3f), 0.08f);
+        real d52 = fmin(u57, d7);
+        u52 = d52;
+    }
+    /* .../a:union/a:union: the second operand only within reach of its bound */
+    real u47 = u52;
+    real g47 = (length(p0 - ((real3)(R(0.0), R(0.0), -R(0.6)))) * R(0.9999)) - R(0.38);
+    if (!(g47 > u47 && g47 > R(0.0))) {
+        /* .../a:union/a:union/b:translate */
+        real3 p4 = p0 - ((real3)(R(0.0), R(0.0), -R(0.6)));
+        /* .../b:translate/color/torus */
+        real d11 = sd_torus(p4, 0.28f, 0.1f);
+        real d47 = fmin(u52, d11);
         u47 = d47;
     }
     /* .../a:union/a:union: the second operand only within reach of its bound */
     real u42 = u47;
-    real g42 = (length(p0 - ((real3)(-R(0.425), R(0.0), -R(0.6)))) * R(0.9999)) - R(0.5196152422706632);
+    real g42 = (length(p0 - ((real3)(R(0.75), R(0.0), -R(0.6)))) * R(0.9999)) - R(0.4301162633521313);
     if (!(g42 > u42 && g42 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p3 = p0 - ((real3)(-R(0.425), R(0.0), -R(0.6)));
-        /* .../b:translate/color/round_box */
-        real d7 = sd_round_box(p3, (real3)(0.3f), 0.08f);
-        real d42 = fmin(u47, d7);
+        real3 p5 = p0 - ((real3)(R(0.75), R(0.0), -R(0.6)));
+        /* .../b:translate/color/cylinder */
+        real d15 = sd_cylinder(p5, 0.25f, 0.35f);
+        real d42 = fmin(u47, d15);
         u42 = d42;
     }
     /* .../a:union/a:union: the second operand only within reach of its bound */
     real u38 = u42;
-    real g38 = (length(p0 - ((real3)(R(0.425), R(0.0), -R(0.6)))) * R(0.9999)) - R(0.38);
+    real g38 = (length(p0 - ((real3)(R(1.5), R(0.0), -R(0.6)))) * R(0.9999)) - R(0.38);
     if (!(g38 > u38 && g38 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p4 = p0 - ((real3)(R(0.425), R(0.0), -R(0.6)));
-        /* .../b:translate/color/torus */
-        real d11 = sd_torus(p4, 0.28f, 0.1f);
-        real d38 = fmin(u42, d11);
+        real3 p6 = p0 - ((real3)(R(1.5), R(0.0), -R(0.6)));
+        /* .../b:translate/color/capsule */
+        real d19 = sd_capsule(p6, (real3)(0.0f, (-0.2f), 0.0f), (real3)(0.0f, 0.2f, 0.0f), 0.18f);
+        real d38 = fmin(u42, d19);
         u38 = d38;
     }
     /* .../a:union/a:union: the second operand only within reach of its bound */
     real u34 = u38;
-    real g34 = (length(p0 - ((real3)(R(1.275), R(0.0), -R(0.6)))) * R(0.9999)) - R(0.4301162633521313);
+    real g34 = (length(p0 - ((real3)(R(2.25), R(0.0), -R(0.6)))) * R(0.9999)) - R(0.4);
     if (!(g34 > u34 && g34 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p5 = p0 - ((real3)(R(1.275), R(0.0), -R(0.6)));
-        /* .../b:translate/color/cylinder */
-        real d15 = sd_cylinder(p5, 0.25f, 0.35f);
-        real d34 = fmin(u38, d15);
+        real3 p7 = p0 - ((real3)(R(2.25), R(0.0), -R(0.6)));
+        /* .../b:translate/color/octahedron */
+        real d23 = sd_octahedron(p7, 0.4f);
+        real d34 = fmin(u38, d23);
         u34 = d34;
     }
     /* .../a:union/a:union: the second operand only within reach of its bound */
     real u30 = u34;
-    real g30 = (length(p0 - ((real3)(R(2.125), R(0.0), -R(0.6)))) * R(0.9999)) - R(0.38);
+    real g30 = (length(p0 - ((real3)(-R(2.25), R(0.0), R(0.6)))) * R(0.9999)) - R(0.4609772228646443);
     if (!(g30 > u30 && g30 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p6 = p0 - ((real3)(R(2.125), R(0.0), -R(0.6)));
-        /* .../b:translate/color/capsule */
-        real d19 = sd_capsule(p6, (real3)(0.0f, (-0.2f), 0.0f), (real3)(0.0f, 0.2f, 0.0f), 0.18f);
-        real d30 = fmin(u34, d19);
+        real3 p8 = p0 - ((real3)(-R(2.25), R(0.0), R(0.6)));
+        /* .../b:translate/color/capped_cone */
+        real d27 = sd_capped_cone(p8, 0.35f, 0.3f, 0.1f);
+        real d30 = fmin(u34, d27);
         u30 = d30;
     }
     /* .../a:union/a:union: the second operand only within reach of its bound */
     real u26 = u30;
-    real g26 = (length(p0 - ((real3)(-R(2.125), R(0.0), R(0.6)))) * R(0.9999)) - R(0.4);
+    real g26 = R(0.5714285714285715) * ((length(p0 - ((real3)(-R(1.5), R(0.0), R(0.6)))) * R(0.9999)) - R(0.35));
     if (!(g26 > u26 && g26 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p7 = p0 - ((real3)(-R(2.125), R(0.0), R(0.6)));
-        /* .../b:translate/color/octahedron */
-        real d23 = sd_octahedron(p7, 0.4f);
-        real d26 = fmin(u30, d23);
+        real3 p9 = p0 - ((real3)(-R(1.5), R(0.0), R(0.6)));
+        /* .../b:translate/color/ellipsoid */
+        real d31 = sd_ellipsoid(p9, (real3)(0.35f, 0.2f, 0.25f));
+        real d26 = fmin(u30, d31);
         u26 = d26;
     }
     /* .../a:union/a:union: the second operand only within reach of its bound */
     real u22 = u26;
-    real g22 = (length(p0 - ((real3)(-R(1.275), R(0.0), R(0.6)))) * R(0.9999)) - R(0.4609772228646443);
+    real g22 = (length(p0 - ((real3)(-R(0.75), R(0.0), R(0.6)))) * R(0.9999)) - R(0.4410593308539491);
     if (!(g22 > u22 && g22 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p8 = p0 - ((real3)(-R(1.275), R(0.0), R(0.6)));
-        /* .../b:translate/color/capped_cone */
-        real d27 = sd_capped_cone(p8, 0.35f, 0.3f, 0.1f);
-        real d22 = fmin(u26, d27);
+        real3 p10 = p0 - ((real3)(-R(0.75), R(0.0), R(0.6)));
+        /* .../b:translate/color/hex_prism */
+        real d35 = sd_hex_prism(p10, 0.28f, 0.3f);
+        real d22 = fmin(u26, d35);
         u22 = d22;
     }
     /* .../a:union/a:union: the second operand only within reach of its bound */
     real u18 = u22;
-    real g18 = R(0.5714285714285715) * ((length(p0 - ((real3)(-R(0.425), R(0.0), R(0.6)))) * R(0.9999)) - R(0.35));
+    real g18 = (length(p0 - ((real3)(R(0.0), R(0.0), R(0.6)))) * R(0.9999)) - R(0.44);
     if (!(g18 > u18 && g18 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p9 = p0 - ((real3)(-R(0.425), R(0.0), R(0.6)));
-        /* .../b:translate/color/ellipsoid */
-        real d31 = sd_ellipsoid(p9, (real3)(0.35f, 0.2f, 0.25f));
-        real d18 = fmin(u22, d31);
+        real3 p11 = p0 - ((real3)(R(0.0), R(0.0), R(0.6)));
+        /* .../b:translate/color/round_cone */
+        real d39 = sd_round_cone(p11, 0.22f, 0.22f, 0.1f);
+        real d18 = fmin(u22, d39);
         u18 = d18;
     }
     /* .../a:union/a:union: the second operand only within reach of its bound */
     real u14 = u18;
-    real g14 = (length(p0 - ((real3)(R(0.425), R(0.0), R(0.6)))) * R(0.9999)) - R(0.4410593308539491);
+    real g14 = (length(p0 - ((real3)(R(0.75), R(0.0), R(0.6)))) * R(0.9999)) - R(0.41000000000000003);
     if (!(g14 > u14 && g14 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p10 = p0 - ((real3)(R(0.425), R(0.0), R(0.6)));
-        /* .../b:translate/color/hex_prism */
-        real d35 = sd_hex_prism(p10, 0.28f, 0.3f);
-        real d14 = fmin(u18, d35);
-        u14 = d14;
-    }
-    /* .../a:union/a:union: the second operand only within reach of its bound */
-    real u10 = u14;
-    real g10 = (length(p0 - ((real3)(R(1.275), R(0.0), R(0.6)))) * R(0.9999)) - R(0.44);
-    if (!(g10 > u10 && g10 > R(0.0))) {
-        /* .../a:union/a:union/b:translate */
-        real3 p11 = p0 - ((real3)(R(1.275), R(0.0), R(0.6)));
-        /* .../b:translate/color/round_cone */
-        real d39 = sd_round_cone(p11, 0.22f, 0.22f, 0.1f);
-        real d10 = fmin(u14, d39);
-        u10 = d10;
-    }
-    /* .../a:union/a:union: the second operand only within reach of its bound */
-    real u6 = u10;
-    real g6 = (length(p0 - ((real3)(R(2.125), R(0.0), R(0.6)))) * R(0.9999)) - R(0.41000000000000003);
-    if (!(g6 > u6 && g6 > R(0.0))) {
-        /* union/a:union/b:translate */
-        real3 p12 = p0 - ((real3)(R(2.125), R(0.0), R(0.6)));
+        real3 p12 = p0 - ((real3)(R(0.75), R(0.0), R(0.6)));
         /* .../b:translate/color/rotate */
         real3 p13 = (real3)((R(0.8775825618903728) * p12.x) - (R(0.479425538604203) * p12.z), p12.y, (R(0.479425538604203) * p12.x) + (R(0.8775825618903728) * p12.z));
         /* .../color/rotate/link */
         real d43 = sd_link(p13, 0.14f, 0.2f, 0.07f);
-        real d6 = fmin(u10, d43);
+        real d14 = fmin(u18, d43);
+        u14 = d14;
+    }
+    /* .../a:union/a:union: the second operand only within reach of its bound */
+    real u10 = u14;
+    real g10 = (length(p0 - ((real3)(R(1.5), R(0.05), R(0.6)))) * R(0.9999)) - R(0.35);
+    if (!(g10 > u10 && g10 > R(0.0))) {
+        /* .../a:union/a:union/b:translate */
+        real3 p14 = p0 - ((real3)(R(1.5), R(0.0), R(0.6)));
+        /* .../b:translate/color/translate */
+        real3 p15 = p14 - ((real3)(R(0.0), R(0.05), R(0.0)));
+        /* .../color/translate/cut_sphere */
+        real d48 = sd_cut_sphere(p15, 0.35f, 0.15f);
+        real d10 = fmin(u14, d48);
+        u10 = d10;
+    }
+    /* .../a:union/a:union: the second operand only within reach of its bound */
+    real u6 = u10;
+    real g6 = (length(p0 - ((real3)(R(2.25), -R(0.3), R(0.6)))) * R(0.9999)) - R(0.45);
+    if (!(g6 > u6 && g6 > R(0.0))) {
+        /* union/a:union/b:translate */
+        real3 p16 = p0 - ((real3)(R(2.25), R(0.0), R(0.6)));
+        /* .../b:translate/color/translate */
+        real3 p17 = p16 - ((real3)(R(0.0), -R(0.3), R(0.0)));
+        /* .../color/translate/solid_angle */
+        real d53 = sd_solid_angle(p17, 0.6f, 0.45f);
+        real d6 = fmin(u10, d53);
         u6 = d6;
     }
     return u6;
@@ -347,42 +398,80 @@ real DE(real3 p0, __global const real* params) {
 real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     /* union */
     /* union/b:color/plane */
-    real d48 = sd_plane(p0, (real3)(0.0f, 1.0f, 0.0f), 0.4f);
+    real d58 = sd_plane(p0, (real3)(0.0f, 1.0f, 0.0f), 0.4f);
     /* union/b:color */
-    real3 c49 = (real3)(0.55f, 0.55f, 0.6f);
+    real3 c59 = (real3)(0.55f, 0.55f, 0.6f);
     /* union: the second operand only within reach of its bound */
-    real u50 = d48;
-    real3 uc50 = c49;
-    real ut50 = R(1.0);
-    real g50 = (length(p0 - ((real3)(-R(2.125), R(0.0), -R(0.6)))) * R(0.9999)) - R(0.35);
-    if (!(g50 > u50 && g50 > R(0.0))) {
+    real u60 = d58;
+    real3 uc60 = c59;
+    real ut60 = R(1.0);
+    real g60 = (length(p0 - ((real3)(-R(2.25), R(0.0), -R(0.6)))) * R(0.9999)) - R(0.35);
+    if (!(g60 > u60 && g60 > R(0.0))) {
         /* .../a:union/a:union/a:translate */
-        real3 p1 = p0 - ((real3)(-R(2.125), R(0.0), -R(0.6)));
+        real3 p1 = p0 - ((real3)(-R(2.25), R(0.0), -R(0.6)));
         /* .../a:translate/color/sphere */
         real d0 = sd_sphere(p1, 0.35f);
         /* .../a:union/a:translate/color */
         real3 c1 = (real3)(0.9f, 0.45f, 0.3f);
-        real d50 = fmin(d48, d0);
-        real3 c50 = d48 < d0 ? c49 : c1;
-        u50 = d50;
-        uc50 = c50;
-        ut50 = R(1.0);
+        real d60 = fmin(d58, d0);
+        real3 c60 = d58 < d0 ? c59 : c1;
+        u60 = d60;
+        uc60 = c60;
+        ut60 = R(1.0);
     }
     /* union/a:union: the second operand only within reach of its bound */
-    real u47 = u50;
-    real3 uc47 = uc50;
-    real ut47 = ut50;
-    real g47 = (length(p0 - ((real3)(-R(1.275), R(0.0), -R(0.6)))) * R(0.9999)) - R(0.5196152422706632);
-    if (!(g47 > u47 && g47 > R(0.0))) {
+    real u57 = u60;
+    real3 uc57 = uc60;
+    real ut57 = ut60;
+    real g57 = (length(p0 - ((real3)(-R(1.5), R(0.0), -R(0.6)))) * R(0.9999)) - R(0.5196152422706632);
+    if (!(g57 > u57 && g57 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p2 = p0 - ((real3)(-R(1.275), R(0.0), -R(0.6)));
+        real3 p2 = p0 - ((real3)(-R(1.5), R(0.0), -R(0.6)));
         /* .../b:translate/color/cuboid */
         real d3 = sd_box(p2, (real3)(0.3f));
         /* .../a:union/b:translate/color */
-        real3 c4 = (real3)(0.8454546f, 0.51363635f, 0.35454544f);
-        real d47 = fmin(u50, d3);
-        real3 c47 = u50 < d3 ? uc50 : c4;
-        real t47 = u50 < d3 ? ut50 : R(1.0);
+        real3 c4 = (real3)(0.85384613f, 0.50384617f, 0.34615386f);
+        real d57 = fmin(u60, d3);
+        real3 c57 = u60 < d3 ? uc60 : c4;
+        real t57 = u60 < d3 ? ut60 : R(1.0);
+        u57 = d57;
+        uc57 = c57;
+        ut57 = t57;
+    }
+    /* .../a:union/a:union: the second operand only within reach of its bound */
+    real u52 = u57;
+    real3 uc52 = uc57;
+    real ut52 = ut57;
+    real g52 = (length(p0 - ((real3)(-R(0.75), R(0.0), -R(0.6)))) * R(0.9999)) - R(0.5196152422706632);
+    if (!(g52 > u52 && g52 > R(0.0))) {
+        /* .../a:union/a:union/b:translate */
+        real3 p3 = p0 - ((real3)(-R(0.75), R(0.0), -R(0.6)));
+        /* .../b:translate/color/round_box */
+        real d7 = sd_round_box(p3, (real3)(0.3f), 0.08f);
+        /* .../a:union/b:translate/color */
+        real3 c8 = (real3)(0.8076923f, 0.5576923f, 0.3923077f);
+        real d52 = fmin(u57, d7);
+        real3 c52 = u57 < d7 ? uc57 : c8;
+        real t52 = u57 < d7 ? ut57 : R(1.0);
+        u52 = d52;
+        uc52 = c52;
+        ut52 = t52;
+    }
+    /* .../a:union/a:union: the second operand only within reach of its bound */
+    real u47 = u52;
+    real3 uc47 = uc52;
+    real ut47 = ut52;
+    real g47 = (length(p0 - ((real3)(R(0.0), R(0.0), -R(0.6)))) * R(0.9999)) - R(0.38);
+    if (!(g47 > u47 && g47 > R(0.0))) {
+        /* .../a:union/a:union/b:translate */
+        real3 p4 = p0 - ((real3)(R(0.0), R(0.0), -R(0.6)));
+        /* .../b:translate/color/torus */
+        real d11 = sd_torus(p4, 0.28f, 0.1f);
+        /* .../a:union/b:translate/color */
+        real3 c12 = (real3)(0.76153845f, 0.61153847f, 0.43846154f);
+        real d47 = fmin(u52, d11);
+        real3 c47 = u52 < d11 ? uc52 : c12;
+        real t47 = u52 < d11 ? ut52 : R(1.0);
         u47 = d47;
         uc47 = c47;
         ut47 = t47;
@@ -391,17 +480,17 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     real u42 = u47;
     real3 uc42 = uc47;
     real ut42 = ut47;
-    real g42 = (length(p0 - ((real3)(-R(0.425), R(0.0), -R(0.6)))) * R(0.9999)) - R(0.5196152422706632);
+    real g42 = (length(p0 - ((real3)(R(0.75), R(0.0), -R(0.6)))) * R(0.9999)) - R(0.4301162633521313);
     if (!(g42 > u42 && g42 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p3 = p0 - ((real3)(-R(0.425), R(0.0), -R(0.6)));
-        /* .../b:translate/color/round_box */
-        real d7 = sd_round_box(p3, (real3)(0.3f), 0.08f);
+        real3 p5 = p0 - ((real3)(R(0.75), R(0.0), -R(0.6)));
+        /* .../b:translate/color/cylinder */
+        real d15 = sd_cylinder(p5, 0.25f, 0.35f);
         /* .../a:union/b:translate/color */
-        real3 c8 = (real3)(0.7909091f, 0.5772727f, 0.4090909f);
-        real d42 = fmin(u47, d7);
-        real3 c42 = u47 < d7 ? uc47 : c8;
-        real t42 = u47 < d7 ? ut47 : R(1.0);
+        real3 c16 = (real3)(0.7153846f, 0.6653846f, 0.4846154f);
+        real d42 = fmin(u47, d15);
+        real3 c42 = u47 < d15 ? uc47 : c16;
+        real t42 = u47 < d15 ? ut47 : R(1.0);
         u42 = d42;
         uc42 = c42;
         ut42 = t42;
@@ -410,17 +499,17 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     real u38 = u42;
     real3 uc38 = uc42;
     real ut38 = ut42;
-    real g38 = (length(p0 - ((real3)(R(0.425), R(0.0), -R(0.6)))) * R(0.9999)) - R(0.38);
+    real g38 = (length(p0 - ((real3)(R(1.5), R(0.0), -R(0.6)))) * R(0.9999)) - R(0.38);
     if (!(g38 > u38 && g38 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p4 = p0 - ((real3)(R(0.425), R(0.0), -R(0.6)));
-        /* .../b:translate/color/torus */
-        real d11 = sd_torus(p4, 0.28f, 0.1f);
+        real3 p6 = p0 - ((real3)(R(1.5), R(0.0), -R(0.6)));
+        /* .../b:translate/color/capsule */
+        real d19 = sd_capsule(p6, (real3)(0.0f, (-0.2f), 0.0f), (real3)(0.0f, 0.2f, 0.0f), 0.18f);
         /* .../a:union/b:translate/color */
-        real3 c12 = (real3)(0.73636365f, 0.6409091f, 0.46363637f);
-        real d38 = fmin(u42, d11);
-        real3 c38 = u42 < d11 ? uc42 : c12;
-        real t38 = u42 < d11 ? ut42 : R(1.0);
+        real3 c20 = (real3)(0.66923076f, 0.7192308f, 0.5307692f);
+        real d38 = fmin(u42, d19);
+        real3 c38 = u42 < d19 ? uc42 : c20;
+        real t38 = u42 < d19 ? ut42 : R(1.0);
         u38 = d38;
         uc38 = c38;
         ut38 = t38;
@@ -429,17 +518,17 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     real u34 = u38;
     real3 uc34 = uc38;
     real ut34 = ut38;
-    real g34 = (length(p0 - ((real3)(R(1.275), R(0.0), -R(0.6)))) * R(0.9999)) - R(0.4301162633521313);
+    real g34 = (length(p0 - ((real3)(R(2.25), R(0.0), -R(0.6)))) * R(0.9999)) - R(0.4);
     if (!(g34 > u34 && g34 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p5 = p0 - ((real3)(R(1.275), R(0.0), -R(0.6)));
-        /* .../b:translate/color/cylinder */
-        real d15 = sd_cylinder(p5, 0.25f, 0.35f);
+        real3 p7 = p0 - ((real3)(R(2.25), R(0.0), -R(0.6)));
+        /* .../b:translate/color/octahedron */
+        real d23 = sd_octahedron(p7, 0.4f);
         /* .../a:union/b:translate/color */
-        real3 c16 = (real3)(0.6818182f, 0.70454544f, 0.5181818f);
-        real d34 = fmin(u38, d15);
-        real3 c34 = u38 < d15 ? uc38 : c16;
-        real t34 = u38 < d15 ? ut38 : R(1.0);
+        real3 c24 = (real3)(0.6230769f, 0.77307695f, 0.5769231f);
+        real d34 = fmin(u38, d23);
+        real3 c34 = u38 < d23 ? uc38 : c24;
+        real t34 = u38 < d23 ? ut38 : R(1.0);
         u34 = d34;
         uc34 = c34;
         ut34 = t34;
@@ -448,17 +537,17 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     real u30 = u34;
     real3 uc30 = uc34;
     real ut30 = ut34;
-    real g30 = (length(p0 - ((real3)(R(2.125), R(0.0), -R(0.6)))) * R(0.9999)) - R(0.38);
+    real g30 = (length(p0 - ((real3)(-R(2.25), R(0.0), R(0.6)))) * R(0.9999)) - R(0.4609772228646443);
     if (!(g30 > u30 && g30 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p6 = p0 - ((real3)(R(2.125), R(0.0), -R(0.6)));
-        /* .../b:translate/color/capsule */
-        real d19 = sd_capsule(p6, (real3)(0.0f, (-0.2f), 0.0f), (real3)(0.0f, 0.2f, 0.0f), 0.18f);
+        real3 p8 = p0 - ((real3)(-R(2.25), R(0.0), R(0.6)));
+        /* .../b:translate/color/capped_cone */
+        real d27 = sd_capped_cone(p8, 0.35f, 0.3f, 0.1f);
         /* .../a:union/b:translate/color */
-        real3 c20 = (real3)(0.6272727f, 0.7681818f, 0.57272726f);
-        real d30 = fmin(u34, d19);
-        real3 c30 = u34 < d19 ? uc34 : c20;
-        real t30 = u34 < d19 ? ut34 : R(1.0);
+        real3 c28 = (real3)(0.5769231f, 0.77307695f, 0.6230769f);
+        real d30 = fmin(u34, d27);
+        real3 c30 = u34 < d27 ? uc34 : c28;
+        real t30 = u34 < d27 ? ut34 : R(1.0);
         u30 = d30;
         uc30 = c30;
         ut30 = t30;
@@ -467,17 +556,17 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     real u26 = u30;
     real3 uc26 = uc30;
     real ut26 = ut30;
-    real g26 = (length(p0 - ((real3)(-R(2.125), R(0.0), R(0.6)))) * R(0.9999)) - R(0.4);
+    real g26 = R(0.5714285714285715) * ((length(p0 - ((real3)(-R(1.5), R(0.0), R(0.6)))) * R(0.9999)) - R(0.35));
     if (!(g26 > u26 && g26 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p7 = p0 - ((real3)(-R(2.125), R(0.0), R(0.6)));
-        /* .../b:translate/color/octahedron */
-        real d23 = sd_octahedron(p7, 0.4f);
+        real3 p9 = p0 - ((real3)(-R(1.5), R(0.0), R(0.6)));
+        /* .../b:translate/color/ellipsoid */
+        real d31 = sd_ellipsoid(p9, (real3)(0.35f, 0.2f, 0.25f));
         /* .../a:union/b:translate/color */
-        real3 c24 = (real3)(0.57272726f, 0.7681818f, 0.6272727f);
-        real d26 = fmin(u30, d23);
-        real3 c26 = u30 < d23 ? uc30 : c24;
-        real t26 = u30 < d23 ? ut30 : R(1.0);
+        real3 c32 = (real3)(0.5307692f, 0.7192308f, 0.66923076f);
+        real d26 = fmin(u30, d31);
+        real3 c26 = u30 < d31 ? uc30 : c32;
+        real t26 = u30 < d31 ? ut30 : R(1.0);
         u26 = d26;
         uc26 = c26;
         ut26 = t26;
@@ -486,17 +575,17 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     real u22 = u26;
     real3 uc22 = uc26;
     real ut22 = ut26;
-    real g22 = (length(p0 - ((real3)(-R(1.275), R(0.0), R(0.6)))) * R(0.9999)) - R(0.4609772228646443);
+    real g22 = (length(p0 - ((real3)(-R(0.75), R(0.0), R(0.6)))) * R(0.9999)) - R(0.4410593308539491);
     if (!(g22 > u22 && g22 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p8 = p0 - ((real3)(-R(1.275), R(0.0), R(0.6)));
-        /* .../b:translate/color/capped_cone */
-        real d27 = sd_capped_cone(p8, 0.35f, 0.3f, 0.1f);
+        real3 p10 = p0 - ((real3)(-R(0.75), R(0.0), R(0.6)));
+        /* .../b:translate/color/hex_prism */
+        real d35 = sd_hex_prism(p10, 0.28f, 0.3f);
         /* .../a:union/b:translate/color */
-        real3 c28 = (real3)(0.5181818f, 0.70454544f, 0.6818182f);
-        real d22 = fmin(u26, d27);
-        real3 c22 = u26 < d27 ? uc26 : c28;
-        real t22 = u26 < d27 ? ut26 : R(1.0);
+        real3 c36 = (real3)(0.4846154f, 0.6653846f, 0.7153846f);
+        real d22 = fmin(u26, d35);
+        real3 c22 = u26 < d35 ? uc26 : c36;
+        real t22 = u26 < d35 ? ut26 : R(1.0);
         u22 = d22;
         uc22 = c22;
         ut22 = t22;
@@ -505,17 +594,17 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     real u18 = u22;
     real3 uc18 = uc22;
     real ut18 = ut22;
-    real g18 = R(0.5714285714285715) * ((length(p0 - ((real3)(-R(0.425), R(0.0), R(0.6)))) * R(0.9999)) - R(0.35));
+    real g18 = (length(p0 - ((real3)(R(0.0), R(0.0), R(0.6)))) * R(0.9999)) - R(0.44);
     if (!(g18 > u18 && g18 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p9 = p0 - ((real3)(-R(0.425), R(0.0), R(0.6)));
-        /* .../b:translate/color/ellipsoid */
-        real d31 = sd_ellipsoid(p9, (real3)(0.35f, 0.2f, 0.25f));
+        real3 p11 = p0 - ((real3)(R(0.0), R(0.0), R(0.6)));
+        /* .../b:translate/color/round_cone */
+        real d39 = sd_round_cone(p11, 0.22f, 0.22f, 0.1f);
         /* .../a:union/b:translate/color */
-        real3 c32 = (real3)(0.46363637f, 0.6409091f, 0.73636365f);
-        real d18 = fmin(u22, d31);
-        real3 c18 = u22 < d31 ? uc22 : c32;
-        real t18 = u22 < d31 ? ut22 : R(1.0);
+        real3 c40 = (real3)(0.43846154f, 0.61153847f, 0.76153845f);
+        real d18 = fmin(u22, d39);
+        real3 c18 = u22 < d39 ? uc22 : c40;
+        real t18 = u22 < d39 ? ut22 : R(1.0);
         u18 = d18;
         uc18 = c18;
         ut18 = t18;
@@ -524,17 +613,19 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     real u14 = u18;
     real3 uc14 = uc18;
     real ut14 = ut18;
-    real g14 = (length(p0 - ((real3)(R(0.425), R(0.0), R(0.6)))) * R(0.9999)) - R(0.4410593308539491);
+    real g14 = (length(p0 - ((real3)(R(0.75), R(0.0), R(0.6)))) * R(0.9999)) - R(0.41000000000000003);
     if (!(g14 > u14 && g14 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p10 = p0 - ((real3)(R(0.425), R(0.0), R(0.6)));
-        /* .../b:translate/color/hex_prism */
-        real d35 = sd_hex_prism(p10, 0.28f, 0.3f);
+        real3 p12 = p0 - ((real3)(R(0.75), R(0.0), R(0.6)));
+        /* .../b:translate/color/rotate */
+        real3 p13 = (real3)((R(0.8775825618903728) * p12.x) - (R(0.479425538604203) * p12.z), p12.y, (R(0.479425538604203) * p12.x) + (R(0.8775825618903728) * p12.z));
+        /* .../color/rotate/link */
+        real d43 = sd_link(p13, 0.14f, 0.2f, 0.07f);
         /* .../a:union/b:translate/color */
-        real3 c36 = (real3)(0.4090909f, 0.5772727f, 0.7909091f);
-        real d14 = fmin(u18, d35);
-        real3 c14 = u18 < d35 ? uc18 : c36;
-        real t14 = u18 < d35 ? ut18 : R(1.0);
+        real3 c45 = (real3)(0.3923077f, 0.5576923f, 0.8076923f);
+        real d14 = fmin(u18, d43);
+        real3 c14 = u18 < d43 ? uc18 : c45;
+        real t14 = u18 < d43 ? ut18 : R(1.0);
         u14 = d14;
         uc14 = c14;
         ut14 = t14;
@@ -543,17 +634,19 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     real u10 = u14;
     real3 uc10 = uc14;
     real ut10 = ut14;
-    real g10 = (length(p0 - ((real3)(R(1.275), R(0.0), R(0.6)))) * R(0.9999)) - R(0.44);
+    real g10 = (length(p0 - ((real3)(R(1.5), R(0.05), R(0.6)))) * R(0.9999)) - R(0.35);
     if (!(g10 > u10 && g10 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p11 = p0 - ((real3)(R(1.275), R(0.0), R(0.6)));
-        /* .../b:translate/color/round_cone */
-        real d39 = sd_round_cone(p11, 0.22f, 0.22f, 0.1f);
+        real3 p14 = p0 - ((real3)(R(1.5), R(0.0), R(0.6)));
+        /* .../b:translate/color/translate */
+        real3 p15 = p14 - ((real3)(R(0.0), R(0.05), R(0.0)));
+        /* .../color/translate/cut_sphere */
+        real d48 = sd_cut_sphere(p15, 0.35f, 0.15f);
         /* .../a:union/b:translate/color */
-        real3 c40 = (real3)(0.35454544f, 0.51363635f, 0.8454546f);
-        real d10 = fmin(u14, d39);
-        real3 c10 = u14 < d39 ? uc14 : c40;
-        real t10 = u14 < d39 ? ut14 : R(1.0);
+        real3 c50 = (real3)(0.34615386f, 0.50384617f, 0.85384613f);
+        real d10 = fmin(u14, d48);
+        real3 c10 = u14 < d48 ? uc14 : c50;
+        real t10 = u14 < d48 ? ut14 : R(1.0);
         u10 = d10;
         uc10 = c10;
         ut10 = t10;
@@ -562,19 +655,19 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     real u6 = u10;
     real3 uc6 = uc10;
     real ut6 = ut10;
-    real g6 = (length(p0 - ((real3)(R(2.125), R(0.0), R(0.6)))) * R(0.9999)) - R(0.41000000000000003);
+    real g6 = (length(p0 - ((real3)(R(2.25), -R(0.3), R(0.6)))) * R(0.9999)) - R(0.45);
     if (!(g6 > u6 && g6 > R(0.0))) {
         /* union/a:union/b:translate */
-        real3 p12 = p0 - ((real3)(R(2.125), R(0.0), R(0.6)));
-        /* .../b:translate/color/rotate */
-        real3 p13 = (real3)((R(0.8775825618903728) * p12.x) - (R(0.479425538604203) * p12.z), p12.y, (R(0.479425538604203) * p12.x) + (R(0.8775825618903728) * p12.z));
-        /* .../color/rotate/link */
-        real d43 = sd_link(p13, 0.14f, 0.2f, 0.07f);
+        real3 p16 = p0 - ((real3)(R(2.25), R(0.0), R(0.6)));
+        /* .../b:translate/color/translate */
+        real3 p17 = p16 - ((real3)(R(0.0), -R(0.3), R(0.0)));
+        /* .../color/translate/solid_angle */
+        real d53 = sd_solid_angle(p17, 0.6f, 0.45f);
         /* .../a:union/b:translate/color */
-        real3 c45 = (real3)(0.3f, 0.45f, 0.9f);
-        real d6 = fmin(u10, d43);
-        real3 c6 = u10 < d43 ? uc10 : c45;
-        real t6 = u10 < d43 ? ut10 : R(1.0);
+        real3 c55 = (real3)(0.3f, 0.45f, 0.9f);
+        real d6 = fmin(u10, d53);
+        real3 c6 = u10 < d53 ? uc10 : c55;
+        real t6 = u10 < d53 ? ut10 : R(1.0);
         u6 = d6;
         uc6 = c6;
         ut6 = t6;

@@ -93,6 +93,8 @@ fn leaf_function(node: &IrNode) -> Option<(Helper, &'static str)> {
         Kind::HexPrism { .. } => (Helper::HexPrism, "sd_hex_prism"),
         Kind::RoundCone { .. } => (Helper::RoundCone, "sd_round_cone"),
         Kind::Link { .. } => (Helper::Link, "sd_link"),
+        Kind::CutSphere { .. } => (Helper::CutSphere, "sd_cut_sphere"),
+        Kind::SolidAngle { .. } => (Helper::SolidAngle, "sd_solid_angle"),
         Kind::Ellipsoid { .. } => (Helper::Ellipsoid, "sd_ellipsoid"),
         _ => return None,
     })
