@@ -725,3 +725,60 @@ fn text_formulas_render_from_files_and_the_command_line() {
         text(&out)
     );
 }
+
+#[test]
+fn nodes_lists_every_node_as_text_and_json() {
+    let dir = scratch("nodes");
+    let out = run(&dir, "", &["nodes"]);
+    assert!(out.status.success(), "{}", text(&out));
+    let listing = String::from_utf8_lossy(&out.stdout);
+    for line in [
+        "  Sphere: radius (>= 0)",
+        "  Ellipsoid [bound]:",
+        "  Kifs: fold (Tetrahedral,",
+    ] {
+        assert!(listing.contains(line), "no `{line}` in:\n{listing}");
+    }
+    let json = run(&dir, "", &["nodes", "--json"]);
+    assert!(json.status.success(), "{}", text(&json));
+    let json = String::from_utf8_lossy(&json.stdout);
+    // One object per node the library lists, each with its fields.
+    let nodes = fractal_sdf::file::node_kinds();
+    assert!(json.trim_start().starts_with('[') && json.trim_end().ends_with(']'));
+    assert_eq!(json.matches("\"name\":").count(), nodes.len(), "{json}");
+    assert_eq!(json.matches("\"fields\":").count(), nodes.len());
+    let exact = json.matches("\"exact\": true").count();
+    assert_eq!(
+        exact,
+        nodes.iter().filter(|n| n.exact == Some(true)).count()
+    );
+    assert!(exact >= 14, "{exact} exact primitives");
+    assert!(
+        json.contains(
+            "\"name\": \"CutSphere\",\n    \"category\": \"primitive\",\n    \"exact\": true"
+        ),
+        "{json}"
+    );
+    assert!(json.contains("\"exact\": null"));
+}
+
+#[test]
+fn a_reader_that_stops_early_ends_the_command_quietly() {
+    // `fractal-sdf emit mandelbulb | head -1`: the pipe closes before the
+    // kernel's source is written.
+    for args in [&["emit", "mandelbulb"][..], &["nodes"], &["nodes", "--json"]] {
+        let dir = scratch("pipe");
+        std::fs::write(dir.join("config.toml"), "").unwrap();
+        let mut child = Command::new(env!("CARGO_BIN_EXE_fractal-sdf"))
+            .args(args)
+            .env("FRACTAL_SDF_CONFIG", dir.join("config.toml"))
+            .stdout(std::process::Stdio::piped())
+            .stderr(std::process::Stdio::piped())
+            .spawn()
+            .unwrap();
+        drop(child.stdout.take());
+        let out = child.wait_with_output().unwrap();
+        assert!(out.status.success(), "{args:?}: {}", text(&out));
+        assert!(out.stderr.is_empty(), "{args:?}: {}", text(&out));
+    }
+}

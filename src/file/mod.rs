@@ -74,6 +74,7 @@ use std::path::Path;
 
 use serde::Deserialize;
 
+mod catalogue;
 mod convert;
 mod layout;
 mod locate;
@@ -82,6 +83,7 @@ mod schema;
 mod sites;
 mod values;
 
+pub use catalogue::{NodeCategory, NodeKindInfo, node_kinds};
 use convert::nesting;
 use layout::layout;
 use locate::{SiteMap, line_and_column, locate, unknown_name};

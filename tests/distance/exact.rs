@@ -252,3 +252,34 @@ fn f32_distances_and_normals() {
         assert!(n.abs_diff_eq(outward, 1e-8), "{p}: {n} vs {outward}");
     }
 }
+
+/// The listing's exact primitives (`fractal-sdf nodes`) are exactly the
+/// primitives the tests above hold to an oracle: every kind
+/// [`testing::exact_primitive`] draws, by its file name.
+#[test]
+fn the_listing_calls_exact_only_the_primitives_tested_here() {
+    use proptest::strategy::{Strategy, ValueTree};
+    use proptest::test_runner::TestRunner;
+    let mut runner = TestRunner::deterministic();
+    let strategy = testing::exact_primitive();
+    let mut drawn: Vec<String> = (0..2000)
+        .map(|_| {
+            let node = strategy.new_tree(&mut runner).unwrap().current();
+            // The file name of `round_box` is `RoundBox`.
+            node.kind()
+                .name()
+                .split('_')
+                .map(|w| w[..1].to_uppercase() + &w[1..])
+                .collect()
+        })
+        .collect();
+    drawn.sort();
+    drawn.dedup();
+    let mut listed: Vec<String> = fractal_sdf::file::node_kinds()
+        .into_iter()
+        .filter(|n| n.exact == Some(true))
+        .map(|n| n.name.to_string())
+        .collect();
+    listed.sort();
+    assert_eq!(drawn, listed);
+}

@@ -3,6 +3,7 @@
 //! `--help`.
 
 mod mesh;
+mod nodes;
 
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -60,6 +61,9 @@ enum Command {
     Mesh(mesh::MeshArgs),
     /// Sample a scene's signed distances on a grid: an NRRD volume, PNG slices.
     Volume(mesh::VolumeArgs),
+    /// List every node a scene file can hold: its fields, kind, and whether
+    /// its distance is exact.
+    Nodes(nodes::NodesArgs),
 }
 
 #[derive(Args)]
@@ -308,6 +312,7 @@ fn run(cli: Cli) -> Outcome {
         Command::Compare(args) => compare(args),
         Command::Mesh(args) => mesh::mesh(args),
         Command::Volume(args) => mesh::volume(args),
+        Command::Nodes(args) => nodes::nodes(args),
     }
 }
 
@@ -707,8 +712,22 @@ fn emit(args: &EmitArgs, settings: &Settings) -> Outcome {
         .effects(file.effects);
     let compiled = file.scene.compile()?;
     let kernel = codegen::emit(&compiled, &options)?;
-    print!("{}", kernel.source);
-    Ok(())
+    write_out(&kernel.source)
+}
+
+/// Writes `text` to standard output. A reader that stops early
+/// (`fractal-sdf emit mandelbulb | head`) ends the command quietly, as it
+/// does other Unix tools, rather than with a panic.
+fn write_out(text: &str) -> Outcome {
+    use std::io::{ErrorKind, Write};
+    let mut out = std::io::stdout().lock();
+    match out.write_all(text.as_bytes()).and_then(|()| out.flush()) {
+        Err(e) if e.kind() != ErrorKind::BrokenPipe => Err(Failure {
+            code: 1,
+            message: format!("cannot write to standard output: {e}"),
+        }),
+        _ => Ok(()),
+    }
 }
 
 fn list_devices() -> Outcome {
