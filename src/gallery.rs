@@ -19,10 +19,10 @@ use crate::error::Result;
 use crate::file::SceneFile;
 use crate::quality::{Effects, Glow, Quality};
 use crate::scene::{
-    Axis, Camera, InsideShape, Kifs, KifsFold, Light, Mandelbulb, Material, Node, QuaternionJulia,
-    Scene, capped_cone, capsule, cuboid, cut_sphere, cylinder, ellipsoid, hex_prism, julia, link,
-    menger, octahedron, param, param3, plane, round_box, round_cone, sierpinski, solid_angle,
-    sphere, torus,
+    Axis, Camera, Hybrid, HybridOp, InsideShape, Kifs, KifsFold, Light, Mandelbulb, Material, Node,
+    QuaternionJulia, Scene, capped_cone, capsule, cuboid, cut_sphere, cylinder, ellipsoid,
+    hex_prism, julia, link, menger, octahedron, param, param3, plane, round_box, round_cone,
+    sierpinski, solid_angle, sphere, torus,
 };
 
 /// Every gallery scene by name.
@@ -44,6 +44,7 @@ pub fn all() -> Vec<(&'static str, Scene)> {
         ("mandelbulb_escape", mandelbulb_escape()),
         ("mandelbox", mandelbox()),
         ("kifs", kifs()),
+        ("hybrid", hybrid()),
     ]
 }
 
@@ -342,6 +343,53 @@ pub fn kifs() -> Scene {
     .translate(dvec3(0.0, -0.1, 0.9));
     Scene::new(row.union(turned).union(floor(0.6)))
         .with_camera(Camera::look_at(dvec3(0.0, 1.4, 3.7), dvec3(0.0, -0.2, 0.0)).fov(45.0))
+        .with_lights(key_and_fill())
+}
+
+/// Three hybrids ([`Hybrid`]): an Abox-Mod (the Mandelbox's folds at
+/// scale −1.5 with a turn in each iteration), the Mandelbox at scale −1.5
+/// three times then the power-8 Mandelbulb once, and a tile of Amazing
+/// Surf (Kali's box fold on `x` and `y` only: a slab, cut to a square).
+#[must_use]
+pub fn hybrid() -> Scene {
+    let abox = Hybrid::new()
+        .stage(
+            1,
+            [
+                HybridOp::box_fold(1.0),
+                HybridOp::sphere_fold(0.5, 1.0),
+                HybridOp::scale(-1.5),
+                HybridOp::AddPoint,
+                HybridOp::rotate([0.15, 0.3, 0.0]),
+            ],
+        )
+        .iterations(12);
+    let bulb_box = Hybrid::new()
+        .stage(3, Hybrid::mandelbox(-1.5).stages[0].ops.clone())
+        .stage(1, [HybridOp::power(8.0), HybridOp::AddPoint])
+        .iterations(8);
+    let surf = Node::from(Hybrid::amazing_surf(1.5, [0.0, 0.0, 0.3]).iterations(10))
+        .intersect(cuboid(dvec3(2.5, 2.5, 1.0)))
+        .rotate(DVec3::X, -1.2);
+    let row = [
+        (Node::from(abox), 1.0 / 3.0, dvec3(0.85, 0.55, 0.3)),
+        (Node::from(bulb_box), 0.3, dvec3(0.4, 0.7, 0.9)),
+        (surf, 1.0 / 3.0, dvec3(0.6, 0.85, 0.45)),
+    ]
+    .into_iter()
+    .enumerate()
+    .map(|(i, (node, size, color))| {
+        #[allow(clippy::cast_precision_loss)]
+        let x = (i as f64 - 1.0) * 1.7;
+        node.scale(size)
+            .rotate(DVec3::Y, 0.5)
+            .color(color)
+            .translate(dvec3(x, 0.0, 0.0))
+    })
+    .reduce(Node::union)
+    .expect("three hybrids");
+    Scene::new(row.union(floor(1.0)))
+        .with_camera(Camera::look_at(dvec3(0.0, 1.8, 4.4), dvec3(0.0, -0.2, 0.0)).fov(45.0))
         .with_lights(key_and_fill())
 }
 

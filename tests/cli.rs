@@ -766,7 +766,11 @@ fn nodes_lists_every_node_as_text_and_json() {
 fn a_reader_that_stops_early_ends_the_command_quietly() {
     // `fractal-sdf emit mandelbulb | head -1`: the pipe closes before the
     // kernel's source is written.
-    for args in [&["emit", "mandelbulb"][..], &["nodes"], &["nodes", "--json"]] {
+    for args in [
+        &["emit", "mandelbulb"][..],
+        &["nodes"],
+        &["nodes", "--json"],
+    ] {
         let dir = scratch("pipe");
         std::fs::write(dir.join("config.toml"), "").unwrap();
         let mut child = Command::new(env!("CARGO_BIN_EXE_fractal-sdf"))

@@ -5,7 +5,7 @@
 use crate::cpu::sdf::{self, Estimate};
 use crate::expr::{Num, OpenCl, Printer, Shape, Signature, Unprintable, Var, trace};
 use crate::math::{V3, v3};
-use crate::scene::KifsFold;
+use crate::scene::{Hybrid, KifsFold, ParamSpec};
 
 use Shape::{Pair, Scalar, Vec3};
 
@@ -270,6 +270,42 @@ pub(crate) fn kifs(fold: KifsFold, turned: bool, name: &str) -> Result<String, U
             k
         };
         pair(sdf::kifs_estimate(vector(a, 0), a[3], &k))
+    })
+}
+
+/// A hybrid of the structure `shape` (its operations, their parameters
+/// the helper's inputs in the order [`Hybrid`]'s parameters are listed),
+/// with the baked integer powers `integer_powers`.
+pub(crate) fn hybrid(
+    name: &str,
+    shape: &Hybrid<()>,
+    integer_powers: &[Option<u32>],
+) -> Result<String, Unprintable> {
+    let mut names = vec!["p".to_string(), "iterations".to_string()];
+    let mut collect = |_: &(), spec: ParamSpec<'_>| -> Result<(), Unprintable> {
+        // `stages[0].ops[1].limit` → `s0_1_limit`.
+        let short = spec
+            .name
+            .replace("stages[", "s")
+            .replace("].ops[", "_")
+            .replace("].", "_")
+            .replace('.', "_");
+        names.push(short);
+        Ok(())
+    };
+    shape.try_map(&mut collect)?;
+    let params: Vec<(&str, Shape)> = names
+        .iter()
+        .enumerate()
+        .map(|(i, n)| (n.as_str(), if i == 0 { Vec3 } else { Scalar }))
+        .collect();
+    print(name, &params, Pair, |a| {
+        let mut next = 4;
+        let h = shape.map(|()| {
+            next += 1;
+            a[next - 1]
+        });
+        pair(sdf::hybrid_estimate(vector(a, 0), a[3], &h, integer_powers))
     })
 }
 

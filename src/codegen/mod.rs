@@ -339,6 +339,8 @@ pub fn emit_ir(ir: &Ir, options: &Options) -> Result<KernelSource> {
     let used = std::mem::take(&mut emitter.used);
     let customs: Vec<_> = emitter.customs.values().cloned().collect();
     let powers: Vec<u32> = emitter.powers.iter().copied().collect();
+    let mut hybrids: Vec<_> = std::mem::take(&mut emitter.hybrids).into_values().collect();
+    hybrids.sort_by(|a, b| a.0.cmp(&b.0));
     let constants = std::mem::take(&mut emitter.constants);
 
     let mut w = writer::Writer::new(precision);
@@ -363,6 +365,16 @@ pub fn emit_ir(ir: &Ir, options: &Options) -> Result<KernelSource> {
             what: "formula",
             reason: e.to_string(),
         })?);
+        w.line("");
+    }
+    for (name, shape, integer_powers) in &hybrids {
+        w.line(format!("/* ---- {name} ---- */"));
+        w.raw(
+            &formulas::hybrid(name, shape, integer_powers).map_err(|e| Error::Invalid {
+                what: "formula",
+                reason: e.to_string(),
+            })?,
+        );
         w.line("");
     }
     let mut custom_regions = Vec::with_capacity(customs.len());

@@ -412,6 +412,12 @@ impl Evaluator {
                 &sdf::KifsParams::new(f.fold, s(f.scale), v(f.offset))
                     .with_turns(f.rotate_before.map(v), f.rotate_after.map(v)),
             )),
+            Kind::Hybrid(h) => Self::fractal(sdf::hybrid(
+                p,
+                h.iterations,
+                &h.map(|x| s(*x)),
+                &sdf::hybrid_integer_powers(h),
+            )),
             Kind::Mandelbox(f) => Self::fractal(sdf::mandelbox(
                 p,
                 f.iterations,

@@ -2,8 +2,8 @@
 
 use crate::error::Error;
 use crate::scene::{
-    CsgOp, CustomShape, InsideShape, Kifs, Kind, Mandelbox, Mandelbulb, Menger, Node, Param,
-    QuaternionJulia, Sierpinski,
+    CsgOp, CustomShape, Hybrid, InsideShape, Kifs, Kind, Mandelbox, Mandelbulb, Menger, Node,
+    Param, QuaternionJulia, Sierpinski,
 };
 
 use super::MAX_NESTING;
@@ -187,6 +187,15 @@ impl NodeRepr {
                 rotate_before,
                 rotate_after,
                 iterations: Some(iterations),
+            },
+            Kind::Hybrid(Hybrid {
+                stages,
+                iterations,
+                bailout,
+            }) => NodeRepr::Hybrid {
+                stages,
+                iterations,
+                bailout,
             },
             Kind::Translate { offset, child: c } => NodeRepr::Translate {
                 offset,
@@ -491,6 +500,16 @@ impl Located<NodeRepr> {
                 k.rotate_after.clone_from(rotate_after);
                 k.into()
             }
+            NodeRepr::Hybrid {
+                stages,
+                iterations,
+                bailout,
+            } => Kind::Hybrid(Hybrid {
+                stages: stages.clone(),
+                iterations: *iterations,
+                bailout: bailout.clone(),
+            })
+            .into(),
             NodeRepr::Translate { offset, child: c } => Kind::Translate {
                 offset: offset.clone(),
                 child: child(c)?,

@@ -5,7 +5,9 @@ use serde::{Deserialize, Serialize};
 
 use crate::animation::{Keyframe, Motion};
 use crate::quality::{Effects, Precision, Preset, Quality, ScreenNormals};
-use crate::scene::{Axis, Camera, KifsFold, Light, Material, Param, Param3, Rule, Scene};
+use crate::scene::{
+    Axis, Camera, HybridStage, KifsFold, Light, Material, Param, Param3, Rule, Scene,
+};
 
 use super::sites::Located;
 use super::values::count;
@@ -292,6 +294,12 @@ pub(super) fn one() -> Param {
 pub(super) fn sixteen_steps() -> u32 {
     16
 }
+pub(super) fn twelve_steps() -> u32 {
+    12
+}
+pub(super) fn sixteen() -> Param {
+    Param::Value(16.0)
+}
 
 /// A material as written in a file: only the values that differ from
 /// [`Material::default`] need be named.
@@ -478,6 +486,13 @@ pub(super) enum NodeRepr {
             deserialize_with = "count::optional_iterations"
         )]
         iterations: Option<u32>,
+    },
+    Hybrid {
+        stages: Vec<HybridStage>,
+        #[serde(default = "twelve_steps", deserialize_with = "count::iterations")]
+        iterations: u32,
+        #[serde(default = "sixteen")]
+        bailout: Param,
     },
     Translate {
         offset: Param3,

@@ -27,7 +27,7 @@ use crate::math::{
     JULIA_FAR_FIELD, JULIA_FAR_FIELD_SLOPE, Limits, Num, V3, julia_radius, kifs_radius,
     mandelbox_extent, mandelbulb_radius, rotation_rows,
 };
-use crate::scene::{Axis, CsgOp, KifsFold, Kind};
+use crate::scene::{Axis, CsgOp, HybridOp, KifsFold, Kind};
 
 /// A conservative bounding sphere of a node, in the coordinates the node
 /// sees: wherever `slope · (|p − centre| − radius) > 0`, the node's
@@ -256,6 +256,9 @@ pub(super) fn bound(node: &IrNode, done: &[Option<Bound>]) -> Option<Bound> {
                 kifs_radius([x?, y?, z?], f.fold == KifsFold::Menger),
             )
         }
+        // The set lies in the ball of the bailout, and the estimate is at
+        // least the distance to it.
+        Kind::Hybrid(h) => Bound::sphere(origin, baked(h.bailout)?),
         // Beyond `JULIA_FAR_FIELD · edge` the estimate is exactly
         // `JULIA_FAR_FIELD_SLOPE (|(p, w)| − edge)`; the bound is that
         // slope beyond that radius (the largest edge of any constant in
@@ -588,6 +591,19 @@ pub(crate) fn costs(ir: &Ir) -> Vec<f64> {
                 #[allow(clippy::cast_precision_loss)]
                 let per_step = fold + 2.0 * turns as f64;
                 per_step * f64::from(f.iterations)
+            }
+            Kind::Hybrid(h) => {
+                // A power's trigonometry or angle doubling against a fold's
+                // few selects.
+                let per_step: f64 = h
+                    .unrolled()
+                    .map(|(_, _, op)| match op {
+                        HybridOp::Power { .. } => 20.0,
+                        HybridOp::Fold(KifsFold::Icosahedral) => 9.0,
+                        _ => 3.0,
+                    })
+                    .sum();
+                per_step * f64::from(h.iterations)
             }
             Kind::Custom { .. } => 10.0,
             _ => 1.0,

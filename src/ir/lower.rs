@@ -10,7 +10,10 @@ use super::params::{Constraint, ParamLayout, ParamSlot, Relation, check_rule};
 use super::{Ir, IrNode, NodeId, Scalar, Vector, baked3};
 use crate::error::{Error, Result};
 use crate::math::{F64_LIMITS, normalize, reduce_angle};
-use crate::scene::{CustomShape, Kind, Mapper, Node, NodeKind, Param, Param3, ParamSpec, Rule};
+use crate::scene::{
+    CustomShape, HybridOp, Kind, MAX_HYBRID_OPS, Mapper, Node, NodeKind, Param, Param3, ParamSpec,
+    Rule,
+};
 
 /// Validates and lowers `geometry` (see [`Ir::lower`]) without recursion,
 /// whatever its depth: a work list visits each node twice, on the way down
@@ -160,6 +163,20 @@ impl Lowering {
                     for angle in turn {
                         if let Scalar::Baked(a) = angle {
                             *a = reduce_angle(*a);
+                        }
+                    }
+                }
+            }
+            // The hybrid's turns, likewise.
+            Kind::Hybrid(h) => {
+                for stage in &mut h.stages {
+                    for op in &mut stage.ops {
+                        if let HybridOp::Rotate { angles } = op {
+                            for angle in angles {
+                                if let Scalar::Baked(a) = angle {
+                                    *a = reduce_angle(*a);
+                                }
+                            }
                         }
                     }
                 }
@@ -530,6 +547,17 @@ fn check_structure(kind: &NodeKind, path: impl Fn() -> String) -> Result<()> {
             if normalize(*axis).is_none() {
                 return Err(zero("axis"));
             }
+        }
+        Kind::Hybrid(h) if h.ops_per_iteration() > MAX_HYBRID_OPS => {
+            return Err(Error::Invalid {
+                what: "fractal",
+                reason: format!(
+                    "{}: {} operations per iteration (each stage's operations times its \
+                     repeat count); at most {MAX_HYBRID_OPS}",
+                    path(),
+                    h.ops_per_iteration()
+                ),
+            });
         }
         Kind::Custom { shape, args } if args.len() != shape.arity() => {
             return Err(Error::CustomShape {

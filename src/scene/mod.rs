@@ -7,6 +7,7 @@
 mod build;
 mod custom;
 mod fractal;
+mod hybrid;
 mod inside;
 mod material;
 pub(crate) mod names;
@@ -27,6 +28,7 @@ pub use custom::{
     CpuDistance, CpuInside, CustomShape, INSIDE_HUGE, InsideBounds, MAX_INSIDE_REACH,
 };
 pub use fractal::{Kifs, KifsFold, Mandelbox, Mandelbulb, Menger, QuaternionJulia, Sierpinski};
+pub use hybrid::{Hybrid, HybridOp, HybridStage, MAX_HYBRID_OPS};
 pub use inside::{
     BRUTE_MAX_STEPS, InsideShape, MANDELBOX_BAILOUT, MANDELBOX_HALF_SIDE, MANDELBULB_BAILOUT,
     mandelbox_contains, mandelbulb_contains,

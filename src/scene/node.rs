@@ -9,6 +9,7 @@ use glam::DVec3;
 
 use super::custom::CustomShape;
 use super::fractal::{Kifs, Mandelbox, Mandelbulb, Menger, QuaternionJulia, Sierpinski};
+use super::hybrid::Hybrid;
 use super::material::Material;
 use super::param::{Param, Param3};
 use super::rule::{ParamSpec, Rule, spec};
@@ -218,6 +219,8 @@ pub enum Kind<S, V, C> {
     Mandelbox(Mandelbox<S>),
     /// See [`Kifs`].
     Kifs(Kifs<S>),
+    /// See [`Hybrid`].
+    Hybrid(Hybrid<S>),
     /// Moves the child by `offset`. Preserves exactness.
     Translate {
         /// The translation.
@@ -404,6 +407,7 @@ impl<S, V, C> Kind<S, V, C> {
             Kind::Sierpinski(_) => "sierpinski",
             Kind::Mandelbox(_) => "mandelbox",
             Kind::Kifs(_) => "kifs",
+            Kind::Hybrid(_) => "hybrid",
             Kind::Translate { .. } => "translate",
             Kind::Rotate { .. } => "rotate",
             Kind::Scale { .. } => "scale",
@@ -477,6 +481,7 @@ impl<S, V, C> Kind<S, V, C> {
             | Kind::Sierpinski(_)
             | Kind::Mandelbox(_)
             | Kind::Kifs(_)
+            | Kind::Hybrid(_)
             | Kind::Custom { .. } => vec![],
             Kind::Translate { child, .. }
             | Kind::Rotate { child, .. }
@@ -495,7 +500,7 @@ impl<S, V, C> Kind<S, V, C> {
         }
     }
 
-    /// Whether this is one of the four fractals.
+    /// Whether this is one of the fractals.
     #[must_use]
     pub fn is_fractal(&self) -> bool {
         matches!(
@@ -506,6 +511,7 @@ impl<S, V, C> Kind<S, V, C> {
                 | Kind::Sierpinski(_)
                 | Kind::Mandelbox(_)
                 | Kind::Kifs(_)
+                | Kind::Hybrid(_)
         )
     }
 
@@ -519,6 +525,7 @@ impl<S, V, C> Kind<S, V, C> {
             Kind::Sierpinski(s) => Some(s.iterations),
             Kind::Mandelbox(b) => Some(b.iterations),
             Kind::Kifs(k) => Some(k.iterations),
+            Kind::Hybrid(h) => Some(h.iterations),
             _ => None,
         }
     }
@@ -531,6 +538,7 @@ impl<S, V, C> Kind<S, V, C> {
                 Some((1, MAX_ESCAPE_ITERATIONS))
             }
             Kind::Menger(_) | Kind::Sierpinski(_) | Kind::Kifs(_) => Some((0, MAX_FOLD_ITERATIONS)),
+            Kind::Hybrid(_) => Some((0, MAX_ESCAPE_ITERATIONS)),
             _ => None,
         }
     }
@@ -694,6 +702,7 @@ impl<S, V, C> Kind<S, V, C> {
                     iterations: f.iterations,
                 })
             }
+            Kind::Hybrid(h) => Kind::Hybrid(h.try_map(&mut |s, spec| m.scalar(s, spec))?),
             Kind::Translate { offset, child } => Kind::Translate {
                 offset: m.vector(offset, spec("offset", Finite))?,
                 child: m.child(child)?,

@@ -299,3 +299,162 @@ pub fn kifs_inside(p: DVec3, k: &crate::scene::Kifs) -> bool {
     }
     z.length() <= radius
 }
+
+/// Whether `p` is in the hybrid `h` as drawn (its parameters' default
+/// values), from the definition in [`Hybrid`](crate::scene::Hybrid): `p`
+/// is within the ball of radius `bailout`, and so is the orbit at the end
+/// of each of `iterations` iterations, and no operation takes it past 16
+/// times the bailout. Each operation is written
+/// here from its definition: the folds as reflections in planes, the
+/// sphere fold by cases, the turns as quaternions, the power in spherical
+/// coordinates with `powf`, `acos` and `atan2`.
+///
+/// ```
+/// use fractal_sdf::prelude::*;
+/// use fractal_sdf::scene::Hybrid;
+/// use fractal_sdf::testing::hybrid_inside;
+/// let h = Hybrid::mandelbox(2.0).iterations(8);
+/// assert!(hybrid_inside(DVec3::ZERO, &h));
+/// assert!(!hybrid_inside(dvec3(7.0, 0.0, 0.0), &h));
+/// ```
+#[must_use]
+pub fn hybrid_inside(p: DVec3, h: &crate::scene::Hybrid) -> bool {
+    use crate::scene::{HybridOp, KifsFold};
+    // Written out here rather than read from the library.
+    const FOLLOW: f64 = 16.0;
+    let value = crate::scene::Param::default_value;
+    let three = |v: &[crate::scene::Param; 3]| DVec3::new(value(&v[0]), value(&v[1]), value(&v[2]));
+    let bailout = value(&h.bailout);
+    // Reflect `z` across the plane through `at` normal to `n` where it is
+    // on the side `n` points away from.
+    let mirror = |z: DVec3, n: DVec3, at: f64| {
+        let n = n.normalize();
+        let d = z.dot(n) - at;
+        if d < 0.0 { z - 2.0 * d * n } else { z }
+    };
+    let box_fold = |v: f64, l: f64| {
+        if v > l {
+            2.0 * l - v
+        } else if v < -l {
+            -2.0 * l - v
+        } else {
+            v
+        }
+    };
+    let phi = (1.0 + 5f64.sqrt()) / 2.0;
+    let step = |z: DVec3, op: &HybridOp| -> DVec3 {
+        match op {
+            HybridOp::BoxFold { limit } => {
+                let l = value(limit);
+                DVec3::new(box_fold(z.x, l), box_fold(z.y, l), box_fold(z.z, l))
+            }
+            HybridOp::SurfFold { limit_x, limit_y } => DVec3::new(
+                box_fold(z.x, value(limit_x)),
+                box_fold(z.y, value(limit_y)),
+                z.z,
+            ),
+            HybridOp::SphereFold {
+                min_radius,
+                fixed_radius,
+            } => {
+                let fixed = value(fixed_radius);
+                let min = value(min_radius).min(fixed);
+                let r = z.length();
+                if r < min {
+                    z * (fixed / min).powi(2)
+                } else if r < fixed {
+                    z * (fixed / r).powi(2)
+                } else {
+                    z
+                }
+            }
+            HybridOp::Scale { factor, center } => {
+                let c = three(center);
+                c + value(factor) * (z - c)
+            }
+            HybridOp::Rotate { angles } => {
+                let a = three(angles);
+                DQuat::from_rotation_z(a.z)
+                    * DQuat::from_rotation_y(a.y)
+                    * DQuat::from_rotation_x(a.x)
+                    * z
+            }
+            HybridOp::AbsFold => z.abs(),
+            HybridOp::PlaneFold { normal, offset } => {
+                let n = three(normal);
+                if n == DVec3::ZERO {
+                    z
+                } else {
+                    mirror(z, n, value(offset))
+                }
+            }
+            HybridOp::Fold(fold) => match fold {
+                KifsFold::Tetrahedral => {
+                    let z = mirror(z, DVec3::new(1.0, 1.0, 0.0), 0.0);
+                    let z = mirror(z, DVec3::new(1.0, 0.0, 1.0), 0.0);
+                    mirror(z, DVec3::new(0.0, 1.0, 1.0), 0.0)
+                }
+                KifsFold::Icosahedral => {
+                    let mut z = z;
+                    for _ in 0..3 {
+                        z = mirror(
+                            mirror(mirror(z, DVec3::X, 0.0), DVec3::Y, 0.0),
+                            DVec3::Z,
+                            0.0,
+                        );
+                        z = mirror(z, DVec3::new(phi, 1.0 - phi, -1.0), 0.0);
+                        z = mirror(z, DVec3::new(-1.0, phi, -phi - 1.0), 0.0);
+                    }
+                    z
+                }
+                _ => {
+                    let z = mirror(
+                        mirror(mirror(z, DVec3::X, 0.0), DVec3::Y, 0.0),
+                        DVec3::Z,
+                        0.0,
+                    );
+                    let z = mirror(z, DVec3::new(1.0, -1.0, 0.0), 0.0);
+                    let z = mirror(z, DVec3::new(1.0, 0.0, -1.0), 0.0);
+                    mirror(z, DVec3::new(0.0, 1.0, -1.0), 0.0)
+                }
+            },
+            HybridOp::Power { power } => {
+                let n = value(power);
+                let r = z.length();
+                if r == 0.0 {
+                    return z;
+                }
+                let theta = (z.z / r).clamp(-1.0, 1.0).acos() * n;
+                let azimuth = z.y.atan2(z.x) * n;
+                r.powf(n)
+                    * DVec3::new(
+                        theta.sin() * azimuth.cos(),
+                        theta.sin() * azimuth.sin(),
+                        theta.cos(),
+                    )
+            }
+            HybridOp::AddPoint => z + p,
+            HybridOp::AddConstant { c } => z + three(c),
+        }
+    };
+    if p.length() > bailout {
+        return false;
+    }
+    let mut z = p;
+    for _ in 0..h.iterations {
+        for stage in &h.stages {
+            for _ in 0..stage.repeat {
+                for op in &stage.ops {
+                    z = step(z, op);
+                    if z.length() > FOLLOW * bailout {
+                        return false;
+                    }
+                }
+            }
+        }
+        if z.length() > bailout {
+            return false;
+        }
+    }
+    true
+}

@@ -9,10 +9,10 @@ use proptest::prelude::*;
 
 use crate::cpu::Ray;
 use crate::scene::{
-    Axis, CsgOp, Kifs, KifsFold, Kind, MAX_ESCAPE_ITERATIONS, MAX_FOLD_ITERATIONS, MAX_SOLID_ANGLE,
-    Mandelbox, Mandelbulb, Menger, Node, Param, Param3, QuaternionJulia, Sierpinski, capped_cone,
-    capsule, cuboid, cut_sphere, cylinder, ellipsoid, hex_prism, link, octahedron, param, plane,
-    round_box, round_cone, solid_angle, sphere, torus,
+    Axis, CsgOp, Hybrid, HybridOp, Kifs, KifsFold, Kind, MAX_ESCAPE_ITERATIONS,
+    MAX_FOLD_ITERATIONS, MAX_SOLID_ANGLE, Mandelbox, Mandelbulb, Menger, Node, Param, Param3,
+    QuaternionJulia, Sierpinski, capped_cone, capsule, cuboid, cut_sphere, cylinder, ellipsoid,
+    hex_prism, link, octahedron, param, plane, round_box, round_cone, solid_angle, sphere, torus,
 };
 
 /// The largest size (radius, half extent, height) the primitive strategies
@@ -595,7 +595,78 @@ pub fn fractal_node() -> impl Strategy<Value = Node> + Clone {
         sierpinski_node(),
         mandelbox_node(),
         kifs_node(),
+        hybrid_node(),
     ]
+}
+
+/// One random hybrid operation of every kind, with parameters in their
+/// valid ranges (20% dynamic); powers are the integers 2 to 8 (a real
+/// power's map is discontinuous across the half-plane `y = 0, x < 0`,
+/// where no estimate from a derivative holds).
+pub fn hybrid_op() -> impl Strategy<Value = HybridOp> + Clone {
+    let size = |tag| scalar(tag, 0.3..=1.5f64);
+    let coordinate = |tag| scalar(tag, -1.0..=1.0f64);
+    let three = move |tag| [coordinate(tag), coordinate(tag), coordinate(tag)];
+    let angle = || scalar("hybrid.angle", -std::f64::consts::PI..=std::f64::consts::PI);
+    let fold = prop_oneof![
+        Just(KifsFold::Tetrahedral),
+        Just(KifsFold::Octahedral),
+        Just(KifsFold::Icosahedral),
+        Just(KifsFold::Menger),
+    ];
+    let power = (2u32..=8).prop_map(f64::from);
+    let factor = (0.5..=3.0f64, any::<bool>()).prop_map(|(s, neg)| if neg { -s } else { s });
+    prop_oneof![
+        size("hybrid.limit").prop_map(|l| HybridOp::BoxFold { limit: l }),
+        (size("hybrid.limit"), size("hybrid.limit")).prop_map(|(x, y)| HybridOp::SurfFold {
+            limit_x: x,
+            limit_y: y
+        }),
+        (scalar("hybrid.min", 0.1..=1.0f64), size("hybrid.fixed")).prop_map(|(m, f)| {
+            HybridOp::SphereFold {
+                min_radius: m,
+                fixed_radius: f,
+            }
+        }),
+        (scalar("hybrid.factor", factor), three("hybrid.center")).prop_map(|(f, c)| {
+            HybridOp::Scale {
+                factor: f,
+                center: c,
+            }
+        }),
+        [angle(), angle(), angle()].prop_map(|a| HybridOp::Rotate { angles: a }),
+        Just(HybridOp::AbsFold),
+        (three("hybrid.normal"), coordinate("hybrid.offset")).prop_map(|(n, o)| {
+            HybridOp::PlaneFold {
+                normal: n,
+                offset: o,
+            }
+        }),
+        fold.prop_map(HybridOp::Fold),
+        scalar("hybrid.power", power).prop_map(|p| HybridOp::Power { power: p }),
+        Just(HybridOp::AddPoint),
+        three("hybrid.c").prop_map(|c| HybridOp::AddConstant { c }),
+    ]
+}
+
+/// Random hybrids: one to three stages of one to four operations
+/// ([`hybrid_op`]), each repeated up to twice, 0 to 8 iterations and a
+/// bailout of 2 to 16.
+pub fn hybrid_node() -> impl Strategy<Value = Node> + Clone {
+    let stage = (1u32..=2, prop::collection::vec(hybrid_op(), 1..=4));
+    (
+        prop::collection::vec(stage, 1..=3),
+        0u32..=8,
+        scalar("hybrid.bailout", 2.0..=16.0f64),
+    )
+        .prop_map(|(stages, n, bailout)| {
+            stages
+                .into_iter()
+                .fold(Hybrid::new(), |h, (repeat, ops)| h.stage(repeat, ops))
+                .iterations(n)
+                .bailout(bailout)
+                .into()
+        })
 }
 
 /// Whole scenes: random trees of depth at most `depth` (and a size that

@@ -21,8 +21,8 @@ use fractal_sdf::scene::octahedron;
 use fractal_sdf::scene::param3;
 use fractal_sdf::scene::{CustomShape, Rule};
 use fractal_sdf::scene::{
-    Kifs, KifsFold, Mandelbox, capped_cone, cut_sphere, hex_prism, kifs, link, round_cone,
-    solid_angle,
+    Hybrid, HybridOp, Kifs, KifsFold, Mandelbox, capped_cone, cut_sphere, hex_prism, kifs, link,
+    round_cone, solid_angle,
 };
 use fractal_sdf::testing::{check_device_matches_cpu, random_points, spicy_points};
 
@@ -109,6 +109,40 @@ fn nodes() -> Vec<(&'static str, Node)> {
                 .scale(param("kifs_scale", 2.4))
                 .rotate_before([0.3.into(), param("kifs_turn", -0.5), 0.1.into()])
                 .iterations(9)
+                .into(),
+        ),
+        ("hybrid_mandelbox", Hybrid::mandelbox(-1.5).into()),
+        (
+            "hybrid_bulb_box",
+            Hybrid::new()
+                .stage(2, [HybridOp::power(8.0), HybridOp::AddPoint])
+                .stage(1, Hybrid::mandelbox(2.0).stages[0].ops.clone())
+                .iterations(6)
+                .into(),
+        ),
+        (
+            "hybrid_every_op_dynamic",
+            Hybrid::new()
+                .stage(
+                    1,
+                    [
+                        HybridOp::surf_fold(1.0, param("hy_limit", 0.8)),
+                        HybridOp::sphere_fold(0.4, 1.0),
+                        HybridOp::scale_about(param("hy_scale", -1.7), [0.1, 0.0, -0.2]),
+                        HybridOp::rotate([0.2.into(), param("hy_turn", -0.4), 0.0.into()]),
+                        HybridOp::AbsFold,
+                        HybridOp::plane_fold(
+                            [1.0.into(), param("hy_normal", 0.5), 0.0.into()],
+                            0.1,
+                        ),
+                        HybridOp::Fold(KifsFold::Icosahedral),
+                        HybridOp::power(param("hy_power", 2.5)),
+                        HybridOp::add_constant([0.2.into(), (-0.1).into(), param("hy_c", 0.3)]),
+                        HybridOp::AddPoint,
+                    ],
+                )
+                .iterations(5)
+                .bailout(param("hy_bailout", 6.0))
                 .into(),
         ),
         ("ellipsoid", ellipsoid(dvec3(0.7, 0.4, 0.5))),

@@ -21,6 +21,8 @@ mod formulas;
 #[cfg(feature = "proptest")]
 mod fractals;
 #[cfg(feature = "proptest")]
+mod hybrid;
+#[cfg(feature = "proptest")]
 mod julia;
 #[cfg(feature = "proptest")]
 mod kifs;
@@ -29,4 +31,6 @@ mod lipschitz;
 #[cfg(feature = "proptest")]
 mod mandelbox;
 mod numeric;
+#[cfg(feature = "proptest")]
+mod ratio;
 mod smooth_oracle;

@@ -19,6 +19,7 @@ use fractal_sdf::testing::{self, check_never_overestimates, mandelbox_inside};
 use proptest::prelude::*;
 
 use super::julia::SplitMix;
+use super::ratio::worst_ratio;
 
 /// The half side of the cube the library says holds the set.
 fn half_side(m: &Mandelbox) -> f64 {
@@ -153,60 +154,18 @@ proptest! {
     }
 }
 
-/// The largest ratio of the raw estimate (the drawn one over
-/// [`sdf::MANDELBOX_SAFETY`], where it is not the distance to the cube) to
-/// the distance to the nearest point found inside, over `count` points
-/// near the surface of `m`. A point found inside is at least as far as the
-/// nearest one, so this is the largest ratio found, a lower bound of the
-/// true largest: thin parts the samples miss can hide more.
-fn worst_ratio(m: &Mandelbox, count: usize, seed: u64) -> (f64, usize, usize) {
-    let h = half_side(m);
-    let eval = cpu::Evaluator::new(&m.clone().into()).unwrap();
-    let inside = |p| mandelbox_inside(p, m);
-    let mut rng = SplitMix(seed);
-    let (mut tested, mut witnessed) = (0, 0);
-    let mut worst = 0.0f64;
-    for p in testing::near_surface_points(inside, 1.8 * h, 0.05 * h, count, seed) {
-        // Where the drawn value is the distance to the cube (exact), the
-        // raw estimate is below it.
-        let drawn = eval.distance(p);
-        let q = p.abs() - DVec3::splat(h);
-        let cube = q.max(DVec3::ZERO).length() + q.max_element().min(0.0);
-        let e = if drawn > cube {
-            drawn / sdf::MANDELBOX_SAFETY
-        } else {
-            drawn
-        };
-        if e <= 0.0 {
-            continue;
-        }
-        tested += 1;
-        // Every point found inside is a witness: half the candidates lie
-        // within 1.2 e (where an overestimate would be), half within 4 e;
-        // the nearest is then moved to where the segment from `p` first
-        // enters the set, by bisection.
-        let witness = (0..4000)
-            .map(|i| p + rng.in_ball(if i % 2 == 0 { 1.2 * e } else { 4.0 * e }))
-            .filter(|&q| inside(q))
-            .min_by(|a, b| a.distance(p).total_cmp(&b.distance(p)));
-        let nearest = witness.map_or(f64::INFINITY, |q| {
-            let (mut out, mut inn) = (0.0, 1.0);
-            for _ in 0..48 {
-                let mid = 0.5 * (out + inn);
-                if inside(p.lerp(q, mid)) {
-                    inn = mid;
-                } else {
-                    out = mid;
-                }
-            }
-            inn * q.distance(p)
-        });
-        if nearest.is_finite() {
-            witnessed += 1;
-            worst = worst.max(e / nearest);
-        }
+/// The raw estimate of `m` at `p`: the drawn one over
+/// [`sdf::MANDELBOX_SAFETY`], where it is not the distance to the cube
+/// (exact, and then the raw estimate is below it).
+fn raw_estimate(eval: &cpu::Evaluator, h: f64, p: DVec3) -> f64 {
+    let drawn = eval.distance(p);
+    let q = p.abs() - DVec3::splat(h);
+    let cube = q.max(DVec3::ZERO).length() + q.max_element().min(0.0);
+    if drawn > cube {
+        drawn / sdf::MANDELBOX_SAFETY
+    } else {
+        drawn
     }
-    (worst, tested, witnessed)
 }
 
 /// The measured table in the guide's fractals chapter: the largest ratio
@@ -250,15 +209,24 @@ fn mandelbox_worst_ratio_is_measured() {
     println!("| Mandelbox | points | with a point inside found | largest ratio |");
     println!("|---|---:|---:|---:|");
     for (i, (name, m)) in cases.iter().enumerate() {
-        let (worst, tested, witnessed) = worst_ratio(m, 400, 1 + i as u64);
-        let ratio = if witnessed > 0 {
-            format!("{worst:.3}")
+        let h = half_side(m);
+        let eval = cpu::Evaluator::new(&m.clone().into()).unwrap();
+        let w = worst_ratio(
+            |p| raw_estimate(&eval, h, p),
+            |p| mandelbox_inside(p, m),
+            (1.8 * h, 0.05 * h),
+            (400, 4000),
+            &[1.2, 4.0],
+            1 + i as u64,
+        );
+        let ratio = if w.witnessed > 0 {
+            format!("{:.3}", w.ratio)
         } else {
             "—".into()
         };
-        println!("| {name} | {tested} | {witnessed} | {ratio} |");
-        total += witnessed;
-        overall = overall.max(worst);
+        println!("| {name} | {} | {} | {ratio} |", w.tested, w.witnessed);
+        total += w.witnessed;
+        overall = overall.max(w.ratio);
     }
     assert!(
         total >= 2500,

@@ -576,6 +576,21 @@ const NODE_FIELDS: &[(&str, &str)] = &[
         "Kifs(fold: Menger, rotate_after: (0, 0, @))",
         "rotate_after",
     ),
+    ("Hybrid(stages: [(ops: [BoxFold(limit: @)])])", "limit"),
+    (
+        "Hybrid(stages: [(repeat: 2, ops: [AddPoint, Power(power: @)])])",
+        "power",
+    ),
+    (
+        "Hybrid(stages: [(ops: [Scale(factor: @, center: (0, 0, 0))])])",
+        "factor",
+    ),
+    (
+        "Hybrid(stages: [(ops: [Rotate(angles: (0, @, 0))])])",
+        "angles",
+    ),
+    ("Hybrid(stages: [], bailout: @)", "bailout"),
+    ("Hybrid(stages: [], iterations: @)", "iterations"),
     ("Translate(offset: @, child: Sphere(radius: 1))", "offset"),
     (
         "Rotate(axis: (0, 1, 0), angle: @, child: Sphere(radius: 1))",

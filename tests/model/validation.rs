@@ -273,7 +273,9 @@ use fractal_sdf::scene::Sierpinski;
 use fractal_sdf::scene::ellipsoid;
 use fractal_sdf::scene::octahedron;
 use fractal_sdf::scene::param3;
-use fractal_sdf::scene::{Kifs, KifsFold, MAX_SOLID_ANGLE, cut_sphere, solid_angle};
+use fractal_sdf::scene::{
+    Hybrid, HybridOp, Kifs, KifsFold, MAX_SOLID_ANGLE, cut_sphere, solid_angle,
+};
 use fractal_sdf::scene::{MAX_ESCAPE_ITERATIONS, MAX_FOLD_ITERATIONS};
 use fractal_sdf::scene::{capped_cone, hex_prism, link, round_cone};
 
@@ -577,6 +579,25 @@ fn broken_node() -> impl Strategy<Value = (Node, &'static str)> {
         outside(1.5, 4.0).prop_map(|v| (Sierpinski::new(2).scale(v).into(), "sierpinski")),
         outside(1.1, 4.0).prop_map(|v| (Kifs::new(KifsFold::Octahedral).scale(v).into(), "kifs")),
         (21..=u32::MAX).prop_map(|n| (Kifs::new(KifsFold::Menger).iterations(n).into(), "kifs")),
+        outside(2.0, 16.0).prop_map(|v| (
+            Hybrid::new()
+                .stage(1, [HybridOp::power(v), HybridOp::AddPoint])
+                .into(),
+            "hybrid"
+        )),
+        outside(1.0, 1000.0).prop_map(|v| (Hybrid::mandelbox(2.0).bailout(v).into(), "hybrid")),
+        bad_size().prop_map(|v| (
+            Hybrid::new()
+                .stage(2, [HybridOp::sphere_fold(v, 1.0)])
+                .into(),
+            "hybrid"
+        )),
+        (25..=1000u32).prop_map(|n| (
+            Hybrid::new()
+                .stage(n, [HybridOp::AbsFold, HybridOp::AddPoint])
+                .into(),
+            "hybrid"
+        )),
         bad_size().prop_map(|v| (cut_sphere(v, 0.5), "cut_sphere")),
         bad_size().prop_map(|v| (solid_angle(0.5, v), "solid_angle")),
         outside(0.0, MAX_SOLID_ANGLE).prop_map(|v| (solid_angle(v, 1.0), "solid_angle")),

@@ -117,11 +117,11 @@ real2 mandelbulb(real3 p, real power, real iterations, real escape, real ball) {
             break;
         }
         real t5 = pow(t4, power - R(1.0));
-        real t6 = t5 * t4;
-        real t7 = acos(fmin(fmax(ts0_0.z / fmax(t4, R(1e-30)), -R(1.0)), R(1.0))) * power;
-        real t8 = atan2(ts0_0.y, ts0_0.x) * power;
-        real t9 = sin(t7);
-        real3 t10 = (((real3)(t9 * cos(t8), t9 * sin(t8), cos(t7))) * t6) + ((real3)(p.x, p.y, p.z));
+        real t6 = acos(fmin(fmax(ts0_0.z / fmax(t4, R(1e-30)), -R(1.0)), R(1.0))) * power;
+        real t7 = atan2(ts0_0.y, ts0_0.x) * power;
+        real t8 = sin(t6);
+        real t9 = t5 * t4;
+        real3 t10 = (((real3)(t8 * cos(t7), t8 * sin(t7), cos(t6))) * t9) + ((real3)(p.x, p.y, p.z));
         real t11 = fmin(((power * t5) * ts0_3) + R(1.0), R(1e30));
         real t12 = fmin(ts0_4, t4);
         ts0_0 = t10;

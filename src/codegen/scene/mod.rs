@@ -32,7 +32,7 @@ use crate::ir::{
 use crate::math::{F32_LIMITS, V3, escape_radius, integer_power, mandelbulb_radius, rotation_rows};
 use crate::quality::Precision;
 use crate::scene::{
-    CsgOp, CustomShape, Kind, MAX_ESCAPE_ITERATIONS, MAX_FOLD_ITERATIONS, Mapper, ParamSpec,
+    CsgOp, CustomShape, Hybrid, Kind, MAX_ESCAPE_ITERATIONS, MAX_FOLD_ITERATIONS, Mapper, ParamSpec,
 };
 
 mod inline;
@@ -150,6 +150,9 @@ pub(crate) struct SceneEmitter<'a> {
     pub(crate) customs: BTreeMap<String, CustomShape>,
     /// The integer Mandelbulb powers that need a specialised helper.
     pub(crate) powers: BTreeSet<u32>,
+    /// The hybrids' helpers, one per structure (their operations and
+    /// integer powers), by the structure's description.
+    pub(crate) hybrids: BTreeMap<String, HybridHelper>,
     /// The instances' table rows, read from `params[slots + i]`.
     pub(crate) constants: Vec<f64>,
     /// How many slots the dynamic parameters take before the tables.
@@ -166,6 +169,10 @@ pub(crate) struct SceneEmitter<'a> {
     /// Booleans whose second operand's block is open.
     gated: BTreeSet<NodeId>,
 }
+
+/// A hybrid's helper: its name, the structure it is printed for (the
+/// hybrid with its parameters left out), and its baked integer powers.
+pub(crate) type HybridHelper = (String, Hybrid<()>, Vec<Option<u32>>);
 
 impl<'a> SceneEmitter<'a> {
     pub(crate) fn new(
@@ -186,6 +193,7 @@ impl<'a> SceneEmitter<'a> {
             used: BTreeSet::new(),
             customs: BTreeMap::new(),
             powers: BTreeSet::new(),
+            hybrids: BTreeMap::new(),
             constants: Vec::new(),
             slots: ir.params().len(),
             instance: HashMap::new(),
@@ -601,6 +609,21 @@ impl<'a> SceneEmitter<'a> {
                     }
                 }
                 Step::Done(self.fractal(id, Helper::Kifs(f.fold, turned), &args))
+            }
+            Kind::Hybrid(h) => {
+                let n = self.iterations(h.iterations, (0, MAX_ESCAPE_ITERATIONS));
+                let mut args = vec![p.to_string(), n.to_string()];
+                let shape = h.map(|s| args.push(w(self, *s)));
+                let powers = sdf::hybrid_integer_powers(h);
+                let key = format!("{shape:?} {powers:?}");
+                let count = self.hybrids.len();
+                let name = self
+                    .hybrids
+                    .entry(key)
+                    .or_insert_with(|| (format!("hybrid_{count}"), shape, powers))
+                    .0
+                    .clone();
+                Step::Done(self.fractal_call(id, &name, &args.join(", ")))
             }
             Kind::Mandelbox(f) => {
                 let n = self.iterations(f.iterations, (1, MAX_ESCAPE_ITERATIONS));

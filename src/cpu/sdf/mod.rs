@@ -22,6 +22,11 @@ use crate::math::{
 };
 use crate::scene::{CsgOp, KifsFold};
 
+mod hybrid;
+
+pub(crate) use hybrid::hybrid_integer_powers;
+pub use hybrid::{HYBRID_FOLLOW, HYBRID_POWER_SAFETY, HYBRID_SAFETY, hybrid, hybrid_estimate};
+
 /// Exact distance to a sphere of radius `r` at the origin.
 #[must_use]
 pub fn sphere<T: Num>(p: V3<T>, r: T) -> T {
@@ -301,6 +306,52 @@ fn angle_power<T: Num>(c: T, s: T, n: u32) -> (T, T) {
     result.unwrap_or((T::one(), T::zero()))
 }
 
+/// The unit direction of the triplex power `z^power` of `z` (of length
+/// `r`): its polar angle and azimuth times `power`. With `integer`, by
+/// binary exponentiation of the angles' cosines and sines, with no
+/// trigonometry; on the `z` axis the azimuth is 0.
+pub(crate) fn triplex_direction<T: Num>(z: V3<T>, r: T, power: T, integer: Option<u32>) -> V3<T> {
+    let (st, ct, sp, cp) = match integer {
+        Some(n) => {
+            let rho = z.x.hypot(z.y);
+            let inv_r = T::one() / r.max(T::tiny());
+            let (ct, st) = angle_power(z.z * inv_r, rho * inv_r, n);
+            // On the z axis the azimuth is 0.
+            let off_axis = rho.gt(T::tiny());
+            let (cp, sp) = angle_power(
+                T::select(off_axis, z.x / rho, T::one()),
+                T::select(off_axis, z.y / rho, T::zero()),
+                n,
+            );
+            (st, ct, sp, cp)
+        }
+        None => {
+            let cos_theta = (z.z / r.max(T::tiny())).clamp(-T::one(), T::one());
+            let theta = cos_theta.acos() * power;
+            let phi = z.y.atan2(z.x) * power;
+            (theta.sin(), theta.cos(), phi.sin(), phi.cos())
+        }
+    };
+    v3(st * cp, st * sp, ct)
+}
+
+/// Tom Lowe's box fold of one coordinate: reflected back where it is
+/// beyond `±limit`.
+pub(crate) fn box_fold<T: Num>(v: T, limit: T) -> T {
+    v.clamp(-limit, limit) * T::of(2.0) - v
+}
+
+/// The sphere fold's scale of a point at squared radius `r2`: `fixed2 /
+/// min2` within the inner radius, `fixed2 / r2` between the radii, 1
+/// beyond (`min2` at most `fixed2`).
+pub(crate) fn sphere_fold_factor<T: Num>(r2: T, min2: T, fixed2: T) -> T {
+    T::select(
+        r2.lt(min2),
+        (fixed2 / min2).min(T::derivative_cap()),
+        T::select(r2.lt(fixed2), fixed2 / r2.max(T::tiny()), T::one()),
+    )
+}
+
 /// Beyond `MANDELBULB_FAR_FIELD` times [`mandelbulb_radius`] the
 /// Mandelbulb's distance is the distance to its bounding ball alone.
 ///
@@ -378,29 +429,7 @@ pub fn mandelbulb_estimate<T: Num>(
             None => r.powf(power - T::one()),
         };
         let dr = (power * r_pow * dr + T::one()).min(T::derivative_cap());
-        let zr = r_pow * r;
-        let (st, ct, sp, cp) = match integer_power {
-            Some(n) => {
-                let rho = z.x.hypot(z.y);
-                let inv_r = T::one() / r.max(T::tiny());
-                let (ct, st) = angle_power(z.z * inv_r, rho * inv_r, n);
-                // On the z axis the azimuth is 0.
-                let off_axis = rho.gt(T::tiny());
-                let (cp, sp) = angle_power(
-                    T::select(off_axis, z.x / rho, T::one()),
-                    T::select(off_axis, z.y / rho, T::zero()),
-                    n,
-                );
-                (st, ct, sp, cp)
-            }
-            None => {
-                let cos_theta = (z.z / r.max(T::tiny())).clamp(-T::one(), T::one());
-                let theta = cos_theta.acos() * power;
-                let phi = z.y.atan2(z.x) * power;
-                (theta.sin(), theta.cos(), phi.sin(), phi.cos())
-            }
-        };
-        let z = v3(st * cp, st * sp, ct) * zr + p;
+        let z = triplex_direction(z, r, power, integer_power) * (r_pow * r) + p;
         Step {
             stop_before: Some(r.gt(escape)),
             next: [z.x, z.y, z.z, dr, trap],
@@ -540,7 +569,7 @@ pub const KIFS_FOLLOW: f64 = 32.0;
 
 /// A turn by angles about `x`, then `y`, then `z`, as the cosines and
 /// sines of the three angles (computed once, outside the loop).
-fn turn<T: Num>(angles: V3<T>) -> impl Fn(V3<T>) -> V3<T> {
+pub(crate) fn turn<T: Num>(angles: V3<T>) -> impl Fn(V3<T>) -> V3<T> {
     let (cx, sx) = (angles.x.cos(), angles.x.sin());
     let (cy, sy) = (angles.y.cos(), angles.y.sin());
     let (cz, sz) = (angles.z.cos(), angles.z.sin());
@@ -567,7 +596,7 @@ fn octahedral_fold<T: Num>(z: V3<T>) -> V3<T> {
 
 /// The fold of [`KifsFold`] (the Menger fold's mirror after the scale is
 /// applied by [`kifs_estimate`]).
-fn kifs_fold<T: Num>(fold: KifsFold, z: V3<T>) -> V3<T> {
+pub(crate) fn kifs_fold<T: Num>(fold: KifsFold, z: V3<T>) -> V3<T> {
     match fold {
         KifsFold::Tetrahedral => {
             let z = V3::select((z.x + z.y).lt(T::zero()), v3(-z.y, -z.x, z.z), z);
@@ -740,13 +769,8 @@ pub fn mandelbox_estimate<T: Num>(p: V3<T>, iterations: T, m: &MandelboxParams<T
     let [x, y, z, dr, trap, steps] =
         T::iterate(iterations, start, |_, [x, y, z, dr, trap, steps]| {
             // The box fold, then the sphere fold.
-            let z = v3(x, y, z).map(|v| v.clamp(-limit, limit) * T::of(2.0) - v);
-            let r2 = z.dot(z);
-            let k = T::select(
-                r2.lt(min2),
-                (fixed2 / min2).min(T::derivative_cap()),
-                T::select(r2.lt(fixed2), fixed2 / r2.max(T::tiny()), T::one()),
-            );
+            let z = v3(x, y, z).map(|v| box_fold(v, limit));
+            let k = sphere_fold_factor(z.dot(z), min2, fixed2);
             let z = z * (k * m.scale) + c;
             let dr = (dr * k * scale_abs + add).min(T::derivative_cap());
             Step {

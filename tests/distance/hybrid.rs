@@ -1,0 +1,338 @@
+//! Hybrid fractals: the estimate's sign held to the membership test
+//! ([`testing::hybrid_inside`], written from the definition with no code of
+//! the estimator), and its size to the distance to the points that test
+//! finds inside.
+//!
+//! The estimate of an arbitrary sequence of steps is not a proven bound,
+//! so it carries a measured safety factor ([`sdf::HYBRID_SAFETY`]):
+//! `hybrid_worst_ratio_is_measured` measures the largest ratio of the raw
+//! estimate to the distance over the classic hybrids and checks that the
+//! factor covers it; the property tests check the estimate as drawn for
+//! random hybrids.
+
+use fractal_sdf::cpu;
+use fractal_sdf::cpu::sdf;
+use fractal_sdf::prelude::*;
+use fractal_sdf::scene::Kind;
+use fractal_sdf::scene::{Hybrid, HybridOp, KifsFold};
+use fractal_sdf::testing::{self, check_never_overestimates, hybrid_inside};
+use proptest::prelude::*;
+use proptest::strategy::ValueTree;
+use proptest::test_runner::{RngSeed, TestRunner};
+
+use super::julia::SplitMix;
+use super::ratio::{Worst, worst_ratio};
+
+/// The classic hybrids of the guide's table, each with the radius of the
+/// ball to sample (holding the set, or the part of it worth sampling).
+fn classics() -> Vec<(&'static str, Hybrid, f64)> {
+    let bulb = |n: f64| [HybridOp::power(n), HybridOp::AddPoint];
+    let boxed = |s: f64| {
+        [
+            HybridOp::box_fold(1.0),
+            HybridOp::sphere_fold(0.5, 1.0),
+            HybridOp::scale(s),
+            HybridOp::AddPoint,
+        ]
+    };
+    vec![
+        (
+            "Mandelbox, scale 2",
+            Hybrid::mandelbox(2.0).iterations(10),
+            7.0,
+        ),
+        (
+            "Mandelbox, scale −1.5",
+            Hybrid::mandelbox(-1.5).iterations(10),
+            3.0,
+        ),
+        (
+            "Amazing Surf, scale 1.5, turn (0, 0, 0.3)",
+            Hybrid::amazing_surf(1.5, [0.0, 0.0, 0.3]).iterations(8),
+            3.0,
+        ),
+        (
+            "Abox-Mod: abs, box, sphere, scale 2, add p, turn (0.1, 0.2, 0)",
+            Hybrid::new()
+                .stage(
+                    1,
+                    [
+                        HybridOp::AbsFold,
+                        HybridOp::box_fold(1.0),
+                        HybridOp::sphere_fold(0.5, 1.0),
+                        HybridOp::scale(2.0),
+                        HybridOp::AddPoint,
+                        HybridOp::rotate([0.1, 0.2, 0.0]),
+                    ],
+                )
+                .iterations(10),
+            7.0,
+        ),
+        (
+            "octahedral fold, scale 3 about (1, 1, 1)",
+            Hybrid::new()
+                .stage(
+                    1,
+                    [
+                        HybridOp::Fold(KifsFold::Octahedral),
+                        HybridOp::scale_about(3.0, [1.0, 1.0, 1.0]),
+                    ],
+                )
+                .bailout(4.0)
+                .iterations(6),
+            2.0,
+        ),
+        (
+            "tetrahedral fold, plane fold y = 0.1, scale 2 about (1, 1, 1)",
+            Hybrid::new()
+                .stage(
+                    1,
+                    [
+                        HybridOp::Fold(KifsFold::Tetrahedral),
+                        HybridOp::plane_fold([0.0, 1.0, 0.0], 0.1),
+                        HybridOp::scale_about(2.0, [1.0, 1.0, 1.0]),
+                    ],
+                )
+                .bailout(4.0)
+                .iterations(8),
+            2.0,
+        ),
+        (
+            "Mandelbulb, power 8",
+            Hybrid::new().stage(1, bulb(8.0)).iterations(8),
+            1.3,
+        ),
+        (
+            "Mandelbulb, power 3",
+            Hybrid::new().stage(1, bulb(3.0)).iterations(8),
+            1.6,
+        ),
+        (
+            "burning bulb: abs, power 2, add p",
+            Hybrid::new()
+                .stage(
+                    1,
+                    [HybridOp::AbsFold, HybridOp::power(2.0), HybridOp::AddPoint],
+                )
+                .iterations(8),
+            2.2,
+        ),
+        (
+            "Julia bulb: power 8, add (0.4, −0.3, 0.2)",
+            Hybrid::new()
+                .stage(
+                    1,
+                    [
+                        HybridOp::power(8.0),
+                        HybridOp::add_constant([0.4, -0.3, 0.2]),
+                    ],
+                )
+                .iterations(8),
+            1.4,
+        ),
+        (
+            "box (scale −1.5), then bulb (power 2)",
+            Hybrid::new()
+                .stage(1, boxed(-1.5))
+                .stage(1, bulb(2.0))
+                .iterations(8),
+            2.0,
+        ),
+        (
+            "bulb (power 2), then box (scale −1.5)",
+            Hybrid::new()
+                .stage(1, bulb(2.0))
+                .stage(1, boxed(-1.5))
+                .iterations(8),
+            2.0,
+        ),
+        (
+            "box (scale −1.5) three times, then bulb (power 8)",
+            Hybrid::new()
+                .stage(3, boxed(-1.5))
+                .stage(1, bulb(8.0))
+                .iterations(6),
+            3.0,
+        ),
+    ]
+}
+
+/// The safety factor of `h`'s estimate.
+fn factor(h: &Hybrid) -> f64 {
+    if h.has_power() {
+        sdf::HYBRID_POWER_SAFETY
+    } else {
+        sdf::HYBRID_SAFETY
+    }
+}
+
+/// The raw estimate at `p`: the drawn one over the factor where it is not
+/// the distance to the bailout ball.
+fn raw_estimate(eval: &cpu::Evaluator, h: &Hybrid, p: DVec3) -> f64 {
+    let drawn = eval.distance(p);
+    if drawn > p.length() - h.bailout.default_value() {
+        drawn / factor(h)
+    } else {
+        drawn
+    }
+}
+
+/// The measured table in the guide's fractals chapter: the largest ratio
+/// of the raw estimate to the distance for the classic hybrids. The safety
+/// factor must cover every one of them.
+/// The largest ratio of the raw estimate to the distance for `h`, over
+/// `count` points within `shell` times `reach` of its surface.
+fn measure(h: &Hybrid, (reach, shell): (f64, f64), count: usize, seed: u64) -> Worst {
+    let eval = cpu::Evaluator::new(&h.clone().into()).unwrap();
+    worst_ratio(
+        |p| raw_estimate(&eval, h, p),
+        |p| hybrid_inside(p, h),
+        (reach, shell * reach),
+        (count, 3000),
+        &[1.2, 4.0, 16.0, 64.0],
+        seed,
+    )
+}
+
+/// [`measure`] near the surface (within 3% of the reach: where the
+/// marcher stops) and farther out (within 30%: where the coarse pass
+/// starts its rays): the larger ratio, and the median near the surface.
+fn measure_both(h: &Hybrid, reach: f64, count: usize, seed: u64) -> (Worst, f64) {
+    let near = measure(h, (reach, 0.03), count, seed);
+    let far = measure(h, (reach, 0.3), count, seed + 1000);
+    let ratio = near.ratio.max(far.ratio);
+    (near, ratio)
+}
+
+/// The measured tables in the guide's fractals chapter: the largest ratio
+/// of the raw estimate to the distance for the classic hybrids, and over
+/// 400 random ones ([`testing::hybrid_node`], drawn the same way every
+/// run), with and without a power. Each safety factor must cover 1.25
+/// times the largest ratio of its kind.
+#[test]
+fn hybrid_worst_ratio_is_measured() {
+    let mut worst = [0.0f64; 2];
+    let mut total = 0;
+    println!(
+        "| hybrid | points | with a point inside found | largest ratio | largest, out to 30% | median |"
+    );
+    println!("|---|---:|---:|---:|---:|---:|");
+    for (i, (name, h, reach)) in classics().iter().enumerate() {
+        let (w, ratio) = measure_both(h, *reach, 300, 1 + i as u64);
+        println!(
+            "| {name} | {} | {} | {:.3} | {ratio:.3} | {:.3} |",
+            w.tested, w.witnessed, w.ratio, w.median
+        );
+        assert!(w.witnessed >= 20, "{name}: only {} witnessed", w.witnessed);
+        total += w.witnessed;
+        let slot = usize::from(h.has_power());
+        worst[slot] = worst[slot].max(ratio);
+    }
+    assert!(
+        total >= 1500,
+        "only {total} points had a point inside within reach"
+    );
+    let mut runner = TestRunner::deterministic();
+    let strategy = testing::hybrid_node();
+    let mut random: [Vec<f64>; 2] = [Vec::new(), Vec::new()];
+    for seed in 0..400 {
+        let h = hybrid_of(&strategy.new_tree(&mut runner).unwrap().current());
+        let (w, ratio) = measure_both(&h, h.bailout.default_value(), 48, seed);
+        if w.witnessed >= 8 {
+            random[usize::from(h.has_power())].push(ratio);
+        }
+    }
+    println!("| random hybrids | measured | largest ratio | median of each one's largest |");
+    println!("|---|---:|---:|---:|");
+    for (slot, name) in ["without a power", "with a power"].into_iter().enumerate() {
+        let ratios = &mut random[slot];
+        ratios.sort_by(f64::total_cmp);
+        let largest = ratios.last().copied().unwrap_or(0.0);
+        let median = ratios.get(ratios.len() / 2).copied().unwrap_or(0.0);
+        println!("| {name} | {} | {largest:.3} | {median:.3} |", ratios.len());
+        assert!(
+            ratios.len() >= 30,
+            "only {} random hybrids {name} measured",
+            ratios.len()
+        );
+        worst[slot] = worst[slot].max(largest);
+    }
+    println!(
+        "largest ratio {:.3} without a power (factor {}), {:.3} with one (factor {})",
+        worst[0],
+        sdf::HYBRID_SAFETY,
+        worst[1],
+        sdf::HYBRID_POWER_SAFETY
+    );
+    for (ratio, factor) in worst
+        .into_iter()
+        .zip([sdf::HYBRID_SAFETY, sdf::HYBRID_POWER_SAFETY])
+    {
+        assert!(
+            1.25 * ratio * factor <= 1.0,
+            "the safety factor {factor} does not cover 1.25 times the measured ratio {ratio}"
+        );
+    }
+}
+
+/// The hybrid a strategy's node holds.
+fn hybrid_of(node: &Node) -> Hybrid {
+    match node.kind() {
+        Kind::Hybrid(h) => h.clone(),
+        other => panic!("not a hybrid: {}", other.name()),
+    }
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(96))]
+
+    /// The estimate is negative exactly inside the set the membership
+    /// test finds, for random hybrids and random points of the ball,
+    /// except within rounding of the surface.
+    #[test]
+    fn the_sign_is_the_membership_tests(node in testing::hybrid_node(), seed in any::<u64>()) {
+        let h = hybrid_of(&node);
+        let eval = cpu::Evaluator::new(&node)?;
+        let bailout = h.bailout.default_value();
+        let mut rng = SplitMix(seed);
+        for _ in 0..64 {
+            let p = rng.in_ball(1.1 * bailout);
+            let d = eval.distance(p);
+            let inside = hybrid_inside(p, &h);
+            prop_assert!(
+                inside == (d <= 0.0) || d.abs() < 1e-9 * bailout,
+                "{p}: estimate {d}, inside {inside}, {h:?}"
+            );
+        }
+    }
+
+}
+
+proptest! {
+    // Drawn the same way every run: the factor is measured, not proven,
+    // and a hybrid found past it is a measurement to add to the table.
+    #![proptest_config(ProptestConfig {
+        cases: 96,
+        rng_seed: RngSeed::Fixed(0x4879_6272_6964),
+        ..ProptestConfig::default()
+    })]
+
+    /// The estimate as drawn never overestimates the distance to the
+    /// points the membership test finds inside, near the surface, for
+    /// random hybrids.
+    #[test]
+    fn random_hybrids_never_overestimate(node in testing::hybrid_node(), seed in any::<u64>()) {
+        let h = hybrid_of(&node);
+        let eval = cpu::Evaluator::new(&node)?;
+        let bailout = h.bailout.default_value();
+        let inside = |p| hybrid_inside(p, &h);
+        let points: Vec<_> = testing::near_surface_points(inside, bailout, 0.02 * bailout, 32, seed)
+            .into_iter()
+            // Within rounding of the surface the two sides may disagree.
+            .filter(|&p| eval.distance(p) > 1e-9 * bailout)
+            .collect();
+        if points.len() >= 4 {
+            check_never_overestimates(&eval, inside, &points, 32)?;
+        }
+    }
+}
