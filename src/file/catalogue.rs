@@ -299,7 +299,10 @@ mod tests {
         assert_eq!(find("Kifs").category, NodeCategory::Fractal);
         assert_eq!(find("Kifs").exact, Some(false));
         assert_eq!(find("Hybrid").category, NodeCategory::Fractal);
-        assert_eq!(find("Hybrid").fields, ["stages", "iterations", "bailout"]);
+        assert_eq!(
+            find("Hybrid").fields,
+            ["stages", "iterations", "bailout", "safety"]
+        );
         assert_eq!(find("Ellipsoid").exact, Some(false));
         assert_eq!(find("Translate").category, NodeCategory::Operation);
         assert_eq!(find("Translate").exact, None);

@@ -192,10 +192,12 @@ impl NodeRepr {
                 stages,
                 iterations,
                 bailout,
+                safety,
             }) => NodeRepr::Hybrid {
                 stages,
                 iterations,
                 bailout,
+                safety,
             },
             Kind::Translate { offset, child: c } => NodeRepr::Translate {
                 offset,
@@ -504,10 +506,12 @@ impl Located<NodeRepr> {
                 stages,
                 iterations,
                 bailout,
+                safety,
             } => Kind::Hybrid(Hybrid {
                 stages: stages.clone(),
                 iterations: *iterations,
                 bailout: bailout.clone(),
+                safety: safety.clone(),
             })
             .into(),
             NodeRepr::Translate { offset, child: c } => Kind::Translate {

@@ -493,6 +493,8 @@ pub(super) enum NodeRepr {
         iterations: u32,
         #[serde(default = "sixteen")]
         bailout: Param,
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        safety: Option<Param>,
     },
     Translate {
         offset: Param3,

@@ -151,6 +151,14 @@ pub struct Hybrid<S = Param> {
     pub iterations: u32,
     /// The radius the orbit must stay within, in `[1, 1000]`.
     pub bailout: S,
+    /// The factor the estimate is multiplied by, in `[0.01, 4]`; `None` is
+    /// the measured one for every hybrid of its kind
+    /// ([`HYBRID_SAFETY`](crate::cpu::sdf::HYBRID_SAFETY) or
+    /// [`HYBRID_POWER_SAFETY`](crate::cpu::sdf::HYBRID_POWER_SAFETY)). A
+    /// hybrid measured on its own (as the guide shows) may take a larger
+    /// one: fewer steps, and less of the swelling a low estimate gives
+    /// thin parts.
+    pub safety: Option<S>,
 }
 
 /// The origin, a scale's default centre in a scene file.
@@ -184,6 +192,7 @@ impl Hybrid {
             stages: Vec::new(),
             iterations: 12,
             bailout: 16.0.into(),
+            safety: None,
         }
     }
 
@@ -208,6 +217,14 @@ impl Hybrid {
     #[must_use]
     pub fn bailout(mut self, bailout: impl Into<Param>) -> Self {
         self.bailout = bailout.into();
+        self
+    }
+
+    /// Sets the factor the estimate is multiplied by (see
+    /// [`safety`](Hybrid::safety)).
+    #[must_use]
+    pub fn safety(mut self, factor: impl Into<Param>) -> Self {
+        self.safety = Some(factor.into());
         self
     }
 
@@ -433,6 +450,10 @@ impl<S> Hybrid<S> {
             stages,
             iterations: self.iterations,
             bailout: f(&self.bailout, spec("bailout", Range(1.0, 1000.0)))?,
+            safety: match &self.safety {
+                Some(k) => Some(f(k, spec("safety", Range(0.01, 4.0)))?),
+                None => None,
+            },
         })
     }
 

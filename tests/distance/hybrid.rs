@@ -195,13 +195,17 @@ fn measure(h: &Hybrid, (reach, shell): (f64, f64), count: usize, seed: u64) -> W
 }
 
 /// [`measure`] near the surface (within 3% of the reach: where the
-/// marcher stops) and farther out (within 30%: where the coarse pass
-/// starts its rays): the larger ratio, and the median near the surface.
-fn measure_both(h: &Hybrid, reach: f64, count: usize, seed: u64) -> (Worst, f64) {
+/// marcher stops), farther out (within 30%: where the coarse pass starts
+/// its rays) and out to where the ball's distance takes over (1.5
+/// bailouts: where rays arrive from): the median near the surface, and
+/// the largest ratio of each.
+fn measure_all(h: &Hybrid, reach: f64, count: usize, seed: u64) -> (Worst, [f64; 3]) {
     let near = measure(h, (reach, 0.03), count, seed);
-    let far = measure(h, (reach, 0.3), count, seed + 1000);
-    let ratio = near.ratio.max(far.ratio);
-    (near, ratio)
+    let mid = measure(h, (reach, 0.3), count, seed + 1000);
+    let far_band = sdf::HYBRID_FAR_FIELD * h.bailout.default_value() / reach;
+    let far = measure(h, (reach, far_band), count, seed + 2000);
+    let ratios = [near.ratio, mid.ratio, far.ratio];
+    (near, ratios)
 }
 
 /// The measured tables in the guide's fractals chapter: the largest ratio
@@ -214,22 +218,23 @@ fn hybrid_worst_ratio_is_measured() {
     let mut worst = [0.0f64; 2];
     let mut total = 0;
     println!(
-        "| hybrid | points | with a point inside found | largest ratio | largest, out to 30% | median |"
+        "| hybrid | points | with a point inside found | largest ratio | out to 30% | out to 1.5 bailouts | median |"
     );
-    println!("|---|---:|---:|---:|---:|---:|");
+    println!("|---|---:|---:|---:|---:|---:|---:|");
     for (i, (name, h, reach)) in classics().iter().enumerate() {
-        let (w, ratio) = measure_both(h, *reach, 300, 1 + i as u64);
+        let (w, [near, mid, far]) = measure_all(h, *reach, 200, 1 + i as u64);
         println!(
-            "| {name} | {} | {} | {:.3} | {ratio:.3} | {:.3} |",
-            w.tested, w.witnessed, w.ratio, w.median
+            "| {name} | {} | {} | {near:.3} | {mid:.3} | {far:.3} | {:.3} |",
+            w.tested, w.witnessed, w.median
         );
-        assert!(w.witnessed >= 20, "{name}: only {} witnessed", w.witnessed);
+        let ratio = near.max(mid).max(far);
+        assert!(w.witnessed >= 15, "{name}: only {} witnessed", w.witnessed);
         total += w.witnessed;
         let slot = usize::from(h.has_power());
         worst[slot] = worst[slot].max(ratio);
     }
     assert!(
-        total >= 1500,
+        total >= 1000,
         "only {total} points had a point inside within reach"
     );
     let mut runner = TestRunner::deterministic();
@@ -237,7 +242,8 @@ fn hybrid_worst_ratio_is_measured() {
     let mut random: [Vec<f64>; 2] = [Vec::new(), Vec::new()];
     for seed in 0..400 {
         let h = hybrid_of(&strategy.new_tree(&mut runner).unwrap().current());
-        let (w, ratio) = measure_both(&h, h.bailout.default_value(), 48, seed);
+        let (w, ratios) = measure_all(&h, h.bailout.default_value(), 32, seed);
+        let ratio = ratios.into_iter().fold(0.0, f64::max);
         if w.witnessed >= 8 {
             random[usize::from(h.has_power())].push(ratio);
         }
@@ -335,4 +341,35 @@ proptest! {
             check_never_overestimates(&eval, inside, &points, 32)?;
         }
     }
+}
+
+/// A hybrid's own factor replaces the measured one: the drawn estimate
+/// scales with it wherever it is not the distance to the ball, and
+/// nowhere else.
+#[test]
+fn a_hybrids_own_factor_scales_its_estimate() {
+    let h = Hybrid::new()
+        .stage(1, [HybridOp::power(8.0), HybridOp::AddPoint])
+        .bailout(2.0)
+        .iterations(8);
+    let default = cpu::Evaluator::new(&h.clone().into()).unwrap();
+    let own = cpu::Evaluator::new(&h.clone().safety(1.5).into()).unwrap();
+    let mut rng = SplitMix(9);
+    let mut scaled = 0;
+    for _ in 0..500 {
+        let p = rng.in_ball(3.5);
+        let (d, e) = (default.distance(p), own.distance(p));
+        let ball = p.length() - 2.0;
+        if d > ball && e > ball {
+            let expected = d * 1.5 / sdf::HYBRID_POWER_SAFETY;
+            assert!(
+                (e - expected).abs() <= 1e-12 * expected.abs().max(1.0),
+                "{p}: {e} vs {expected}"
+            );
+            scaled += 1;
+        } else if p.length() > sdf::HYBRID_FAR_FIELD * 2.0 {
+            assert_eq!((d, e), (ball, ball), "{p}");
+        }
+    }
+    assert!(scaled > 100, "{scaled}");
 }

@@ -590,6 +590,7 @@ const NODE_FIELDS: &[(&str, &str)] = &[
         "angles",
     ),
     ("Hybrid(stages: [], bailout: @)", "bailout"),
+    ("Hybrid(stages: [], safety: Some(@))", "safety"),
     ("Hybrid(stages: [], iterations: @)", "iterations"),
     ("Translate(offset: @, child: Sphere(radius: 1))", "offset"),
     (

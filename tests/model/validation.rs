@@ -586,6 +586,7 @@ fn broken_node() -> impl Strategy<Value = (Node, &'static str)> {
             "hybrid"
         )),
         outside(1.0, 1000.0).prop_map(|v| (Hybrid::mandelbox(2.0).bailout(v).into(), "hybrid")),
+        outside(0.01, 4.0).prop_map(|v| (Hybrid::mandelbox(2.0).safety(v).into(), "hybrid")),
         bad_size().prop_map(|v| (
             Hybrid::new()
                 .stage(2, [HybridOp::sphere_fold(v, 1.0)])

@@ -11,8 +11,8 @@ use crate::scene::{Hybrid, HybridOp};
 /// multiplied by this safety factor: a running-derivative estimate of an
 /// arbitrary sequence of steps is not a proven bound. The largest ratio of
 /// estimate to distance measured against brute-force membership, over the
-/// classic hybrids and 400 random ones, near their surfaces and out to 30%
-/// of their size from them, is 1.14 (`tests/distance/hybrid.rs`, and the
+/// classic hybrids and 400 random ones, near their surfaces and out to 1.5
+/// bailouts from them, is 1.20 (`tests/distance/hybrid.rs`, and the
 /// table in the [fractals chapter](crate::guide::fractals#hybrids) of the
 /// guide); the factor covers 1.25 times that.
 pub const HYBRID_SAFETY: f64 = 0.65;
@@ -21,11 +21,17 @@ pub const HYBRID_SAFETY: f64 = 0.65;
 /// [`Power`](HybridOp::Power) step. With each power's largest stretch in
 /// the running derivative, the largest ratio measured over the classic
 /// forms (the Mandelbulb, the burning bulb, Julia bulbs, boxes and bulbs
-/// alternated) is 0.95, out from the surface (0.47 near it), and over 400
-/// random hybrids 1.96 (a power of a point that folds and turns send near
-/// a pole, with no addition of the point to temper it); the factor covers
-/// 1.25 times that.
+/// alternated) is 1.45 and over 400 random hybrids 1.49, both far from the
+/// surface, where the logarithmic form grows faster than the distance
+/// (near it, at most 0.47); the factor covers 1.25 times that.
 pub const HYBRID_POWER_SAFETY: f64 = 0.4;
+
+/// Beyond this many times the bailout the estimate is the distance to the
+/// bailout's ball alone, a proven bound: there the escape-time estimate,
+/// which grows faster than the distance, would overestimate it (as the
+/// Mandelbulb's does beyond
+/// [`MANDELBULB_FAR_FIELD`](super::MANDELBULB_FAR_FIELD) radii).
+pub const HYBRID_FAR_FIELD: f64 = 1.5;
 
 /// An orbit is followed until it passes this many times the bailout (or
 /// its iterations end): the estimate is then taken far from the ball's
@@ -141,8 +147,10 @@ fn prepare<'a, T: Num + 'a>(op: &HybridOp<T>, integer: Option<u32>) -> Op<'a, T>
 /// of that iteration leaves it there, and the loop ends). With `r` the
 /// orbit's last radius and `dr` its running derivative, the estimate is
 /// `0.5 · r · ln(r / bailout) / dr` where an iteration raises to a power
-/// and `(r − bailout) / dr` otherwise, times [`HYBRID_POWER_SAFETY`] or
-/// [`HYBRID_SAFETY`], and at least the distance to the ball; an orbit that
+/// and `(r − bailout) / dr` otherwise, times the hybrid's
+/// [`safety`](Hybrid::safety) ([`HYBRID_POWER_SAFETY`] or
+/// [`HYBRID_SAFETY`] where it has none), and at least the distance to the
+/// ball; an orbit that
 /// left the ball is outside whatever it does next, so the sign is the
 /// membership's. `integer_powers` lists the baked integer power of each
 /// operation in the order the stages list them (`None` for the rest, or an
@@ -178,6 +186,9 @@ pub fn hybrid_estimate<T: Num>(
     // followed, for an estimate of the distance to the set rather than to
     // the ball.
     let escaped = T::select(outer.gt(T::zero()), T::one(), T::zero());
+    // Far from the ball its distance alone: no orbit to follow.
+    let far_field = r0.gt(bailout * T::of(HYBRID_FAR_FIELD));
+    let iterations = T::select(far_field, T::zero(), iterations);
     let start = [p.x, p.y, p.z, T::one(), p.dot(p), escaped];
     let [x, y, z, dr, trap, escaped] =
         T::iterate(iterations, start, |_, [x, y, z, dr, trap, escaped]| {
@@ -217,13 +228,15 @@ pub fn hybrid_estimate<T: Num>(
     .clamp(-T::magnitude_cap(), T::magnitude_cap());
     // An orbit that left the ball and came back is still outside.
     let estimate = T::select(escaped.gt(T::of(0.5)), estimate.max(T::tiny()), estimate);
-    let factor = if h.has_power() {
-        HYBRID_POWER_SAFETY
-    } else {
-        HYBRID_SAFETY
-    };
+    let factor = h.safety.unwrap_or_else(|| {
+        T::of(if h.has_power() {
+            HYBRID_POWER_SAFETY
+        } else {
+            HYBRID_SAFETY
+        })
+    });
     Estimate {
-        distance: (T::of(factor) * estimate).max(outer),
+        distance: T::select(far_field, outer, (factor * estimate).max(outer)),
         trap: trap.sqrt().min(T::one()),
     }
 }

@@ -25,7 +25,9 @@ use crate::scene::{CsgOp, KifsFold};
 mod hybrid;
 
 pub(crate) use hybrid::hybrid_integer_powers;
-pub use hybrid::{HYBRID_FOLLOW, HYBRID_POWER_SAFETY, HYBRID_SAFETY, hybrid, hybrid_estimate};
+pub use hybrid::{
+    HYBRID_FAR_FIELD, HYBRID_FOLLOW, HYBRID_POWER_SAFETY, HYBRID_SAFETY, hybrid, hybrid_estimate,
+};
 
 /// Exact distance to a sphere of radius `r` at the origin.
 #[must_use]
