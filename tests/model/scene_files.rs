@@ -572,3 +572,20 @@ fn a_cut_plane_is_a_node_of_its_own() {
     assert!(err.starts_with("<scene>:2:12:"), "{err}");
     assert!(err.contains("`normal`"), "{err}");
 }
+
+/// The one-formula scenes of the guide's cost table (`benches/formulas`)
+/// load and compile.
+#[test]
+fn the_formula_benchmark_scenes_load() {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("benches/formulas");
+    let mut count = 0;
+    for entry in std::fs::read_dir(&dir).unwrap() {
+        let path = entry.unwrap().path();
+        let file = SceneFile::load(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+        file.scene
+            .compile()
+            .unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+        count += 1;
+    }
+    assert!(count >= 13, "{count} scenes in {}", dir.display());
+}
