@@ -586,16 +586,19 @@ pub fn kifs_node() -> impl Strategy<Value = Node> + Clone {
         .boxed()
 }
 
-/// Any of the six fractals with valid parameters.
+/// Any of the fractals with valid parameters (hybrids small and rare).
 pub fn fractal_node() -> impl Strategy<Value = Node> + Clone {
     prop_oneof![
-        mandelbulb_node(),
-        menger_node(),
-        julia_node(),
-        sierpinski_node(),
-        mandelbox_node(),
-        kifs_node(),
-        hybrid_node(),
+        4 => mandelbulb_node(),
+        4 => menger_node(),
+        4 => julia_node(),
+        4 => sierpinski_node(),
+        4 => mandelbox_node(),
+        4 => kifs_node(),
+        // Small and rare: every operation is written out in the kernel,
+        // which an OpenCL compiler takes its time over, and whole scenes
+        // hold many fractals ([`hybrid_node`] has the full range).
+        1 => hybrid_of_size(2, 3, 1),
     ]
 }
 
@@ -653,9 +656,15 @@ pub fn hybrid_op() -> impl Strategy<Value = HybridOp> + Clone {
 /// ([`hybrid_op`]), each repeated up to twice, 0 to 8 iterations and a
 /// bailout of 2 to 16.
 pub fn hybrid_node() -> impl Strategy<Value = Node> + Clone {
-    let stage = (1u32..=2, prop::collection::vec(hybrid_op(), 1..=4));
+    hybrid_of_size(3, 4, 2)
+}
+
+/// Random hybrids of at most `stages` stages of at most `ops` operations,
+/// each repeated at most `repeat` times.
+fn hybrid_of_size(stages: usize, ops: usize, repeat: u32) -> impl Strategy<Value = Node> + Clone {
+    let stage = (1u32..=repeat, prop::collection::vec(hybrid_op(), 1..=ops));
     (
-        prop::collection::vec(stage, 1..=3),
+        prop::collection::vec(stage, 1..=stages),
         0u32..=8,
         scalar("hybrid.bailout", 2.0..=16.0f64),
     )
