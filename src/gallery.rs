@@ -20,9 +20,9 @@ use crate::file::SceneFile;
 use crate::quality::{Effects, Glow, Quality};
 use crate::scene::{
     Axis, Camera, Hybrid, HybridOp, InsideShape, Kifs, KifsFold, Light, Mandelbulb, Material, Node,
-    QuaternionJulia, Scene, capped_cone, capsule, cuboid, cut_sphere, cylinder, ellipsoid,
-    hex_prism, julia, link, menger, octahedron, param, param3, plane, round_box, round_cone,
-    sierpinski, solid_angle, sphere, torus,
+    OrbitTrap, Palette, QuaternionJulia, Scene, Trap, capped_cone, capsule, cuboid, cut_sphere,
+    cylinder, ellipsoid, hex_prism, julia, link, menger, octahedron, param, param3, plane,
+    round_box, round_cone, sierpinski, solid_angle, sphere, torus,
 };
 
 /// Every gallery scene by name.
@@ -45,6 +45,7 @@ pub fn all() -> Vec<(&'static str, Scene)> {
         ("mandelbox", mandelbox()),
         ("kifs", kifs()),
         ("hybrid", hybrid()),
+        ("orbit_traps", orbit_traps()),
     ]
 }
 
@@ -390,6 +391,58 @@ pub fn hybrid() -> Scene {
     .expect("three hybrids");
     Scene::new(row.union(floor(1.0)))
         .with_camera(Camera::look_at(dvec3(0.0, 1.8, 4.4), dvec3(0.0, -0.2, 0.0)).fov(45.0))
+        .with_lights(key_and_fill())
+}
+
+/// Four fractals coloured by their orbits ([`Node::orbit_trap`]): the
+/// Mandelbulb by the plane through its equator (fire), the Mandelbox by a
+/// sphere (viridis), a quaternion Julia set by a line (ocean) and an
+/// icosahedral KIFS by a point (magma).
+#[must_use]
+pub fn orbit_traps() -> Scene {
+    let bulb = Node::from(Mandelbulb::new(8.0).iterations(10))
+        .orbit_coloring(
+            OrbitTrap::new(Trap::plane([0.0, 0.0, 1.0], 0.0), Palette::fire()).range(0.0, 0.8),
+        )
+        .rotate(DVec3::X, -FRAC_PI_2)
+        .scale(0.55);
+    let boxed = crate::scene::mandelbox(2.0)
+        .orbit_coloring(
+            OrbitTrap::new(Trap::sphere([0.0, 0.0, 0.0], 2.0), Palette::viridis()).range(0.0, 2.0),
+        )
+        .rotate(DVec3::Y, 0.6)
+        .scale(0.11);
+    let set = julia([-0.2, 0.6, 0.2, 0.2])
+        .orbit_coloring(
+            OrbitTrap::new(
+                Trap::line([0.0, 0.0, 0.0], [1.0, 0.0, 0.0]),
+                Palette::ocean(),
+            )
+            .range(0.0, 0.9),
+        )
+        .scale(0.6);
+    let ifs = crate::scene::kifs(KifsFold::Icosahedral)
+        .orbit_coloring(
+            OrbitTrap::new(Trap::point([0.0, 0.0, 0.0]), Palette::magma()).range(0.3, 1.6),
+        )
+        .rotate(DVec3::Y, 0.4)
+        .scale(0.6);
+    // Two rows: the Mandelbox and the KIFS behind, the Mandelbulb and the
+    // Julia set in front.
+    let at = [
+        dvec3(-0.95, 0.0, 0.75),
+        dvec3(-0.75, 0.0, -0.95),
+        dvec3(0.85, -0.1, 0.8),
+        dvec3(1.05, 0.0, -0.95),
+    ];
+    let all = [bulb, boxed, set, ifs]
+        .into_iter()
+        .zip(at)
+        .map(|(node, at)| node.translate(at))
+        .reduce(Node::union)
+        .expect("four fractals");
+    Scene::new(all.union(floor(0.7)))
+        .with_camera(Camera::look_at(dvec3(0.0, 2.7, 4.3), dvec3(0.0, -0.25, 0.0)).fov(42.0))
         .with_lights(key_and_fill())
 }
 

@@ -79,7 +79,7 @@ pub use strategy::{
     bounded_node, capped_cone_node, capsule_node, cuboid_node, cut_sphere_node, cylinder_node,
     ellipsoid_node, exact_node, exact_primitive, fractal_node, hex_prism_node, hybrid_node,
     hybrid_op, julia_node, kifs_node, link_node, mandelbox_node, mandelbulb_node, menger_node,
-    octahedron_node, plane_node, point, point_pair, ray, repeated_node, rotation, round_box_node,
-    round_cone_node, scene_node, sierpinski_node, solid_angle_node, sphere_node, torus_node,
-    unit_vector,
+    octahedron_node, orbit_trap_node, palette, plane_node, point, point_pair, ray, repeated_node,
+    rotation, round_box_node, round_cone_node, scene_node, sierpinski_node, solid_angle_node,
+    sphere_node, torus_node, trap, unit_vector,
 };

@@ -178,6 +178,44 @@ fn fractals_mesh_closed_and_coloured() {
     }
 }
 
+/// An orbit trap's palette reaches the mesh: each vertex takes the colour
+/// the CPU reference paints there, and the colours vary over the surface.
+#[test]
+fn orbit_trap_colours_reach_the_vertices() {
+    use fractal_sdf::scene::{OrbitTrap, Palette, Trap};
+    let Some(sampler) = device() else { return };
+    let node = mandelbulb(8.0).orbit_coloring(
+        OrbitTrap::new(Trap::plane([0.0, 0.0, 1.0], 0.0), Palette::viridis()).range(0.0, 0.8),
+    );
+    let scene = compiled(node);
+    let options = GridOptions::default().resolution(48).sampler(sampler);
+    let mesh = mesh::extract(&scene, &options).unwrap();
+    assert_eq!(mesh.colors.len(), mesh.positions.len());
+    let eval = cpu::Evaluator::from_compiled(&scene);
+    let mut off = 0;
+    for (p, got) in mesh.positions.iter().zip(&mesh.colors) {
+        let expected = DVec3::from(eval.sample::<f64>(p.as_dvec3().into()).color)
+            .to_array()
+            .map(|c| (c.powf(1.0 / 2.2) * 255.0).round());
+        if got
+            .iter()
+            .zip(expected)
+            .any(|(&g, e)| (f64::from(g) - e).abs() > 1.0)
+        {
+            off += 1;
+        }
+    }
+    // The device samples in single precision: a vertex whose orbit passes
+    // within rounding of the bailout may colour differently.
+    assert!(
+        off * 1000 <= mesh.positions.len(),
+        "{off} of {} vertices off",
+        mesh.positions.len()
+    );
+    let distinct: std::collections::HashSet<[u8; 3]> = mesh.colors.iter().copied().collect();
+    assert!(distinct.len() > 200, "{} distinct colours", distinct.len());
+}
+
 #[test]
 fn a_box_that_cuts_the_scene_closes_the_mesh() {
     // A floor has no bound: the box is required, and the cut is capped.

@@ -2,7 +2,7 @@
 //! each is traced into the expression IR and written by the OpenCL
 //! printer, so the kernel and the CPU reference run one definition.
 
-use crate::cpu::sdf::{self, Estimate};
+use crate::cpu::sdf::{self, Estimate, TrapShape};
 use crate::expr::{Num, OpenCl, Printer, Shape, Signature, Unprintable, Var, trace};
 use crate::math::{V3, v3};
 use crate::scene::{Hybrid, KifsFold, ParamSpec};
@@ -140,14 +140,49 @@ pub(crate) fn ellipsoid() -> Result<String, Unprintable> {
     })
 }
 
-/// A fractal's estimate as the pair (distance, trap).
-fn pair(e: Estimate<Var>) -> Vec<Var> {
-    vec![e.distance, e.trap]
+/// The suffix of a fractal helper's trapped form (see [`fractal`]).
+pub(crate) const TRAP_SUFFIX: &str = "_trap";
+
+/// The name of a fractal helper's form, trapped or not.
+pub(crate) fn fractal_name(name: &str, trap: bool) -> String {
+    if trap {
+        format!("{name}{TRAP_SUFFIX}")
+    } else {
+        name.to_string()
+    }
+}
+
+/// Prints a fractal's helper, which returns the pair (distance, trap).
+/// With `trap`, the form named with [`TRAP_SUFFIX`] that takes a trap
+/// shape after the fractal's own parameters (the nine numbers of
+/// [`TrapShape::values`]) and returns the orbit's smallest distance to it
+/// as the trap.
+fn fractal(
+    name: &str,
+    params: &[(&str, Shape)],
+    trap: bool,
+    formula: impl FnOnce(&[Var], Option<&TrapShape<Var>>) -> Estimate<Var>,
+) -> Result<String, Unprintable> {
+    let mut all = params.to_vec();
+    if trap {
+        all.extend([
+            ("trap_centre", Vec3),
+            ("trap_axis", Vec3),
+            ("trap_across", Scalar),
+            ("trap_along", Scalar),
+            ("trap_radius", Scalar),
+        ]);
+    }
+    print(&fractal_name(name, trap), &all, Pair, |a| {
+        let shape = trap.then(|| TrapShape::from_values(&a[a.len() - 9..]));
+        let e = formula(a, shape.as_ref());
+        vec![e.distance, e.trap]
+    })
 }
 
 /// The Mandelbulb of any real power, with `acos`/`atan2`/`sin`/`cos`.
-pub(crate) fn mandelbulb() -> Result<String, Unprintable> {
-    print(
+pub(crate) fn mandelbulb(trap: bool) -> Result<String, Unprintable> {
+    fractal(
         "mandelbulb",
         &[
             ("p", Vec3),
@@ -156,17 +191,8 @@ pub(crate) fn mandelbulb() -> Result<String, Unprintable> {
             ("escape", Scalar),
             ("ball", Scalar),
         ],
-        Pair,
-        |a| {
-            pair(sdf::mandelbulb_estimate(
-                vector(a, 0),
-                a[3],
-                a[4],
-                a[5],
-                a[6],
-                None,
-            ))
-        },
+        trap,
+        |a, t| sdf::mandelbulb_estimate(vector(a, 0), a[3], a[4], a[5], a[6], None, t),
     )
 }
 
@@ -181,8 +207,8 @@ pub(crate) fn power_helper_name(n: u32) -> String {
 /// traced with the power fixed: its binary exponentiation and angle powers
 /// unroll into straight-line multiplications (no loop over the bits of
 /// `n`, no trigonometry).
-pub(crate) fn mandelbulb_power(n: u32) -> Result<String, Unprintable> {
-    print(
+pub(crate) fn mandelbulb_power(n: u32, trap: bool) -> Result<String, Unprintable> {
+    fractal(
         &power_helper_name(n),
         &[
             ("p", Vec3),
@@ -190,43 +216,36 @@ pub(crate) fn mandelbulb_power(n: u32) -> Result<String, Unprintable> {
             ("escape", Scalar),
             ("ball", Scalar),
         ],
-        Pair,
-        |a| {
+        trap,
+        |a, t| {
             let power = Var::of(f64::from(n));
-            pair(sdf::mandelbulb_estimate(
-                vector(a, 0),
-                power,
-                a[3],
-                a[4],
-                a[5],
-                Some(n),
-            ))
+            sdf::mandelbulb_estimate(vector(a, 0), power, a[3], a[4], a[5], Some(n), t)
         },
     )
 }
 
 /// The Menger sponge.
-pub(crate) fn menger() -> Result<String, Unprintable> {
-    print(
+pub(crate) fn menger(trap: bool) -> Result<String, Unprintable> {
+    fractal(
         "menger",
         &[("p", Vec3), ("iterations", Scalar), ("scale", Scalar)],
-        Pair,
-        |a| pair(sdf::menger_estimate(vector(a, 0), a[3], a[4])),
+        trap,
+        |a, t| sdf::menger_estimate(vector(a, 0), a[3], a[4], t),
     )
 }
 
 /// The Sierpinski tetrahedron.
-pub(crate) fn sierpinski() -> Result<String, Unprintable> {
-    print(
+pub(crate) fn sierpinski(trap: bool) -> Result<String, Unprintable> {
+    fractal(
         "sierpinski",
         &[("p", Vec3), ("iterations", Scalar), ("scale", Scalar)],
-        Pair,
-        |a| pair(sdf::sierpinski_estimate(vector(a, 0), a[3], a[4])),
+        trap,
+        |a, t| sdf::sierpinski_estimate(vector(a, 0), a[3], a[4], t),
     )
 }
 
 /// The Mandelbox, in Mandelbrot mode or (`julia`) with a constant.
-pub(crate) fn mandelbox(julia: bool) -> Result<String, Unprintable> {
+pub(crate) fn mandelbox(julia: bool, trap: bool) -> Result<String, Unprintable> {
     let mut params = vec![
         ("p", Vec3),
         ("iterations", Scalar),
@@ -243,16 +262,21 @@ pub(crate) fn mandelbox(julia: bool) -> Result<String, Unprintable> {
     } else {
         "mandelbox"
     };
-    print(name, &params, Pair, |a| {
+    fractal(name, &params, trap, |a, t| {
         let m = sdf::MandelboxParams::new(a[4], a[5], a[6], a[7], julia.then(|| vector(a, 8)));
-        pair(sdf::mandelbox_estimate(vector(a, 0), a[3], &m))
+        sdf::mandelbox_estimate(vector(a, 0), a[3], &m, t)
     })
 }
 
 /// A kaleidoscopic IFS of `fold`; with `turned`, the turns before and
 /// after the fold as two vectors of angles (zeros for a turn the node
 /// leaves out: no turn, exactly).
-pub(crate) fn kifs(fold: KifsFold, turned: bool, name: &str) -> Result<String, Unprintable> {
+pub(crate) fn kifs(
+    fold: KifsFold,
+    turned: bool,
+    name: &str,
+    trap: bool,
+) -> Result<String, Unprintable> {
     let mut params = vec![
         ("p", Vec3),
         ("iterations", Scalar),
@@ -262,14 +286,14 @@ pub(crate) fn kifs(fold: KifsFold, turned: bool, name: &str) -> Result<String, U
     if turned {
         params.extend([("before", Vec3), ("after", Vec3)]);
     }
-    print(name, &params, Pair, |a| {
+    fractal(name, &params, trap, |a, t| {
         let k = sdf::KifsParams::new(fold, a[4], vector(a, 5));
         let k = if turned {
             k.with_turns(Some(vector(a, 8)), Some(vector(a, 11)))
         } else {
             k
         };
-        pair(sdf::kifs_estimate(vector(a, 0), a[3], &k))
+        sdf::kifs_estimate(vector(a, 0), a[3], &k, t)
     })
 }
 
@@ -280,6 +304,7 @@ pub(crate) fn hybrid(
     name: &str,
     shape: &Hybrid<()>,
     integer_powers: &[Option<u32>],
+    trap: bool,
 ) -> Result<String, Unprintable> {
     let mut names = vec!["p".to_string(), "iterations".to_string()];
     let mut collect = |_: &(), spec: ParamSpec<'_>| -> Result<(), Unprintable> {
@@ -299,19 +324,19 @@ pub(crate) fn hybrid(
         .enumerate()
         .map(|(i, n)| (n.as_str(), if i == 0 { Vec3 } else { Scalar }))
         .collect();
-    print(name, &params, Pair, |a| {
+    fractal(name, &params, trap, |a, t| {
         let mut next = 4;
         let h = shape.map(|()| {
             next += 1;
             a[next - 1]
         });
-        pair(sdf::hybrid_estimate(vector(a, 0), a[3], &h, integer_powers))
+        sdf::hybrid_estimate(vector(a, 0), a[3], &h, integer_powers, t)
     })
 }
 
 /// The quaternion Julia set, `c` as four numbers.
-pub(crate) fn julia() -> Result<String, Unprintable> {
-    print(
+pub(crate) fn julia(trap: bool) -> Result<String, Unprintable> {
+    fractal(
         "julia",
         &[
             ("p", Vec3),
@@ -323,10 +348,10 @@ pub(crate) fn julia() -> Result<String, Unprintable> {
             ("iterations", Scalar),
             ("bailout", Scalar),
         ],
-        Pair,
-        |a| {
+        trap,
+        |a, t| {
             let c = [a[3], a[4], a[5], a[6]];
-            pair(sdf::julia_estimate(vector(a, 0), c, a[7], a[8], a[9]))
+            sdf::julia_estimate(vector(a, 0), c, a[7], a[8], a[9], t)
         },
     )
 }
@@ -337,7 +362,7 @@ mod power_tests {
 
     #[test]
     fn power_eight_needs_no_trigonometry_and_three_squarings() {
-        let src = mandelbulb_power(8).unwrap();
+        let src = mandelbulb_power(8, false).unwrap();
         assert!(src.contains("real2 mandelbulb_p8("), "{src}");
         for f in ["sin(", "cos(", "acos(", "atan2(", "pow("] {
             assert!(!src.contains(f), "{f} in {src}");
@@ -348,7 +373,7 @@ mod power_tests {
 
     #[test]
     fn a_real_power_uses_the_trigonometric_form() {
-        let src = mandelbulb().unwrap();
+        let src = mandelbulb(false).unwrap();
         for f in ["acos(", "atan2(", "pow("] {
             assert!(src.contains(f), "{f} missing from {src}");
         }

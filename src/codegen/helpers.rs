@@ -124,14 +124,29 @@ impl Helper {
             Helper::CutSphere => formulas::cut_sphere(),
             Helper::SolidAngle => formulas::solid_angle(),
             Helper::Ellipsoid => formulas::ellipsoid(),
-            Helper::Mandelbulb => formulas::mandelbulb(),
-            Helper::Menger => formulas::menger(),
-            Helper::Sierpinski => formulas::sierpinski(),
-            Helper::Julia => formulas::julia(),
-            Helper::Mandelbox => formulas::mandelbox(false),
-            Helper::MandelboxJulia => formulas::mandelbox(true),
-            Helper::Kifs(fold, turned) => formulas::kifs(fold, turned, self.name()),
+            Helper::Mandelbulb
+            | Helper::Menger
+            | Helper::Sierpinski
+            | Helper::Julia
+            | Helper::Mandelbox
+            | Helper::MandelboxJulia
+            | Helper::Kifs(..) => self.fractal_source(false).expect("a fractal's helper"),
         }
+    }
+
+    /// A fractal helper's source, trapped (see
+    /// [`formulas::fractal_name`]) or not; `None` for the primitives.
+    pub(crate) fn fractal_source(self, trap: bool) -> Option<Result<String, Unprintable>> {
+        Some(match self {
+            Helper::Mandelbulb => formulas::mandelbulb(trap),
+            Helper::Menger => formulas::menger(trap),
+            Helper::Sierpinski => formulas::sierpinski(trap),
+            Helper::Julia => formulas::julia(trap),
+            Helper::Mandelbox => formulas::mandelbox(false, trap),
+            Helper::MandelboxJulia => formulas::mandelbox(true, trap),
+            Helper::Kifs(fold, turned) => formulas::kifs(fold, turned, self.name(), trap),
+            _ => return None,
+        })
     }
 }
 
@@ -148,6 +163,20 @@ mod tests {
                 "{}",
                 h.name()
             );
+        }
+    }
+
+    #[test]
+    fn every_fractal_has_a_trapped_form_that_takes_the_shape() {
+        for h in Helper::ALL {
+            let Some(trapped) = h.fractal_source(true) else {
+                continue;
+            };
+            let trapped = trapped.unwrap();
+            let name = format!("real2 {}(", formulas::fractal_name(h.name(), true));
+            assert!(trapped.contains(&name), "{trapped}");
+            assert!(trapped.contains("trap_radius"), "{trapped}");
+            assert!(!h.source().unwrap().contains("trap_radius"), "{}", h.name());
         }
     }
 }

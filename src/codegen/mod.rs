@@ -38,6 +38,7 @@ use std::sync::atomic::{AtomicU64, Ordering};
 use glam::DVec3;
 
 use crate::error::{Error, Result};
+use crate::expr::Unprintable;
 use crate::ir::{Bound, CompiledScene, Ir, union_chain};
 use crate::math::{DEFAULT_COLOR, DERIVATIVE_CAP, MAGNITUDE_CAP, REAL_TINY};
 use crate::quality::{Effects, Precision, Quality, ScreenNormals};
@@ -337,6 +338,7 @@ pub fn emit_ir(ir: &Ir, options: &Options) -> Result<KernelSource> {
         glow: glow_bound(ir, options, origin),
     };
     let used = std::mem::take(&mut emitter.used);
+    let trapped = std::mem::take(&mut emitter.trapped);
     let customs: Vec<_> = emitter.customs.values().cloned().collect();
     let powers: Vec<u32> = emitter.powers.iter().copied().collect();
     let mut hybrids: Vec<_> = std::mem::take(&mut emitter.hybrids).into_values().collect();
@@ -345,37 +347,46 @@ pub fn emit_ir(ir: &Ir, options: &Options) -> Result<KernelSource> {
 
     let mut w = writer::Writer::new(precision);
     header(&mut w, options, &features);
+    // Each helper, and after it its trapped form where an orbit trap
+    // colours the fractal.
+    let mut section = |name: &str, source: Result<String, Unprintable>| -> Result<()> {
+        w.line(format!("/* ---- {name} ---- */"));
+        w.raw(&source.map_err(|e| Error::Invalid {
+            what: "formula",
+            reason: e.to_string(),
+        })?);
+        w.line("");
+        Ok(())
+    };
     for helper in helpers::Helper::ALL
         .into_iter()
         .filter(|h| used.contains(h))
     {
-        w.line(format!("/* ---- {} ---- */", helper.name()));
-        w.raw(&helper.source().map_err(|e| Error::Invalid {
-            what: "formula",
-            reason: e.to_string(),
-        })?);
-        w.line("");
+        section(helper.name(), helper.source())?;
+        if trapped.contains(helper.name())
+            && let Some(source) = helper.fractal_source(true)
+        {
+            section(&formulas::fractal_name(helper.name(), true), source)?;
+        }
     }
     for n in powers {
-        w.line(format!(
-            "/* ---- {} ---- */",
-            formulas::power_helper_name(n)
-        ));
-        w.raw(&formulas::mandelbulb_power(n).map_err(|e| Error::Invalid {
-            what: "formula",
-            reason: e.to_string(),
-        })?);
-        w.line("");
+        let name = formulas::power_helper_name(n);
+        section(&name, formulas::mandelbulb_power(n, false))?;
+        if trapped.contains(&name) {
+            section(
+                &formulas::fractal_name(&name, true),
+                formulas::mandelbulb_power(n, true),
+            )?;
+        }
     }
     for (name, shape, integer_powers) in &hybrids {
-        w.line(format!("/* ---- {name} ---- */"));
-        w.raw(
-            &formulas::hybrid(name, shape, integer_powers).map_err(|e| Error::Invalid {
-                what: "formula",
-                reason: e.to_string(),
-            })?,
-        );
-        w.line("");
+        section(name, formulas::hybrid(name, shape, integer_powers, false))?;
+        if trapped.contains(name) {
+            section(
+                &formulas::fractal_name(name, true),
+                formulas::hybrid(name, shape, integer_powers, true),
+            )?;
+        }
     }
     let mut custom_regions = Vec::with_capacity(customs.len());
     for shape in &customs {

@@ -147,7 +147,12 @@ fn library_texts() -> Vec<String> {
         }
     }
     texts.extend(Helper::ALL.iter().filter_map(|h| h.source().ok()));
-    texts.extend(formulas::mandelbulb_power(8).ok());
+    texts.extend(
+        Helper::ALL
+            .iter()
+            .filter_map(|h| h.fractal_source(true).and_then(Result::ok)),
+    );
+    texts.extend(formulas::mandelbulb_power(8, false).ok());
     texts.push(super::RENDER_KERNEL.into());
     texts.push(include_str!("../../kernels/eval.cl").into());
     texts

@@ -10,7 +10,9 @@ pub mod shade;
 
 use glam::DVec3;
 
-use crate::math::{DEFAULT_COLOR, integer_power, normalize, rotation_rows};
+use crate::math::{
+    DEFAULT_COLOR, escape_radius, integer_power, mandelbulb_radius, normalize, rotation_rows,
+};
 use crate::math::{Real, V3, v3};
 use sdf::Estimate;
 
@@ -23,7 +25,7 @@ use crate::ir::{
 };
 use crate::math::F32_LIMITS;
 use crate::scene::{
-    BRUTE_MAX_STEPS, CsgOp, DEFAULT_MATERIAL, INSIDE_HUGE, Kind, MATERIAL_LEN, Node,
+    BRUTE_MAX_STEPS, CsgOp, DEFAULT_MATERIAL, INSIDE_HUGE, Kind, MATERIAL_LEN, Node, Palette,
 };
 
 /// What the scene is like at one point.
@@ -390,45 +392,16 @@ impl Evaluator {
                 s(*minor_radius),
             )),
             Kind::Ellipsoid { radii } => Self::leaf(sdf::ellipsoid(p, v(*radii))),
-            Kind::Mandelbulb(f) => Self::fractal(sdf::mandelbulb(
-                p,
-                s(f.power),
-                f.iterations,
-                s(f.bailout),
-                f.power.baked().and_then(integer_power),
-            )),
-            Kind::Menger(f) => Self::fractal(sdf::menger(p, f.iterations, s(f.scale))),
-            Kind::Julia(f) => Self::fractal(sdf::julia(
-                p,
-                f.c.map(s),
-                s(f.slice_w),
-                f.iterations,
-                s(f.bailout),
-            )),
-            Kind::Sierpinski(f) => Self::fractal(sdf::sierpinski(p, f.iterations, s(f.scale))),
-            Kind::Kifs(f) => Self::fractal(sdf::kifs(
-                p,
-                f.iterations,
-                &sdf::KifsParams::new(f.fold, s(f.scale), v(f.offset))
-                    .with_turns(f.rotate_before.map(v), f.rotate_after.map(v)),
-            )),
-            Kind::Hybrid(h) => Self::fractal(sdf::hybrid(
-                p,
-                h.iterations,
-                &h.map(|x| s(*x)),
-                &sdf::hybrid_integer_powers(h),
-            )),
-            Kind::Mandelbox(f) => Self::fractal(sdf::mandelbox(
-                p,
-                f.iterations,
-                &sdf::MandelboxParams::new(
-                    s(f.scale),
-                    s(f.min_radius),
-                    s(f.fixed_radius),
-                    s(f.fold_limit),
-                    f.julia.map(|[x, y, z]| v3(s(x), s(y), s(z))),
-                ),
-            )),
+            Kind::Mandelbulb(_)
+            | Kind::Menger(_)
+            | Kind::Julia(_)
+            | Kind::Sierpinski(_)
+            | Kind::Kifs(_)
+            | Kind::Hybrid(_)
+            | Kind::Mandelbox(_) => Self::fractal(
+                self.fractal_estimate(node, p, None)
+                    .expect("a fractal has an estimate"),
+            ),
             Kind::Translate { child, .. }
             | Kind::Rotate { child, .. }
             | Kind::Mirror { child, .. }
@@ -492,7 +465,88 @@ impl Evaluator {
                 material: material.values().map(|x| s(*x)),
                 ..of(child)
             },
+            Kind::OrbitTrap { coloring, child } => {
+                let shape = sdf::TrapShape::of(&coloring.trap, s);
+                let m = self
+                    .fractal_estimate(self.ir.node(*child), p, Some(&shape))
+                    .expect("validation keeps orbit traps on fractals")
+                    .trap;
+                let t = Palette::position(m, s(coloring.near), s(coloring.far));
+                Sample {
+                    color: coloring.palette.at(t),
+                    trap: T::one(),
+                    ..of(child)
+                }
+            }
         }
+    }
+
+    /// A fractal's estimate at `p`, its trap the orbit's smallest distance
+    /// to `trap` where one is given; `None` for other nodes.
+    fn fractal_estimate<T: Real>(
+        &self,
+        node: &IrNode,
+        p: V3<T>,
+        trap: Option<&sdf::TrapShape<T>>,
+    ) -> Option<Estimate<T>> {
+        let s = |x: Scalar| self.scalar::<T>(x);
+        let v = |x: [Scalar; 3]| self.vector::<T>(x);
+        let count = |n: u32| T::of(f64::from(n));
+        Some(match node {
+            Kind::Mandelbulb(f) => {
+                let power = s(f.power);
+                let bailout = s(f.bailout);
+                let escape = T::of(escape_radius(power.to_f64(), bailout.to_f64()));
+                sdf::mandelbulb_estimate(
+                    p,
+                    power,
+                    count(f.iterations),
+                    escape,
+                    mandelbulb_radius(power),
+                    f.power.baked().and_then(integer_power),
+                    trap,
+                )
+            }
+            Kind::Menger(f) => sdf::menger_estimate(p, count(f.iterations), s(f.scale), trap),
+            Kind::Julia(f) => sdf::julia_estimate(
+                p,
+                f.c.map(s),
+                s(f.slice_w),
+                count(f.iterations),
+                s(f.bailout),
+                trap,
+            ),
+            Kind::Sierpinski(f) => {
+                sdf::sierpinski_estimate(p, count(f.iterations), s(f.scale), trap)
+            }
+            Kind::Kifs(f) => sdf::kifs_estimate(
+                p,
+                count(f.iterations),
+                &sdf::KifsParams::new(f.fold, s(f.scale), v(f.offset))
+                    .with_turns(f.rotate_before.map(v), f.rotate_after.map(v)),
+                trap,
+            ),
+            Kind::Hybrid(h) => sdf::hybrid_estimate(
+                p,
+                count(h.iterations),
+                &h.map(|x| s(*x)),
+                &sdf::hybrid_integer_powers(h),
+                trap,
+            ),
+            Kind::Mandelbox(f) => sdf::mandelbox_estimate(
+                p,
+                count(f.iterations),
+                &sdf::MandelboxParams::new(
+                    s(f.scale),
+                    s(f.min_radius),
+                    s(f.fixed_radius),
+                    s(f.fold_limit),
+                    f.julia.map(|[x, y, z]| v3(s(x), s(y), s(z))),
+                ),
+                trap,
+            ),
+            _ => return None,
+        })
     }
 }
 

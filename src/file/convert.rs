@@ -3,12 +3,12 @@
 use crate::error::Error;
 use crate::scene::{
     CsgOp, CustomShape, Hybrid, InsideShape, Kifs, Kind, Mandelbox, Mandelbulb, Menger, Node,
-    Param, QuaternionJulia, Sierpinski,
+    OrbitTrap, Param, QuaternionJulia, Sierpinski,
 };
 
 use super::MAX_NESTING;
 use super::locate::SiteMap;
-use super::schema::{Child, MaterialRepr, NodeRepr};
+use super::schema::{Child, MaterialRepr, NodeRepr, PaletteRepr};
 use super::sites::Located;
 
 /// How deep `node` nests in a file: a chain of hard unions down their
@@ -262,6 +262,13 @@ impl NodeRepr {
             },
             Kind::Material { material, child: c } => NodeRepr::Material {
                 material: MaterialRepr::from_material(&material),
+                child: child(&c),
+            },
+            Kind::OrbitTrap { coloring, child: c } => NodeRepr::OrbitTrap {
+                trap: coloring.trap,
+                palette: PaletteRepr::from_palette(&coloring.palette),
+                near: coloring.near,
+                far: coloring.far,
                 child: child(&c),
             },
             Kind::Csg {
@@ -592,6 +599,15 @@ impl Located<NodeRepr> {
                 child: child(c)?,
             }
             .into(),
+            NodeRepr::OrbitTrap {
+                trap,
+                palette,
+                near,
+                far,
+                child: c,
+            } => child(c)?.orbit_coloring(
+                OrbitTrap::new(trap.clone(), palette.to_palette()).range(near.clone(), far.clone()),
+            ),
             NodeRepr::Union(operands) => {
                 let mut operands = operands.iter();
                 let first = operands

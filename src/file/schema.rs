@@ -6,7 +6,7 @@ use serde::{Deserialize, Serialize};
 use crate::animation::{Keyframe, Motion};
 use crate::quality::{Effects, Precision, Preset, Quality, ScreenNormals};
 use crate::scene::{
-    Axis, Camera, HybridStage, KifsFold, Light, Material, Param, Param3, Rule, Scene,
+    Axis, Camera, HybridStage, KifsFold, Light, Material, Palette, Param, Param3, Rule, Scene, Trap,
 };
 
 use super::sites::Located;
@@ -324,6 +324,50 @@ pub(super) struct MaterialRepr {
     ior: Option<Param>,
 }
 
+/// A palette: one of the named ones, or a gradient of `(position, (r,
+/// g, b))` stops in linear RGB.
+#[derive(Serialize, Deserialize)]
+#[serde(deny_unknown_fields, rename = "Palette")]
+pub(super) enum PaletteRepr {
+    Fire,
+    Ocean,
+    Viridis,
+    Magma,
+    Copper,
+    Rainbow,
+    Grey,
+    Gradient(Vec<(f64, [f64; 3])>),
+}
+
+impl PaletteRepr {
+    pub(super) fn from_palette(p: &Palette) -> Self {
+        match p.name() {
+            Some("fire") => PaletteRepr::Fire,
+            Some("ocean") => PaletteRepr::Ocean,
+            Some("viridis") => PaletteRepr::Viridis,
+            Some("magma") => PaletteRepr::Magma,
+            Some("copper") => PaletteRepr::Copper,
+            Some("rainbow") => PaletteRepr::Rainbow,
+            Some("grey") => PaletteRepr::Grey,
+            _ => PaletteRepr::Gradient(p.stops().to_vec()),
+        }
+    }
+
+    pub(super) fn to_palette(&self) -> Palette {
+        let named = |n: &str| Palette::named(n).expect("a named palette");
+        match self {
+            PaletteRepr::Fire => named("fire"),
+            PaletteRepr::Ocean => named("ocean"),
+            PaletteRepr::Viridis => named("viridis"),
+            PaletteRepr::Magma => named("magma"),
+            PaletteRepr::Copper => named("copper"),
+            PaletteRepr::Rainbow => named("rainbow"),
+            PaletteRepr::Grey => named("grey"),
+            PaletteRepr::Gradient(stops) => Palette::gradient(stops.iter().copied()),
+        }
+    }
+}
+
 impl MaterialRepr {
     pub(super) fn from_material(m: &Material) -> Self {
         let defaults = Material::default();
@@ -549,6 +593,15 @@ pub(super) enum NodeRepr {
     },
     Material {
         material: MaterialRepr,
+        child: Child,
+    },
+    OrbitTrap {
+        trap: Trap,
+        palette: PaletteRepr,
+        #[serde(default = "zero")]
+        near: Param,
+        #[serde(default = "one")]
+        far: Param,
         child: Child,
     },
     Union(Vec<Located<NodeRepr>>),

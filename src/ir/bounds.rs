@@ -352,7 +352,9 @@ pub(super) fn bound(node: &IrNode, done: &[Option<Bound>]) -> Option<Bound> {
         // Where the bound is positive the child's estimate is above the
         // thickness, so its absolute value is itself.
         Kind::Onion { thickness, child } => of(child)?.grow(baked(*thickness)?),
-        Kind::Color { child, .. } | Kind::Material { child, .. } => of(child)?,
+        Kind::Color { child, .. }
+        | Kind::Material { child, .. }
+        | Kind::OrbitTrap { child, .. } => of(child)?,
         Kind::Csg {
             op,
             smoothing,
@@ -545,7 +547,12 @@ pub(crate) fn reach(ir: &Ir, id: NodeId, bounds: &[Option<Bound>]) -> Option<Rea
                 stack.push((*b, offset + k));
                 stack.push((*a, offset + k));
             }
-            (Kind::Color { child, .. } | Kind::Material { child, .. }, _) => {
+            (
+                Kind::Color { child, .. }
+                | Kind::Material { child, .. }
+                | Kind::OrbitTrap { child, .. },
+                _,
+            ) => {
                 stack.push((*child, offset));
             }
             _ => match bounds[at.index()] {

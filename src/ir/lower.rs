@@ -189,6 +189,14 @@ impl Lowering {
                     *normal = unit.to_array().map(Scalar::Baked);
                 }
             }
+            // A trap's direction, likewise.
+            Kind::OrbitTrap { coloring, .. } => {
+                if let Some(direction) = coloring.trap.direction_mut()
+                    && let Some(unit) = baked3(*direction).and_then(normalize)
+                {
+                    *direction = unit.to_array().map(Scalar::Baked);
+                }
+            }
             _ => {}
         }
         self.visits[v].lowered = Some(lowered);
@@ -233,6 +241,10 @@ impl Lowering {
                 },
             )),
             Kind::Plane { normal, .. } => Some(("normal", Relation::NonZero { vector: *normal })),
+            Kind::OrbitTrap { coloring, .. } => coloring
+                .trap
+                .direction()
+                .map(|(name, d)| (name, Relation::NonZero { vector: *d })),
             _ => None,
         };
         let Some((param, relation)) = relation else {
@@ -558,6 +570,30 @@ fn check_structure(kind: &NodeKind, path: impl Fn() -> String) -> Result<()> {
                     h.ops_per_iteration()
                 ),
             });
+        }
+        Kind::OrbitTrap { coloring, child } => {
+            let invalid = |reason: String| Error::Invalid {
+                what: "orbit trap",
+                reason: format!("{}: {reason}", path()),
+            };
+            if !child.kind().is_fractal() {
+                return Err(invalid(format!(
+                    "colours a fractal by its orbit, and its child is a {} (put the orbit \
+                     trap directly on the fractal, inside any transform)",
+                    child.kind().name()
+                )));
+            }
+            coloring
+                .palette
+                .check()
+                .map_err(|e| invalid(format!("its palette {e}")))?;
+            if let (Param::Value(near), Param::Value(far)) = (&coloring.near, &coloring.far)
+                && near == far
+            {
+                return Err(invalid(format!(
+                    "near and far are both {near}; the palette spans the trap values between them"
+                )));
+            }
         }
         Kind::Custom { shape, args } if args.len() != shape.arity() => {
             return Err(Error::CustomShape {

@@ -14,6 +14,7 @@ use super::fractal::{Kifs, KifsFold, Mandelbox, Mandelbulb, Menger, QuaternionJu
 use super::material::Material;
 use super::node::{Axis, CsgOp, Kind, Node};
 use super::param::{Param, Param3};
+use super::trap::{OrbitTrap, Palette, Trap};
 
 /// A sphere of `radius` at the origin.
 #[must_use]
@@ -611,6 +612,35 @@ impl Node {
     pub fn material(self, material: Material) -> Node {
         Kind::Material {
             material,
+            child: self,
+        }
+        .into()
+    }
+
+    /// Colours the node, a fractal, by its orbit trap: the smallest distance
+    /// from its orbit to `trap`, from 0 to 1 spanning `palette` (see
+    /// [`OrbitTrap`], and [`Node::orbit_coloring`] for another range). The
+    /// colour replaces the fractal's own; an outer colour paints over it.
+    /// Compiling refuses a node that is not a fractal.
+    ///
+    /// ```
+    /// use fractal_sdf::prelude::*;
+    /// use fractal_sdf::scene::{Palette, Trap};
+    ///
+    /// let bulb = mandelbulb(8.0).orbit_trap(Trap::point([0.0, 0.0, 0.0]), Palette::ocean());
+    /// assert!(Scene::new(bulb).compile().is_ok());
+    /// ```
+    #[must_use]
+    pub fn orbit_trap(self, trap: Trap, palette: Palette) -> Node {
+        self.orbit_coloring(OrbitTrap::new(trap, palette))
+    }
+
+    /// Colours the node, a fractal, by its orbit trap (see
+    /// [`Node::orbit_trap`]).
+    #[must_use]
+    pub fn orbit_coloring(self, coloring: OrbitTrap) -> Node {
+        Kind::OrbitTrap {
+            coloring,
             child: self,
         }
         .into()

@@ -15,6 +15,7 @@ mod node;
 mod param;
 mod rule;
 mod stereo;
+mod trap;
 
 use glam::{DVec2, DVec3};
 use serde::{Deserialize, Serialize};
@@ -43,6 +44,7 @@ pub use node::{
 pub use param::{Param, Param3, param, param3};
 pub use rule::{ParamSpec, Rule};
 pub use stereo::{Stereo, StereoLayout};
+pub use trap::{MAX_PALETTE_STOPS, OrbitTrap, Palette, Trap};
 
 use crate::error::{Error, Result, fmt_value};
 use crate::math::{F64_LIMITS, Magnitude, normalize};

@@ -13,6 +13,7 @@ use super::hybrid::Hybrid;
 use super::material::Material;
 use super::param::{Param, Param3};
 use super::rule::{ParamSpec, Rule, spec};
+use super::trap::OrbitTrap;
 
 /// The largest iteration count accepted by the escape-time fractals
 /// (Mandelbulb, quaternion Julia).
@@ -363,6 +364,14 @@ pub enum Kind<S, V, C> {
         /// The node it covers.
         child: C,
     },
+    /// Colours the child, a fractal, by its orbit trap through a palette
+    /// (see [`OrbitTrap`]). The distance is the child's.
+    OrbitTrap {
+        /// The trap, the palette and the range of trap values shown.
+        coloring: OrbitTrap<S, V>,
+        /// The fractal.
+        child: C,
+    },
 }
 
 /// Converts the scalars, vectors and children of a [`Kind`] into another
@@ -432,6 +441,7 @@ impl<S, V, C> Kind<S, V, C> {
             Kind::Custom { .. } => "custom",
             Kind::Color { .. } => "color",
             Kind::Material { .. } => "material",
+            Kind::OrbitTrap { .. } => "orbit_trap",
         }
     }
 
@@ -450,7 +460,8 @@ impl<S, V, C> Kind<S, V, C> {
             | Kind::Twist { child, .. }
             | Kind::Bend { child, .. }
             | Kind::Color { child, .. }
-            | Kind::Material { child, .. } => vec![child],
+            | Kind::Material { child, .. }
+            | Kind::OrbitTrap { child, .. } => vec![child],
             Kind::Csg { a, b, .. } => vec![a, b],
             _ => vec![],
         }
@@ -495,7 +506,8 @@ impl<S, V, C> Kind<S, V, C> {
             | Kind::Twist { child, .. }
             | Kind::Bend { child, .. }
             | Kind::Color { child, .. }
-            | Kind::Material { child, .. } => vec![child],
+            | Kind::Material { child, .. }
+            | Kind::OrbitTrap { child, .. } => vec![child],
             Kind::Csg { a, b, .. } => vec![a, b],
         }
     }
@@ -783,6 +795,18 @@ impl<S, V, C> Kind<S, V, C> {
                 material: material.try_map(|s, spec| m.scalar(s, spec))?,
                 child: m.child(child)?,
             },
+            Kind::OrbitTrap { coloring, child } => {
+                // Both closures need the mapper: they take turns.
+                let m = std::cell::RefCell::new(m);
+                let coloring = coloring.try_map(
+                    &mut |s, spec| m.borrow_mut().scalar(s, spec),
+                    &mut |v, spec| m.borrow_mut().vector(v, spec),
+                )?;
+                Kind::OrbitTrap {
+                    coloring,
+                    child: m.into_inner().child(child)?,
+                }
+            }
         })
     }
 }

@@ -10,9 +10,10 @@ use proptest::prelude::*;
 use crate::cpu::Ray;
 use crate::scene::{
     Axis, CsgOp, Hybrid, HybridOp, Kifs, KifsFold, Kind, MAX_ESCAPE_ITERATIONS,
-    MAX_FOLD_ITERATIONS, MAX_SOLID_ANGLE, Mandelbox, Mandelbulb, Menger, Node, Param, Param3,
-    QuaternionJulia, Sierpinski, capped_cone, capsule, cuboid, cut_sphere, cylinder, ellipsoid,
-    hex_prism, link, octahedron, param, plane, round_box, round_cone, solid_angle, sphere, torus,
+    MAX_FOLD_ITERATIONS, MAX_SOLID_ANGLE, Mandelbox, Mandelbulb, Menger, Node, OrbitTrap, Palette,
+    Param, Param3, QuaternionJulia, Sierpinski, Trap, capped_cone, capsule, cuboid, cut_sphere,
+    cylinder, ellipsoid, hex_prism, link, octahedron, param, plane, round_box, round_cone,
+    solid_angle, sphere, torus,
 };
 
 /// The largest size (radius, half extent, height) the primitive strategies
@@ -602,6 +603,52 @@ pub fn fractal_node() -> impl Strategy<Value = Node> + Clone {
     ]
 }
 
+/// A trap of every kind, with values near the fractals (20% dynamic
+/// scalars); directions are never zero.
+pub fn trap() -> impl Strategy<Value = Trap> + Clone {
+    let at = || vector_param(-1.0..=1.0f64);
+    let direction = || unit_vector().prop_map(Param3::from);
+    prop_oneof![
+        at().prop_map(Trap::point),
+        (at(), scalar("trap.radius", 0.0..=1.0f64)).prop_map(|(c, r)| Trap::sphere(c, r)),
+        (direction(), scalar("trap.offset", -1.0..=1.0f64)).prop_map(|(n, d)| Trap::plane(n, d)),
+        (at(), direction()).prop_map(|(q, u)| Trap::line(q, u)),
+    ]
+}
+
+/// A named palette, or a gradient of 1 to 5 stops.
+pub fn palette() -> impl Strategy<Value = Palette> + Clone {
+    let names: Vec<&'static str> = Palette::names().collect();
+    let gradient = prop::collection::vec((0.0..=1.0f64, color()), 1..=5).prop_map(|mut stops| {
+        stops.sort_by(|a, b| a.0.total_cmp(&b.0));
+        stops.dedup_by(|a, b| a.0 == b.0);
+        Palette::gradient(stops.into_iter().map(|(t, c)| (t, c.to_array())))
+    });
+    prop_oneof![
+        prop::sample::select(names).prop_map(|n| Palette::named(n).expect("a named palette")),
+        gradient,
+    ]
+}
+
+/// A fractal ([`fractal_node`]) coloured by an orbit trap: a random trap
+/// and palette, and a range that may be reversed.
+pub fn orbit_trap_node() -> impl Strategy<Value = Node> + Clone {
+    let range = (
+        scalar("trap.near", -0.5..=0.5f64),
+        scalar("trap.far", 0.6..=2.0f64),
+        any::<bool>(),
+    );
+    (fractal_node(), trap(), palette(), range).prop_map(|(f, trap, palette, (near, far, flip))| {
+        let coloring = OrbitTrap::new(trap, palette);
+        let coloring = if flip {
+            coloring.range(far, near)
+        } else {
+            coloring.range(near, far)
+        };
+        f.orbit_coloring(coloring)
+    })
+}
+
 /// One random hybrid operation of every kind, with parameters in their
 /// valid ranges (20% dynamic); powers are the integers 2 to 8 (a real
 /// power's map is discontinuous across the half-plane `y = 0, x < 0`,
@@ -689,6 +736,7 @@ pub fn scene_node(depth: u32) -> impl Strategy<Value = Node> + Clone {
         6 => exact_node(),
         1 => ellipsoid_node(),
         2 => fractal_node(),
+        1 => orbit_trap_node(),
     ];
     leaf.prop_recursive(depth, 4 * depth + 4, 2, |inner| {
         let period = vector(prop_oneof![Just(0.0), 0.5..=4.0f64]);

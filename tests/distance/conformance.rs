@@ -15,14 +15,15 @@ use fractal_sdf::prelude::*;
 use fractal_sdf::quality::Precision;
 use fractal_sdf::render::{DeviceInfo, DeviceKind, DeviceSelector, PointEvaluator};
 use fractal_sdf::scene::Axis;
+use fractal_sdf::scene::Mandelbulb;
 use fractal_sdf::scene::QuaternionJulia;
 use fractal_sdf::scene::ellipsoid;
 use fractal_sdf::scene::octahedron;
 use fractal_sdf::scene::param3;
 use fractal_sdf::scene::{CustomShape, Rule};
 use fractal_sdf::scene::{
-    Hybrid, HybridOp, Kifs, KifsFold, Mandelbox, capped_cone, cut_sphere, hex_prism, kifs, link,
-    round_cone, solid_angle,
+    Hybrid, HybridOp, Kifs, KifsFold, Mandelbox, OrbitTrap, Palette, Trap, capped_cone, cut_sphere,
+    hex_prism, kifs, link, round_cone, solid_angle,
 };
 use fractal_sdf::testing::{check_device_matches_cpu, random_points, spicy_points};
 
@@ -178,6 +179,62 @@ fn nodes() -> Vec<(&'static str, Node)> {
             "repeat_limited",
             sphere(0.2).repeat_limited(dvec3(0.6, 0.6, 0.0), [2, 1, 0]),
         ),
+        // Orbit traps: each trap on a fractal, the palette's colour
+        // compared; dynamic trap values reach the kernel as given.
+        (
+            "orbit_trap_point_bulb",
+            mandelbulb(8.0).orbit_trap(Trap::point([0.3, 0.2, -0.1]), Palette::fire()),
+        ),
+        (
+            "orbit_trap_plane_menger",
+            menger(3).orbit_coloring(
+                OrbitTrap::new(
+                    Trap::plane(param3("trap_n", dvec3(0.2, 1.0, 0.4)), param("trap_d", 0.3)),
+                    Palette::viridis(),
+                )
+                .range(0.0, param("trap_far", 2.0)),
+            ),
+        ),
+        (
+            "orbit_trap_sphere_mandelbox",
+            mandelbox(-1.5).orbit_trap(Trap::sphere([0.5, 0.0, 0.5], 0.8), Palette::ocean()),
+        ),
+        (
+            "orbit_trap_line_julia",
+            julia([-0.2, 0.6, 0.2, 0.2]).orbit_coloring(
+                OrbitTrap::new(
+                    Trap::line([0.0, 0.1, 0.0], [1.0, 1.0, 0.0]),
+                    Palette::magma(),
+                )
+                .range(0.8, 0.0),
+            ),
+        ),
+        (
+            "orbit_trap_kifs_hybrid_sierpinski",
+            kifs(KifsFold::Octahedral)
+                .orbit_trap(Trap::plane([0.0, 0.0, 1.0], 0.5), Palette::copper())
+                .union(
+                    Node::from(Hybrid::mandelbox(2.0))
+                        .orbit_trap(Trap::point([0.0, 0.0, 0.0]), Palette::rainbow())
+                        .translate(dvec3(1.0, 0.0, 0.0)),
+                )
+                .union(
+                    sierpinski(4)
+                        .orbit_trap(Trap::sphere([1.0, 1.0, 1.0], 0.5), Palette::grey())
+                        .translate(dvec3(0.0, 1.0, 0.0)),
+                ),
+        ),
+        (
+            "orbit_trap_dynamic_power",
+            Node::from(Mandelbulb::new(param("trap_power", 5.0)).iterations(5)).orbit_trap(
+                Trap::line([0.0, 0.0, 0.0], [0.0, 0.0, 1.0]),
+                Palette::gradient([
+                    (0.0, [0.1, 0.0, 0.2]),
+                    (0.3, [0.9, 0.5, 0.1]),
+                    (1.0, [1.0; 3]),
+                ]),
+            ),
+        ),
         ("twist", b().twist(1.5)),
         ("bend", b().bend(0.9)),
         ("union", s().union(b().translate(dvec3(0.5, 0.0, 0.0)))),
@@ -205,10 +262,10 @@ fn nodes() -> Vec<(&'static str, Node)> {
 
 /// The tolerance per precision and device class. On a CPU device (PoCL,
 /// where `make test` and CI run) the worst errors measured over every node
-/// below and 10,065 points are 3.6e-6 in F32 (`mandelbulb_dynamic`: the
-/// trigonometric map through many iterations) and 7.8e-16 in F64
-/// (`julia_dynamic_bailout_2`); the tolerances are about 5 and 13 times
-/// those. Other devices (GPUs) are not measured here: their single-precision
+/// below and 10,065 points are 5.0e-6 in F32 (`orbit_trap_dynamic_power`:
+/// the trigonometric map, a colour from its orbit) and 2.3e-15 in F64
+/// (the same node; 7.8e-16 for distances alone, `julia_dynamic_bailout_2`);
+/// the tolerances are about 4 times those. Other devices (GPUs) are not measured here: their single-precision
 /// built-ins may be several ulps from correctly rounded (OpenCL C allows up
 /// to 4 for `sin`, `cos` and `atan2`, 16 for `pow`), which the iterated
 /// fractal maps amplify, so they keep the looser 1e-4 and 1e-10 until a

@@ -32,5 +32,7 @@ mod lipschitz;
 mod mandelbox;
 mod numeric;
 #[cfg(feature = "proptest")]
+mod orbit_trap;
+#[cfg(feature = "proptest")]
 mod ratio;
 mod smooth_oracle;

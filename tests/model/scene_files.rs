@@ -367,6 +367,63 @@ fn shorthand_forms_read_as_their_long_forms() {
     assert_eq!(file.effects, Effects::default());
 }
 
+/// Orbit traps read in every form: each trap, each named palette, a
+/// gradient, the range's defaults; a palette the parser does not know is
+/// an error that names the word.
+#[test]
+fn orbit_traps_read_in_every_form() {
+    use fractal_sdf::scene::{OrbitTrap, Palette, Trap};
+    let names = [
+        "Fire", "Ocean", "Viridis", "Magma", "Copper", "Rainbow", "Grey",
+    ];
+    for name in names {
+        let text = format!(
+            "(version: 1, geometry: OrbitTrap(trap: Point(centre: (0, 0, 1)), palette: {name}, \
+             child: Menger(iterations: 2)))"
+        );
+        let file = SceneFile::parse(&text).unwrap();
+        let palette = Palette::named(&name.to_lowercase()).unwrap();
+        let expected = menger(2).orbit_trap(Trap::point(dvec3(0.0, 0.0, 1.0)), palette);
+        assert_eq!(file.scene.geometry, Some(expected));
+        // And it is written back by its name.
+        assert!(
+            file.to_text()
+                .unwrap()
+                .contains(&format!("palette: {name}"))
+        );
+    }
+    let text = "(version: 1, geometry: OrbitTrap(
+        trap: Line(point: (0, 0, 0), direction: param3(\"dir\", (0, 1, 0))),
+        palette: Gradient([(0, (0, 0, 0.1)), (0.5, (1, 0.2, 0)), (1, (1, 1, 1))]),
+        near: 0.1, far: param(\"far\", 2),
+        child: Mandelbulb(power: 8)))";
+    let file = SceneFile::parse(text).unwrap();
+    let expected = mandelbulb(8.0).orbit_coloring(
+        OrbitTrap::new(
+            Trap::line(DVec3::ZERO, fractal_sdf::scene::param3("dir", DVec3::Y)),
+            Palette::gradient([
+                (0.0, [0.0, 0.0, 0.1]),
+                (0.5, [1.0, 0.2, 0.0]),
+                (1.0, [1.0, 1.0, 1.0]),
+            ]),
+        )
+        .range(0.1, param("far", 2.0)),
+    );
+    assert_eq!(file.scene.geometry, Some(expected));
+    let again = SceneFile::parse(&file.to_text().unwrap()).unwrap();
+    assert_eq!(again.scene.geometry, file.scene.geometry);
+
+    let plaid = "(version: 1, geometry: OrbitTrap(trap: Point(centre: 0), palette: Plaid, \
+                 child: Menger(iterations: 2)))";
+    let err = SceneFile::parse(plaid).unwrap_err().to_string();
+    assert!(err.contains("Plaid"), "{err}");
+    // A trap on a shape that is not a fractal is refused where it is.
+    let on_sphere = "(version: 1, geometry: OrbitTrap(trap: Point(centre: 0), palette: Fire, \
+                     child: Sphere(radius: 1)))";
+    let err = SceneFile::parse(on_sphere).unwrap_err().to_string();
+    assert!(err.contains("its child is a sphere"), "{err}");
+}
+
 /// The README's complete scene file reads, with every part it shows.
 #[test]
 fn the_readme_example_file_reads() {

@@ -753,3 +753,67 @@ fn brute_steps_too_small_to_reach_a_set_are_refused() {
             .is_ok()
     );
 }
+
+/// An orbit trap colours a fractal: on anything else, with a degenerate
+/// direction, an empty range or a bad palette, compiling says what is
+/// wrong and where.
+#[test]
+fn bad_orbit_traps_say_what_is_wrong() {
+    use fractal_sdf::scene::{OrbitTrap, Palette, Trap};
+    let invalid = |node: Node| match error_of(node) {
+        Error::Invalid { what, reason } => {
+            assert_eq!(what, "orbit trap");
+            reason
+        }
+        other => panic!("expected an invalid orbit trap, got {other:?}"),
+    };
+    let on_sphere = invalid(sphere(1.0).orbit_trap(Trap::point(DVec3::ZERO), Palette::fire()));
+    assert!(on_sphere.starts_with("orbit_trap: "), "{on_sphere}");
+    assert!(on_sphere.contains("its child is a sphere"), "{on_sphere}");
+    // Under a transform the fractal is not the child either.
+    let moved = mandelbulb(8.0)
+        .translate(DVec3::X)
+        .orbit_trap(Trap::point(DVec3::ZERO), Palette::fire());
+    assert!(invalid(moved).contains("child is a translate"));
+
+    let flat = OrbitTrap::new(Trap::point(DVec3::ZERO), Palette::grey()).range(0.5, 0.5);
+    assert!(invalid(menger(2).orbit_coloring(flat)).contains("near and far are both 0.5"));
+    let backwards = Palette::gradient([(0.6, [1.0; 3]), (0.4, [0.0; 3])]);
+    let reason = invalid(menger(2).orbit_trap(Trap::point(DVec3::ZERO), backwards));
+    assert!(reason.contains("its palette stop 1 is at 0.4"), "{reason}");
+    let empty = Palette::gradient([]);
+    assert!(invalid(menger(2).orbit_trap(Trap::point(DVec3::ZERO), empty)).contains("0 stops"));
+
+    assert_zero_vector(
+        menger(2).orbit_trap(Trap::plane(DVec3::ZERO, 0.0), Palette::fire()),
+        "orbit_trap",
+        "trap.normal",
+    );
+    assert_zero_vector(
+        menger(2).orbit_trap(Trap::line(DVec3::ONE, DVec3::ZERO), Palette::fire()),
+        "orbit_trap",
+        "trap.direction",
+    );
+    assert_out_of_range(
+        menger(2).orbit_trap(Trap::sphere(DVec3::ZERO, -1.0), Palette::fire()),
+        "orbit_trap",
+        "trap.radius",
+        -1.0,
+        ">= 0",
+    );
+    assert_non_finite(
+        menger(2).orbit_coloring(
+            OrbitTrap::new(Trap::point(DVec3::ZERO), Palette::fire()).range(0.0, f64::NAN),
+        ),
+        "orbit_trap",
+        "far",
+    );
+    // A dynamic direction cannot become zero either.
+    let node = menger(2).orbit_trap(
+        Trap::plane(param3("n", dvec3(0.0, 0.0, 1.0)), 0.0),
+        Palette::fire(),
+    );
+    let mut eval = cpu::Evaluator::new(&node).unwrap();
+    let err = eval.set_param("n.z", 0.0).unwrap_err();
+    assert!(matches!(err, Error::ZeroVector { .. }), "{err}");
+}

@@ -16,6 +16,7 @@
 //! of one operand however many there are, and computes what the unrolled
 //! code would.
 
+use std::cell::RefCell;
 use std::collections::{BTreeMap, BTreeSet, HashMap};
 use std::convert::Infallible;
 use std::fmt::Write as _;
@@ -23,16 +24,19 @@ use std::fmt::Write as _;
 use super::formulas::vector;
 use super::helpers::Helper;
 use super::writer::{INSTANCE_SLOT, Writer};
-use crate::cpu::sdf;
+use crate::cpu::sdf::{self, TrapShape};
 use crate::expr::{Num, OpenCl, Printer, Shape, Var, trace};
 use crate::ir::{
     Bound, Ir, IrNode, NodeId, Reach, Scalar, UnionChain, Vector, constant, costs, reach, swaps,
     union_chain,
 };
-use crate::math::{F32_LIMITS, V3, escape_radius, integer_power, mandelbulb_radius, rotation_rows};
+use crate::math::{
+    F32_LIMITS, V3, escape_radius, integer_power, mandelbulb_radius, rotation_rows, v3,
+};
 use crate::quality::Precision;
 use crate::scene::{
-    CsgOp, CustomShape, Hybrid, Kind, MAX_ESCAPE_ITERATIONS, MAX_FOLD_ITERATIONS, Mapper, ParamSpec,
+    CsgOp, CustomShape, Hybrid, Kind, MAX_ESCAPE_ITERATIONS, MAX_FOLD_ITERATIONS, Mapper, Palette,
+    ParamSpec, Trap,
 };
 
 mod inline;
@@ -153,6 +157,13 @@ pub(crate) struct SceneEmitter<'a> {
     /// The hybrids' helpers, one per structure (their operations and
     /// integer powers), by the structure's description.
     pub(crate) hybrids: BTreeMap<String, HybridHelper>,
+    /// The fractal helpers called in their trapped form (by the plain
+    /// form's name).
+    pub(crate) trapped: BTreeSet<String>,
+    /// The trap shapes (the nine arguments of a trapped form) of the
+    /// fractals an orbit trap colours, by the fractal's node, while it is
+    /// entered.
+    traps: HashMap<NodeId, String>,
     /// The instances' table rows, read from `params[slots + i]`.
     pub(crate) constants: Vec<f64>,
     /// How many slots the dynamic parameters take before the tables.
@@ -194,6 +205,8 @@ impl<'a> SceneEmitter<'a> {
             customs: BTreeMap::new(),
             powers: BTreeSet::new(),
             hybrids: BTreeMap::new(),
+            trapped: BTreeSet::new(),
+            traps: HashMap::new(),
             constants: Vec::new(),
             slots: ir.params().len(),
             instance: HashMap::new(),
@@ -301,11 +314,20 @@ impl<'a> SceneEmitter<'a> {
         self.fractal_call(id, helper.name(), args)
     }
 
-    /// A call of a fractal function (library or specialised).
+    /// A call of a fractal function (library or specialised): its trapped
+    /// form where an orbit trap colours the node.
     fn fractal_call(&mut self, id: NodeId, function: &str, args: &str) -> Vars {
         let v = vars(id);
         let pair = format!("f{}", id.index());
-        self.w.line(format!("real2 {pair} = {function}({args});"));
+        match self.traps.remove(&id) {
+            Some(trap) => {
+                self.trapped.insert(function.to_string());
+                let function = super::formulas::fractal_name(function, true);
+                self.w
+                    .line(format!("real2 {pair} = {function}({args}, {trap});"));
+            }
+            None => self.w.line(format!("real2 {pair} = {function}({args});")),
+        }
         self.w.line(format!("real {} = {pair}.x;", v.d));
         let t = if self.traps() {
             self.w.line(format!("real {} = {pair}.y;", v.t));
@@ -521,6 +543,7 @@ impl<'a> SceneEmitter<'a> {
             Kind::Csg { .. }
                 | Kind::Color { .. }
                 | Kind::Material { .. }
+                | Kind::OrbitTrap { .. }
                 | Kind::Round { .. }
                 | Kind::Onion { .. }
         ) {
@@ -730,8 +753,51 @@ impl<'a> SceneEmitter<'a> {
                 let needs = !self.material && needs_color;
                 Step::Descend(vec![(*child, p.to_string(), needs)])
             }
+            Kind::OrbitTrap { coloring, child } => {
+                if self.traps() && needs_color {
+                    let trap = self.trap_shape(&coloring.trap);
+                    self.traps.insert(*child, trap);
+                }
+                Step::Descend(vec![(*child, p.to_string(), needs_color)])
+            }
             _ => unreachable!("leaves are emitted from the table above"),
         }
+    }
+
+    /// The arguments a trapped fractal helper takes after its own for
+    /// `trap` (its nine numbers, the first six as two vectors), as source
+    /// expressions: literals where its values are baked.
+    fn trap_shape(&mut self, trap: &Trap<Scalar, Vector>) -> String {
+        // The trap's values in order; both closures add to the list.
+        let args = RefCell::new(Vec::new());
+        let Ok(_) = trap.try_map(
+            &mut |s, _| {
+                args.borrow_mut().push(Arg::Scalar(*s));
+                Ok::<_, Infallible>(())
+            },
+            &mut |v, _| {
+                args.borrow_mut().push(Arg::Vector(*v));
+                Ok(())
+            },
+        );
+        let args = args.into_inner();
+        let values: Vec<String> = if let Some(shape) = TrapShape::baked(trap) {
+            // Baked: the numbers, computed here in `f64`.
+            shape.values().iter().map(|&v| self.w.float(v)).collect()
+        } else {
+            self.inline(&args, &[Shape::Scalar; 9], |a| {
+                let next = RefCell::new(a.iter().copied());
+                let take = || next.borrow_mut().next().expect("one value per input");
+                let Ok(trap) = trap
+                    .try_map(&mut |_, _| Ok::<_, Infallible>(take()), &mut |_, _| {
+                        Ok(v3(take(), take(), take()))
+                    });
+                TrapShape::new(&trap).values().to_vec()
+            })
+        };
+        // The helper takes the centre and the axis as vectors.
+        let [cx, cy, cz, ax, ay, az, across, along, radius] = take(values);
+        format!("(real3)({cx}, {cy}, {cz}), (real3)({ax}, {ay}, {az}), {across}, {along}, {radius}")
     }
 
     /// Leaving a node after its children: the lines that combine their
@@ -806,6 +872,31 @@ impl<'a> SceneEmitter<'a> {
                 let rgb = self.w.vector(*color);
                 self.w.line(format!("real3 {} = {rgb};", v.c));
                 Vars { c: v.c, ..c }
+            }
+            Kind::OrbitTrap { coloring, .. } => {
+                let c = child();
+                if !self.traps() {
+                    return c;
+                }
+                // The fractal's own trap tints no colour here.
+                let t = "R(1.0)".to_string();
+                if !needs_color {
+                    return Vars { t, ..c };
+                }
+                self.label(id);
+                let palette = &coloring.palette;
+                let args = [
+                    Arg::Value(&c.t),
+                    Arg::Scalar(coloring.near),
+                    Arg::Scalar(coloring.far),
+                ];
+                let [color] = take(self.inline(&args, &[Shape::Vec3], |a| {
+                    let c = palette.at(Palette::position(a[0], a[1], a[2]));
+                    vec![c.x, c.y, c.z]
+                }));
+                let v = vars(id);
+                self.w.line(format!("real3 {} = {color};", v.c));
+                Vars { c: v.c, t, d: c.d }
             }
             Kind::Material { material, .. } => {
                 let c = child();

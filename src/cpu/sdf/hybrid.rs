@@ -1,7 +1,9 @@
 //! The hybrid fractal's estimate ([`Hybrid`]): its operations run in
 //! order on the orbit's point and the running derivative.
 
-use super::{Estimate, box_fold, kifs_fold, sphere_fold_factor, triplex_direction, turn};
+use super::{
+    Estimate, TrapShape, TrapSlot, box_fold, kifs_fold, sphere_fold_factor, triplex_direction, turn,
+};
 use crate::expr::Step;
 use crate::ir::Scalar;
 use crate::math::{Num, V3, integer_power, v3};
@@ -63,7 +65,7 @@ pub fn hybrid<T: Num>(
     h: &Hybrid<T>,
     integer_powers: &[Option<u32>],
 ) -> Estimate<T> {
-    hybrid_estimate(p, T::of(f64::from(iterations)), h, integer_powers)
+    hybrid_estimate(p, T::of(f64::from(iterations)), h, integer_powers, None)
 }
 
 /// One operation, ready to run: `(z, dr, p) → (z', dr')`.
@@ -162,7 +164,9 @@ pub fn hybrid_estimate<T: Num>(
     iterations: T,
     h: &Hybrid<T>,
     integer_powers: &[Option<u32>],
+    trap: Option<&TrapShape<T>>,
 ) -> Estimate<T> {
+    let slot = TrapSlot::new(trap);
     let bailout = h.bailout;
     let bailout2 = bailout * bailout;
     let mut integer = integer_powers.iter().copied();
@@ -189,7 +193,7 @@ pub fn hybrid_estimate<T: Num>(
     // Far from the ball its distance alone: no orbit to follow.
     let far_field = r0.gt(bailout * T::of(HYBRID_FAR_FIELD));
     let iterations = T::select(far_field, T::zero(), iterations);
-    let start = [p.x, p.y, p.z, T::one(), p.dot(p), escaped];
+    let start = [p.x, p.y, p.z, T::one(), slot.start(p.dot(p), p), escaped];
     let [x, y, z, dr, trap, escaped] =
         T::iterate(iterations, start, |_, [x, y, z, dr, trap, escaped]| {
             let (mut z, mut dr, mut escaped) = (v3(x, y, z), dr, escaped);
@@ -212,7 +216,7 @@ pub fn hybrid_estimate<T: Num>(
             escaped = T::select(out, T::one(), escaped);
             Step {
                 stop_before: None,
-                next: [z.x, z.y, z.z, dr, trap.min(z.dot(z)), escaped],
+                next: [z.x, z.y, z.z, dr, slot.step(trap, z, || z.dot(z)), escaped],
                 stop_after: Some(far.gt(T::of(0.5))),
             }
         });
@@ -237,6 +241,6 @@ pub fn hybrid_estimate<T: Num>(
     });
     Estimate {
         distance: T::select(far_field, outer, (factor * estimate).max(outer)),
-        trap: trap.sqrt().min(T::one()),
+        trap: slot.end(trap, |t| t.sqrt().min(T::one())),
     }
 }

@@ -23,6 +23,10 @@ use crate::math::{
 use crate::scene::{CsgOp, KifsFold};
 
 mod hybrid;
+mod trap;
+
+pub use trap::TrapShape;
+pub(crate) use trap::TrapSlot;
 
 pub(crate) use hybrid::hybrid_integer_powers;
 pub use hybrid::{
@@ -394,6 +398,7 @@ pub fn mandelbulb<T: Real>(
         escape,
         mandelbulb_radius(power),
         integer_power,
+        None,
     )
 }
 
@@ -415,16 +420,18 @@ pub fn mandelbulb_estimate<T: Num>(
     escape: T,
     ball: T,
     integer_power: Option<u32>,
+    trap: Option<&TrapShape<T>>,
 ) -> Estimate<T> {
+    let slot = TrapSlot::new(trap);
     let r0 = p.length();
     let outer = r0 - ball;
     let far = r0.gt(T::of(MANDELBULB_FAR_FIELD) * ball);
     let count = T::select(far, T::zero(), iterations);
-    let start = [p.x, p.y, p.z, T::one(), T::one()];
+    let start = [p.x, p.y, p.z, T::one(), slot.start(T::one(), p)];
     let [x, y, z, dr, trap] = T::iterate(count, start, |_, [x, y, z, dr, trap]| {
         let z = v3(x, y, z);
         let r = z.length();
-        let trap = trap.min(r);
+        let trap = slot.step(trap, z, || r);
         // r^(power - 1), by repeated multiplication in the integer form.
         let r_pow = match integer_power {
             Some(n) => pow_int(r, n - 1),
@@ -442,7 +449,7 @@ pub fn mandelbulb_estimate<T: Num>(
     let estimate = (T::of(0.5) * r.max(T::tiny()).ln() * r / dr).max(outer);
     Estimate {
         distance: T::select(far, outer, estimate),
-        trap: T::select(far, T::one(), trap),
+        trap: slot.end(trap, |t| T::select(far, T::one(), t)),
     }
 }
 
@@ -451,22 +458,28 @@ pub fn mandelbulb_estimate<T: Num>(
 /// distance divided by `scale^iterations`.
 #[must_use]
 pub fn menger<T: Num>(p: V3<T>, iterations: u32, scale: T) -> Estimate<T> {
-    menger_estimate(p, T::of(f64::from(iterations)), scale)
+    menger_estimate(p, T::of(f64::from(iterations)), scale, None)
 }
 
 /// [`menger`] with the iteration count as a number: the formula written
 /// once (the kernels' `menger` helper).
 #[must_use]
-pub fn menger_estimate<T: Num>(p: V3<T>, iterations: T, scale: T) -> Estimate<T> {
+pub fn menger_estimate<T: Num>(
+    p: V3<T>,
+    iterations: T,
+    scale: T,
+    trap: Option<&TrapShape<T>>,
+) -> Estimate<T> {
+    let slot = TrapSlot::new(trap);
     let shift = scale - T::one();
-    let start = [p.x, p.y, p.z, T::one(), T::one()];
+    let start = [p.x, p.y, p.z, T::one(), slot.start(T::one(), p)];
     let [x, y, z, s, trap] = T::iterate(iterations, start, |_, [x, y, z, s, trap]| {
         let z = v3(x, y, z).abs();
         // Sort the components, largest first.
         let z = V3::select(z.x.lt(z.y), v3(z.y, z.x, z.z), z);
         let z = V3::select(z.x.lt(z.z), v3(z.z, z.y, z.x), z);
         let z = V3::select(z.y.lt(z.z), v3(z.x, z.z, z.y), z);
-        let trap = trap.min(z.length() * T::of(0.577_350_269_189_625_8));
+        let trap = slot.step(trap, z, || z.length() * T::of(0.577_350_269_189_625_8));
         let w = v3(z.x * scale - shift, z.y * scale - shift, z.z * scale);
         let wz = T::select(w.z.gt(T::of(0.5) * shift), w.z - shift, w.z);
         Step {
@@ -495,21 +508,27 @@ pub fn tetrahedron<T: Num>(z: V3<T>) -> T {
 /// divided by `scale^iterations`.
 #[must_use]
 pub fn sierpinski<T: Num>(p: V3<T>, iterations: u32, scale: T) -> Estimate<T> {
-    sierpinski_estimate(p, T::of(f64::from(iterations)), scale)
+    sierpinski_estimate(p, T::of(f64::from(iterations)), scale, None)
 }
 
 /// [`sierpinski`] with the iteration count as a number: the formula
 /// written once (the kernels' `sierpinski` helper).
 #[must_use]
-pub fn sierpinski_estimate<T: Num>(p: V3<T>, iterations: T, scale: T) -> Estimate<T> {
+pub fn sierpinski_estimate<T: Num>(
+    p: V3<T>,
+    iterations: T,
+    scale: T,
+    trap: Option<&TrapShape<T>>,
+) -> Estimate<T> {
+    let slot = TrapSlot::new(trap);
     let shift = scale - T::one();
-    let start = [p.x, p.y, p.z, T::one(), T::one()];
+    let start = [p.x, p.y, p.z, T::one(), slot.start(T::one(), p)];
     let [x, y, z, s, trap] = T::iterate(iterations, start, |_, [x, y, z, s, trap]| {
         let z = v3(x, y, z);
         let z = V3::select((z.x + z.y).lt(T::zero()), v3(-z.y, -z.x, z.z), z);
         let z = V3::select((z.x + z.z).lt(T::zero()), v3(-z.z, z.y, -z.x), z);
         let z = V3::select((z.y + z.z).lt(T::zero()), v3(z.x, -z.z, -z.y), z);
-        let trap = trap.min(z.length() * T::of(0.577_350_269_189_625_8));
+        let trap = slot.step(trap, z, || z.length() * T::of(0.577_350_269_189_625_8));
         let w = z * scale - V3::splat(shift);
         Step {
             stop_before: None,
@@ -627,7 +646,7 @@ pub(crate) fn kifs_fold<T: Num>(fold: KifsFold, z: V3<T>) -> V3<T> {
 /// [`kifs_estimate`] with an integer iteration count.
 #[must_use]
 pub fn kifs<T: Num>(p: V3<T>, iterations: u32, k: &KifsParams<T>) -> Estimate<T> {
-    kifs_estimate(p, T::of(f64::from(iterations)), k)
+    kifs_estimate(p, T::of(f64::from(iterations)), k, None)
 }
 
 /// A kaleidoscopic IFS (Knighty) distance bound: each step turns the
@@ -640,7 +659,13 @@ pub fn kifs<T: Num>(p: V3<T>, iterations: u32, k: &KifsParams<T>) -> Estimate<T>
 /// with a lower bound of the estimate. The trap is the orbit's smallest
 /// radius over `R`.
 #[must_use]
-pub fn kifs_estimate<T: Num>(p: V3<T>, iterations: T, k: &KifsParams<T>) -> Estimate<T> {
+pub fn kifs_estimate<T: Num>(
+    p: V3<T>,
+    iterations: T,
+    k: &KifsParams<T>,
+    trap: Option<&TrapShape<T>>,
+) -> Estimate<T> {
+    let slot = TrapSlot::new(trap);
     let menger = k.fold == KifsFold::Menger;
     let o = k.offset;
     let radius = kifs_radius([o.x, o.y, o.z], menger);
@@ -655,7 +680,7 @@ pub fn kifs_estimate<T: Num>(p: V3<T>, iterations: T, k: &KifsParams<T>) -> Esti
     let height = T::of(0.5) * o.z * grow;
     let before = k.rotate_before.map(turn);
     let after = k.rotate_after.map(turn);
-    let start = [p.x, p.y, p.z, T::one(), p.dot(p)];
+    let start = [p.x, p.y, p.z, T::one(), slot.start(p.dot(p), p)];
     let [x, y, z, s, trap] = T::iterate(iterations, start, |_, [x, y, z, s, trap]| {
         let mut z = v3(x, y, z);
         if let Some(turn) = &before {
@@ -672,13 +697,13 @@ pub fn kifs_estimate<T: Num>(p: V3<T>, iterations: T, k: &KifsParams<T>) -> Esti
         let r2 = w.dot(w);
         Step {
             stop_before: None,
-            next: [w.x, w.y, w.z, s * k.scale, trap.min(r2)],
+            next: [w.x, w.y, w.z, s * k.scale, slot.step(trap, w, || r2)],
             stop_after: Some(r2.gt(follow2)),
         }
     });
     Estimate {
         distance: (v3(x, y, z).length() - radius) / s,
-        trap: (trap.sqrt() / radius.max(T::tiny())).min(T::one()),
+        trap: slot.end(trap, |t| (t.sqrt() / radius.max(T::tiny())).min(T::one())),
     }
 }
 
@@ -736,7 +761,7 @@ impl<T: Num> MandelboxParams<T> {
 /// [`mandelbox_estimate`] with an integer iteration count.
 #[must_use]
 pub fn mandelbox<T: Num>(p: V3<T>, iterations: u32, m: &MandelboxParams<T>) -> Estimate<T> {
-    mandelbox_estimate(p, T::of(f64::from(iterations)), m)
+    mandelbox_estimate(p, T::of(f64::from(iterations)), m, None)
 }
 
 /// The Mandelbox (Tom Lowe's box fold and sphere fold) distance estimate.
@@ -752,7 +777,13 @@ pub fn mandelbox<T: Num>(p: V3<T>, iterations: u32, m: &MandelboxParams<T>) -> E
 /// early, with a lower bound of the estimate after the steps it skips. The trap is the orbit's smallest
 /// radius over the fixed radius.
 #[must_use]
-pub fn mandelbox_estimate<T: Num>(p: V3<T>, iterations: T, m: &MandelboxParams<T>) -> Estimate<T> {
+pub fn mandelbox_estimate<T: Num>(
+    p: V3<T>,
+    iterations: T,
+    m: &MandelboxParams<T>,
+    trap: Option<&TrapShape<T>>,
+) -> Estimate<T> {
+    let slot = TrapSlot::new(trap);
     let fixed2 = m.fixed_radius * m.fixed_radius;
     let min2 = (m.min_radius * m.min_radius).min(fixed2);
     let limit = m.fold_limit;
@@ -767,7 +798,7 @@ pub fn mandelbox_estimate<T: Num>(p: V3<T>, iterations: T, m: &MandelboxParams<T
     };
     let scale_abs = m.scale.abs();
     let largest = |z: V3<T>| z.x.abs().max(z.y.abs()).max(z.z.abs());
-    let start = [p.x, p.y, p.z, T::one(), p.dot(p), T::zero()];
+    let start = [p.x, p.y, p.z, T::one(), slot.start(p.dot(p), p), T::zero()];
     let [x, y, z, dr, trap, steps] =
         T::iterate(iterations, start, |_, [x, y, z, dr, trap, steps]| {
             // The box fold, then the sphere fold.
@@ -777,7 +808,14 @@ pub fn mandelbox_estimate<T: Num>(p: V3<T>, iterations: T, m: &MandelboxParams<T
             let dr = (dr * k * scale_abs + add).min(T::derivative_cap());
             Step {
                 stop_before: None,
-                next: [z.x, z.y, z.z, dr, trap.min(z.dot(z)), steps + T::one()],
+                next: [
+                    z.x,
+                    z.y,
+                    z.z,
+                    dr,
+                    slot.step(trap, z, || z.dot(z)),
+                    steps + T::one(),
+                ],
                 stop_after: Some(largest(z).gt(follow)),
             }
         });
@@ -791,7 +829,9 @@ pub fn mandelbox_estimate<T: Num>(p: V3<T>, iterations: T, m: &MandelboxParams<T
     let estimate = (largest(v3(x, y, z)) - escape) / (dr + added).max(T::tiny());
     Estimate {
         distance: (T::of(MANDELBOX_SAFETY) * estimate).max(cuboid(p, V3::splat(half_side))),
-        trap: (trap.sqrt() / m.fixed_radius.max(T::tiny())).min(T::one()),
+        trap: slot.end(trap, |t| {
+            (t.sqrt() / m.fixed_radius.max(T::tiny())).min(T::one())
+        }),
     }
 }
 
@@ -981,13 +1021,21 @@ fn square_plus<T: Num>(z0: T, z1: T, z2: T, z3: T, c: [T; 4]) -> [T; 4] {
 /// and 36 iterations).
 #[must_use]
 pub fn julia<T: Num>(p: V3<T>, c: [T; 4], w: T, iterations: u32, bailout: T) -> Estimate<T> {
-    julia_estimate(p, c, w, T::of(f64::from(iterations)), bailout)
+    julia_estimate(p, c, w, T::of(f64::from(iterations)), bailout, None)
 }
 
 /// [`julia`] with the iteration count as a number: the formula written
 /// once (the kernels' `julia` helper).
 #[must_use]
-pub fn julia_estimate<T: Num>(p: V3<T>, c: [T; 4], w: T, iterations: T, bailout: T) -> Estimate<T> {
+pub fn julia_estimate<T: Num>(
+    p: V3<T>,
+    c: [T; 4],
+    w: T,
+    iterations: T,
+    bailout: T,
+    trap: Option<&TrapShape<T>>,
+) -> Estimate<T> {
+    let slot = TrapSlot::new(trap);
     let radius = julia_radius(c);
     let edge = radius.min(bailout);
     let mz2 = p.x * p.x + p.y * p.y + p.z * p.z + w * w;
@@ -995,7 +1043,16 @@ pub fn julia_estimate<T: Num>(p: V3<T>, c: [T; 4], w: T, iterations: T, bailout:
     let far = r0.gt(T::of(JULIA_FAR_FIELD) * edge);
     let bailout2 = bailout * bailout;
     let count = T::select(far, T::zero(), iterations);
-    let start = [p.x, p.y, p.z, w, mz2, T::one(), mz2, T::zero()];
+    let start = [
+        p.x,
+        p.y,
+        p.z,
+        w,
+        mz2,
+        T::one(),
+        slot.start(mz2, p),
+        T::zero(),
+    ];
     let [.., mz2, md2, trap, n] =
         T::iterate(count, start, |_, [z0, z1, z2, z3, mz2, md2, trap, n]| {
             let next = md2 * T::of(4.0) * mz2;
@@ -1010,7 +1067,7 @@ pub fn julia_estimate<T: Num>(p: V3<T>, c: [T; 4], w: T, iterations: T, bailout:
                     z[3],
                     mz2,
                     next,
-                    trap.min(mz2),
+                    slot.step(trap, v3(z[0], z[1], z[2]), || mz2),
                     n + T::one(),
                 ],
                 stop_after: Some(mz2.gt(bailout2)),
@@ -1031,7 +1088,7 @@ pub fn julia_estimate<T: Num>(p: V3<T>, c: [T; 4], w: T, iterations: T, bailout:
     let near = T::select(bounded, estimate.min(bound), estimate);
     Estimate {
         distance: T::select(far, T::of(JULIA_FAR_FIELD_SLOPE) * (r0 - edge), near),
-        trap: T::select(far, T::one(), trap.sqrt().min(T::one())),
+        trap: slot.end(trap, |t| T::select(far, T::one(), t.sqrt().min(T::one()))),
     }
 }
 

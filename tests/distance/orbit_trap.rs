@@ -1,0 +1,249 @@
+//! Orbit traps against an oracle that shares no code with the formulas:
+//! each orbit iterated from its fractal's definition (the Mandelbulb's
+//! power in spherical coordinates with `powf`, `acos` and `atan2`; the
+//! Menger sponge's fold by sorting; the Mandelbox's folds by cases), each
+//! trap's distance from its own closed form (a cross product for a line,
+//! the plane's equation), and the palette read back through a grey ramp.
+
+use fractal_sdf::cpu::Evaluator;
+use fractal_sdf::prelude::*;
+use fractal_sdf::scene::{OrbitTrap, Palette, Trap};
+use fractal_sdf::testing::random_points;
+
+/// A trap, by definition.
+#[derive(Clone, Copy, Debug)]
+enum Shape {
+    Point(DVec3),
+    Sphere(DVec3, f64),
+    Plane(DVec3, f64),
+    Line(DVec3, DVec3),
+}
+
+impl Shape {
+    fn distance(self, z: DVec3) -> f64 {
+        match self {
+            Shape::Point(c) => z.distance(c),
+            Shape::Sphere(c, r) => (z.distance(c) - r).abs(),
+            Shape::Plane(n, d) => (n.normalize().dot(z) - d).abs(),
+            Shape::Line(q, u) => (z - q).cross(u.normalize()).length(),
+        }
+    }
+
+    fn trap(self) -> Trap {
+        match self {
+            Shape::Point(c) => Trap::point(c),
+            Shape::Sphere(c, r) => Trap::sphere(c, r),
+            Shape::Plane(n, d) => Trap::plane(n, d),
+            Shape::Line(q, u) => Trap::line(q, u),
+        }
+    }
+}
+
+const SHAPES: [Shape; 4] = [
+    Shape::Point(DVec3::new(0.3, -0.2, 0.1)),
+    Shape::Sphere(DVec3::new(0.0, 0.2, 0.0), 0.7),
+    Shape::Plane(DVec3::new(1.0, 2.0, -0.5), 0.25),
+    Shape::Line(DVec3::new(0.1, 0.0, -0.3), DVec3::new(0.0, 1.0, 1.0)),
+];
+
+/// Trap values up to this span the grey ramp.
+const FAR: f64 = 8.0;
+
+/// The trap value the CPU reference paints at `p`, read back from a grey
+/// ramp from 0 to [`FAR`].
+fn painted(fractal: &Node, shape: Shape, p: DVec3) -> f64 {
+    let ramp = Palette::gradient([(0.0, [0.0; 3]), (1.0, [1.0; 3])]);
+    let node = fractal
+        .clone()
+        .orbit_coloring(OrbitTrap::new(shape.trap(), ramp).range(0.0, FAR));
+    let color: DVec3 = Evaluator::new(&node)
+        .unwrap()
+        .sample::<f64>(p.into())
+        .color
+        .into();
+    assert!(color.x == color.y && color.y == color.z, "{color:?}");
+    color.x * FAR
+}
+
+/// The orbit of `p` under the power-`n` Mandelbulb, by definition: `z0 =
+/// p`, then `z^n + p` with the radius raised to `n` and both angles times
+/// `n`, each point kept while it is within the bailout (at most
+/// `iterations` of them); `None` where a radius is so near the bailout
+/// that rounding decides whether the orbit stops.
+fn bulb_orbit(p: DVec3, n: f64, iterations: u32, bailout: f64) -> Option<Vec<DVec3>> {
+    let mut z = p;
+    let mut points = Vec::new();
+    for _ in 0..iterations {
+        let r = z.length();
+        if (r - bailout).abs() < 1e-6 {
+            return None;
+        }
+        if r > bailout {
+            break;
+        }
+        points.push(z);
+        let (theta, phi) = ((z.z / r).acos() * n, z.y.atan2(z.x) * n);
+        z = r.powf(n)
+            * DVec3::new(
+                theta.sin() * phi.cos(),
+                theta.sin() * phi.sin(),
+                theta.cos(),
+            )
+            + p;
+    }
+    Some(points)
+}
+
+/// The classic Menger sponge's orbit: the point, then at each level its
+/// coordinates' magnitudes sorted largest first (the fold), scaled by 3
+/// about the corner cube and shifted back into the cube.
+fn menger_orbit(p: DVec3, iterations: u32) -> Vec<DVec3> {
+    let mut z = p;
+    let mut points = vec![p];
+    for _ in 0..iterations {
+        let mut a = z.abs().to_array();
+        a.sort_by(|x, y| y.total_cmp(x));
+        let folded = DVec3::from_array(a);
+        points.push(folded);
+        z = DVec3::new(3.0 * a[0] - 2.0, 3.0 * a[1] - 2.0, 3.0 * a[2]);
+        if z.z > 1.0 {
+            z.z -= 2.0;
+        }
+    }
+    points
+}
+
+/// The Mandelbox's orbit (scale `s`, radii 0.5 and 1, fold limit 1): the
+/// point, then each `s · sphere_fold(box_fold(z)) + p`. Every point is
+/// kept: the formula stops following an orbit once it is far beyond the
+/// box, where no point comes nearer a trap near the origin than the start.
+fn mandelbox_orbit(p: DVec3, s: f64, iterations: u32) -> Vec<DVec3> {
+    let fold = |v: f64| {
+        if v > 1.0 {
+            2.0 - v
+        } else if v < -1.0 {
+            -2.0 - v
+        } else {
+            v
+        }
+    };
+    let mut z = p;
+    let mut points = vec![p];
+    for _ in 0..iterations {
+        let b = DVec3::new(fold(z.x), fold(z.y), fold(z.z));
+        let r2 = b.length_squared();
+        let k = if r2 < 0.25 {
+            4.0
+        } else if r2 < 1.0 {
+            1.0 / r2
+        } else {
+            1.0
+        };
+        z = b * k * s + p;
+        points.push(z);
+        if z.length() > 1e6 {
+            break;
+        }
+    }
+    points
+}
+
+/// The smallest distance from `orbit` to `shape`.
+fn nearest(orbit: &[DVec3], shape: Shape) -> f64 {
+    orbit
+        .iter()
+        .map(|&z| shape.distance(z))
+        .fold(f64::INFINITY, f64::min)
+}
+
+/// Checks the painted trap values of `fractal` against `oracle` at random
+/// points, returning the largest difference and how many were compared.
+fn check(
+    name: &str,
+    fractal: &Node,
+    radius: f64,
+    oracle: impl Fn(DVec3) -> Option<Vec<DVec3>>,
+) -> (f64, usize) {
+    let mut worst: f64 = 0.0;
+    let mut compared = 0;
+    for shape in SHAPES {
+        for p in random_points(400, radius, 0x0b17) {
+            let Some(orbit) = oracle(p) else {
+                continue;
+            };
+            let expected = nearest(&orbit, shape);
+            if expected >= FAR {
+                continue;
+            }
+            let got = painted(fractal, shape, p);
+            let error = (got - expected).abs();
+            assert!(
+                error <= 1e-9,
+                "{name}, {shape:?} at {p}: painted {got}, the orbit comes within {expected}"
+            );
+            worst = worst.max(error);
+            compared += 1;
+        }
+    }
+    assert!(compared > 1500, "{name}: {compared} points compared");
+    (worst, compared)
+}
+
+#[test]
+fn orbit_traps_paint_the_orbits_nearest_approach() {
+    let bulb = check(
+        "mandelbulb",
+        &fractal_sdf::scene::Mandelbulb::new(8.0)
+            .iterations(6)
+            .into(),
+        1.3,
+        |p| bulb_orbit(p, 8.0, 6, 2.0),
+    );
+    let real = check(
+        "mandelbulb of power 5.5",
+        &fractal_sdf::scene::Mandelbulb::new(5.5)
+            .iterations(6)
+            .into(),
+        1.3,
+        |p| bulb_orbit(p, 5.5, 6, 2.0),
+    );
+    let sponge = check("menger", &menger(4), 1.5, |p| Some(menger_orbit(p, 4)));
+    let boxed = check(
+        "mandelbox",
+        &fractal_sdf::scene::Mandelbox::new(2.0).iterations(8).into(),
+        2.0,
+        |p| Some(mandelbox_orbit(p, 2.0, 8)),
+    );
+    let compared = bulb.1 + real.1 + sponge.1 + boxed.1;
+    eprintln!(
+        "orbit traps, {compared} points: largest difference from the oracle {:.1e} \
+         (Mandelbulb 8), {:.1e} (5.5), {:.1e} (Menger), {:.1e} (Mandelbox)",
+        bulb.0, real.0, sponge.0, boxed.0
+    );
+}
+
+/// The colour is the palette's at the trap value's place between `near`
+/// and `far`, clamped at the ends, reversed when `far` is below `near`.
+#[test]
+fn the_range_places_trap_values_on_the_palette() {
+    let fire = Palette::fire();
+    let shape = Shape::Point(DVec3::ZERO);
+    for p in random_points(50, 1.5, 7) {
+        let m = nearest(&menger_orbit(p, 3), shape);
+        for (near, far) in [(0.0, 1.0), (0.2, 0.6), (1.0, 0.0)] {
+            let node = menger(3)
+                .orbit_coloring(OrbitTrap::new(shape.trap(), fire.clone()).range(near, far));
+            let color: DVec3 = Evaluator::new(&node)
+                .unwrap()
+                .sample::<f64>(p.into())
+                .color
+                .into();
+            let t = ((m - near) / (far - near)).clamp(0.0, 1.0);
+            let expected = DVec3::from_array(fire.color(t));
+            assert!(
+                color.distance(expected) < 1e-12,
+                "{near}..{far} at {p}: {color} for trap {m}, expected {expected}"
+            );
+        }
+    }
+}
