@@ -20,7 +20,7 @@ use crate::file::SceneFile;
 use crate::quality::{Effects, Glow, Quality};
 use crate::scene::{
     Axis, Camera, Hybrid, HybridOp, InsideShape, Kifs, KifsFold, Light, Mandelbulb, Material, Node,
-    OrbitTrap, Palette, QuaternionJulia, Scene, Trap, capped_cone, capsule, cuboid, cut_sphere,
+    OrbitColoring, Palette, QuaternionJulia, Scene, Trap, capped_cone, capsule, cuboid, cut_sphere,
     cylinder, ellipsoid, hex_prism, julia, link, menger, octahedron, param, param3, plane,
     round_box, round_cone, sierpinski, solid_angle, sphere, torus,
 };
@@ -402,19 +402,20 @@ pub fn hybrid() -> Scene {
 pub fn orbit_traps() -> Scene {
     let bulb = Node::from(Mandelbulb::new(8.0).iterations(10))
         .orbit_coloring(
-            OrbitTrap::new(Trap::plane([0.0, 0.0, 1.0], 0.0), Palette::fire()).range(0.0, 0.8),
+            OrbitColoring::new(Trap::plane([0.0, 0.0, 1.0], 0.0), Palette::fire()).range(0.0, 0.8),
         )
         .rotate(DVec3::X, -FRAC_PI_2)
         .scale(0.55);
     let boxed = crate::scene::mandelbox(2.0)
         .orbit_coloring(
-            OrbitTrap::new(Trap::sphere([0.0, 0.0, 0.0], 2.0), Palette::viridis()).range(0.0, 2.0),
+            OrbitColoring::new(Trap::sphere([0.0, 0.0, 0.0], 2.0), Palette::viridis())
+                .range(0.0, 2.0),
         )
         .rotate(DVec3::Y, 0.6)
         .scale(0.11);
     let set = julia([-0.2, 0.6, 0.2, 0.2])
         .orbit_coloring(
-            OrbitTrap::new(
+            OrbitColoring::new(
                 Trap::line([0.0, 0.0, 0.0], [1.0, 0.0, 0.0]),
                 Palette::ocean(),
             )
@@ -423,7 +424,7 @@ pub fn orbit_traps() -> Scene {
         .scale(0.6);
     let ifs = crate::scene::kifs(KifsFold::Icosahedral)
         .orbit_coloring(
-            OrbitTrap::new(Trap::point([0.0, 0.0, 0.0]), Palette::magma()).range(0.3, 1.6),
+            OrbitColoring::new(Trap::point([0.0, 0.0, 0.0]), Palette::magma()).range(0.3, 1.6),
         )
         .rotate(DVec3::Y, 0.4)
         .scale(0.6);

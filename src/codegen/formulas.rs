@@ -154,9 +154,9 @@ pub(crate) fn fractal_name(name: &str, trap: bool) -> String {
 
 /// Prints a fractal's helper, which returns the pair (distance, trap).
 /// With `trap`, the form named with [`TRAP_SUFFIX`] that takes a trap
-/// shape after the fractal's own parameters (the nine numbers of
-/// [`TrapShape::values`]) and returns the orbit's smallest distance to it
-/// as the trap.
+/// shape after the fractal's own parameters (the ten numbers of
+/// [`TrapShape::values`]) and returns the shape's value of the orbit as
+/// the trap.
 fn fractal(
     name: &str,
     params: &[(&str, Shape)],
@@ -171,10 +171,14 @@ fn fractal(
             ("trap_across", Scalar),
             ("trap_along", Scalar),
             ("trap_radius", Scalar),
+            ("trap_count", Scalar),
         ]);
     }
     print(&fractal_name(name, trap), &all, Pair, |a| {
-        let shape = trap.then(|| TrapShape::from_values(&a[a.len() - 9..]));
+        let shape = trap.then(|| {
+            let values = a[a.len() - 10..].try_into().expect("ten trap numbers");
+            TrapShape::from_values(values)
+        });
         let e = formula(a, shape.as_ref());
         vec![e.distance, e.trap]
     })

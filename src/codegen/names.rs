@@ -82,9 +82,14 @@ pub(crate) fn body_directive_problem(body: &str) -> Option<String> {
 /// Why the file-scope name `name` (a custom shape's function) would
 /// collide with the generated program, or `None`.
 pub(crate) fn generated(name: &str) -> Option<String> {
-    let specialised = name
-        .strip_prefix("mandelbulb_p")
-        .is_some_and(|n| !n.is_empty() && n.bytes().all(|b| b.is_ascii_digit()));
+    // The numbered helpers (`mandelbulb_p8`, `hybrid_0`), and their
+    // trapped forms.
+    let base = name.strip_suffix(formulas::TRAP_SUFFIX).unwrap_or(name);
+    let numbered = |prefix: &str| {
+        base.strip_prefix(prefix)
+            .is_some_and(|n| !n.is_empty() && n.bytes().all(|b| b.is_ascii_digit()))
+    };
+    let specialised = numbered("mandelbulb_p") || numbered("hybrid_");
     if specialised || program_names().contains(name) {
         return Some("is a name the generated program defines or calls".into());
     }
@@ -337,6 +342,9 @@ mod tests {
             ("DE_shade", "generated program"),
             ("menger", "generated program"),
             ("mandelbulb_p12", "generated program"),
+            ("mandelbulb_p5_trap", "generated program"),
+            ("menger_trap", "generated program"),
+            ("hybrid_3", "generated program"),
             ("params", "buffer"),
         ] {
             let reason = reserved(name).unwrap_or_else(|| panic!("{name} is allowed"));

@@ -68,6 +68,9 @@ pub struct Evaluator {
     /// The smooth unions that evaluate their second operand first
     /// (`ir::swaps`).
     swapped: Vec<bool>,
+    /// The fractals an orbit trap colours: their parent evaluates them,
+    /// once, with the trap.
+    trapped: Vec<bool>,
     prune: bool,
 }
 
@@ -121,6 +124,12 @@ impl Evaluator {
                 tested.push(if swapped[i] { *a } else { *b });
             }
         }
+        let mut trapped = vec![false; ir.nodes().len()];
+        for node in ir.nodes() {
+            if let Kind::OrbitTrap { child, .. } = node {
+                trapped[child.index()] = true;
+            }
+        }
         let reaches = tested
             .into_iter()
             .filter_map(|o| {
@@ -135,6 +144,7 @@ impl Evaluator {
             chains,
             reaches,
             swapped,
+            trapped,
             prune: true,
         }
     }
@@ -398,10 +408,16 @@ impl Evaluator {
             | Kind::Sierpinski(_)
             | Kind::Kifs(_)
             | Kind::Hybrid(_)
-            | Kind::Mandelbox(_) => Self::fractal(
-                self.fractal_estimate(node, p, None)
-                    .expect("a fractal has an estimate"),
-            ),
+            | Kind::Mandelbox(_) => {
+                if self.trapped[id] {
+                    // Its orbit trap evaluates it.
+                    return Self::leaf(T::zero());
+                }
+                Self::fractal(
+                    self.fractal_estimate(node, p, None)
+                        .expect("a fractal has an estimate"),
+                )
+            }
             Kind::Translate { child, .. }
             | Kind::Rotate { child, .. }
             | Kind::Mirror { child, .. }
@@ -467,15 +483,13 @@ impl Evaluator {
             },
             Kind::OrbitTrap { coloring, child } => {
                 let shape = sdf::TrapShape::of(&coloring.trap, s);
-                let m = self
+                let e = self
                     .fractal_estimate(self.ir.node(*child), p, Some(&shape))
-                    .expect("validation keeps orbit traps on fractals")
-                    .trap;
-                let t = Palette::position(m, s(coloring.near), s(coloring.far));
+                    .expect("validation keeps orbit traps on fractals");
+                let t = Palette::position(e.trap, s(coloring.near), s(coloring.far));
                 Sample {
                     color: coloring.palette.at(t),
-                    trap: T::one(),
-                    ..of(child)
+                    ..Self::leaf(e.distance)
                 }
             }
         }

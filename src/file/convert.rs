@@ -3,7 +3,7 @@
 use crate::error::Error;
 use crate::scene::{
     CsgOp, CustomShape, Hybrid, InsideShape, Kifs, Kind, Mandelbox, Mandelbulb, Menger, Node,
-    OrbitTrap, Param, QuaternionJulia, Sierpinski,
+    OrbitColoring, Param, QuaternionJulia, Sierpinski,
 };
 
 use super::MAX_NESTING;
@@ -606,7 +606,8 @@ impl Located<NodeRepr> {
                 far,
                 child: c,
             } => child(c)?.orbit_coloring(
-                OrbitTrap::new(trap.clone(), palette.to_palette()).range(near.clone(), far.clone()),
+                OrbitColoring::new(trap.clone(), palette.to_palette())
+                    .range(near.clone(), far.clone()),
             ),
             NodeRepr::Union(operands) => {
                 let mut operands = operands.iter();

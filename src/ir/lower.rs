@@ -228,44 +228,53 @@ impl Lowering {
     /// values (baked, or the defaults of dynamic ones), and keeps those that
     /// read dynamic parameters for [`ParamValues::set`](super::ParamValues::set).
     fn relate(&mut self, node: &IrNode, v: usize) -> Result<()> {
-        let relation = match node {
+        let relations: Vec<(&'static str, Relation)> = match node {
             Kind::RoundBox {
                 half_extents,
                 radius,
-            } => Some((
+            } => vec![(
                 "radius",
                 Relation::AtMostSmallest {
                     value: *radius,
                     bound: *half_extents,
                     bound_name: "half extent",
                 },
-            )),
-            Kind::Plane { normal, .. } => Some(("normal", Relation::NonZero { vector: *normal })),
-            Kind::OrbitTrap { coloring, .. } => coloring
-                .trap
-                .direction()
-                .map(|(name, d)| (name, Relation::NonZero { vector: *d })),
-            _ => None,
+            )],
+            Kind::Plane { normal, .. } => vec![("normal", Relation::NonZero { vector: *normal })],
+            Kind::OrbitTrap { coloring, .. } => {
+                let mut relations = vec![(
+                    "far",
+                    Relation::Distinct {
+                        value: coloring.far,
+                        other: coloring.near,
+                        other_name: "near",
+                    },
+                )];
+                if let Some((name, d)) = coloring.trap.direction() {
+                    relations.push((name, Relation::NonZero { vector: *d }));
+                }
+                relations
+            }
+            _ => Vec::new(),
         };
-        let Some((param, relation)) = relation else {
-            return Ok(());
-        };
-        let mut constraint = Constraint {
-            node: String::new(),
-            param,
-            relation,
-        };
-        let defaults = |s: Scalar| match s {
-            Scalar::Baked(v) => v,
-            Scalar::Dynamic(slot) => self.slots[slot as usize].default,
-        };
-        let dynamic = constraint.is_dynamic();
-        if dynamic || constraint.check(defaults).is_err() {
-            constraint.node = self.path(v);
-            constraint.check(defaults)?;
-        }
-        if dynamic {
-            self.constraints.push(constraint);
+        for (param, relation) in relations {
+            let mut constraint = Constraint {
+                node: String::new(),
+                param,
+                relation,
+            };
+            let defaults = |s: Scalar| match s {
+                Scalar::Baked(v) => v,
+                Scalar::Dynamic(slot) => self.slots[slot as usize].default,
+            };
+            let dynamic = constraint.is_dynamic();
+            if dynamic || constraint.check(defaults).is_err() {
+                constraint.node = self.path(v);
+                constraint.check(defaults)?;
+            }
+            if dynamic {
+                self.constraints.push(constraint);
+            }
         }
         Ok(())
     }
@@ -587,13 +596,6 @@ fn check_structure(kind: &NodeKind, path: impl Fn() -> String) -> Result<()> {
                 .palette
                 .check()
                 .map_err(|e| invalid(format!("its palette {e}")))?;
-            if let (Param::Value(near), Param::Value(far)) = (&coloring.near, &coloring.far)
-                && near == far
-            {
-                return Err(invalid(format!(
-                    "near and far are both {near}; the palette spans the trap values between them"
-                )));
-            }
         }
         Kind::Custom { shape, args } if args.len() != shape.arity() => {
             return Err(Error::CustomShape {

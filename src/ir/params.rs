@@ -42,6 +42,16 @@ pub enum Relation {
         /// The vector.
         vector: Vector,
     },
+    /// `value` differs from `other` (the two ends of an orbit colouring's
+    /// range).
+    Distinct {
+        /// The parameter the error names.
+        value: Scalar,
+        /// The one it must differ from.
+        other: Scalar,
+        /// What `other` is, for the message (`"near"`).
+        other_name: &'static str,
+    },
 }
 
 /// A [`Relation`] at one node, with the parameter it is reported against.
@@ -87,6 +97,21 @@ impl Constraint {
                     });
                 }
             }
+            Relation::Distinct {
+                value: v,
+                other,
+                other_name,
+            } => {
+                let (v, other) = (value(*v), value(*other));
+                if v == other {
+                    return Err(Error::OutOfRange {
+                        node: self.node.clone(),
+                        param: self.param.into(),
+                        value: v,
+                        expected: format!("!= {other_name} ({})", fmt_value(other)),
+                    });
+                }
+            }
         }
         Ok(())
     }
@@ -98,6 +123,7 @@ impl Constraint {
                 .chain(bound.iter().copied())
                 .collect(),
             Relation::NonZero { vector } => vector.to_vec(),
+            Relation::Distinct { value, other, .. } => vec![*value, *other],
         };
         scalars.into_iter().filter_map(|s| match s {
             Scalar::Dynamic(slot) => Some(slot),

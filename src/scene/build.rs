@@ -14,7 +14,7 @@ use super::fractal::{Kifs, KifsFold, Mandelbox, Mandelbulb, Menger, QuaternionJu
 use super::material::Material;
 use super::node::{Axis, CsgOp, Kind, Node};
 use super::param::{Param, Param3};
-use super::trap::{OrbitTrap, Palette, Trap};
+use super::trap::{OrbitColoring, Palette, Trap};
 
 /// A sphere of `radius` at the origin.
 #[must_use]
@@ -619,7 +619,7 @@ impl Node {
 
     /// Colours the node, a fractal, by its orbit trap: the smallest distance
     /// from its orbit to `trap`, from 0 to 1 spanning `palette` (see
-    /// [`OrbitTrap`], and [`Node::orbit_coloring`] for another range). The
+    /// [`OrbitColoring`], and [`Node::orbit_coloring`] for another range). The
     /// colour replaces the fractal's own; an outer colour paints over it.
     /// Compiling refuses a node that is not a fractal.
     ///
@@ -632,13 +632,13 @@ impl Node {
     /// ```
     #[must_use]
     pub fn orbit_trap(self, trap: Trap, palette: Palette) -> Node {
-        self.orbit_coloring(OrbitTrap::new(trap, palette))
+        self.orbit_coloring(OrbitColoring::new(trap, palette))
     }
 
     /// Colours the node, a fractal, by its orbit trap (see
     /// [`Node::orbit_trap`]).
     #[must_use]
-    pub fn orbit_coloring(self, coloring: OrbitTrap) -> Node {
+    pub fn orbit_coloring(self, coloring: OrbitColoring) -> Node {
         Kind::OrbitTrap {
             coloring,
             child: self,

@@ -44,7 +44,7 @@ pub use node::{
 pub use param::{Param, Param3, param, param3};
 pub use rule::{ParamSpec, Rule};
 pub use stereo::{Stereo, StereoLayout};
-pub use trap::{MAX_PALETTE_STOPS, OrbitTrap, Palette, Trap};
+pub use trap::{MAX_PALETTE_STOPS, OrbitColoring, Palette, Trap};
 
 use crate::error::{Error, Result, fmt_value};
 use crate::math::{F64_LIMITS, Magnitude, normalize};

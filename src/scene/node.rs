@@ -13,7 +13,7 @@ use super::hybrid::Hybrid;
 use super::material::Material;
 use super::param::{Param, Param3};
 use super::rule::{ParamSpec, Rule, spec};
-use super::trap::OrbitTrap;
+use super::trap::OrbitColoring;
 
 /// The largest iteration count accepted by the escape-time fractals
 /// (Mandelbulb, quaternion Julia).
@@ -365,10 +365,10 @@ pub enum Kind<S, V, C> {
         child: C,
     },
     /// Colours the child, a fractal, by its orbit trap through a palette
-    /// (see [`OrbitTrap`]). The distance is the child's.
+    /// (see [`OrbitColoring`]). The distance is the child's.
     OrbitTrap {
         /// The trap, the palette and the range of trap values shown.
-        coloring: OrbitTrap<S, V>,
+        coloring: OrbitColoring<S, V>,
         /// The fractal.
         child: C,
     },

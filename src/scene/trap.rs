@@ -4,9 +4,10 @@
 //! Every fractal iterates a map from the point it is asked about. An
 //! orbit trap is a shape in the fractal's own coordinates; the trap value
 //! of a point is the smallest distance from its orbit (the point itself
-//! and each iterate) to the shape. Points near each other on the surface
-//! have similar orbits, so the value paints bands and whorls that follow
-//! the fractal's structure. [`Node::orbit_trap`](super::Node::orbit_trap)
+//! and each iterate within the fractal's bailout) to the shape, or for
+//! [`Trap::Iterations`] the orbit's smooth iteration count. Points near
+//! each other on the surface have similar orbits, so the value paints
+//! bands and whorls that follow the fractal's structure. [`Node::orbit_trap`](super::Node::orbit_trap)
 //! maps the values from `near` to `far` onto a palette and makes that the
 //! fractal's colour: in every render, under every material, and in mesh
 //! vertex colours.
@@ -51,11 +52,12 @@ pub enum Trap<S = Param, V = Param3> {
         /// Its radius, at least 0.
         radius: S,
     },
-    /// A plane, `normal · z = offset` (`normal` is normalised).
+    /// A plane, `normal · z + offset = 0` (`normal` normalised), as the
+    /// scene's [`plane`](super::plane) writes it.
     Plane {
         /// The plane's normal, not zero.
         normal: V,
-        /// Its signed distance from the origin along the normal.
+        /// Minus its signed distance from the origin along the normal.
         offset: S,
     },
     /// A line through `point` along `direction` (normalised).
@@ -65,6 +67,14 @@ pub enum Trap<S = Param, V = Param3> {
         /// Its direction, not zero.
         direction: V,
     },
+    /// Not a shape: the iteration count, smoothed. The value is the sum
+    /// of `e^(−|z|)` over the orbit, so each point near the origin adds
+    /// about 1 and a point that has escaped almost nothing: it grows with
+    /// the iterations the orbit spends near the set, and unlike the count
+    /// itself it has no steps where the orbit escapes one iteration
+    /// sooner. Set the range to the values wanted (up to the fractal's
+    /// iteration count, plus 1 for the point itself).
+    Iterations,
 }
 
 impl Trap {
@@ -85,7 +95,8 @@ impl Trap {
         }
     }
 
-    /// A plane trap, `normal · z = offset`.
+    /// A plane trap, `normal · z + offset = 0` (the convention of the
+    /// scene's [`plane`](super::plane)).
     #[must_use]
     pub fn plane(normal: impl Into<Param3>, offset: impl Into<Param>) -> Trap {
         Trap::Plane {
@@ -113,6 +124,7 @@ impl<S, V> Trap<S, V> {
             Trap::Sphere { .. } => "Sphere",
             Trap::Plane { .. } => "Plane",
             Trap::Line { .. } => "Line",
+            Trap::Iterations => "Iterations",
         }
     }
 
@@ -140,6 +152,7 @@ impl<S, V> Trap<S, V> {
                 point: vector(point, spec("trap.point", Finite))?,
                 direction: vector(direction, spec("trap.direction", Direction))?,
             },
+            Trap::Iterations => Trap::Iterations,
         })
     }
 
@@ -149,7 +162,7 @@ impl<S, V> Trap<S, V> {
         match self {
             Trap::Plane { normal, .. } => Some(("trap.normal", normal)),
             Trap::Line { direction, .. } => Some(("trap.direction", direction)),
-            Trap::Point { .. } | Trap::Sphere { .. } => None,
+            Trap::Point { .. } | Trap::Sphere { .. } | Trap::Iterations => None,
         }
     }
 
@@ -158,7 +171,7 @@ impl<S, V> Trap<S, V> {
         match self {
             Trap::Plane { normal, .. } => Some(normal),
             Trap::Line { direction, .. } => Some(direction),
-            Trap::Point { .. } | Trap::Sphere { .. } => None,
+            Trap::Point { .. } | Trap::Sphere { .. } | Trap::Iterations => None,
         }
     }
 }
@@ -328,7 +341,9 @@ impl Palette {
         &self.stops
     }
 
-    /// The colour at `t` (clamped to the stops).
+    /// The colour at `t` (clamped to the stops), for a palette that
+    /// passes the checks compiling a scene makes (stops at increasing
+    /// positions).
     #[must_use]
     pub fn color(&self, t: f64) -> [f64; 3] {
         let c = self.at(t);
@@ -356,11 +371,13 @@ impl Palette {
 
     /// The palette position of the trap value `value`: `near` at 0, `far`
     /// at 1, clamped to `[0, 1]` (a `far` below `near` reverses it; equal
-    /// ones are kept apart by the smallest size).
+    /// ones are refused when a scene compiles, and ends nearer than the
+    /// smallest size are taken that far apart).
     #[must_use]
     pub fn position<T: Num>(value: T, near: T, far: T) -> T {
         let span = far - near;
-        let span = T::select(span.abs().lt(T::tiny()), T::tiny(), span);
+        let least = T::select(span.lt(T::zero()), -T::tiny(), T::tiny());
+        let span = T::select(span.abs().lt(T::tiny()), least, span);
         ((value - near) / span).clamp(T::zero(), T::one())
     }
 
@@ -398,7 +415,7 @@ impl Palette {
 /// [`Node::orbit_trap`](super::Node::orbit_trap)).
 #[derive(Debug, Clone, PartialEq)]
 #[non_exhaustive]
-pub struct OrbitTrap<S = Param, V = Param3> {
+pub struct OrbitColoring<S = Param, V = Param3> {
     /// The shape the orbit is measured against.
     pub trap: Trap<S, V>,
     /// The colours.
@@ -411,11 +428,11 @@ pub struct OrbitTrap<S = Param, V = Param3> {
     pub far: S,
 }
 
-impl OrbitTrap {
+impl OrbitColoring {
     /// Trap values from 0 to 1 span the palette.
     #[must_use]
-    pub fn new(trap: Trap, palette: Palette) -> OrbitTrap {
-        OrbitTrap {
+    pub fn new(trap: Trap, palette: Palette) -> OrbitColoring {
+        OrbitColoring {
             trap,
             palette,
             near: Param::from(0.0),
@@ -425,22 +442,22 @@ impl OrbitTrap {
 
     /// The trap values shown at the palette's two ends.
     #[must_use]
-    pub fn range(mut self, near: impl Into<Param>, far: impl Into<Param>) -> OrbitTrap {
+    pub fn range(mut self, near: impl Into<Param>, far: impl Into<Param>) -> OrbitColoring {
         self.near = near.into();
         self.far = far.into();
         self
     }
 }
 
-impl<S, V> OrbitTrap<S, V> {
+impl<S, V> OrbitColoring<S, V> {
     /// Rebuilds the colouring with every value converted: the trap's,
     /// then `near` and `far`.
     pub(crate) fn try_map<S2, V2, E>(
         &self,
         scalar: &mut impl FnMut(&S, ParamSpec<'static>) -> Result<S2, E>,
         vector: &mut impl FnMut(&V, ParamSpec<'static>) -> Result<V2, E>,
-    ) -> Result<OrbitTrap<S2, V2>, E> {
-        Ok(OrbitTrap {
+    ) -> Result<OrbitColoring<S2, V2>, E> {
+        Ok(OrbitColoring {
             trap: self.trap.try_map(scalar, vector)?,
             palette: self.palette.clone(),
             near: scalar(&self.near, spec("near", Rule::Finite))?,

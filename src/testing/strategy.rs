@@ -10,10 +10,10 @@ use proptest::prelude::*;
 use crate::cpu::Ray;
 use crate::scene::{
     Axis, CsgOp, Hybrid, HybridOp, Kifs, KifsFold, Kind, MAX_ESCAPE_ITERATIONS,
-    MAX_FOLD_ITERATIONS, MAX_SOLID_ANGLE, Mandelbox, Mandelbulb, Menger, Node, OrbitTrap, Palette,
-    Param, Param3, QuaternionJulia, Sierpinski, Trap, capped_cone, capsule, cuboid, cut_sphere,
-    cylinder, ellipsoid, hex_prism, link, octahedron, param, plane, round_box, round_cone,
-    solid_angle, sphere, torus,
+    MAX_FOLD_ITERATIONS, MAX_SOLID_ANGLE, Mandelbox, Mandelbulb, Menger, Node, OrbitColoring,
+    Palette, Param, Param3, QuaternionJulia, Sierpinski, Trap, capped_cone, capsule, cuboid,
+    cut_sphere, cylinder, ellipsoid, hex_prism, link, octahedron, param, plane, round_box,
+    round_cone, solid_angle, sphere, torus,
 };
 
 /// The largest size (radius, half extent, height) the primitive strategies
@@ -613,6 +613,7 @@ pub fn trap() -> impl Strategy<Value = Trap> + Clone {
         (at(), scalar("trap.radius", 0.0..=1.0f64)).prop_map(|(c, r)| Trap::sphere(c, r)),
         (direction(), scalar("trap.offset", -1.0..=1.0f64)).prop_map(|(n, d)| Trap::plane(n, d)),
         (at(), direction()).prop_map(|(q, u)| Trap::line(q, u)),
+        Just(Trap::Iterations),
     ]
 }
 
@@ -639,7 +640,7 @@ pub fn orbit_trap_node() -> impl Strategy<Value = Node> + Clone {
         any::<bool>(),
     );
     (fractal_node(), trap(), palette(), range).prop_map(|(f, trap, palette, (near, far, flip))| {
-        let coloring = OrbitTrap::new(trap, palette);
+        let coloring = OrbitColoring::new(trap, palette);
         let coloring = if flip {
             coloring.range(far, near)
         } else {

@@ -22,8 +22,8 @@ use fractal_sdf::scene::octahedron;
 use fractal_sdf::scene::param3;
 use fractal_sdf::scene::{CustomShape, Rule};
 use fractal_sdf::scene::{
-    Hybrid, HybridOp, Kifs, KifsFold, Mandelbox, OrbitTrap, Palette, Trap, capped_cone, cut_sphere,
-    hex_prism, kifs, link, round_cone, solid_angle,
+    Hybrid, HybridOp, Kifs, KifsFold, Mandelbox, OrbitColoring, Palette, Trap, capped_cone,
+    cut_sphere, hex_prism, kifs, link, round_cone, solid_angle,
 };
 use fractal_sdf::testing::{check_device_matches_cpu, random_points, spicy_points};
 
@@ -188,7 +188,7 @@ fn nodes() -> Vec<(&'static str, Node)> {
         (
             "orbit_trap_plane_menger",
             menger(3).orbit_coloring(
-                OrbitTrap::new(
+                OrbitColoring::new(
                     Trap::plane(param3("trap_n", dvec3(0.2, 1.0, 0.4)), param("trap_d", 0.3)),
                     Palette::viridis(),
                 )
@@ -202,7 +202,7 @@ fn nodes() -> Vec<(&'static str, Node)> {
         (
             "orbit_trap_line_julia",
             julia([-0.2, 0.6, 0.2, 0.2]).orbit_coloring(
-                OrbitTrap::new(
+                OrbitColoring::new(
                     Trap::line([0.0, 0.1, 0.0], [1.0, 1.0, 0.0]),
                     Palette::magma(),
                 )
@@ -225,8 +225,22 @@ fn nodes() -> Vec<(&'static str, Node)> {
                 ),
         ),
         (
+            "orbit_trap_iterations_julia_hybrid",
+            julia([-0.2, 0.6, 0.2, 0.2])
+                .orbit_coloring(
+                    OrbitColoring::new(Trap::Iterations, Palette::viridis()).range(0.0, 12.0),
+                )
+                .union(
+                    Node::from(Hybrid::mandelbox(-1.5))
+                        .orbit_coloring(
+                            OrbitColoring::new(Trap::Iterations, Palette::fire()).range(0.0, 8.0),
+                        )
+                        .translate(dvec3(0.0, 0.0, 1.0)),
+                ),
+        ),
+        (
             "orbit_trap_dynamic_power",
-            Node::from(Mandelbulb::new(param("trap_power", 5.0)).iterations(5)).orbit_trap(
+            Node::from(Mandelbulb::new(param("trap_power", 5.0)).iterations(4)).orbit_trap(
                 Trap::line([0.0, 0.0, 0.0], [0.0, 0.0, 1.0]),
                 Palette::gradient([
                     (0.0, [0.1, 0.0, 0.2]),

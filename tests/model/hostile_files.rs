@@ -630,6 +630,38 @@ const NODE_FIELDS: &[(&str, &str)] = &[
         "transparency",
     ),
     (
+        "OrbitTrap(trap: Sphere(centre: @, radius: 1), palette: Fire, child: Menger(iterations: 2))",
+        "centre",
+    ),
+    (
+        "OrbitTrap(trap: Sphere(centre: 0, radius: @), palette: Fire, child: Menger(iterations: 2))",
+        "radius",
+    ),
+    (
+        "OrbitTrap(trap: Plane(normal: (@, 0, 0), offset: 0), palette: Fire, child: Menger(iterations: 2))",
+        "normal",
+    ),
+    (
+        "OrbitTrap(trap: Line(point: 0, direction: @), palette: Fire, child: Menger(iterations: 2))",
+        "direction",
+    ),
+    (
+        "OrbitTrap(trap: Iterations, palette: Fire, near: @, child: Menger(iterations: 2))",
+        "near",
+    ),
+    (
+        "OrbitTrap(trap: Iterations, palette: Fire, far: @, child: Menger(iterations: 2))",
+        "far",
+    ),
+    (
+        "OrbitTrap(trap: Iterations, palette: Gradient([(@, (1, 1, 1))]), child: Menger(iterations: 2))",
+        "palette",
+    ),
+    (
+        "OrbitTrap(trap: Iterations, palette: Gradient([(0, (1, @, 1))]), child: Menger(iterations: 2))",
+        "palette",
+    ),
+    (
         "CutPlane(normal: @, offset: 0, child: Sphere(radius: 1))",
         "normal",
     ),

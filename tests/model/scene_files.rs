@@ -372,7 +372,7 @@ fn shorthand_forms_read_as_their_long_forms() {
 /// an error that names the word.
 #[test]
 fn orbit_traps_read_in_every_form() {
-    use fractal_sdf::scene::{OrbitTrap, Palette, Trap};
+    use fractal_sdf::scene::{OrbitColoring, Palette, Trap};
     let names = [
         "Fire", "Ocean", "Viridis", "Magma", "Copper", "Rainbow", "Grey",
     ];
@@ -399,7 +399,7 @@ fn orbit_traps_read_in_every_form() {
         child: Mandelbulb(power: 8)))";
     let file = SceneFile::parse(text).unwrap();
     let expected = mandelbulb(8.0).orbit_coloring(
-        OrbitTrap::new(
+        OrbitColoring::new(
             Trap::line(DVec3::ZERO, fractal_sdf::scene::param3("dir", DVec3::Y)),
             Palette::gradient([
                 (0.0, [0.0, 0.0, 0.1]),

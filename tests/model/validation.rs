@@ -759,7 +759,7 @@ fn brute_steps_too_small_to_reach_a_set_are_refused() {
 /// wrong and where.
 #[test]
 fn bad_orbit_traps_say_what_is_wrong() {
-    use fractal_sdf::scene::{OrbitTrap, Palette, Trap};
+    use fractal_sdf::scene::{OrbitColoring, Palette, Trap};
     let invalid = |node: Node| match error_of(node) {
         Error::Invalid { what, reason } => {
             assert_eq!(what, "orbit trap");
@@ -776,8 +776,14 @@ fn bad_orbit_traps_say_what_is_wrong() {
         .orbit_trap(Trap::point(DVec3::ZERO), Palette::fire());
     assert!(invalid(moved).contains("child is a translate"));
 
-    let flat = OrbitTrap::new(Trap::point(DVec3::ZERO), Palette::grey()).range(0.5, 0.5);
-    assert!(invalid(menger(2).orbit_coloring(flat)).contains("near and far are both 0.5"));
+    let flat = OrbitColoring::new(Trap::point(DVec3::ZERO), Palette::grey()).range(0.5, 0.5);
+    assert_out_of_range(
+        menger(2).orbit_coloring(flat),
+        "orbit_trap",
+        "far",
+        0.5,
+        "!= near (0.5)",
+    );
     let backwards = Palette::gradient([(0.6, [1.0; 3]), (0.4, [0.0; 3])]);
     let reason = invalid(menger(2).orbit_trap(Trap::point(DVec3::ZERO), backwards));
     assert!(reason.contains("its palette stop 1 is at 0.4"), "{reason}");
@@ -803,7 +809,7 @@ fn bad_orbit_traps_say_what_is_wrong() {
     );
     assert_non_finite(
         menger(2).orbit_coloring(
-            OrbitTrap::new(Trap::point(DVec3::ZERO), Palette::fire()).range(0.0, f64::NAN),
+            OrbitColoring::new(Trap::point(DVec3::ZERO), Palette::fire()).range(0.0, f64::NAN),
         ),
         "orbit_trap",
         "far",
@@ -816,4 +822,18 @@ fn bad_orbit_traps_say_what_is_wrong() {
     let mut eval = cpu::Evaluator::new(&node).unwrap();
     let err = eval.set_param("n.z", 0.0).unwrap_err();
     assert!(matches!(err, Error::ZeroVector { .. }), "{err}");
+    // Nor can a dynamic range close up.
+    let node = menger(2).orbit_coloring(
+        OrbitColoring::new(Trap::point(DVec3::ZERO), Palette::fire())
+            .range(param("near", 0.0), param("far", 1.0)),
+    );
+    let mut eval = cpu::Evaluator::new(&node).unwrap();
+    eval.set_param("near", 0.5).unwrap();
+    let err = eval.set_param("far", 0.5).unwrap_err();
+    assert_eq!(
+        err.to_string(),
+        "orbit_trap: parameter `far` must be != near (0.5), got 0.5"
+    );
+    let err = eval.set_param("near", 1.0).unwrap_err();
+    assert!(err.to_string().contains("!= near (1)"), "{err}");
 }

@@ -209,7 +209,7 @@ real2 julia(real3 p, real cx, real cy, real cz, real cw, real w, real iterations
 }
 
 /* ---- julia_trap ---- */
-real2 julia_trap(real3 p, real cx, real cy, real cz, real cw, real w, real iterations, real bailout, real3 trap_centre, real3 trap_axis, real trap_across, real trap_along, real trap_radius) {
+real2 julia_trap(real3 p, real cx, real cy, real cz, real cw, real w, real iterations, real bailout, real3 trap_centre, real3 trap_axis, real trap_across, real trap_along, real trap_radius, real trap_count) {
     real t_0 = cy * cy;
     real t_1 = cz * cz;
     real t_2 = cw * cw;
@@ -223,66 +223,68 @@ real2 julia_trap(real3 p, real cx, real cy, real cz, real cw, real w, real itera
     real3 t_10 = p - trap_centre;
     real t_11 = trap_along * (((trap_axis.x * t_10.x) + (trap_axis.y * t_10.y)) + (trap_axis.z * t_10.z));
     real t_12 = fabs(length((t_10 * trap_across) + (trap_axis * t_11)) - trap_radius);
+    real t_13 = (R(0.5) < trap_count) ? exp(-t_12) : t_12;
     real t_s0_0 = p.x;
     real t_s0_1 = p.y;
     real t_s0_2 = p.z;
     real t_s0_3 = w;
     real t_s0_4 = t_5;
     real t_s0_5 = R(1.0);
-    real t_s0_6 = t_12;
+    real t_s0_6 = t_13;
     real t_s0_7 = R(0.0);
     int t_n0 = (int)clamp(ceil(t_9), R(0.0), R(1048576.0));
     for (int t_i0 = 0; t_i0 < t_n0; t_i0++) {
-        real t_13 = (t_s0_5 * R(4.0)) * t_s0_4;
-        if (R(1e30) < t_13) {
+        real t_14 = (t_s0_5 * R(4.0)) * t_s0_4;
+        if (R(1e30) < t_14) {
             break;
         }
-        real t_14 = R(2.0) * t_s0_0;
-        real t_15 = ((((t_s0_0 * t_s0_0) - (t_s0_1 * t_s0_1)) - (t_s0_2 * t_s0_2)) - (t_s0_3 * t_s0_3)) + cx;
-        real t_16 = (t_14 * t_s0_1) + cy;
-        real t_17 = (t_14 * t_s0_2) + cz;
-        real t_18 = (t_14 * t_s0_3) + cw;
-        real t_19 = (((t_15 * t_15) + (t_16 * t_16)) + (t_17 * t_17)) + (t_18 * t_18);
-        real3 t_20 = ((real3)(t_15, t_16, t_17)) - ((real3)(trap_centre.x, trap_centre.y, trap_centre.z));
-        real t_21 = trap_along * (((trap_axis.x * t_20.x) + (trap_axis.y * t_20.y)) + (trap_axis.z * t_20.z));
-        real t_22 = fmin(t_s0_6, fabs(length((t_20 * trap_across) + (((real3)(trap_axis.x, trap_axis.y, trap_axis.z)) * t_21)) - trap_radius));
-        real t_23 = t_s0_7 + R(1.0);
-        bool t_24 = t_8 < t_19;
-        t_s0_0 = t_15;
-        t_s0_1 = t_16;
-        t_s0_2 = t_17;
-        t_s0_3 = t_18;
-        t_s0_4 = t_19;
-        t_s0_5 = t_13;
-        t_s0_6 = t_22;
-        t_s0_7 = t_23;
-        if (t_24) {
+        real t_15 = R(2.0) * t_s0_0;
+        real t_16 = ((((t_s0_0 * t_s0_0) - (t_s0_1 * t_s0_1)) - (t_s0_2 * t_s0_2)) - (t_s0_3 * t_s0_3)) + cx;
+        real t_17 = (t_15 * t_s0_1) + cy;
+        real t_18 = (t_15 * t_s0_2) + cz;
+        real t_19 = (t_15 * t_s0_3) + cw;
+        real t_20 = (((t_16 * t_16) + (t_17 * t_17)) + (t_18 * t_18)) + (t_19 * t_19);
+        real3 t_21 = ((real3)(t_16, t_17, t_18)) - ((real3)(trap_centre.x, trap_centre.y, trap_centre.z));
+        real t_22 = trap_along * (((trap_axis.x * t_21.x) + (trap_axis.y * t_21.y)) + (trap_axis.z * t_21.z));
+        real t_23 = fabs(length((t_21 * trap_across) + (((real3)(trap_axis.x, trap_axis.y, trap_axis.z)) * t_22)) - trap_radius);
+        real t_24 = (t_20 <= t_8) ? ((R(0.5) < trap_count) ? (t_s0_6 + exp(-t_23)) : fmin(t_s0_6, t_23)) : t_s0_6;
+        real t_25 = t_s0_7 + R(1.0);
+        bool t_26 = t_8 < t_20;
+        t_s0_0 = t_16;
+        t_s0_1 = t_17;
+        t_s0_2 = t_18;
+        t_s0_3 = t_19;
+        t_s0_4 = t_20;
+        t_s0_5 = t_14;
+        t_s0_6 = t_24;
+        t_s0_7 = t_25;
+        if (t_26) {
             break;
         }
     }
-    real t_25 = sqrt(t_s0_4 / fmax(t_s0_5, R(1e-30)));
-    real t_26 = (R(0.25) * log(fmax(t_s0_4, R(1e-30)))) * t_25;
-    bool t_27 = bailout < (R(2.5) * t_3);
-    real t_28 = (t_27 || t_7) ? R(0.0) : (t_s0_7 + R(2.0));
-    real t_29 = sqrt((t_0 + t_1) + t_2);
+    real t_27 = sqrt(t_s0_4 / fmax(t_s0_5, R(1e-30)));
+    real t_28 = (R(0.25) * log(fmax(t_s0_4, R(1e-30)))) * t_27;
+    bool t_29 = bailout < (R(2.5) * t_3);
+    real t_30 = (t_29 || t_7) ? R(0.0) : (t_s0_7 + R(2.0));
+    real t_31 = sqrt((t_0 + t_1) + t_2);
     real t_s1_0 = R(0.0);
     real t_s1_1 = R(0.0);
     real t_s1_2 = R(0.0);
-    int t_n1 = (int)clamp(ceil(t_28), R(0.0), R(1048576.0));
+    int t_n1 = (int)clamp(ceil(t_30), R(0.0), R(1048576.0));
     for (int t_i1 = 0; t_i1 < t_n1; t_i1++) {
-        real t_30 = ((t_s1_0 * t_s1_0) - (t_s1_1 * t_s1_1)) + cx;
-        real t_31 = ((R(2.0) * t_s1_0) * t_s1_1) + t_29;
-        bool t_32 = R(0.81) < ((t_30 * t_30) + (t_31 * t_31));
-        real t_33 = t_32 ? R(1.0) : R(0.0);
-        t_s1_0 = t_30;
-        t_s1_1 = t_31;
-        t_s1_2 = t_33;
-        if (t_32) {
+        real t_32 = ((t_s1_0 * t_s1_0) - (t_s1_1 * t_s1_1)) + cx;
+        real t_33 = ((R(2.0) * t_s1_0) * t_s1_1) + t_31;
+        bool t_34 = R(0.81) < ((t_32 * t_32) + (t_33 * t_33));
+        real t_35 = t_34 ? R(1.0) : R(0.0);
+        t_s1_0 = t_32;
+        t_s1_1 = t_33;
+        t_s1_2 = t_35;
+        if (t_34) {
             break;
         }
     }
-    bool t_34 = t_27 || (R(0.5) < t_s1_2);
-    real t_35 = (t_34 && (!t_7)) ? (t_s0_7 + R(3.0)) : R(0.0);
+    bool t_36 = t_29 || (R(0.5) < t_s1_2);
+    real t_37 = (t_36 && (!t_7)) ? (t_s0_7 + R(3.0)) : R(0.0);
     real t_s2_0 = p.x;
     real t_s2_1 = p.y;
     real t_s2_2 = p.z;
@@ -292,37 +294,37 @@ real2 julia_trap(real3 p, real cx, real cy, real cz, real cw, real w, real itera
     real t_s2_6 = R(0.0);
     real t_s2_7 = R(1.0);
     real t_s2_8 = R(0.0);
-    int t_n2 = (int)clamp(ceil(t_35), R(0.0), R(1048576.0));
+    int t_n2 = (int)clamp(ceil(t_37), R(0.0), R(1048576.0));
     for (int t_i2 = 0; t_i2 < t_n2; t_i2++) {
         if (R(1e36) < t_s2_4) {
             break;
         }
-        real t_36 = sqrt(t_s2_4);
-        real t_37 = t_36 - t_4;
-        real t_38 = fmin((t_s2_7 * R(2.0)) * t_36, R(1e30));
-        real t_39 = fmin(t_25 * t_38, R(1e30));
-        real t_40 = fmax(sqrt(t_s2_4 + t_39), R(1e-30));
-        real t_41 = R(0.5) / t_40;
-        real t_42 = R(2.0) * t_s2_0;
-        real t_43 = ((((t_s2_0 * t_s2_0) - (t_s2_1 * t_s2_1)) - (t_s2_2 * t_s2_2)) - (t_s2_3 * t_s2_3)) + cx;
-        real t_44 = (t_42 * t_s2_1) + cy;
-        real t_45 = (t_42 * t_s2_2) + cz;
-        real t_46 = (t_42 * t_s2_3) + cw;
-        real t_47 = (((t_43 * t_43) + (t_44 * t_44)) + (t_45 * t_45)) + (t_46 * t_46);
-        real t_48 = fmin(t_s2_5 * ((t_36 + t_40) - (t_39 * t_41)), R(1e30));
-        real t_49 = fmin((t_s2_5 * t_41) + t_s2_6, R(1e30));
-        real t_50 = (R(0.0) < t_37) ? fmax(t_s2_8, t_37 / (t_s2_5 + (t_s2_6 * t_37))) : t_s2_8;
-        t_s2_0 = t_43;
-        t_s2_1 = t_44;
-        t_s2_2 = t_45;
-        t_s2_3 = t_46;
-        t_s2_4 = t_47;
-        t_s2_5 = t_48;
-        t_s2_6 = t_49;
-        t_s2_7 = t_38;
-        t_s2_8 = t_50;
+        real t_38 = sqrt(t_s2_4);
+        real t_39 = t_38 - t_4;
+        real t_40 = fmin((t_s2_7 * R(2.0)) * t_38, R(1e30));
+        real t_41 = fmin(t_27 * t_40, R(1e30));
+        real t_42 = fmax(sqrt(t_s2_4 + t_41), R(1e-30));
+        real t_43 = R(0.5) / t_42;
+        real t_44 = R(2.0) * t_s2_0;
+        real t_45 = ((((t_s2_0 * t_s2_0) - (t_s2_1 * t_s2_1)) - (t_s2_2 * t_s2_2)) - (t_s2_3 * t_s2_3)) + cx;
+        real t_46 = (t_44 * t_s2_1) + cy;
+        real t_47 = (t_44 * t_s2_2) + cz;
+        real t_48 = (t_44 * t_s2_3) + cw;
+        real t_49 = (((t_45 * t_45) + (t_46 * t_46)) + (t_47 * t_47)) + (t_48 * t_48);
+        real t_50 = fmin(t_s2_5 * ((t_38 + t_42) - (t_41 * t_43)), R(1e30));
+        real t_51 = fmin((t_s2_5 * t_43) + t_s2_6, R(1e30));
+        real t_52 = (R(0.0) < t_39) ? fmax(t_s2_8, t_39 / (t_s2_5 + (t_s2_6 * t_39))) : t_s2_8;
+        t_s2_0 = t_45;
+        t_s2_1 = t_46;
+        t_s2_2 = t_47;
+        t_s2_3 = t_48;
+        t_s2_4 = t_49;
+        t_s2_5 = t_50;
+        t_s2_6 = t_51;
+        t_s2_7 = t_40;
+        t_s2_8 = t_52;
     }
-    return (real2)(t_7 ? (R(0.9) * (t_6 - t_4)) : (t_34 ? fmin(t_26, t_s2_8) : t_26), t_s0_6);
+    return (real2)(t_7 ? (R(0.9) * (t_6 - t_4)) : (t_36 ? fmin(t_28, t_s2_8) : t_28), t_s0_6);
 }
 
 /* ---- mandelbox ---- */
@@ -367,7 +369,7 @@ real2 mandelbox(real3 p, real iterations, real scale, real min_radius, real fixe
 }
 
 /* ---- mandelbox_trap ---- */
-real2 mandelbox_trap(real3 p, real iterations, real scale, real min_radius, real fixed_radius, real fold_limit, real3 trap_centre, real3 trap_axis, real trap_across, real trap_along, real trap_radius) {
+real2 mandelbox_trap(real3 p, real iterations, real scale, real min_radius, real fixed_radius, real fold_limit, real3 trap_centre, real3 trap_axis, real trap_across, real trap_along, real trap_radius, real trap_count) {
     real t_0 = fixed_radius * fixed_radius;
     real t_1 = fmin(min_radius * min_radius, t_0);
     real t_2 = fabs(scale);
@@ -379,36 +381,39 @@ real2 mandelbox_trap(real3 p, real iterations, real scale, real min_radius, real
     real3 t_8 = p - trap_centre;
     real t_9 = trap_along * (((trap_axis.x * t_8.x) + (trap_axis.y * t_8.y)) + (trap_axis.z * t_8.z));
     real t_10 = fabs(length((t_8 * trap_across) + (trap_axis * t_9)) - trap_radius);
+    real t_11 = (R(0.5) < trap_count) ? exp(-t_10) : t_10;
     real3 t_s0_0 = p;
     real t_s0_3 = R(1.0);
-    real t_s0_4 = t_10;
+    real t_s0_4 = t_11;
     real t_s0_5 = R(0.0);
     int t_n0 = (int)clamp(ceil(iterations), R(0.0), R(1048576.0));
     for (int t_i0 = 0; t_i0 < t_n0; t_i0++) {
-        real t_11 = -fold_limit;
-        real t_12 = (fmin(fmax(t_s0_0.x, t_11), fold_limit) * R(2.0)) - t_s0_0.x;
-        real t_13 = (fmin(fmax(t_s0_0.y, t_11), fold_limit) * R(2.0)) - t_s0_0.y;
-        real t_14 = (fmin(fmax(t_s0_0.z, t_11), fold_limit) * R(2.0)) - t_s0_0.z;
-        real t_15 = ((t_12 * t_12) + (t_13 * t_13)) + (t_14 * t_14);
-        real t_16 = (t_15 < t_1) ? fmin(t_0 / t_1, R(1e30)) : ((t_15 < t_0) ? (t_0 / fmax(t_15, R(1e-30))) : R(1.0));
-        real t_17 = t_16 * scale;
-        real3 t_18 = (((real3)(t_12, t_13, t_14)) * t_17) + ((real3)(p.x, p.y, p.z));
-        real3 t_19 = t_18 - ((real3)(trap_centre.x, trap_centre.y, trap_centre.z));
-        real t_20 = trap_along * (((trap_axis.x * t_19.x) + (trap_axis.y * t_19.y)) + (trap_axis.z * t_19.z));
-        real t_21 = fmin(((t_s0_3 * t_16) * t_2) + R(1.0), R(1e30));
-        real t_22 = fmin(t_s0_4, fabs(length((t_19 * trap_across) + (((real3)(trap_axis.x, trap_axis.y, trap_axis.z)) * t_20)) - trap_radius));
-        real t_23 = t_s0_5 + R(1.0);
-        bool t_24 = t_7 < fmax(fmax(fabs(t_18.x), fabs(t_18.y)), fabs(t_18.z));
-        t_s0_0 = t_18;
-        t_s0_3 = t_21;
-        t_s0_4 = t_22;
-        t_s0_5 = t_23;
-        if (t_24) {
+        real t_12 = -fold_limit;
+        real t_13 = (fmin(fmax(t_s0_0.x, t_12), fold_limit) * R(2.0)) - t_s0_0.x;
+        real t_14 = (fmin(fmax(t_s0_0.y, t_12), fold_limit) * R(2.0)) - t_s0_0.y;
+        real t_15 = (fmin(fmax(t_s0_0.z, t_12), fold_limit) * R(2.0)) - t_s0_0.z;
+        real t_16 = ((t_13 * t_13) + (t_14 * t_14)) + (t_15 * t_15);
+        real t_17 = (t_16 < t_1) ? fmin(t_0 / t_1, R(1e30)) : ((t_16 < t_0) ? (t_0 / fmax(t_16, R(1e-30))) : R(1.0));
+        real t_18 = t_17 * scale;
+        real3 t_19 = (((real3)(t_13, t_14, t_15)) * t_18) + ((real3)(p.x, p.y, p.z));
+        real t_20 = fmax(fmax(fabs(t_19.x), fabs(t_19.y)), fabs(t_19.z));
+        real3 t_21 = t_19 - ((real3)(trap_centre.x, trap_centre.y, trap_centre.z));
+        real t_22 = trap_along * (((trap_axis.x * t_21.x) + (trap_axis.y * t_21.y)) + (trap_axis.z * t_21.z));
+        real t_23 = fabs(length((t_21 * trap_across) + (((real3)(trap_axis.x, trap_axis.y, trap_axis.z)) * t_22)) - trap_radius);
+        real t_24 = fmin(((t_s0_3 * t_17) * t_2) + R(1.0), R(1e30));
+        real t_25 = (t_20 <= t_6) ? ((R(0.5) < trap_count) ? (t_s0_4 + exp(-t_23)) : fmin(t_s0_4, t_23)) : t_s0_4;
+        real t_26 = t_s0_5 + R(1.0);
+        bool t_27 = t_7 < t_20;
+        t_s0_0 = t_19;
+        t_s0_3 = t_24;
+        t_s0_4 = t_25;
+        t_s0_5 = t_26;
+        if (t_27) {
             break;
         }
     }
-    real3 t_25 = fabs(p) - t_5;
-    return (real2)(fmax(R(0.8) * ((fmax(fmax(fabs(t_s0_0.x), fabs(t_s0_0.y)), fabs(t_s0_0.z)) - t_6) / fmax(t_s0_3 + ((R(1.0) - (R(1.0) / exp((iterations - t_s0_5) * log(t_2)))) / t_4), R(1e-30))), length(fmax(t_25, R(0.0))) + fmin(fmax(fmax(t_25.x, t_25.y), t_25.z), R(0.0))), t_s0_4);
+    real3 t_28 = fabs(p) - t_5;
+    return (real2)(fmax(R(0.8) * ((fmax(fmax(fabs(t_s0_0.x), fabs(t_s0_0.y)), fabs(t_s0_0.z)) - t_6) / fmax(t_s0_3 + ((R(1.0) - (R(1.0) / exp((iterations - t_s0_5) * log(t_2)))) / t_4), R(1e-30))), length(fmax(t_28, R(0.0))) + fmin(fmax(fmax(t_28.x, t_28.y), t_28.z), R(0.0))), t_s0_4);
 }
 
 /* ---- kifs_icosahedral ---- */
@@ -456,7 +461,7 @@ real2 kifs_icosahedral(real3 p, real iterations, real scale, real3 offset) {
 }
 
 /* ---- kifs_icosahedral_trap ---- */
-real2 kifs_icosahedral_trap(real3 p, real iterations, real scale, real3 offset, real3 trap_centre, real3 trap_axis, real trap_across, real trap_along, real trap_radius) {
+real2 kifs_icosahedral_trap(real3 p, real iterations, real scale, real3 offset, real3 trap_centre, real3 trap_axis, real trap_across, real trap_along, real trap_radius, real trap_count) {
     real t_0 = length(offset);
     real t_1 = fmax(t_0 * R(32.0), R(1e-30));
     real t_2 = t_1 * t_1;
@@ -467,35 +472,38 @@ real2 kifs_icosahedral_trap(real3 p, real iterations, real scale, real3 offset, 
     real3 t_7 = p - trap_centre;
     real t_8 = trap_along * (((trap_axis.x * t_7.x) + (trap_axis.y * t_7.y)) + (trap_axis.z * t_7.z));
     real t_9 = fabs(length((t_7 * trap_across) + (trap_axis * t_8)) - trap_radius);
+    real t_10 = (R(0.5) < trap_count) ? exp(-t_9) : t_9;
     real3 t_s0_0 = p;
     real t_s0_3 = R(1.0);
-    real t_s0_4 = t_9;
+    real t_s0_4 = t_10;
     int t_n0 = (int)clamp(ceil(iterations), R(0.0), R(1048576.0));
     for (int t_i0 = 0; t_i0 < t_n0; t_i0++) {
-        real3 t_10 = fabs(t_s0_0);
-        real t_11 = R(2.0) * fmax(((t_10.x * (-R(0.8090169943749475))) + (t_10.y * R(0.30901699437494745))) + (t_10.z * R(0.5)), R(0.0));
-        real3 t_12 = (real3)(-R(0.8090169943749475), R(0.30901699437494745), R(0.5));
-        real3 t_13 = t_10 - (t_12 * t_11);
-        real t_14 = R(2.0) * fmax(((t_13.x * R(0.3090169943749474)) + (t_13.y * (-R(0.5)))) + (t_13.z * R(0.8090169943749475)), R(0.0));
-        real3 t_15 = (real3)(R(0.3090169943749474), -R(0.5), R(0.8090169943749475));
-        real3 t_16 = fabs(t_13 - (t_15 * t_14));
-        real t_17 = R(2.0) * fmax(((t_16.x * (-R(0.8090169943749475))) + (t_16.y * R(0.30901699437494745))) + (t_16.z * R(0.5)), R(0.0));
-        real3 t_18 = t_16 - (t_12 * t_17);
-        real t_19 = R(2.0) * fmax(((t_18.x * R(0.3090169943749474)) + (t_18.y * (-R(0.5)))) + (t_18.z * R(0.8090169943749475)), R(0.0));
-        real3 t_20 = fabs(t_18 - (t_15 * t_19));
-        real t_21 = R(2.0) * fmax(((t_20.x * (-R(0.8090169943749475))) + (t_20.y * R(0.30901699437494745))) + (t_20.z * R(0.5)), R(0.0));
-        real3 t_22 = t_20 - (t_12 * t_21);
-        real t_23 = R(2.0) * fmax(((t_22.x * R(0.3090169943749474)) + (t_22.y * (-R(0.5)))) + (t_22.z * R(0.8090169943749475)), R(0.0));
-        real3 t_24 = ((t_22 - (t_15 * t_23)) * scale) - ((real3)(t_4, t_5, t_6));
-        real3 t_25 = t_24 - ((real3)(trap_centre.x, trap_centre.y, trap_centre.z));
-        real t_26 = trap_along * (((trap_axis.x * t_25.x) + (trap_axis.y * t_25.y)) + (trap_axis.z * t_25.z));
-        real t_27 = t_s0_3 * scale;
-        real t_28 = fmin(t_s0_4, fabs(length((t_25 * trap_across) + (((real3)(trap_axis.x, trap_axis.y, trap_axis.z)) * t_26)) - trap_radius));
-        bool t_29 = t_2 < (((t_24.x * t_24.x) + (t_24.y * t_24.y)) + (t_24.z * t_24.z));
-        t_s0_0 = t_24;
-        t_s0_3 = t_27;
-        t_s0_4 = t_28;
-        if (t_29) {
+        real3 t_11 = fabs(t_s0_0);
+        real t_12 = R(2.0) * fmax(((t_11.x * (-R(0.8090169943749475))) + (t_11.y * R(0.30901699437494745))) + (t_11.z * R(0.5)), R(0.0));
+        real3 t_13 = (real3)(-R(0.8090169943749475), R(0.30901699437494745), R(0.5));
+        real3 t_14 = t_11 - (t_13 * t_12);
+        real t_15 = R(2.0) * fmax(((t_14.x * R(0.3090169943749474)) + (t_14.y * (-R(0.5)))) + (t_14.z * R(0.8090169943749475)), R(0.0));
+        real3 t_16 = (real3)(R(0.3090169943749474), -R(0.5), R(0.8090169943749475));
+        real3 t_17 = fabs(t_14 - (t_16 * t_15));
+        real t_18 = R(2.0) * fmax(((t_17.x * (-R(0.8090169943749475))) + (t_17.y * R(0.30901699437494745))) + (t_17.z * R(0.5)), R(0.0));
+        real3 t_19 = t_17 - (t_13 * t_18);
+        real t_20 = R(2.0) * fmax(((t_19.x * R(0.3090169943749474)) + (t_19.y * (-R(0.5)))) + (t_19.z * R(0.8090169943749475)), R(0.0));
+        real3 t_21 = fabs(t_19 - (t_16 * t_20));
+        real t_22 = R(2.0) * fmax(((t_21.x * (-R(0.8090169943749475))) + (t_21.y * R(0.30901699437494745))) + (t_21.z * R(0.5)), R(0.0));
+        real3 t_23 = t_21 - (t_13 * t_22);
+        real t_24 = R(2.0) * fmax(((t_23.x * R(0.3090169943749474)) + (t_23.y * (-R(0.5)))) + (t_23.z * R(0.8090169943749475)), R(0.0));
+        real3 t_25 = ((t_23 - (t_16 * t_24)) * scale) - ((real3)(t_4, t_5, t_6));
+        real t_26 = ((t_25.x * t_25.x) + (t_25.y * t_25.y)) + (t_25.z * t_25.z);
+        real3 t_27 = t_25 - ((real3)(trap_centre.x, trap_centre.y, trap_centre.z));
+        real t_28 = trap_along * (((trap_axis.x * t_27.x) + (trap_axis.y * t_27.y)) + (trap_axis.z * t_27.z));
+        real t_29 = fabs(length((t_27 * trap_across) + (((real3)(trap_axis.x, trap_axis.y, trap_axis.z)) * t_28)) - trap_radius);
+        real t_30 = t_s0_3 * scale;
+        real t_31 = (t_26 <= (t_0 * t_0)) ? ((R(0.5) < trap_count) ? (t_s0_4 + exp(-t_29)) : fmin(t_s0_4, t_29)) : t_s0_4;
+        bool t_32 = t_2 < t_26;
+        t_s0_0 = t_25;
+        t_s0_3 = t_30;
+        t_s0_4 = t_31;
+        if (t_32) {
             break;
         }
     }
@@ -548,7 +556,7 @@ real2 mandelbulb_p8(real3 p, real iterations, real escape, real ball) {
 }
 
 /* ---- mandelbulb_p8_trap ---- */
-real2 mandelbulb_p8_trap(real3 p, real iterations, real escape, real ball, real3 trap_centre, real3 trap_axis, real trap_across, real trap_along, real trap_radius) {
+real2 mandelbulb_p8_trap(real3 p, real iterations, real escape, real ball, real3 trap_centre, real3 trap_axis, real trap_across, real trap_along, real trap_radius, real trap_count) {
     real t_0 = length(p);
     real t_1 = t_0 - ball;
     bool t_2 = (R(1.5) * ball) < t_0;
@@ -556,45 +564,47 @@ real2 mandelbulb_p8_trap(real3 p, real iterations, real escape, real ball, real3
     real3 t_4 = p - trap_centre;
     real t_5 = trap_along * (((trap_axis.x * t_4.x) + (trap_axis.y * t_4.y)) + (trap_axis.z * t_4.z));
     real t_6 = fabs(length((t_4 * trap_across) + (trap_axis * t_5)) - trap_radius);
+    real t_7 = (R(0.5) < trap_count) ? exp(-t_6) : t_6;
     real3 t_s0_0 = p;
     real t_s0_3 = R(1.0);
-    real t_s0_4 = t_6;
+    real t_s0_4 = t_7;
     int t_n0 = (int)clamp(ceil(t_3), R(0.0), R(1048576.0));
     for (int t_i0 = 0; t_i0 < t_n0; t_i0++) {
-        real t_7 = length(t_s0_0);
-        if (escape < t_7) {
+        real t_8 = length(t_s0_0);
+        if (escape < t_8) {
             break;
         }
-        real3 t_8 = t_s0_0 - ((real3)(trap_centre.x, trap_centre.y, trap_centre.z));
-        real t_9 = trap_along * (((trap_axis.x * t_8.x) + (trap_axis.y * t_8.y)) + (trap_axis.z * t_8.z));
-        real t_10 = t_7 * t_7;
-        real t_11 = (t_7 * t_10) * (t_10 * t_10);
-        real t_12 = hypot(t_s0_0.x, t_s0_0.y);
-        real t_13 = R(1.0) / fmax(t_7, R(1e-30));
-        real t_14 = t_s0_0.z * t_13;
-        real t_15 = t_12 * t_13;
-        real t_16 = (t_14 * t_14) - (t_15 * t_15);
-        real t_17 = (R(2.0) * t_14) * t_15;
-        real t_18 = (t_16 * t_16) - (t_17 * t_17);
-        real t_19 = (R(2.0) * t_16) * t_17;
-        real t_20 = (R(2.0) * t_18) * t_19;
-        bool t_21 = R(1e-30) < t_12;
-        real t_22 = t_21 ? (t_s0_0.x / t_12) : R(1.0);
-        real t_23 = t_21 ? (t_s0_0.y / t_12) : R(0.0);
-        real t_24 = (t_22 * t_22) - (t_23 * t_23);
-        real t_25 = (R(2.0) * t_22) * t_23;
-        real t_26 = (t_24 * t_24) - (t_25 * t_25);
-        real t_27 = (R(2.0) * t_24) * t_25;
-        real t_28 = t_11 * t_7;
-        real3 t_29 = (((real3)(t_20 * ((t_26 * t_26) - (t_27 * t_27)), t_20 * ((R(2.0) * t_26) * t_27), (t_18 * t_18) - (t_19 * t_19))) * t_28) + ((real3)(p.x, p.y, p.z));
-        real t_30 = fmin(((R(8.0) * t_11) * t_s0_3) + R(1.0), R(1e30));
-        real t_31 = fmin(t_s0_4, fabs(length((t_8 * trap_across) + (((real3)(trap_axis.x, trap_axis.y, trap_axis.z)) * t_9)) - trap_radius));
-        t_s0_0 = t_29;
-        t_s0_3 = t_30;
-        t_s0_4 = t_31;
+        real t_9 = t_8 * t_8;
+        real t_10 = (t_8 * t_9) * (t_9 * t_9);
+        real t_11 = hypot(t_s0_0.x, t_s0_0.y);
+        real t_12 = R(1.0) / fmax(t_8, R(1e-30));
+        real t_13 = t_s0_0.z * t_12;
+        real t_14 = t_11 * t_12;
+        real t_15 = (t_13 * t_13) - (t_14 * t_14);
+        real t_16 = (R(2.0) * t_13) * t_14;
+        real t_17 = (t_15 * t_15) - (t_16 * t_16);
+        real t_18 = (R(2.0) * t_15) * t_16;
+        real t_19 = (R(2.0) * t_17) * t_18;
+        bool t_20 = R(1e-30) < t_11;
+        real t_21 = t_20 ? (t_s0_0.x / t_11) : R(1.0);
+        real t_22 = t_20 ? (t_s0_0.y / t_11) : R(0.0);
+        real t_23 = (t_21 * t_21) - (t_22 * t_22);
+        real t_24 = (R(2.0) * t_21) * t_22;
+        real t_25 = (t_23 * t_23) - (t_24 * t_24);
+        real t_26 = (R(2.0) * t_23) * t_24;
+        real t_27 = t_10 * t_8;
+        real3 t_28 = (((real3)(t_19 * ((t_25 * t_25) - (t_26 * t_26)), t_19 * ((R(2.0) * t_25) * t_26), (t_17 * t_17) - (t_18 * t_18))) * t_27) + ((real3)(p.x, p.y, p.z));
+        real3 t_29 = t_28 - ((real3)(trap_centre.x, trap_centre.y, trap_centre.z));
+        real t_30 = trap_along * (((trap_axis.x * t_29.x) + (trap_axis.y * t_29.y)) + (trap_axis.z * t_29.z));
+        real t_31 = fabs(length((t_29 * trap_across) + (((real3)(trap_axis.x, trap_axis.y, trap_axis.z)) * t_30)) - trap_radius);
+        real t_32 = fmin(((R(8.0) * t_10) * t_s0_3) + R(1.0), R(1e30));
+        real t_33 = (length(t_28) <= escape) ? ((R(0.5) < trap_count) ? (t_s0_4 + exp(-t_31)) : fmin(t_s0_4, t_31)) : t_s0_4;
+        t_s0_0 = t_28;
+        t_s0_3 = t_32;
+        t_s0_4 = t_33;
     }
-    real t_32 = length(t_s0_0);
-    return (real2)(t_2 ? t_1 : fmax(((R(0.5) * log(fmax(t_32, R(1e-30)))) * t_32) / t_s0_3, t_1), t_s0_4);
+    real t_34 = length(t_s0_0);
+    return (real2)(t_2 ? t_1 : fmax(((R(0.5) * log(fmax(t_34, R(1e-30)))) * t_34) / t_s0_3, t_1), t_s0_4);
 }
 
 /* ---- scene ---- */
@@ -690,7 +700,7 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
         /* .../a:translate/scale/rotate */
         real3 p3 = (real3)(p2.x, -p2.z, p2.y);
         /* .../rotate/orbit_trap/mandelbulb */
-        real2 f0 = mandelbulb_p8_trap(p3, 10, R(2.0), 1.1040895f, (real3)(0.0f, 0.0f, 0.0f), (real3)(0.0f, 0.0f, 1.0f), 0.0f, 1.0f, 0.0f);
+        real2 f0 = mandelbulb_p8_trap(p3, 10, R(2.0), 1.1040895f, (real3)((-0.0f), (-0.0f), (-0.0f)), (real3)(0.0f, 0.0f, 1.0f), 0.0f, 1.0f, 0.0f, 0.0f);
         real d0 = f0.x;
         real t0 = f0.y;
         /* .../scale/rotate/orbit_trap */
@@ -720,7 +730,7 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
         /* .../b:translate/scale/rotate */
         real3 p6 = (real3)((R(0.8253356149096783) * p5.x) - (R(0.5646424733950354) * p5.z), p5.y, (R(0.5646424733950354) * p5.x) + (R(0.8253356149096783) * p5.z));
         /* .../rotate/orbit_trap/mandelbox */
-        real2 f5 = mandelbox_trap(p6, 16, 2.0f, 0.5f, 1.0f, 1.0f, (real3)(0.0f, 0.0f, 0.0f), (real3)(0.0f, 0.0f, 0.0f), 1.0f, 0.0f, 2.0f);
+        real2 f5 = mandelbox_trap(p6, 16, 2.0f, 0.5f, 1.0f, 1.0f, (real3)(0.0f, 0.0f, 0.0f), (real3)(0.0f, 0.0f, 0.0f), 1.0f, 0.0f, 2.0f, 0.0f);
         real d5 = f5.x;
         real t5 = f5.y;
         /* .../scale/rotate/orbit_trap */
@@ -749,7 +759,7 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
         /* .../a:union/b:translate/scale */
         real3 p8 = p7 / R(0.6);
         /* .../scale/orbit_trap/julia */
-        real2 f11 = julia_trap(p8, (-0.2f), 0.6f, 0.2f, 0.2f, 0.0f, 12, 4.0f, (real3)(0.0f, 0.0f, 0.0f), (real3)(1.0f, 0.0f, 0.0f), 1.0f, (-1.0f), 0.0f);
+        real2 f11 = julia_trap(p8, (-0.2f), 0.6f, 0.2f, 0.2f, 0.0f, 12, 4.0f, (real3)(0.0f, 0.0f, 0.0f), (real3)(1.0f, 0.0f, 0.0f), 1.0f, (-1.0f), 0.0f, 0.0f);
         real d11 = f11.x;
         real t11 = f11.y;
         /* .../b:translate/scale/orbit_trap */
@@ -779,7 +789,7 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
         /* .../b:translate/scale/rotate */
         real3 p11 = (real3)((R(0.9210609940028851) * p10.x) - (R(0.3894183423086505) * p10.z), p10.y, (R(0.3894183423086505) * p10.x) + (R(0.9210609940028851) * p10.z));
         /* .../rotate/orbit_trap/kifs */
-        real2 f16 = kifs_icosahedral_trap(p11, 12, 2.618034f, (real3)(0.8506508f, 0.5257311f, 0.0f), (real3)(0.0f, 0.0f, 0.0f), (real3)(0.0f, 0.0f, 0.0f), 1.0f, 0.0f, 0.0f);
+        real2 f16 = kifs_icosahedral_trap(p11, 12, 2.618034f, (real3)(0.8506508f, 0.5257311f, 0.0f), (real3)(0.0f, 0.0f, 0.0f), (real3)(0.0f, 0.0f, 0.0f), 1.0f, 0.0f, 0.0f, 0.0f);
         real d16 = f16.x;
         real t16 = f16.y;
         /* .../scale/rotate/orbit_trap */

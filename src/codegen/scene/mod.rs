@@ -160,7 +160,7 @@ pub(crate) struct SceneEmitter<'a> {
     /// The fractal helpers called in their trapped form (by the plain
     /// form's name).
     pub(crate) trapped: BTreeSet<String>,
-    /// The trap shapes (the nine arguments of a trapped form) of the
+    /// The trap shapes (the arguments of a trapped form) of the
     /// fractals an orbit trap colours, by the fractal's node, while it is
     /// entered.
     traps: HashMap<NodeId, String>,
@@ -730,12 +730,13 @@ impl<'a> SceneEmitter<'a> {
                 let q = self.map_point(p, &[Arg::Scalar(*rate)], |p, a| sdf::bend(p, a[0]));
                 Step::Descend(vec![(*child, q, needs_color)])
             }
-            Kind::Csg { a, b, .. } => {
+            Kind::Csg { op, a, b, .. } => {
+                // A cut shows its first operand's surface everywhere: the
+                // cutter's is never read.
+                let a = (*a, needs_color);
+                let b = (*b, needs_color && *op != CsgOp::Cut);
                 let (a, b) = if self.swapped(id) { (b, a) } else { (a, b) };
-                Step::Descend(vec![
-                    (*a, p.to_string(), needs_color),
-                    (*b, p.to_string(), needs_color),
-                ])
+                Step::Descend(vec![(a.0, p.to_string(), a.1), (b.0, p.to_string(), b.1)])
             }
             Kind::Custom { shape, .. } => {
                 self.customs.insert(shape.name().to_string(), shape.clone());
@@ -765,7 +766,7 @@ impl<'a> SceneEmitter<'a> {
     }
 
     /// The arguments a trapped fractal helper takes after its own for
-    /// `trap` (its nine numbers, the first six as two vectors), as source
+    /// `trap` (its ten numbers, the first six as two vectors), as source
     /// expressions: literals where its values are baked.
     fn trap_shape(&mut self, trap: &Trap<Scalar, Vector>) -> String {
         // The trap's values in order; both closures add to the list.
@@ -785,7 +786,7 @@ impl<'a> SceneEmitter<'a> {
             // Baked: the numbers, computed here in `f64`.
             shape.values().iter().map(|&v| self.w.float(v)).collect()
         } else {
-            self.inline(&args, &[Shape::Scalar; 9], |a| {
+            self.inline(&args, &[Shape::Scalar; 10], |a| {
                 let next = RefCell::new(a.iter().copied());
                 let take = || next.borrow_mut().next().expect("one value per input");
                 let Ok(trap) = trap
@@ -796,8 +797,11 @@ impl<'a> SceneEmitter<'a> {
             })
         };
         // The helper takes the centre and the axis as vectors.
-        let [cx, cy, cz, ax, ay, az, across, along, radius] = take(values);
-        format!("(real3)({cx}, {cy}, {cz}), (real3)({ax}, {ay}, {az}), {across}, {along}, {radius}")
+        let [cx, cy, cz, ax, ay, az, across, along, radius, count] = take(values);
+        format!(
+            "(real3)({cx}, {cy}, {cz}), (real3)({ax}, {ay}, {az}), {across}, {along}, {radius}, \
+             {count}"
+        )
     }
 
     /// Leaving a node after its children: the lines that combine their

@@ -216,7 +216,14 @@ pub fn hybrid_estimate<T: Num>(
             escaped = T::select(out, T::one(), escaped);
             Step {
                 stop_before: None,
-                next: [z.x, z.y, z.z, dr, slot.step(trap, z, || z.dot(z)), escaped],
+                next: [
+                    z.x,
+                    z.y,
+                    z.z,
+                    dr,
+                    slot.shape_within(slot.own(trap, || z.dot(z)), z, !out),
+                    escaped,
+                ],
                 stop_after: Some(far.gt(T::of(0.5))),
             }
         });

@@ -431,7 +431,7 @@ pub fn mandelbulb_estimate<T: Num>(
     let [x, y, z, dr, trap] = T::iterate(count, start, |_, [x, y, z, dr, trap]| {
         let z = v3(x, y, z);
         let r = z.length();
-        let trap = slot.step(trap, z, || r);
+        let trap = slot.own(trap, || r);
         // r^(power - 1), by repeated multiplication in the integer form.
         let r_pow = match integer_power {
             Some(n) => pow_int(r, n - 1),
@@ -439,6 +439,7 @@ pub fn mandelbulb_estimate<T: Num>(
         };
         let dr = (power * r_pow * dr + T::one()).min(T::derivative_cap());
         let z = triplex_direction(z, r, power, integer_power) * (r_pow * r) + p;
+        let trap = slot.shape_within(trap, z, z.length().le(escape));
         Step {
             stop_before: Some(r.gt(escape)),
             next: [z.x, z.y, z.z, dr, trap],
@@ -479,9 +480,10 @@ pub fn menger_estimate<T: Num>(
         let z = V3::select(z.x.lt(z.y), v3(z.y, z.x, z.z), z);
         let z = V3::select(z.x.lt(z.z), v3(z.z, z.y, z.x), z);
         let z = V3::select(z.y.lt(z.z), v3(z.x, z.z, z.y), z);
-        let trap = slot.step(trap, z, || z.length() * T::of(0.577_350_269_189_625_8));
+        let trap = slot.own(trap, || z.length() * T::of(0.577_350_269_189_625_8));
         let w = v3(z.x * scale - shift, z.y * scale - shift, z.z * scale);
         let wz = T::select(w.z.gt(T::of(0.5) * shift), w.z - shift, w.z);
+        let trap = slot.shape(trap, v3(w.x, w.y, wz));
         Step {
             stop_before: None,
             next: [w.x, w.y, wz, s * scale, trap],
@@ -528,8 +530,9 @@ pub fn sierpinski_estimate<T: Num>(
         let z = V3::select((z.x + z.y).lt(T::zero()), v3(-z.y, -z.x, z.z), z);
         let z = V3::select((z.x + z.z).lt(T::zero()), v3(-z.z, z.y, -z.x), z);
         let z = V3::select((z.y + z.z).lt(T::zero()), v3(z.x, -z.z, -z.y), z);
-        let trap = slot.step(trap, z, || z.length() * T::of(0.577_350_269_189_625_8));
+        let trap = slot.own(trap, || z.length() * T::of(0.577_350_269_189_625_8));
         let w = z * scale - V3::splat(shift);
+        let trap = slot.shape(trap, w);
         Step {
             stop_before: None,
             next: [w.x, w.y, w.z, s * scale, trap],
@@ -697,7 +700,13 @@ pub fn kifs_estimate<T: Num>(
         let r2 = w.dot(w);
         Step {
             stop_before: None,
-            next: [w.x, w.y, w.z, s * k.scale, slot.step(trap, w, || r2)],
+            next: [
+                w.x,
+                w.y,
+                w.z,
+                s * k.scale,
+                slot.shape_within(slot.own(trap, || r2), w, r2.le(radius * radius)),
+            ],
             stop_after: Some(r2.gt(follow2)),
         }
     });
@@ -813,7 +822,7 @@ pub fn mandelbox_estimate<T: Num>(
                     z.y,
                     z.z,
                     dr,
-                    slot.step(trap, z, || z.dot(z)),
+                    slot.shape_within(slot.own(trap, || z.dot(z)), z, largest(z).le(escape)),
                     steps + T::one(),
                 ],
                 stop_after: Some(largest(z).gt(follow)),
@@ -1067,7 +1076,11 @@ pub fn julia_estimate<T: Num>(
                     z[3],
                     mz2,
                     next,
-                    slot.step(trap, v3(z[0], z[1], z[2]), || mz2),
+                    slot.shape_within(
+                        slot.own(trap, || mz2),
+                        v3(z[0], z[1], z[2]),
+                        mz2.le(bailout2),
+                    ),
                     n + T::one(),
                 ],
                 stop_after: Some(mz2.gt(bailout2)),
