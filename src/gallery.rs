@@ -20,9 +20,9 @@ use crate::file::SceneFile;
 use crate::quality::{Effects, Glow, Quality};
 use crate::scene::{
     Axis, Camera, Hybrid, HybridOp, InsideShape, Kifs, KifsFold, Light, Mandelbulb, Material, Node,
-    OrbitColoring, Palette, QuaternionJulia, Scene, Trap, capped_cone, capsule, cuboid, cut_sphere,
-    cylinder, ellipsoid, hex_prism, julia, link, menger, octahedron, param, param3, plane,
-    round_box, round_cone, sierpinski, solid_angle, sphere, torus,
+    OrbitColoring, Palette, QuaternionJulia, Scene, Trap, capped_cone, capped_torus, capsule,
+    cuboid, cut_sphere, cylinder, ellipsoid, hex_prism, julia, link, menger, octahedron, param,
+    param3, plane, round_box, round_cone, sierpinski, solid_angle, sphere, torus,
 };
 
 /// Every gallery scene by name.
@@ -490,6 +490,7 @@ pub fn primitives() -> Scene {
         link(0.14, 0.2, 0.07).rotate(DVec3::Y, 0.5),
         cut_sphere(0.35, 0.15).translate(dvec3(0.0, 0.05, 0.0)),
         solid_angle(0.6, 0.45).translate(dvec3(0.0, -0.3, 0.0)),
+        capped_torus(2.2, 0.25, 0.07),
     ];
     let count = items.len();
     let row = items
@@ -503,13 +504,17 @@ pub fn primitives() -> Scene {
                 0.45 + 0.35 * (1.0 - (2.0 * t - 1.0).abs()),
                 0.3 + 0.6 * t,
             );
-            // Seven in the back row, seven in front, 0.75 apart.
+            // Eight in the back row, seven in front, 0.75 apart.
             #[allow(clippy::cast_precision_loss)]
-            let (column, z) = ((i % 7) as f64 - 3.0, if i < 7 { -0.6 } else { 0.6 });
+            let (column, z) = if i < 8 {
+                (i as f64 - 3.5, -0.6)
+            } else {
+                ((i - 8) as f64 - 3.0, 0.6)
+            };
             node.color(hue).translate(dvec3(column * 0.75, 0.0, z))
         })
         .reduce(Node::union)
-        .expect("fourteen primitives");
+        .expect("fifteen primitives");
     Scene::new(row.union(floor(0.4)))
         .with_camera(Camera::look_at(dvec3(0.0, 2.3, 5.4), dvec3(0.0, -0.15, 0.0)).fov(45.0))
         .with_lights(key_and_fill())

@@ -126,6 +126,14 @@ pub(crate) fn solid_angle() -> Result<String, Unprintable> {
     )
 }
 
+pub(crate) fn capped_torus() -> Result<String, Unprintable> {
+    distance(
+        "sd_capped_torus",
+        &[("angle", Scalar), ("ra", Scalar), ("rb", Scalar)],
+        |p, a| sdf::capped_torus(p, a[0], a[1], a[2]),
+    )
+}
+
 pub(crate) fn link() -> Result<String, Unprintable> {
     distance(
         "sd_link",

@@ -24,6 +24,7 @@ pub(crate) enum Helper {
     Link,
     CutSphere,
     SolidAngle,
+    CappedTorus,
     Ellipsoid,
     Mandelbulb,
     Menger,
@@ -37,7 +38,7 @@ pub(crate) enum Helper {
 
 impl Helper {
     /// Every helper, in the order they are emitted.
-    pub(crate) const ALL: [Helper; 29] = [
+    pub(crate) const ALL: [Helper; 30] = [
         Helper::Sphere,
         Helper::Cuboid,
         Helper::RoundBox,
@@ -52,6 +53,7 @@ impl Helper {
         Helper::Link,
         Helper::CutSphere,
         Helper::SolidAngle,
+        Helper::CappedTorus,
         Helper::Ellipsoid,
         Helper::Mandelbulb,
         Helper::Menger,
@@ -86,6 +88,7 @@ impl Helper {
             Helper::Link => "link",
             Helper::CutSphere => "cut_sphere",
             Helper::SolidAngle => "solid_angle",
+            Helper::CappedTorus => "capped_torus",
             Helper::Ellipsoid => "ellipsoid",
             Helper::Mandelbulb => "mandelbulb",
             Helper::Menger => "menger",
@@ -123,6 +126,7 @@ impl Helper {
             Helper::Link => formulas::link(),
             Helper::CutSphere => formulas::cut_sphere(),
             Helper::SolidAngle => formulas::solid_angle(),
+            Helper::CappedTorus => formulas::capped_torus(),
             Helper::Ellipsoid => formulas::ellipsoid(),
             Helper::Mandelbulb
             | Helper::Menger

@@ -391,6 +391,16 @@ impl Evaluator {
             Kind::SolidAngle { angle, radius } => {
                 Self::leaf(sdf::solid_angle(p, s(*angle), s(*radius)))
             }
+            Kind::CappedTorus {
+                angle,
+                major_radius,
+                minor_radius,
+            } => Self::leaf(sdf::capped_torus(
+                p,
+                s(*angle),
+                s(*major_radius),
+                s(*minor_radius),
+            )),
             Kind::Link {
                 half_length,
                 major_radius,

@@ -32,7 +32,7 @@ const REFERENCE: &str = include_str!("reference.md");
 /// independent oracle within 1e-13 by the crate's tests (the torus and the
 /// link where the tube is no thicker than its major radius); a test checks
 /// that this list is exactly the primitives those tests draw.
-const EXACT: [&str; 14] = [
+const EXACT: [&str; 15] = [
     "Sphere",
     "Cuboid",
     "RoundBox",
@@ -47,6 +47,7 @@ const EXACT: [&str; 14] = [
     "Link",
     "CutSphere",
     "SolidAngle",
+    "CappedTorus",
 ];
 
 /// What kind of node a scene-file node is.

@@ -133,6 +133,15 @@ impl NodeRepr {
             },
             Kind::CutSphere { radius, height } => NodeRepr::CutSphere { radius, height },
             Kind::SolidAngle { angle, radius } => NodeRepr::SolidAngle { angle, radius },
+            Kind::CappedTorus {
+                angle,
+                major_radius,
+                minor_radius,
+            } => NodeRepr::CappedTorus {
+                angle,
+                major_radius,
+                minor_radius,
+            },
             Kind::Ellipsoid { radii } => NodeRepr::Ellipsoid { radii },
             Kind::Mandelbulb(Mandelbulb {
                 power,
@@ -428,6 +437,16 @@ impl Located<NodeRepr> {
             NodeRepr::CutSphere { radius, height } => Kind::CutSphere {
                 radius: radius.clone(),
                 height: height.clone(),
+            }
+            .into(),
+            NodeRepr::CappedTorus {
+                angle,
+                major_radius,
+                minor_radius,
+            } => Kind::CappedTorus {
+                angle: angle.clone(),
+                major_radius: major_radius.clone(),
+                minor_radius: minor_radius.clone(),
             }
             .into(),
             NodeRepr::SolidAngle { angle, radius } => Kind::SolidAngle {

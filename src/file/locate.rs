@@ -38,6 +38,7 @@ pub(super) const NAMES: &[&str] = &[
     "Link",
     "CutSphere",
     "SolidAngle",
+    "CappedTorus",
     "Ellipsoid",
     "Mandelbulb",
     "Menger",

@@ -468,6 +468,11 @@ pub(super) enum NodeRepr {
         angle: Param,
         radius: Param,
     },
+    CappedTorus {
+        angle: Param,
+        major_radius: Param,
+        minor_radius: Param,
+    },
     Ellipsoid {
         radii: Param3,
     },

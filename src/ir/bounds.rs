@@ -210,6 +210,12 @@ pub(super) fn bound(node: &IrNode, done: &[Option<Bound>]) -> Option<Bound> {
         Kind::CutSphere { radius, .. } | Kind::SolidAngle { radius, .. } => {
             Bound::sphere(origin, baked(*radius)?)
         }
+        // Within the tube's radius of a circle of the arc's.
+        Kind::CappedTorus {
+            major_radius,
+            minor_radius,
+            ..
+        } => Bound::sphere(origin, baked(*major_radius)? + baked(*minor_radius)?),
         // The estimate is `(k0 − 1) / |u / r|` with `k0 = |p / r|` and `u`
         // a unit vector, so it is at least `(k0 − 1) min(r)`, and
         // `k0 >= |p| / max(r)`: at least `min(r) / max(r) · (|p| − max(r))`,

@@ -161,6 +161,24 @@ pub fn solid_angle(angle: impl Into<Param>, radius: impl Into<Param>) -> Node {
     .into()
 }
 
+/// A torus cut to an arc: the tube of `minor_radius` around the arc of the
+/// circle of `major_radius` in the xy plane within `angle` radians (in
+/// `[0, π]`) of the +y axis, its ends capped by half balls. Exact where
+/// `minor_radius <= major_radius` and the caps do not meet.
+#[must_use]
+pub fn capped_torus(
+    angle: impl Into<Param>,
+    major_radius: impl Into<Param>,
+    minor_radius: impl Into<Param>,
+) -> Node {
+    Kind::CappedTorus {
+        angle: angle.into(),
+        major_radius: major_radius.into(),
+        minor_radius: minor_radius.into(),
+    }
+    .into()
+}
+
 /// A capped cone along y from radius `bottom_radius` at `-half_height` to
 /// `top_radius` at `+half_height`.
 #[must_use]

@@ -21,9 +21,9 @@ use glam::{DVec2, DVec3};
 use serde::{Deserialize, Serialize};
 
 pub use build::{
-    capped_cone, capsule, cuboid, cut_sphere, cylinder, ellipsoid, hex_prism, julia, kifs, link,
-    mandelbox, mandelbulb, menger, octahedron, plane, round_box, round_cone, sierpinski,
-    solid_angle, sphere, torus,
+    capped_cone, capped_torus, capsule, cuboid, cut_sphere, cylinder, ellipsoid, hex_prism, julia,
+    kifs, link, mandelbox, mandelbulb, menger, octahedron, plane, round_box, round_cone,
+    sierpinski, solid_angle, sphere, torus,
 };
 pub use custom::{
     CpuDistance, CpuInside, CustomShape, INSIDE_HUGE, InsideBounds, MAX_INSIDE_REACH,

@@ -200,6 +200,21 @@ pub enum Kind<S, V, C> {
         /// The ball's radius, at least 0.
         radius: S,
     },
+    /// A torus cut to an arc: the tube of radius `minor_radius` around the
+    /// arc of the circle of radius `major_radius` in the xy plane within
+    /// `angle` of the +y axis, capped by half balls. Exact where the tube
+    /// is no thicker than the arc's radius and its two caps do not meet
+    /// (`minor <= major`, and `minor <= major sin(angle)` past a quarter
+    /// turn short of the whole torus).
+    CappedTorus {
+        /// The arc's half-angle in radians, in `[0, π]` (π: the whole
+        /// torus).
+        angle: S,
+        /// The arc's radius, at least 0.
+        major_radius: S,
+        /// The tube's radius, at least 0.
+        minor_radius: S,
+    },
     /// An axis-aligned ellipsoid. A bound, not exact: outside, the distance
     /// is underestimated away from the axes (Quilez's `k0 (k0 - 1) / k1`,
     /// which is not 1-Lipschitz near thin ellipsoids); inside, the depth is
@@ -409,6 +424,7 @@ impl<S, V, C> Kind<S, V, C> {
             Kind::Link { .. } => "link",
             Kind::CutSphere { .. } => "cut_sphere",
             Kind::SolidAngle { .. } => "solid_angle",
+            Kind::CappedTorus { .. } => "capped_torus",
             Kind::Ellipsoid { .. } => "ellipsoid",
             Kind::Mandelbulb(_) => "mandelbulb",
             Kind::Menger(_) => "menger",
@@ -485,6 +501,7 @@ impl<S, V, C> Kind<S, V, C> {
             | Kind::Link { .. }
             | Kind::CutSphere { .. }
             | Kind::SolidAngle { .. }
+            | Kind::CappedTorus { .. }
             | Kind::Ellipsoid { .. }
             | Kind::Mandelbulb(_)
             | Kind::Menger(_)
@@ -644,6 +661,15 @@ impl<S, V, C> Kind<S, V, C> {
             Kind::SolidAngle { angle, radius } => Kind::SolidAngle {
                 angle: m.scalar(angle, spec("angle", Range(0.0, MAX_SOLID_ANGLE)))?,
                 radius: m.scalar(radius, spec("radius", NonNegative))?,
+            },
+            Kind::CappedTorus {
+                angle,
+                major_radius,
+                minor_radius,
+            } => Kind::CappedTorus {
+                angle: m.scalar(angle, spec("angle", Range(0.0, std::f64::consts::PI)))?,
+                major_radius: m.scalar(major_radius, spec("major_radius", NonNegative))?,
+                minor_radius: m.scalar(minor_radius, spec("minor_radius", NonNegative))?,
             },
             Kind::Ellipsoid { radii } => Kind::Ellipsoid {
                 radii: m.vector(radii, spec("radii", Positive))?,

@@ -11,8 +11,8 @@ use crate::cpu::Ray;
 use crate::scene::{
     Axis, CsgOp, Hybrid, HybridOp, Kifs, KifsFold, Kind, MAX_ESCAPE_ITERATIONS,
     MAX_FOLD_ITERATIONS, MAX_SOLID_ANGLE, Mandelbox, Mandelbulb, Menger, Node, OrbitColoring,
-    Palette, Param, Param3, QuaternionJulia, Sierpinski, Trap, capped_cone, capsule, cuboid,
-    cut_sphere, cylinder, ellipsoid, hex_prism, link, octahedron, param, plane, round_box,
+    Palette, Param, Param3, QuaternionJulia, Sierpinski, Trap, capped_cone, capped_torus, capsule,
+    cuboid, cut_sphere, cylinder, ellipsoid, hex_prism, link, octahedron, param, plane, round_box,
     round_cone, solid_angle, sphere, torus,
 };
 
@@ -254,6 +254,29 @@ pub fn solid_angle_node() -> impl Strategy<Value = Node> + Clone {
         .prop_map(|(a, r)| solid_angle(a, r))
 }
 
+/// A capped torus where it is exact: half-angle in `[0, π]` (often a
+/// quarter turn or the whole torus), arc radius in `[0, 1.5]`, and a tube
+/// no thicker than the arc's radius, nor than `major sin(angle)` past a
+/// quarter turn short of the whole torus (where the end caps would meet).
+pub fn capped_torus_node() -> impl Strategy<Value = Node> + Clone {
+    let angle = prop_oneof![
+        3 => 0.0..=PI,
+        1 => Just(0.0),
+        1 => Just(PI / 2.0),
+        1 => Just(PI),
+    ];
+    (angle, size(MAX_SIZE), 0.0..=1.0f64)
+        .prop_flat_map(|(a, major, t)| {
+            let room = if a > PI / 2.0 && a < PI { a.sin() } else { 1.0 };
+            (
+                scalar("capped_torus.angle", Just(a)),
+                scalar("capped_torus.major", Just(major)),
+                scalar("capped_torus.minor", Just(t * major * room)),
+            )
+        })
+        .prop_map(|(a, major, minor)| capped_torus(a, major, minor))
+}
+
 /// An ellipsoid (a distance bound, not exact) with semi-axes in
 /// `[0.05, 1.5]`.
 pub fn ellipsoid_node() -> impl Strategy<Value = Node> + Clone {
@@ -277,6 +300,7 @@ pub fn exact_primitive() -> impl Strategy<Value = Node> + Clone {
         link_node(),
         cut_sphere_node(),
         solid_angle_node(),
+        capped_torus_node(),
     ]
 }
 

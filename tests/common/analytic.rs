@@ -79,6 +79,14 @@ pub fn exact_distance(node: &Node, p: DVec3) -> Option<f64> {
         Kind::SolidAngle { angle, radius } => {
             solid_angle_distance(p, angle.default_value(), radius.default_value())
         }
+        Kind::CappedTorus {
+            angle,
+            major_radius,
+            minor_radius,
+        } => {
+            arc_distance(p, angle.default_value(), major_radius.default_value())
+                - minor_radius.default_value()
+        }
         Kind::Translate { offset, child } => exact_distance(child, p - offset.default_value())?,
         Kind::Rotate { axis, angle, child } => {
             let rotation = DQuat::from_axis_angle(*axis, angle.default_value());
@@ -373,4 +381,16 @@ pub fn solid_angle_distance(p: DVec3, angle: f64, r: f64) -> f64 {
     } else {
         d
     }
+}
+
+/// Distance to the arc `major (sin t, cos t, 0)`, `|t| <= angle`: the
+/// squared distance is `|p|² + major² − 2 major (x sin t + y cos t)`, whose
+/// last term is `R cos(t − φ)` with `φ` the point's angle from +y in the
+/// xy plane; folded to `x >= 0`, `φ` is in `[0, π]` and the nearest `t`
+/// is `φ` clamped to the arc.
+pub fn arc_distance(p: DVec3, angle: f64, major: f64) -> f64 {
+    let q = DVec3::new(p.x.abs(), p.y, p.z);
+    let phi = q.x.atan2(q.y);
+    let t = phi.min(angle);
+    q.distance(DVec3::new(major * t.sin(), major * t.cos(), 0.0))
 }

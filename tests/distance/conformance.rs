@@ -23,7 +23,7 @@ use fractal_sdf::scene::param3;
 use fractal_sdf::scene::{CustomShape, Rule};
 use fractal_sdf::scene::{
     Hybrid, HybridOp, Kifs, KifsFold, Mandelbox, OrbitColoring, Palette, Trap, capped_cone,
-    cut_sphere, hex_prism, kifs, link, round_cone, solid_angle,
+    capped_torus, cut_sphere, hex_prism, kifs, link, round_cone, solid_angle,
 };
 use fractal_sdf::testing::{check_device_matches_cpu, random_points, spicy_points};
 
@@ -95,6 +95,11 @@ fn nodes() -> Vec<(&'static str, Node)> {
         ("cut_sphere_low", cut_sphere(0.6, -0.4)),
         ("solid_angle", solid_angle(0.7, 0.6)),
         ("solid_angle_wide", solid_angle(2.4, 0.6)),
+        ("capped_torus", capped_torus(1.0, 0.6, 0.15)),
+        (
+            "capped_torus_dynamic_wide",
+            capped_torus(param("arc", 2.6), 0.6, param("tube", 0.2)),
+        ),
         ("mandelbox", mandelbox(-1.5)),
         (
             "mandelbox_julia",

@@ -68,6 +68,7 @@ exact! {
     link_is_exact: testing::link_node();
     cut_sphere_is_exact: testing::cut_sphere_node();
     solid_angle_is_exact: testing::solid_angle_node();
+    capped_torus_is_exact: testing::capped_torus_node();
     transformed_primitives_are_exact: testing::exact_node();
 }
 

@@ -547,6 +547,18 @@ const NODE_FIELDS: &[(&str, &str)] = &[
     ("CutSphere(radius: 1, height: @)", "height"),
     ("SolidAngle(angle: @, radius: 1)", "angle"),
     ("SolidAngle(angle: 0.5, radius: @)", "radius"),
+    (
+        "CappedTorus(angle: @, major_radius: 1, minor_radius: 0.2)",
+        "angle",
+    ),
+    (
+        "CappedTorus(angle: 1, major_radius: @, minor_radius: 0.2)",
+        "major_radius",
+    ),
+    (
+        "CappedTorus(angle: 1, major_radius: 1, minor_radius: @)",
+        "minor_radius",
+    ),
     ("Ellipsoid(radii: @)", "radii"),
     ("Mandelbulb(power: @)", "power"),
     ("Mandelbulb(power: 8, iterations: @)", "iterations"),

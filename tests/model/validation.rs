@@ -274,7 +274,7 @@ use fractal_sdf::scene::ellipsoid;
 use fractal_sdf::scene::octahedron;
 use fractal_sdf::scene::param3;
 use fractal_sdf::scene::{
-    Hybrid, HybridOp, Kifs, KifsFold, MAX_SOLID_ANGLE, cut_sphere, solid_angle,
+    Hybrid, HybridOp, Kifs, KifsFold, MAX_SOLID_ANGLE, capped_torus, cut_sphere, solid_angle,
 };
 use fractal_sdf::scene::{MAX_ESCAPE_ITERATIONS, MAX_FOLD_ITERATIONS};
 use fractal_sdf::scene::{capped_cone, hex_prism, link, round_cone};
@@ -602,6 +602,10 @@ fn broken_node() -> impl Strategy<Value = (Node, &'static str)> {
         bad_size().prop_map(|v| (cut_sphere(v, 0.5), "cut_sphere")),
         bad_size().prop_map(|v| (solid_angle(0.5, v), "solid_angle")),
         outside(0.0, MAX_SOLID_ANGLE).prop_map(|v| (solid_angle(v, 1.0), "solid_angle")),
+        outside(0.0, std::f64::consts::PI)
+            .prop_map(|v| (capped_torus(v, 1.0, 0.2), "capped_torus")),
+        bad_size().prop_map(|v| (capped_torus(1.0, v, 0.2), "capped_torus")),
+        bad_size().prop_map(|v| (capped_torus(1.0, 1.0, v), "capped_torus")),
         prop_oneof![Just(0u32), 257..=u32::MAX]
             .prop_map(|n| (Mandelbulb::new(8.0).iterations(n).into(), "mandelbulb")),
         (21..=u32::MAX).prop_map(|n| (menger(n), "menger")),

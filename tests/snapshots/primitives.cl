@@ -214,6 +214,15 @@ real sd_solid_angle(real3 p, real angle, real r) {
     return (t8 && (t3 <= r)) ? (-fmin(t6, r - t3)) : (t8 ? fmin(t6, t3 - r) : t6);
 }
 
+/* ---- capped_torus ---- */
+real sd_capped_torus(real3 p, real angle, real ra, real rb) {
+    real t0 = fabs(p.x);
+    real t1 = hypot(t0, p.y);
+    bool t2 = angle < atan2(t0, p.y);
+    bool t3 = t1 <= R(1e-30);
+    return length((real3)(t0 - (ra * (t2 ? sin(angle) : (t3 ? R(0.0) : (t0 / t1)))), p.y - (ra * (t2 ? cos(angle) : (t3 ? R(1.0) : (p.y / t1)))), p.z)) - rb;
+}
+
 /* ---- ellipsoid ---- */
 real sd_ellipsoid(real3 p, real3 r) {
     real3 t0 = p / r;
@@ -231,165 +240,176 @@ real sd_ellipsoid(real3 p, real3 r) {
 real DE(real3 p0, __global const real* params) {
     /* union */
     /* union/b:color/plane */
-    real d58 = sd_plane(p0, (real3)(0.0f, 1.0f, 0.0f), 0.4f);
+    real d62 = sd_plane(p0, (real3)(0.0f, 1.0f, 0.0f), 0.4f);
     /* union: the second operand only within reach of its bound */
-    real u60 = d58;
-    real g60 = (length(p0 - ((real3)(-R(2.25), R(0.0), -R(0.6)))) * R(0.9999)) - R(0.35);
-    if (!(g60 > u60 && g60 > R(0.0))) {
+    real u64 = d62;
+    real g64 = (length(p0 - ((real3)(-R(2.625), R(0.0), -R(0.6)))) * R(0.9999)) - R(0.35);
+    if (!(g64 > u64 && g64 > R(0.0))) {
         /* .../a:union/a:union/a:translate */
-        real3 p1 = p0 - ((real3)(-R(2.25), R(0.0), -R(0.6)));
+        real3 p1 = p0 - ((real3)(-R(2.625), R(0.0), -R(0.6)));
         /* .../a:translate/color/sphere */
         real d0 = sd_sphere(p1, 0.35f);
-        real d60 = fmin(d58, d0);
-        u60 = d60;
+        real d64 = fmin(d62, d0);
+        u64 = d64;
     }
     /* union/a:union: the second operand only within reach of its bound */
-    real u57 = u60;
-    real g57 = (length(p0 - ((real3)(-R(1.5), R(0.0), -R(0.6)))) * R(0.9999)) - R(0.5196152422706632);
-    if (!(g57 > u57 && g57 > R(0.0))) {
+    real u61 = u64;
+    real g61 = (length(p0 - ((real3)(-R(1.875), R(0.0), -R(0.6)))) * R(0.9999)) - R(0.5196152422706632);
+    if (!(g61 > u61 && g61 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p2 = p0 - ((real3)(-R(1.5), R(0.0), -R(0.6)));
+        real3 p2 = p0 - ((real3)(-R(1.875), R(0.0), -R(0.6)));
         /* .../b:translate/color/cuboid */
         real d3 = sd_box(p2, (real3)(0.3f));
-        real d57 = fmin(u60, d3);
+        real d61 = fmin(u64, d3);
+        u61 = d61;
+    }
+    /* .../a:union/a:union: the second operand only within reach of its bound */
+    real u57 = u61;
+    real g57 = (length(p0 - ((real3)(-R(1.125), R(0.0), -R(0.6)))) * R(0.9999)) - R(0.5196152422706632);
+    if (!(g57 > u57 && g57 > R(0.0))) {
+        /* .../a:union/a:union/b:translate */
+        real3 p3 = p0 - ((real3)(-R(1.125), R(0.0), -R(0.6)));
+        /* .../b:translate/color/round_box */
+        real d7 = sd_round_box(p3, (real3)(0.3f), 0.08f);
+        real d57 = fmin(u61, d7);
         u57 = d57;
     }
     /* .../a:union/a:union: the second operand only within reach of its bound */
     real u52 = u57;
-    real g52 = (length(p0 - ((real3)(-R(0.75), R(0.0), -R(0.6)))) * R(0.9999)) - R(0.5196152422706632);
+    real g52 = (length(p0 - ((real3)(-R(0.375), R(0.0), -R(0.6)))) * R(0.9999)) - R(0.38);
     if (!(g52 > u52 && g52 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p3 = p0 - ((real3)(-R(0.75), R(0.0), -R(0.6)));
-        /* .../b:translate/color/round_box */
-        real d7 = sd_round_box(p3, (real3)(0.3f), 0.08f);
-        real d52 = fmin(u57, d7);
+        real3 p4 = p0 - ((real3)(-R(0.375), R(0.0), -R(0.6)));
+        /* .../b:translate/color/torus */
+        real d11 = sd_torus(p4, 0.28f, 0.1f);
+        real d52 = fmin(u57, d11);
         u52 = d52;
     }
     /* .../a:union/a:union: the second operand only within reach of its bound */
     real u47 = u52;
-    real g47 = (length(p0 - ((real3)(R(0.0), R(0.0), -R(0.6)))) * R(0.9999)) - R(0.38);
+    real g47 = (length(p0 - ((real3)(R(0.375), R(0.0), -R(0.6)))) * R(0.9999)) - R(0.4301162633521313);
     if (!(g47 > u47 && g47 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p4 = p0 - ((real3)(R(0.0), R(0.0), -R(0.6)));
-        /* .../b:translate/color/torus */
-        real d11 = sd_torus(p4, 0.28f, 0.1f);
-        real d47 = fmin(u52, d11);
+        real3 p5 = p0 - ((real3)(R(0.375), R(0.0), -R(0.6)));
+        /* .../b:translate/color/cylinder */
+        real d15 = sd_cylinder(p5, 0.25f, 0.35f);
+        real d47 = fmin(u52, d15);
         u47 = d47;
     }
     /* .../a:union/a:union: the second operand only within reach of its bound */
     real u42 = u47;
-    real g42 = (length(p0 - ((real3)(R(0.75), R(0.0), -R(0.6)))) * R(0.9999)) - R(0.4301162633521313);
+    real g42 = (length(p0 - ((real3)(R(1.125), R(0.0), -R(0.6)))) * R(0.9999)) - R(0.38);
     if (!(g42 > u42 && g42 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p5 = p0 - ((real3)(R(0.75), R(0.0), -R(0.6)));
-        /* .../b:translate/color/cylinder */
-        real d15 = sd_cylinder(p5, 0.25f, 0.35f);
-        real d42 = fmin(u47, d15);
+        real3 p6 = p0 - ((real3)(R(1.125), R(0.0), -R(0.6)));
+        /* .../b:translate/color/capsule */
+        real d19 = sd_capsule(p6, (real3)(0.0f, (-0.2f), 0.0f), (real3)(0.0f, 0.2f, 0.0f), 0.18f);
+        real d42 = fmin(u47, d19);
         u42 = d42;
     }
     /* .../a:union/a:union: the second operand only within reach of its bound */
     real u38 = u42;
-    real g38 = (length(p0 - ((real3)(R(1.5), R(0.0), -R(0.6)))) * R(0.9999)) - R(0.38);
+    real g38 = (length(p0 - ((real3)(R(1.875), R(0.0), -R(0.6)))) * R(0.9999)) - R(0.4);
     if (!(g38 > u38 && g38 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p6 = p0 - ((real3)(R(1.5), R(0.0), -R(0.6)));
-        /* .../b:translate/color/capsule */
-        real d19 = sd_capsule(p6, (real3)(0.0f, (-0.2f), 0.0f), (real3)(0.0f, 0.2f, 0.0f), 0.18f);
-        real d38 = fmin(u42, d19);
+        real3 p7 = p0 - ((real3)(R(1.875), R(0.0), -R(0.6)));
+        /* .../b:translate/color/octahedron */
+        real d23 = sd_octahedron(p7, 0.4f);
+        real d38 = fmin(u42, d23);
         u38 = d38;
     }
     /* .../a:union/a:union: the second operand only within reach of its bound */
     real u34 = u38;
-    real g34 = (length(p0 - ((real3)(R(2.25), R(0.0), -R(0.6)))) * R(0.9999)) - R(0.4);
+    real g34 = (length(p0 - ((real3)(R(2.625), R(0.0), -R(0.6)))) * R(0.9999)) - R(0.4609772228646443);
     if (!(g34 > u34 && g34 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p7 = p0 - ((real3)(R(2.25), R(0.0), -R(0.6)));
-        /* .../b:translate/color/octahedron */
-        real d23 = sd_octahedron(p7, 0.4f);
-        real d34 = fmin(u38, d23);
+        real3 p8 = p0 - ((real3)(R(2.625), R(0.0), -R(0.6)));
+        /* .../b:translate/color/capped_cone */
+        real d27 = sd_capped_cone(p8, 0.35f, 0.3f, 0.1f);
+        real d34 = fmin(u38, d27);
         u34 = d34;
     }
     /* .../a:union/a:union: the second operand only within reach of its bound */
     real u30 = u34;
-    real g30 = (length(p0 - ((real3)(-R(2.25), R(0.0), R(0.6)))) * R(0.9999)) - R(0.4609772228646443);
+    real g30 = R(0.5714285714285715) * ((length(p0 - ((real3)(-R(2.25), R(0.0), R(0.6)))) * R(0.9999)) - R(0.35));
     if (!(g30 > u30 && g30 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p8 = p0 - ((real3)(-R(2.25), R(0.0), R(0.6)));
-        /* .../b:translate/color/capped_cone */
-        real d27 = sd_capped_cone(p8, 0.35f, 0.3f, 0.1f);
-        real d30 = fmin(u34, d27);
+        real3 p9 = p0 - ((real3)(-R(2.25), R(0.0), R(0.6)));
+        /* .../b:translate/color/ellipsoid */
+        real d31 = sd_ellipsoid(p9, (real3)(0.35f, 0.2f, 0.25f));
+        real d30 = fmin(u34, d31);
         u30 = d30;
     }
     /* .../a:union/a:union: the second operand only within reach of its bound */
     real u26 = u30;
-    real g26 = R(0.5714285714285715) * ((length(p0 - ((real3)(-R(1.5), R(0.0), R(0.6)))) * R(0.9999)) - R(0.35));
+    real g26 = (length(p0 - ((real3)(-R(1.5), R(0.0), R(0.6)))) * R(0.9999)) - R(0.4410593308539491);
     if (!(g26 > u26 && g26 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p9 = p0 - ((real3)(-R(1.5), R(0.0), R(0.6)));
-        /* .../b:translate/color/ellipsoid */
-        real d31 = sd_ellipsoid(p9, (real3)(0.35f, 0.2f, 0.25f));
-        real d26 = fmin(u30, d31);
+        real3 p10 = p0 - ((real3)(-R(1.5), R(0.0), R(0.6)));
+        /* .../b:translate/color/hex_prism */
+        real d35 = sd_hex_prism(p10, 0.28f, 0.3f);
+        real d26 = fmin(u30, d35);
         u26 = d26;
     }
     /* .../a:union/a:union: the second operand only within reach of its bound */
     real u22 = u26;
-    real g22 = (length(p0 - ((real3)(-R(0.75), R(0.0), R(0.6)))) * R(0.9999)) - R(0.4410593308539491);
+    real g22 = (length(p0 - ((real3)(-R(0.75), R(0.0), R(0.6)))) * R(0.9999)) - R(0.44);
     if (!(g22 > u22 && g22 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p10 = p0 - ((real3)(-R(0.75), R(0.0), R(0.6)));
-        /* .../b:translate/color/hex_prism */
-        real d35 = sd_hex_prism(p10, 0.28f, 0.3f);
-        real d22 = fmin(u26, d35);
+        real3 p11 = p0 - ((real3)(-R(0.75), R(0.0), R(0.6)));
+        /* .../b:translate/color/round_cone */
+        real d39 = sd_round_cone(p11, 0.22f, 0.22f, 0.1f);
+        real d22 = fmin(u26, d39);
         u22 = d22;
     }
     /* .../a:union/a:union: the second operand only within reach of its bound */
     real u18 = u22;
-    real g18 = (length(p0 - ((real3)(R(0.0), R(0.0), R(0.6)))) * R(0.9999)) - R(0.44);
+    real g18 = (length(p0 - ((real3)(R(0.0), R(0.0), R(0.6)))) * R(0.9999)) - R(0.41000000000000003);
     if (!(g18 > u18 && g18 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p11 = p0 - ((real3)(R(0.0), R(0.0), R(0.6)));
-        /* .../b:translate/color/round_cone */
-        real d39 = sd_round_cone(p11, 0.22f, 0.22f, 0.1f);
-        real d18 = fmin(u22, d39);
-        u18 = d18;
-    }
-    /* .../a:union/a:union: the second operand only within reach of its bound */
-    real u14 = u18;
-    real g14 = (length(p0 - ((real3)(R(0.75), R(0.0), R(0.6)))) * R(0.9999)) - R(0.41000000000000003);
-    if (!(g14 > u14 && g14 > R(0.0))) {
-        /* .../a:union/a:union/b:translate */
-        real3 p12 = p0 - ((real3)(R(0.75), R(0.0), R(0.6)));
+        real3 p12 = p0 - ((real3)(R(0.0), R(0.0), R(0.6)));
         /* .../b:translate/color/rotate */
         real3 p13 = (real3)((R(0.8775825618903728) * p12.x) - (R(0.479425538604203) * p12.z), p12.y, (R(0.479425538604203) * p12.x) + (R(0.8775825618903728) * p12.z));
         /* .../color/rotate/link */
         real d43 = sd_link(p13, 0.14f, 0.2f, 0.07f);
-        real d14 = fmin(u18, d43);
-        u14 = d14;
+        real d18 = fmin(u22, d43);
+        u18 = d18;
     }
     /* .../a:union/a:union: the second operand only within reach of its bound */
-    real u10 = u14;
-    real g10 = (length(p0 - ((real3)(R(1.5), R(0.05), R(0.6)))) * R(0.9999)) - R(0.35);
-    if (!(g10 > u10 && g10 > R(0.0))) {
+    real u14 = u18;
+    real g14 = (length(p0 - ((real3)(R(0.75), R(0.05), R(0.6)))) * R(0.9999)) - R(0.35);
+    if (!(g14 > u14 && g14 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p14 = p0 - ((real3)(R(1.5), R(0.0), R(0.6)));
+        real3 p14 = p0 - ((real3)(R(0.75), R(0.0), R(0.6)));
         /* .../b:translate/color/translate */
         real3 p15 = p14 - ((real3)(R(0.0), R(0.05), R(0.0)));
         /* .../color/translate/cut_sphere */
         real d48 = sd_cut_sphere(p15, 0.35f, 0.15f);
-        real d10 = fmin(u14, d48);
-        u10 = d10;
+        real d14 = fmin(u18, d48);
+        u14 = d14;
     }
     /* .../a:union/a:union: the second operand only within reach of its bound */
-    real u6 = u10;
-    real g6 = (length(p0 - ((real3)(R(2.25), -R(0.3), R(0.6)))) * R(0.9999)) - R(0.45);
-    if (!(g6 > u6 && g6 > R(0.0))) {
-        /* union/a:union/b:translate */
-        real3 p16 = p0 - ((real3)(R(2.25), R(0.0), R(0.6)));
+    real u10 = u14;
+    real g10 = (length(p0 - ((real3)(R(1.5), -R(0.3), R(0.6)))) * R(0.9999)) - R(0.45);
+    if (!(g10 > u10 && g10 > R(0.0))) {
+        /* .../a:union/a:union/b:translate */
+        real3 p16 = p0 - ((real3)(R(1.5), R(0.0), R(0.6)));
         /* .../b:translate/color/translate */
         real3 p17 = p16 - ((real3)(R(0.0), -R(0.3), R(0.0)));
         /* .../color/translate/solid_angle */
         real d53 = sd_solid_angle(p17, 0.6f, 0.45f);
-        real d6 = fmin(u10, d53);
+        real d10 = fmin(u14, d53);
+        u10 = d10;
+    }
+    /* .../a:union/a:union: the second operand only within reach of its bound */
+    real u6 = u10;
+    real g6 = (length(p0 - ((real3)(R(2.25), R(0.0), R(0.6)))) * R(0.9999)) - R(0.32);
+    if (!(g6 > u6 && g6 > R(0.0))) {
+        /* union/a:union/b:translate */
+        real3 p18 = p0 - ((real3)(R(2.25), R(0.0), R(0.6)));
+        /* .../b:translate/color/capped_torus */
+        real d58 = sd_capped_torus(p18, 2.2f, 0.25f, 0.07f);
+        real d6 = fmin(u10, d58);
         u6 = d6;
     }
     return u6;
@@ -398,42 +418,61 @@ real DE(real3 p0, __global const real* params) {
 real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     /* union */
     /* union/b:color/plane */
-    real d58 = sd_plane(p0, (real3)(0.0f, 1.0f, 0.0f), 0.4f);
+    real d62 = sd_plane(p0, (real3)(0.0f, 1.0f, 0.0f), 0.4f);
     /* union/b:color */
-    real3 c59 = (real3)(0.55f, 0.55f, 0.6f);
+    real3 c63 = (real3)(0.55f, 0.55f, 0.6f);
     /* union: the second operand only within reach of its bound */
-    real u60 = d58;
-    real3 uc60 = c59;
-    real ut60 = R(1.0);
-    real g60 = (length(p0 - ((real3)(-R(2.25), R(0.0), -R(0.6)))) * R(0.9999)) - R(0.35);
-    if (!(g60 > u60 && g60 > R(0.0))) {
+    real u64 = d62;
+    real3 uc64 = c63;
+    real ut64 = R(1.0);
+    real g64 = (length(p0 - ((real3)(-R(2.625), R(0.0), -R(0.6)))) * R(0.9999)) - R(0.35);
+    if (!(g64 > u64 && g64 > R(0.0))) {
         /* .../a:union/a:union/a:translate */
-        real3 p1 = p0 - ((real3)(-R(2.25), R(0.0), -R(0.6)));
+        real3 p1 = p0 - ((real3)(-R(2.625), R(0.0), -R(0.6)));
         /* .../a:translate/color/sphere */
         real d0 = sd_sphere(p1, 0.35f);
         /* .../a:union/a:translate/color */
         real3 c1 = (real3)(0.9f, 0.45f, 0.3f);
-        real d60 = fmin(d58, d0);
-        real3 c60 = d58 < d0 ? c59 : c1;
-        u60 = d60;
-        uc60 = c60;
-        ut60 = R(1.0);
+        real d64 = fmin(d62, d0);
+        real3 c64 = d62 < d0 ? c63 : c1;
+        u64 = d64;
+        uc64 = c64;
+        ut64 = R(1.0);
     }
     /* union/a:union: the second operand only within reach of its bound */
-    real u57 = u60;
-    real3 uc57 = uc60;
-    real ut57 = ut60;
-    real g57 = (length(p0 - ((real3)(-R(1.5), R(0.0), -R(0.6)))) * R(0.9999)) - R(0.5196152422706632);
-    if (!(g57 > u57 && g57 > R(0.0))) {
+    real u61 = u64;
+    real3 uc61 = uc64;
+    real ut61 = ut64;
+    real g61 = (length(p0 - ((real3)(-R(1.875), R(0.0), -R(0.6)))) * R(0.9999)) - R(0.5196152422706632);
+    if (!(g61 > u61 && g61 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p2 = p0 - ((real3)(-R(1.5), R(0.0), -R(0.6)));
+        real3 p2 = p0 - ((real3)(-R(1.875), R(0.0), -R(0.6)));
         /* .../b:translate/color/cuboid */
         real d3 = sd_box(p2, (real3)(0.3f));
         /* .../a:union/b:translate/color */
-        real3 c4 = (real3)(0.85384613f, 0.50384617f, 0.34615386f);
-        real d57 = fmin(u60, d3);
-        real3 c57 = u60 < d3 ? uc60 : c4;
-        real t57 = u60 < d3 ? ut60 : R(1.0);
+        real3 c4 = (real3)(0.85714287f, 0.5f, 0.34285715f);
+        real d61 = fmin(u64, d3);
+        real3 c61 = u64 < d3 ? uc64 : c4;
+        real t61 = u64 < d3 ? ut64 : R(1.0);
+        u61 = d61;
+        uc61 = c61;
+        ut61 = t61;
+    }
+    /* .../a:union/a:union: the second operand only within reach of its bound */
+    real u57 = u61;
+    real3 uc57 = uc61;
+    real ut57 = ut61;
+    real g57 = (length(p0 - ((real3)(-R(1.125), R(0.0), -R(0.6)))) * R(0.9999)) - R(0.5196152422706632);
+    if (!(g57 > u57 && g57 > R(0.0))) {
+        /* .../a:union/a:union/b:translate */
+        real3 p3 = p0 - ((real3)(-R(1.125), R(0.0), -R(0.6)));
+        /* .../b:translate/color/round_box */
+        real d7 = sd_round_box(p3, (real3)(0.3f), 0.08f);
+        /* .../a:union/b:translate/color */
+        real3 c8 = (real3)(0.8142857f, 0.55f, 0.3857143f);
+        real d57 = fmin(u61, d7);
+        real3 c57 = u61 < d7 ? uc61 : c8;
+        real t57 = u61 < d7 ? ut61 : R(1.0);
         u57 = d57;
         uc57 = c57;
         ut57 = t57;
@@ -442,17 +481,17 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     real u52 = u57;
     real3 uc52 = uc57;
     real ut52 = ut57;
-    real g52 = (length(p0 - ((real3)(-R(0.75), R(0.0), -R(0.6)))) * R(0.9999)) - R(0.5196152422706632);
+    real g52 = (length(p0 - ((real3)(-R(0.375), R(0.0), -R(0.6)))) * R(0.9999)) - R(0.38);
     if (!(g52 > u52 && g52 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p3 = p0 - ((real3)(-R(0.75), R(0.0), -R(0.6)));
-        /* .../b:translate/color/round_box */
-        real d7 = sd_round_box(p3, (real3)(0.3f), 0.08f);
+        real3 p4 = p0 - ((real3)(-R(0.375), R(0.0), -R(0.6)));
+        /* .../b:translate/color/torus */
+        real d11 = sd_torus(p4, 0.28f, 0.1f);
         /* .../a:union/b:translate/color */
-        real3 c8 = (real3)(0.8076923f, 0.5576923f, 0.3923077f);
-        real d52 = fmin(u57, d7);
-        real3 c52 = u57 < d7 ? uc57 : c8;
-        real t52 = u57 < d7 ? ut57 : R(1.0);
+        real3 c12 = (real3)(0.7714286f, 0.6f, 0.42857143f);
+        real d52 = fmin(u57, d11);
+        real3 c52 = u57 < d11 ? uc57 : c12;
+        real t52 = u57 < d11 ? ut57 : R(1.0);
         u52 = d52;
         uc52 = c52;
         ut52 = t52;
@@ -461,17 +500,17 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     real u47 = u52;
     real3 uc47 = uc52;
     real ut47 = ut52;
-    real g47 = (length(p0 - ((real3)(R(0.0), R(0.0), -R(0.6)))) * R(0.9999)) - R(0.38);
+    real g47 = (length(p0 - ((real3)(R(0.375), R(0.0), -R(0.6)))) * R(0.9999)) - R(0.4301162633521313);
     if (!(g47 > u47 && g47 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p4 = p0 - ((real3)(R(0.0), R(0.0), -R(0.6)));
-        /* .../b:translate/color/torus */
-        real d11 = sd_torus(p4, 0.28f, 0.1f);
+        real3 p5 = p0 - ((real3)(R(0.375), R(0.0), -R(0.6)));
+        /* .../b:translate/color/cylinder */
+        real d15 = sd_cylinder(p5, 0.25f, 0.35f);
         /* .../a:union/b:translate/color */
-        real3 c12 = (real3)(0.76153845f, 0.61153847f, 0.43846154f);
-        real d47 = fmin(u52, d11);
-        real3 c47 = u52 < d11 ? uc52 : c12;
-        real t47 = u52 < d11 ? ut52 : R(1.0);
+        real3 c16 = (real3)(0.7285714f, 0.65f, 0.47142857f);
+        real d47 = fmin(u52, d15);
+        real3 c47 = u52 < d15 ? uc52 : c16;
+        real t47 = u52 < d15 ? ut52 : R(1.0);
         u47 = d47;
         uc47 = c47;
         ut47 = t47;
@@ -480,17 +519,17 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     real u42 = u47;
     real3 uc42 = uc47;
     real ut42 = ut47;
-    real g42 = (length(p0 - ((real3)(R(0.75), R(0.0), -R(0.6)))) * R(0.9999)) - R(0.4301162633521313);
+    real g42 = (length(p0 - ((real3)(R(1.125), R(0.0), -R(0.6)))) * R(0.9999)) - R(0.38);
     if (!(g42 > u42 && g42 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p5 = p0 - ((real3)(R(0.75), R(0.0), -R(0.6)));
-        /* .../b:translate/color/cylinder */
-        real d15 = sd_cylinder(p5, 0.25f, 0.35f);
+        real3 p6 = p0 - ((real3)(R(1.125), R(0.0), -R(0.6)));
+        /* .../b:translate/color/capsule */
+        real d19 = sd_capsule(p6, (real3)(0.0f, (-0.2f), 0.0f), (real3)(0.0f, 0.2f, 0.0f), 0.18f);
         /* .../a:union/b:translate/color */
-        real3 c16 = (real3)(0.7153846f, 0.6653846f, 0.4846154f);
-        real d42 = fmin(u47, d15);
-        real3 c42 = u47 < d15 ? uc47 : c16;
-        real t42 = u47 < d15 ? ut47 : R(1.0);
+        real3 c20 = (real3)(0.6857143f, 0.7f, 0.51428574f);
+        real d42 = fmin(u47, d19);
+        real3 c42 = u47 < d19 ? uc47 : c20;
+        real t42 = u47 < d19 ? ut47 : R(1.0);
         u42 = d42;
         uc42 = c42;
         ut42 = t42;
@@ -499,17 +538,17 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     real u38 = u42;
     real3 uc38 = uc42;
     real ut38 = ut42;
-    real g38 = (length(p0 - ((real3)(R(1.5), R(0.0), -R(0.6)))) * R(0.9999)) - R(0.38);
+    real g38 = (length(p0 - ((real3)(R(1.875), R(0.0), -R(0.6)))) * R(0.9999)) - R(0.4);
     if (!(g38 > u38 && g38 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p6 = p0 - ((real3)(R(1.5), R(0.0), -R(0.6)));
-        /* .../b:translate/color/capsule */
-        real d19 = sd_capsule(p6, (real3)(0.0f, (-0.2f), 0.0f), (real3)(0.0f, 0.2f, 0.0f), 0.18f);
+        real3 p7 = p0 - ((real3)(R(1.875), R(0.0), -R(0.6)));
+        /* .../b:translate/color/octahedron */
+        real d23 = sd_octahedron(p7, 0.4f);
         /* .../a:union/b:translate/color */
-        real3 c20 = (real3)(0.66923076f, 0.7192308f, 0.5307692f);
-        real d38 = fmin(u42, d19);
-        real3 c38 = u42 < d19 ? uc42 : c20;
-        real t38 = u42 < d19 ? ut42 : R(1.0);
+        real3 c24 = (real3)(0.64285713f, 0.75f, 0.55714285f);
+        real d38 = fmin(u42, d23);
+        real3 c38 = u42 < d23 ? uc42 : c24;
+        real t38 = u42 < d23 ? ut42 : R(1.0);
         u38 = d38;
         uc38 = c38;
         ut38 = t38;
@@ -518,17 +557,17 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     real u34 = u38;
     real3 uc34 = uc38;
     real ut34 = ut38;
-    real g34 = (length(p0 - ((real3)(R(2.25), R(0.0), -R(0.6)))) * R(0.9999)) - R(0.4);
+    real g34 = (length(p0 - ((real3)(R(2.625), R(0.0), -R(0.6)))) * R(0.9999)) - R(0.4609772228646443);
     if (!(g34 > u34 && g34 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p7 = p0 - ((real3)(R(2.25), R(0.0), -R(0.6)));
-        /* .../b:translate/color/octahedron */
-        real d23 = sd_octahedron(p7, 0.4f);
+        real3 p8 = p0 - ((real3)(R(2.625), R(0.0), -R(0.6)));
+        /* .../b:translate/color/capped_cone */
+        real d27 = sd_capped_cone(p8, 0.35f, 0.3f, 0.1f);
         /* .../a:union/b:translate/color */
-        real3 c24 = (real3)(0.6230769f, 0.77307695f, 0.5769231f);
-        real d34 = fmin(u38, d23);
-        real3 c34 = u38 < d23 ? uc38 : c24;
-        real t34 = u38 < d23 ? ut38 : R(1.0);
+        real3 c28 = (real3)(0.6f, 0.8f, 0.6f);
+        real d34 = fmin(u38, d27);
+        real3 c34 = u38 < d27 ? uc38 : c28;
+        real t34 = u38 < d27 ? ut38 : R(1.0);
         u34 = d34;
         uc34 = c34;
         ut34 = t34;
@@ -537,17 +576,17 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     real u30 = u34;
     real3 uc30 = uc34;
     real ut30 = ut34;
-    real g30 = (length(p0 - ((real3)(-R(2.25), R(0.0), R(0.6)))) * R(0.9999)) - R(0.4609772228646443);
+    real g30 = R(0.5714285714285715) * ((length(p0 - ((real3)(-R(2.25), R(0.0), R(0.6)))) * R(0.9999)) - R(0.35));
     if (!(g30 > u30 && g30 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p8 = p0 - ((real3)(-R(2.25), R(0.0), R(0.6)));
-        /* .../b:translate/color/capped_cone */
-        real d27 = sd_capped_cone(p8, 0.35f, 0.3f, 0.1f);
+        real3 p9 = p0 - ((real3)(-R(2.25), R(0.0), R(0.6)));
+        /* .../b:translate/color/ellipsoid */
+        real d31 = sd_ellipsoid(p9, (real3)(0.35f, 0.2f, 0.25f));
         /* .../a:union/b:translate/color */
-        real3 c28 = (real3)(0.5769231f, 0.77307695f, 0.6230769f);
-        real d30 = fmin(u34, d27);
-        real3 c30 = u34 < d27 ? uc34 : c28;
-        real t30 = u34 < d27 ? ut34 : R(1.0);
+        real3 c32 = (real3)(0.55714285f, 0.75f, 0.64285713f);
+        real d30 = fmin(u34, d31);
+        real3 c30 = u34 < d31 ? uc34 : c32;
+        real t30 = u34 < d31 ? ut34 : R(1.0);
         u30 = d30;
         uc30 = c30;
         ut30 = t30;
@@ -556,17 +595,17 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     real u26 = u30;
     real3 uc26 = uc30;
     real ut26 = ut30;
-    real g26 = R(0.5714285714285715) * ((length(p0 - ((real3)(-R(1.5), R(0.0), R(0.6)))) * R(0.9999)) - R(0.35));
+    real g26 = (length(p0 - ((real3)(-R(1.5), R(0.0), R(0.6)))) * R(0.9999)) - R(0.4410593308539491);
     if (!(g26 > u26 && g26 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p9 = p0 - ((real3)(-R(1.5), R(0.0), R(0.6)));
-        /* .../b:translate/color/ellipsoid */
-        real d31 = sd_ellipsoid(p9, (real3)(0.35f, 0.2f, 0.25f));
+        real3 p10 = p0 - ((real3)(-R(1.5), R(0.0), R(0.6)));
+        /* .../b:translate/color/hex_prism */
+        real d35 = sd_hex_prism(p10, 0.28f, 0.3f);
         /* .../a:union/b:translate/color */
-        real3 c32 = (real3)(0.5307692f, 0.7192308f, 0.66923076f);
-        real d26 = fmin(u30, d31);
-        real3 c26 = u30 < d31 ? uc30 : c32;
-        real t26 = u30 < d31 ? ut30 : R(1.0);
+        real3 c36 = (real3)(0.51428574f, 0.7f, 0.6857143f);
+        real d26 = fmin(u30, d35);
+        real3 c26 = u30 < d35 ? uc30 : c36;
+        real t26 = u30 < d35 ? ut30 : R(1.0);
         u26 = d26;
         uc26 = c26;
         ut26 = t26;
@@ -575,17 +614,17 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     real u22 = u26;
     real3 uc22 = uc26;
     real ut22 = ut26;
-    real g22 = (length(p0 - ((real3)(-R(0.75), R(0.0), R(0.6)))) * R(0.9999)) - R(0.4410593308539491);
+    real g22 = (length(p0 - ((real3)(-R(0.75), R(0.0), R(0.6)))) * R(0.9999)) - R(0.44);
     if (!(g22 > u22 && g22 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p10 = p0 - ((real3)(-R(0.75), R(0.0), R(0.6)));
-        /* .../b:translate/color/hex_prism */
-        real d35 = sd_hex_prism(p10, 0.28f, 0.3f);
+        real3 p11 = p0 - ((real3)(-R(0.75), R(0.0), R(0.6)));
+        /* .../b:translate/color/round_cone */
+        real d39 = sd_round_cone(p11, 0.22f, 0.22f, 0.1f);
         /* .../a:union/b:translate/color */
-        real3 c36 = (real3)(0.4846154f, 0.6653846f, 0.7153846f);
-        real d22 = fmin(u26, d35);
-        real3 c22 = u26 < d35 ? uc26 : c36;
-        real t22 = u26 < d35 ? ut26 : R(1.0);
+        real3 c40 = (real3)(0.47142857f, 0.65f, 0.7285714f);
+        real d22 = fmin(u26, d39);
+        real3 c22 = u26 < d39 ? uc26 : c40;
+        real t22 = u26 < d39 ? ut26 : R(1.0);
         u22 = d22;
         uc22 = c22;
         ut22 = t22;
@@ -594,17 +633,19 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     real u18 = u22;
     real3 uc18 = uc22;
     real ut18 = ut22;
-    real g18 = (length(p0 - ((real3)(R(0.0), R(0.0), R(0.6)))) * R(0.9999)) - R(0.44);
+    real g18 = (length(p0 - ((real3)(R(0.0), R(0.0), R(0.6)))) * R(0.9999)) - R(0.41000000000000003);
     if (!(g18 > u18 && g18 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p11 = p0 - ((real3)(R(0.0), R(0.0), R(0.6)));
-        /* .../b:translate/color/round_cone */
-        real d39 = sd_round_cone(p11, 0.22f, 0.22f, 0.1f);
+        real3 p12 = p0 - ((real3)(R(0.0), R(0.0), R(0.6)));
+        /* .../b:translate/color/rotate */
+        real3 p13 = (real3)((R(0.8775825618903728) * p12.x) - (R(0.479425538604203) * p12.z), p12.y, (R(0.479425538604203) * p12.x) + (R(0.8775825618903728) * p12.z));
+        /* .../color/rotate/link */
+        real d43 = sd_link(p13, 0.14f, 0.2f, 0.07f);
         /* .../a:union/b:translate/color */
-        real3 c40 = (real3)(0.43846154f, 0.61153847f, 0.76153845f);
-        real d18 = fmin(u22, d39);
-        real3 c18 = u22 < d39 ? uc22 : c40;
-        real t18 = u22 < d39 ? ut22 : R(1.0);
+        real3 c45 = (real3)(0.42857143f, 0.6f, 0.7714286f);
+        real d18 = fmin(u22, d43);
+        real3 c18 = u22 < d43 ? uc22 : c45;
+        real t18 = u22 < d43 ? ut22 : R(1.0);
         u18 = d18;
         uc18 = c18;
         ut18 = t18;
@@ -613,19 +654,19 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     real u14 = u18;
     real3 uc14 = uc18;
     real ut14 = ut18;
-    real g14 = (length(p0 - ((real3)(R(0.75), R(0.0), R(0.6)))) * R(0.9999)) - R(0.41000000000000003);
+    real g14 = (length(p0 - ((real3)(R(0.75), R(0.05), R(0.6)))) * R(0.9999)) - R(0.35);
     if (!(g14 > u14 && g14 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p12 = p0 - ((real3)(R(0.75), R(0.0), R(0.6)));
-        /* .../b:translate/color/rotate */
-        real3 p13 = (real3)((R(0.8775825618903728) * p12.x) - (R(0.479425538604203) * p12.z), p12.y, (R(0.479425538604203) * p12.x) + (R(0.8775825618903728) * p12.z));
-        /* .../color/rotate/link */
-        real d43 = sd_link(p13, 0.14f, 0.2f, 0.07f);
+        real3 p14 = p0 - ((real3)(R(0.75), R(0.0), R(0.6)));
+        /* .../b:translate/color/translate */
+        real3 p15 = p14 - ((real3)(R(0.0), R(0.05), R(0.0)));
+        /* .../color/translate/cut_sphere */
+        real d48 = sd_cut_sphere(p15, 0.35f, 0.15f);
         /* .../a:union/b:translate/color */
-        real3 c45 = (real3)(0.3923077f, 0.5576923f, 0.8076923f);
-        real d14 = fmin(u18, d43);
-        real3 c14 = u18 < d43 ? uc18 : c45;
-        real t14 = u18 < d43 ? ut18 : R(1.0);
+        real3 c50 = (real3)(0.3857143f, 0.55f, 0.8142857f);
+        real d14 = fmin(u18, d48);
+        real3 c14 = u18 < d48 ? uc18 : c50;
+        real t14 = u18 < d48 ? ut18 : R(1.0);
         u14 = d14;
         uc14 = c14;
         ut14 = t14;
@@ -634,19 +675,19 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     real u10 = u14;
     real3 uc10 = uc14;
     real ut10 = ut14;
-    real g10 = (length(p0 - ((real3)(R(1.5), R(0.05), R(0.6)))) * R(0.9999)) - R(0.35);
+    real g10 = (length(p0 - ((real3)(R(1.5), -R(0.3), R(0.6)))) * R(0.9999)) - R(0.45);
     if (!(g10 > u10 && g10 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p14 = p0 - ((real3)(R(1.5), R(0.0), R(0.6)));
+        real3 p16 = p0 - ((real3)(R(1.5), R(0.0), R(0.6)));
         /* .../b:translate/color/translate */
-        real3 p15 = p14 - ((real3)(R(0.0), R(0.05), R(0.0)));
-        /* .../color/translate/cut_sphere */
-        real d48 = sd_cut_sphere(p15, 0.35f, 0.15f);
+        real3 p17 = p16 - ((real3)(R(0.0), -R(0.3), R(0.0)));
+        /* .../color/translate/solid_angle */
+        real d53 = sd_solid_angle(p17, 0.6f, 0.45f);
         /* .../a:union/b:translate/color */
-        real3 c50 = (real3)(0.34615386f, 0.50384617f, 0.85384613f);
-        real d10 = fmin(u14, d48);
-        real3 c10 = u14 < d48 ? uc14 : c50;
-        real t10 = u14 < d48 ? ut14 : R(1.0);
+        real3 c55 = (real3)(0.34285715f, 0.5f, 0.85714287f);
+        real d10 = fmin(u14, d53);
+        real3 c10 = u14 < d53 ? uc14 : c55;
+        real t10 = u14 < d53 ? ut14 : R(1.0);
         u10 = d10;
         uc10 = c10;
         ut10 = t10;
@@ -655,19 +696,17 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     real u6 = u10;
     real3 uc6 = uc10;
     real ut6 = ut10;
-    real g6 = (length(p0 - ((real3)(R(2.25), -R(0.3), R(0.6)))) * R(0.9999)) - R(0.45);
+    real g6 = (length(p0 - ((real3)(R(2.25), R(0.0), R(0.6)))) * R(0.9999)) - R(0.32);
     if (!(g6 > u6 && g6 > R(0.0))) {
         /* union/a:union/b:translate */
-        real3 p16 = p0 - ((real3)(R(2.25), R(0.0), R(0.6)));
-        /* .../b:translate/color/translate */
-        real3 p17 = p16 - ((real3)(R(0.0), -R(0.3), R(0.0)));
-        /* .../color/translate/solid_angle */
-        real d53 = sd_solid_angle(p17, 0.6f, 0.45f);
+        real3 p18 = p0 - ((real3)(R(2.25), R(0.0), R(0.6)));
+        /* .../b:translate/color/capped_torus */
+        real d58 = sd_capped_torus(p18, 2.2f, 0.25f, 0.07f);
         /* .../a:union/b:translate/color */
-        real3 c55 = (real3)(0.3f, 0.45f, 0.9f);
-        real d6 = fmin(u10, d53);
-        real3 c6 = u10 < d53 ? uc10 : c55;
-        real t6 = u10 < d53 ? ut10 : R(1.0);
+        real3 c59 = (real3)(0.3f, 0.45f, 0.9f);
+        real d6 = fmin(u10, d58);
+        real3 c6 = u10 < d58 ? uc10 : c59;
+        real t6 = u10 < d58 ? ut10 : R(1.0);
         u6 = d6;
         uc6 = c6;
         ut6 = t6;

@@ -99,6 +99,7 @@ fn leaf_function(node: &IrNode) -> Option<(Helper, &'static str)> {
         Kind::Link { .. } => (Helper::Link, "sd_link"),
         Kind::CutSphere { .. } => (Helper::CutSphere, "sd_cut_sphere"),
         Kind::SolidAngle { .. } => (Helper::SolidAngle, "sd_solid_angle"),
+        Kind::CappedTorus { .. } => (Helper::CappedTorus, "sd_capped_torus"),
         Kind::Ellipsoid { .. } => (Helper::Ellipsoid, "sd_ellipsoid"),
         _ => return None,
     })

@@ -238,6 +238,29 @@ pub fn solid_angle<T: Num>(p: V3<T>, angle: T, r: T) -> T {
     )
 }
 
+/// Exact distance to the tube of radius `minor` around the arc of the
+/// circle of radius `major` in the xy plane within `angle` of +y (where
+/// `minor <= major` and the end caps do not meet): the distance to the
+/// arc's nearest point, minus `minor`. Folded to `x >= 0`, the nearest
+/// point is the point's own direction on the circle while its angle from
+/// +y is within the arc's, else the arc's end; measured as the length of
+/// the difference, with no cancellation near the arc.
+#[must_use]
+pub fn capped_torus<T: Num>(p: V3<T>, angle: T, major: T, minor: T) -> T {
+    let (s, c) = (angle.sin(), angle.cos());
+    let x = p.x.abs();
+    let rho = x.hypot(p.y);
+    // Past the end: the point's angle from +y beyond the arc's (a cross
+    // product's sign cannot tell the ray opposite the end from the end).
+    let past = x.atan2(p.y).gt(angle);
+    let on_axis = rho.le(T::tiny());
+    let (ux, uy) = (
+        T::select(past, s, T::select(on_axis, T::zero(), x / rho)),
+        T::select(past, c, T::select(on_axis, T::one(), p.y / rho)),
+    );
+    T::length3(x - major * ux, p.y - major * uy, p.z) - minor
+}
+
 /// A distance bound for an axis-aligned ellipsoid with semi-axes `r`.
 ///
 /// Outside, Quilez's `k0 (k0 - 1) / k1` with `k0 = |p / r|` and
