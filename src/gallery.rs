@@ -20,9 +20,10 @@ use crate::file::SceneFile;
 use crate::quality::{Effects, Glow, Quality};
 use crate::scene::{
     Axis, Camera, Hybrid, HybridOp, InsideShape, Kifs, KifsFold, Light, Mandelbulb, Material, Node,
-    OrbitColoring, Palette, QuaternionJulia, Scene, Trap, capped_cone, capped_torus, capsule,
-    cuboid, cut_sphere, cylinder, ellipsoid, hex_prism, julia, link, menger, octahedron, param,
-    param3, plane, round_box, round_cone, sierpinski, solid_angle, sphere, torus,
+    OrbitColoring, Palette, Profile, QuaternionJulia, Scene, Trap, capped_cone, capped_torus,
+    capsule, cone_between, cuboid, cut_sphere, cylinder, cylinder_between, ellipsoid, extrude,
+    hex_prism, julia, link, menger, octahedron, param, param3, plane, revolve, round_box,
+    round_cone, round_cone_between, sierpinski, solid_angle, sphere, torus,
 };
 
 /// Every gallery scene by name.
@@ -46,6 +47,7 @@ pub fn all() -> Vec<(&'static str, Scene)> {
         ("kifs", kifs()),
         ("hybrid", hybrid()),
         ("orbit_traps", orbit_traps()),
+        ("profiles", profiles()),
     ]
 }
 
@@ -447,6 +449,70 @@ pub fn orbit_traps() -> Scene {
         .with_lights(key_and_fill())
 }
 
+/// Solids made from plane profiles ([`extrude`], [`revolve`]): a star and
+/// an arrow extruded, a goblet, a lampshade and a ring of rounded-square
+/// section revolved.
+#[must_use]
+pub fn profiles() -> Scene {
+    let star = extrude(
+        Profile::polygon((0..10).map(|i| {
+            let r = if i % 2 == 0 { 0.42 } else { 0.17 };
+            let a = f64::from(i) * std::f64::consts::PI / 5.0;
+            [r * a.sin(), r * a.cos()]
+        })),
+        0.06,
+    )
+    .color(dvec3(0.95, 0.7, 0.2))
+    .rotate(DVec3::Y, 0.35)
+    .translate(dvec3(-1.3, -0.03, -0.45));
+    let goblet = revolve(
+        Profile::polygon([
+            [0.0, -0.45],
+            [0.3, -0.45],
+            [0.3, -0.41],
+            [0.05, -0.36],
+            [0.04, 0.0],
+            [0.3, 0.12],
+            [0.33, 0.45],
+            [0.3, 0.45],
+            [0.27, 0.15],
+            [0.0, 0.06],
+        ]),
+        0.0,
+    )
+    .color(dvec3(0.75, 0.85, 0.95))
+    .translate(dvec3(-0.45, 0.0, -0.6));
+    let shade = revolve(Profile::segment([0.32, -0.2], [0.14, 0.2], 0.025), 0.0)
+        .color(dvec3(0.9, 0.35, 0.3))
+        .translate(dvec3(0.5, -0.225, -0.55));
+    let ring = revolve(Profile::round_rect(0.09, 0.09, 0.03), 0.3)
+        .color(dvec3(0.3, 0.6, 0.95))
+        .rotate(DVec3::X, 1.2)
+        .translate(dvec3(1.3, -0.085, -0.45));
+    let arrow = extrude(
+        Profile::polygon([
+            [-0.5, -0.07],
+            [0.15, -0.07],
+            [0.15, -0.2],
+            [0.45, 0.0],
+            [0.15, 0.2],
+            [0.15, 0.07],
+            [-0.5, 0.07],
+        ]),
+        0.05,
+    )
+    .color(dvec3(0.4, 0.8, 0.45))
+    .rotate(DVec3::X, -FRAC_PI_2)
+    .translate(dvec3(0.05, -0.4, 0.45));
+    let all = [star, goblet, shade, ring, arrow]
+        .into_iter()
+        .reduce(Node::union)
+        .expect("five solids");
+    Scene::new(all.union(floor(0.45)))
+        .with_camera(Camera::look_at(dvec3(0.0, 1.2, 3.0), dvec3(0.0, -0.2, -0.1)).fov(48.0))
+        .with_lights(key_and_fill())
+}
+
 /// Smooth union, subtraction and intersection of transformed primitives.
 #[must_use]
 pub fn csg() -> Scene {
@@ -491,6 +557,9 @@ pub fn primitives() -> Scene {
         cut_sphere(0.35, 0.15).translate(dvec3(0.0, 0.05, 0.0)),
         solid_angle(0.6, 0.45).translate(dvec3(0.0, -0.3, 0.0)),
         capped_torus(2.2, 0.25, 0.07),
+        cylinder_between(dvec3(-0.2, -0.3, 0.0), dvec3(0.15, 0.25, 0.0), 0.12),
+        cone_between(dvec3(0.2, -0.25, 0.0), dvec3(-0.15, 0.3, 0.0), 0.22, 0.05),
+        round_cone_between(dvec3(-0.15, -0.2, 0.0), dvec3(0.2, 0.25, 0.0), 0.16, 0.07),
     ];
     let count = items.len();
     let row = items
@@ -504,19 +573,19 @@ pub fn primitives() -> Scene {
                 0.45 + 0.35 * (1.0 - (2.0 * t - 1.0).abs()),
                 0.3 + 0.6 * t,
             );
-            // Eight in the back row, seven in front, 0.75 apart.
+            // Nine in each row, 0.8 apart.
             #[allow(clippy::cast_precision_loss)]
-            let (column, z) = if i < 8 {
-                (i as f64 - 3.5, -0.6)
+            let (column, z) = if i < 9 {
+                (i as f64 - 4.0, -0.75)
             } else {
-                ((i - 8) as f64 - 3.0, 0.6)
+                ((i - 9) as f64 - 4.0, 0.75)
             };
-            node.color(hue).translate(dvec3(column * 0.75, 0.0, z))
+            node.color(hue).translate(dvec3(column * 0.8, 0.0, z))
         })
         .reduce(Node::union)
-        .expect("fifteen primitives");
+        .expect("eighteen primitives");
     Scene::new(row.union(floor(0.4)))
-        .with_camera(Camera::look_at(dvec3(0.0, 2.3, 5.4), dvec3(0.0, -0.15, 0.0)).fov(45.0))
+        .with_camera(Camera::look_at(dvec3(0.0, 4.0, 6.4), dvec3(0.0, 0.0, 0.6)).fov(44.0))
         .with_lights(key_and_fill())
 }
 

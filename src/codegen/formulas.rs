@@ -142,6 +142,30 @@ pub(crate) fn link() -> Result<String, Unprintable> {
     )
 }
 
+pub(crate) fn cylinder_between() -> Result<String, Unprintable> {
+    distance(
+        "sd_cylinder_between",
+        &[("a", Vec3), ("b", Vec3), ("r", Scalar)],
+        |p, a| sdf::cylinder_between(p, vector(a, 0), vector(a, 3), a[6]),
+    )
+}
+
+pub(crate) fn cone_between() -> Result<String, Unprintable> {
+    distance(
+        "sd_cone_between",
+        &[("a", Vec3), ("b", Vec3), ("ra", Scalar), ("rb", Scalar)],
+        |p, a| sdf::cone_between(p, vector(a, 0), vector(a, 3), a[6], a[7]),
+    )
+}
+
+pub(crate) fn round_cone_between() -> Result<String, Unprintable> {
+    distance(
+        "sd_round_cone_between",
+        &[("a", Vec3), ("b", Vec3), ("ra", Scalar), ("rb", Scalar)],
+        |p, a| sdf::round_cone_between(p, vector(a, 0), vector(a, 3), a[6], a[7]),
+    )
+}
+
 pub(crate) fn ellipsoid() -> Result<String, Unprintable> {
     distance("sd_ellipsoid", &[("r", Vec3)], |p, a| {
         sdf::ellipsoid(p, vector(a, 0))

@@ -25,6 +25,9 @@ pub(crate) enum Helper {
     CutSphere,
     SolidAngle,
     CappedTorus,
+    CylinderBetween,
+    ConeBetween,
+    RoundConeBetween,
     Ellipsoid,
     Mandelbulb,
     Menger,
@@ -38,7 +41,7 @@ pub(crate) enum Helper {
 
 impl Helper {
     /// Every helper, in the order they are emitted.
-    pub(crate) const ALL: [Helper; 30] = [
+    pub(crate) const ALL: [Helper; 33] = [
         Helper::Sphere,
         Helper::Cuboid,
         Helper::RoundBox,
@@ -54,6 +57,9 @@ impl Helper {
         Helper::CutSphere,
         Helper::SolidAngle,
         Helper::CappedTorus,
+        Helper::CylinderBetween,
+        Helper::ConeBetween,
+        Helper::RoundConeBetween,
         Helper::Ellipsoid,
         Helper::Mandelbulb,
         Helper::Menger,
@@ -89,6 +95,9 @@ impl Helper {
             Helper::CutSphere => "cut_sphere",
             Helper::SolidAngle => "solid_angle",
             Helper::CappedTorus => "capped_torus",
+            Helper::CylinderBetween => "cylinder_between",
+            Helper::ConeBetween => "cone_between",
+            Helper::RoundConeBetween => "round_cone_between",
             Helper::Ellipsoid => "ellipsoid",
             Helper::Mandelbulb => "mandelbulb",
             Helper::Menger => "menger",
@@ -127,6 +136,9 @@ impl Helper {
             Helper::CutSphere => formulas::cut_sphere(),
             Helper::SolidAngle => formulas::solid_angle(),
             Helper::CappedTorus => formulas::capped_torus(),
+            Helper::CylinderBetween => formulas::cylinder_between(),
+            Helper::ConeBetween => formulas::cone_between(),
+            Helper::RoundConeBetween => formulas::round_cone_between(),
             Helper::Ellipsoid => formulas::ellipsoid(),
             Helper::Mandelbulb
             | Helper::Menger

@@ -411,6 +411,40 @@ impl Evaluator {
                 s(*major_radius),
                 s(*minor_radius),
             )),
+            Kind::CylinderBetween { a, b, radius } => {
+                Self::leaf(sdf::cylinder_between(p, v(*a), v(*b), s(*radius)))
+            }
+            Kind::ConeBetween {
+                a,
+                b,
+                radius_a,
+                radius_b,
+            } => Self::leaf(sdf::cone_between(
+                p,
+                v(*a),
+                v(*b),
+                s(*radius_a),
+                s(*radius_b),
+            )),
+            Kind::RoundConeBetween {
+                a,
+                b,
+                radius_a,
+                radius_b,
+            } => Self::leaf(sdf::round_cone_between(
+                p,
+                v(*a),
+                v(*b),
+                s(*radius_a),
+                s(*radius_b),
+            )),
+            Kind::Extrude {
+                profile,
+                half_height,
+            } => Self::leaf(sdf::extrude(p, &profile.map(|x| s(*x)), s(*half_height))),
+            Kind::Revolve { profile, offset } => {
+                Self::leaf(sdf::revolve(p, &profile.map(|x| s(*x)), s(*offset)))
+            }
             Kind::Ellipsoid { radii } => Self::leaf(sdf::ellipsoid(p, v(*radii))),
             Kind::Mandelbulb(_)
             | Kind::Menger(_)

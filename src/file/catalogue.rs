@@ -32,7 +32,7 @@ const REFERENCE: &str = include_str!("reference.md");
 /// independent oracle within 1e-13 by the crate's tests (the torus and the
 /// link where the tube is no thicker than its major radius); a test checks
 /// that this list is exactly the primitives those tests draw.
-const EXACT: [&str; 15] = [
+const EXACT: [&str; 20] = [
     "Sphere",
     "Cuboid",
     "RoundBox",
@@ -48,6 +48,11 @@ const EXACT: [&str; 15] = [
     "CutSphere",
     "SolidAngle",
     "CappedTorus",
+    "CylinderBetween",
+    "ConeBetween",
+    "RoundConeBetween",
+    "Extrude",
+    "Revolve",
 ];
 
 /// What kind of node a scene-file node is.

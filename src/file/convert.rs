@@ -142,6 +142,37 @@ impl NodeRepr {
                 major_radius,
                 minor_radius,
             },
+            Kind::CylinderBetween { a, b, radius } => NodeRepr::CylinderBetween { a, b, radius },
+            Kind::ConeBetween {
+                a,
+                b,
+                radius_a,
+                radius_b,
+            } => NodeRepr::ConeBetween {
+                a,
+                b,
+                radius_a,
+                radius_b,
+            },
+            Kind::RoundConeBetween {
+                a,
+                b,
+                radius_a,
+                radius_b,
+            } => NodeRepr::RoundConeBetween {
+                a,
+                b,
+                radius_a,
+                radius_b,
+            },
+            Kind::Extrude {
+                profile,
+                half_height,
+            } => NodeRepr::Extrude {
+                profile,
+                half_height,
+            },
+            Kind::Revolve { profile, offset } => NodeRepr::Revolve { profile, offset },
             Kind::Ellipsoid { radii } => NodeRepr::Ellipsoid { radii },
             Kind::Mandelbulb(Mandelbulb {
                 power,
@@ -452,6 +483,49 @@ impl Located<NodeRepr> {
             NodeRepr::SolidAngle { angle, radius } => Kind::SolidAngle {
                 angle: angle.clone(),
                 radius: radius.clone(),
+            }
+            .into(),
+            NodeRepr::CylinderBetween { a, b, radius } => Kind::CylinderBetween {
+                a: a.clone(),
+                b: b.clone(),
+                radius: radius.clone(),
+            }
+            .into(),
+            NodeRepr::ConeBetween {
+                a,
+                b,
+                radius_a,
+                radius_b,
+            } => Kind::ConeBetween {
+                a: a.clone(),
+                b: b.clone(),
+                radius_a: radius_a.clone(),
+                radius_b: radius_b.clone(),
+            }
+            .into(),
+            NodeRepr::RoundConeBetween {
+                a,
+                b,
+                radius_a,
+                radius_b,
+            } => Kind::RoundConeBetween {
+                a: a.clone(),
+                b: b.clone(),
+                radius_a: radius_a.clone(),
+                radius_b: radius_b.clone(),
+            }
+            .into(),
+            NodeRepr::Extrude {
+                profile,
+                half_height,
+            } => Kind::Extrude {
+                profile: profile.clone(),
+                half_height: half_height.clone(),
+            }
+            .into(),
+            NodeRepr::Revolve { profile, offset } => Kind::Revolve {
+                profile: profile.clone(),
+                offset: offset.clone(),
             }
             .into(),
             NodeRepr::Ellipsoid { radii } => Kind::Ellipsoid {

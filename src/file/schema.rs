@@ -6,7 +6,8 @@ use serde::{Deserialize, Serialize};
 use crate::animation::{Keyframe, Motion};
 use crate::quality::{Effects, Precision, Preset, Quality, ScreenNormals};
 use crate::scene::{
-    Axis, Camera, HybridStage, KifsFold, Light, Material, Palette, Param, Param3, Rule, Scene, Trap,
+    Axis, Camera, HybridStage, KifsFold, Light, Material, Palette, Param, Param3, Profile, Rule,
+    Scene, Trap,
 };
 
 use super::sites::Located;
@@ -472,6 +473,32 @@ pub(super) enum NodeRepr {
         angle: Param,
         major_radius: Param,
         minor_radius: Param,
+    },
+    CylinderBetween {
+        a: Param3,
+        b: Param3,
+        radius: Param,
+    },
+    ConeBetween {
+        a: Param3,
+        b: Param3,
+        radius_a: Param,
+        radius_b: Param,
+    },
+    RoundConeBetween {
+        a: Param3,
+        b: Param3,
+        radius_a: Param,
+        radius_b: Param,
+    },
+    Extrude {
+        profile: Profile,
+        half_height: Param,
+    },
+    Revolve {
+        profile: Profile,
+        #[serde(default = "zero")]
+        offset: Param,
     },
     Ellipsoid {
         radii: Param3,

@@ -27,7 +27,7 @@ use crate::math::{
     JULIA_FAR_FIELD, JULIA_FAR_FIELD_SLOPE, Limits, Num, V3, julia_radius, kifs_radius,
     mandelbox_extent, mandelbulb_radius, rotation_rows,
 };
-use crate::scene::{Axis, CsgOp, HybridOp, KifsFold, Kind};
+use crate::scene::{Axis, CsgOp, HybridOp, KifsFold, Kind, Profile};
 
 /// A conservative bounding sphere of a node, in the coordinates the node
 /// sees: wherever `slope · (|p − centre| − radius) > 0`, the node's
@@ -216,6 +216,45 @@ pub(super) fn bound(node: &IrNode, done: &[Option<Bound>]) -> Option<Bound> {
             minor_radius,
             ..
         } => Bound::sphere(origin, baked(*major_radius)? + baked(*minor_radius)?),
+        // Each lies in the ball about the segment's midpoint that holds
+        // its caps (the cylinder and the cone) or its balls.
+        Kind::CylinderBetween { a, b, radius } => {
+            let (a, b) = (baked3(*a)?, baked3(*b)?);
+            Bound::sphere(0.5 * (a + b), (0.5 * a.distance(b)).hypot(baked(*radius)?))
+        }
+        Kind::ConeBetween {
+            a,
+            b,
+            radius_a,
+            radius_b,
+        } => {
+            let (a, b) = (baked3(*a)?, baked3(*b)?);
+            let r = baked(*radius_a)?.max(baked(*radius_b)?);
+            Bound::sphere(0.5 * (a + b), (0.5 * a.distance(b)).hypot(r))
+        }
+        Kind::RoundConeBetween {
+            a,
+            b,
+            radius_a,
+            radius_b,
+        } => {
+            let (a, b) = (baked3(*a)?, baked3(*b)?);
+            let r = baked(*radius_a)?.max(baked(*radius_b)?);
+            Bound::sphere(0.5 * (a + b), 0.5 * a.distance(b) + r)
+        }
+        // The profile lies in its disc; the extrusion's is the cylinder of
+        // that disc, the revolution's a torus about the axis.
+        Kind::Extrude {
+            profile,
+            half_height,
+        } => Bound::sphere(
+            origin,
+            baked_profile(profile)?.extent().hypot(baked(*half_height)?),
+        ),
+        Kind::Revolve { profile, offset } => Bound::sphere(
+            origin,
+            baked(*offset)?.abs() + baked_profile(profile)?.extent(),
+        ),
         // The estimate is `(k0 − 1) / |u / r|` with `k0 = |p / r|` and `u`
         // a unit vector, so it is at least `(k0 − 1) min(r)`, and
         // `k0 >= |p| / max(r)`: at least `min(r) / max(r) · (|p| − max(r))`,
@@ -647,4 +686,9 @@ pub(crate) fn swaps(ir: &Ir, id: NodeId, bounds: &[Option<Bound>], costs: &[f64]
         (Some(_), Some(_)) => costs[a.index()] > costs[b.index()],
         _ => false,
     }
+}
+
+/// The profile's values, where all are baked.
+fn baked_profile(profile: &Profile<Scalar>) -> Option<Profile<f64>> {
+    profile.try_map(&mut |s, _| s.baked().ok_or(())).ok()
 }

@@ -11,8 +11,8 @@ use super::{Ir, IrNode, NodeId, Scalar, Vector, baked3};
 use crate::error::{Error, Result};
 use crate::math::{F64_LIMITS, normalize, reduce_angle};
 use crate::scene::{
-    CustomShape, HybridOp, Kind, MAX_HYBRID_OPS, Mapper, Node, NodeKind, Param, Param3, ParamSpec,
-    Rule,
+    CustomShape, HybridOp, Kind, MAX_HYBRID_OPS, MAX_PROFILE_VERTICES, Mapper, Node, NodeKind,
+    Param, Param3, ParamSpec, Profile, Rule,
 };
 
 /// Validates and lowers `geometry` (see [`Ir::lower`]) without recursion,
@@ -237,6 +237,29 @@ impl Lowering {
                 Relation::AtMostSmallest {
                     value: *radius,
                     bound: *half_extents,
+                    bound_name: "half extent",
+                },
+            )],
+            Kind::Extrude {
+                profile:
+                    Profile::RoundRect {
+                        half_extents: [x, y],
+                        radius,
+                    },
+                ..
+            }
+            | Kind::Revolve {
+                profile:
+                    Profile::RoundRect {
+                        half_extents: [x, y],
+                        radius,
+                    },
+                ..
+            } => vec![(
+                "profile.radius",
+                Relation::AtMostSmallest {
+                    value: *radius,
+                    bound: [*x, *y, *y],
                     bound_name: "half extent",
                 },
             )],
@@ -597,6 +620,9 @@ fn check_structure(kind: &NodeKind, path: impl Fn() -> String) -> Result<()> {
                 .check()
                 .map_err(|e| invalid(format!("its palette {e}")))?;
         }
+        Kind::Extrude { profile, .. } | Kind::Revolve { profile, .. } => {
+            check_profile(profile, &path)?;
+        }
         Kind::Custom { shape, args } if args.len() != shape.arity() => {
             return Err(Error::CustomShape {
                 name: shape.name().into(),
@@ -609,6 +635,36 @@ fn check_structure(kind: &NodeKind, path: impl Fn() -> String) -> Result<()> {
             });
         }
         _ => {}
+    }
+    Ok(())
+}
+
+/// A polygon profile's corner count, and that its corners, where all are
+/// baked, enclose some area.
+fn check_profile(profile: &Profile, path: &impl Fn() -> String) -> Result<()> {
+    let Profile::Polygon { vertices } = profile else {
+        return Ok(());
+    };
+    let invalid = |reason: String| Error::Invalid {
+        what: "profile",
+        reason: format!("{}: {reason}", path()),
+    };
+    if !(3..=MAX_PROFILE_VERTICES).contains(&vertices.len()) {
+        return Err(invalid(format!(
+            "a polygon has 3 to {MAX_PROFILE_VERTICES} vertices, and this one has {}",
+            vertices.len()
+        )));
+    }
+    let baked = profile.try_map(&mut |s, _| match s {
+        Param::Value(v) => Ok(*v),
+        Param::Dynamic { .. } => Err(()),
+    });
+    if let Ok(area) = baked.map(|p| p.twice_area())
+        && area == Some(0.0)
+    {
+        return Err(invalid(
+            "the polygon's vertices enclose no area (they lie on one line)".into(),
+        ));
     }
     Ok(())
 }

@@ -14,6 +14,7 @@ use super::fractal::{Kifs, KifsFold, Mandelbox, Mandelbulb, Menger, QuaternionJu
 use super::material::Material;
 use super::node::{Axis, CsgOp, Kind, Node};
 use super::param::{Param, Param3};
+use super::profile::Profile;
 use super::trap::{OrbitColoring, Palette, Trap};
 
 /// A sphere of `radius` at the origin.
@@ -175,6 +176,106 @@ pub fn capped_torus(
         angle: angle.into(),
         major_radius: major_radius.into(),
         minor_radius: minor_radius.into(),
+    }
+    .into()
+}
+
+/// A capped cylinder of `radius` around the segment from `a` to `b`.
+#[must_use]
+pub fn cylinder_between(
+    a: impl Into<Param3>,
+    b: impl Into<Param3>,
+    radius: impl Into<Param>,
+) -> Node {
+    Kind::CylinderBetween {
+        a: a.into(),
+        b: b.into(),
+        radius: radius.into(),
+    }
+    .into()
+}
+
+/// A capped cone around the segment from `a` to `b`, of radius `radius_a`
+/// at `a` and `radius_b` at `b`.
+#[must_use]
+pub fn cone_between(
+    a: impl Into<Param3>,
+    b: impl Into<Param3>,
+    radius_a: impl Into<Param>,
+    radius_b: impl Into<Param>,
+) -> Node {
+    Kind::ConeBetween {
+        a: a.into(),
+        b: b.into(),
+        radius_a: radius_a.into(),
+        radius_b: radius_b.into(),
+    }
+    .into()
+}
+
+/// The convex hull of the ball of `radius_a` about `a` and the ball of
+/// `radius_b` about `b`: a round cone between two points.
+#[must_use]
+pub fn round_cone_between(
+    a: impl Into<Param3>,
+    b: impl Into<Param3>,
+    radius_a: impl Into<Param>,
+    radius_b: impl Into<Param>,
+) -> Node {
+    Kind::RoundConeBetween {
+        a: a.into(),
+        b: b.into(),
+        radius_a: radius_a.into(),
+        radius_b: radius_b.into(),
+    }
+    .into()
+}
+
+/// The prism of `profile`, a plane shape in the xy plane, between
+/// `z = ±half_height`. Exact.
+///
+/// ```
+/// use fractal_sdf::scene::{Profile, extrude};
+///
+/// // A five-pointed star, a tenth of a unit thick.
+/// let star = extrude(
+///     Profile::polygon((0..10).map(|i| {
+///         let (r, a) = (if i % 2 == 0 { 1.0 } else { 0.4 }, i as f64 * 0.2 * std::f64::consts::PI);
+///         [r * a.sin(), r * a.cos()]
+///     })),
+///     0.05,
+/// );
+/// # let _ = star;
+/// ```
+#[must_use]
+pub fn extrude(profile: Profile, half_height: impl Into<Param>) -> Node {
+    Kind::Extrude {
+        profile,
+        half_height: half_height.into(),
+    }
+    .into()
+}
+
+/// The solid swept by `profile` turning around the y axis, its x axis
+/// running out from the axis with its origin at `offset`: a circle of
+/// radius `r` at offset `R` sweeps a torus, a rectangle at offset 0 a
+/// cylinder. Exact where the profile lies at `x >= -offset`.
+///
+/// ```
+/// use fractal_sdf::scene::{Profile, revolve};
+///
+/// // A bowl: the cross-section of its wall and base, turned.
+/// let bowl = revolve(
+///     Profile::polygon([[0.0, -0.5], [0.6, -0.5], [0.9, 0.3], [0.8, 0.3], [0.52, -0.42], [0.0, -0.42]]),
+///     0.0,
+/// );
+/// # let _ = bowl;
+/// ```
+#[must_use]
+pub fn revolve(profile: Profile, offset: impl Into<Param>) -> Node {
+    Kind::Revolve {
+        profile,
+        offset: offset.into(),
     }
     .into()
 }

@@ -13,6 +13,7 @@ mod material;
 pub(crate) mod names;
 mod node;
 mod param;
+mod profile;
 mod rule;
 mod stereo;
 mod trap;
@@ -21,9 +22,10 @@ use glam::{DVec2, DVec3};
 use serde::{Deserialize, Serialize};
 
 pub use build::{
-    capped_cone, capped_torus, capsule, cuboid, cut_sphere, cylinder, ellipsoid, hex_prism, julia,
-    kifs, link, mandelbox, mandelbulb, menger, octahedron, plane, round_box, round_cone,
-    sierpinski, solid_angle, sphere, torus,
+    capped_cone, capped_torus, capsule, cone_between, cuboid, cut_sphere, cylinder,
+    cylinder_between, ellipsoid, extrude, hex_prism, julia, kifs, link, mandelbox, mandelbulb,
+    menger, octahedron, plane, revolve, round_box, round_cone, round_cone_between, sierpinski,
+    solid_angle, sphere, torus,
 };
 pub use custom::{
     CpuDistance, CpuInside, CustomShape, INSIDE_HUGE, InsideBounds, MAX_INSIDE_REACH,
@@ -42,6 +44,7 @@ pub use node::{
     Node, NodeKind,
 };
 pub use param::{Param, Param3, param, param3};
+pub use profile::{MAX_PROFILE_VERTICES, Profile};
 pub use rule::{ParamSpec, Rule};
 pub use stereo::{Stereo, StereoLayout};
 pub use trap::{MAX_PALETTE_STOPS, OrbitColoring, Palette, Trap};

@@ -12,6 +12,7 @@ use super::fractal::{Kifs, Mandelbox, Mandelbulb, Menger, QuaternionJulia, Sierp
 use super::hybrid::Hybrid;
 use super::material::Material;
 use super::param::{Param, Param3};
+use super::profile::Profile;
 use super::rule::{ParamSpec, Rule, spec};
 use super::trap::OrbitColoring;
 
@@ -214,6 +215,60 @@ pub enum Kind<S, V, C> {
         major_radius: S,
         /// The tube's radius, at least 0.
         minor_radius: S,
+    },
+    /// A capped cylinder around the segment from `a` to `b`. Exact.
+    CylinderBetween {
+        /// The centre of one cap.
+        a: V,
+        /// The centre of the other cap.
+        b: V,
+        /// Radius, at least 0.
+        radius: S,
+    },
+    /// A capped cone around the segment from `a` to `b`, of radius
+    /// `radius_a` at `a` and `radius_b` at `b`. Exact.
+    ConeBetween {
+        /// The centre of one cap.
+        a: V,
+        /// The centre of the other cap.
+        b: V,
+        /// Radius at `a`, at least 0.
+        radius_a: S,
+        /// Radius at `b`, at least 0.
+        radius_b: S,
+    },
+    /// A round cone between two balls: the convex hull of the ball of
+    /// `radius_a` about `a` and the ball of `radius_b` about `b`. Exact.
+    RoundConeBetween {
+        /// The centre of one ball.
+        a: V,
+        /// The centre of the other ball.
+        b: V,
+        /// Radius of the ball about `a`, at least 0.
+        radius_a: S,
+        /// Radius of the ball about `b`, at least 0.
+        radius_b: S,
+    },
+    /// A plane shape in the xy plane extruded along z: the prism of
+    /// `profile` between `z = ±half_height`. Exact.
+    Extrude {
+        /// The cross-section.
+        profile: Profile<S>,
+        /// Half the height along z, at least 0.
+        half_height: S,
+    },
+    /// The solid swept by a plane shape turning around the y axis: the
+    /// profile's x axis runs out from the axis, its origin at `offset`
+    /// (so a circle of radius `r` at offset `R` sweeps a torus). Exact
+    /// where the profile lies at `x >= -offset`; a profile reaching past
+    /// the axis sweeps only its part at `x >= -offset`, and there the
+    /// distance is a bound.
+    Revolve {
+        /// The cross-section.
+        profile: Profile<S>,
+        /// How far the profile's origin lies from the axis, any finite
+        /// value.
+        offset: S,
     },
     /// An axis-aligned ellipsoid. A bound, not exact: outside, the distance
     /// is underestimated away from the axes (Quilez's `k0 (k0 - 1) / k1`,
@@ -425,6 +480,11 @@ impl<S, V, C> Kind<S, V, C> {
             Kind::CutSphere { .. } => "cut_sphere",
             Kind::SolidAngle { .. } => "solid_angle",
             Kind::CappedTorus { .. } => "capped_torus",
+            Kind::CylinderBetween { .. } => "cylinder_between",
+            Kind::ConeBetween { .. } => "cone_between",
+            Kind::RoundConeBetween { .. } => "round_cone_between",
+            Kind::Extrude { .. } => "extrude",
+            Kind::Revolve { .. } => "revolve",
             Kind::Ellipsoid { .. } => "ellipsoid",
             Kind::Mandelbulb(_) => "mandelbulb",
             Kind::Menger(_) => "menger",
@@ -502,6 +562,11 @@ impl<S, V, C> Kind<S, V, C> {
             | Kind::CutSphere { .. }
             | Kind::SolidAngle { .. }
             | Kind::CappedTorus { .. }
+            | Kind::CylinderBetween { .. }
+            | Kind::ConeBetween { .. }
+            | Kind::RoundConeBetween { .. }
+            | Kind::Extrude { .. }
+            | Kind::Revolve { .. }
             | Kind::Ellipsoid { .. }
             | Kind::Mandelbulb(_)
             | Kind::Menger(_)
@@ -670,6 +735,44 @@ impl<S, V, C> Kind<S, V, C> {
                 angle: m.scalar(angle, spec("angle", Range(0.0, std::f64::consts::PI)))?,
                 major_radius: m.scalar(major_radius, spec("major_radius", NonNegative))?,
                 minor_radius: m.scalar(minor_radius, spec("minor_radius", NonNegative))?,
+            },
+            Kind::CylinderBetween { a, b, radius } => Kind::CylinderBetween {
+                a: m.vector(a, spec("a", Finite))?,
+                b: m.vector(b, spec("b", Finite))?,
+                radius: m.scalar(radius, spec("radius", NonNegative))?,
+            },
+            Kind::ConeBetween {
+                a,
+                b,
+                radius_a,
+                radius_b,
+            } => Kind::ConeBetween {
+                a: m.vector(a, spec("a", Finite))?,
+                b: m.vector(b, spec("b", Finite))?,
+                radius_a: m.scalar(radius_a, spec("radius_a", NonNegative))?,
+                radius_b: m.scalar(radius_b, spec("radius_b", NonNegative))?,
+            },
+            Kind::RoundConeBetween {
+                a,
+                b,
+                radius_a,
+                radius_b,
+            } => Kind::RoundConeBetween {
+                a: m.vector(a, spec("a", Finite))?,
+                b: m.vector(b, spec("b", Finite))?,
+                radius_a: m.scalar(radius_a, spec("radius_a", NonNegative))?,
+                radius_b: m.scalar(radius_b, spec("radius_b", NonNegative))?,
+            },
+            Kind::Extrude {
+                profile,
+                half_height,
+            } => Kind::Extrude {
+                profile: profile.try_map(&mut |s, spec| m.scalar(s, spec))?,
+                half_height: m.scalar(half_height, spec("half_height", NonNegative))?,
+            },
+            Kind::Revolve { profile, offset } => Kind::Revolve {
+                profile: profile.try_map(&mut |s, spec| m.scalar(s, spec))?,
+                offset: m.scalar(offset, spec("offset", Finite))?,
             },
             Kind::Ellipsoid { radii } => Kind::Ellipsoid {
                 radii: m.vector(radii, spec("radii", Positive))?,

@@ -11,9 +11,10 @@ use crate::cpu::Ray;
 use crate::scene::{
     Axis, CsgOp, Hybrid, HybridOp, Kifs, KifsFold, Kind, MAX_ESCAPE_ITERATIONS,
     MAX_FOLD_ITERATIONS, MAX_SOLID_ANGLE, Mandelbox, Mandelbulb, Menger, Node, OrbitColoring,
-    Palette, Param, Param3, QuaternionJulia, Sierpinski, Trap, capped_cone, capped_torus, capsule,
-    cuboid, cut_sphere, cylinder, ellipsoid, hex_prism, link, octahedron, param, plane, round_box,
-    round_cone, solid_angle, sphere, torus,
+    Palette, Param, Param3, Profile, QuaternionJulia, Sierpinski, Trap, capped_cone, capped_torus,
+    capsule, cone_between, cuboid, cut_sphere, cylinder, cylinder_between, ellipsoid, extrude,
+    hex_prism, link, octahedron, param, plane, revolve, round_box, round_cone, round_cone_between,
+    solid_angle, sphere, torus,
 };
 
 /// The largest size (radius, half extent, height) the primitive strategies
@@ -277,6 +278,155 @@ pub fn capped_torus_node() -> impl Strategy<Value = Node> + Clone {
         .prop_map(|(a, major, minor)| capped_torus(a, major, minor))
 }
 
+/// The two ends of a segment in `[-1, 1]^3`, one time in eight the same
+/// point.
+fn segment_ends() -> impl Strategy<Value = (DVec3, DVec3)> + Clone {
+    prop_oneof![
+        7 => (point(1.0), point(1.0)),
+        1 => point(1.0).prop_map(|a| (a, a)),
+    ]
+}
+
+/// A capped cylinder around a segment in `[-1, 1]^3` (sometimes of length
+/// 0), radius in `[0, 0.75]`.
+pub fn cylinder_between_node() -> impl Strategy<Value = Node> + Clone {
+    (
+        segment_ends(),
+        scalar("cylinder_between.radius", size(0.75)),
+    )
+        .prop_map(|((a, b), r)| cylinder_between(a, b, r))
+}
+
+/// A capped cone around a segment in `[-1, 1]^3` (sometimes of length 0),
+/// each radius in `[0, 0.75]`.
+pub fn cone_between_node() -> impl Strategy<Value = Node> + Clone {
+    (
+        segment_ends(),
+        scalar("cone_between.radius_a", size(0.75)),
+        scalar("cone_between.radius_b", size(0.75)),
+    )
+        .prop_map(|((a, b), ra, rb)| cone_between(a, b, ra, rb))
+}
+
+/// A round cone between balls about the ends of a segment in `[-1, 1]^3`
+/// (sometimes of length 0, or with one ball holding the other), each
+/// radius in `[0, 0.75]`.
+pub fn round_cone_between_node() -> impl Strategy<Value = Node> + Clone {
+    (
+        segment_ends(),
+        scalar("round_cone_between.radius_a", size(0.75)),
+        scalar("round_cone_between.radius_b", size(0.75)),
+    )
+        .prop_map(|((a, b), ra, rb)| round_cone_between(a, b, ra, rb))
+}
+
+/// A plane profile's values: a disc, a rectangle, a rounded rectangle, a
+/// segment's stadium, or a polygon of 3 to 12 corners in either winding,
+/// star-shaped about a point near the origin (so its edges never cross),
+/// sometimes with a corner repeated (an edge of length 0).
+fn profile_values() -> impl Strategy<Value = Profile<f64>> + Clone {
+    let corner = (0.0..=0.8f64, 0.1..=1.2f64);
+    let polygon = (
+        prop::collection::vec(corner, 3..=12),
+        (-0.4..=0.4f64, -0.4..=0.4f64),
+        any::<bool>(),
+        prop::option::weighted(0.15, any::<prop::sample::Index>()),
+    )
+        .prop_map(|(corners, centre, reversed, repeated)| {
+            let n = corners.len() as f64;
+            let mut vertices: Vec<[f64; 2]> = corners
+                .iter()
+                .enumerate()
+                .map(|(i, (jitter, r))| {
+                    let a = (i as f64 + jitter) * 2.0 * PI / n;
+                    [centre.0 + r * a.cos(), centre.1 + r * a.sin()]
+                })
+                .collect();
+            if reversed {
+                vertices.reverse();
+            }
+            if let Some(i) = repeated {
+                let i = i.index(vertices.len());
+                vertices.insert(i, vertices[i]);
+            }
+            Profile::Polygon { vertices }
+        });
+    let at = (-1.0..=1.0f64, -1.0..=1.0f64).prop_map(|(x, y)| [x, y]);
+    prop_oneof![
+        1 => size(1.0).prop_map(|radius| Profile::Circle { radius }),
+        1 => (size(1.0), size(1.0)).prop_map(|(x, y)| Profile::Rect {
+            half_extents: [x, y]
+        }),
+        1 => (size(1.0), size(1.0), 0.0..=1.0f64).prop_map(|(x, y, t)| Profile::RoundRect {
+            half_extents: [x, y],
+            radius: t * x.min(y),
+        }),
+        1 => (at.clone(), at, 0.02..=0.5f64).prop_map(|(a, b, radius)| Profile::Segment {
+            a,
+            b,
+            radius
+        }),
+        3 => polygon,
+    ]
+}
+
+/// A profile from its values: all baked, or (one time in five) all
+/// dynamic, each named after its place and value.
+fn profile_params(values: &Profile<f64>, dynamic: bool) -> Profile {
+    let Ok(profile) = values.try_map(&mut |v, spec| {
+        Ok::<_, std::convert::Infallible>(if dynamic {
+            param(format!("{}#{:016x}", spec.name, v.to_bits()), *v)
+        } else {
+            Param::Value(*v)
+        })
+    });
+    profile
+}
+
+/// A plane profile (see [`extrude_node`]).
+pub fn profile() -> impl Strategy<Value = Profile> + Clone {
+    (profile_values(), prop::bool::weighted(0.2)).prop_map(|(v, d)| profile_params(&v, d))
+}
+
+/// A profile extruded to a half height in `[0, 1]`: a disc, a rectangle,
+/// a rounded rectangle, a stadium or a simple polygon (star-shaped, in
+/// either winding, sometimes with an edge of length 0).
+pub fn extrude_node() -> impl Strategy<Value = Node> + Clone {
+    (profile(), scalar("extrude.half_height", size(1.0))).prop_map(|(p, h)| extrude(p, h))
+}
+
+/// A profile revolved where it is exact: its origin at an offset that
+/// keeps it at `x >= -offset` (touching the axis one time in four).
+pub fn revolve_node() -> impl Strategy<Value = Node> + Clone {
+    (
+        profile_values(),
+        prop::bool::weighted(0.2),
+        prop_oneof![1 => Just(0.0), 3 => 0.0..=0.8f64],
+    )
+        .prop_flat_map(|(values, dynamic, gap)| {
+            let offset = gap - profile_left(&values).min(0.0);
+            (
+                Just(profile_params(&values, dynamic)),
+                scalar("revolve.offset", Just(offset)),
+            )
+        })
+        .prop_map(|(p, offset)| revolve(p, offset))
+}
+
+/// The profile's smallest x.
+fn profile_left(profile: &Profile<f64>) -> f64 {
+    match profile {
+        Profile::Circle { radius } => -radius,
+        Profile::Rect { half_extents } | Profile::RoundRect { half_extents, .. } => {
+            -half_extents[0]
+        }
+        Profile::Segment { a, b, radius } => a[0].min(b[0]) - radius,
+        Profile::Polygon { vertices } => {
+            vertices.iter().map(|v| v[0]).fold(f64::INFINITY, f64::min)
+        }
+    }
+}
+
 /// An ellipsoid (a distance bound, not exact) with semi-axes in
 /// `[0.05, 1.5]`.
 pub fn ellipsoid_node() -> impl Strategy<Value = Node> + Clone {
@@ -301,6 +451,11 @@ pub fn exact_primitive() -> impl Strategy<Value = Node> + Clone {
         cut_sphere_node(),
         solid_angle_node(),
         capped_torus_node(),
+        cylinder_between_node(),
+        cone_between_node(),
+        round_cone_between_node(),
+        extrude_node(),
+        revolve_node(),
     ]
 }
 

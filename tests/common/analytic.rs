@@ -87,6 +87,36 @@ pub fn exact_distance(node: &Node, p: DVec3) -> Option<f64> {
             arc_distance(p, angle.default_value(), major_radius.default_value())
                 - minor_radius.default_value()
         }
+        Kind::CylinderBetween { a, b, radius } => {
+            let (q, h) = segment_frame(p, a.default_value(), b.default_value());
+            let r = radius.default_value();
+            revolved_trapezoid(q, h, r, r)
+        }
+        Kind::ConeBetween {
+            a,
+            b,
+            radius_a,
+            radius_b,
+        } => {
+            let (q, h) = segment_frame(p, a.default_value(), b.default_value());
+            revolved_trapezoid(q, h, radius_a.default_value(), radius_b.default_value())
+        }
+        Kind::RoundConeBetween {
+            a,
+            b,
+            radius_a,
+            radius_b,
+        } => {
+            let (q, h) = segment_frame(p, a.default_value(), b.default_value());
+            round_cone_distance(q, h, radius_a.default_value(), radius_b.default_value())
+        }
+        Kind::Extrude {
+            profile,
+            half_height,
+        } => super::profiles::extrude_distance(profile, half_height.default_value(), p),
+        Kind::Revolve { profile, offset } => {
+            super::profiles::revolve_distance(profile, offset.default_value(), p)
+        }
         Kind::Translate { offset, child } => exact_distance(child, p - offset.default_value())?,
         Kind::Rotate { axis, angle, child } => {
             let rotation = DQuat::from_axis_angle(*axis, angle.default_value());
@@ -99,6 +129,18 @@ pub fn exact_distance(node: &Node, p: DVec3) -> Option<f64> {
         Kind::Color { child, .. } => exact_distance(child, p)?,
         _ => return None,
     })
+}
+
+/// The point `p` turned and moved so that the segment `a`-`b` runs along
+/// y from `-h` to `h` (a quaternion taking its direction to +y; a segment
+/// of length 0 lies along y already), and `h`.
+fn segment_frame(p: DVec3, a: DVec3, b: DVec3) -> (DVec3, f64) {
+    let turn = if a == b {
+        DQuat::IDENTITY
+    } else {
+        DQuat::from_rotation_arc((b - a).normalize(), DVec3::Y)
+    };
+    (turn * (p - 0.5 * (a + b)), 0.5 * a.distance(b))
 }
 
 /// Signed distance to the box `[-b, b]`: the gap to the clamped point

@@ -4,3 +4,4 @@
 
 pub mod analytic;
 pub mod fixtures;
+pub mod profiles;

@@ -22,8 +22,9 @@ use fractal_sdf::scene::octahedron;
 use fractal_sdf::scene::param3;
 use fractal_sdf::scene::{CustomShape, Rule};
 use fractal_sdf::scene::{
-    Hybrid, HybridOp, Kifs, KifsFold, Mandelbox, OrbitColoring, Palette, Trap, capped_cone,
-    capped_torus, cut_sphere, hex_prism, kifs, link, round_cone, solid_angle,
+    Hybrid, HybridOp, Kifs, KifsFold, Mandelbox, OrbitColoring, Palette, Profile, Trap,
+    capped_cone, capped_torus, cone_between, cut_sphere, cylinder_between, extrude, hex_prism,
+    kifs, link, revolve, round_cone, round_cone_between, solid_angle,
 };
 use fractal_sdf::testing::{check_device_matches_cpu, random_points, spicy_points};
 
@@ -100,6 +101,56 @@ fn nodes() -> Vec<(&'static str, Node)> {
             "capped_torus_dynamic_wide",
             capped_torus(param("arc", 2.6), 0.6, param("tube", 0.2)),
         ),
+        (
+            "cylinder_between",
+            cylinder_between(dvec3(-0.3, -0.4, 0.1), dvec3(0.4, 0.3, -0.2), 0.25),
+        ),
+        (
+            "cone_between_dynamic",
+            cone_between(
+                param3("cone_a", dvec3(0.2, -0.5, 0.0)),
+                dvec3(-0.1, 0.5, 0.3),
+                param("cone_ra", 0.4),
+                0.1,
+            ),
+        ),
+        (
+            "round_cone_between",
+            round_cone_between(dvec3(0.0, -0.3, -0.3), dvec3(0.2, 0.4, 0.3), 0.3, 0.12),
+        ),
+        (
+            "extrude_polygon",
+            extrude(
+                Profile::polygon([[0.0, 0.6], [-0.5, -0.3], [0.1, 0.0], [0.5, -0.4]]),
+                0.3,
+            ),
+        ),
+        (
+            "extrude_round_rect_dynamic",
+            extrude(
+                Profile::round_rect(0.5, param("rect_y", 0.3), param("corner", 0.1)),
+                param("depth", 0.2),
+            ),
+        ),
+        (
+            "revolve_segment",
+            revolve(Profile::segment([0.1, -0.4], [0.3, 0.4], 0.1), 0.3),
+        ),
+        (
+            "revolve_dynamic_polygon",
+            revolve(
+                Profile::Polygon {
+                    vertices: vec![
+                        [0.0.into(), (-0.5).into()],
+                        [param("rim", 0.6), 0.0.into()],
+                        [0.0.into(), 0.5.into()],
+                    ],
+                },
+                param("ring", 0.2),
+            ),
+        ),
+        ("revolve_circle", revolve(Profile::circle(0.2), 0.5)),
+        ("extrude_rect", extrude(Profile::rect(0.4, 0.2), 0.5)),
         ("mandelbox", mandelbox(-1.5)),
         (
             "mandelbox_julia",

@@ -69,6 +69,11 @@ exact! {
     cut_sphere_is_exact: testing::cut_sphere_node();
     solid_angle_is_exact: testing::solid_angle_node();
     capped_torus_is_exact: testing::capped_torus_node();
+    cylinder_between_is_exact: testing::cylinder_between_node();
+    cone_between_is_exact: testing::cone_between_node();
+    round_cone_between_is_exact: testing::round_cone_between_node();
+    extrude_is_exact: testing::extrude_node();
+    revolve_is_exact: testing::revolve_node();
     transformed_primitives_are_exact: testing::exact_node();
 }
 

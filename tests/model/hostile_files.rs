@@ -559,6 +559,58 @@ const NODE_FIELDS: &[(&str, &str)] = &[
         "CappedTorus(angle: 1, major_radius: 1, minor_radius: @)",
         "minor_radius",
     ),
+    ("CylinderBetween(a: @, b: (0, 1, 0), radius: 0.2)", "a"),
+    ("CylinderBetween(a: 0, b: (0, 1, 0), radius: @)", "radius"),
+    ("ConeBetween(a: 0, b: @, radius_a: 0.5, radius_b: 0.2)", "b"),
+    (
+        "ConeBetween(a: 0, b: (0, 1, 0), radius_a: @, radius_b: 0.2)",
+        "radius_a",
+    ),
+    (
+        "ConeBetween(a: 0, b: (0, 1, 0), radius_a: 0.5, radius_b: @)",
+        "radius_b",
+    ),
+    (
+        "RoundConeBetween(a: @, b: (0, 1, 0), radius_a: 0.5, radius_b: 0.2)",
+        "a",
+    ),
+    (
+        "RoundConeBetween(a: 0, b: (0, 1, 0), radius_a: @, radius_b: 0.2)",
+        "radius_a",
+    ),
+    (
+        "RoundConeBetween(a: 0, b: (0, 1, 0), radius_a: 0.5, radius_b: @)",
+        "radius_b",
+    ),
+    (
+        "Extrude(profile: Circle(radius: @), half_height: 1)",
+        "radius",
+    ),
+    (
+        "Extrude(profile: Rect(half_extents: (@, 1)), half_height: 1)",
+        "half_extents",
+    ),
+    (
+        "Extrude(profile: RoundRect(half_extents: (1, 1), radius: @), half_height: 1)",
+        "radius",
+    ),
+    (
+        "Extrude(profile: Segment(a: (@, 0), b: (1, 0), radius: 0.2), half_height: 1)",
+        "profile.a",
+    ),
+    (
+        "Extrude(profile: Segment(a: (0, 0), b: (1, 0), radius: @), half_height: 1)",
+        "radius",
+    ),
+    (
+        "Extrude(profile: Polygon(vertices: [(0, 0), (1, @), (0, 1)]), half_height: 1)",
+        "vertices",
+    ),
+    (
+        "Extrude(profile: Circle(radius: 1), half_height: @)",
+        "half_height",
+    ),
+    ("Revolve(profile: Circle(radius: 0.2), offset: @)", "offset"),
     ("Ellipsoid(radii: @)", "radii"),
     ("Mandelbulb(power: @)", "power"),
     ("Mandelbulb(power: 8, iterations: @)", "iterations"),

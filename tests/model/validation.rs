@@ -274,7 +274,8 @@ use fractal_sdf::scene::ellipsoid;
 use fractal_sdf::scene::octahedron;
 use fractal_sdf::scene::param3;
 use fractal_sdf::scene::{
-    Hybrid, HybridOp, Kifs, KifsFold, MAX_SOLID_ANGLE, capped_torus, cut_sphere, solid_angle,
+    Hybrid, HybridOp, Kifs, KifsFold, MAX_SOLID_ANGLE, Profile, capped_torus, cone_between,
+    cut_sphere, cylinder_between, extrude, revolve, round_cone_between, solid_angle,
 };
 use fractal_sdf::scene::{MAX_ESCAPE_ITERATIONS, MAX_FOLD_ITERATIONS};
 use fractal_sdf::scene::{capped_cone, hex_prism, link, round_cone};
@@ -556,6 +557,11 @@ fn outside(lo: f64, hi: f64) -> impl Strategy<Value = f64> {
     ]
 }
 
+/// A value that is not finite.
+fn not_finite() -> impl Strategy<Value = f64> {
+    prop_oneof![Just(f64::NAN), Just(f64::INFINITY), Just(f64::NEG_INFINITY)]
+}
+
 /// A node with exactly one invalid setting, and its node name.
 fn broken_node() -> impl Strategy<Value = (Node, &'static str)> {
     prop_oneof![
@@ -606,6 +612,52 @@ fn broken_node() -> impl Strategy<Value = (Node, &'static str)> {
             .prop_map(|v| (capped_torus(v, 1.0, 0.2), "capped_torus")),
         bad_size().prop_map(|v| (capped_torus(1.0, v, 0.2), "capped_torus")),
         bad_size().prop_map(|v| (capped_torus(1.0, 1.0, v), "capped_torus")),
+        bad_size().prop_map(|v| (
+            cylinder_between(DVec3::ZERO, DVec3::Y, v),
+            "cylinder_between"
+        )),
+        not_finite().prop_map(|v| (
+            cylinder_between(dvec3(v, 0.0, 0.0), DVec3::Y, 0.5),
+            "cylinder_between"
+        )),
+        bad_size().prop_map(|v| (cone_between(DVec3::ZERO, DVec3::Y, 0.5, v), "cone_between")),
+        not_finite().prop_map(|v| (
+            cone_between(DVec3::ZERO, dvec3(0.0, v, 0.0), 0.5, 0.2),
+            "cone_between"
+        )),
+        bad_size().prop_map(|v| (
+            round_cone_between(DVec3::ZERO, DVec3::Y, v, 0.2),
+            "round_cone_between"
+        )),
+        bad_size().prop_map(|v| (extrude(Profile::circle(v), 0.5), "extrude")),
+        bad_size().prop_map(|v| (extrude(Profile::rect(0.5, v), 0.5), "extrude")),
+        bad_size().prop_map(|v| (revolve(Profile::round_rect(v, 0.5, 0.1), 0.5), "revolve")),
+        (0.51..1e300f64).prop_map(|v| (extrude(Profile::round_rect(0.5, 0.6, v), 0.5), "extrude")),
+        prop_oneof![bad_size(), Just(0.0)].prop_map(|v| (
+            revolve(Profile::segment([0.0, 0.0], [0.0, 1.0], v), 1.0),
+            "revolve"
+        )),
+        bad_size().prop_map(|v| (extrude(Profile::circle(1.0), v), "extrude")),
+        not_finite().prop_map(|v| (revolve(Profile::circle(0.2), v), "revolve")),
+        not_finite().prop_map(|v| (
+            extrude(Profile::polygon([[0.0, 0.0], [1.0, v], [0.0, 1.0]]), 0.5),
+            "extrude"
+        )),
+        (0usize..3).prop_map(|n| (
+            extrude(Profile::polygon((0..n).map(|i| [i as f64, 1.0])), 0.5),
+            "extrude"
+        )),
+        Just((
+            extrude(
+                Profile::polygon((0..65).map(|i| [(i as f64).cos(), (i as f64).sin()])),
+                0.5
+            ),
+            "extrude"
+        )),
+        Just((
+            revolve(Profile::polygon([[0.0, 0.0], [1.0, 1.0], [2.0, 2.0]]), 0.5),
+            "revolve"
+        )),
         prop_oneof![Just(0u32), 257..=u32::MAX]
             .prop_map(|n| (Mandelbulb::new(8.0).iterations(n).into(), "mandelbulb")),
         (21..=u32::MAX).prop_map(|n| (menger(n), "menger")),

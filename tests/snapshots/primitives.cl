@@ -223,6 +223,60 @@ real sd_capped_torus(real3 p, real angle, real ra, real rb) {
     return length((real3)(t0 - (ra * (t2 ? sin(angle) : (t3 ? R(0.0) : (t0 / t1)))), p.y - (ra * (t2 ? cos(angle) : (t3 ? R(1.0) : (p.y / t1)))), p.z)) - rb;
 }
 
+/* ---- cylinder_between ---- */
+real sd_cylinder_between(real3 p, real3 a, real3 b, real r) {
+    real3 t0 = b - a;
+    real t1 = length(t0);
+    real t2 = fmax(t1, R(1e-30));
+    real3 t3 = (R(1e-30) < t1) ? (t0 / t2) : ((real3)(R(0.0), R(1.0), R(0.0)));
+    real3 t4 = p - ((a + b) * R(0.5));
+    real t5 = ((t4.x * t3.x) + (t4.y * t3.y)) + (t4.z * t3.z);
+    real t6 = hypot(length(t4 - (t3 * t5)), R(0.0)) - r;
+    real t7 = fabs(t5) - (t1 * R(0.5));
+    return fmin(fmax(t6, t7), R(0.0)) + hypot(fmax(t6, R(0.0)), fmax(t7, R(0.0)));
+}
+
+/* ---- cone_between ---- */
+real sd_cone_between(real3 p, real3 a, real3 b, real ra, real rb) {
+    real3 t0 = b - a;
+    real t1 = length(t0);
+    real t2 = fmax(t1, R(1e-30));
+    real3 t3 = (R(1e-30) < t1) ? (t0 / t2) : ((real3)(R(0.0), R(1.0), R(0.0)));
+    real3 t4 = p - ((a + b) * R(0.5));
+    real t5 = ((t4.x * t3.x) + (t4.y * t3.y)) + (t4.z * t3.z);
+    real t6 = t1 * R(0.5);
+    real t7 = hypot(length(t4 - (t3 * t5)), R(0.0));
+    real t8 = rb - ra;
+    real t9 = R(2.0) * t6;
+    real t10 = t7 - fmin(t7, (t5 < R(0.0)) ? ra : rb);
+    real t11 = fabs(t5) - t6;
+    real t12 = fmin(fmax((((rb - t7) * t8) + ((t6 - t5) * t9)) / fmax((t8 * t8) + (t9 * t9), R(1e-30)), R(0.0)), R(1.0));
+    real t13 = (t7 - rb) + (t8 * t12);
+    real t14 = (t5 - t6) + (t9 * t12);
+    return (((t13 < R(0.0)) && (t11 < R(0.0))) ? (-R(1.0)) : R(1.0)) * sqrt(fmin((t10 * t10) + (t11 * t11), (t13 * t13) + (t14 * t14)));
+}
+
+/* ---- round_cone_between ---- */
+real sd_round_cone_between(real3 p, real3 a, real3 b, real ra, real rb) {
+    real3 t0 = b - a;
+    real t1 = length(t0);
+    real t2 = fmax(t1, R(1e-30));
+    real3 t3 = (R(1e-30) < t1) ? (t0 / t2) : ((real3)(R(0.0), R(1.0), R(0.0)));
+    real3 t4 = p - ((a + b) * R(0.5));
+    real t5 = ((t4.x * t3.x) + (t4.y * t3.y)) + (t4.z * t3.z);
+    real t6 = t1 * R(0.5);
+    real t7 = R(2.0) * t6;
+    real t8 = hypot(length(t4 - (t3 * t5)), R(0.0));
+    real t9 = t5 + t6;
+    real t10 = hypot(t8, t9) - ra;
+    real t11 = hypot(t8, t9 - t7) - rb;
+    real t12 = ra - rb;
+    real t13 = t12 / fmax(t7, R(1e-30));
+    real t14 = sqrt(fmax(R(1.0) - (t13 * t13), R(0.0)));
+    real t15 = ((-t13) * t8) + (t14 * t9);
+    return (t7 <= fabs(t12)) ? fmin(t10, t11) : ((t15 < R(0.0)) ? t10 : (((t14 * t7) < t15) ? t11 : (((t14 * t8) + (t13 * t9)) - ra)));
+}
+
 /* ---- ellipsoid ---- */
 real sd_ellipsoid(real3 p, real3 r) {
     real3 t0 = p / r;
@@ -240,176 +294,209 @@ real sd_ellipsoid(real3 p, real3 r) {
 real DE(real3 p0, __global const real* params) {
     /* union */
     /* union/b:color/plane */
-    real d62 = sd_plane(p0, (real3)(0.0f, 1.0f, 0.0f), 0.4f);
+    real d74 = sd_plane(p0, (real3)(0.0f, 1.0f, 0.0f), 0.4f);
     /* union: the second operand only within reach of its bound */
-    real u64 = d62;
-    real g64 = (length(p0 - ((real3)(-R(2.625), R(0.0), -R(0.6)))) * R(0.9999)) - R(0.35);
-    if (!(g64 > u64 && g64 > R(0.0))) {
+    real u76 = d74;
+    real g76 = (length(p0 - ((real3)(-R(3.2), R(0.0), -R(0.75)))) * R(0.9999)) - R(0.35);
+    if (!(g76 > u76 && g76 > R(0.0))) {
         /* .../a:union/a:union/a:translate */
-        real3 p1 = p0 - ((real3)(-R(2.625), R(0.0), -R(0.6)));
+        real3 p1 = p0 - ((real3)(-R(3.2), R(0.0), -R(0.75)));
         /* .../a:translate/color/sphere */
         real d0 = sd_sphere(p1, 0.35f);
-        real d64 = fmin(d62, d0);
-        u64 = d64;
+        real d76 = fmin(d74, d0);
+        u76 = d76;
     }
     /* union/a:union: the second operand only within reach of its bound */
-    real u61 = u64;
-    real g61 = (length(p0 - ((real3)(-R(1.875), R(0.0), -R(0.6)))) * R(0.9999)) - R(0.5196152422706632);
-    if (!(g61 > u61 && g61 > R(0.0))) {
+    real u73 = u76;
+    real g73 = (length(p0 - ((real3)(-R(2.4000000000000004), R(0.0), -R(0.75)))) * R(0.9999)) - R(0.5196152422706632);
+    if (!(g73 > u73 && g73 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p2 = p0 - ((real3)(-R(1.875), R(0.0), -R(0.6)));
+        real3 p2 = p0 - ((real3)(-R(2.4000000000000004), R(0.0), -R(0.75)));
         /* .../b:translate/color/cuboid */
         real d3 = sd_box(p2, (real3)(0.3f));
-        real d61 = fmin(u64, d3);
+        real d73 = fmin(u76, d3);
+        u73 = d73;
+    }
+    /* .../a:union/a:union: the second operand only within reach of its bound */
+    real u69 = u73;
+    real g69 = (length(p0 - ((real3)(-R(1.6), R(0.0), -R(0.75)))) * R(0.9999)) - R(0.5196152422706632);
+    if (!(g69 > u69 && g69 > R(0.0))) {
+        /* .../a:union/a:union/b:translate */
+        real3 p3 = p0 - ((real3)(-R(1.6), R(0.0), -R(0.75)));
+        /* .../b:translate/color/round_box */
+        real d7 = sd_round_box(p3, (real3)(0.3f), 0.08f);
+        real d69 = fmin(u73, d7);
+        u69 = d69;
+    }
+    /* .../a:union/a:union: the second operand only within reach of its bound */
+    real u65 = u69;
+    real g65 = (length(p0 - ((real3)(-R(0.8), R(0.0), -R(0.75)))) * R(0.9999)) - R(0.38);
+    if (!(g65 > u65 && g65 > R(0.0))) {
+        /* .../a:union/a:union/b:translate */
+        real3 p4 = p0 - ((real3)(-R(0.8), R(0.0), -R(0.75)));
+        /* .../b:translate/color/torus */
+        real d11 = sd_torus(p4, 0.28f, 0.1f);
+        real d65 = fmin(u69, d11);
+        u65 = d65;
+    }
+    /* .../a:union/a:union: the second operand only within reach of its bound */
+    real u61 = u65;
+    real g61 = (length(p0 - ((real3)(R(0.0), R(0.0), -R(0.75)))) * R(0.9999)) - R(0.4301162633521313);
+    if (!(g61 > u61 && g61 > R(0.0))) {
+        /* .../a:union/a:union/b:translate */
+        real3 p5 = p0 - ((real3)(R(0.0), R(0.0), -R(0.75)));
+        /* .../b:translate/color/cylinder */
+        real d15 = sd_cylinder(p5, 0.25f, 0.35f);
+        real d61 = fmin(u65, d15);
         u61 = d61;
     }
     /* .../a:union/a:union: the second operand only within reach of its bound */
     real u57 = u61;
-    real g57 = (length(p0 - ((real3)(-R(1.125), R(0.0), -R(0.6)))) * R(0.9999)) - R(0.5196152422706632);
+    real g57 = (length(p0 - ((real3)(R(0.8), R(0.0), -R(0.75)))) * R(0.9999)) - R(0.38);
     if (!(g57 > u57 && g57 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p3 = p0 - ((real3)(-R(1.125), R(0.0), -R(0.6)));
-        /* .../b:translate/color/round_box */
-        real d7 = sd_round_box(p3, (real3)(0.3f), 0.08f);
-        real d57 = fmin(u61, d7);
+        real3 p6 = p0 - ((real3)(R(0.8), R(0.0), -R(0.75)));
+        /* .../b:translate/color/capsule */
+        real d19 = sd_capsule(p6, (real3)(0.0f, (-0.2f), 0.0f), (real3)(0.0f, 0.2f, 0.0f), 0.18f);
+        real d57 = fmin(u61, d19);
         u57 = d57;
     }
     /* .../a:union/a:union: the second operand only within reach of its bound */
     real u52 = u57;
-    real g52 = (length(p0 - ((real3)(-R(0.375), R(0.0), -R(0.6)))) * R(0.9999)) - R(0.38);
+    real g52 = (length(p0 - ((real3)(R(1.6), R(0.0), -R(0.75)))) * R(0.9999)) - R(0.4);
     if (!(g52 > u52 && g52 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p4 = p0 - ((real3)(-R(0.375), R(0.0), -R(0.6)));
-        /* .../b:translate/color/torus */
-        real d11 = sd_torus(p4, 0.28f, 0.1f);
-        real d52 = fmin(u57, d11);
+        real3 p7 = p0 - ((real3)(R(1.6), R(0.0), -R(0.75)));
+        /* .../b:translate/color/octahedron */
+        real d23 = sd_octahedron(p7, 0.4f);
+        real d52 = fmin(u57, d23);
         u52 = d52;
     }
     /* .../a:union/a:union: the second operand only within reach of its bound */
     real u47 = u52;
-    real g47 = (length(p0 - ((real3)(R(0.375), R(0.0), -R(0.6)))) * R(0.9999)) - R(0.4301162633521313);
+    real g47 = (length(p0 - ((real3)(R(2.4000000000000004), R(0.0), -R(0.75)))) * R(0.9999)) - R(0.4609772228646443);
     if (!(g47 > u47 && g47 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p5 = p0 - ((real3)(R(0.375), R(0.0), -R(0.6)));
-        /* .../b:translate/color/cylinder */
-        real d15 = sd_cylinder(p5, 0.25f, 0.35f);
-        real d47 = fmin(u52, d15);
+        real3 p8 = p0 - ((real3)(R(2.4000000000000004), R(0.0), -R(0.75)));
+        /* .../b:translate/color/capped_cone */
+        real d27 = sd_capped_cone(p8, 0.35f, 0.3f, 0.1f);
+        real d47 = fmin(u52, d27);
         u47 = d47;
     }
     /* .../a:union/a:union: the second operand only within reach of its bound */
     real u42 = u47;
-    real g42 = (length(p0 - ((real3)(R(1.125), R(0.0), -R(0.6)))) * R(0.9999)) - R(0.38);
+    real g42 = R(0.5714285714285715) * ((length(p0 - ((real3)(R(3.2), R(0.0), -R(0.75)))) * R(0.9999)) - R(0.35));
     if (!(g42 > u42 && g42 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p6 = p0 - ((real3)(R(1.125), R(0.0), -R(0.6)));
-        /* .../b:translate/color/capsule */
-        real d19 = sd_capsule(p6, (real3)(0.0f, (-0.2f), 0.0f), (real3)(0.0f, 0.2f, 0.0f), 0.18f);
-        real d42 = fmin(u47, d19);
+        real3 p9 = p0 - ((real3)(R(3.2), R(0.0), -R(0.75)));
+        /* .../b:translate/color/ellipsoid */
+        real d31 = sd_ellipsoid(p9, (real3)(0.35f, 0.2f, 0.25f));
+        real d42 = fmin(u47, d31);
         u42 = d42;
     }
     /* .../a:union/a:union: the second operand only within reach of its bound */
     real u38 = u42;
-    real g38 = (length(p0 - ((real3)(R(1.875), R(0.0), -R(0.6)))) * R(0.9999)) - R(0.4);
+    real g38 = (length(p0 - ((real3)(-R(3.2), R(0.0), R(0.75)))) * R(0.9999)) - R(0.4410593308539491);
     if (!(g38 > u38 && g38 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p7 = p0 - ((real3)(R(1.875), R(0.0), -R(0.6)));
-        /* .../b:translate/color/octahedron */
-        real d23 = sd_octahedron(p7, 0.4f);
-        real d38 = fmin(u42, d23);
+        real3 p10 = p0 - ((real3)(-R(3.2), R(0.0), R(0.75)));
+        /* .../b:translate/color/hex_prism */
+        real d35 = sd_hex_prism(p10, 0.28f, 0.3f);
+        real d38 = fmin(u42, d35);
         u38 = d38;
     }
     /* .../a:union/a:union: the second operand only within reach of its bound */
     real u34 = u38;
-    real g34 = (length(p0 - ((real3)(R(2.625), R(0.0), -R(0.6)))) * R(0.9999)) - R(0.4609772228646443);
+    real g34 = (length(p0 - ((real3)(-R(2.4000000000000004), R(0.0), R(0.75)))) * R(0.9999)) - R(0.44);
     if (!(g34 > u34 && g34 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p8 = p0 - ((real3)(R(2.625), R(0.0), -R(0.6)));
-        /* .../b:translate/color/capped_cone */
-        real d27 = sd_capped_cone(p8, 0.35f, 0.3f, 0.1f);
-        real d34 = fmin(u38, d27);
+        real3 p11 = p0 - ((real3)(-R(2.4000000000000004), R(0.0), R(0.75)));
+        /* .../b:translate/color/round_cone */
+        real d39 = sd_round_cone(p11, 0.22f, 0.22f, 0.1f);
+        real d34 = fmin(u38, d39);
         u34 = d34;
     }
     /* .../a:union/a:union: the second operand only within reach of its bound */
     real u30 = u34;
-    real g30 = R(0.5714285714285715) * ((length(p0 - ((real3)(-R(2.25), R(0.0), R(0.6)))) * R(0.9999)) - R(0.35));
+    real g30 = (length(p0 - ((real3)(-R(1.6), R(0.0), R(0.75)))) * R(0.9999)) - R(0.41000000000000003);
     if (!(g30 > u30 && g30 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p9 = p0 - ((real3)(-R(2.25), R(0.0), R(0.6)));
-        /* .../b:translate/color/ellipsoid */
-        real d31 = sd_ellipsoid(p9, (real3)(0.35f, 0.2f, 0.25f));
-        real d30 = fmin(u34, d31);
-        u30 = d30;
-    }
-    /* .../a:union/a:union: the second operand only within reach of its bound */
-    real u26 = u30;
-    real g26 = (length(p0 - ((real3)(-R(1.5), R(0.0), R(0.6)))) * R(0.9999)) - R(0.4410593308539491);
-    if (!(g26 > u26 && g26 > R(0.0))) {
-        /* .../a:union/a:union/b:translate */
-        real3 p10 = p0 - ((real3)(-R(1.5), R(0.0), R(0.6)));
-        /* .../b:translate/color/hex_prism */
-        real d35 = sd_hex_prism(p10, 0.28f, 0.3f);
-        real d26 = fmin(u30, d35);
-        u26 = d26;
-    }
-    /* .../a:union/a:union: the second operand only within reach of its bound */
-    real u22 = u26;
-    real g22 = (length(p0 - ((real3)(-R(0.75), R(0.0), R(0.6)))) * R(0.9999)) - R(0.44);
-    if (!(g22 > u22 && g22 > R(0.0))) {
-        /* .../a:union/a:union/b:translate */
-        real3 p11 = p0 - ((real3)(-R(0.75), R(0.0), R(0.6)));
-        /* .../b:translate/color/round_cone */
-        real d39 = sd_round_cone(p11, 0.22f, 0.22f, 0.1f);
-        real d22 = fmin(u26, d39);
-        u22 = d22;
-    }
-    /* .../a:union/a:union: the second operand only within reach of its bound */
-    real u18 = u22;
-    real g18 = (length(p0 - ((real3)(R(0.0), R(0.0), R(0.6)))) * R(0.9999)) - R(0.41000000000000003);
-    if (!(g18 > u18 && g18 > R(0.0))) {
-        /* .../a:union/a:union/b:translate */
-        real3 p12 = p0 - ((real3)(R(0.0), R(0.0), R(0.6)));
+        real3 p12 = p0 - ((real3)(-R(1.6), R(0.0), R(0.75)));
         /* .../b:translate/color/rotate */
         real3 p13 = (real3)((R(0.8775825618903728) * p12.x) - (R(0.479425538604203) * p12.z), p12.y, (R(0.479425538604203) * p12.x) + (R(0.8775825618903728) * p12.z));
         /* .../color/rotate/link */
         real d43 = sd_link(p13, 0.14f, 0.2f, 0.07f);
-        real d18 = fmin(u22, d43);
-        u18 = d18;
+        real d30 = fmin(u34, d43);
+        u30 = d30;
     }
     /* .../a:union/a:union: the second operand only within reach of its bound */
-    real u14 = u18;
-    real g14 = (length(p0 - ((real3)(R(0.75), R(0.05), R(0.6)))) * R(0.9999)) - R(0.35);
-    if (!(g14 > u14 && g14 > R(0.0))) {
+    real u26 = u30;
+    real g26 = (length(p0 - ((real3)(-R(0.8), R(0.05), R(0.75)))) * R(0.9999)) - R(0.35);
+    if (!(g26 > u26 && g26 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p14 = p0 - ((real3)(R(0.75), R(0.0), R(0.6)));
+        real3 p14 = p0 - ((real3)(-R(0.8), R(0.0), R(0.75)));
         /* .../b:translate/color/translate */
         real3 p15 = p14 - ((real3)(R(0.0), R(0.05), R(0.0)));
         /* .../color/translate/cut_sphere */
         real d48 = sd_cut_sphere(p15, 0.35f, 0.15f);
-        real d14 = fmin(u18, d48);
-        u14 = d14;
+        real d26 = fmin(u30, d48);
+        u26 = d26;
     }
     /* .../a:union/a:union: the second operand only within reach of its bound */
-    real u10 = u14;
-    real g10 = (length(p0 - ((real3)(R(1.5), -R(0.3), R(0.6)))) * R(0.9999)) - R(0.45);
-    if (!(g10 > u10 && g10 > R(0.0))) {
+    real u22 = u26;
+    real g22 = (length(p0 - ((real3)(R(0.0), -R(0.3), R(0.75)))) * R(0.9999)) - R(0.45);
+    if (!(g22 > u22 && g22 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p16 = p0 - ((real3)(R(1.5), R(0.0), R(0.6)));
+        real3 p16 = p0 - ((real3)(R(0.0), R(0.0), R(0.75)));
         /* .../b:translate/color/translate */
         real3 p17 = p16 - ((real3)(R(0.0), -R(0.3), R(0.0)));
         /* .../color/translate/solid_angle */
         real d53 = sd_solid_angle(p17, 0.6f, 0.45f);
-        real d10 = fmin(u14, d53);
+        real d22 = fmin(u26, d53);
+        u22 = d22;
+    }
+    /* .../a:union/a:union: the second operand only within reach of its bound */
+    real u18 = u22;
+    real g18 = (length(p0 - ((real3)(R(0.8), R(0.0), R(0.75)))) * R(0.9999)) - R(0.32);
+    if (!(g18 > u18 && g18 > R(0.0))) {
+        /* .../a:union/a:union/b:translate */
+        real3 p18 = p0 - ((real3)(R(0.8), R(0.0), R(0.75)));
+        /* .../b:translate/color/capped_torus */
+        real d58 = sd_capped_torus(p18, 2.2f, 0.25f, 0.07f);
+        real d18 = fmin(u22, d58);
+        u18 = d18;
+    }
+    /* .../a:union/a:union: the second operand only within reach of its bound */
+    real u14 = u18;
+    real g14 = (length(p0 - ((real3)(R(1.5750000000000002), -R(0.024999999999999994), R(0.75)))) * R(0.9999)) - R(0.34734708865916814);
+    if (!(g14 > u14 && g14 > R(0.0))) {
+        /* .../a:union/a:union/b:translate */
+        real3 p19 = p0 - ((real3)(R(1.6), R(0.0), R(0.75)));
+        /* .../b:translate/color/cylinder_between */
+        real d62 = sd_cylinder_between(p19, (real3)((-0.2f), (-0.3f), 0.0f), (real3)(0.15f, 0.25f, 0.0f), 0.12f);
+        real d14 = fmin(u18, d62);
+        u14 = d14;
+    }
+    /* .../a:union/a:union: the second operand only within reach of its bound */
+    real u10 = u14;
+    real g10 = (length(p0 - ((real3)(R(2.4250000000000003), R(0.024999999999999994), R(0.75)))) * R(0.9999)) - R(0.3932556420447137);
+    if (!(g10 > u10 && g10 > R(0.0))) {
+        /* .../a:union/a:union/b:translate */
+        real3 p20 = p0 - ((real3)(R(2.4000000000000004), R(0.0), R(0.75)));
+        /* .../b:translate/color/cone_between */
+        real d66 = sd_cone_between(p20, (real3)(0.2f, (-0.25f), 0.0f), (real3)((-0.15f), 0.3f, 0.0f), 0.22f, 0.05f);
+        real d10 = fmin(u14, d66);
         u10 = d10;
     }
     /* .../a:union/a:union: the second operand only within reach of its bound */
     real u6 = u10;
-    real g6 = (length(p0 - ((real3)(R(2.25), R(0.0), R(0.6)))) * R(0.9999)) - R(0.32);
+    real g6 = (length(p0 - ((real3)(R(3.225), R(0.024999999999999994), R(0.75)))) * R(0.9999)) - R(0.4450438562747845);
     if (!(g6 > u6 && g6 > R(0.0))) {
         /* union/a:union/b:translate */
-        real3 p18 = p0 - ((real3)(R(2.25), R(0.0), R(0.6)));
-        /* .../b:translate/color/capped_torus */
-        real d58 = sd_capped_torus(p18, 2.2f, 0.25f, 0.07f);
-        real d6 = fmin(u10, d58);
+        real3 p21 = p0 - ((real3)(R(3.2), R(0.0), R(0.75)));
+        /* .../b:translate/color/round_cone_between */
+        real d70 = sd_round_cone_between(p21, (real3)((-0.15f), (-0.2f), 0.0f), (real3)(0.2f, 0.25f, 0.0f), 0.16f, 0.07f);
+        real d6 = fmin(u10, d70);
         u6 = d6;
     }
     return u6;
@@ -418,42 +505,99 @@ real DE(real3 p0, __global const real* params) {
 real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     /* union */
     /* union/b:color/plane */
-    real d62 = sd_plane(p0, (real3)(0.0f, 1.0f, 0.0f), 0.4f);
+    real d74 = sd_plane(p0, (real3)(0.0f, 1.0f, 0.0f), 0.4f);
     /* union/b:color */
-    real3 c63 = (real3)(0.55f, 0.55f, 0.6f);
+    real3 c75 = (real3)(0.55f, 0.55f, 0.6f);
     /* union: the second operand only within reach of its bound */
-    real u64 = d62;
-    real3 uc64 = c63;
-    real ut64 = R(1.0);
-    real g64 = (length(p0 - ((real3)(-R(2.625), R(0.0), -R(0.6)))) * R(0.9999)) - R(0.35);
-    if (!(g64 > u64 && g64 > R(0.0))) {
+    real u76 = d74;
+    real3 uc76 = c75;
+    real ut76 = R(1.0);
+    real g76 = (length(p0 - ((real3)(-R(3.2), R(0.0), -R(0.75)))) * R(0.9999)) - R(0.35);
+    if (!(g76 > u76 && g76 > R(0.0))) {
         /* .../a:union/a:union/a:translate */
-        real3 p1 = p0 - ((real3)(-R(2.625), R(0.0), -R(0.6)));
+        real3 p1 = p0 - ((real3)(-R(3.2), R(0.0), -R(0.75)));
         /* .../a:translate/color/sphere */
         real d0 = sd_sphere(p1, 0.35f);
         /* .../a:union/a:translate/color */
         real3 c1 = (real3)(0.9f, 0.45f, 0.3f);
-        real d64 = fmin(d62, d0);
-        real3 c64 = d62 < d0 ? c63 : c1;
-        u64 = d64;
-        uc64 = c64;
-        ut64 = R(1.0);
+        real d76 = fmin(d74, d0);
+        real3 c76 = d74 < d0 ? c75 : c1;
+        u76 = d76;
+        uc76 = c76;
+        ut76 = R(1.0);
     }
     /* union/a:union: the second operand only within reach of its bound */
-    real u61 = u64;
-    real3 uc61 = uc64;
-    real ut61 = ut64;
-    real g61 = (length(p0 - ((real3)(-R(1.875), R(0.0), -R(0.6)))) * R(0.9999)) - R(0.5196152422706632);
-    if (!(g61 > u61 && g61 > R(0.0))) {
+    real u73 = u76;
+    real3 uc73 = uc76;
+    real ut73 = ut76;
+    real g73 = (length(p0 - ((real3)(-R(2.4000000000000004), R(0.0), -R(0.75)))) * R(0.9999)) - R(0.5196152422706632);
+    if (!(g73 > u73 && g73 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p2 = p0 - ((real3)(-R(1.875), R(0.0), -R(0.6)));
+        real3 p2 = p0 - ((real3)(-R(2.4000000000000004), R(0.0), -R(0.75)));
         /* .../b:translate/color/cuboid */
         real d3 = sd_box(p2, (real3)(0.3f));
         /* .../a:union/b:translate/color */
-        real3 c4 = (real3)(0.85714287f, 0.5f, 0.34285715f);
-        real d61 = fmin(u64, d3);
-        real3 c61 = u64 < d3 ? uc64 : c4;
-        real t61 = u64 < d3 ? ut64 : R(1.0);
+        real3 c4 = (real3)(0.86470586f, 0.49117646f, 0.33529413f);
+        real d73 = fmin(u76, d3);
+        real3 c73 = u76 < d3 ? uc76 : c4;
+        real t73 = u76 < d3 ? ut76 : R(1.0);
+        u73 = d73;
+        uc73 = c73;
+        ut73 = t73;
+    }
+    /* .../a:union/a:union: the second operand only within reach of its bound */
+    real u69 = u73;
+    real3 uc69 = uc73;
+    real ut69 = ut73;
+    real g69 = (length(p0 - ((real3)(-R(1.6), R(0.0), -R(0.75)))) * R(0.9999)) - R(0.5196152422706632);
+    if (!(g69 > u69 && g69 > R(0.0))) {
+        /* .../a:union/a:union/b:translate */
+        real3 p3 = p0 - ((real3)(-R(1.6), R(0.0), -R(0.75)));
+        /* .../b:translate/color/round_box */
+        real d7 = sd_round_box(p3, (real3)(0.3f), 0.08f);
+        /* .../a:union/b:translate/color */
+        real3 c8 = (real3)(0.82941175f, 0.5323529f, 0.37058824f);
+        real d69 = fmin(u73, d7);
+        real3 c69 = u73 < d7 ? uc73 : c8;
+        real t69 = u73 < d7 ? ut73 : R(1.0);
+        u69 = d69;
+        uc69 = c69;
+        ut69 = t69;
+    }
+    /* .../a:union/a:union: the second operand only within reach of its bound */
+    real u65 = u69;
+    real3 uc65 = uc69;
+    real ut65 = ut69;
+    real g65 = (length(p0 - ((real3)(-R(0.8), R(0.0), -R(0.75)))) * R(0.9999)) - R(0.38);
+    if (!(g65 > u65 && g65 > R(0.0))) {
+        /* .../a:union/a:union/b:translate */
+        real3 p4 = p0 - ((real3)(-R(0.8), R(0.0), -R(0.75)));
+        /* .../b:translate/color/torus */
+        real d11 = sd_torus(p4, 0.28f, 0.1f);
+        /* .../a:union/b:translate/color */
+        real3 c12 = (real3)(0.7941176f, 0.5735294f, 0.40588236f);
+        real d65 = fmin(u69, d11);
+        real3 c65 = u69 < d11 ? uc69 : c12;
+        real t65 = u69 < d11 ? ut69 : R(1.0);
+        u65 = d65;
+        uc65 = c65;
+        ut65 = t65;
+    }
+    /* .../a:union/a:union: the second operand only within reach of its bound */
+    real u61 = u65;
+    real3 uc61 = uc65;
+    real ut61 = ut65;
+    real g61 = (length(p0 - ((real3)(R(0.0), R(0.0), -R(0.75)))) * R(0.9999)) - R(0.4301162633521313);
+    if (!(g61 > u61 && g61 > R(0.0))) {
+        /* .../a:union/a:union/b:translate */
+        real3 p5 = p0 - ((real3)(R(0.0), R(0.0), -R(0.75)));
+        /* .../b:translate/color/cylinder */
+        real d15 = sd_cylinder(p5, 0.25f, 0.35f);
+        /* .../a:union/b:translate/color */
+        real3 c16 = (real3)(0.7588235f, 0.61470586f, 0.44117647f);
+        real d61 = fmin(u65, d15);
+        real3 c61 = u65 < d15 ? uc65 : c16;
+        real t61 = u65 < d15 ? ut65 : R(1.0);
         u61 = d61;
         uc61 = c61;
         ut61 = t61;
@@ -462,17 +606,17 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     real u57 = u61;
     real3 uc57 = uc61;
     real ut57 = ut61;
-    real g57 = (length(p0 - ((real3)(-R(1.125), R(0.0), -R(0.6)))) * R(0.9999)) - R(0.5196152422706632);
+    real g57 = (length(p0 - ((real3)(R(0.8), R(0.0), -R(0.75)))) * R(0.9999)) - R(0.38);
     if (!(g57 > u57 && g57 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p3 = p0 - ((real3)(-R(1.125), R(0.0), -R(0.6)));
-        /* .../b:translate/color/round_box */
-        real d7 = sd_round_box(p3, (real3)(0.3f), 0.08f);
+        real3 p6 = p0 - ((real3)(R(0.8), R(0.0), -R(0.75)));
+        /* .../b:translate/color/capsule */
+        real d19 = sd_capsule(p6, (real3)(0.0f, (-0.2f), 0.0f), (real3)(0.0f, 0.2f, 0.0f), 0.18f);
         /* .../a:union/b:translate/color */
-        real3 c8 = (real3)(0.8142857f, 0.55f, 0.3857143f);
-        real d57 = fmin(u61, d7);
-        real3 c57 = u61 < d7 ? uc61 : c8;
-        real t57 = u61 < d7 ? ut61 : R(1.0);
+        real3 c20 = (real3)(0.7235294f, 0.65588236f, 0.4764706f);
+        real d57 = fmin(u61, d19);
+        real3 c57 = u61 < d19 ? uc61 : c20;
+        real t57 = u61 < d19 ? ut61 : R(1.0);
         u57 = d57;
         uc57 = c57;
         ut57 = t57;
@@ -481,17 +625,17 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     real u52 = u57;
     real3 uc52 = uc57;
     real ut52 = ut57;
-    real g52 = (length(p0 - ((real3)(-R(0.375), R(0.0), -R(0.6)))) * R(0.9999)) - R(0.38);
+    real g52 = (length(p0 - ((real3)(R(1.6), R(0.0), -R(0.75)))) * R(0.9999)) - R(0.4);
     if (!(g52 > u52 && g52 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p4 = p0 - ((real3)(-R(0.375), R(0.0), -R(0.6)));
-        /* .../b:translate/color/torus */
-        real d11 = sd_torus(p4, 0.28f, 0.1f);
+        real3 p7 = p0 - ((real3)(R(1.6), R(0.0), -R(0.75)));
+        /* .../b:translate/color/octahedron */
+        real d23 = sd_octahedron(p7, 0.4f);
         /* .../a:union/b:translate/color */
-        real3 c12 = (real3)(0.7714286f, 0.6f, 0.42857143f);
-        real d52 = fmin(u57, d11);
-        real3 c52 = u57 < d11 ? uc57 : c12;
-        real t52 = u57 < d11 ? ut57 : R(1.0);
+        real3 c24 = (real3)(0.6882353f, 0.6970588f, 0.5117647f);
+        real d52 = fmin(u57, d23);
+        real3 c52 = u57 < d23 ? uc57 : c24;
+        real t52 = u57 < d23 ? ut57 : R(1.0);
         u52 = d52;
         uc52 = c52;
         ut52 = t52;
@@ -500,17 +644,17 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     real u47 = u52;
     real3 uc47 = uc52;
     real ut47 = ut52;
-    real g47 = (length(p0 - ((real3)(R(0.375), R(0.0), -R(0.6)))) * R(0.9999)) - R(0.4301162633521313);
+    real g47 = (length(p0 - ((real3)(R(2.4000000000000004), R(0.0), -R(0.75)))) * R(0.9999)) - R(0.4609772228646443);
     if (!(g47 > u47 && g47 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p5 = p0 - ((real3)(R(0.375), R(0.0), -R(0.6)));
-        /* .../b:translate/color/cylinder */
-        real d15 = sd_cylinder(p5, 0.25f, 0.35f);
+        real3 p8 = p0 - ((real3)(R(2.4000000000000004), R(0.0), -R(0.75)));
+        /* .../b:translate/color/capped_cone */
+        real d27 = sd_capped_cone(p8, 0.35f, 0.3f, 0.1f);
         /* .../a:union/b:translate/color */
-        real3 c16 = (real3)(0.7285714f, 0.65f, 0.47142857f);
-        real d47 = fmin(u52, d15);
-        real3 c47 = u52 < d15 ? uc52 : c16;
-        real t47 = u52 < d15 ? ut52 : R(1.0);
+        real3 c28 = (real3)(0.65294117f, 0.7382353f, 0.5470588f);
+        real d47 = fmin(u52, d27);
+        real3 c47 = u52 < d27 ? uc52 : c28;
+        real t47 = u52 < d27 ? ut52 : R(1.0);
         u47 = d47;
         uc47 = c47;
         ut47 = t47;
@@ -519,17 +663,17 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     real u42 = u47;
     real3 uc42 = uc47;
     real ut42 = ut47;
-    real g42 = (length(p0 - ((real3)(R(1.125), R(0.0), -R(0.6)))) * R(0.9999)) - R(0.38);
+    real g42 = R(0.5714285714285715) * ((length(p0 - ((real3)(R(3.2), R(0.0), -R(0.75)))) * R(0.9999)) - R(0.35));
     if (!(g42 > u42 && g42 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p6 = p0 - ((real3)(R(1.125), R(0.0), -R(0.6)));
-        /* .../b:translate/color/capsule */
-        real d19 = sd_capsule(p6, (real3)(0.0f, (-0.2f), 0.0f), (real3)(0.0f, 0.2f, 0.0f), 0.18f);
+        real3 p9 = p0 - ((real3)(R(3.2), R(0.0), -R(0.75)));
+        /* .../b:translate/color/ellipsoid */
+        real d31 = sd_ellipsoid(p9, (real3)(0.35f, 0.2f, 0.25f));
         /* .../a:union/b:translate/color */
-        real3 c20 = (real3)(0.6857143f, 0.7f, 0.51428574f);
-        real d42 = fmin(u47, d19);
-        real3 c42 = u47 < d19 ? uc47 : c20;
-        real t42 = u47 < d19 ? ut47 : R(1.0);
+        real3 c32 = (real3)(0.61764705f, 0.7794118f, 0.58235294f);
+        real d42 = fmin(u47, d31);
+        real3 c42 = u47 < d31 ? uc47 : c32;
+        real t42 = u47 < d31 ? ut47 : R(1.0);
         u42 = d42;
         uc42 = c42;
         ut42 = t42;
@@ -538,17 +682,17 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     real u38 = u42;
     real3 uc38 = uc42;
     real ut38 = ut42;
-    real g38 = (length(p0 - ((real3)(R(1.875), R(0.0), -R(0.6)))) * R(0.9999)) - R(0.4);
+    real g38 = (length(p0 - ((real3)(-R(3.2), R(0.0), R(0.75)))) * R(0.9999)) - R(0.4410593308539491);
     if (!(g38 > u38 && g38 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p7 = p0 - ((real3)(R(1.875), R(0.0), -R(0.6)));
-        /* .../b:translate/color/octahedron */
-        real d23 = sd_octahedron(p7, 0.4f);
+        real3 p10 = p0 - ((real3)(-R(3.2), R(0.0), R(0.75)));
+        /* .../b:translate/color/hex_prism */
+        real d35 = sd_hex_prism(p10, 0.28f, 0.3f);
         /* .../a:union/b:translate/color */
-        real3 c24 = (real3)(0.64285713f, 0.75f, 0.55714285f);
-        real d38 = fmin(u42, d23);
-        real3 c38 = u42 < d23 ? uc42 : c24;
-        real t38 = u42 < d23 ? ut42 : R(1.0);
+        real3 c36 = (real3)(0.58235294f, 0.7794118f, 0.61764705f);
+        real d38 = fmin(u42, d35);
+        real3 c38 = u42 < d35 ? uc42 : c36;
+        real t38 = u42 < d35 ? ut42 : R(1.0);
         u38 = d38;
         uc38 = c38;
         ut38 = t38;
@@ -557,17 +701,17 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     real u34 = u38;
     real3 uc34 = uc38;
     real ut34 = ut38;
-    real g34 = (length(p0 - ((real3)(R(2.625), R(0.0), -R(0.6)))) * R(0.9999)) - R(0.4609772228646443);
+    real g34 = (length(p0 - ((real3)(-R(2.4000000000000004), R(0.0), R(0.75)))) * R(0.9999)) - R(0.44);
     if (!(g34 > u34 && g34 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p8 = p0 - ((real3)(R(2.625), R(0.0), -R(0.6)));
-        /* .../b:translate/color/capped_cone */
-        real d27 = sd_capped_cone(p8, 0.35f, 0.3f, 0.1f);
+        real3 p11 = p0 - ((real3)(-R(2.4000000000000004), R(0.0), R(0.75)));
+        /* .../b:translate/color/round_cone */
+        real d39 = sd_round_cone(p11, 0.22f, 0.22f, 0.1f);
         /* .../a:union/b:translate/color */
-        real3 c28 = (real3)(0.6f, 0.8f, 0.6f);
-        real d34 = fmin(u38, d27);
-        real3 c34 = u38 < d27 ? uc38 : c28;
-        real t34 = u38 < d27 ? ut38 : R(1.0);
+        real3 c40 = (real3)(0.5470588f, 0.7382353f, 0.65294117f);
+        real d34 = fmin(u38, d39);
+        real3 c34 = u38 < d39 ? uc38 : c40;
+        real t34 = u38 < d39 ? ut38 : R(1.0);
         u34 = d34;
         uc34 = c34;
         ut34 = t34;
@@ -576,17 +720,19 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     real u30 = u34;
     real3 uc30 = uc34;
     real ut30 = ut34;
-    real g30 = R(0.5714285714285715) * ((length(p0 - ((real3)(-R(2.25), R(0.0), R(0.6)))) * R(0.9999)) - R(0.35));
+    real g30 = (length(p0 - ((real3)(-R(1.6), R(0.0), R(0.75)))) * R(0.9999)) - R(0.41000000000000003);
     if (!(g30 > u30 && g30 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p9 = p0 - ((real3)(-R(2.25), R(0.0), R(0.6)));
-        /* .../b:translate/color/ellipsoid */
-        real d31 = sd_ellipsoid(p9, (real3)(0.35f, 0.2f, 0.25f));
+        real3 p12 = p0 - ((real3)(-R(1.6), R(0.0), R(0.75)));
+        /* .../b:translate/color/rotate */
+        real3 p13 = (real3)((R(0.8775825618903728) * p12.x) - (R(0.479425538604203) * p12.z), p12.y, (R(0.479425538604203) * p12.x) + (R(0.8775825618903728) * p12.z));
+        /* .../color/rotate/link */
+        real d43 = sd_link(p13, 0.14f, 0.2f, 0.07f);
         /* .../a:union/b:translate/color */
-        real3 c32 = (real3)(0.55714285f, 0.75f, 0.64285713f);
-        real d30 = fmin(u34, d31);
-        real3 c30 = u34 < d31 ? uc34 : c32;
-        real t30 = u34 < d31 ? ut34 : R(1.0);
+        real3 c45 = (real3)(0.5117647f, 0.6970588f, 0.6882353f);
+        real d30 = fmin(u34, d43);
+        real3 c30 = u34 < d43 ? uc34 : c45;
+        real t30 = u34 < d43 ? ut34 : R(1.0);
         u30 = d30;
         uc30 = c30;
         ut30 = t30;
@@ -595,17 +741,19 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     real u26 = u30;
     real3 uc26 = uc30;
     real ut26 = ut30;
-    real g26 = (length(p0 - ((real3)(-R(1.5), R(0.0), R(0.6)))) * R(0.9999)) - R(0.4410593308539491);
+    real g26 = (length(p0 - ((real3)(-R(0.8), R(0.05), R(0.75)))) * R(0.9999)) - R(0.35);
     if (!(g26 > u26 && g26 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p10 = p0 - ((real3)(-R(1.5), R(0.0), R(0.6)));
-        /* .../b:translate/color/hex_prism */
-        real d35 = sd_hex_prism(p10, 0.28f, 0.3f);
+        real3 p14 = p0 - ((real3)(-R(0.8), R(0.0), R(0.75)));
+        /* .../b:translate/color/translate */
+        real3 p15 = p14 - ((real3)(R(0.0), R(0.05), R(0.0)));
+        /* .../color/translate/cut_sphere */
+        real d48 = sd_cut_sphere(p15, 0.35f, 0.15f);
         /* .../a:union/b:translate/color */
-        real3 c36 = (real3)(0.51428574f, 0.7f, 0.6857143f);
-        real d26 = fmin(u30, d35);
-        real3 c26 = u30 < d35 ? uc30 : c36;
-        real t26 = u30 < d35 ? ut30 : R(1.0);
+        real3 c50 = (real3)(0.4764706f, 0.65588236f, 0.7235294f);
+        real d26 = fmin(u30, d48);
+        real3 c26 = u30 < d48 ? uc30 : c50;
+        real t26 = u30 < d48 ? ut30 : R(1.0);
         u26 = d26;
         uc26 = c26;
         ut26 = t26;
@@ -614,17 +762,19 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     real u22 = u26;
     real3 uc22 = uc26;
     real ut22 = ut26;
-    real g22 = (length(p0 - ((real3)(-R(0.75), R(0.0), R(0.6)))) * R(0.9999)) - R(0.44);
+    real g22 = (length(p0 - ((real3)(R(0.0), -R(0.3), R(0.75)))) * R(0.9999)) - R(0.45);
     if (!(g22 > u22 && g22 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p11 = p0 - ((real3)(-R(0.75), R(0.0), R(0.6)));
-        /* .../b:translate/color/round_cone */
-        real d39 = sd_round_cone(p11, 0.22f, 0.22f, 0.1f);
+        real3 p16 = p0 - ((real3)(R(0.0), R(0.0), R(0.75)));
+        /* .../b:translate/color/translate */
+        real3 p17 = p16 - ((real3)(R(0.0), -R(0.3), R(0.0)));
+        /* .../color/translate/solid_angle */
+        real d53 = sd_solid_angle(p17, 0.6f, 0.45f);
         /* .../a:union/b:translate/color */
-        real3 c40 = (real3)(0.47142857f, 0.65f, 0.7285714f);
-        real d22 = fmin(u26, d39);
-        real3 c22 = u26 < d39 ? uc26 : c40;
-        real t22 = u26 < d39 ? ut26 : R(1.0);
+        real3 c55 = (real3)(0.44117647f, 0.61470586f, 0.7588235f);
+        real d22 = fmin(u26, d53);
+        real3 c22 = u26 < d53 ? uc26 : c55;
+        real t22 = u26 < d53 ? ut26 : R(1.0);
         u22 = d22;
         uc22 = c22;
         ut22 = t22;
@@ -633,19 +783,17 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     real u18 = u22;
     real3 uc18 = uc22;
     real ut18 = ut22;
-    real g18 = (length(p0 - ((real3)(R(0.0), R(0.0), R(0.6)))) * R(0.9999)) - R(0.41000000000000003);
+    real g18 = (length(p0 - ((real3)(R(0.8), R(0.0), R(0.75)))) * R(0.9999)) - R(0.32);
     if (!(g18 > u18 && g18 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p12 = p0 - ((real3)(R(0.0), R(0.0), R(0.6)));
-        /* .../b:translate/color/rotate */
-        real3 p13 = (real3)((R(0.8775825618903728) * p12.x) - (R(0.479425538604203) * p12.z), p12.y, (R(0.479425538604203) * p12.x) + (R(0.8775825618903728) * p12.z));
-        /* .../color/rotate/link */
-        real d43 = sd_link(p13, 0.14f, 0.2f, 0.07f);
+        real3 p18 = p0 - ((real3)(R(0.8), R(0.0), R(0.75)));
+        /* .../b:translate/color/capped_torus */
+        real d58 = sd_capped_torus(p18, 2.2f, 0.25f, 0.07f);
         /* .../a:union/b:translate/color */
-        real3 c45 = (real3)(0.42857143f, 0.6f, 0.7714286f);
-        real d18 = fmin(u22, d43);
-        real3 c18 = u22 < d43 ? uc22 : c45;
-        real t18 = u22 < d43 ? ut22 : R(1.0);
+        real3 c59 = (real3)(0.40588236f, 0.5735294f, 0.7941176f);
+        real d18 = fmin(u22, d58);
+        real3 c18 = u22 < d58 ? uc22 : c59;
+        real t18 = u22 < d58 ? ut22 : R(1.0);
         u18 = d18;
         uc18 = c18;
         ut18 = t18;
@@ -654,19 +802,17 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     real u14 = u18;
     real3 uc14 = uc18;
     real ut14 = ut18;
-    real g14 = (length(p0 - ((real3)(R(0.75), R(0.05), R(0.6)))) * R(0.9999)) - R(0.35);
+    real g14 = (length(p0 - ((real3)(R(1.5750000000000002), -R(0.024999999999999994), R(0.75)))) * R(0.9999)) - R(0.34734708865916814);
     if (!(g14 > u14 && g14 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p14 = p0 - ((real3)(R(0.75), R(0.0), R(0.6)));
-        /* .../b:translate/color/translate */
-        real3 p15 = p14 - ((real3)(R(0.0), R(0.05), R(0.0)));
-        /* .../color/translate/cut_sphere */
-        real d48 = sd_cut_sphere(p15, 0.35f, 0.15f);
+        real3 p19 = p0 - ((real3)(R(1.6), R(0.0), R(0.75)));
+        /* .../b:translate/color/cylinder_between */
+        real d62 = sd_cylinder_between(p19, (real3)((-0.2f), (-0.3f), 0.0f), (real3)(0.15f, 0.25f, 0.0f), 0.12f);
         /* .../a:union/b:translate/color */
-        real3 c50 = (real3)(0.3857143f, 0.55f, 0.8142857f);
-        real d14 = fmin(u18, d48);
-        real3 c14 = u18 < d48 ? uc18 : c50;
-        real t14 = u18 < d48 ? ut18 : R(1.0);
+        real3 c63 = (real3)(0.37058824f, 0.5323529f, 0.82941175f);
+        real d14 = fmin(u18, d62);
+        real3 c14 = u18 < d62 ? uc18 : c63;
+        real t14 = u18 < d62 ? ut18 : R(1.0);
         u14 = d14;
         uc14 = c14;
         ut14 = t14;
@@ -675,19 +821,17 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     real u10 = u14;
     real3 uc10 = uc14;
     real ut10 = ut14;
-    real g10 = (length(p0 - ((real3)(R(1.5), -R(0.3), R(0.6)))) * R(0.9999)) - R(0.45);
+    real g10 = (length(p0 - ((real3)(R(2.4250000000000003), R(0.024999999999999994), R(0.75)))) * R(0.9999)) - R(0.3932556420447137);
     if (!(g10 > u10 && g10 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p16 = p0 - ((real3)(R(1.5), R(0.0), R(0.6)));
-        /* .../b:translate/color/translate */
-        real3 p17 = p16 - ((real3)(R(0.0), -R(0.3), R(0.0)));
-        /* .../color/translate/solid_angle */
-        real d53 = sd_solid_angle(p17, 0.6f, 0.45f);
+        real3 p20 = p0 - ((real3)(R(2.4000000000000004), R(0.0), R(0.75)));
+        /* .../b:translate/color/cone_between */
+        real d66 = sd_cone_between(p20, (real3)(0.2f, (-0.25f), 0.0f), (real3)((-0.15f), 0.3f, 0.0f), 0.22f, 0.05f);
         /* .../a:union/b:translate/color */
-        real3 c55 = (real3)(0.34285715f, 0.5f, 0.85714287f);
-        real d10 = fmin(u14, d53);
-        real3 c10 = u14 < d53 ? uc14 : c55;
-        real t10 = u14 < d53 ? ut14 : R(1.0);
+        real3 c67 = (real3)(0.33529413f, 0.49117646f, 0.86470586f);
+        real d10 = fmin(u14, d66);
+        real3 c10 = u14 < d66 ? uc14 : c67;
+        real t10 = u14 < d66 ? ut14 : R(1.0);
         u10 = d10;
         uc10 = c10;
         ut10 = t10;
@@ -696,17 +840,17 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     real u6 = u10;
     real3 uc6 = uc10;
     real ut6 = ut10;
-    real g6 = (length(p0 - ((real3)(R(2.25), R(0.0), R(0.6)))) * R(0.9999)) - R(0.32);
+    real g6 = (length(p0 - ((real3)(R(3.225), R(0.024999999999999994), R(0.75)))) * R(0.9999)) - R(0.4450438562747845);
     if (!(g6 > u6 && g6 > R(0.0))) {
         /* union/a:union/b:translate */
-        real3 p18 = p0 - ((real3)(R(2.25), R(0.0), R(0.6)));
-        /* .../b:translate/color/capped_torus */
-        real d58 = sd_capped_torus(p18, 2.2f, 0.25f, 0.07f);
+        real3 p21 = p0 - ((real3)(R(3.2), R(0.0), R(0.75)));
+        /* .../b:translate/color/round_cone_between */
+        real d70 = sd_round_cone_between(p21, (real3)((-0.15f), (-0.2f), 0.0f), (real3)(0.2f, 0.25f, 0.0f), 0.16f, 0.07f);
         /* .../a:union/b:translate/color */
-        real3 c59 = (real3)(0.3f, 0.45f, 0.9f);
-        real d6 = fmin(u10, d58);
-        real3 c6 = u10 < d58 ? uc10 : c59;
-        real t6 = u10 < d58 ? ut10 : R(1.0);
+        real3 c71 = (real3)(0.3f, 0.45f, 0.9f);
+        real d6 = fmin(u10, d70);
+        real3 c6 = u10 < d70 ? uc10 : c71;
+        real t6 = u10 < d70 ? ut10 : R(1.0);
         u6 = d6;
         uc6 = c6;
         ut6 = t6;

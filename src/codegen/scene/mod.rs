@@ -36,7 +36,7 @@ use crate::math::{
 use crate::quality::Precision;
 use crate::scene::{
     CsgOp, CustomShape, Hybrid, Kind, MAX_ESCAPE_ITERATIONS, MAX_FOLD_ITERATIONS, Mapper, Palette,
-    ParamSpec, Trap,
+    ParamSpec, Profile, Trap,
 };
 
 mod inline;
@@ -100,6 +100,9 @@ fn leaf_function(node: &IrNode) -> Option<(Helper, &'static str)> {
         Kind::CutSphere { .. } => (Helper::CutSphere, "sd_cut_sphere"),
         Kind::SolidAngle { .. } => (Helper::SolidAngle, "sd_solid_angle"),
         Kind::CappedTorus { .. } => (Helper::CappedTorus, "sd_capped_torus"),
+        Kind::CylinderBetween { .. } => (Helper::CylinderBetween, "sd_cylinder_between"),
+        Kind::ConeBetween { .. } => (Helper::ConeBetween, "sd_cone_between"),
+        Kind::RoundConeBetween { .. } => (Helper::RoundConeBetween, "sd_round_cone_between"),
         Kind::Ellipsoid { .. } => (Helper::Ellipsoid, "sd_ellipsoid"),
         _ => return None,
     })
@@ -307,6 +310,29 @@ impl<'a> SceneEmitter<'a> {
             c: self.default_surface(),
             t: "R(1.0)".into(),
         }
+    }
+
+    /// A solid made of a plane profile (an extrusion or a revolution),
+    /// written in place: a polygon's edges unroll, its baked corners
+    /// folded into the code.
+    fn profile_leaf(
+        &mut self,
+        id: NodeId,
+        p: &str,
+        profile: &Profile<Scalar>,
+        last: Scalar,
+        solid: fn(V3<Var>, &Profile<Var>, Var) -> Var,
+    ) -> Vars {
+        let mut args = vec![Arg::Point(p)];
+        profile.map(|s| args.push(Arg::Scalar(*s)));
+        args.push(Arg::Scalar(last));
+        let [d] = take(self.inline(&args, &[Shape::Scalar], |a| {
+            let mut values = a[3..].iter().copied();
+            let shape = profile.map(|_| values.next().expect("one value per number"));
+            let last = values.next().expect("the sweep's own value");
+            vec![solid(vector(a, 0), &shape, last)]
+        }));
+        self.leaf(id, d)
     }
 
     /// A fractal: the helper returns the distance and the trap.
@@ -667,6 +693,13 @@ impl<'a> SceneEmitter<'a> {
                     None => Helper::Mandelbox,
                 };
                 Step::Done(self.fractal(id, helper, &args))
+            }
+            Kind::Extrude {
+                profile,
+                half_height,
+            } => Step::Done(self.profile_leaf(id, p, profile, *half_height, sdf::extrude)),
+            Kind::Revolve { profile, offset } => {
+                Step::Done(self.profile_leaf(id, p, profile, *offset, sdf::revolve))
             }
             Kind::Translate { offset, child } => {
                 let q = self.map_point(p, &[Arg::Vector(*offset)], |p, a| {

@@ -23,7 +23,10 @@ use crate::math::{
 use crate::scene::{CsgOp, KifsFold};
 
 mod hybrid;
+mod profile;
 mod trap;
+
+pub use profile::{extrude, profile, revolve};
 
 pub use trap::TrapShape;
 pub(crate) use trap::TrapSlot;
@@ -176,6 +179,56 @@ pub fn round_cone<T: Num>(p: V3<T>, h: T, r1: T, r2: T) -> T {
     );
     // One ball holds the other: `|r1 - r2| >= 2h`.
     T::select((r1 - r2).abs().ge(length), bottom.min(top), hull)
+}
+
+/// The point `p` in the frame of the segment `a`-`b`: as a point of the
+/// plane through the segment, its distance from the segment's line as `x`
+/// and its height along the segment from the midpoint as `y` (`z` 0), and
+/// half the segment's length. A segment of length 0 is taken along y.
+/// The solids of revolution along y ([`cylinder`], [`capped_cone`],
+/// [`round_cone`]) read only `|p.xz|` and `p.y`, so at this point they
+/// give the same solid along the segment.
+fn segment_frame<T: Num>(p: V3<T>, a: V3<T>, b: V3<T>) -> (V3<T>, T) {
+    let ba = b - a;
+    let length = ba.length();
+    let axis = V3::select(
+        length.gt(T::tiny()),
+        ba / length.max(T::tiny()),
+        v3(T::zero(), T::one(), T::zero()),
+    );
+    let q = p - (a + b) * T::of(0.5);
+    let y = q.dot(axis);
+    (
+        v3((q - axis * y).length(), y, T::zero()),
+        length * T::of(0.5),
+    )
+}
+
+/// Exact distance to the capped cylinder of radius `r` around the segment
+/// `a`-`b` (Quilez's arbitrary `sdCappedCylinder`), through the segment's
+/// frame and [`cylinder`].
+#[must_use]
+pub fn cylinder_between<T: Num>(p: V3<T>, a: V3<T>, b: V3<T>, r: T) -> T {
+    let (q, h) = segment_frame(p, a, b);
+    cylinder(q, r, h)
+}
+
+/// Exact distance to the capped cone around the segment `a`-`b`, of
+/// radius `ra` at `a` and `rb` at `b` (Quilez's arbitrary
+/// `sdCappedCone`), through the segment's frame and [`capped_cone`].
+#[must_use]
+pub fn cone_between<T: Num>(p: V3<T>, a: V3<T>, b: V3<T>, ra: T, rb: T) -> T {
+    let (q, h) = segment_frame(p, a, b);
+    capped_cone(q, h, ra, rb)
+}
+
+/// Exact distance to the convex hull of the ball of radius `ra` about `a`
+/// and the ball of radius `rb` about `b` (Quilez's arbitrary
+/// `sdRoundCone`), through the segment's frame and [`round_cone`].
+#[must_use]
+pub fn round_cone_between<T: Num>(p: V3<T>, a: V3<T>, b: V3<T>, ra: T, rb: T) -> T {
+    let (q, h) = segment_frame(p, a, b);
+    round_cone(q, h, ra, rb)
 }
 
 /// Exact distance to a chain link in the xy plane: a tube of radius `r2`

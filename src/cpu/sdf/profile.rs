@@ -1,0 +1,91 @@
+//! Plane profiles and the two sweeps that make solids of them: extrusion
+//! along z and revolution around y (Quilez's `opExtrusion` and
+//! `opRevolution`, and his exact 2D distances).
+
+use crate::math::{Num, V3};
+use crate::scene::Profile;
+
+/// Exact signed distance from the point `(x, y)` to `profile`.
+#[must_use]
+pub fn profile<T: Num>(x: T, y: T, profile: &Profile<T>) -> T {
+    let zero = T::zero();
+    match profile {
+        Profile::Circle { radius } => x.hypot(y) - *radius,
+        Profile::Rect {
+            half_extents: [bx, by],
+        } => rect(x, y, *bx, *by),
+        Profile::RoundRect {
+            half_extents: [bx, by],
+            radius,
+        } => rect(x, y, *bx - *radius, *by - *radius) - *radius,
+        Profile::Segment { a, b, radius } => {
+            let [px, py] = [x - a[0], y - a[1]];
+            let [ex, ey] = [b[0] - a[0], b[1] - a[1]];
+            let h = ((px * ex + py * ey) / (ex * ex + ey * ey).max(T::tiny()))
+                .max(zero)
+                .min(T::one());
+            (px - ex * h).hypot(py - ey * h) - *radius
+        }
+        Profile::Polygon { vertices } => polygon(x, y, vertices),
+    }
+}
+
+/// The rectangle of half extents `bx`, `by` about the origin.
+fn rect<T: Num>(x: T, y: T, bx: T, by: T) -> T {
+    let zero = T::zero();
+    let (qx, qy) = (x.abs() - bx, y.abs() - by);
+    qx.max(zero).hypot(qy.max(zero)) + qx.max(qy).min(zero)
+}
+
+/// The polygon through `v`: the distance to its nearest edge, negative
+/// where a ray towards +x crosses its edges an odd number of times.
+fn polygon<T: Num>(x: T, y: T, v: &[[T; 2]]) -> T {
+    let Some(last) = v.last() else {
+        return T::of(f64::INFINITY);
+    };
+    let mut nearest = (x - last[0]).hypot(y - last[1]);
+    let mut inside: Option<T::Bool> = None;
+    let mut j = v.len() - 1;
+    for (i, vi) in v.iter().enumerate() {
+        let vj = v[j];
+        let [ex, ey] = [vj[0] - vi[0], vj[1] - vi[1]];
+        let [wx, wy] = [x - vi[0], y - vi[1]];
+        let h = ((wx * ex + wy * ey) / (ex * ex + ey * ey).max(T::tiny()))
+            .max(T::zero())
+            .min(T::one());
+        nearest = nearest.min((wx - ex * h).hypot(wy - ey * h));
+        // The edge crosses the point's height, the point left of it going
+        // up or right of it going down: the ray crosses it.
+        let (up, down, left) = (y.ge(vi[1]), y.lt(vj[1]), (ey * wx).lt(ex * wy));
+        let crosses = (up & down & left) | (!up & !down & !left);
+        inside = Some(match inside {
+            Some(odd) => (odd & !crosses) | (!odd & crosses),
+            None => crosses,
+        });
+        j = i;
+    }
+    match inside {
+        Some(inside) => T::select(inside, -nearest, nearest),
+        None => nearest,
+    }
+}
+
+/// Exact distance to `profile` in the xy plane extruded along z to
+/// `±half_height`.
+#[must_use]
+pub fn extrude<T: Num>(p: V3<T>, profile: &Profile<T>, half_height: T) -> T {
+    let zero = T::zero();
+    let d = self::profile(p.x, p.y, profile);
+    let h = p.z.abs() - half_height;
+    d.max(h).min(zero) + d.max(zero).hypot(h.max(zero))
+}
+
+/// The solid swept by `profile` turning around the y axis, its x axis
+/// moved out to `offset`: the profile's distance at `(|p.xz| - offset,
+/// p.y)`. Exact where the profile lies at `x >= -offset`; past the axis,
+/// the solid is the sweep of the profile's part at `x >= -offset` and this
+/// is a bound.
+#[must_use]
+pub fn revolve<T: Num>(p: V3<T>, profile: &Profile<T>, offset: T) -> T {
+    self::profile(p.x.hypot(p.z) - offset, p.y, profile)
+}
