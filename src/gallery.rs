@@ -21,9 +21,10 @@ use crate::quality::{Effects, Glow, Quality};
 use crate::scene::{
     Axis, Camera, Hybrid, HybridOp, InsideShape, Kifs, KifsFold, Light, Mandelbulb, Material, Node,
     OrbitColoring, Palette, Profile, QuaternionJulia, Scene, Trap, capped_cone, capped_torus,
-    capsule, cone_between, cuboid, cut_sphere, cylinder, cylinder_between, ellipsoid, extrude,
-    hex_prism, julia, link, menger, octahedron, param, param3, plane, revolve, round_box,
-    round_cone, round_cone_between, sierpinski, solid_angle, sphere, torus,
+    capsule, cone, cone_between, cuboid, cut_hollow_sphere, cut_sphere, cylinder, cylinder_between,
+    death_star, ellipsoid, extrude, hex_prism, julia, link, menger, octahedron, param, param3,
+    plane, pyramid, quad, revolve, rhombus, round_box, round_cone, round_cone_between,
+    rounded_cylinder, sierpinski, solid_angle, sphere, torus, tri_prism, triangle,
 };
 
 /// Every gallery scene by name.
@@ -538,7 +539,8 @@ pub fn csg() -> Scene {
         .with_lights(key_and_fill())
 }
 
-/// One of every primitive, in two rows.
+/// One of every bounded primitive, in three rows (the plane is the
+/// floor).
 #[must_use]
 pub fn primitives() -> Scene {
     let items = [
@@ -560,6 +562,33 @@ pub fn primitives() -> Scene {
         cylinder_between(dvec3(-0.2, -0.3, 0.0), dvec3(0.15, 0.25, 0.0), 0.12),
         cone_between(dvec3(0.2, -0.25, 0.0), dvec3(-0.15, 0.3, 0.0), 0.22, 0.05),
         round_cone_between(dvec3(-0.15, -0.2, 0.0), dvec3(0.2, 0.25, 0.0), 0.16, 0.07),
+        triangle(
+            dvec3(-0.3, -0.35, 0.0),
+            dvec3(0.3, -0.35, 0.0),
+            dvec3(0.0, 0.3, 0.0),
+            0.03,
+        )
+        .rotate(DVec3::Y, 0.4),
+        quad(
+            dvec3(-0.28, -0.35, -0.12),
+            dvec3(0.28, -0.35, -0.12),
+            dvec3(0.2, 0.3, 0.1),
+            dvec3(-0.2, 0.3, 0.1),
+            0.03,
+        ),
+        pyramid(0.3, 0.55)
+            .rotate(DVec3::Y, 0.5)
+            .translate(dvec3(0.0, -0.4, 0.0)),
+        rhombus(0.36, 0.22, 0.06, 0.04)
+            .rotate(DVec3::Y, 0.6)
+            .translate(dvec3(0.0, -0.34, 0.0)),
+        tri_prism(0.17, 0.3).translate(dvec3(0.0, -0.1, 0.0)),
+        rounded_cylinder(0.28, 0.2, 0.08).translate(dvec3(0.0, -0.2, 0.0)),
+        cone(0.28, 0.6).translate(dvec3(0.0, 0.2, 0.0)),
+        cut_hollow_sphere(0.32, 0.12, 0.02).translate(dvec3(0.0, -0.06, 0.0)),
+        death_star(0.32, 0.25, 0.3)
+            .rotate(DVec3::Y, -FRAC_PI_2)
+            .translate(dvec3(0.0, -0.08, 0.0)),
     ];
     let count = items.len();
     let row = items
@@ -573,19 +602,16 @@ pub fn primitives() -> Scene {
                 0.45 + 0.35 * (1.0 - (2.0 * t - 1.0).abs()),
                 0.3 + 0.6 * t,
             );
-            // Nine in each row, 0.8 apart.
+            // Nine in each of three rows, 0.8 apart.
             #[allow(clippy::cast_precision_loss)]
-            let (column, z) = if i < 9 {
-                (i as f64 - 4.0, -0.75)
-            } else {
-                ((i - 9) as f64 - 4.0, 0.75)
-            };
-            node.color(hue).translate(dvec3(column * 0.8, 0.0, z))
+            let (column, row) = ((i % 9) as f64 - 4.0, (i / 9) as f64 - 1.0);
+            node.color(hue)
+                .translate(dvec3(column * 0.8, 0.0, row * 1.1))
         })
         .reduce(Node::union)
-        .expect("eighteen primitives");
+        .expect("twenty-seven primitives");
     Scene::new(row.union(floor(0.4)))
-        .with_camera(Camera::look_at(dvec3(0.0, 4.0, 6.4), dvec3(0.0, 0.0, 0.6)).fov(44.0))
+        .with_camera(Camera::look_at(dvec3(0.0, 4.6, 7.2), dvec3(0.0, -0.1, 0.4)).fov(40.5))
         .with_lights(key_and_fill())
 }
 

@@ -142,6 +142,99 @@ pub(crate) fn link() -> Result<String, Unprintable> {
     )
 }
 
+pub(crate) fn triangle() -> Result<String, Unprintable> {
+    distance(
+        "sd_triangle",
+        &[("a", Vec3), ("b", Vec3), ("c", Vec3), ("t", Scalar)],
+        |p, a| sdf::triangle(p, vector(a, 0), vector(a, 3), vector(a, 6), a[9]),
+    )
+}
+
+pub(crate) fn quad() -> Result<String, Unprintable> {
+    distance(
+        "sd_quad",
+        &[
+            ("a", Vec3),
+            ("b", Vec3),
+            ("c", Vec3),
+            ("d", Vec3),
+            ("t", Scalar),
+        ],
+        |p, a| {
+            sdf::quad(
+                p,
+                vector(a, 0),
+                vector(a, 3),
+                vector(a, 6),
+                vector(a, 9),
+                a[12],
+            )
+        },
+    )
+}
+
+pub(crate) fn pyramid() -> Result<String, Unprintable> {
+    distance("sd_pyramid", &[("w", Scalar), ("h", Scalar)], |p, a| {
+        sdf::pyramid(p, a[0], a[1])
+    })
+}
+
+pub(crate) fn rhombus() -> Result<String, Unprintable> {
+    distance(
+        "sd_rhombus",
+        &[("la", Scalar), ("lb", Scalar), ("h", Scalar), ("r", Scalar)],
+        |p, a| sdf::rhombus(p, a[0], a[1], a[2], a[3]),
+    )
+}
+
+pub(crate) fn tri_prism() -> Result<String, Unprintable> {
+    distance("sd_tri_prism", &[("r", Scalar), ("h", Scalar)], |p, a| {
+        sdf::tri_prism(p, a[0], a[1])
+    })
+}
+
+pub(crate) fn rounded_cylinder() -> Result<String, Unprintable> {
+    distance(
+        "sd_rounded_cylinder",
+        &[("r", Scalar), ("h", Scalar), ("e", Scalar)],
+        |p, a| sdf::rounded_cylinder(p, a[0], a[1], a[2]),
+    )
+}
+
+pub(crate) fn cone() -> Result<String, Unprintable> {
+    distance("sd_cone", &[("r", Scalar), ("h", Scalar)], |p, a| {
+        sdf::cone(p, a[0], a[1])
+    })
+}
+
+pub(crate) fn infinite_cylinder() -> Result<String, Unprintable> {
+    distance("sd_infinite_cylinder", &[("r", Scalar)], |p, a| {
+        sdf::infinite_cylinder(p, a[0])
+    })
+}
+
+pub(crate) fn infinite_cone() -> Result<String, Unprintable> {
+    distance("sd_infinite_cone", &[("angle", Scalar)], |p, a| {
+        sdf::infinite_cone(p, a[0])
+    })
+}
+
+pub(crate) fn cut_hollow_sphere() -> Result<String, Unprintable> {
+    distance(
+        "sd_cut_hollow_sphere",
+        &[("r", Scalar), ("h", Scalar), ("t", Scalar)],
+        |p, a| sdf::cut_hollow_sphere(p, a[0], a[1], a[2]),
+    )
+}
+
+pub(crate) fn death_star() -> Result<String, Unprintable> {
+    distance(
+        "sd_death_star",
+        &[("ra", Scalar), ("rb", Scalar), ("d", Scalar)],
+        |p, a| sdf::death_star(p, a[0], a[1], a[2]),
+    )
+}
+
 pub(crate) fn cylinder_between() -> Result<String, Unprintable> {
     distance(
         "sd_cylinder_between",

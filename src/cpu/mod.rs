@@ -411,6 +411,68 @@ impl Evaluator {
                 s(*major_radius),
                 s(*minor_radius),
             )),
+            Kind::Triangle { a, b, c, thickness } => {
+                Self::leaf(sdf::triangle(p, v(*a), v(*b), v(*c), s(*thickness)))
+            }
+            Kind::Quad {
+                a,
+                b,
+                c,
+                d,
+                thickness,
+            } => Self::leaf(sdf::quad(p, v(*a), v(*b), v(*c), v(*d), s(*thickness))),
+            Kind::Pyramid { half_base, height } => {
+                Self::leaf(sdf::pyramid(p, s(*half_base), s(*height)))
+            }
+            Kind::Rhombus {
+                half_x,
+                half_z,
+                half_height,
+                radius,
+            } => Self::leaf(sdf::rhombus(
+                p,
+                s(*half_x),
+                s(*half_z),
+                s(*half_height),
+                s(*radius),
+            )),
+            Kind::TriPrism {
+                radius,
+                half_height,
+            } => Self::leaf(sdf::tri_prism(p, s(*radius), s(*half_height))),
+            Kind::RoundedCylinder {
+                radius,
+                half_height,
+                rounding,
+            } => Self::leaf(sdf::rounded_cylinder(
+                p,
+                s(*radius),
+                s(*half_height),
+                s(*rounding),
+            )),
+            Kind::Cone { radius, height } => Self::leaf(sdf::cone(p, s(*radius), s(*height))),
+            Kind::InfiniteCylinder { radius } => Self::leaf(sdf::infinite_cylinder(p, s(*radius))),
+            Kind::InfiniteCone { angle } => Self::leaf(sdf::infinite_cone(p, s(*angle))),
+            Kind::CutHollowSphere {
+                radius,
+                height,
+                thickness,
+            } => Self::leaf(sdf::cut_hollow_sphere(
+                p,
+                s(*radius),
+                s(*height),
+                s(*thickness),
+            )),
+            Kind::DeathStar {
+                radius,
+                carve_radius,
+                carve_distance,
+            } => Self::leaf(sdf::death_star(
+                p,
+                s(*radius),
+                s(*carve_radius),
+                s(*carve_distance),
+            )),
             Kind::CylinderBetween { a, b, radius } => {
                 Self::leaf(sdf::cylinder_between(p, v(*a), v(*b), s(*radius)))
             }

@@ -32,7 +32,7 @@ const REFERENCE: &str = include_str!("reference.md");
 /// independent oracle within 1e-13 by the crate's tests (the torus and the
 /// link where the tube is no thicker than its major radius); a test checks
 /// that this list is exactly the primitives those tests draw.
-const EXACT: [&str; 20] = [
+const EXACT: [&str; 31] = [
     "Sphere",
     "Cuboid",
     "RoundBox",
@@ -48,6 +48,17 @@ const EXACT: [&str; 20] = [
     "CutSphere",
     "SolidAngle",
     "CappedTorus",
+    "Triangle",
+    "Quad",
+    "Pyramid",
+    "Rhombus",
+    "TriPrism",
+    "RoundedCylinder",
+    "Cone",
+    "InfiniteCylinder",
+    "InfiniteCone",
+    "CutHollowSphere",
+    "DeathStar",
     "CylinderBetween",
     "ConeBetween",
     "RoundConeBetween",

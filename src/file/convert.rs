@@ -142,6 +142,69 @@ impl NodeRepr {
                 major_radius,
                 minor_radius,
             },
+            Kind::Triangle { a, b, c, thickness } => NodeRepr::Triangle { a, b, c, thickness },
+            Kind::Quad {
+                a,
+                b,
+                c,
+                d,
+                thickness,
+            } => NodeRepr::Quad {
+                a,
+                b,
+                c,
+                d,
+                thickness,
+            },
+            Kind::Pyramid { half_base, height } => NodeRepr::Pyramid { half_base, height },
+            Kind::Rhombus {
+                half_x,
+                half_z,
+                half_height,
+                radius,
+            } => NodeRepr::Rhombus {
+                half_x,
+                half_z,
+                half_height,
+                radius,
+            },
+            Kind::TriPrism {
+                radius,
+                half_height,
+            } => NodeRepr::TriPrism {
+                radius,
+                half_height,
+            },
+            Kind::RoundedCylinder {
+                radius,
+                half_height,
+                rounding,
+            } => NodeRepr::RoundedCylinder {
+                radius,
+                half_height,
+                rounding,
+            },
+            Kind::Cone { radius, height } => NodeRepr::Cone { radius, height },
+            Kind::InfiniteCylinder { radius } => NodeRepr::InfiniteCylinder { radius },
+            Kind::InfiniteCone { angle } => NodeRepr::InfiniteCone { angle },
+            Kind::CutHollowSphere {
+                radius,
+                height,
+                thickness,
+            } => NodeRepr::CutHollowSphere {
+                radius,
+                height,
+                thickness,
+            },
+            Kind::DeathStar {
+                radius,
+                carve_radius,
+                carve_distance,
+            } => NodeRepr::DeathStar {
+                radius,
+                carve_radius,
+                carve_distance,
+            },
             Kind::CylinderBetween { a, b, radius } => NodeRepr::CylinderBetween { a, b, radius },
             Kind::ConeBetween {
                 a,
@@ -483,6 +546,95 @@ impl Located<NodeRepr> {
             NodeRepr::SolidAngle { angle, radius } => Kind::SolidAngle {
                 angle: angle.clone(),
                 radius: radius.clone(),
+            }
+            .into(),
+            NodeRepr::Triangle { a, b, c, thickness } => Kind::Triangle {
+                a: a.clone(),
+                b: b.clone(),
+                c: c.clone(),
+                thickness: thickness.clone(),
+            }
+            .into(),
+            NodeRepr::Quad {
+                a,
+                b,
+                c,
+                d,
+                thickness,
+            } => Kind::Quad {
+                a: a.clone(),
+                b: b.clone(),
+                c: c.clone(),
+                d: d.clone(),
+                thickness: thickness.clone(),
+            }
+            .into(),
+            NodeRepr::Pyramid { half_base, height } => Kind::Pyramid {
+                half_base: half_base.clone(),
+                height: height.clone(),
+            }
+            .into(),
+            NodeRepr::Rhombus {
+                half_x,
+                half_z,
+                half_height,
+                radius,
+            } => Kind::Rhombus {
+                half_x: half_x.clone(),
+                half_z: half_z.clone(),
+                half_height: half_height.clone(),
+                radius: radius.clone(),
+            }
+            .into(),
+            NodeRepr::TriPrism {
+                radius,
+                half_height,
+            } => Kind::TriPrism {
+                radius: radius.clone(),
+                half_height: half_height.clone(),
+            }
+            .into(),
+            NodeRepr::RoundedCylinder {
+                radius,
+                half_height,
+                rounding,
+            } => Kind::RoundedCylinder {
+                radius: radius.clone(),
+                half_height: half_height.clone(),
+                rounding: rounding.clone(),
+            }
+            .into(),
+            NodeRepr::Cone { radius, height } => Kind::Cone {
+                radius: radius.clone(),
+                height: height.clone(),
+            }
+            .into(),
+            NodeRepr::InfiniteCylinder { radius } => Kind::InfiniteCylinder {
+                radius: radius.clone(),
+            }
+            .into(),
+            NodeRepr::InfiniteCone { angle } => Kind::InfiniteCone {
+                angle: angle.clone(),
+            }
+            .into(),
+            NodeRepr::CutHollowSphere {
+                radius,
+                height,
+                thickness,
+            } => Kind::CutHollowSphere {
+                radius: radius.clone(),
+                height: height.clone(),
+                thickness: thickness.clone(),
+            }
+            .into(),
+            NodeRepr::DeathStar {
+                radius,
+                carve_radius,
+                carve_distance,
+            } => Kind::DeathStar {
+                radius: radius.clone(),
+                carve_radius: carve_radius.clone(),
+                carve_distance: carve_distance.clone(),
             }
             .into(),
             NodeRepr::CylinderBetween { a, b, radius } => Kind::CylinderBetween {

@@ -474,6 +474,58 @@ pub(super) enum NodeRepr {
         major_radius: Param,
         minor_radius: Param,
     },
+    Triangle {
+        a: Param3,
+        b: Param3,
+        c: Param3,
+        thickness: Param,
+    },
+    Quad {
+        a: Param3,
+        b: Param3,
+        c: Param3,
+        d: Param3,
+        thickness: Param,
+    },
+    Pyramid {
+        half_base: Param,
+        height: Param,
+    },
+    Rhombus {
+        half_x: Param,
+        half_z: Param,
+        half_height: Param,
+        radius: Param,
+    },
+    TriPrism {
+        radius: Param,
+        half_height: Param,
+    },
+    RoundedCylinder {
+        radius: Param,
+        half_height: Param,
+        rounding: Param,
+    },
+    Cone {
+        radius: Param,
+        height: Param,
+    },
+    InfiniteCylinder {
+        radius: Param,
+    },
+    InfiniteCone {
+        angle: Param,
+    },
+    CutHollowSphere {
+        radius: Param,
+        height: Param,
+        thickness: Param,
+    },
+    DeathStar {
+        radius: Param,
+        carve_radius: Param,
+        carve_distance: Param,
+    },
     CylinderBetween {
         a: Param3,
         b: Param3,

@@ -216,6 +216,57 @@ pub(super) fn bound(node: &IrNode, done: &[Option<Bound>]) -> Option<Bound> {
             minor_radius,
             ..
         } => Bound::sphere(origin, baked(*major_radius)? + baked(*minor_radius)?),
+        // Within the thickness of the ball about the corners' centroid
+        // that holds them.
+        Kind::Triangle { a, b, c, thickness } => {
+            corners_ball(&[baked3(*a)?, baked3(*b)?, baked3(*c)?], baked(*thickness)?)
+        }
+        Kind::Quad {
+            a,
+            b,
+            c,
+            d,
+            thickness,
+        } => corners_ball(
+            &[baked3(*a)?, baked3(*b)?, baked3(*c)?, baked3(*d)?],
+            baked(*thickness)?,
+        ),
+        // The base's corners and the apex.
+        Kind::Pyramid { half_base, height } => Bound::sphere(
+            origin,
+            (baked(*half_base)? * 2f64.sqrt()).max(baked(*height)?),
+        ),
+        Kind::Rhombus {
+            half_x,
+            half_z,
+            half_height,
+            radius,
+        } => Bound::sphere(
+            origin,
+            (baked(*half_x)?.max(baked(*half_z)?) + baked(*radius)?).hypot(baked(*half_height)?),
+        ),
+        Kind::TriPrism {
+            radius,
+            half_height,
+        } => Bound::sphere(origin, (2.0 * baked(*radius)?).hypot(baked(*half_height)?)),
+        Kind::RoundedCylinder {
+            radius,
+            half_height,
+            ..
+        } => Bound::sphere(origin, baked(*radius)?.hypot(baked(*half_height)?)),
+        // The base's rim and the apex lie in the ball about the axis's
+        // middle.
+        Kind::Cone { radius, height } => {
+            let h = baked(*height)?;
+            Bound::sphere(
+                DVec3::new(0.0, -0.5 * h, 0.0),
+                (0.5 * h).hypot(baked(*radius)?),
+            )
+        }
+        Kind::CutHollowSphere {
+            radius, thickness, ..
+        } => Bound::sphere(origin, baked(*radius)? + baked(*thickness)?),
+        Kind::DeathStar { radius, .. } => Bound::sphere(origin, baked(*radius)?),
         // Each lies in the ball about the segment's midpoint that holds
         // its caps (the cylinder and the cone) or its balls.
         Kind::CylinderBetween { a, b, radius } => {
@@ -432,7 +483,11 @@ pub(super) fn bound(node: &IrNode, done: &[Option<Bound>]) -> Option<Bound> {
         // `warp_ball`), so the bound holds with slope 1.
         Kind::Twist { child, .. } => warp_ball(Axis::Y, of(child)?),
         Kind::Bend { child, .. } => warp_ball(Axis::Z, of(child)?),
-        Kind::Plane { .. } | Kind::Repeat { .. } => {
+        // Unbounded.
+        Kind::Plane { .. }
+        | Kind::InfiniteCylinder { .. }
+        | Kind::InfiniteCone { .. }
+        | Kind::Repeat { .. } => {
             return None;
         }
         // An inside shape's value is `INSIDE_HUGE` outside its bounds; a
@@ -691,4 +746,15 @@ pub(crate) fn swaps(ir: &Ir, id: NodeId, bounds: &[Option<Bound>], costs: &[f64]
 /// The profile's values, where all are baked.
 fn baked_profile(profile: &Profile<Scalar>) -> Option<Profile<f64>> {
     profile.try_map(&mut |s, _| s.baked().ok_or(())).ok()
+}
+
+/// The ball about the corners' centroid that holds them, grown by `grow`.
+fn corners_ball(corners: &[DVec3], grow: f64) -> Bound {
+    #[allow(clippy::cast_precision_loss)]
+    let centre = corners.iter().sum::<DVec3>() / corners.len() as f64;
+    let radius = corners
+        .iter()
+        .map(|c| c.distance(centre))
+        .fold(0.0, f64::max);
+    Bound::sphere(centre, radius + grow)
 }

@@ -263,6 +263,18 @@ impl Lowering {
                     bound_name: "half extent",
                 },
             )],
+            Kind::RoundedCylinder {
+                radius,
+                half_height,
+                rounding,
+            } => vec![(
+                "rounding",
+                Relation::AtMostSmallest {
+                    value: *rounding,
+                    bound: [*radius, *half_height, *half_height],
+                    bound_name: "of radius and half height",
+                },
+            )],
             Kind::Plane { normal, .. } => vec![("normal", Relation::NonZero { vector: *normal })],
             Kind::OrbitTrap { coloring, .. } => {
                 let mut relations = vec![(

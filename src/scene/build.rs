@@ -180,6 +180,152 @@ pub fn capped_torus(
     .into()
 }
 
+/// All points within `thickness` (greater than 0) of the triangle with corners `a`, `b` and `c`: a thickened triangle, its edges rounded.
+#[must_use]
+pub fn triangle(
+    a: impl Into<Param3>,
+    b: impl Into<Param3>,
+    c: impl Into<Param3>,
+    thickness: impl Into<Param>,
+) -> Node {
+    Kind::Triangle {
+        a: a.into(),
+        b: b.into(),
+        c: c.into(),
+        thickness: thickness.into(),
+    }
+    .into()
+}
+
+/// All points within `thickness` (greater than 0) of the quadrilateral with corners `a`, `b`, `c`, `d` in order (the triangles `abc` and `acd`): exact where it is flat and convex.
+#[must_use]
+pub fn quad(
+    a: impl Into<Param3>,
+    b: impl Into<Param3>,
+    c: impl Into<Param3>,
+    d: impl Into<Param3>,
+    thickness: impl Into<Param>,
+) -> Node {
+    Kind::Quad {
+        a: a.into(),
+        b: b.into(),
+        c: c.into(),
+        d: d.into(),
+        thickness: thickness.into(),
+    }
+    .into()
+}
+
+/// A pyramid on the square `|x|, |z| <= half_base` at `y = 0`, its apex `height` above the origin.
+#[must_use]
+pub fn pyramid(half_base: impl Into<Param>, height: impl Into<Param>) -> Node {
+    Kind::Pyramid {
+        half_base: half_base.into(),
+        height: height.into(),
+    }
+    .into()
+}
+
+/// A rhombus in the xz plane with half diagonals `half_x` and `half_z`, grown by `radius` in its plane, between `y = ±half_height`.
+#[must_use]
+pub fn rhombus(
+    half_x: impl Into<Param>,
+    half_z: impl Into<Param>,
+    half_height: impl Into<Param>,
+    radius: impl Into<Param>,
+) -> Node {
+    Kind::Rhombus {
+        half_x: half_x.into(),
+        half_z: half_z.into(),
+        half_height: half_height.into(),
+        radius: radius.into(),
+    }
+    .into()
+}
+
+/// A prism along y over the equilateral triangle in the xz plane whose sides lie `radius` from the axis (a corner towards +z), between `y = ±half_height`.
+#[must_use]
+pub fn tri_prism(radius: impl Into<Param>, half_height: impl Into<Param>) -> Node {
+    Kind::TriPrism {
+        radius: radius.into(),
+        half_height: half_height.into(),
+    }
+    .into()
+}
+
+/// A cylinder along y of outer `radius` between `y = ±half_height`, its rims rounded by `rounding` (at most the smaller of the two).
+#[must_use]
+pub fn rounded_cylinder(
+    radius: impl Into<Param>,
+    half_height: impl Into<Param>,
+    rounding: impl Into<Param>,
+) -> Node {
+    Kind::RoundedCylinder {
+        radius: radius.into(),
+        half_height: half_height.into(),
+        rounding: rounding.into(),
+    }
+    .into()
+}
+
+/// A cone with its apex at the origin and its base, a disc of `radius`, at `y = -height`.
+#[must_use]
+pub fn cone(radius: impl Into<Param>, height: impl Into<Param>) -> Node {
+    Kind::Cone {
+        radius: radius.into(),
+        height: height.into(),
+    }
+    .into()
+}
+
+/// An infinite cylinder of `radius` around the y axis.
+#[must_use]
+pub fn infinite_cylinder(radius: impl Into<Param>) -> Node {
+    Kind::InfiniteCylinder {
+        radius: radius.into(),
+    }
+    .into()
+}
+
+/// An infinite cone with its apex at the origin, opening around +y with the half-angle `angle` (radians, in `[0, π/2]`; π/2 is the half-space above the xz plane).
+#[must_use]
+pub fn infinite_cone(angle: impl Into<Param>) -> Node {
+    Kind::InfiniteCone {
+        angle: angle.into(),
+    }
+    .into()
+}
+
+/// A bowl: the shell of `thickness` about the sphere of `radius`, cut by the plane `y = height`, keeping the part below.
+#[must_use]
+pub fn cut_hollow_sphere(
+    radius: impl Into<Param>,
+    height: impl Into<Param>,
+    thickness: impl Into<Param>,
+) -> Node {
+    Kind::CutHollowSphere {
+        radius: radius.into(),
+        height: height.into(),
+        thickness: thickness.into(),
+    }
+    .into()
+}
+
+/// The ball of `radius` about the origin with the ball of `carve_radius` about `(carve_distance, 0, 0)` carved from it.
+#[must_use]
+pub fn death_star(
+    radius: impl Into<Param>,
+    carve_radius: impl Into<Param>,
+    carve_distance: impl Into<Param>,
+) -> Node {
+    Kind::DeathStar {
+        radius: radius.into(),
+        carve_radius: carve_radius.into(),
+        carve_distance: carve_distance.into(),
+    }
+    .into()
+}
+
 /// A capped cylinder of `radius` around the segment from `a` to `b`.
 #[must_use]
 pub fn cylinder_between(

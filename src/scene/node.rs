@@ -2,6 +2,7 @@
 //! tree ([`Node`]) and the lowered IR, so every node type, its parameters
 //! and their validity rules are written down exactly once.
 
+use std::f64::consts::FRAC_PI_2;
 use std::fmt;
 use std::sync::{Arc, OnceLock};
 
@@ -215,6 +216,99 @@ pub enum Kind<S, V, C> {
         major_radius: S,
         /// The tube's radius, at least 0.
         minor_radius: S,
+    },
+    /// All points within `thickness` of the triangle `abc`: a thickened triangle, its edges rounded. Exact.
+    Triangle {
+        /// One corner.
+        a: V,
+        /// The second corner.
+        b: V,
+        /// The third corner.
+        c: V,
+        /// How far the solid reaches from the triangle, greater than 0.
+        thickness: S,
+    },
+    /// All points within `thickness` of the quadrilateral `abcd` (the triangles `abc` and `acd`): a thickened quad, its edges rounded. Exact where the quad is flat and convex; otherwise exact outside and a bound inside.
+    Quad {
+        /// One corner.
+        a: V,
+        /// The second corner.
+        b: V,
+        /// The third corner.
+        c: V,
+        /// The fourth corner.
+        d: V,
+        /// How far the solid reaches from the quad, greater than 0.
+        thickness: S,
+    },
+    /// A pyramid on the square `|x|, |z| <= half_base` at `y = 0` with its apex at `(0, height, 0)`. Exact.
+    Pyramid {
+        /// Half the side of the square base, greater than 0.
+        half_base: S,
+        /// The apex's height above the base, at least 0.
+        height: S,
+    },
+    /// A rhombus in the xz plane with half diagonals `half_x` and `half_z`, grown by `radius` in its plane (its corners rounded), between `y = ±half_height`. Exact.
+    Rhombus {
+        /// Half the diagonal along x, at least 0.
+        half_x: S,
+        /// Half the diagonal along z, at least 0.
+        half_z: S,
+        /// Half the height along y, at least 0.
+        half_height: S,
+        /// How far the rhombus grows in its plane, rounding its corners, at least 0.
+        radius: S,
+    },
+    /// A prism along y over the equilateral triangle in the xz plane whose sides lie `radius` from the axis, a corner towards +z. Exact.
+    TriPrism {
+        /// The distance from the axis to each side, at least 0.
+        radius: S,
+        /// Half the height, at least 0.
+        half_height: S,
+    },
+    /// A cylinder along y of outer `radius` between `y = ±half_height`, its rims rounded by `rounding`. Exact.
+    RoundedCylinder {
+        /// Radius, at least 0.
+        radius: S,
+        /// Half the height, at least 0.
+        half_height: S,
+        /// Radius of the rounded rims, from 0 to the smaller of `radius` and `half_height`.
+        rounding: S,
+    },
+    /// A cone with its apex at the origin and its base, a disc of `radius`, at `y = -height`. Exact.
+    Cone {
+        /// Radius of the base, at least 0.
+        radius: S,
+        /// Height, at least 0.
+        height: S,
+    },
+    /// An infinite cylinder of `radius` around the y axis. Exact.
+    InfiniteCylinder {
+        /// Radius, at least 0.
+        radius: S,
+    },
+    /// An infinite cone with its apex at the origin, opening around +y with the half-angle `angle`. Exact.
+    InfiniteCone {
+        /// The half-angle in radians, in `[0, π/2]`.
+        angle: S,
+    },
+    /// A shell of `thickness` about the sphere of `radius` about the origin, cut by the plane `y = height`, keeping the part below: a bowl. Exact.
+    CutHollowSphere {
+        /// The sphere's radius, at least 0.
+        radius: S,
+        /// The cutting plane's height, any finite value: taken as `±radius` beyond them.
+        height: S,
+        /// Half the shell's thickness, at least 0.
+        thickness: S,
+    },
+    /// The ball of `radius` about the origin with the ball of `carve_radius` about `(carve_distance, 0, 0)` carved from it. Exact.
+    DeathStar {
+        /// The ball's radius, at least 0.
+        radius: S,
+        /// The carved ball's radius, at least 0.
+        carve_radius: S,
+        /// How far along +x the carved ball's centre lies, greater than 0.
+        carve_distance: S,
     },
     /// A capped cylinder around the segment from `a` to `b`. Exact.
     CylinderBetween {
@@ -480,6 +574,17 @@ impl<S, V, C> Kind<S, V, C> {
             Kind::CutSphere { .. } => "cut_sphere",
             Kind::SolidAngle { .. } => "solid_angle",
             Kind::CappedTorus { .. } => "capped_torus",
+            Kind::Triangle { .. } => "triangle",
+            Kind::Quad { .. } => "quad",
+            Kind::Pyramid { .. } => "pyramid",
+            Kind::Rhombus { .. } => "rhombus",
+            Kind::TriPrism { .. } => "tri_prism",
+            Kind::RoundedCylinder { .. } => "rounded_cylinder",
+            Kind::Cone { .. } => "cone",
+            Kind::InfiniteCylinder { .. } => "infinite_cylinder",
+            Kind::InfiniteCone { .. } => "infinite_cone",
+            Kind::CutHollowSphere { .. } => "cut_hollow_sphere",
+            Kind::DeathStar { .. } => "death_star",
             Kind::CylinderBetween { .. } => "cylinder_between",
             Kind::ConeBetween { .. } => "cone_between",
             Kind::RoundConeBetween { .. } => "round_cone_between",
@@ -562,6 +667,17 @@ impl<S, V, C> Kind<S, V, C> {
             | Kind::CutSphere { .. }
             | Kind::SolidAngle { .. }
             | Kind::CappedTorus { .. }
+            | Kind::Triangle { .. }
+            | Kind::Quad { .. }
+            | Kind::Pyramid { .. }
+            | Kind::Rhombus { .. }
+            | Kind::TriPrism { .. }
+            | Kind::RoundedCylinder { .. }
+            | Kind::Cone { .. }
+            | Kind::InfiniteCylinder { .. }
+            | Kind::InfiniteCone { .. }
+            | Kind::CutHollowSphere { .. }
+            | Kind::DeathStar { .. }
             | Kind::CylinderBetween { .. }
             | Kind::ConeBetween { .. }
             | Kind::RoundConeBetween { .. }
@@ -735,6 +851,84 @@ impl<S, V, C> Kind<S, V, C> {
                 angle: m.scalar(angle, spec("angle", Range(0.0, std::f64::consts::PI)))?,
                 major_radius: m.scalar(major_radius, spec("major_radius", NonNegative))?,
                 minor_radius: m.scalar(minor_radius, spec("minor_radius", NonNegative))?,
+            },
+            Kind::Triangle { a, b, c, thickness } => Kind::Triangle {
+                a: m.vector(a, spec("a", Finite))?,
+                b: m.vector(b, spec("b", Finite))?,
+                c: m.vector(c, spec("c", Finite))?,
+                thickness: m.scalar(thickness, spec("thickness", Positive))?,
+            },
+            Kind::Quad {
+                a,
+                b,
+                c,
+                d,
+                thickness,
+            } => Kind::Quad {
+                a: m.vector(a, spec("a", Finite))?,
+                b: m.vector(b, spec("b", Finite))?,
+                c: m.vector(c, spec("c", Finite))?,
+                d: m.vector(d, spec("d", Finite))?,
+                thickness: m.scalar(thickness, spec("thickness", Positive))?,
+            },
+            Kind::Pyramid { half_base, height } => Kind::Pyramid {
+                half_base: m.scalar(half_base, spec("half_base", Positive))?,
+                height: m.scalar(height, spec("height", NonNegative))?,
+            },
+            Kind::Rhombus {
+                half_x,
+                half_z,
+                half_height,
+                radius,
+            } => Kind::Rhombus {
+                half_x: m.scalar(half_x, spec("half_x", NonNegative))?,
+                half_z: m.scalar(half_z, spec("half_z", NonNegative))?,
+                half_height: m.scalar(half_height, spec("half_height", NonNegative))?,
+                radius: m.scalar(radius, spec("radius", NonNegative))?,
+            },
+            Kind::TriPrism {
+                radius,
+                half_height,
+            } => Kind::TriPrism {
+                radius: m.scalar(radius, spec("radius", NonNegative))?,
+                half_height: m.scalar(half_height, spec("half_height", NonNegative))?,
+            },
+            Kind::RoundedCylinder {
+                radius,
+                half_height,
+                rounding,
+            } => Kind::RoundedCylinder {
+                radius: m.scalar(radius, spec("radius", NonNegative))?,
+                half_height: m.scalar(half_height, spec("half_height", NonNegative))?,
+                rounding: m.scalar(rounding, spec("rounding", NonNegative))?,
+            },
+            Kind::Cone { radius, height } => Kind::Cone {
+                radius: m.scalar(radius, spec("radius", NonNegative))?,
+                height: m.scalar(height, spec("height", NonNegative))?,
+            },
+            Kind::InfiniteCylinder { radius } => Kind::InfiniteCylinder {
+                radius: m.scalar(radius, spec("radius", NonNegative))?,
+            },
+            Kind::InfiniteCone { angle } => Kind::InfiniteCone {
+                angle: m.scalar(angle, spec("angle", Range(0.0, FRAC_PI_2)))?,
+            },
+            Kind::CutHollowSphere {
+                radius,
+                height,
+                thickness,
+            } => Kind::CutHollowSphere {
+                radius: m.scalar(radius, spec("radius", NonNegative))?,
+                height: m.scalar(height, spec("height", Finite))?,
+                thickness: m.scalar(thickness, spec("thickness", NonNegative))?,
+            },
+            Kind::DeathStar {
+                radius,
+                carve_radius,
+                carve_distance,
+            } => Kind::DeathStar {
+                radius: m.scalar(radius, spec("radius", NonNegative))?,
+                carve_radius: m.scalar(carve_radius, spec("carve_radius", NonNegative))?,
+                carve_distance: m.scalar(carve_distance, spec("carve_distance", Positive))?,
             },
             Kind::CylinderBetween { a, b, radius } => Kind::CylinderBetween {
                 a: m.vector(a, spec("a", Finite))?,

@@ -12,9 +12,10 @@ use crate::scene::{
     Axis, CsgOp, Hybrid, HybridOp, Kifs, KifsFold, Kind, MAX_ESCAPE_ITERATIONS,
     MAX_FOLD_ITERATIONS, MAX_SOLID_ANGLE, Mandelbox, Mandelbulb, Menger, Node, OrbitColoring,
     Palette, Param, Param3, Profile, QuaternionJulia, Sierpinski, Trap, capped_cone, capped_torus,
-    capsule, cone_between, cuboid, cut_sphere, cylinder, cylinder_between, ellipsoid, extrude,
-    hex_prism, link, octahedron, param, plane, revolve, round_box, round_cone, round_cone_between,
-    solid_angle, sphere, torus,
+    capsule, cone, cone_between, cuboid, cut_hollow_sphere, cut_sphere, cylinder, cylinder_between,
+    death_star, ellipsoid, extrude, hex_prism, infinite_cone, infinite_cylinder, link, octahedron,
+    param, plane, pyramid, quad, revolve, rhombus, round_box, round_cone, round_cone_between,
+    rounded_cylinder, solid_angle, sphere, torus, tri_prism, triangle,
 };
 
 /// The largest size (radius, half extent, height) the primitive strategies
@@ -278,6 +279,142 @@ pub fn capped_torus_node() -> impl Strategy<Value = Node> + Clone {
         .prop_map(|(a, major, minor)| capped_torus(a, major, minor))
 }
 
+/// A thickened triangle with corners in `[-1, 1]^3` (one time in eight
+/// two of them the same), thickness in `[0.02, 0.4]`.
+pub fn triangle_node() -> impl Strategy<Value = Node> + Clone {
+    (
+        segment_ends(),
+        point(1.0),
+        scalar("triangle.thickness", 0.02..=0.4f64),
+    )
+        .prop_map(|((a, b), c, t)| triangle(a, b, c, t))
+}
+
+/// A thickened quad where it is exact: flat and convex, its corners on a
+/// circle of radius `[0.2, 1]` in a random plane about a point in
+/// `[-0.5, 0.5]^3`, thickness in `[0.02, 0.4]`.
+pub fn quad_node() -> impl Strategy<Value = Node> + Clone {
+    (
+        rotation(),
+        point(0.5),
+        0.2..=1.0f64,
+        prop::array::uniform4(0.0..1.0f64),
+        scalar("quad.thickness", 0.02..=0.4f64),
+    )
+        .prop_map(|(turn, centre, r, mut angles, t)| {
+            angles.sort_by(f64::total_cmp);
+            let [a, b, c, d] = angles.map(|u| {
+                let (s, k) = (u * 2.0 * PI).sin_cos();
+                centre + turn * DVec3::new(r * k, 0.0, r * s)
+            });
+            quad(a, b, c, d, t)
+        })
+}
+
+/// A pyramid: half base in `[0.05, 1]`, height in `[0, 1.5]`.
+pub fn pyramid_node() -> impl Strategy<Value = Node> + Clone {
+    (
+        scalar("pyramid.half_base", 0.05..=1.0f64),
+        scalar("pyramid.height", size(MAX_SIZE)),
+    )
+        .prop_map(|(w, h)| pyramid(w, h))
+}
+
+/// A rounded rhombus: half diagonals and half height in `[0, 1]`, radius
+/// in `[0, 0.5]`.
+pub fn rhombus_node() -> impl Strategy<Value = Node> + Clone {
+    (
+        scalar("rhombus.half_x", size(1.0)),
+        scalar("rhombus.half_z", size(1.0)),
+        scalar("rhombus.half_height", size(1.0)),
+        scalar("rhombus.radius", size(0.5)),
+    )
+        .prop_map(|(x, z, h, r)| rhombus(x, z, h, r))
+}
+
+/// A triangular prism: radius and half height in `[0, 1]`.
+pub fn tri_prism_node() -> impl Strategy<Value = Node> + Clone {
+    (
+        scalar("tri_prism.radius", size(1.0)),
+        scalar("tri_prism.half_height", size(1.0)),
+    )
+        .prop_map(|(r, h)| tri_prism(r, h))
+}
+
+/// A rounded cylinder: radius and half height in `[0, 1.2]`, rounding up
+/// to the smaller.
+pub fn rounded_cylinder_node() -> impl Strategy<Value = Node> + Clone {
+    (size(1.2), size(1.2), 0.0..=1.0f64)
+        .prop_flat_map(|(r, h, t)| {
+            (
+                scalar("rounded_cylinder.radius", Just(r)),
+                scalar("rounded_cylinder.half_height", Just(h)),
+                scalar("rounded_cylinder.rounding", Just(t * r.min(h))),
+            )
+        })
+        .prop_map(|(r, h, e)| rounded_cylinder(r, h, e))
+}
+
+/// A cone: radius and height in `[0, 1.5]`.
+pub fn cone_node() -> impl Strategy<Value = Node> + Clone {
+    (
+        scalar("cone.radius", size(MAX_SIZE)),
+        scalar("cone.height", size(MAX_SIZE)),
+    )
+        .prop_map(|(r, h)| cone(r, h))
+}
+
+/// An infinite cylinder of radius in `[0, 1.5]`.
+pub fn infinite_cylinder_node() -> impl Strategy<Value = Node> + Clone {
+    scalar("infinite_cylinder.radius", size(MAX_SIZE)).prop_map(infinite_cylinder)
+}
+
+/// An infinite cone: half-angle in `[0, π/2]` (often either end).
+pub fn infinite_cone_node() -> impl Strategy<Value = Node> + Clone {
+    let angle = prop_oneof![
+        4 => 0.0..=PI / 2.0,
+        1 => Just(0.0),
+        1 => Just(PI / 2.0),
+    ];
+    scalar("infinite_cone.angle", angle).prop_map(infinite_cone)
+}
+
+/// A cut hollow sphere where it is exact: radius in `[0, 1.5]`, the cut
+/// anywhere (sometimes past the sphere), the shell no thicker than the
+/// rim's radius (the sphere's, where the plane misses it).
+pub fn cut_hollow_sphere_node() -> impl Strategy<Value = Node> + Clone {
+    (size(MAX_SIZE), -1.2..=1.2f64, 0.0..=1.0f64)
+        .prop_flat_map(|(r, k, u)| {
+            let h = r * k;
+            let rim = if h.abs() >= r {
+                r
+            } else {
+                (r * r - h * h).sqrt()
+            };
+            (
+                scalar("cut_hollow_sphere.radius", Just(r)),
+                scalar("cut_hollow_sphere.height", Just(h)),
+                scalar("cut_hollow_sphere.thickness", Just(u * rim)),
+            )
+        })
+        .prop_map(|(r, h, t)| cut_hollow_sphere(r, h, t))
+}
+
+/// A death star: radius in `[0.2, 1.5]`, the carve's centre `(0, 2.5]`
+/// along x, its radius in `[0.05, 1.5]` and short of holding the ball.
+pub fn death_star_node() -> impl Strategy<Value = Node> + Clone {
+    (0.2..=MAX_SIZE, 0.05..=2.5f64, 0.0..=1.0f64)
+        .prop_flat_map(|(ra, d, u)| {
+            let rb = 0.05 + u * (MAX_SIZE.min(ra + d - 0.05) - 0.05);
+            (
+                scalar("death_star.radius", Just(ra)),
+                scalar("death_star.carve_radius", Just(rb)),
+                scalar("death_star.carve_distance", Just(d)),
+            )
+        })
+        .prop_map(|(ra, rb, d)| death_star(ra, rb, d))
+}
+
 /// The two ends of a segment in `[-1, 1]^3`, one time in eight the same
 /// point.
 fn segment_ends() -> impl Strategy<Value = (DVec3, DVec3)> + Clone {
@@ -451,6 +588,17 @@ pub fn exact_primitive() -> impl Strategy<Value = Node> + Clone {
         cut_sphere_node(),
         solid_angle_node(),
         capped_torus_node(),
+        triangle_node(),
+        quad_node(),
+        pyramid_node(),
+        rhombus_node(),
+        tri_prism_node(),
+        rounded_cylinder_node(),
+        cone_node(),
+        infinite_cylinder_node(),
+        infinite_cone_node(),
+        cut_hollow_sphere_node(),
+        death_star_node(),
         cylinder_between_node(),
         cone_between_node(),
         round_cone_between_node(),

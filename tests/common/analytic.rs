@@ -87,6 +87,17 @@ pub fn exact_distance(node: &Node, p: DVec3) -> Option<f64> {
             arc_distance(p, angle.default_value(), major_radius.default_value())
                 - minor_radius.default_value()
         }
+        Kind::Triangle { .. }
+        | Kind::Quad { .. }
+        | Kind::Pyramid { .. }
+        | Kind::Rhombus { .. }
+        | Kind::TriPrism { .. }
+        | Kind::RoundedCylinder { .. }
+        | Kind::Cone { .. }
+        | Kind::InfiniteCylinder { .. }
+        | Kind::InfiniteCone { .. }
+        | Kind::CutHollowSphere { .. }
+        | Kind::DeathStar { .. } => super::shapes::distance(node, p)?,
         Kind::CylinderBetween { a, b, radius } => {
             let (q, h) = segment_frame(p, a.default_value(), b.default_value());
             let r = radius.default_value();

@@ -5,3 +5,4 @@
 pub mod analytic;
 pub mod fixtures;
 pub mod profiles;
+pub mod shapes;

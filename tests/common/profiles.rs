@@ -146,7 +146,14 @@ pub fn profile_distance(profile: &Profile, q: DVec2) -> f64 {
 /// of its walls (the profile's boundary times `[-h, h]`) and the cap on
 /// the point's side (the profile at `z = ±h`).
 pub fn extrude_distance(profile: &Profile, h: f64, p: DVec3) -> f64 {
-    let (b, within) = boundary(&values(profile), DVec2::new(p.x, p.y));
+    let profile = values(profile);
+    with_boundary(|q| boundary(&profile, q), h, p)
+}
+
+/// Signed distance to the prism between `z = ±h` over the plane region
+/// whose boundary's distance and membership at a point `boundary` gives.
+pub fn with_boundary(boundary: impl Fn(DVec2) -> (f64, bool), h: f64, p: DVec3) -> f64 {
+    let (b, within) = boundary(DVec2::new(p.x, p.y));
     let over = p.z.abs() - h;
     let wall = b.hypot(over.max(0.0));
     let cap = if within { over.abs() } else { b.hypot(over) };

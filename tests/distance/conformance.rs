@@ -23,8 +23,10 @@ use fractal_sdf::scene::param3;
 use fractal_sdf::scene::{CustomShape, Rule};
 use fractal_sdf::scene::{
     Hybrid, HybridOp, Kifs, KifsFold, Mandelbox, OrbitColoring, Palette, Profile, Trap,
-    capped_cone, capped_torus, cone_between, cut_sphere, cylinder_between, extrude, hex_prism,
-    kifs, link, revolve, round_cone, round_cone_between, solid_angle,
+    capped_cone, capped_torus, cone, cone_between, cut_hollow_sphere, cut_sphere, cylinder_between,
+    death_star, extrude, hex_prism, infinite_cone, infinite_cylinder, kifs, link, pyramid, quad,
+    revolve, rhombus, round_cone, round_cone_between, rounded_cylinder, solid_angle, tri_prism,
+    triangle,
 };
 use fractal_sdf::testing::{check_device_matches_cpu, random_points, spicy_points};
 
@@ -101,6 +103,41 @@ fn nodes() -> Vec<(&'static str, Node)> {
             "capped_torus_dynamic_wide",
             capped_torus(param("arc", 2.6), 0.6, param("tube", 0.2)),
         ),
+        (
+            "triangle",
+            triangle(
+                dvec3(-0.5, -0.3, 0.1),
+                dvec3(0.5, -0.2, -0.2),
+                dvec3(0.0, 0.6, 0.2),
+                0.05,
+            ),
+        ),
+        (
+            "quad_dynamic",
+            quad(
+                dvec3(-0.5, -0.4, 0.0),
+                dvec3(0.5, -0.4, 0.0),
+                param3("quad_c", dvec3(0.4, 0.5, 0.1)),
+                dvec3(-0.4, 0.4, 0.1),
+                param("quad_t", 0.04),
+            ),
+        ),
+        ("pyramid", pyramid(0.5, 0.8)),
+        ("rhombus", rhombus(0.6, 0.3, 0.1, 0.05)),
+        ("tri_prism", tri_prism(0.3, 0.5)),
+        (
+            "rounded_cylinder_dynamic",
+            rounded_cylinder(0.5, param("cyl_h", 0.4), param("cyl_e", 0.1)),
+        ),
+        ("cone", cone(0.4, 0.8)),
+        ("infinite_cylinder", infinite_cylinder(0.3)),
+        ("infinite_cone", infinite_cone(0.5)),
+        ("cut_hollow_sphere", cut_hollow_sphere(0.6, 0.2, 0.04)),
+        (
+            "cut_hollow_sphere_dynamic_low",
+            cut_hollow_sphere(0.6, param("bowl_cut", -0.45), 0.03),
+        ),
+        ("death_star", death_star(0.6, 0.4, 0.7)),
         (
             "cylinder_between",
             cylinder_between(dvec3(-0.3, -0.4, 0.1), dvec3(0.4, 0.3, -0.2), 0.25),

@@ -69,6 +69,17 @@ exact! {
     cut_sphere_is_exact: testing::cut_sphere_node();
     solid_angle_is_exact: testing::solid_angle_node();
     capped_torus_is_exact: testing::capped_torus_node();
+    triangle_is_exact: testing::triangle_node();
+    quad_is_exact: testing::quad_node();
+    pyramid_is_exact: testing::pyramid_node();
+    rhombus_is_exact: testing::rhombus_node();
+    tri_prism_is_exact: testing::tri_prism_node();
+    rounded_cylinder_is_exact: testing::rounded_cylinder_node();
+    cone_is_exact: testing::cone_node();
+    infinite_cylinder_is_exact: testing::infinite_cylinder_node();
+    infinite_cone_is_exact: testing::infinite_cone_node();
+    cut_hollow_sphere_is_exact: testing::cut_hollow_sphere_node();
+    death_star_is_exact: testing::death_star_node();
     cylinder_between_is_exact: testing::cylinder_between_node();
     cone_between_is_exact: testing::cone_between_node();
     round_cone_between_is_exact: testing::round_cone_between_node();

@@ -559,6 +559,70 @@ const NODE_FIELDS: &[(&str, &str)] = &[
         "CappedTorus(angle: 1, major_radius: 1, minor_radius: @)",
         "minor_radius",
     ),
+    (
+        "Triangle(a: @, b: (1, 0, 0), c: (0, 1, 0), thickness: 0.1)",
+        "a",
+    ),
+    (
+        "Triangle(a: 0, b: (1, 0, 0), c: (0, 1, 0), thickness: @)",
+        "thickness",
+    ),
+    (
+        "Quad(a: 0, b: (1, 0, 0), c: @, d: (0, 1, 0), thickness: 0.1)",
+        "c",
+    ),
+    (
+        "Quad(a: 0, b: (1, 0, 0), c: (1, 1, 0), d: (0, 1, 0), thickness: @)",
+        "thickness",
+    ),
+    ("Pyramid(half_base: @, height: 1)", "half_base"),
+    ("Pyramid(half_base: 0.5, height: @)", "height"),
+    (
+        "Rhombus(half_x: @, half_z: 0.5, half_height: 0.1, radius: 0.05)",
+        "half_x",
+    ),
+    (
+        "Rhombus(half_x: 0.5, half_z: 0.5, half_height: 0.1, radius: @)",
+        "radius",
+    ),
+    ("TriPrism(radius: @, half_height: 1)", "radius"),
+    ("TriPrism(radius: 1, half_height: @)", "half_height"),
+    (
+        "RoundedCylinder(radius: @, half_height: 1, rounding: 0.1)",
+        "radius",
+    ),
+    (
+        "RoundedCylinder(radius: 1, half_height: 1, rounding: @)",
+        "rounding",
+    ),
+    ("Cone(radius: @, height: 1)", "radius"),
+    ("Cone(radius: 1, height: @)", "height"),
+    ("InfiniteCylinder(radius: @)", "radius"),
+    ("InfiniteCone(angle: @)", "angle"),
+    (
+        "CutHollowSphere(radius: @, height: 0.2, thickness: 0.1)",
+        "radius",
+    ),
+    (
+        "CutHollowSphere(radius: 1, height: @, thickness: 0.1)",
+        "height",
+    ),
+    (
+        "CutHollowSphere(radius: 1, height: 0.2, thickness: @)",
+        "thickness",
+    ),
+    (
+        "DeathStar(radius: @, carve_radius: 0.5, carve_distance: 0.8)",
+        "radius",
+    ),
+    (
+        "DeathStar(radius: 1, carve_radius: @, carve_distance: 0.8)",
+        "carve_radius",
+    ),
+    (
+        "DeathStar(radius: 1, carve_radius: 0.5, carve_distance: @)",
+        "carve_distance",
+    ),
     ("CylinderBetween(a: @, b: (0, 1, 0), radius: 0.2)", "a"),
     ("CylinderBetween(a: 0, b: (0, 1, 0), radius: @)", "radius"),
     ("ConeBetween(a: 0, b: @, radius_a: 0.5, radius_b: 0.2)", "b"),

@@ -274,8 +274,10 @@ use fractal_sdf::scene::ellipsoid;
 use fractal_sdf::scene::octahedron;
 use fractal_sdf::scene::param3;
 use fractal_sdf::scene::{
-    Hybrid, HybridOp, Kifs, KifsFold, MAX_SOLID_ANGLE, Profile, capped_torus, cone_between,
-    cut_sphere, cylinder_between, extrude, revolve, round_cone_between, solid_angle,
+    Hybrid, HybridOp, Kifs, KifsFold, MAX_SOLID_ANGLE, Profile, capped_torus, cone, cone_between,
+    cut_hollow_sphere, cut_sphere, cylinder_between, death_star, extrude, infinite_cone,
+    infinite_cylinder, pyramid, quad, revolve, rhombus, round_cone_between, rounded_cylinder,
+    solid_angle, tri_prism, triangle,
 };
 use fractal_sdf::scene::{MAX_ESCAPE_ITERATIONS, MAX_FOLD_ITERATIONS};
 use fractal_sdf::scene::{capped_cone, hex_prism, link, round_cone};
@@ -612,6 +614,25 @@ fn broken_node() -> impl Strategy<Value = (Node, &'static str)> {
             .prop_map(|v| (capped_torus(v, 1.0, 0.2), "capped_torus")),
         bad_size().prop_map(|v| (capped_torus(1.0, v, 0.2), "capped_torus")),
         bad_size().prop_map(|v| (capped_torus(1.0, 1.0, v), "capped_torus")),
+        prop_oneof![bad_size(), Just(0.0)]
+            .prop_map(|v| (triangle(DVec3::ZERO, DVec3::X, DVec3::Y, v), "triangle")),
+        not_finite().prop_map(|v| (
+            quad(DVec3::ZERO, DVec3::X, dvec3(1.0, v, 0.0), DVec3::Y, 0.1),
+            "quad"
+        )),
+        prop_oneof![bad_size(), Just(0.0)].prop_map(|v| (pyramid(v, 1.0), "pyramid")),
+        bad_size().prop_map(|v| (pyramid(0.5, v), "pyramid")),
+        bad_size().prop_map(|v| (rhombus(0.5, 0.5, 0.1, v), "rhombus")),
+        bad_size().prop_map(|v| (tri_prism(v, 0.5), "tri_prism")),
+        bad_size().prop_map(|v| (rounded_cylinder(0.5, v, 0.1), "rounded_cylinder")),
+        (0.51..1e300f64).prop_map(|v| (rounded_cylinder(0.5, 0.6, v), "rounded_cylinder")),
+        bad_size().prop_map(|v| (cone(v, 0.5), "cone")),
+        bad_size().prop_map(|v| (infinite_cylinder(v), "infinite_cylinder")),
+        outside(0.0, std::f64::consts::FRAC_PI_2).prop_map(|v| (infinite_cone(v), "infinite_cone")),
+        not_finite().prop_map(|v| (cut_hollow_sphere(1.0, v, 0.1), "cut_hollow_sphere")),
+        bad_size().prop_map(|v| (cut_hollow_sphere(1.0, 0.2, v), "cut_hollow_sphere")),
+        prop_oneof![bad_size(), Just(0.0)].prop_map(|v| (death_star(1.0, 0.5, v), "death_star")),
+        bad_size().prop_map(|v| (death_star(1.0, v, 0.8), "death_star")),
         bad_size().prop_map(|v| (
             cylinder_between(DVec3::ZERO, DVec3::Y, v),
             "cylinder_between"

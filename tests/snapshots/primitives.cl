@@ -223,6 +223,214 @@ real sd_capped_torus(real3 p, real angle, real ra, real rb) {
     return length((real3)(t0 - (ra * (t2 ? sin(angle) : (t3 ? R(0.0) : (t0 / t1)))), p.y - (ra * (t2 ? cos(angle) : (t3 ? R(1.0) : (p.y / t1)))), p.z)) - rb;
 }
 
+/* ---- triangle ---- */
+real sd_triangle(real3 p, real3 a, real3 b, real3 c, real t) {
+    real3 t_0 = b - a;
+    real3 t_1 = c - b;
+    real3 t_2 = a - c;
+    real3 t_3 = p - a;
+    real3 t_4 = p - b;
+    real3 t_5 = p - c;
+    real t_6 = (t_0.y * t_2.z) - (t_0.z * t_2.y);
+    real t_7 = (t_0.z * t_2.x) - (t_0.x * t_2.z);
+    real t_8 = (t_0.x * t_2.y) - (t_0.y * t_2.x);
+    real t_9 = ((t_6 * t_6) + (t_7 * t_7)) + (t_8 * t_8);
+    real t_10 = fmin(fmax((((t_3.x * t_0.x) + (t_3.y * t_0.y)) + (t_3.z * t_0.z)) / fmax(((t_0.x * t_0.x) + (t_0.y * t_0.y)) + (t_0.z * t_0.z), R(1e-30)), R(0.0)), R(1.0));
+    real3 t_11 = (t_0 * t_10) - t_3;
+    real t_12 = fmin(fmax((((t_4.x * t_1.x) + (t_4.y * t_1.y)) + (t_4.z * t_1.z)) / fmax(((t_1.x * t_1.x) + (t_1.y * t_1.y)) + (t_1.z * t_1.z), R(1e-30)), R(0.0)), R(1.0));
+    real3 t_13 = (t_1 * t_12) - t_4;
+    real t_14 = fmin(fmax((((t_5.x * t_2.x) + (t_5.y * t_2.y)) + (t_5.z * t_2.z)) / fmax(((t_2.x * t_2.x) + (t_2.y * t_2.y)) + (t_2.z * t_2.z), R(1e-30)), R(0.0)), R(1.0));
+    real3 t_15 = (t_2 * t_14) - t_5;
+    real t_16 = ((t_6 * t_3.x) + (t_7 * t_3.y)) + (t_8 * t_3.z);
+    return sqrt(((((R(0.0) <= (((((t_0.y * t_8) - (t_0.z * t_7)) * t_3.x) + (((t_0.z * t_6) - (t_0.x * t_8)) * t_3.y)) + (((t_0.x * t_7) - (t_0.y * t_6)) * t_3.z))) && (R(0.0) <= (((((t_1.y * t_8) - (t_1.z * t_7)) * t_4.x) + (((t_1.z * t_6) - (t_1.x * t_8)) * t_4.y)) + (((t_1.x * t_7) - (t_1.y * t_6)) * t_4.z)))) && (R(0.0) <= (((((t_2.y * t_8) - (t_2.z * t_7)) * t_5.x) + (((t_2.z * t_6) - (t_2.x * t_8)) * t_5.y)) + (((t_2.x * t_7) - (t_2.y * t_6)) * t_5.z)))) && (R(0.0) < t_9)) ? ((t_16 * t_16) / fmax(t_9, R(1e-30))) : fmin(fmin(((t_11.x * t_11.x) + (t_11.y * t_11.y)) + (t_11.z * t_11.z), ((t_13.x * t_13.x) + (t_13.y * t_13.y)) + (t_13.z * t_13.z)), ((t_15.x * t_15.x) + (t_15.y * t_15.y)) + (t_15.z * t_15.z))) - t;
+}
+
+/* ---- quad ---- */
+real sd_quad(real3 p, real3 a, real3 b, real3 c, real3 d, real t) {
+    real3 t_0 = b - a;
+    real3 t_1 = c - b;
+    real3 t_2 = a - c;
+    real3 t_3 = p - a;
+    real3 t_4 = p - b;
+    real3 t_5 = p - c;
+    real t_6 = (t_0.y * t_2.z) - (t_0.z * t_2.y);
+    real t_7 = (t_0.z * t_2.x) - (t_0.x * t_2.z);
+    real t_8 = (t_0.x * t_2.y) - (t_0.y * t_2.x);
+    real t_9 = ((t_6 * t_6) + (t_7 * t_7)) + (t_8 * t_8);
+    real t_10 = fmin(fmax((((t_3.x * t_0.x) + (t_3.y * t_0.y)) + (t_3.z * t_0.z)) / fmax(((t_0.x * t_0.x) + (t_0.y * t_0.y)) + (t_0.z * t_0.z), R(1e-30)), R(0.0)), R(1.0));
+    real3 t_11 = (t_0 * t_10) - t_3;
+    real t_12 = fmin(fmax((((t_4.x * t_1.x) + (t_4.y * t_1.y)) + (t_4.z * t_1.z)) / fmax(((t_1.x * t_1.x) + (t_1.y * t_1.y)) + (t_1.z * t_1.z), R(1e-30)), R(0.0)), R(1.0));
+    real3 t_13 = (t_1 * t_12) - t_4;
+    real t_14 = fmin(fmax((((t_5.x * t_2.x) + (t_5.y * t_2.y)) + (t_5.z * t_2.z)) / fmax(((t_2.x * t_2.x) + (t_2.y * t_2.y)) + (t_2.z * t_2.z), R(1e-30)), R(0.0)), R(1.0));
+    real3 t_15 = (t_2 * t_14) - t_5;
+    real t_16 = ((t_6 * t_3.x) + (t_7 * t_3.y)) + (t_8 * t_3.z);
+    real3 t_17 = c - a;
+    real3 t_18 = d - c;
+    real3 t_19 = a - d;
+    real3 t_20 = p - d;
+    real t_21 = (t_17.y * t_19.z) - (t_17.z * t_19.y);
+    real t_22 = (t_17.z * t_19.x) - (t_17.x * t_19.z);
+    real t_23 = (t_17.x * t_19.y) - (t_17.y * t_19.x);
+    real t_24 = ((t_21 * t_21) + (t_22 * t_22)) + (t_23 * t_23);
+    real t_25 = fmin(fmax((((t_3.x * t_17.x) + (t_3.y * t_17.y)) + (t_3.z * t_17.z)) / fmax(((t_17.x * t_17.x) + (t_17.y * t_17.y)) + (t_17.z * t_17.z), R(1e-30)), R(0.0)), R(1.0));
+    real3 t_26 = (t_17 * t_25) - t_3;
+    real t_27 = fmin(fmax((((t_5.x * t_18.x) + (t_5.y * t_18.y)) + (t_5.z * t_18.z)) / fmax(((t_18.x * t_18.x) + (t_18.y * t_18.y)) + (t_18.z * t_18.z), R(1e-30)), R(0.0)), R(1.0));
+    real3 t_28 = (t_18 * t_27) - t_5;
+    real t_29 = fmin(fmax((((t_20.x * t_19.x) + (t_20.y * t_19.y)) + (t_20.z * t_19.z)) / fmax(((t_19.x * t_19.x) + (t_19.y * t_19.y)) + (t_19.z * t_19.z), R(1e-30)), R(0.0)), R(1.0));
+    real3 t_30 = (t_19 * t_29) - t_20;
+    real t_31 = ((t_21 * t_3.x) + (t_22 * t_3.y)) + (t_23 * t_3.z);
+    return fmin(sqrt(((((R(0.0) <= (((((t_0.y * t_8) - (t_0.z * t_7)) * t_3.x) + (((t_0.z * t_6) - (t_0.x * t_8)) * t_3.y)) + (((t_0.x * t_7) - (t_0.y * t_6)) * t_3.z))) && (R(0.0) <= (((((t_1.y * t_8) - (t_1.z * t_7)) * t_4.x) + (((t_1.z * t_6) - (t_1.x * t_8)) * t_4.y)) + (((t_1.x * t_7) - (t_1.y * t_6)) * t_4.z)))) && (R(0.0) <= (((((t_2.y * t_8) - (t_2.z * t_7)) * t_5.x) + (((t_2.z * t_6) - (t_2.x * t_8)) * t_5.y)) + (((t_2.x * t_7) - (t_2.y * t_6)) * t_5.z)))) && (R(0.0) < t_9)) ? ((t_16 * t_16) / fmax(t_9, R(1e-30))) : fmin(fmin(((t_11.x * t_11.x) + (t_11.y * t_11.y)) + (t_11.z * t_11.z), ((t_13.x * t_13.x) + (t_13.y * t_13.y)) + (t_13.z * t_13.z)), ((t_15.x * t_15.x) + (t_15.y * t_15.y)) + (t_15.z * t_15.z))), sqrt(((((R(0.0) <= (((((t_17.y * t_23) - (t_17.z * t_22)) * t_3.x) + (((t_17.z * t_21) - (t_17.x * t_23)) * t_3.y)) + (((t_17.x * t_22) - (t_17.y * t_21)) * t_3.z))) && (R(0.0) <= (((((t_18.y * t_23) - (t_18.z * t_22)) * t_5.x) + (((t_18.z * t_21) - (t_18.x * t_23)) * t_5.y)) + (((t_18.x * t_22) - (t_18.y * t_21)) * t_5.z)))) && (R(0.0) <= (((((t_19.y * t_23) - (t_19.z * t_22)) * t_20.x) + (((t_19.z * t_21) - (t_19.x * t_23)) * t_20.y)) + (((t_19.x * t_22) - (t_19.y * t_21)) * t_20.z)))) && (R(0.0) < t_24)) ? ((t_31 * t_31) / fmax(t_24, R(1e-30))) : fmin(fmin(((t_26.x * t_26.x) + (t_26.y * t_26.y)) + (t_26.z * t_26.z), ((t_28.x * t_28.x) + (t_28.y * t_28.y)) + (t_28.z * t_28.z)), ((t_30.x * t_30.x) + (t_30.y * t_30.y)) + (t_30.z * t_30.z)))) - t;
+}
+
+/* ---- pyramid ---- */
+real sd_pyramid(real3 p, real w, real h) {
+    real t0 = fabs(p.x);
+    real t1 = fabs(p.z);
+    real t2 = fmax(t0, t1);
+    real t3 = fmin(t0, t1);
+    real3 t4 = (real3)(w, R(0.0), -w);
+    real3 t5 = (real3)(w, R(0.0), w);
+    real3 t6 = t4 - t5;
+    real3 t7 = (real3)(R(0.0), h, R(0.0));
+    real3 t8 = t7 - t4;
+    real3 t9 = t5 - t7;
+    real3 t10 = (real3)(t2, p.y, t3);
+    real3 t11 = t10 - t5;
+    real3 t12 = t10 - t4;
+    real3 t13 = t10 - t7;
+    real t14 = (t6.y * t9.z) - (t6.z * t9.y);
+    real t15 = (t6.z * t9.x) - (t6.x * t9.z);
+    real t16 = (t6.x * t9.y) - (t6.y * t9.x);
+    real t17 = ((t14 * t14) + (t15 * t15)) + (t16 * t16);
+    real t18 = fmin(fmax((((t11.x * t6.x) + (t11.y * t6.y)) + (t11.z * t6.z)) / fmax(((t6.x * t6.x) + (t6.y * t6.y)) + (t6.z * t6.z), R(1e-30)), R(0.0)), R(1.0));
+    real3 t19 = (t6 * t18) - t11;
+    real t20 = fmin(fmax((((t12.x * t8.x) + (t12.y * t8.y)) + (t12.z * t8.z)) / fmax(((t8.x * t8.x) + (t8.y * t8.y)) + (t8.z * t8.z), R(1e-30)), R(0.0)), R(1.0));
+    real3 t21 = (t8 * t20) - t12;
+    real t22 = fmin(fmax((((t13.x * t9.x) + (t13.y * t9.y)) + (t13.z * t9.z)) / fmax(((t9.x * t9.x) + (t9.y * t9.y)) + (t9.z * t9.z), R(1e-30)), R(0.0)), R(1.0));
+    real3 t23 = (t9 * t22) - t13;
+    real t24 = ((t14 * t11.x) + (t15 * t11.y)) + (t16 * t11.z);
+    real t25 = t2 - w;
+    real t26 = ((h * t25) + (w * p.y)) / fmax(hypot(h, w), R(1e-30));
+    return ((t26 < R(0.0)) && (R(0.0) < p.y)) ? fmax(t26, -p.y) : fmin(sqrt(((((R(0.0) <= (((((t6.y * t16) - (t6.z * t15)) * t11.x) + (((t6.z * t14) - (t6.x * t16)) * t11.y)) + (((t6.x * t15) - (t6.y * t14)) * t11.z))) && (R(0.0) <= (((((t8.y * t16) - (t8.z * t15)) * t12.x) + (((t8.z * t14) - (t8.x * t16)) * t12.y)) + (((t8.x * t15) - (t8.y * t14)) * t12.z)))) && (R(0.0) <= (((((t9.y * t16) - (t9.z * t15)) * t13.x) + (((t9.z * t14) - (t9.x * t16)) * t13.y)) + (((t9.x * t15) - (t9.y * t14)) * t13.z)))) && (R(0.0) < t17)) ? ((t24 * t24) / fmax(t17, R(1e-30))) : fmin(fmin(((t19.x * t19.x) + (t19.y * t19.y)) + (t19.z * t19.z), ((t21.x * t21.x) + (t21.y * t21.y)) + (t21.z * t21.z)), ((t23.x * t23.x) + (t23.y * t23.y)) + (t23.z * t23.z))), length((real3)(fmax(t25, R(0.0)), p.y, fmax(t3 - w, R(0.0)))));
+}
+
+/* ---- rhombus ---- */
+real sd_rhombus(real3 p, real la, real lb, real h, real r) {
+    real t0 = -la;
+    real t1 = -lb;
+    real t2 = p.z - t1;
+    real t3 = R(0.0) - la;
+    real t4 = p.x - la;
+    real t5 = fmin(fmax(((t4 * t3) + (p.z * t1)) / fmax((t3 * t3) + (t1 * t1), R(1e-30)), R(0.0)), R(1.0));
+    bool t6 = R(0.0) <= p.z;
+    bool t7 = p.z < t1;
+    bool t8 = (t1 * t4) < (t3 * p.z);
+    bool t9 = !t6;
+    bool t10 = ((t6 && t7) && t8) || ((t9 && (!t7)) && (!t8));
+    real t11 = R(0.0) - lb;
+    real t12 = p.z - lb;
+    real t13 = fmin(fmax(((p.x * la) + (t12 * t11)) / fmax((la * la) + (t11 * t11), R(1e-30)), R(0.0)), R(1.0));
+    bool t14 = lb <= p.z;
+    bool t15 = p.z < R(0.0);
+    bool t16 = (t11 * p.x) < (la * t12);
+    bool t17 = !t15;
+    bool t18 = ((t14 && t15) && t16) || (((!t14) && t17) && (!t16));
+    bool t19 = (t10 && (!t18)) || ((!t10) && t18);
+    real t20 = R(0.0) - t0;
+    real t21 = p.x - t0;
+    real t22 = fmin(fmax(((t21 * t20) + (p.z * lb)) / fmax((t20 * t20) + (lb * lb), R(1e-30)), R(0.0)), R(1.0));
+    bool t23 = p.z < lb;
+    bool t24 = (lb * t21) < (t20 * p.z);
+    bool t25 = ((t6 && t23) && t24) || ((t9 && (!t23)) && (!t24));
+    bool t26 = (t19 && (!t25)) || ((!t19) && t25);
+    real t27 = R(0.0) - t1;
+    real t28 = fmin(fmax(((p.x * t0) + (t2 * t27)) / fmax((t0 * t0) + (t27 * t27), R(1e-30)), R(0.0)), R(1.0));
+    real t29 = fmin(fmin(fmin(fmin(hypot(p.x, t2), hypot(t4 - (t3 * t5), p.z - (t1 * t5))), hypot(p.x - (la * t13), t12 - (t11 * t13))), hypot(t21 - (t20 * t22), p.z - (lb * t22))), hypot(p.x - (t0 * t28), t2 - (t27 * t28)));
+    bool t30 = t1 <= p.z;
+    bool t31 = (t27 * p.x) < (t0 * t2);
+    bool t32 = ((t30 && t15) && t31) || (((!t30) && t17) && (!t31));
+    real t33 = (((t26 && (!t32)) || ((!t26) && t32)) ? (-t29) : t29) - r;
+    real t34 = fabs(p.y) - h;
+    return fmin(fmax(t33, t34), R(0.0)) + hypot(fmax(t33, R(0.0)), fmax(t34, R(0.0)));
+}
+
+/* ---- tri_prism ---- */
+real sd_tri_prism(real3 p, real r, real h) {
+    real t0 = R(1.7320508075688772) * r;
+    real t1 = R(2.0) * r;
+    real t2 = -t0;
+    real t3 = -r;
+    real t4 = p.x - t0;
+    real t5 = p.z - t3;
+    real t6 = t3 - t1;
+    real t7 = p.z - t1;
+    real t8 = fmin(fmax(((p.x * t0) + (t7 * t6)) / fmax((t0 * t0) + (t6 * t6), R(1e-30)), R(0.0)), R(1.0));
+    bool t9 = t1 <= p.z;
+    bool t10 = p.z < t3;
+    bool t11 = (t6 * p.x) < (t0 * t7);
+    bool t12 = !t10;
+    bool t13 = ((t9 && t10) && t11) || (((!t9) && t12) && (!t11));
+    real t14 = R(0.0) - t2;
+    real t15 = t1 - t3;
+    real t16 = p.x - t2;
+    real t17 = fmin(fmax(((t16 * t14) + (t5 * t15)) / fmax((t14 * t14) + (t15 * t15), R(1e-30)), R(0.0)), R(1.0));
+    bool t18 = t3 <= p.z;
+    bool t19 = p.z < t1;
+    bool t20 = (t15 * t16) < (t14 * t5);
+    bool t21 = !t18;
+    bool t22 = ((t18 && t19) && t20) || ((t21 && (!t19)) && (!t20));
+    bool t23 = (t13 && (!t22)) || ((!t13) && t22);
+    real t24 = t2 - t0;
+    real t25 = t3 - t3;
+    real t26 = fmin(fmax(((t4 * t24) + (t5 * t25)) / fmax((t24 * t24) + (t25 * t25), R(1e-30)), R(0.0)), R(1.0));
+    real t27 = fmin(fmin(fmin(hypot(t4, t5), hypot(p.x - (t0 * t8), t7 - (t6 * t8))), hypot(t16 - (t14 * t17), t5 - (t15 * t17))), hypot(t4 - (t24 * t26), t5 - (t25 * t26)));
+    bool t28 = (t25 * t4) < (t24 * t5);
+    bool t29 = ((t18 && t10) && t28) || ((t21 && t12) && (!t28));
+    real t30 = ((t23 && (!t29)) || ((!t23) && t29)) ? (-t27) : t27;
+    real t31 = fabs(p.y) - h;
+    return fmin(fmax(t30, t31), R(0.0)) + hypot(fmax(t30, R(0.0)), fmax(t31, R(0.0)));
+}
+
+/* ---- rounded_cylinder ---- */
+real sd_rounded_cylinder(real3 p, real r, real h, real e) {
+    real t0 = fabs(hypot(p.x, p.z)) - (r - e);
+    real t1 = fabs(p.y) - (h - e);
+    return (hypot(fmax(t0, R(0.0)), fmax(t1, R(0.0))) + fmin(fmax(t0, t1), R(0.0))) - e;
+}
+
+/* ---- cone ---- */
+real sd_cone(real3 p, real r, real h) {
+    real t0 = R(0.5) * h;
+    real t1 = p.y + t0;
+    real t2 = hypot(p.x, p.z);
+    real t3 = R(0.0) - r;
+    real t4 = R(2.0) * t0;
+    real t5 = t2 - fmin(t2, (t1 < R(0.0)) ? r : R(0.0));
+    real t6 = fabs(t1) - t0;
+    real t7 = fmin(fmax((((R(0.0) - t2) * t3) + ((t0 - t1) * t4)) / fmax((t3 * t3) + (t4 * t4), R(1e-30)), R(0.0)), R(1.0));
+    real t8 = t2 + (t3 * t7);
+    real t9 = (t1 - t0) + (t4 * t7);
+    return (((t8 < R(0.0)) && (t6 < R(0.0))) ? (-R(1.0)) : R(1.0)) * sqrt(fmin((t5 * t5) + (t6 * t6), (t8 * t8) + (t9 * t9)));
+}
+
+/* ---- cut_hollow_sphere ---- */
+real sd_cut_hollow_sphere(real3 p, real r, real h, real t) {
+    real t_0 = fmin(fmax(h, -r), r);
+    real t_1 = sqrt(fmax((r * r) - (t_0 * t_0), R(0.0)));
+    real t_2 = hypot(p.x, p.z);
+    return ((atan2(t_2, p.y) < atan2(t_1, t_0)) ? hypot(t_2 - t_1, p.y - t_0) : fabs(hypot(t_2, p.y) - r)) - t;
+}
+
+/* ---- death_star ---- */
+real sd_death_star(real3 p, real ra, real rb, real d) {
+    real t0 = fmax(d, R(1e-30));
+    real t1 = ra * ra;
+    real t2 = ((t1 - (rb * rb)) + (t0 * t0)) / (R(2.0) * t0);
+    real t3 = sqrt(fmax(t1 - (t2 * t2), R(0.0)));
+    real t4 = hypot(p.y, p.z);
+    return ((t0 * fmax(t3 - t4, R(0.0))) < ((p.x * t3) - (t4 * t2))) ? hypot(p.x - t2, t4 - t3) : fmax(hypot(p.x, t4) - ra, rb - hypot(p.x - t0, t4));
+}
+
 /* ---- cylinder_between ---- */
 real sd_cylinder_between(real3 p, real3 a, real3 b, real r) {
     real3 t0 = b - a;
@@ -294,209 +502,328 @@ real sd_ellipsoid(real3 p, real3 r) {
 real DE(real3 p0, __global const real* params) {
     /* union */
     /* union/b:color/plane */
-    real d74 = sd_plane(p0, (real3)(0.0f, 1.0f, 0.0f), 0.4f);
+    real d120 = sd_plane(p0, (real3)(0.0f, 1.0f, 0.0f), 0.4f);
     /* union: the second operand only within reach of its bound */
-    real u76 = d74;
-    real g76 = (length(p0 - ((real3)(-R(3.2), R(0.0), -R(0.75)))) * R(0.9999)) - R(0.35);
-    if (!(g76 > u76 && g76 > R(0.0))) {
+    real u122 = d120;
+    real g122 = (length(p0 - ((real3)(-R(3.2), R(0.0), -R(1.1)))) * R(0.9999)) - R(0.35);
+    if (!(g122 > u122 && g122 > R(0.0))) {
         /* .../a:union/a:union/a:translate */
-        real3 p1 = p0 - ((real3)(-R(3.2), R(0.0), -R(0.75)));
+        real3 p1 = p0 - ((real3)(-R(3.2), R(0.0), -R(1.1)));
         /* .../a:translate/color/sphere */
         real d0 = sd_sphere(p1, 0.35f);
-        real d76 = fmin(d74, d0);
-        u76 = d76;
+        real d122 = fmin(d120, d0);
+        u122 = d122;
     }
     /* union/a:union: the second operand only within reach of its bound */
-    real u73 = u76;
-    real g73 = (length(p0 - ((real3)(-R(2.4000000000000004), R(0.0), -R(0.75)))) * R(0.9999)) - R(0.5196152422706632);
-    if (!(g73 > u73 && g73 > R(0.0))) {
+    real u119 = u122;
+    real g119 = (length(p0 - ((real3)(-R(2.4000000000000004), R(0.0), -R(1.1)))) * R(0.9999)) - R(0.5196152422706632);
+    if (!(g119 > u119 && g119 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p2 = p0 - ((real3)(-R(2.4000000000000004), R(0.0), -R(0.75)));
+        real3 p2 = p0 - ((real3)(-R(2.4000000000000004), R(0.0), -R(1.1)));
         /* .../b:translate/color/cuboid */
         real d3 = sd_box(p2, (real3)(0.3f));
-        real d73 = fmin(u76, d3);
-        u73 = d73;
+        real d119 = fmin(u122, d3);
+        u119 = d119;
     }
     /* .../a:union/a:union: the second operand only within reach of its bound */
-    real u69 = u73;
-    real g69 = (length(p0 - ((real3)(-R(1.6), R(0.0), -R(0.75)))) * R(0.9999)) - R(0.5196152422706632);
-    if (!(g69 > u69 && g69 > R(0.0))) {
+    real u113 = u119;
+    real g113 = (length(p0 - ((real3)(-R(1.6), R(0.0), -R(1.1)))) * R(0.9999)) - R(0.5196152422706632);
+    if (!(g113 > u113 && g113 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p3 = p0 - ((real3)(-R(1.6), R(0.0), -R(0.75)));
+        real3 p3 = p0 - ((real3)(-R(1.6), R(0.0), -R(1.1)));
         /* .../b:translate/color/round_box */
         real d7 = sd_round_box(p3, (real3)(0.3f), 0.08f);
-        real d69 = fmin(u73, d7);
-        u69 = d69;
+        real d113 = fmin(u119, d7);
+        u113 = d113;
     }
     /* .../a:union/a:union: the second operand only within reach of its bound */
-    real u65 = u69;
-    real g65 = (length(p0 - ((real3)(-R(0.8), R(0.0), -R(0.75)))) * R(0.9999)) - R(0.38);
-    if (!(g65 > u65 && g65 > R(0.0))) {
+    real u108 = u113;
+    real g108 = (length(p0 - ((real3)(-R(0.8), R(0.0), -R(1.1)))) * R(0.9999)) - R(0.38);
+    if (!(g108 > u108 && g108 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p4 = p0 - ((real3)(-R(0.8), R(0.0), -R(0.75)));
+        real3 p4 = p0 - ((real3)(-R(0.8), R(0.0), -R(1.1)));
         /* .../b:translate/color/torus */
         real d11 = sd_torus(p4, 0.28f, 0.1f);
-        real d65 = fmin(u69, d11);
-        u65 = d65;
+        real d108 = fmin(u113, d11);
+        u108 = d108;
     }
     /* .../a:union/a:union: the second operand only within reach of its bound */
-    real u61 = u65;
-    real g61 = (length(p0 - ((real3)(R(0.0), R(0.0), -R(0.75)))) * R(0.9999)) - R(0.4301162633521313);
-    if (!(g61 > u61 && g61 > R(0.0))) {
+    real u103 = u108;
+    real g103 = (length(p0 - ((real3)(R(0.0), R(0.0), -R(1.1)))) * R(0.9999)) - R(0.4301162633521313);
+    if (!(g103 > u103 && g103 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p5 = p0 - ((real3)(R(0.0), R(0.0), -R(0.75)));
+        real3 p5 = p0 - ((real3)(R(0.0), R(0.0), -R(1.1)));
         /* .../b:translate/color/cylinder */
         real d15 = sd_cylinder(p5, 0.25f, 0.35f);
-        real d61 = fmin(u65, d15);
-        u61 = d61;
+        real d103 = fmin(u108, d15);
+        u103 = d103;
     }
     /* .../a:union/a:union: the second operand only within reach of its bound */
-    real u57 = u61;
-    real g57 = (length(p0 - ((real3)(R(0.8), R(0.0), -R(0.75)))) * R(0.9999)) - R(0.38);
-    if (!(g57 > u57 && g57 > R(0.0))) {
+    real u98 = u103;
+    real g98 = (length(p0 - ((real3)(R(0.8), R(0.0), -R(1.1)))) * R(0.9999)) - R(0.38);
+    if (!(g98 > u98 && g98 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p6 = p0 - ((real3)(R(0.8), R(0.0), -R(0.75)));
+        real3 p6 = p0 - ((real3)(R(0.8), R(0.0), -R(1.1)));
         /* .../b:translate/color/capsule */
         real d19 = sd_capsule(p6, (real3)(0.0f, (-0.2f), 0.0f), (real3)(0.0f, 0.2f, 0.0f), 0.18f);
-        real d57 = fmin(u61, d19);
-        u57 = d57;
+        real d98 = fmin(u103, d19);
+        u98 = d98;
     }
     /* .../a:union/a:union: the second operand only within reach of its bound */
-    real u52 = u57;
-    real g52 = (length(p0 - ((real3)(R(1.6), R(0.0), -R(0.75)))) * R(0.9999)) - R(0.4);
-    if (!(g52 > u52 && g52 > R(0.0))) {
+    real u93 = u98;
+    real g93 = (length(p0 - ((real3)(R(1.6), R(0.0), -R(1.1)))) * R(0.9999)) - R(0.4);
+    if (!(g93 > u93 && g93 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p7 = p0 - ((real3)(R(1.6), R(0.0), -R(0.75)));
+        real3 p7 = p0 - ((real3)(R(1.6), R(0.0), -R(1.1)));
         /* .../b:translate/color/octahedron */
         real d23 = sd_octahedron(p7, 0.4f);
-        real d52 = fmin(u57, d23);
-        u52 = d52;
+        real d93 = fmin(u98, d23);
+        u93 = d93;
     }
     /* .../a:union/a:union: the second operand only within reach of its bound */
-    real u47 = u52;
-    real g47 = (length(p0 - ((real3)(R(2.4000000000000004), R(0.0), -R(0.75)))) * R(0.9999)) - R(0.4609772228646443);
-    if (!(g47 > u47 && g47 > R(0.0))) {
+    real u87 = u93;
+    real g87 = (length(p0 - ((real3)(R(2.4000000000000004), R(0.0), -R(1.1)))) * R(0.9999)) - R(0.4609772228646443);
+    if (!(g87 > u87 && g87 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p8 = p0 - ((real3)(R(2.4000000000000004), R(0.0), -R(0.75)));
+        real3 p8 = p0 - ((real3)(R(2.4000000000000004), R(0.0), -R(1.1)));
         /* .../b:translate/color/capped_cone */
         real d27 = sd_capped_cone(p8, 0.35f, 0.3f, 0.1f);
-        real d47 = fmin(u52, d27);
-        u47 = d47;
+        real d87 = fmin(u93, d27);
+        u87 = d87;
     }
     /* .../a:union/a:union: the second operand only within reach of its bound */
-    real u42 = u47;
-    real g42 = R(0.5714285714285715) * ((length(p0 - ((real3)(R(3.2), R(0.0), -R(0.75)))) * R(0.9999)) - R(0.35));
-    if (!(g42 > u42 && g42 > R(0.0))) {
+    real u81 = u87;
+    real g81 = R(0.5714285714285715) * ((length(p0 - ((real3)(R(3.2), R(0.0), -R(1.1)))) * R(0.9999)) - R(0.35));
+    if (!(g81 > u81 && g81 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p9 = p0 - ((real3)(R(3.2), R(0.0), -R(0.75)));
+        real3 p9 = p0 - ((real3)(R(3.2), R(0.0), -R(1.1)));
         /* .../b:translate/color/ellipsoid */
         real d31 = sd_ellipsoid(p9, (real3)(0.35f, 0.2f, 0.25f));
-        real d42 = fmin(u47, d31);
-        u42 = d42;
+        real d81 = fmin(u87, d31);
+        u81 = d81;
     }
     /* .../a:union/a:union: the second operand only within reach of its bound */
-    real u38 = u42;
-    real g38 = (length(p0 - ((real3)(-R(3.2), R(0.0), R(0.75)))) * R(0.9999)) - R(0.4410593308539491);
-    if (!(g38 > u38 && g38 > R(0.0))) {
+    real u77 = u81;
+    real g77 = (length(p0 - ((real3)(-R(3.2), R(0.0), R(0.0)))) * R(0.9999)) - R(0.4410593308539491);
+    if (!(g77 > u77 && g77 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p10 = p0 - ((real3)(-R(3.2), R(0.0), R(0.75)));
+        real3 p10 = p0 - ((real3)(-R(3.2), R(0.0), R(0.0)));
         /* .../b:translate/color/hex_prism */
         real d35 = sd_hex_prism(p10, 0.28f, 0.3f);
-        real d38 = fmin(u42, d35);
-        u38 = d38;
+        real d77 = fmin(u81, d35);
+        u77 = d77;
     }
     /* .../a:union/a:union: the second operand only within reach of its bound */
-    real u34 = u38;
-    real g34 = (length(p0 - ((real3)(-R(2.4000000000000004), R(0.0), R(0.75)))) * R(0.9999)) - R(0.44);
-    if (!(g34 > u34 && g34 > R(0.0))) {
+    real u72 = u77;
+    real g72 = (length(p0 - ((real3)(-R(2.4000000000000004), R(0.0), R(0.0)))) * R(0.9999)) - R(0.44);
+    if (!(g72 > u72 && g72 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p11 = p0 - ((real3)(-R(2.4000000000000004), R(0.0), R(0.75)));
+        real3 p11 = p0 - ((real3)(-R(2.4000000000000004), R(0.0), R(0.0)));
         /* .../b:translate/color/round_cone */
         real d39 = sd_round_cone(p11, 0.22f, 0.22f, 0.1f);
-        real d34 = fmin(u38, d39);
-        u34 = d34;
+        real d72 = fmin(u77, d39);
+        u72 = d72;
     }
     /* .../a:union/a:union: the second operand only within reach of its bound */
-    real u30 = u34;
-    real g30 = (length(p0 - ((real3)(-R(1.6), R(0.0), R(0.75)))) * R(0.9999)) - R(0.41000000000000003);
-    if (!(g30 > u30 && g30 > R(0.0))) {
+    real u68 = u72;
+    real g68 = (length(p0 - ((real3)(-R(1.6), R(0.0), R(0.0)))) * R(0.9999)) - R(0.41000000000000003);
+    if (!(g68 > u68 && g68 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p12 = p0 - ((real3)(-R(1.6), R(0.0), R(0.75)));
+        real3 p12 = p0 - ((real3)(-R(1.6), R(0.0), R(0.0)));
         /* .../b:translate/color/rotate */
         real3 p13 = (real3)((R(0.8775825618903728) * p12.x) - (R(0.479425538604203) * p12.z), p12.y, (R(0.479425538604203) * p12.x) + (R(0.8775825618903728) * p12.z));
         /* .../color/rotate/link */
         real d43 = sd_link(p13, 0.14f, 0.2f, 0.07f);
-        real d30 = fmin(u34, d43);
-        u30 = d30;
+        real d68 = fmin(u72, d43);
+        u68 = d68;
     }
     /* .../a:union/a:union: the second operand only within reach of its bound */
-    real u26 = u30;
-    real g26 = (length(p0 - ((real3)(-R(0.8), R(0.05), R(0.75)))) * R(0.9999)) - R(0.35);
-    if (!(g26 > u26 && g26 > R(0.0))) {
+    real u64 = u68;
+    real g64 = (length(p0 - ((real3)(-R(0.8), R(0.05), R(0.0)))) * R(0.9999)) - R(0.35);
+    if (!(g64 > u64 && g64 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p14 = p0 - ((real3)(-R(0.8), R(0.0), R(0.75)));
+        real3 p14 = p0 - ((real3)(-R(0.8), R(0.0), R(0.0)));
         /* .../b:translate/color/translate */
         real3 p15 = p14 - ((real3)(R(0.0), R(0.05), R(0.0)));
         /* .../color/translate/cut_sphere */
         real d48 = sd_cut_sphere(p15, 0.35f, 0.15f);
-        real d26 = fmin(u30, d48);
+        real d64 = fmin(u68, d48);
+        u64 = d64;
+    }
+    /* .../a:union/a:union: the second operand only within reach of its bound */
+    real u60 = u64;
+    real g60 = (length(p0 - ((real3)(R(0.0), -R(0.3), R(0.0)))) * R(0.9999)) - R(0.45);
+    if (!(g60 > u60 && g60 > R(0.0))) {
+        /* .../a:union/b:translate/translate */
+        real3 p16 = p0 - ((real3)(R(0.0), -R(0.3), R(0.0)));
+        /* .../b:translate/translate/solid_angle */
+        real d53 = sd_solid_angle(p16, 0.6f, 0.45f);
+        real d60 = fmin(u64, d53);
+        u60 = d60;
+    }
+    /* .../a:union/a:union: the second operand only within reach of its bound */
+    real u56 = u60;
+    real g56 = (length(p0 - ((real3)(R(0.8), R(0.0), R(0.0)))) * R(0.9999)) - R(0.32);
+    if (!(g56 > u56 && g56 > R(0.0))) {
+        /* .../a:union/a:union/b:translate */
+        real3 p17 = p0 - ((real3)(R(0.8), R(0.0), R(0.0)));
+        /* .../b:translate/color/capped_torus */
+        real d57 = sd_capped_torus(p17, 2.2f, 0.25f, 0.07f);
+        real d56 = fmin(u60, d57);
+        u56 = d56;
+    }
+    /* .../a:union/a:union: the second operand only within reach of its bound */
+    real u52 = u56;
+    real g52 = (length(p0 - ((real3)(R(1.5750000000000002), -R(0.024999999999999994), R(0.0)))) * R(0.9999)) - R(0.34734708865916814);
+    if (!(g52 > u52 && g52 > R(0.0))) {
+        /* .../a:union/a:union/b:translate */
+        real3 p18 = p0 - ((real3)(R(1.6), R(0.0), R(0.0)));
+        /* .../b:translate/color/cylinder_between */
+        real d61 = sd_cylinder_between(p18, (real3)((-0.2f), (-0.3f), 0.0f), (real3)(0.15f, 0.25f, 0.0f), 0.12f);
+        real d52 = fmin(u56, d61);
+        u52 = d52;
+    }
+    /* .../a:union/a:union: the second operand only within reach of its bound */
+    real u47 = u52;
+    real g47 = (length(p0 - ((real3)(R(2.4250000000000003), R(0.024999999999999994), R(0.0)))) * R(0.9999)) - R(0.3932556420447137);
+    if (!(g47 > u47 && g47 > R(0.0))) {
+        /* .../a:union/a:union/b:translate */
+        real3 p19 = p0 - ((real3)(R(2.4000000000000004), R(0.0), R(0.0)));
+        /* .../b:translate/color/cone_between */
+        real d65 = sd_cone_between(p19, (real3)(0.2f, (-0.25f), 0.0f), (real3)((-0.15f), 0.3f, 0.0f), 0.22f, 0.05f);
+        real d47 = fmin(u52, d65);
+        u47 = d47;
+    }
+    /* .../a:union/a:union: the second operand only within reach of its bound */
+    real u42 = u47;
+    real g42 = (length(p0 - ((real3)(R(3.225), R(0.024999999999999994), R(0.0)))) * R(0.9999)) - R(0.4450438562747845);
+    if (!(g42 > u42 && g42 > R(0.0))) {
+        /* .../a:union/a:union/b:translate */
+        real3 p20 = p0 - ((real3)(R(3.2), R(0.0), R(0.0)));
+        /* .../b:translate/color/round_cone_between */
+        real d69 = sd_round_cone_between(p20, (real3)((-0.15f), (-0.2f), 0.0f), (real3)(0.2f, 0.25f, 0.0f), 0.16f, 0.07f);
+        real d42 = fmin(u47, d69);
+        u42 = d42;
+    }
+    /* .../a:union/a:union: the second operand only within reach of its bound */
+    real u38 = u42;
+    real g38 = (length(p0 - ((real3)(-R(3.2), -R(0.13333333333333333), R(1.1)))) * R(0.9999)) - R(0.4633333333333334);
+    if (!(g38 > u38 && g38 > R(0.0))) {
+        /* .../a:union/a:union/b:translate */
+        real3 p21 = p0 - ((real3)(-R(3.2), R(0.0), R(1.1)));
+        /* .../b:translate/color/rotate */
+        real3 p22 = (real3)((R(0.9210609940028851) * p21.x) - (R(0.3894183423086505) * p21.z), p21.y, (R(0.3894183423086505) * p21.x) + (R(0.9210609940028851) * p21.z));
+        /* .../color/rotate/triangle */
+        real d73 = sd_triangle(p22, (real3)((-0.3f), (-0.35f), 0.0f), (real3)(0.3f, (-0.35f), 0.0f), (real3)(0.0f, 0.3f, 0.0f), 0.03f);
+        real d38 = fmin(u42, d73);
+        u38 = d38;
+    }
+    /* .../a:union/a:union: the second operand only within reach of its bound */
+    real u34 = u38;
+    real g34 = (length(p0 - ((real3)(-R(2.4000000000000004), -R(0.024999999999999994), R(1.09)))) * R(0.9999)) - R(0.47286002303210883);
+    if (!(g34 > u34 && g34 > R(0.0))) {
+        /* .../a:union/a:union/b:translate */
+        real3 p23 = p0 - ((real3)(-R(2.4000000000000004), R(0.0), R(1.1)));
+        /* .../b:translate/color/quad */
+        real d78 = sd_quad(p23, (real3)((-0.28f), (-0.35f), (-0.12f)), (real3)(0.28f, (-0.35f), (-0.12f)), (real3)(0.2f, 0.3f, 0.1f), (real3)((-0.2f), 0.3f, 0.1f), 0.03f);
+        real d34 = fmin(u38, d78);
+        u34 = d34;
+    }
+    /* .../a:union/a:union: the second operand only within reach of its bound */
+    real u30 = u34;
+    real g30 = (length(p0 - ((real3)(-R(1.6), -R(0.4), R(1.1)))) * R(0.9999)) - R(0.55);
+    if (!(g30 > u30 && g30 > R(0.0))) {
+        /* .../a:union/a:union/b:translate */
+        real3 p24 = p0 - ((real3)(-R(1.6), R(0.0), R(1.1)));
+        /* .../b:translate/color/translate */
+        real3 p25 = p24 - ((real3)(R(0.0), -R(0.4), R(0.0)));
+        /* .../color/translate/rotate */
+        real3 p26 = (real3)((R(0.8775825618903728) * p25.x) - (R(0.479425538604203) * p25.z), p25.y, (R(0.479425538604203) * p25.x) + (R(0.8775825618903728) * p25.z));
+        /* .../translate/rotate/pyramid */
+        real d82 = sd_pyramid(p26, 0.3f, 0.55f);
+        real d30 = fmin(u34, d82);
+        u30 = d30;
+    }
+    /* .../a:union/a:union: the second operand only within reach of its bound */
+    real u26 = u30;
+    real g26 = (length(p0 - ((real3)(-R(0.8), -R(0.34), R(1.1)))) * R(0.9999)) - R(0.4044749683231337);
+    if (!(g26 > u26 && g26 > R(0.0))) {
+        /* .../a:union/a:union/b:translate */
+        real3 p27 = p0 - ((real3)(-R(0.8), R(0.0), R(1.1)));
+        /* .../b:translate/color/translate */
+        real3 p28 = p27 - ((real3)(R(0.0), -R(0.34), R(0.0)));
+        /* .../color/translate/rotate */
+        real3 p29 = (real3)((R(0.8253356149096783) * p28.x) - (R(0.5646424733950354) * p28.z), p28.y, (R(0.5646424733950354) * p28.x) + (R(0.8253356149096783) * p28.z));
+        /* .../translate/rotate/rhombus */
+        real d88 = sd_rhombus(p29, 0.36f, 0.22f, 0.06f, 0.04f);
+        real d26 = fmin(u30, d88);
         u26 = d26;
     }
     /* .../a:union/a:union: the second operand only within reach of its bound */
     real u22 = u26;
-    real g22 = (length(p0 - ((real3)(R(0.0), -R(0.3), R(0.75)))) * R(0.9999)) - R(0.45);
+    real g22 = (length(p0 - ((real3)(R(0.0), -R(0.1), R(1.1)))) * R(0.9999)) - R(0.45343136195018535);
     if (!(g22 > u22 && g22 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p16 = p0 - ((real3)(R(0.0), R(0.0), R(0.75)));
+        real3 p30 = p0 - ((real3)(R(0.0), R(0.0), R(1.1)));
         /* .../b:translate/color/translate */
-        real3 p17 = p16 - ((real3)(R(0.0), -R(0.3), R(0.0)));
-        /* .../color/translate/solid_angle */
-        real d53 = sd_solid_angle(p17, 0.6f, 0.45f);
-        real d22 = fmin(u26, d53);
+        real3 p31 = p30 - ((real3)(R(0.0), -R(0.1), R(0.0)));
+        /* .../color/translate/tri_prism */
+        real d94 = sd_tri_prism(p31, 0.17f, 0.3f);
+        real d22 = fmin(u26, d94);
         u22 = d22;
     }
     /* .../a:union/a:union: the second operand only within reach of its bound */
     real u18 = u22;
-    real g18 = (length(p0 - ((real3)(R(0.8), R(0.0), R(0.75)))) * R(0.9999)) - R(0.32);
+    real g18 = (length(p0 - ((real3)(R(0.8), -R(0.2), R(1.1)))) * R(0.9999)) - R(0.3440930106817051);
     if (!(g18 > u18 && g18 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p18 = p0 - ((real3)(R(0.8), R(0.0), R(0.75)));
-        /* .../b:translate/color/capped_torus */
-        real d58 = sd_capped_torus(p18, 2.2f, 0.25f, 0.07f);
-        real d18 = fmin(u22, d58);
+        real3 p32 = p0 - ((real3)(R(0.8), R(0.0), R(1.1)));
+        /* .../b:translate/color/translate */
+        real3 p33 = p32 - ((real3)(R(0.0), -R(0.2), R(0.0)));
+        /* .../color/translate/rounded_cylinder */
+        real d99 = sd_rounded_cylinder(p33, 0.28f, 0.2f, 0.08f);
+        real d18 = fmin(u22, d99);
         u18 = d18;
     }
     /* .../a:union/a:union: the second operand only within reach of its bound */
     real u14 = u18;
-    real g14 = (length(p0 - ((real3)(R(1.5750000000000002), -R(0.024999999999999994), R(0.75)))) * R(0.9999)) - R(0.34734708865916814);
+    real g14 = (length(p0 - ((real3)(R(1.6), -R(0.09999999999999998), R(1.1)))) * R(0.9999)) - R(0.41036569057366384);
     if (!(g14 > u14 && g14 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p19 = p0 - ((real3)(R(1.6), R(0.0), R(0.75)));
-        /* .../b:translate/color/cylinder_between */
-        real d62 = sd_cylinder_between(p19, (real3)((-0.2f), (-0.3f), 0.0f), (real3)(0.15f, 0.25f, 0.0f), 0.12f);
-        real d14 = fmin(u18, d62);
+        real3 p34 = p0 - ((real3)(R(1.6), R(0.0), R(1.1)));
+        /* .../b:translate/color/translate */
+        real3 p35 = p34 - ((real3)(R(0.0), R(0.2), R(0.0)));
+        /* .../color/translate/cone */
+        real d104 = sd_cone(p35, 0.28f, 0.6f);
+        real d14 = fmin(u18, d104);
         u14 = d14;
     }
     /* .../a:union/a:union: the second operand only within reach of its bound */
     real u10 = u14;
-    real g10 = (length(p0 - ((real3)(R(2.4250000000000003), R(0.024999999999999994), R(0.75)))) * R(0.9999)) - R(0.3932556420447137);
+    real g10 = (length(p0 - ((real3)(R(2.4000000000000004), -R(0.06), R(1.1)))) * R(0.9999)) - R(0.34);
     if (!(g10 > u10 && g10 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p20 = p0 - ((real3)(R(2.4000000000000004), R(0.0), R(0.75)));
-        /* .../b:translate/color/cone_between */
-        real d66 = sd_cone_between(p20, (real3)(0.2f, (-0.25f), 0.0f), (real3)((-0.15f), 0.3f, 0.0f), 0.22f, 0.05f);
-        real d10 = fmin(u14, d66);
+        real3 p36 = p0 - ((real3)(R(2.4000000000000004), R(0.0), R(1.1)));
+        /* .../b:translate/color/translate */
+        real3 p37 = p36 - ((real3)(R(0.0), -R(0.06), R(0.0)));
+        /* .../color/translate/cut_hollow_sphere */
+        real d109 = sd_cut_hollow_sphere(p37, 0.32f, 0.12f, 0.02f);
+        real d10 = fmin(u14, d109);
         u10 = d10;
     }
     /* .../a:union/a:union: the second operand only within reach of its bound */
     real u6 = u10;
-    real g6 = (length(p0 - ((real3)(R(3.225), R(0.024999999999999994), R(0.75)))) * R(0.9999)) - R(0.4450438562747845);
+    real g6 = (length(p0 - ((real3)(R(3.2), -R(0.08), R(1.1)))) * R(0.9999)) - R(0.32);
     if (!(g6 > u6 && g6 > R(0.0))) {
         /* union/a:union/b:translate */
-        real3 p21 = p0 - ((real3)(R(3.2), R(0.0), R(0.75)));
-        /* .../b:translate/color/round_cone_between */
-        real d70 = sd_round_cone_between(p21, (real3)((-0.15f), (-0.2f), 0.0f), (real3)(0.2f, 0.25f, 0.0f), 0.16f, 0.07f);
-        real d6 = fmin(u10, d70);
+        real3 p38 = p0 - ((real3)(R(3.2), R(0.0), R(1.1)));
+        /* .../b:translate/color/translate */
+        real3 p39 = p38 - ((real3)(R(0.0), -R(0.08), R(0.0)));
+        /* .../color/translate/rotate */
+        real3 p40 = (real3)(p39.z, p39.y, -p39.x);
+        /* .../translate/rotate/death_star */
+        real d114 = sd_death_star(p40, 0.32f, 0.25f, 0.3f);
+        real d6 = fmin(u10, d114);
         u6 = d6;
     }
     return u6;
@@ -505,137 +832,312 @@ real DE(real3 p0, __global const real* params) {
 real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     /* union */
     /* union/b:color/plane */
-    real d74 = sd_plane(p0, (real3)(0.0f, 1.0f, 0.0f), 0.4f);
+    real d120 = sd_plane(p0, (real3)(0.0f, 1.0f, 0.0f), 0.4f);
     /* union/b:color */
-    real3 c75 = (real3)(0.55f, 0.55f, 0.6f);
+    real3 c121 = (real3)(0.55f, 0.55f, 0.6f);
     /* union: the second operand only within reach of its bound */
-    real u76 = d74;
-    real3 uc76 = c75;
-    real ut76 = R(1.0);
-    real g76 = (length(p0 - ((real3)(-R(3.2), R(0.0), -R(0.75)))) * R(0.9999)) - R(0.35);
-    if (!(g76 > u76 && g76 > R(0.0))) {
+    real u122 = d120;
+    real3 uc122 = c121;
+    real ut122 = R(1.0);
+    real g122 = (length(p0 - ((real3)(-R(3.2), R(0.0), -R(1.1)))) * R(0.9999)) - R(0.35);
+    if (!(g122 > u122 && g122 > R(0.0))) {
         /* .../a:union/a:union/a:translate */
-        real3 p1 = p0 - ((real3)(-R(3.2), R(0.0), -R(0.75)));
+        real3 p1 = p0 - ((real3)(-R(3.2), R(0.0), -R(1.1)));
         /* .../a:translate/color/sphere */
         real d0 = sd_sphere(p1, 0.35f);
         /* .../a:union/a:translate/color */
         real3 c1 = (real3)(0.9f, 0.45f, 0.3f);
-        real d76 = fmin(d74, d0);
-        real3 c76 = d74 < d0 ? c75 : c1;
-        u76 = d76;
-        uc76 = c76;
-        ut76 = R(1.0);
+        real d122 = fmin(d120, d0);
+        real3 c122 = d120 < d0 ? c121 : c1;
+        u122 = d122;
+        uc122 = c122;
+        ut122 = R(1.0);
     }
     /* union/a:union: the second operand only within reach of its bound */
-    real u73 = u76;
-    real3 uc73 = uc76;
-    real ut73 = ut76;
-    real g73 = (length(p0 - ((real3)(-R(2.4000000000000004), R(0.0), -R(0.75)))) * R(0.9999)) - R(0.5196152422706632);
-    if (!(g73 > u73 && g73 > R(0.0))) {
+    real u119 = u122;
+    real3 uc119 = uc122;
+    real ut119 = ut122;
+    real g119 = (length(p0 - ((real3)(-R(2.4000000000000004), R(0.0), -R(1.1)))) * R(0.9999)) - R(0.5196152422706632);
+    if (!(g119 > u119 && g119 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p2 = p0 - ((real3)(-R(2.4000000000000004), R(0.0), -R(0.75)));
+        real3 p2 = p0 - ((real3)(-R(2.4000000000000004), R(0.0), -R(1.1)));
         /* .../b:translate/color/cuboid */
         real d3 = sd_box(p2, (real3)(0.3f));
         /* .../a:union/b:translate/color */
-        real3 c4 = (real3)(0.86470586f, 0.49117646f, 0.33529413f);
-        real d73 = fmin(u76, d3);
-        real3 c73 = u76 < d3 ? uc76 : c4;
-        real t73 = u76 < d3 ? ut76 : R(1.0);
-        u73 = d73;
-        uc73 = c73;
-        ut73 = t73;
+        real3 c4 = (real3)(0.8769231f, 0.47692308f, 0.32307693f);
+        real d119 = fmin(u122, d3);
+        real3 c119 = u122 < d3 ? uc122 : c4;
+        real t119 = u122 < d3 ? ut122 : R(1.0);
+        u119 = d119;
+        uc119 = c119;
+        ut119 = t119;
     }
     /* .../a:union/a:union: the second operand only within reach of its bound */
-    real u69 = u73;
-    real3 uc69 = uc73;
-    real ut69 = ut73;
-    real g69 = (length(p0 - ((real3)(-R(1.6), R(0.0), -R(0.75)))) * R(0.9999)) - R(0.5196152422706632);
-    if (!(g69 > u69 && g69 > R(0.0))) {
+    real u113 = u119;
+    real3 uc113 = uc119;
+    real ut113 = ut119;
+    real g113 = (length(p0 - ((real3)(-R(1.6), R(0.0), -R(1.1)))) * R(0.9999)) - R(0.5196152422706632);
+    if (!(g113 > u113 && g113 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p3 = p0 - ((real3)(-R(1.6), R(0.0), -R(0.75)));
+        real3 p3 = p0 - ((real3)(-R(1.6), R(0.0), -R(1.1)));
         /* .../b:translate/color/round_box */
         real d7 = sd_round_box(p3, (real3)(0.3f), 0.08f);
         /* .../a:union/b:translate/color */
-        real3 c8 = (real3)(0.82941175f, 0.5323529f, 0.37058824f);
-        real d69 = fmin(u73, d7);
-        real3 c69 = u73 < d7 ? uc73 : c8;
-        real t69 = u73 < d7 ? ut73 : R(1.0);
-        u69 = d69;
-        uc69 = c69;
-        ut69 = t69;
+        real3 c8 = (real3)(0.85384613f, 0.50384617f, 0.34615386f);
+        real d113 = fmin(u119, d7);
+        real3 c113 = u119 < d7 ? uc119 : c8;
+        real t113 = u119 < d7 ? ut119 : R(1.0);
+        u113 = d113;
+        uc113 = c113;
+        ut113 = t113;
     }
     /* .../a:union/a:union: the second operand only within reach of its bound */
-    real u65 = u69;
-    real3 uc65 = uc69;
-    real ut65 = ut69;
-    real g65 = (length(p0 - ((real3)(-R(0.8), R(0.0), -R(0.75)))) * R(0.9999)) - R(0.38);
-    if (!(g65 > u65 && g65 > R(0.0))) {
+    real u108 = u113;
+    real3 uc108 = uc113;
+    real ut108 = ut113;
+    real g108 = (length(p0 - ((real3)(-R(0.8), R(0.0), -R(1.1)))) * R(0.9999)) - R(0.38);
+    if (!(g108 > u108 && g108 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p4 = p0 - ((real3)(-R(0.8), R(0.0), -R(0.75)));
+        real3 p4 = p0 - ((real3)(-R(0.8), R(0.0), -R(1.1)));
         /* .../b:translate/color/torus */
         real d11 = sd_torus(p4, 0.28f, 0.1f);
         /* .../a:union/b:translate/color */
-        real3 c12 = (real3)(0.7941176f, 0.5735294f, 0.40588236f);
-        real d65 = fmin(u69, d11);
-        real3 c65 = u69 < d11 ? uc69 : c12;
-        real t65 = u69 < d11 ? ut69 : R(1.0);
-        u65 = d65;
-        uc65 = c65;
-        ut65 = t65;
+        real3 c12 = (real3)(0.83076924f, 0.5307692f, 0.36923078f);
+        real d108 = fmin(u113, d11);
+        real3 c108 = u113 < d11 ? uc113 : c12;
+        real t108 = u113 < d11 ? ut113 : R(1.0);
+        u108 = d108;
+        uc108 = c108;
+        ut108 = t108;
     }
     /* .../a:union/a:union: the second operand only within reach of its bound */
-    real u61 = u65;
-    real3 uc61 = uc65;
-    real ut61 = ut65;
-    real g61 = (length(p0 - ((real3)(R(0.0), R(0.0), -R(0.75)))) * R(0.9999)) - R(0.4301162633521313);
-    if (!(g61 > u61 && g61 > R(0.0))) {
+    real u103 = u108;
+    real3 uc103 = uc108;
+    real ut103 = ut108;
+    real g103 = (length(p0 - ((real3)(R(0.0), R(0.0), -R(1.1)))) * R(0.9999)) - R(0.4301162633521313);
+    if (!(g103 > u103 && g103 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p5 = p0 - ((real3)(R(0.0), R(0.0), -R(0.75)));
+        real3 p5 = p0 - ((real3)(R(0.0), R(0.0), -R(1.1)));
         /* .../b:translate/color/cylinder */
         real d15 = sd_cylinder(p5, 0.25f, 0.35f);
         /* .../a:union/b:translate/color */
-        real3 c16 = (real3)(0.7588235f, 0.61470586f, 0.44117647f);
-        real d61 = fmin(u65, d15);
-        real3 c61 = u65 < d15 ? uc65 : c16;
-        real t61 = u65 < d15 ? ut65 : R(1.0);
-        u61 = d61;
-        uc61 = c61;
-        ut61 = t61;
+        real3 c16 = (real3)(0.8076923f, 0.5576923f, 0.3923077f);
+        real d103 = fmin(u108, d15);
+        real3 c103 = u108 < d15 ? uc108 : c16;
+        real t103 = u108 < d15 ? ut108 : R(1.0);
+        u103 = d103;
+        uc103 = c103;
+        ut103 = t103;
     }
     /* .../a:union/a:union: the second operand only within reach of its bound */
-    real u57 = u61;
-    real3 uc57 = uc61;
-    real ut57 = ut61;
-    real g57 = (length(p0 - ((real3)(R(0.8), R(0.0), -R(0.75)))) * R(0.9999)) - R(0.38);
-    if (!(g57 > u57 && g57 > R(0.0))) {
+    real u98 = u103;
+    real3 uc98 = uc103;
+    real ut98 = ut103;
+    real g98 = (length(p0 - ((real3)(R(0.8), R(0.0), -R(1.1)))) * R(0.9999)) - R(0.38);
+    if (!(g98 > u98 && g98 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p6 = p0 - ((real3)(R(0.8), R(0.0), -R(0.75)));
+        real3 p6 = p0 - ((real3)(R(0.8), R(0.0), -R(1.1)));
         /* .../b:translate/color/capsule */
         real d19 = sd_capsule(p6, (real3)(0.0f, (-0.2f), 0.0f), (real3)(0.0f, 0.2f, 0.0f), 0.18f);
         /* .../a:union/b:translate/color */
-        real3 c20 = (real3)(0.7235294f, 0.65588236f, 0.4764706f);
-        real d57 = fmin(u61, d19);
-        real3 c57 = u61 < d19 ? uc61 : c20;
-        real t57 = u61 < d19 ? ut61 : R(1.0);
-        u57 = d57;
-        uc57 = c57;
-        ut57 = t57;
+        real3 c20 = (real3)(0.7846154f, 0.5846154f, 0.41538462f);
+        real d98 = fmin(u103, d19);
+        real3 c98 = u103 < d19 ? uc103 : c20;
+        real t98 = u103 < d19 ? ut103 : R(1.0);
+        u98 = d98;
+        uc98 = c98;
+        ut98 = t98;
     }
     /* .../a:union/a:union: the second operand only within reach of its bound */
-    real u52 = u57;
-    real3 uc52 = uc57;
-    real ut52 = ut57;
-    real g52 = (length(p0 - ((real3)(R(1.6), R(0.0), -R(0.75)))) * R(0.9999)) - R(0.4);
-    if (!(g52 > u52 && g52 > R(0.0))) {
+    real u93 = u98;
+    real3 uc93 = uc98;
+    real ut93 = ut98;
+    real g93 = (length(p0 - ((real3)(R(1.6), R(0.0), -R(1.1)))) * R(0.9999)) - R(0.4);
+    if (!(g93 > u93 && g93 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p7 = p0 - ((real3)(R(1.6), R(0.0), -R(0.75)));
+        real3 p7 = p0 - ((real3)(R(1.6), R(0.0), -R(1.1)));
         /* .../b:translate/color/octahedron */
         real d23 = sd_octahedron(p7, 0.4f);
         /* .../a:union/b:translate/color */
-        real3 c24 = (real3)(0.6882353f, 0.6970588f, 0.5117647f);
-        real d52 = fmin(u57, d23);
-        real3 c52 = u57 < d23 ? uc57 : c24;
-        real t52 = u57 < d23 ? ut57 : R(1.0);
+        real3 c24 = (real3)(0.76153845f, 0.61153847f, 0.43846154f);
+        real d93 = fmin(u98, d23);
+        real3 c93 = u98 < d23 ? uc98 : c24;
+        real t93 = u98 < d23 ? ut98 : R(1.0);
+        u93 = d93;
+        uc93 = c93;
+        ut93 = t93;
+    }
+    /* .../a:union/a:union: the second operand only within reach of its bound */
+    real u87 = u93;
+    real3 uc87 = uc93;
+    real ut87 = ut93;
+    real g87 = (length(p0 - ((real3)(R(2.4000000000000004), R(0.0), -R(1.1)))) * R(0.9999)) - R(0.4609772228646443);
+    if (!(g87 > u87 && g87 > R(0.0))) {
+        /* .../a:union/a:union/b:translate */
+        real3 p8 = p0 - ((real3)(R(2.4000000000000004), R(0.0), -R(1.1)));
+        /* .../b:translate/color/capped_cone */
+        real d27 = sd_capped_cone(p8, 0.35f, 0.3f, 0.1f);
+        /* .../a:union/b:translate/color */
+        real3 c28 = (real3)(0.73846155f, 0.63846153f, 0.46153846f);
+        real d87 = fmin(u93, d27);
+        real3 c87 = u93 < d27 ? uc93 : c28;
+        real t87 = u93 < d27 ? ut93 : R(1.0);
+        u87 = d87;
+        uc87 = c87;
+        ut87 = t87;
+    }
+    /* .../a:union/a:union: the second operand only within reach of its bound */
+    real u81 = u87;
+    real3 uc81 = uc87;
+    real ut81 = ut87;
+    real g81 = R(0.5714285714285715) * ((length(p0 - ((real3)(R(3.2), R(0.0), -R(1.1)))) * R(0.9999)) - R(0.35));
+    if (!(g81 > u81 && g81 > R(0.0))) {
+        /* .../a:union/a:union/b:translate */
+        real3 p9 = p0 - ((real3)(R(3.2), R(0.0), -R(1.1)));
+        /* .../b:translate/color/ellipsoid */
+        real d31 = sd_ellipsoid(p9, (real3)(0.35f, 0.2f, 0.25f));
+        /* .../a:union/b:translate/color */
+        real3 c32 = (real3)(0.7153846f, 0.6653846f, 0.4846154f);
+        real d81 = fmin(u87, d31);
+        real3 c81 = u87 < d31 ? uc87 : c32;
+        real t81 = u87 < d31 ? ut87 : R(1.0);
+        u81 = d81;
+        uc81 = c81;
+        ut81 = t81;
+    }
+    /* .../a:union/a:union: the second operand only within reach of its bound */
+    real u77 = u81;
+    real3 uc77 = uc81;
+    real ut77 = ut81;
+    real g77 = (length(p0 - ((real3)(-R(3.2), R(0.0), R(0.0)))) * R(0.9999)) - R(0.4410593308539491);
+    if (!(g77 > u77 && g77 > R(0.0))) {
+        /* .../a:union/a:union/b:translate */
+        real3 p10 = p0 - ((real3)(-R(3.2), R(0.0), R(0.0)));
+        /* .../b:translate/color/hex_prism */
+        real d35 = sd_hex_prism(p10, 0.28f, 0.3f);
+        /* .../a:union/b:translate/color */
+        real3 c36 = (real3)(0.6923077f, 0.6923077f, 0.50769234f);
+        real d77 = fmin(u81, d35);
+        real3 c77 = u81 < d35 ? uc81 : c36;
+        real t77 = u81 < d35 ? ut81 : R(1.0);
+        u77 = d77;
+        uc77 = c77;
+        ut77 = t77;
+    }
+    /* .../a:union/a:union: the second operand only within reach of its bound */
+    real u72 = u77;
+    real3 uc72 = uc77;
+    real ut72 = ut77;
+    real g72 = (length(p0 - ((real3)(-R(2.4000000000000004), R(0.0), R(0.0)))) * R(0.9999)) - R(0.44);
+    if (!(g72 > u72 && g72 > R(0.0))) {
+        /* .../a:union/a:union/b:translate */
+        real3 p11 = p0 - ((real3)(-R(2.4000000000000004), R(0.0), R(0.0)));
+        /* .../b:translate/color/round_cone */
+        real d39 = sd_round_cone(p11, 0.22f, 0.22f, 0.1f);
+        /* .../a:union/b:translate/color */
+        real3 c40 = (real3)(0.66923076f, 0.7192308f, 0.5307692f);
+        real d72 = fmin(u77, d39);
+        real3 c72 = u77 < d39 ? uc77 : c40;
+        real t72 = u77 < d39 ? ut77 : R(1.0);
+        u72 = d72;
+        uc72 = c72;
+        ut72 = t72;
+    }
+    /* .../a:union/a:union: the second operand only within reach of its bound */
+    real u68 = u72;
+    real3 uc68 = uc72;
+    real ut68 = ut72;
+    real g68 = (length(p0 - ((real3)(-R(1.6), R(0.0), R(0.0)))) * R(0.9999)) - R(0.41000000000000003);
+    if (!(g68 > u68 && g68 > R(0.0))) {
+        /* .../a:union/a:union/b:translate */
+        real3 p12 = p0 - ((real3)(-R(1.6), R(0.0), R(0.0)));
+        /* .../b:translate/color/rotate */
+        real3 p13 = (real3)((R(0.8775825618903728) * p12.x) - (R(0.479425538604203) * p12.z), p12.y, (R(0.479425538604203) * p12.x) + (R(0.8775825618903728) * p12.z));
+        /* .../color/rotate/link */
+        real d43 = sd_link(p13, 0.14f, 0.2f, 0.07f);
+        /* .../a:union/b:translate/color */
+        real3 c45 = (real3)(0.64615387f, 0.74615383f, 0.5538462f);
+        real d68 = fmin(u72, d43);
+        real3 c68 = u72 < d43 ? uc72 : c45;
+        real t68 = u72 < d43 ? ut72 : R(1.0);
+        u68 = d68;
+        uc68 = c68;
+        ut68 = t68;
+    }
+    /* .../a:union/a:union: the second operand only within reach of its bound */
+    real u64 = u68;
+    real3 uc64 = uc68;
+    real ut64 = ut68;
+    real g64 = (length(p0 - ((real3)(-R(0.8), R(0.05), R(0.0)))) * R(0.9999)) - R(0.35);
+    if (!(g64 > u64 && g64 > R(0.0))) {
+        /* .../a:union/a:union/b:translate */
+        real3 p14 = p0 - ((real3)(-R(0.8), R(0.0), R(0.0)));
+        /* .../b:translate/color/translate */
+        real3 p15 = p14 - ((real3)(R(0.0), R(0.05), R(0.0)));
+        /* .../color/translate/cut_sphere */
+        real d48 = sd_cut_sphere(p15, 0.35f, 0.15f);
+        /* .../a:union/b:translate/color */
+        real3 c50 = (real3)(0.6230769f, 0.77307695f, 0.5769231f);
+        real d64 = fmin(u68, d48);
+        real3 c64 = u68 < d48 ? uc68 : c50;
+        real t64 = u68 < d48 ? ut68 : R(1.0);
+        u64 = d64;
+        uc64 = c64;
+        ut64 = t64;
+    }
+    /* .../a:union/a:union: the second operand only within reach of its bound */
+    real u60 = u64;
+    real3 uc60 = uc64;
+    real ut60 = ut64;
+    real g60 = (length(p0 - ((real3)(R(0.0), -R(0.3), R(0.0)))) * R(0.9999)) - R(0.45);
+    if (!(g60 > u60 && g60 > R(0.0))) {
+        /* .../a:union/b:translate/translate */
+        real3 p16 = p0 - ((real3)(R(0.0), -R(0.3), R(0.0)));
+        /* .../b:translate/translate/solid_angle */
+        real d53 = sd_solid_angle(p16, 0.6f, 0.45f);
+        /* .../a:union/a:union/b:translate */
+        real3 c55 = (real3)(0.6f, 0.8f, 0.6f);
+        real d60 = fmin(u64, d53);
+        real3 c60 = u64 < d53 ? uc64 : c55;
+        real t60 = u64 < d53 ? ut64 : R(1.0);
+        u60 = d60;
+        uc60 = c60;
+        ut60 = t60;
+    }
+    /* .../a:union/a:union: the second operand only within reach of its bound */
+    real u56 = u60;
+    real3 uc56 = uc60;
+    real ut56 = ut60;
+    real g56 = (length(p0 - ((real3)(R(0.8), R(0.0), R(0.0)))) * R(0.9999)) - R(0.32);
+    if (!(g56 > u56 && g56 > R(0.0))) {
+        /* .../a:union/a:union/b:translate */
+        real3 p17 = p0 - ((real3)(R(0.8), R(0.0), R(0.0)));
+        /* .../b:translate/color/capped_torus */
+        real d57 = sd_capped_torus(p17, 2.2f, 0.25f, 0.07f);
+        /* .../a:union/b:translate/color */
+        real3 c58 = (real3)(0.5769231f, 0.77307695f, 0.6230769f);
+        real d56 = fmin(u60, d57);
+        real3 c56 = u60 < d57 ? uc60 : c58;
+        real t56 = u60 < d57 ? ut60 : R(1.0);
+        u56 = d56;
+        uc56 = c56;
+        ut56 = t56;
+    }
+    /* .../a:union/a:union: the second operand only within reach of its bound */
+    real u52 = u56;
+    real3 uc52 = uc56;
+    real ut52 = ut56;
+    real g52 = (length(p0 - ((real3)(R(1.5750000000000002), -R(0.024999999999999994), R(0.0)))) * R(0.9999)) - R(0.34734708865916814);
+    if (!(g52 > u52 && g52 > R(0.0))) {
+        /* .../a:union/a:union/b:translate */
+        real3 p18 = p0 - ((real3)(R(1.6), R(0.0), R(0.0)));
+        /* .../b:translate/color/cylinder_between */
+        real d61 = sd_cylinder_between(p18, (real3)((-0.2f), (-0.3f), 0.0f), (real3)(0.15f, 0.25f, 0.0f), 0.12f);
+        /* .../a:union/b:translate/color */
+        real3 c62 = (real3)(0.5538462f, 0.74615383f, 0.64615387f);
+        real d52 = fmin(u56, d61);
+        real3 c52 = u56 < d61 ? uc56 : c62;
+        real t52 = u56 < d61 ? ut56 : R(1.0);
         u52 = d52;
         uc52 = c52;
         ut52 = t52;
@@ -644,17 +1146,17 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     real u47 = u52;
     real3 uc47 = uc52;
     real ut47 = ut52;
-    real g47 = (length(p0 - ((real3)(R(2.4000000000000004), R(0.0), -R(0.75)))) * R(0.9999)) - R(0.4609772228646443);
+    real g47 = (length(p0 - ((real3)(R(2.4250000000000003), R(0.024999999999999994), R(0.0)))) * R(0.9999)) - R(0.3932556420447137);
     if (!(g47 > u47 && g47 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p8 = p0 - ((real3)(R(2.4000000000000004), R(0.0), -R(0.75)));
-        /* .../b:translate/color/capped_cone */
-        real d27 = sd_capped_cone(p8, 0.35f, 0.3f, 0.1f);
+        real3 p19 = p0 - ((real3)(R(2.4000000000000004), R(0.0), R(0.0)));
+        /* .../b:translate/color/cone_between */
+        real d65 = sd_cone_between(p19, (real3)(0.2f, (-0.25f), 0.0f), (real3)((-0.15f), 0.3f, 0.0f), 0.22f, 0.05f);
         /* .../a:union/b:translate/color */
-        real3 c28 = (real3)(0.65294117f, 0.7382353f, 0.5470588f);
-        real d47 = fmin(u52, d27);
-        real3 c47 = u52 < d27 ? uc52 : c28;
-        real t47 = u52 < d27 ? ut52 : R(1.0);
+        real3 c66 = (real3)(0.5307692f, 0.7192308f, 0.66923076f);
+        real d47 = fmin(u52, d65);
+        real3 c47 = u52 < d65 ? uc52 : c66;
+        real t47 = u52 < d65 ? ut52 : R(1.0);
         u47 = d47;
         uc47 = c47;
         ut47 = t47;
@@ -663,17 +1165,17 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     real u42 = u47;
     real3 uc42 = uc47;
     real ut42 = ut47;
-    real g42 = R(0.5714285714285715) * ((length(p0 - ((real3)(R(3.2), R(0.0), -R(0.75)))) * R(0.9999)) - R(0.35));
+    real g42 = (length(p0 - ((real3)(R(3.225), R(0.024999999999999994), R(0.0)))) * R(0.9999)) - R(0.4450438562747845);
     if (!(g42 > u42 && g42 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p9 = p0 - ((real3)(R(3.2), R(0.0), -R(0.75)));
-        /* .../b:translate/color/ellipsoid */
-        real d31 = sd_ellipsoid(p9, (real3)(0.35f, 0.2f, 0.25f));
+        real3 p20 = p0 - ((real3)(R(3.2), R(0.0), R(0.0)));
+        /* .../b:translate/color/round_cone_between */
+        real d69 = sd_round_cone_between(p20, (real3)((-0.15f), (-0.2f), 0.0f), (real3)(0.2f, 0.25f, 0.0f), 0.16f, 0.07f);
         /* .../a:union/b:translate/color */
-        real3 c32 = (real3)(0.61764705f, 0.7794118f, 0.58235294f);
-        real d42 = fmin(u47, d31);
-        real3 c42 = u47 < d31 ? uc47 : c32;
-        real t42 = u47 < d31 ? ut47 : R(1.0);
+        real3 c70 = (real3)(0.50769234f, 0.6923077f, 0.6923077f);
+        real d42 = fmin(u47, d69);
+        real3 c42 = u47 < d69 ? uc47 : c70;
+        real t42 = u47 < d69 ? ut47 : R(1.0);
         u42 = d42;
         uc42 = c42;
         ut42 = t42;
@@ -682,17 +1184,19 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     real u38 = u42;
     real3 uc38 = uc42;
     real ut38 = ut42;
-    real g38 = (length(p0 - ((real3)(-R(3.2), R(0.0), R(0.75)))) * R(0.9999)) - R(0.4410593308539491);
+    real g38 = (length(p0 - ((real3)(-R(3.2), -R(0.13333333333333333), R(1.1)))) * R(0.9999)) - R(0.4633333333333334);
     if (!(g38 > u38 && g38 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p10 = p0 - ((real3)(-R(3.2), R(0.0), R(0.75)));
-        /* .../b:translate/color/hex_prism */
-        real d35 = sd_hex_prism(p10, 0.28f, 0.3f);
+        real3 p21 = p0 - ((real3)(-R(3.2), R(0.0), R(1.1)));
+        /* .../b:translate/color/rotate */
+        real3 p22 = (real3)((R(0.9210609940028851) * p21.x) - (R(0.3894183423086505) * p21.z), p21.y, (R(0.3894183423086505) * p21.x) + (R(0.9210609940028851) * p21.z));
+        /* .../color/rotate/triangle */
+        real d73 = sd_triangle(p22, (real3)((-0.3f), (-0.35f), 0.0f), (real3)(0.3f, (-0.35f), 0.0f), (real3)(0.0f, 0.3f, 0.0f), 0.03f);
         /* .../a:union/b:translate/color */
-        real3 c36 = (real3)(0.58235294f, 0.7794118f, 0.61764705f);
-        real d38 = fmin(u42, d35);
-        real3 c38 = u42 < d35 ? uc42 : c36;
-        real t38 = u42 < d35 ? ut42 : R(1.0);
+        real3 c75 = (real3)(0.4846154f, 0.6653846f, 0.7153846f);
+        real d38 = fmin(u42, d73);
+        real3 c38 = u42 < d73 ? uc42 : c75;
+        real t38 = u42 < d73 ? ut42 : R(1.0);
         u38 = d38;
         uc38 = c38;
         ut38 = t38;
@@ -701,17 +1205,17 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     real u34 = u38;
     real3 uc34 = uc38;
     real ut34 = ut38;
-    real g34 = (length(p0 - ((real3)(-R(2.4000000000000004), R(0.0), R(0.75)))) * R(0.9999)) - R(0.44);
+    real g34 = (length(p0 - ((real3)(-R(2.4000000000000004), -R(0.024999999999999994), R(1.09)))) * R(0.9999)) - R(0.47286002303210883);
     if (!(g34 > u34 && g34 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p11 = p0 - ((real3)(-R(2.4000000000000004), R(0.0), R(0.75)));
-        /* .../b:translate/color/round_cone */
-        real d39 = sd_round_cone(p11, 0.22f, 0.22f, 0.1f);
+        real3 p23 = p0 - ((real3)(-R(2.4000000000000004), R(0.0), R(1.1)));
+        /* .../b:translate/color/quad */
+        real d78 = sd_quad(p23, (real3)((-0.28f), (-0.35f), (-0.12f)), (real3)(0.28f, (-0.35f), (-0.12f)), (real3)(0.2f, 0.3f, 0.1f), (real3)((-0.2f), 0.3f, 0.1f), 0.03f);
         /* .../a:union/b:translate/color */
-        real3 c40 = (real3)(0.5470588f, 0.7382353f, 0.65294117f);
-        real d34 = fmin(u38, d39);
-        real3 c34 = u38 < d39 ? uc38 : c40;
-        real t34 = u38 < d39 ? ut38 : R(1.0);
+        real3 c79 = (real3)(0.46153846f, 0.63846153f, 0.73846155f);
+        real d34 = fmin(u38, d78);
+        real3 c34 = u38 < d78 ? uc38 : c79;
+        real t34 = u38 < d78 ? ut38 : R(1.0);
         u34 = d34;
         uc34 = c34;
         ut34 = t34;
@@ -720,19 +1224,21 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     real u30 = u34;
     real3 uc30 = uc34;
     real ut30 = ut34;
-    real g30 = (length(p0 - ((real3)(-R(1.6), R(0.0), R(0.75)))) * R(0.9999)) - R(0.41000000000000003);
+    real g30 = (length(p0 - ((real3)(-R(1.6), -R(0.4), R(1.1)))) * R(0.9999)) - R(0.55);
     if (!(g30 > u30 && g30 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p12 = p0 - ((real3)(-R(1.6), R(0.0), R(0.75)));
-        /* .../b:translate/color/rotate */
-        real3 p13 = (real3)((R(0.8775825618903728) * p12.x) - (R(0.479425538604203) * p12.z), p12.y, (R(0.479425538604203) * p12.x) + (R(0.8775825618903728) * p12.z));
-        /* .../color/rotate/link */
-        real d43 = sd_link(p13, 0.14f, 0.2f, 0.07f);
+        real3 p24 = p0 - ((real3)(-R(1.6), R(0.0), R(1.1)));
+        /* .../b:translate/color/translate */
+        real3 p25 = p24 - ((real3)(R(0.0), -R(0.4), R(0.0)));
+        /* .../color/translate/rotate */
+        real3 p26 = (real3)((R(0.8775825618903728) * p25.x) - (R(0.479425538604203) * p25.z), p25.y, (R(0.479425538604203) * p25.x) + (R(0.8775825618903728) * p25.z));
+        /* .../translate/rotate/pyramid */
+        real d82 = sd_pyramid(p26, 0.3f, 0.55f);
         /* .../a:union/b:translate/color */
-        real3 c45 = (real3)(0.5117647f, 0.6970588f, 0.6882353f);
-        real d30 = fmin(u34, d43);
-        real3 c30 = u34 < d43 ? uc34 : c45;
-        real t30 = u34 < d43 ? ut34 : R(1.0);
+        real3 c85 = (real3)(0.43846154f, 0.61153847f, 0.76153845f);
+        real d30 = fmin(u34, d82);
+        real3 c30 = u34 < d82 ? uc34 : c85;
+        real t30 = u34 < d82 ? ut34 : R(1.0);
         u30 = d30;
         uc30 = c30;
         ut30 = t30;
@@ -741,19 +1247,21 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     real u26 = u30;
     real3 uc26 = uc30;
     real ut26 = ut30;
-    real g26 = (length(p0 - ((real3)(-R(0.8), R(0.05), R(0.75)))) * R(0.9999)) - R(0.35);
+    real g26 = (length(p0 - ((real3)(-R(0.8), -R(0.34), R(1.1)))) * R(0.9999)) - R(0.4044749683231337);
     if (!(g26 > u26 && g26 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p14 = p0 - ((real3)(-R(0.8), R(0.0), R(0.75)));
+        real3 p27 = p0 - ((real3)(-R(0.8), R(0.0), R(1.1)));
         /* .../b:translate/color/translate */
-        real3 p15 = p14 - ((real3)(R(0.0), R(0.05), R(0.0)));
-        /* .../color/translate/cut_sphere */
-        real d48 = sd_cut_sphere(p15, 0.35f, 0.15f);
+        real3 p28 = p27 - ((real3)(R(0.0), -R(0.34), R(0.0)));
+        /* .../color/translate/rotate */
+        real3 p29 = (real3)((R(0.8253356149096783) * p28.x) - (R(0.5646424733950354) * p28.z), p28.y, (R(0.5646424733950354) * p28.x) + (R(0.8253356149096783) * p28.z));
+        /* .../translate/rotate/rhombus */
+        real d88 = sd_rhombus(p29, 0.36f, 0.22f, 0.06f, 0.04f);
         /* .../a:union/b:translate/color */
-        real3 c50 = (real3)(0.4764706f, 0.65588236f, 0.7235294f);
-        real d26 = fmin(u30, d48);
-        real3 c26 = u30 < d48 ? uc30 : c50;
-        real t26 = u30 < d48 ? ut30 : R(1.0);
+        real3 c91 = (real3)(0.41538462f, 0.5846154f, 0.7846154f);
+        real d26 = fmin(u30, d88);
+        real3 c26 = u30 < d88 ? uc30 : c91;
+        real t26 = u30 < d88 ? ut30 : R(1.0);
         u26 = d26;
         uc26 = c26;
         ut26 = t26;
@@ -762,19 +1270,19 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     real u22 = u26;
     real3 uc22 = uc26;
     real ut22 = ut26;
-    real g22 = (length(p0 - ((real3)(R(0.0), -R(0.3), R(0.75)))) * R(0.9999)) - R(0.45);
+    real g22 = (length(p0 - ((real3)(R(0.0), -R(0.1), R(1.1)))) * R(0.9999)) - R(0.45343136195018535);
     if (!(g22 > u22 && g22 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p16 = p0 - ((real3)(R(0.0), R(0.0), R(0.75)));
+        real3 p30 = p0 - ((real3)(R(0.0), R(0.0), R(1.1)));
         /* .../b:translate/color/translate */
-        real3 p17 = p16 - ((real3)(R(0.0), -R(0.3), R(0.0)));
-        /* .../color/translate/solid_angle */
-        real d53 = sd_solid_angle(p17, 0.6f, 0.45f);
+        real3 p31 = p30 - ((real3)(R(0.0), -R(0.1), R(0.0)));
+        /* .../color/translate/tri_prism */
+        real d94 = sd_tri_prism(p31, 0.17f, 0.3f);
         /* .../a:union/b:translate/color */
-        real3 c55 = (real3)(0.44117647f, 0.61470586f, 0.7588235f);
-        real d22 = fmin(u26, d53);
-        real3 c22 = u26 < d53 ? uc26 : c55;
-        real t22 = u26 < d53 ? ut26 : R(1.0);
+        real3 c96 = (real3)(0.3923077f, 0.5576923f, 0.8076923f);
+        real d22 = fmin(u26, d94);
+        real3 c22 = u26 < d94 ? uc26 : c96;
+        real t22 = u26 < d94 ? ut26 : R(1.0);
         u22 = d22;
         uc22 = c22;
         ut22 = t22;
@@ -783,17 +1291,19 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     real u18 = u22;
     real3 uc18 = uc22;
     real ut18 = ut22;
-    real g18 = (length(p0 - ((real3)(R(0.8), R(0.0), R(0.75)))) * R(0.9999)) - R(0.32);
+    real g18 = (length(p0 - ((real3)(R(0.8), -R(0.2), R(1.1)))) * R(0.9999)) - R(0.3440930106817051);
     if (!(g18 > u18 && g18 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p18 = p0 - ((real3)(R(0.8), R(0.0), R(0.75)));
-        /* .../b:translate/color/capped_torus */
-        real d58 = sd_capped_torus(p18, 2.2f, 0.25f, 0.07f);
+        real3 p32 = p0 - ((real3)(R(0.8), R(0.0), R(1.1)));
+        /* .../b:translate/color/translate */
+        real3 p33 = p32 - ((real3)(R(0.0), -R(0.2), R(0.0)));
+        /* .../color/translate/rounded_cylinder */
+        real d99 = sd_rounded_cylinder(p33, 0.28f, 0.2f, 0.08f);
         /* .../a:union/b:translate/color */
-        real3 c59 = (real3)(0.40588236f, 0.5735294f, 0.7941176f);
-        real d18 = fmin(u22, d58);
-        real3 c18 = u22 < d58 ? uc22 : c59;
-        real t18 = u22 < d58 ? ut22 : R(1.0);
+        real3 c101 = (real3)(0.36923078f, 0.5307692f, 0.83076924f);
+        real d18 = fmin(u22, d99);
+        real3 c18 = u22 < d99 ? uc22 : c101;
+        real t18 = u22 < d99 ? ut22 : R(1.0);
         u18 = d18;
         uc18 = c18;
         ut18 = t18;
@@ -802,17 +1312,19 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     real u14 = u18;
     real3 uc14 = uc18;
     real ut14 = ut18;
-    real g14 = (length(p0 - ((real3)(R(1.5750000000000002), -R(0.024999999999999994), R(0.75)))) * R(0.9999)) - R(0.34734708865916814);
+    real g14 = (length(p0 - ((real3)(R(1.6), -R(0.09999999999999998), R(1.1)))) * R(0.9999)) - R(0.41036569057366384);
     if (!(g14 > u14 && g14 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p19 = p0 - ((real3)(R(1.6), R(0.0), R(0.75)));
-        /* .../b:translate/color/cylinder_between */
-        real d62 = sd_cylinder_between(p19, (real3)((-0.2f), (-0.3f), 0.0f), (real3)(0.15f, 0.25f, 0.0f), 0.12f);
+        real3 p34 = p0 - ((real3)(R(1.6), R(0.0), R(1.1)));
+        /* .../b:translate/color/translate */
+        real3 p35 = p34 - ((real3)(R(0.0), R(0.2), R(0.0)));
+        /* .../color/translate/cone */
+        real d104 = sd_cone(p35, 0.28f, 0.6f);
         /* .../a:union/b:translate/color */
-        real3 c63 = (real3)(0.37058824f, 0.5323529f, 0.82941175f);
-        real d14 = fmin(u18, d62);
-        real3 c14 = u18 < d62 ? uc18 : c63;
-        real t14 = u18 < d62 ? ut18 : R(1.0);
+        real3 c106 = (real3)(0.34615386f, 0.50384617f, 0.85384613f);
+        real d14 = fmin(u18, d104);
+        real3 c14 = u18 < d104 ? uc18 : c106;
+        real t14 = u18 < d104 ? ut18 : R(1.0);
         u14 = d14;
         uc14 = c14;
         ut14 = t14;
@@ -821,17 +1333,19 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     real u10 = u14;
     real3 uc10 = uc14;
     real ut10 = ut14;
-    real g10 = (length(p0 - ((real3)(R(2.4250000000000003), R(0.024999999999999994), R(0.75)))) * R(0.9999)) - R(0.3932556420447137);
+    real g10 = (length(p0 - ((real3)(R(2.4000000000000004), -R(0.06), R(1.1)))) * R(0.9999)) - R(0.34);
     if (!(g10 > u10 && g10 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p20 = p0 - ((real3)(R(2.4000000000000004), R(0.0), R(0.75)));
-        /* .../b:translate/color/cone_between */
-        real d66 = sd_cone_between(p20, (real3)(0.2f, (-0.25f), 0.0f), (real3)((-0.15f), 0.3f, 0.0f), 0.22f, 0.05f);
+        real3 p36 = p0 - ((real3)(R(2.4000000000000004), R(0.0), R(1.1)));
+        /* .../b:translate/color/translate */
+        real3 p37 = p36 - ((real3)(R(0.0), -R(0.06), R(0.0)));
+        /* .../color/translate/cut_hollow_sphere */
+        real d109 = sd_cut_hollow_sphere(p37, 0.32f, 0.12f, 0.02f);
         /* .../a:union/b:translate/color */
-        real3 c67 = (real3)(0.33529413f, 0.49117646f, 0.86470586f);
-        real d10 = fmin(u14, d66);
-        real3 c10 = u14 < d66 ? uc14 : c67;
-        real t10 = u14 < d66 ? ut14 : R(1.0);
+        real3 c111 = (real3)(0.32307693f, 0.47692308f, 0.8769231f);
+        real d10 = fmin(u14, d109);
+        real3 c10 = u14 < d109 ? uc14 : c111;
+        real t10 = u14 < d109 ? ut14 : R(1.0);
         u10 = d10;
         uc10 = c10;
         ut10 = t10;
@@ -840,17 +1354,21 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     real u6 = u10;
     real3 uc6 = uc10;
     real ut6 = ut10;
-    real g6 = (length(p0 - ((real3)(R(3.225), R(0.024999999999999994), R(0.75)))) * R(0.9999)) - R(0.4450438562747845);
+    real g6 = (length(p0 - ((real3)(R(3.2), -R(0.08), R(1.1)))) * R(0.9999)) - R(0.32);
     if (!(g6 > u6 && g6 > R(0.0))) {
         /* union/a:union/b:translate */
-        real3 p21 = p0 - ((real3)(R(3.2), R(0.0), R(0.75)));
-        /* .../b:translate/color/round_cone_between */
-        real d70 = sd_round_cone_between(p21, (real3)((-0.15f), (-0.2f), 0.0f), (real3)(0.2f, 0.25f, 0.0f), 0.16f, 0.07f);
+        real3 p38 = p0 - ((real3)(R(3.2), R(0.0), R(1.1)));
+        /* .../b:translate/color/translate */
+        real3 p39 = p38 - ((real3)(R(0.0), -R(0.08), R(0.0)));
+        /* .../color/translate/rotate */
+        real3 p40 = (real3)(p39.z, p39.y, -p39.x);
+        /* .../translate/rotate/death_star */
+        real d114 = sd_death_star(p40, 0.32f, 0.25f, 0.3f);
         /* .../a:union/b:translate/color */
-        real3 c71 = (real3)(0.3f, 0.45f, 0.9f);
-        real d6 = fmin(u10, d70);
-        real3 c6 = u10 < d70 ? uc10 : c71;
-        real t6 = u10 < d70 ? ut10 : R(1.0);
+        real3 c117 = (real3)(0.3f, 0.45f, 0.9f);
+        real d6 = fmin(u10, d114);
+        real3 c6 = u10 < d114 ? uc10 : c117;
+        real t6 = u10 < d114 ? ut10 : R(1.0);
         u6 = d6;
         uc6 = c6;
         ut6 = t6;

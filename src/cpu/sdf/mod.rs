@@ -24,9 +24,14 @@ use crate::scene::{CsgOp, KifsFold};
 
 mod hybrid;
 mod profile;
+mod shapes;
 mod trap;
 
 pub use profile::{extrude, profile, revolve};
+pub use shapes::{
+    cone, cut_hollow_sphere, death_star, infinite_cone, infinite_cylinder, pyramid, quad, rhombus,
+    rounded_cylinder, tri_prism, triangle, triangle_unsigned,
+};
 
 pub use trap::TrapShape;
 pub(crate) use trap::TrapSlot;

@@ -74,9 +74,14 @@ fn polygon<T: Num>(x: T, y: T, v: &[[T; 2]]) -> T {
 /// `±half_height`.
 #[must_use]
 pub fn extrude<T: Num>(p: V3<T>, profile: &Profile<T>, half_height: T) -> T {
+    extrusion(self::profile(p.x, p.y, profile), p.z, half_height)
+}
+
+/// The extrusion of a plane shape whose signed distance at the point is
+/// `d` between `±half_height` along the axis the point is `z` along.
+pub(crate) fn extrusion<T: Num>(d: T, z: T, half_height: T) -> T {
     let zero = T::zero();
-    let d = self::profile(p.x, p.y, profile);
-    let h = p.z.abs() - half_height;
+    let h = z.abs() - half_height;
     d.max(h).min(zero) + d.max(zero).hypot(h.max(zero))
 }
 
