@@ -43,7 +43,9 @@ fn polygon<T: Num>(x: T, y: T, v: &[[T; 2]]) -> T {
     let Some(last) = v.last() else {
         return T::of(f64::INFINITY);
     };
-    let mut nearest = (x - last[0]).hypot(y - last[1]);
+    // The smallest squared distance, with one square root at the end.
+    let (lx, ly) = (x - last[0], y - last[1]);
+    let mut nearest = lx * lx + ly * ly;
     let mut inside: Option<T::Bool> = None;
     let mut j = v.len() - 1;
     for (i, vi) in v.iter().enumerate() {
@@ -53,7 +55,8 @@ fn polygon<T: Num>(x: T, y: T, v: &[[T; 2]]) -> T {
         let h = ((wx * ex + wy * ey) / (ex * ex + ey * ey).max(T::tiny()))
             .max(T::zero())
             .min(T::one());
-        nearest = nearest.min((wx - ex * h).hypot(wy - ey * h));
+        let (dx, dy) = (wx - ex * h, wy - ey * h);
+        nearest = nearest.min(dx * dx + dy * dy);
         // The edge crosses the point's height, the point left of it going
         // up or right of it going down: the ray crosses it.
         let (up, down, left) = (y.ge(vi[1]), y.lt(vj[1]), (ey * wx).lt(ex * wy));
@@ -64,6 +67,7 @@ fn polygon<T: Num>(x: T, y: T, v: &[[T; 2]]) -> T {
         });
         j = i;
     }
+    let nearest = nearest.sqrt();
     match inside {
         Some(inside) => T::select(inside, -nearest, nearest),
         None => nearest,
