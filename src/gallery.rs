@@ -451,8 +451,8 @@ pub fn orbit_traps() -> Scene {
 }
 
 /// Solids made from plane profiles ([`extrude`], [`revolve`]): a star and
-/// an arrow extruded, a goblet, a lampshade and a ring of rounded-square
-/// section revolved.
+/// an arrow extruded, a goblet, a lampshade, a ring of rounded-square
+/// section and a spheroid (an ellipse) revolved.
 #[must_use]
 pub fn profiles() -> Scene {
     let star = extrude(
@@ -504,11 +504,14 @@ pub fn profiles() -> Scene {
     )
     .color(dvec3(0.4, 0.8, 0.45))
     .rotate(DVec3::X, -FRAC_PI_2)
-    .translate(dvec3(0.05, -0.4, 0.45));
-    let all = [star, goblet, shade, ring, arrow]
+    .translate(dvec3(0.5, -0.4, 0.5));
+    let spheroid = revolve(Profile::ellipse(0.2, 0.32), 0.0)
+        .color(dvec3(0.85, 0.55, 0.85))
+        .translate(dvec3(-0.6, -0.13, 0.6));
+    let all = [star, goblet, shade, ring, arrow, spheroid]
         .into_iter()
         .reduce(Node::union)
-        .expect("five solids");
+        .expect("six solids");
     Scene::new(all.union(floor(0.45)))
         .with_camera(Camera::look_at(dvec3(0.0, 1.2, 3.0), dvec3(0.0, -0.2, -0.1)).fov(48.0))
         .with_lights(key_and_fill())

@@ -59,6 +59,7 @@ pub(super) const NAMES: &[&str] = &[
     "Rect",
     "RoundRect",
     "Segment",
+    "Ellipse",
     "Polygon",
     "Ellipsoid",
     "Mandelbulb",

@@ -1,4 +1,5 @@
-//! Plane shapes: the cross-sections that [`extrude`](super::extrude) and
+//! Plane shapes (circle, rectangle, rounded rectangle, stadium, ellipse,
+//! polygon): the cross-sections that [`extrude`](super::extrude) and
 //! [`revolve`](super::revolve) sweep into solids.
 
 use super::param::Param;
@@ -52,6 +53,11 @@ pub enum Profile<S = Param> {
         /// Radius, greater than 0.
         radius: S,
     },
+    /// An axis-aligned ellipse about the origin.
+    Ellipse {
+        /// The semi-axes along x and y, each greater than 0.
+        radii: [S; 2],
+    },
     /// A closed polygon through `vertices`, in order (either winding), of 3
     /// to [`MAX_PROFILE_VERTICES`] vertices. Where its edges cross, a point
     /// is inside when a ray from it crosses the edges an odd number of
@@ -103,6 +109,14 @@ impl Profile {
         }
     }
 
+    /// The ellipse of semi-axes `a` along x and `b` along y.
+    #[must_use]
+    pub fn ellipse(a: impl Into<Param>, b: impl Into<Param>) -> Self {
+        Profile::Ellipse {
+            radii: [a.into(), b.into()],
+        }
+    }
+
     /// The polygon through `vertices`, in order.
     #[must_use]
     pub fn polygon(vertices: impl IntoIterator<Item = [f64; 2]>) -> Self {
@@ -139,6 +153,9 @@ impl<S> Profile<S> {
                 b: two(f, b, "profile.b", Finite)?,
                 radius: f(radius, spec("profile.radius", Positive))?,
             },
+            Profile::Ellipse { radii } => Profile::Ellipse {
+                radii: two(f, radii, "profile.radii", Positive)?,
+            },
             Profile::Polygon { vertices } => Profile::Polygon {
                 vertices: vertices
                     .iter()
@@ -168,6 +185,7 @@ impl Profile<f64> {
                 length(half_extents)
             }
             Profile::Segment { a, b, radius } => length(a).max(length(b)) + radius,
+            Profile::Ellipse { radii } => radii[0].max(radii[1]),
             Profile::Polygon { vertices } => vertices.iter().map(length).fold(0.0, f64::max),
         }
     }

@@ -458,7 +458,7 @@ pub fn round_cone_between_node() -> impl Strategy<Value = Node> + Clone {
 }
 
 /// A plane profile's values: a disc, a rectangle, a rounded rectangle, a
-/// segment's stadium, or a polygon of 3 to 12 corners in either winding,
+/// segment's stadium, an ellipse (sometimes a circle), or a polygon of 3 to 12 corners in either winding,
 /// star-shaped about a point near the origin (so its edges never cross),
 /// sometimes with a corner repeated (an edge of length 0).
 fn profile_values() -> impl Strategy<Value = Profile<f64>> + Clone {
@@ -503,6 +503,11 @@ fn profile_values() -> impl Strategy<Value = Profile<f64>> + Clone {
             b,
             radius
         }),
+        1 => prop_oneof![
+            3 => (0.05..=1.0f64, 0.05..=1.0f64).prop_map(|(a, b)| [a, b]),
+            1 => (0.05..=1.0f64).prop_map(|a| [a, a]),
+        ]
+        .prop_map(|radii| Profile::Ellipse { radii }),
         3 => polygon,
     ]
 }
@@ -561,6 +566,7 @@ fn profile_left(profile: &Profile<f64>) -> f64 {
         Profile::Polygon { vertices } => {
             vertices.iter().map(|v| v[0]).fold(f64::INFINITY, f64::min)
         }
+        Profile::Ellipse { radii } => -radii[0],
     }
 }
 

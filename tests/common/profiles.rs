@@ -32,6 +32,7 @@ fn values(profile: &Profile) -> Profile<f64> {
         Profile::Polygon { vertices } => Profile::Polygon {
             vertices: vertices.iter().map(two).collect(),
         },
+        Profile::Ellipse { radii } => Profile::Ellipse { radii: two(radii) },
         _ => panic!("a profile the oracle does not know"),
     }
 }
@@ -124,6 +125,10 @@ fn boundary(profile: &Profile<f64>, q: DVec2) -> (f64, bool) {
             let d = edge(q, DVec2::from(*a), DVec2::from(*b));
             ((d - radius).abs(), d <= *radius)
         }
+        Profile::Ellipse { radii: [a, b] } => {
+            let inside = (q.x / a).powi(2) + (q.y / b).powi(2) <= 1.0;
+            (ellipse_boundary(q, *a, *b), inside)
+        }
         Profile::Polygon { vertices } => {
             let v: Vec<DVec2> = vertices.iter().copied().map(DVec2::from).collect();
             let n = v.len();
@@ -134,6 +139,39 @@ fn boundary(profile: &Profile<f64>, q: DVec2) -> (f64, bool) {
         }
         _ => unreachable!(),
     }
+}
+
+/// The distance from `q` to the ellipse `(a cos u, b sin u)`: the smallest
+/// over its parameter (see [`minimise_over_turn`]).
+fn ellipse_boundary(q: DVec2, a: f64, b: f64) -> f64 {
+    // A point's distance along an ellipse has at most two valleys, each
+    // wider than a grid step of 3 degrees.
+    minimise_over_turn(120, |u| q.distance(DVec2::new(a * u.cos(), b * u.sin())))
+}
+
+/// The smallest value of `f` over a turn: a grid of `points`, then golden
+/// sections within a grid step of its best three points.
+fn minimise_over_turn(points: usize, f: impl Fn(f64) -> f64) -> f64 {
+    let step = std::f64::consts::TAU / points as f64;
+    let mut grid: Vec<(f64, f64)> = (0..points)
+        .map(|i| (f(i as f64 * step), i as f64 * step))
+        .collect();
+    grid.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let ratio = (5f64.sqrt() - 1.0) / 2.0;
+    let mut best = grid[0].0;
+    for &(_, u) in &grid[..3] {
+        let (mut lo, mut hi) = (u - step, u + step);
+        for _ in 0..64 {
+            let (x1, x2) = (hi - ratio * (hi - lo), lo + ratio * (hi - lo));
+            if f(x1) <= f(x2) {
+                hi = x2;
+            } else {
+                lo = x1;
+            }
+        }
+        best = best.min(f(0.5 * (lo + hi)));
+    }
+    best
 }
 
 /// The signed distance from `q` to the profile.
@@ -164,9 +202,8 @@ pub fn with_boundary(boundary: impl Fn(DVec2) -> (f64, bool), h: f64, p: DVec3) 
 /// Signed distance to the solid `profile` sweeps turning around the y axis
 /// with its origin at `offset` (where the profile lies at `x >= -offset`):
 /// the smallest distance to the profile's boundary turned by any angle,
-/// found by a search over the turn (a grid, then golden sections about its
-/// best points), signed by whether the point's meridian lies in the
-/// profile.
+/// found by a search over the turn ([`minimise_over_turn`]), signed by
+/// whether the point's meridian lies in the profile.
 pub fn revolve_distance(profile: &Profile, offset: f64, p: DVec3) -> f64 {
     let profile = values(profile);
     // The distance to the boundary turned by `phi`: in its plane, and
@@ -176,26 +213,9 @@ pub fn revolve_distance(profile: &Profile, offset: f64, p: DVec3) -> f64 {
         let (u, w) = (p.x * c + p.z * s, p.z * c - p.x * s);
         boundary(&profile, DVec2::new(u - offset, p.y)).0.hypot(w)
     };
-    const GRID: usize = 360;
-    let step = std::f64::consts::TAU / GRID as f64;
-    let mut grid: Vec<(f64, f64)> = (0..GRID)
-        .map(|i| (at(i as f64 * step), i as f64 * step))
-        .collect();
-    grid.sort_by(|a, b| a.0.total_cmp(&b.0));
-    let ratio = (5f64.sqrt() - 1.0) / 2.0;
-    let mut best = grid[0].0;
-    for &(_, phi) in &grid[..3] {
-        let (mut lo, mut hi) = (phi - step, phi + step);
-        for _ in 0..100 {
-            let (x1, x2) = (hi - ratio * (hi - lo), lo + ratio * (hi - lo));
-            if at(x1) <= at(x2) {
-                hi = x2;
-            } else {
-                lo = x1;
-            }
-        }
-        best = best.min(at(0.5 * (lo + hi)));
-    }
+    // The distance along the turn has its valley at the point's own
+    // meridian, wider than a grid step of 5 degrees.
+    let best = minimise_over_turn(72, at);
     let meridian = DVec2::new(p.x.hypot(p.z) - offset, p.y);
     if boundary(&profile, meridian).1 {
         -best

@@ -671,6 +671,10 @@ const NODE_FIELDS: &[(&str, &str)] = &[
         "vertices",
     ),
     (
+        "Extrude(profile: Ellipse(radii: (1, @)), half_height: 1)",
+        "radii",
+    ),
+    (
         "Extrude(profile: Circle(radius: 1), half_height: @)",
         "half_height",
     ),

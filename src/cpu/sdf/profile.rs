@@ -2,6 +2,7 @@
 //! along z and revolution around y (Quilez's `opExtrusion` and
 //! `opRevolution`, and his exact 2D distances).
 
+use crate::expr::Step;
 use crate::math::{Num, V3};
 use crate::scene::Profile;
 
@@ -27,7 +28,63 @@ pub fn profile<T: Num>(x: T, y: T, profile: &Profile<T>) -> T {
             (px - ex * h).hypot(py - ey * h) - *radius
         }
         Profile::Polygon { vertices } => polygon(x, y, vertices),
+        Profile::Ellipse { radii: [a, b] } => ellipse(x, y, *a, *b),
     }
+}
+
+/// Bisection steps of the ellipse's root: the bracket shrinks by `2^-64`,
+/// below `f64`'s resolution of the root for every point.
+const ELLIPSE_STEPS: f64 = 64.0;
+
+/// The ellipse of semi-axes `a` along x and `b` along y (after Eberly,
+/// "Distance from a point to an ellipse"): folded to the first quadrant
+/// with the longer axis first, the nearest point is `(r y0 / (σ + r - 1),
+/// y1 / σ)` (`r` the squared ratio of the axes, `z` the point in units of
+/// the axes) for the root `σ` of `(r z0 / (σ + r - 1))² + (z1 / σ)² = 1`,
+/// found by bisection and polished by two Newton steps within the bracket
+/// (solving for `σ` rather than Eberly's `σ - 1` keeps the small root of a
+/// point near the centre free of cancellation); on the longer axis the
+/// nearest point is found directly.
+fn ellipse<T: Num>(x: T, y: T, a: T, b: T) -> T {
+    let (zero, one, half) = (T::zero(), T::one(), T::of(0.5));
+    let swap = b.gt(a);
+    let (e0, e1) = (T::select(swap, b, a), T::select(swap, a, b));
+    let (y0, y1) = (
+        T::select(swap, y.abs(), x.abs()),
+        T::select(swap, x.abs(), y.abs()),
+    );
+    let (z0, z1) = (y0 / e0, y1 / e1);
+    let g = z0 * z0 + z1 * z1 - one;
+    let r = (e0 / e1) * (e0 / e1);
+    let (rz0, c) = (r * z0, r - one);
+    let top = T::select(g.lt(zero), one, rz0.hypot(z1));
+    let terms = |s: T| (rz0 / (s + c), z1 / s);
+    let [lo, hi] = T::iterate(T::of(ELLIPSE_STEPS), [z1, top], |_, [lo, hi]| {
+        let s = half * (lo + hi);
+        let (u, v) = terms(s);
+        let beyond = (u * u + v * v - one).gt(zero);
+        Step {
+            stop_before: None,
+            next: [T::select(beyond, s, lo), T::select(beyond, hi, s)],
+            stop_after: None,
+        }
+    });
+    let mut s = half * (lo + hi);
+    for _ in 0..2 {
+        let (u, v) = terms(s);
+        let slope = -T::of(2.0) * (u * u / (s + c) + v * v / s);
+        s = (s - (u * u + v * v - one) / slope).clamp(lo, hi);
+    }
+    let off_axis = (y0 - r * y0 / (s + c)).hypot(y1 - y1 / s);
+    // On the longer axis: the nearest point is off it while the point is
+    // within the centre of curvature of its end.
+    let (numerator, denominator) = (e0 * y0, e0 * e0 - e1 * e1);
+    let inner = numerator.lt(denominator);
+    let t = numerator / denominator.max(T::tiny());
+    let across = (one - t * t).max(zero).sqrt();
+    let on_axis = T::select(inner, (e0 * t - y0).hypot(e1 * across), (y0 - e0).abs());
+    let d = T::select(y1.gt(zero), off_axis, on_axis);
+    T::select(g.lt(zero), -d, d)
 }
 
 /// The rectangle of half extents `bx`, `by` about the origin.
