@@ -59,6 +59,7 @@ pub(super) const NAMES: &[&str] = &[
     "Rect",
     "RoundRect",
     "Segment",
+    "Vesica",
     "Ellipse",
     "Polygon",
     "Ellipsoid",

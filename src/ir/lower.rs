@@ -240,29 +240,31 @@ impl Lowering {
                     bound_name: "half extent",
                 },
             )],
-            Kind::Extrude {
-                profile:
-                    Profile::RoundRect {
-                        half_extents: [x, y],
-                        radius,
+            Kind::Extrude { profile, .. } | Kind::Revolve { profile, .. } => match profile {
+                Profile::RoundRect {
+                    half_extents: [x, y],
+                    radius,
+                } => vec![(
+                    "profile.radius",
+                    Relation::AtMostSmallest {
+                        value: *radius,
+                        bound: [*x, *y, *y],
+                        bound_name: "half extent",
                     },
-                ..
-            }
-            | Kind::Revolve {
-                profile:
-                    Profile::RoundRect {
-                        half_extents: [x, y],
-                        radius,
+                )],
+                Profile::Vesica {
+                    half_length,
+                    half_width,
+                } => vec![(
+                    "profile.half_width",
+                    Relation::AtMostSmallest {
+                        value: *half_width,
+                        bound: [*half_length; 3],
+                        bound_name: "half length",
                     },
-                ..
-            } => vec![(
-                "profile.radius",
-                Relation::AtMostSmallest {
-                    value: *radius,
-                    bound: [*x, *y, *y],
-                    bound_name: "half extent",
-                },
-            )],
+                )],
+                _ => Vec::new(),
+            },
             Kind::RoundedCylinder {
                 radius,
                 half_height,

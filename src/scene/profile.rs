@@ -1,5 +1,5 @@
-//! Plane shapes (circle, rectangle, rounded rectangle, stadium, ellipse,
-//! polygon): the cross-sections that [`extrude`](super::extrude) and
+//! Plane shapes (circle, rectangle, rounded rectangle, stadium, vesica,
+//! ellipse, polygon): the cross-sections that [`extrude`](super::extrude) and
 //! [`revolve`](super::revolve) sweep into solids.
 
 use super::param::Param;
@@ -52,6 +52,15 @@ pub enum Profile<S = Param> {
         b: [S; 2],
         /// Radius, greater than 0.
         radius: S,
+    },
+    /// A vesica: the lens where two equal discs overlap, pointed at `(0,
+    /// ±half_length)` and `half_width` wide each side of the y axis.
+    Vesica {
+        /// From the centre to each point, greater than 0.
+        half_length: S,
+        /// From the centre to each side, greater than 0 and at most
+        /// `half_length` (there the vesica is a disc).
+        half_width: S,
     },
     /// An axis-aligned ellipse about the origin.
     Ellipse {
@@ -109,6 +118,16 @@ impl Profile {
         }
     }
 
+    /// The vesica pointed at `(0, ±half_length)`, `half_width` wide each side
+    /// of the y axis.
+    #[must_use]
+    pub fn vesica(half_length: impl Into<Param>, half_width: impl Into<Param>) -> Self {
+        Profile::Vesica {
+            half_length: half_length.into(),
+            half_width: half_width.into(),
+        }
+    }
+
     /// The ellipse of semi-axes `a` along x and `b` along y.
     #[must_use]
     pub fn ellipse(a: impl Into<Param>, b: impl Into<Param>) -> Self {
@@ -153,6 +172,13 @@ impl<S> Profile<S> {
                 b: two(f, b, "profile.b", Finite)?,
                 radius: f(radius, spec("profile.radius", Positive))?,
             },
+            Profile::Vesica {
+                half_length,
+                half_width,
+            } => Profile::Vesica {
+                half_length: f(half_length, spec("profile.half_length", Positive))?,
+                half_width: f(half_width, spec("profile.half_width", Positive))?,
+            },
             Profile::Ellipse { radii } => Profile::Ellipse {
                 radii: two(f, radii, "profile.radii", Positive)?,
             },
@@ -186,6 +212,7 @@ impl Profile<f64> {
             }
             Profile::Segment { a, b, radius } => length(a).max(length(b)) + radius,
             Profile::Ellipse { radii } => radii[0].max(radii[1]),
+            Profile::Vesica { half_length, .. } => *half_length,
             Profile::Polygon { vertices } => vertices.iter().map(length).fold(0.0, f64::max),
         }
     }

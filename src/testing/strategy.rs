@@ -458,7 +458,8 @@ pub fn round_cone_between_node() -> impl Strategy<Value = Node> + Clone {
 }
 
 /// A plane profile's values: a disc, a rectangle, a rounded rectangle, a
-/// segment's stadium, an ellipse (sometimes a circle), or a polygon of 3 to 12 corners in either winding,
+/// segment's stadium, an ellipse (sometimes a circle), a vesica, or a
+/// polygon of 3 to 12 corners in either winding,
 /// star-shaped about a point near the origin (so its edges never cross),
 /// sometimes with a corner repeated (an edge of length 0).
 fn profile_values() -> impl Strategy<Value = Profile<f64>> + Clone {
@@ -508,6 +509,10 @@ fn profile_values() -> impl Strategy<Value = Profile<f64>> + Clone {
             1 => (0.05..=1.0f64).prop_map(|a| [a, a]),
         ]
         .prop_map(|radii| Profile::Ellipse { radii }),
+        1 => (0.1..=1.0f64, 0.05..=1.0f64).prop_map(|(half_length, u)| Profile::Vesica {
+            half_length,
+            half_width: u * half_length,
+        }),
         3 => polygon,
     ]
 }
@@ -567,6 +572,7 @@ fn profile_left(profile: &Profile<f64>) -> f64 {
             vertices.iter().map(|v| v[0]).fold(f64::INFINITY, f64::min)
         }
         Profile::Ellipse { radii } => -radii[0],
+        Profile::Vesica { half_width, .. } => -half_width,
     }
 }
 

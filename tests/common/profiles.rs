@@ -33,6 +33,13 @@ fn values(profile: &Profile) -> Profile<f64> {
             vertices: vertices.iter().map(two).collect(),
         },
         Profile::Ellipse { radii } => Profile::Ellipse { radii: two(radii) },
+        Profile::Vesica {
+            half_length,
+            half_width,
+        } => Profile::Vesica {
+            half_length: v(half_length),
+            half_width: v(half_width),
+        },
         _ => panic!("a profile the oracle does not know"),
     }
 }
@@ -124,6 +131,26 @@ fn boundary(profile: &Profile<f64>, q: DVec2) -> (f64, bool) {
         Profile::Segment { a, b, radius } => {
             let d = edge(q, DVec2::from(*a), DVec2::from(*b));
             ((d - radius).abs(), d <= *radius)
+        }
+        Profile::Vesica {
+            half_length: b,
+            half_width: w,
+        } => {
+            // Two arcs meeting at the tips: the circle through `(w, 0)` and
+            // both tips, its centre on the x axis found from those three
+            // points, and its mirror.
+            let tips = [DVec2::new(0.0, *b), DVec2::new(0.0, -*b)];
+            let centre_x = (w * w - b * b) / (2.0 * w);
+            let radius = DVec2::new(centre_x, 0.0).distance(tips[0]);
+            let mut d = f64::INFINITY;
+            let mut inside = true;
+            for side in [1.0, -1.0] {
+                let centre = DVec2::new(side * centre_x, 0.0);
+                let keep = |x: DVec2| x.x * side >= 0.0;
+                d = d.min(super::shapes::arc_distance(q, centre, radius, keep, &tips));
+                inside &= q.distance(centre) <= radius;
+            }
+            (d, inside)
         }
         Profile::Ellipse { radii: [a, b] } => {
             let inside = (q.x / a).powi(2) + (q.y / b).powi(2) <= 1.0;

@@ -146,7 +146,7 @@ fn cut_hollow_sphere(p: DVec3, r: f64, h: f64) -> f64 {
 /// The nearest point to `q` of the circle about `centre` of radius `r` where
 /// `keep` holds, else of the ends `ends`: the distance along a circle falls
 /// to the projection and rises away from it.
-fn arc_distance(
+pub fn arc_distance(
     q: DVec2,
     centre: DVec2,
     r: f64,

@@ -188,6 +188,7 @@ fn nodes() -> Vec<(&'static str, Node)> {
         ),
         ("revolve_circle", revolve(Profile::circle(0.2), 0.5)),
         ("extrude_ellipse", extrude(Profile::ellipse(0.6, 0.25), 0.3)),
+        ("revolved_vesica", revolve(Profile::vesica(0.6, 0.2), 0.0)),
         (
             "revolve_ellipse_dynamic",
             revolve(Profile::ellipse(param("ell_a", 0.15), 0.4), 0.4),

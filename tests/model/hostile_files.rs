@@ -671,6 +671,14 @@ const NODE_FIELDS: &[(&str, &str)] = &[
         "vertices",
     ),
     (
+        "Revolve(profile: Vesica(half_length: @, half_width: 0.2))",
+        "half_length",
+    ),
+    (
+        "Revolve(profile: Vesica(half_length: 1, half_width: @))",
+        "half_width",
+    ),
+    (
         "Extrude(profile: Ellipse(radii: (1, @)), half_height: 1)",
         "radii",
     ),

@@ -651,6 +651,8 @@ fn broken_node() -> impl Strategy<Value = (Node, &'static str)> {
             "round_cone_between"
         )),
         bad_size().prop_map(|v| (extrude(Profile::circle(v), 0.5), "extrude")),
+        prop_oneof![bad_size(), Just(0.0), 1.01..1e300f64]
+            .prop_map(|v| (revolve(Profile::vesica(1.0, v), 0.0), "revolve")),
         prop_oneof![bad_size(), Just(0.0)]
             .prop_map(|v| (revolve(Profile::ellipse(0.5, v), 1.0), "revolve")),
         bad_size().prop_map(|v| (extrude(Profile::rect(0.5, v), 0.5), "extrude")),

@@ -29,7 +29,25 @@ pub fn profile<T: Num>(x: T, y: T, profile: &Profile<T>) -> T {
         }
         Profile::Polygon { vertices } => polygon(x, y, vertices),
         Profile::Ellipse { radii: [a, b] } => ellipse(x, y, *a, *b),
+        Profile::Vesica {
+            half_length,
+            half_width,
+        } => vesica(x, y, *half_length, *half_width),
     }
+}
+
+/// The vesica pointed at `(0, ±b)`, `w` wide each side of the y axis
+/// (Quilez's `sdVesica`): the overlap of the discs of radius `(b² + w²) /
+/// 2w` about `(∓d, 0)`, `d = (b² - w²) / 2w`. Folded to the first
+/// quadrant, a point beyond the line from the far centre through the
+/// point is nearest the point; elsewhere the arc is.
+fn vesica<T: Num>(x: T, y: T, b: T, w: T) -> T {
+    let two_w = T::of(2.0) * w.max(T::tiny());
+    let (d, r) = ((b * b - w * w) / two_w, (b * b + w * w) / two_w);
+    let (x, y) = (x.abs(), y.abs());
+    let tip = x.hypot(y - b);
+    let arc = (x + d).hypot(y) - r;
+    T::select(((y - b) * d).gt(x * b), tip, arc)
 }
 
 /// Bisection steps of the ellipse's root: the bracket shrinks by `2^-64`,
