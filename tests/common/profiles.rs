@@ -5,6 +5,7 @@
 //! distance is the smallest over every turn of the profile, searched
 //! numerically rather than taken in the point's own meridian.
 
+use super::analytic::segment_distance;
 use fractal_sdf::scene::{Param, Profile};
 use glam::{DVec2, DVec3};
 
@@ -44,21 +45,11 @@ fn values(profile: &Profile) -> Profile<f64> {
     }
 }
 
-/// Unsigned distance from `q` to the segment `a`-`b`: to an end, or the
-/// perpendicular through the cross product.
+/// Unsigned distance from `q` to the segment `a`-`b`, in the plane `z = 0`
+/// ([`segment_distance`]: to an end, or the perpendicular through the
+/// cross product).
 fn edge(q: DVec2, a: DVec2, b: DVec2) -> f64 {
-    let ab = b - a;
-    if ab == DVec2::ZERO {
-        return q.distance(a);
-    }
-    let t = (q - a).dot(ab) / ab.length_squared();
-    if t <= 0.0 {
-        q.distance(a)
-    } else if t >= 1.0 {
-        q.distance(b)
-    } else {
-        ab.perp_dot(q - a).abs() / ab.length()
-    }
+    segment_distance(q.extend(0.0), a.extend(0.0), b.extend(0.0))
 }
 
 /// The polygon's winding number about `q`: the sum of the angles its
