@@ -20,11 +20,12 @@ use crate::file::SceneFile;
 use crate::quality::{Effects, Glow, Quality};
 use crate::scene::{
     Axis, Camera, Hybrid, HybridOp, InsideShape, Kifs, KifsFold, Light, Mandelbulb, Material, Node,
-    OrbitColoring, Palette, Profile, QuaternionJulia, Scene, Trap, capped_cone, capped_torus,
-    capsule, cone, cone_between, cuboid, cut_hollow_sphere, cut_sphere, cylinder, cylinder_between,
-    death_star, ellipsoid, extrude, hex_prism, julia, link, menger, octahedron, param, param3,
-    plane, pyramid, quad, revolve, rhombus, round_box, round_cone, round_cone_between,
-    rounded_cylinder, sierpinski, solid_angle, sphere, torus, tri_prism, triangle,
+    OrbitColoring, Palette, Profile, QuaternionJulia, Scene, Trap, box_frame, capped_cone,
+    capped_torus, capsule, cone, cone_between, cuboid, cut_hollow_sphere, cut_sphere, cylinder,
+    cylinder_between, death_star, ellipsoid, extrude, hex_prism, julia, link, menger, octahedron,
+    param, param3, plane, pyramid, quad, revolve, rhombus, round_box, round_cone,
+    round_cone_between, rounded_cylinder, sierpinski, solid_angle, sphere, torus, tri_prism,
+    triangle,
 };
 
 /// Every gallery scene by name.
@@ -542,7 +543,7 @@ pub fn csg() -> Scene {
         .with_lights(key_and_fill())
 }
 
-/// One of every bounded primitive, in three rows (the plane is the
+/// One of every bounded primitive, in four rows (the plane is the
 /// floor).
 #[must_use]
 pub fn primitives() -> Scene {
@@ -592,6 +593,9 @@ pub fn primitives() -> Scene {
         death_star(0.32, 0.25, 0.3)
             .rotate(DVec3::Y, -FRAC_PI_2)
             .translate(dvec3(0.0, -0.08, 0.0)),
+        box_frame(dvec3(0.28, 0.28, 0.28), 0.05)
+            .rotate(DVec3::Y, 0.5)
+            .translate(dvec3(0.0, -0.12, 0.0)),
     ];
     let count = items.len();
     let row = items
@@ -605,16 +609,16 @@ pub fn primitives() -> Scene {
                 0.45 + 0.35 * (1.0 - (2.0 * t - 1.0).abs()),
                 0.3 + 0.6 * t,
             );
-            // Nine in each of three rows, 0.8 apart.
+            // Seven in each of four rows, 0.85 apart.
             #[allow(clippy::cast_precision_loss)]
-            let (column, row) = ((i % 9) as f64 - 4.0, (i / 9) as f64 - 1.0);
+            let (column, row) = ((i % 7) as f64 - 3.0, (i / 7) as f64 - 1.5);
             node.color(hue)
-                .translate(dvec3(column * 0.8, 0.0, row * 1.1))
+                .translate(dvec3(column * 0.85, 0.0, row * 0.95))
         })
         .reduce(Node::union)
-        .expect("twenty-seven primitives");
+        .expect("twenty-eight primitives");
     Scene::new(row.union(floor(0.4)))
-        .with_camera(Camera::look_at(dvec3(0.0, 4.6, 7.2), dvec3(0.0, -0.1, 0.4)).fov(40.5))
+        .with_camera(Camera::look_at(dvec3(0.0, 4.6, 7.2), dvec3(0.0, -0.15, 0.3)).fov(36.0))
         .with_lights(key_and_fill())
 }
 

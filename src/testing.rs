@@ -76,13 +76,14 @@ pub use membership::{
 pub use sample::near_surface_points;
 pub use sites::{Site, parameter_sites, substitute};
 pub use strategy::{
-    bounded_node, capped_cone_node, capped_torus_node, capsule_node, cone_between_node, cone_node,
-    cuboid_node, cut_hollow_sphere_node, cut_sphere_node, cylinder_between_node, cylinder_node,
-    death_star_node, ellipsoid_node, exact_node, exact_primitive, extrude_node, fractal_node,
-    hex_prism_node, hybrid_node, hybrid_op, infinite_cone_node, infinite_cylinder_node, julia_node,
-    kifs_node, link_node, mandelbox_node, mandelbulb_node, menger_node, octahedron_node,
-    orbit_trap_node, palette, plane_node, point, point_pair, profile, pyramid_node, quad_node, ray,
-    repeated_node, revolve_node, rhombus_node, rotation, round_box_node, round_cone_between_node,
-    round_cone_node, rounded_cylinder_node, scene_node, sierpinski_node, solid_angle_node,
-    sphere_node, torus_node, trap, tri_prism_node, triangle_node, unit_vector,
+    bounded_node, box_frame_node, capped_cone_node, capped_torus_node, capsule_node,
+    cone_between_node, cone_node, cuboid_node, cut_hollow_sphere_node, cut_sphere_node,
+    cylinder_between_node, cylinder_node, death_star_node, ellipsoid_node, exact_node,
+    exact_primitive, extrude_node, fractal_node, hex_prism_node, hybrid_node, hybrid_op,
+    infinite_cone_node, infinite_cylinder_node, julia_node, kifs_node, link_node, mandelbox_node,
+    mandelbulb_node, menger_node, octahedron_node, orbit_trap_node, palette, plane_node, point,
+    point_pair, profile, pyramid_node, quad_node, ray, repeated_node, revolve_node, rhombus_node,
+    rotation, round_box_node, round_cone_between_node, round_cone_node, rounded_cylinder_node,
+    scene_node, sierpinski_node, solid_angle_node, sphere_node, torus_node, trap, tri_prism_node,
+    triangle_node, unit_vector,
 };

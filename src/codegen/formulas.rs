@@ -235,6 +235,12 @@ pub(crate) fn death_star() -> Result<String, Unprintable> {
     )
 }
 
+pub(crate) fn box_frame() -> Result<String, Unprintable> {
+    distance("sd_box_frame", &[("b", Vec3), ("t", Scalar)], |p, a| {
+        sdf::box_frame(p, vector(a, 0), a[3])
+    })
+}
+
 pub(crate) fn cylinder_between() -> Result<String, Unprintable> {
     distance(
         "sd_cylinder_between",

@@ -36,6 +36,7 @@ pub(crate) enum Helper {
     InfiniteCone,
     CutHollowSphere,
     DeathStar,
+    BoxFrame,
     CylinderBetween,
     ConeBetween,
     RoundConeBetween,
@@ -52,7 +53,7 @@ pub(crate) enum Helper {
 
 impl Helper {
     /// Every helper, in the order they are emitted.
-    pub(crate) const ALL: [Helper; 44] = [
+    pub(crate) const ALL: [Helper; 45] = [
         Helper::Sphere,
         Helper::Cuboid,
         Helper::RoundBox,
@@ -79,6 +80,7 @@ impl Helper {
         Helper::InfiniteCone,
         Helper::CutHollowSphere,
         Helper::DeathStar,
+        Helper::BoxFrame,
         Helper::CylinderBetween,
         Helper::ConeBetween,
         Helper::RoundConeBetween,
@@ -128,6 +130,7 @@ impl Helper {
             Helper::InfiniteCone => "infinite_cone",
             Helper::CutHollowSphere => "cut_hollow_sphere",
             Helper::DeathStar => "death_star",
+            Helper::BoxFrame => "box_frame",
             Helper::CylinderBetween => "cylinder_between",
             Helper::ConeBetween => "cone_between",
             Helper::RoundConeBetween => "round_cone_between",
@@ -180,6 +183,7 @@ impl Helper {
             Helper::InfiniteCone => formulas::infinite_cone(),
             Helper::CutHollowSphere => formulas::cut_hollow_sphere(),
             Helper::DeathStar => formulas::death_star(),
+            Helper::BoxFrame => formulas::box_frame(),
             Helper::CylinderBetween => formulas::cylinder_between(),
             Helper::ConeBetween => formulas::cone_between(),
             Helper::RoundConeBetween => formulas::round_cone_between(),

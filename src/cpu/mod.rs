@@ -473,6 +473,10 @@ impl Evaluator {
                 s(*carve_radius),
                 s(*carve_distance),
             )),
+            Kind::BoxFrame {
+                half_extents,
+                thickness,
+            } => Self::leaf(sdf::box_frame(p, v(*half_extents), s(*thickness))),
             Kind::CylinderBetween { a, b, radius } => {
                 Self::leaf(sdf::cylinder_between(p, v(*a), v(*b), s(*radius)))
             }

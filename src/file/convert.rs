@@ -205,6 +205,13 @@ impl NodeRepr {
                 carve_radius,
                 carve_distance,
             },
+            Kind::BoxFrame {
+                half_extents,
+                thickness,
+            } => NodeRepr::BoxFrame {
+                half_extents,
+                thickness,
+            },
             Kind::CylinderBetween { a, b, radius } => NodeRepr::CylinderBetween { a, b, radius },
             Kind::ConeBetween {
                 a,
@@ -635,6 +642,14 @@ impl Located<NodeRepr> {
                 radius: radius.clone(),
                 carve_radius: carve_radius.clone(),
                 carve_distance: carve_distance.clone(),
+            }
+            .into(),
+            NodeRepr::BoxFrame {
+                half_extents,
+                thickness,
+            } => Kind::BoxFrame {
+                half_extents: half_extents.clone(),
+                thickness: thickness.clone(),
             }
             .into(),
             NodeRepr::CylinderBetween { a, b, radius } => Kind::CylinderBetween {

@@ -50,6 +50,7 @@ pub(super) const NAMES: &[&str] = &[
     "InfiniteCone",
     "CutHollowSphere",
     "DeathStar",
+    "BoxFrame",
     "CylinderBetween",
     "ConeBetween",
     "RoundConeBetween",

@@ -526,6 +526,10 @@ pub(super) enum NodeRepr {
         carve_radius: Param,
         carve_distance: Param,
     },
+    BoxFrame {
+        half_extents: Param3,
+        thickness: Param,
+    },
     CylinderBetween {
         a: Param3,
         b: Param3,

@@ -267,6 +267,9 @@ pub(super) fn bound(node: &IrNode, done: &[Option<Bound>]) -> Option<Bound> {
             radius, thickness, ..
         } => Bound::sphere(origin, baked(*radius)? + baked(*thickness)?),
         Kind::DeathStar { radius, .. } => Bound::sphere(origin, baked(*radius)?),
+        Kind::BoxFrame { half_extents, .. } => {
+            Bound::sphere(origin, baked3(*half_extents)?.length())
+        }
         // Each lies in the ball about the segment's midpoint that holds
         // its caps (the cylinder and the cone) or its balls.
         Kind::CylinderBetween { a, b, radius } => {

@@ -265,6 +265,17 @@ impl Lowering {
                 )],
                 _ => Vec::new(),
             },
+            Kind::BoxFrame {
+                half_extents,
+                thickness,
+            } => vec![(
+                "thickness",
+                Relation::AtMostSmallest {
+                    value: *thickness,
+                    bound: *half_extents,
+                    bound_name: "half extent",
+                },
+            )],
             Kind::RoundedCylinder {
                 radius,
                 half_height,

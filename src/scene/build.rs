@@ -326,6 +326,16 @@ pub fn death_star(
     .into()
 }
 
+/// The edges of the box of `half_extents`: twelve square bars of `thickness` (at most the smallest half extent). Exact outside, a bound inside.
+#[must_use]
+pub fn box_frame(half_extents: impl Into<Param3>, thickness: impl Into<Param>) -> Node {
+    Kind::BoxFrame {
+        half_extents: half_extents.into(),
+        thickness: thickness.into(),
+    }
+    .into()
+}
+
 /// A capped cylinder of `radius` around the segment from `a` to `b`.
 #[must_use]
 pub fn cylinder_between(

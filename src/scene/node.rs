@@ -310,6 +310,13 @@ pub enum Kind<S, V, C> {
         /// How far along +x the carved ball's centre lies, greater than 0.
         carve_distance: S,
     },
+    /// The edges of a box: twelve square bars of `thickness` along the edges of the box of `half_extents`. Exact outside; inside, a bound (where bars meet, the depth can exceed the deepest bar's).
+    BoxFrame {
+        /// Half the outer size along each axis, each at least 0.
+        half_extents: V,
+        /// The edges' thickness, from 0 to the smallest half extent.
+        thickness: S,
+    },
     /// A capped cylinder around the segment from `a` to `b`. Exact.
     CylinderBetween {
         /// The centre of one cap.
@@ -585,6 +592,7 @@ impl<S, V, C> Kind<S, V, C> {
             Kind::InfiniteCone { .. } => "infinite_cone",
             Kind::CutHollowSphere { .. } => "cut_hollow_sphere",
             Kind::DeathStar { .. } => "death_star",
+            Kind::BoxFrame { .. } => "box_frame",
             Kind::CylinderBetween { .. } => "cylinder_between",
             Kind::ConeBetween { .. } => "cone_between",
             Kind::RoundConeBetween { .. } => "round_cone_between",
@@ -678,6 +686,7 @@ impl<S, V, C> Kind<S, V, C> {
             | Kind::InfiniteCone { .. }
             | Kind::CutHollowSphere { .. }
             | Kind::DeathStar { .. }
+            | Kind::BoxFrame { .. }
             | Kind::CylinderBetween { .. }
             | Kind::ConeBetween { .. }
             | Kind::RoundConeBetween { .. }
@@ -929,6 +938,13 @@ impl<S, V, C> Kind<S, V, C> {
                 radius: m.scalar(radius, spec("radius", NonNegative))?,
                 carve_radius: m.scalar(carve_radius, spec("carve_radius", NonNegative))?,
                 carve_distance: m.scalar(carve_distance, spec("carve_distance", Positive))?,
+            },
+            Kind::BoxFrame {
+                half_extents,
+                thickness,
+            } => Kind::BoxFrame {
+                half_extents: m.vector(half_extents, spec("half_extents", NonNegative))?,
+                thickness: m.scalar(thickness, spec("thickness", NonNegative))?,
             },
             Kind::CylinderBetween { a, b, radius } => Kind::CylinderBetween {
                 a: m.vector(a, spec("a", Finite))?,

@@ -11,11 +11,11 @@ use crate::cpu::Ray;
 use crate::scene::{
     Axis, CsgOp, Hybrid, HybridOp, Kifs, KifsFold, Kind, MAX_ESCAPE_ITERATIONS,
     MAX_FOLD_ITERATIONS, MAX_SOLID_ANGLE, Mandelbox, Mandelbulb, Menger, Node, OrbitColoring,
-    Palette, Param, Param3, Profile, QuaternionJulia, Sierpinski, Trap, capped_cone, capped_torus,
-    capsule, cone, cone_between, cuboid, cut_hollow_sphere, cut_sphere, cylinder, cylinder_between,
-    death_star, ellipsoid, extrude, hex_prism, infinite_cone, infinite_cylinder, link, octahedron,
-    param, plane, pyramid, quad, revolve, rhombus, round_box, round_cone, round_cone_between,
-    rounded_cylinder, solid_angle, sphere, torus, tri_prism, triangle,
+    Palette, Param, Param3, Profile, QuaternionJulia, Sierpinski, Trap, box_frame, capped_cone,
+    capped_torus, capsule, cone, cone_between, cuboid, cut_hollow_sphere, cut_sphere, cylinder,
+    cylinder_between, death_star, ellipsoid, extrude, hex_prism, infinite_cone, infinite_cylinder,
+    link, octahedron, param, plane, pyramid, quad, revolve, rhombus, round_box, round_cone,
+    round_cone_between, rounded_cylinder, solid_angle, sphere, torus, tri_prism, triangle,
 };
 
 /// The largest size (radius, half extent, height) the primitive strategies
@@ -576,6 +576,19 @@ fn profile_left(profile: &Profile<f64>) -> f64 {
     }
 }
 
+/// A box frame (exact outside, a bound inside): half extents in `[0,
+/// 1.2]`, thickness up to the smallest.
+pub fn box_frame_node() -> impl Strategy<Value = Node> + Clone {
+    (vector(size(1.2)), 0.0..=1.0f64)
+        .prop_flat_map(|(b, u)| {
+            (
+                Just(b),
+                scalar("box_frame.thickness", Just(u * b.min_element())),
+            )
+        })
+        .prop_map(|(b, t)| box_frame(b, t))
+}
+
 /// An ellipsoid (a distance bound, not exact) with semi-axes in
 /// `[0.05, 1.5]`.
 pub fn ellipsoid_node() -> impl Strategy<Value = Node> + Clone {
@@ -1075,6 +1088,7 @@ pub fn scene_node(depth: u32) -> impl Strategy<Value = Node> + Clone {
     let leaf = prop_oneof![
         6 => exact_node(),
         1 => ellipsoid_node(),
+        1 => box_frame_node(),
         2 => fractal_node(),
         1 => orbit_trap_node(),
     ];

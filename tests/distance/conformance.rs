@@ -22,7 +22,7 @@ use fractal_sdf::scene::octahedron;
 use fractal_sdf::scene::param3;
 use fractal_sdf::scene::{CustomShape, Rule};
 use fractal_sdf::scene::{
-    Hybrid, HybridOp, Kifs, KifsFold, Mandelbox, OrbitColoring, Palette, Profile, Trap,
+    Hybrid, HybridOp, Kifs, KifsFold, Mandelbox, OrbitColoring, Palette, Profile, Trap, box_frame,
     capped_cone, capped_torus, cone, cone_between, cut_hollow_sphere, cut_sphere, cylinder_between,
     death_star, extrude, hex_prism, infinite_cone, infinite_cylinder, kifs, link, pyramid, quad,
     revolve, rhombus, round_cone, round_cone_between, rounded_cylinder, solid_angle, tri_prism,
@@ -123,6 +123,10 @@ fn nodes() -> Vec<(&'static str, Node)> {
             ),
         ),
         ("pyramid", pyramid(0.5, 0.8)),
+        (
+            "box_frame_dynamic",
+            box_frame(dvec3(0.6, 0.4, 0.5), param("frame_t", 0.08)),
+        ),
         ("rhombus", rhombus(0.6, 0.3, 0.1, 0.05)),
         ("tri_prism", tri_prism(0.3, 0.5)),
         (

@@ -7,6 +7,7 @@
 use crate::common::analytic::{self, exact_distance};
 use fractal_sdf::cpu;
 use fractal_sdf::prelude::*;
+use fractal_sdf::scene::Kind;
 use fractal_sdf::scene::octahedron;
 use fractal_sdf::scene::{capped_cone, hex_prism, link, round_cone};
 use fractal_sdf::testing::{self, Failure, check_exact, point};
@@ -299,4 +300,60 @@ fn the_listing_calls_exact_only_the_primitives_tested_here() {
         .collect();
     listed.sort();
     assert_eq!(drawn, listed);
+}
+
+/// The twelve bars of a box frame of half extents `b` and thickness `t`:
+/// each a box along one axis, in one of the four corners of the other two.
+fn frame_bars(b: DVec3, t: f64) -> Vec<(DVec3, DVec3)> {
+    let mut bars = Vec::new();
+    for axis in 0..3 {
+        let (j, k) = ((axis + 1) % 3, (axis + 2) % 3);
+        for (sj, sk) in [(1.0, 1.0), (1.0, -1.0), (-1.0, 1.0), (-1.0, -1.0)] {
+            let (mut centre, mut half) = (DVec3::ZERO, DVec3::splat(0.5 * t));
+            centre[j] = sj * (b[j] - 0.5 * t);
+            centre[k] = sk * (b[k] - 0.5 * t);
+            half[axis] = b[axis];
+            bars.push((centre, half));
+        }
+    }
+    bars
+}
+
+proptest! {
+    /// A box frame is the union of its twelve bars: outside, its distance
+    /// is the nearest bar's (within the exact tolerance); inside, it never
+    /// exceeds the depth to the nearest point outside every bar (sampled).
+    #[test]
+    fn box_frame_is_exact_outside_and_a_bound_inside(
+        node in testing::box_frame_node(),
+        points in prop::collection::vec(point(1.5), 48),
+    ) {
+        let Kind::BoxFrame { half_extents, thickness } = node.kind() else {
+            unreachable!("the strategy draws box frames")
+        };
+        let bars = frame_bars(half_extents.default_value(), thickness.default_value());
+        let nearest = |p: DVec3| {
+            bars.iter()
+                .map(|(c, h)| analytic::box_distance(p - *c, *h))
+                .fold(f64::INFINITY, f64::min)
+        };
+        let eval = cpu::Evaluator::new(&node)?;
+        for &p in &points {
+            let (d, oracle) = (eval.distance(p), nearest(p));
+            if oracle > 0.0 {
+                prop_assert!(
+                    (d - oracle).abs() <= TOLERANCE * oracle.max(1.0),
+                    "outside at {p}: {d} against {oracle}"
+                );
+            }
+        }
+        // Inside a frame with room for sampled points (not a flat or thin
+        // one), about its bars.
+        let (b, t) = (half_extents.default_value(), thickness.default_value());
+        if t >= 0.05 {
+            let inside = |p: DVec3| nearest(p) <= 0.0;
+            let near = testing::near_surface_points(inside, 1.1 * b.length(), t, 64, 3);
+            testing::check_never_overestimates(&node, inside, &near, 32)?;
+        }
+    }
 }

@@ -575,6 +575,8 @@ const NODE_FIELDS: &[(&str, &str)] = &[
         "Quad(a: 0, b: (1, 0, 0), c: (1, 1, 0), d: (0, 1, 0), thickness: @)",
         "thickness",
     ),
+    ("BoxFrame(half_extents: @, thickness: 0)", "half_extents"),
+    ("BoxFrame(half_extents: 1, thickness: @)", "thickness"),
     ("Pyramid(half_base: @, height: 1)", "half_base"),
     ("Pyramid(half_base: 0.5, height: @)", "height"),
     (

@@ -274,10 +274,10 @@ use fractal_sdf::scene::ellipsoid;
 use fractal_sdf::scene::octahedron;
 use fractal_sdf::scene::param3;
 use fractal_sdf::scene::{
-    Hybrid, HybridOp, Kifs, KifsFold, MAX_SOLID_ANGLE, Profile, capped_torus, cone, cone_between,
-    cut_hollow_sphere, cut_sphere, cylinder_between, death_star, extrude, infinite_cone,
-    infinite_cylinder, pyramid, quad, revolve, rhombus, round_cone_between, rounded_cylinder,
-    solid_angle, tri_prism, triangle,
+    Hybrid, HybridOp, Kifs, KifsFold, MAX_SOLID_ANGLE, Profile, box_frame, capped_torus, cone,
+    cone_between, cut_hollow_sphere, cut_sphere, cylinder_between, death_star, extrude,
+    infinite_cone, infinite_cylinder, pyramid, quad, revolve, rhombus, round_cone_between,
+    rounded_cylinder, solid_angle, tri_prism, triangle,
 };
 use fractal_sdf::scene::{MAX_ESCAPE_ITERATIONS, MAX_FOLD_ITERATIONS};
 use fractal_sdf::scene::{capped_cone, hex_prism, link, round_cone};
@@ -621,6 +621,8 @@ fn broken_node() -> impl Strategy<Value = (Node, &'static str)> {
             "quad"
         )),
         prop_oneof![bad_size(), Just(0.0)].prop_map(|v| (pyramid(v, 1.0), "pyramid")),
+        bad_size().prop_map(|v| (box_frame(dvec3(0.5, v, 0.5), 0.1), "box_frame")),
+        (0.51..1e300f64).prop_map(|v| (box_frame(dvec3(0.5, 0.6, 0.7), v), "box_frame")),
         bad_size().prop_map(|v| (pyramid(0.5, v), "pyramid")),
         bad_size().prop_map(|v| (rhombus(0.5, 0.5, 0.1, v), "rhombus")),
         bad_size().prop_map(|v| (tri_prism(v, 0.5), "tri_prism")),

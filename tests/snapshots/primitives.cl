@@ -445,6 +445,18 @@ real sd_death_star(real3 p, real ra, real rb, real d) {
     return ((t0 * fmax(t3 - t4, R(0.0))) < ((p.x * t3) - (t4 * t2))) ? hypot(p.x - t2, t4 - t3) : fmax(hypot(p.x, t4) - ra, rb - hypot(p.x - t0, t4));
 }
 
+/* ---- box_frame ---- */
+real sd_box_frame(real3 p, real3 b, real t) {
+    real t_0 = R(0.5) * t;
+    real3 t_1 = fabs(p) - b;
+    real3 t_2 = (real3)(t_0);
+    real3 t_3 = fabs(t_1 + t_0) - t_0;
+    real t_4 = fmax(t_3.y, R(0.0));
+    real t_5 = fmax(t_3.z, R(0.0));
+    real t_6 = fmax(t_3.x, R(0.0));
+    return fmin(fmin(length((real3)(fmax(t_1.x, R(0.0)), t_4, t_5)) + fmin(fmax(t_1.x, fmax(t_3.y, t_3.z)), R(0.0)), length((real3)(t_6, fmax(t_1.y, R(0.0)), t_5)) + fmin(fmax(t_3.x, fmax(t_1.y, t_3.z)), R(0.0))), length((real3)(t_6, t_4, fmax(t_1.z, R(0.0)))) + fmin(fmax(t_3.x, fmax(t_3.y, t_1.z)), R(0.0)));
+}
+
 /* ---- cylinder_between ---- */
 real sd_cylinder_between(real3 p, real3 a, real3 b, real r) {
     real3 t0 = b - a;
@@ -516,328 +528,345 @@ real sd_ellipsoid(real3 p, real3 r) {
 real DE(real3 p0, __global const real* params) {
     /* union */
     /* union/b:color/plane */
-    real d120 = sd_plane(p0, (real3)(0.0f, 1.0f, 0.0f), 0.4f);
+    real d127 = sd_plane(p0, (real3)(0.0f, 1.0f, 0.0f), 0.4f);
     /* union: the second operand only within reach of its bound */
-    real u122 = d120;
-    real g122 = (length(p0 - ((real3)(-R(3.2), R(0.0), -R(1.1)))) * R(0.9999)) - R(0.35);
-    if (!(g122 > u122 && g122 > R(0.0))) {
+    real u129 = d127;
+    real g129 = (length(p0 - ((real3)(-R(2.55), R(0.0), -R(1.4249999999999998)))) * R(0.9999)) - R(0.35);
+    if (!(g129 > u129 && g129 > R(0.0))) {
         /* .../a:union/a:union/a:translate */
-        real3 p1 = p0 - ((real3)(-R(3.2), R(0.0), -R(1.1)));
+        real3 p1 = p0 - ((real3)(-R(2.55), R(0.0), -R(1.4249999999999998)));
         /* .../a:translate/color/sphere */
         real d0 = sd_sphere(p1, 0.35f);
-        real d122 = fmin(d120, d0);
-        u122 = d122;
+        real d129 = fmin(d127, d0);
+        u129 = d129;
     }
     /* union/a:union: the second operand only within reach of its bound */
-    real u119 = u122;
-    real g119 = (length(p0 - ((real3)(-R(2.4000000000000004), R(0.0), -R(1.1)))) * R(0.9999)) - R(0.5196152422706632);
-    if (!(g119 > u119 && g119 > R(0.0))) {
+    real u126 = u129;
+    real g126 = (length(p0 - ((real3)(-R(1.7), R(0.0), -R(1.4249999999999998)))) * R(0.9999)) - R(0.5196152422706632);
+    if (!(g126 > u126 && g126 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p2 = p0 - ((real3)(-R(2.4000000000000004), R(0.0), -R(1.1)));
+        real3 p2 = p0 - ((real3)(-R(1.7), R(0.0), -R(1.4249999999999998)));
         /* .../b:translate/color/cuboid */
         real d3 = sd_box(p2, (real3)(0.3f));
-        real d119 = fmin(u122, d3);
-        u119 = d119;
+        real d126 = fmin(u129, d3);
+        u126 = d126;
     }
     /* .../a:union/a:union: the second operand only within reach of its bound */
-    real u113 = u119;
-    real g113 = (length(p0 - ((real3)(-R(1.6), R(0.0), -R(1.1)))) * R(0.9999)) - R(0.5196152422706632);
-    if (!(g113 > u113 && g113 > R(0.0))) {
+    real u120 = u126;
+    real g120 = (length(p0 - ((real3)(-R(0.85), R(0.0), -R(1.4249999999999998)))) * R(0.9999)) - R(0.5196152422706632);
+    if (!(g120 > u120 && g120 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p3 = p0 - ((real3)(-R(1.6), R(0.0), -R(1.1)));
+        real3 p3 = p0 - ((real3)(-R(0.85), R(0.0), -R(1.4249999999999998)));
         /* .../b:translate/color/round_box */
         real d7 = sd_round_box(p3, (real3)(0.3f), 0.08f);
-        real d113 = fmin(u119, d7);
-        u113 = d113;
+        real d120 = fmin(u126, d7);
+        u120 = d120;
     }
     /* .../a:union/a:union: the second operand only within reach of its bound */
-    real u108 = u113;
-    real g108 = (length(p0 - ((real3)(-R(0.8), R(0.0), -R(1.1)))) * R(0.9999)) - R(0.38);
-    if (!(g108 > u108 && g108 > R(0.0))) {
+    real u114 = u120;
+    real g114 = (length(p0 - ((real3)(R(0.0), R(0.0), -R(1.4249999999999998)))) * R(0.9999)) - R(0.38);
+    if (!(g114 > u114 && g114 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p4 = p0 - ((real3)(-R(0.8), R(0.0), -R(1.1)));
+        real3 p4 = p0 - ((real3)(R(0.0), R(0.0), -R(1.4249999999999998)));
         /* .../b:translate/color/torus */
         real d11 = sd_torus(p4, 0.28f, 0.1f);
-        real d108 = fmin(u113, d11);
-        u108 = d108;
+        real d114 = fmin(u120, d11);
+        u114 = d114;
     }
     /* .../a:union/a:union: the second operand only within reach of its bound */
-    real u103 = u108;
-    real g103 = (length(p0 - ((real3)(R(0.0), R(0.0), -R(1.1)))) * R(0.9999)) - R(0.4301162633521313);
-    if (!(g103 > u103 && g103 > R(0.0))) {
+    real u109 = u114;
+    real g109 = (length(p0 - ((real3)(R(0.85), R(0.0), -R(1.4249999999999998)))) * R(0.9999)) - R(0.4301162633521313);
+    if (!(g109 > u109 && g109 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p5 = p0 - ((real3)(R(0.0), R(0.0), -R(1.1)));
+        real3 p5 = p0 - ((real3)(R(0.85), R(0.0), -R(1.4249999999999998)));
         /* .../b:translate/color/cylinder */
         real d15 = sd_cylinder(p5, 0.25f, 0.35f);
-        real d103 = fmin(u108, d15);
-        u103 = d103;
+        real d109 = fmin(u114, d15);
+        u109 = d109;
     }
     /* .../a:union/a:union: the second operand only within reach of its bound */
-    real u98 = u103;
-    real g98 = (length(p0 - ((real3)(R(0.8), R(0.0), -R(1.1)))) * R(0.9999)) - R(0.38);
-    if (!(g98 > u98 && g98 > R(0.0))) {
+    real u104 = u109;
+    real g104 = (length(p0 - ((real3)(R(1.7), R(0.0), -R(1.4249999999999998)))) * R(0.9999)) - R(0.38);
+    if (!(g104 > u104 && g104 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p6 = p0 - ((real3)(R(0.8), R(0.0), -R(1.1)));
+        real3 p6 = p0 - ((real3)(R(1.7), R(0.0), -R(1.4249999999999998)));
         /* .../b:translate/color/capsule */
         real d19 = sd_capsule(p6, (real3)(0.0f, (-0.2f), 0.0f), (real3)(0.0f, 0.2f, 0.0f), 0.18f);
-        real d98 = fmin(u103, d19);
-        u98 = d98;
+        real d104 = fmin(u109, d19);
+        u104 = d104;
     }
     /* .../a:union/a:union: the second operand only within reach of its bound */
-    real u93 = u98;
-    real g93 = (length(p0 - ((real3)(R(1.6), R(0.0), -R(1.1)))) * R(0.9999)) - R(0.4);
-    if (!(g93 > u93 && g93 > R(0.0))) {
+    real u99 = u104;
+    real g99 = (length(p0 - ((real3)(R(2.55), R(0.0), -R(1.4249999999999998)))) * R(0.9999)) - R(0.4);
+    if (!(g99 > u99 && g99 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p7 = p0 - ((real3)(R(1.6), R(0.0), -R(1.1)));
+        real3 p7 = p0 - ((real3)(R(2.55), R(0.0), -R(1.4249999999999998)));
         /* .../b:translate/color/octahedron */
         real d23 = sd_octahedron(p7, 0.4f);
-        real d93 = fmin(u98, d23);
-        u93 = d93;
+        real d99 = fmin(u104, d23);
+        u99 = d99;
     }
     /* .../a:union/a:union: the second operand only within reach of its bound */
-    real u87 = u93;
-    real g87 = (length(p0 - ((real3)(R(2.4000000000000004), R(0.0), -R(1.1)))) * R(0.9999)) - R(0.4609772228646443);
-    if (!(g87 > u87 && g87 > R(0.0))) {
+    real u94 = u99;
+    real g94 = (length(p0 - ((real3)(-R(2.55), R(0.0), -R(0.475)))) * R(0.9999)) - R(0.4609772228646443);
+    if (!(g94 > u94 && g94 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p8 = p0 - ((real3)(R(2.4000000000000004), R(0.0), -R(1.1)));
+        real3 p8 = p0 - ((real3)(-R(2.55), R(0.0), -R(0.475)));
         /* .../b:translate/color/capped_cone */
         real d27 = sd_capped_cone(p8, 0.35f, 0.3f, 0.1f);
-        real d87 = fmin(u93, d27);
-        u87 = d87;
+        real d94 = fmin(u99, d27);
+        u94 = d94;
     }
     /* .../a:union/a:union: the second operand only within reach of its bound */
-    real u81 = u87;
-    real g81 = R(0.5714285714285715) * ((length(p0 - ((real3)(R(3.2), R(0.0), -R(1.1)))) * R(0.9999)) - R(0.35));
-    if (!(g81 > u81 && g81 > R(0.0))) {
+    real u88 = u94;
+    real g88 = R(0.5714285714285715) * ((length(p0 - ((real3)(-R(1.7), R(0.0), -R(0.475)))) * R(0.9999)) - R(0.35));
+    if (!(g88 > u88 && g88 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p9 = p0 - ((real3)(R(3.2), R(0.0), -R(1.1)));
+        real3 p9 = p0 - ((real3)(-R(1.7), R(0.0), -R(0.475)));
         /* .../b:translate/color/ellipsoid */
         real d31 = sd_ellipsoid(p9, (real3)(0.35f, 0.2f, 0.25f));
-        real d81 = fmin(u87, d31);
-        u81 = d81;
+        real d88 = fmin(u94, d31);
+        u88 = d88;
     }
     /* .../a:union/a:union: the second operand only within reach of its bound */
-    real u77 = u81;
-    real g77 = (length(p0 - ((real3)(-R(3.2), R(0.0), R(0.0)))) * R(0.9999)) - R(0.4410593308539491);
-    if (!(g77 > u77 && g77 > R(0.0))) {
+    real u82 = u88;
+    real g82 = (length(p0 - ((real3)(-R(0.85), R(0.0), -R(0.475)))) * R(0.9999)) - R(0.4410593308539491);
+    if (!(g82 > u82 && g82 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p10 = p0 - ((real3)(-R(3.2), R(0.0), R(0.0)));
+        real3 p10 = p0 - ((real3)(-R(0.85), R(0.0), -R(0.475)));
         /* .../b:translate/color/hex_prism */
         real d35 = sd_hex_prism(p10, 0.28f, 0.3f);
-        real d77 = fmin(u81, d35);
-        u77 = d77;
+        real d82 = fmin(u88, d35);
+        u82 = d82;
     }
     /* .../a:union/a:union: the second operand only within reach of its bound */
-    real u72 = u77;
-    real g72 = (length(p0 - ((real3)(-R(2.4000000000000004), R(0.0), R(0.0)))) * R(0.9999)) - R(0.44);
-    if (!(g72 > u72 && g72 > R(0.0))) {
+    real u78 = u82;
+    real g78 = (length(p0 - ((real3)(R(0.0), R(0.0), -R(0.475)))) * R(0.9999)) - R(0.44);
+    if (!(g78 > u78 && g78 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p11 = p0 - ((real3)(-R(2.4000000000000004), R(0.0), R(0.0)));
+        real3 p11 = p0 - ((real3)(R(0.0), R(0.0), -R(0.475)));
         /* .../b:translate/color/round_cone */
         real d39 = sd_round_cone(p11, 0.22f, 0.22f, 0.1f);
-        real d72 = fmin(u77, d39);
-        u72 = d72;
+        real d78 = fmin(u82, d39);
+        u78 = d78;
     }
     /* .../a:union/a:union: the second operand only within reach of its bound */
-    real u68 = u72;
-    real g68 = (length(p0 - ((real3)(-R(1.6), R(0.0), R(0.0)))) * R(0.9999)) - R(0.41000000000000003);
-    if (!(g68 > u68 && g68 > R(0.0))) {
+    real u73 = u78;
+    real g73 = (length(p0 - ((real3)(R(0.85), R(0.0), -R(0.475)))) * R(0.9999)) - R(0.41000000000000003);
+    if (!(g73 > u73 && g73 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p12 = p0 - ((real3)(-R(1.6), R(0.0), R(0.0)));
+        real3 p12 = p0 - ((real3)(R(0.85), R(0.0), -R(0.475)));
         /* .../b:translate/color/rotate */
         real3 p13 = (real3)((R(0.8775825618903728) * p12.x) - (R(0.479425538604203) * p12.z), p12.y, (R(0.479425538604203) * p12.x) + (R(0.8775825618903728) * p12.z));
         /* .../color/rotate/link */
         real d43 = sd_link(p13, 0.14f, 0.2f, 0.07f);
-        real d68 = fmin(u72, d43);
-        u68 = d68;
+        real d73 = fmin(u78, d43);
+        u73 = d73;
     }
     /* .../a:union/a:union: the second operand only within reach of its bound */
-    real u64 = u68;
-    real g64 = (length(p0 - ((real3)(-R(0.8), R(0.05), R(0.0)))) * R(0.9999)) - R(0.35);
-    if (!(g64 > u64 && g64 > R(0.0))) {
+    real u69 = u73;
+    real g69 = (length(p0 - ((real3)(R(1.7), R(0.05), -R(0.475)))) * R(0.9999)) - R(0.35);
+    if (!(g69 > u69 && g69 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p14 = p0 - ((real3)(-R(0.8), R(0.0), R(0.0)));
+        real3 p14 = p0 - ((real3)(R(1.7), R(0.0), -R(0.475)));
         /* .../b:translate/color/translate */
         real3 p15 = p14 - ((real3)(R(0.0), R(0.05), R(0.0)));
         /* .../color/translate/cut_sphere */
         real d48 = sd_cut_sphere(p15, 0.35f, 0.15f);
-        real d64 = fmin(u68, d48);
-        u64 = d64;
+        real d69 = fmin(u73, d48);
+        u69 = d69;
     }
     /* .../a:union/a:union: the second operand only within reach of its bound */
-    real u60 = u64;
-    real g60 = (length(p0 - ((real3)(R(0.0), -R(0.3), R(0.0)))) * R(0.9999)) - R(0.45);
-    if (!(g60 > u60 && g60 > R(0.0))) {
-        /* .../a:union/b:translate/translate */
-        real3 p16 = p0 - ((real3)(R(0.0), -R(0.3), R(0.0)));
-        /* .../b:translate/translate/solid_angle */
-        real d53 = sd_solid_angle(p16, 0.6f, 0.45f);
-        real d60 = fmin(u64, d53);
-        u60 = d60;
-    }
-    /* .../a:union/a:union: the second operand only within reach of its bound */
-    real u56 = u60;
-    real g56 = (length(p0 - ((real3)(R(0.8), R(0.0), R(0.0)))) * R(0.9999)) - R(0.32);
-    if (!(g56 > u56 && g56 > R(0.0))) {
+    real u65 = u69;
+    real g65 = (length(p0 - ((real3)(R(2.55), -R(0.3), -R(0.475)))) * R(0.9999)) - R(0.45);
+    if (!(g65 > u65 && g65 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p17 = p0 - ((real3)(R(0.8), R(0.0), R(0.0)));
-        /* .../b:translate/color/capped_torus */
-        real d57 = sd_capped_torus(p17, 2.2f, 0.25f, 0.07f);
-        real d56 = fmin(u60, d57);
-        u56 = d56;
+        real3 p16 = p0 - ((real3)(R(2.55), R(0.0), -R(0.475)));
+        /* .../b:translate/color/translate */
+        real3 p17 = p16 - ((real3)(R(0.0), -R(0.3), R(0.0)));
+        /* .../color/translate/solid_angle */
+        real d53 = sd_solid_angle(p17, 0.6f, 0.45f);
+        real d65 = fmin(u69, d53);
+        u65 = d65;
     }
     /* .../a:union/a:union: the second operand only within reach of its bound */
-    real u52 = u56;
-    real g52 = (length(p0 - ((real3)(R(1.5750000000000002), -R(0.024999999999999994), R(0.0)))) * R(0.9999)) - R(0.34734708865916814);
+    real u61 = u65;
+    real g61 = (length(p0 - ((real3)(-R(2.55), R(0.0), R(0.475)))) * R(0.9999)) - R(0.32);
+    if (!(g61 > u61 && g61 > R(0.0))) {
+        /* .../a:union/a:union/b:translate */
+        real3 p18 = p0 - ((real3)(-R(2.55), R(0.0), R(0.475)));
+        /* .../b:translate/color/capped_torus */
+        real d58 = sd_capped_torus(p18, 2.2f, 0.25f, 0.07f);
+        real d61 = fmin(u65, d58);
+        u61 = d61;
+    }
+    /* .../a:union/a:union: the second operand only within reach of its bound */
+    real u57 = u61;
+    real g57 = (length(p0 - ((real3)(-R(1.7249999999999999), -R(0.024999999999999994), R(0.475)))) * R(0.9999)) - R(0.34734708865916814);
+    if (!(g57 > u57 && g57 > R(0.0))) {
+        /* .../a:union/a:union/b:translate */
+        real3 p19 = p0 - ((real3)(-R(1.7), R(0.0), R(0.475)));
+        /* .../b:translate/color/cylinder_between */
+        real d62 = sd_cylinder_between(p19, (real3)((-0.2f), (-0.3f), 0.0f), (real3)(0.15f, 0.25f, 0.0f), 0.12f);
+        real d57 = fmin(u61, d62);
+        u57 = d57;
+    }
+    /* .../a:union/a:union: the second operand only within reach of its bound */
+    real u52 = u57;
+    real g52 = (length(p0 - ((real3)(-R(0.825), R(0.024999999999999994), R(0.475)))) * R(0.9999)) - R(0.3932556420447137);
     if (!(g52 > u52 && g52 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p18 = p0 - ((real3)(R(1.6), R(0.0), R(0.0)));
-        /* .../b:translate/color/cylinder_between */
-        real d61 = sd_cylinder_between(p18, (real3)((-0.2f), (-0.3f), 0.0f), (real3)(0.15f, 0.25f, 0.0f), 0.12f);
-        real d52 = fmin(u56, d61);
+        real3 p20 = p0 - ((real3)(-R(0.85), R(0.0), R(0.475)));
+        /* .../b:translate/color/cone_between */
+        real d66 = sd_cone_between(p20, (real3)(0.2f, (-0.25f), 0.0f), (real3)((-0.15f), 0.3f, 0.0f), 0.22f, 0.05f);
+        real d52 = fmin(u57, d66);
         u52 = d52;
     }
     /* .../a:union/a:union: the second operand only within reach of its bound */
     real u47 = u52;
-    real g47 = (length(p0 - ((real3)(R(2.4250000000000003), R(0.024999999999999994), R(0.0)))) * R(0.9999)) - R(0.3932556420447137);
+    real g47 = (length(p0 - ((real3)(R(0.02500000000000001), R(0.024999999999999994), R(0.475)))) * R(0.9999)) - R(0.4450438562747845);
     if (!(g47 > u47 && g47 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p19 = p0 - ((real3)(R(2.4000000000000004), R(0.0), R(0.0)));
-        /* .../b:translate/color/cone_between */
-        real d65 = sd_cone_between(p19, (real3)(0.2f, (-0.25f), 0.0f), (real3)((-0.15f), 0.3f, 0.0f), 0.22f, 0.05f);
-        real d47 = fmin(u52, d65);
+        real3 p21 = p0 - ((real3)(R(0.0), R(0.0), R(0.475)));
+        /* .../b:translate/color/round_cone_between */
+        real d70 = sd_round_cone_between(p21, (real3)((-0.15f), (-0.2f), 0.0f), (real3)(0.2f, 0.25f, 0.0f), 0.16f, 0.07f);
+        real d47 = fmin(u52, d70);
         u47 = d47;
     }
     /* .../a:union/a:union: the second operand only within reach of its bound */
     real u42 = u47;
-    real g42 = (length(p0 - ((real3)(R(3.225), R(0.024999999999999994), R(0.0)))) * R(0.9999)) - R(0.4450438562747845);
+    real g42 = (length(p0 - ((real3)(R(0.85), -R(0.13333333333333333), R(0.475)))) * R(0.9999)) - R(0.4633333333333334);
     if (!(g42 > u42 && g42 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p20 = p0 - ((real3)(R(3.2), R(0.0), R(0.0)));
-        /* .../b:translate/color/round_cone_between */
-        real d69 = sd_round_cone_between(p20, (real3)((-0.15f), (-0.2f), 0.0f), (real3)(0.2f, 0.25f, 0.0f), 0.16f, 0.07f);
-        real d42 = fmin(u47, d69);
+        real3 p22 = p0 - ((real3)(R(0.85), R(0.0), R(0.475)));
+        /* .../b:translate/color/rotate */
+        real3 p23 = (real3)((R(0.9210609940028851) * p22.x) - (R(0.3894183423086505) * p22.z), p22.y, (R(0.3894183423086505) * p22.x) + (R(0.9210609940028851) * p22.z));
+        /* .../color/rotate/triangle */
+        real d74 = sd_triangle(p23, (real3)((-0.3f), (-0.35f), 0.0f), (real3)(0.3f, (-0.35f), 0.0f), (real3)(0.0f, 0.3f, 0.0f), 0.03f);
+        real d42 = fmin(u47, d74);
         u42 = d42;
     }
     /* .../a:union/a:union: the second operand only within reach of its bound */
     real u38 = u42;
-    real g38 = (length(p0 - ((real3)(-R(3.2), -R(0.13333333333333333), R(1.1)))) * R(0.9999)) - R(0.4633333333333334);
+    real g38 = (length(p0 - ((real3)(R(1.7), -R(0.024999999999999994), R(0.46499999999999997)))) * R(0.9999)) - R(0.47286002303210883);
     if (!(g38 > u38 && g38 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p21 = p0 - ((real3)(-R(3.2), R(0.0), R(1.1)));
-        /* .../b:translate/color/rotate */
-        real3 p22 = (real3)((R(0.9210609940028851) * p21.x) - (R(0.3894183423086505) * p21.z), p21.y, (R(0.3894183423086505) * p21.x) + (R(0.9210609940028851) * p21.z));
-        /* .../color/rotate/triangle */
-        real d73 = sd_triangle(p22, (real3)((-0.3f), (-0.35f), 0.0f), (real3)(0.3f, (-0.35f), 0.0f), (real3)(0.0f, 0.3f, 0.0f), 0.03f);
-        real d38 = fmin(u42, d73);
+        real3 p24 = p0 - ((real3)(R(1.7), R(0.0), R(0.475)));
+        /* .../b:translate/color/quad */
+        real d79 = sd_quad(p24, (real3)((-0.28f), (-0.35f), (-0.12f)), (real3)(0.28f, (-0.35f), (-0.12f)), (real3)(0.2f, 0.3f, 0.1f), (real3)((-0.2f), 0.3f, 0.1f), 0.03f);
+        real d38 = fmin(u42, d79);
         u38 = d38;
     }
     /* .../a:union/a:union: the second operand only within reach of its bound */
     real u34 = u38;
-    real g34 = (length(p0 - ((real3)(-R(2.4000000000000004), -R(0.024999999999999994), R(1.09)))) * R(0.9999)) - R(0.47286002303210883);
+    real g34 = (length(p0 - ((real3)(R(2.55), -R(0.4), R(0.475)))) * R(0.9999)) - R(0.55);
     if (!(g34 > u34 && g34 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p23 = p0 - ((real3)(-R(2.4000000000000004), R(0.0), R(1.1)));
-        /* .../b:translate/color/quad */
-        real d78 = sd_quad(p23, (real3)((-0.28f), (-0.35f), (-0.12f)), (real3)(0.28f, (-0.35f), (-0.12f)), (real3)(0.2f, 0.3f, 0.1f), (real3)((-0.2f), 0.3f, 0.1f), 0.03f);
-        real d34 = fmin(u38, d78);
+        real3 p25 = p0 - ((real3)(R(2.55), R(0.0), R(0.475)));
+        /* .../b:translate/color/translate */
+        real3 p26 = p25 - ((real3)(R(0.0), -R(0.4), R(0.0)));
+        /* .../color/translate/rotate */
+        real3 p27 = (real3)((R(0.8775825618903728) * p26.x) - (R(0.479425538604203) * p26.z), p26.y, (R(0.479425538604203) * p26.x) + (R(0.8775825618903728) * p26.z));
+        /* .../translate/rotate/pyramid */
+        real d83 = sd_pyramid(p27, 0.3f, 0.55f);
+        real d34 = fmin(u38, d83);
         u34 = d34;
     }
     /* .../a:union/a:union: the second operand only within reach of its bound */
     real u30 = u34;
-    real g30 = (length(p0 - ((real3)(-R(1.6), -R(0.4), R(1.1)))) * R(0.9999)) - R(0.55);
+    real g30 = (length(p0 - ((real3)(-R(2.55), -R(0.34), R(1.4249999999999998)))) * R(0.9999)) - R(0.4044749683231337);
     if (!(g30 > u30 && g30 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p24 = p0 - ((real3)(-R(1.6), R(0.0), R(1.1)));
+        real3 p28 = p0 - ((real3)(-R(2.55), R(0.0), R(1.4249999999999998)));
         /* .../b:translate/color/translate */
-        real3 p25 = p24 - ((real3)(R(0.0), -R(0.4), R(0.0)));
+        real3 p29 = p28 - ((real3)(R(0.0), -R(0.34), R(0.0)));
         /* .../color/translate/rotate */
-        real3 p26 = (real3)((R(0.8775825618903728) * p25.x) - (R(0.479425538604203) * p25.z), p25.y, (R(0.479425538604203) * p25.x) + (R(0.8775825618903728) * p25.z));
-        /* .../translate/rotate/pyramid */
-        real d82 = sd_pyramid(p26, 0.3f, 0.55f);
-        real d30 = fmin(u34, d82);
+        real3 p30 = (real3)((R(0.8253356149096783) * p29.x) - (R(0.5646424733950354) * p29.z), p29.y, (R(0.5646424733950354) * p29.x) + (R(0.8253356149096783) * p29.z));
+        /* .../translate/rotate/rhombus */
+        real d89 = sd_rhombus(p30, 0.36f, 0.22f, 0.06f, 0.04f);
+        real d30 = fmin(u34, d89);
         u30 = d30;
     }
     /* .../a:union/a:union: the second operand only within reach of its bound */
     real u26 = u30;
-    real g26 = (length(p0 - ((real3)(-R(0.8), -R(0.34), R(1.1)))) * R(0.9999)) - R(0.4044749683231337);
+    real g26 = (length(p0 - ((real3)(-R(1.7), -R(0.1), R(1.4249999999999998)))) * R(0.9999)) - R(0.45343136195018535);
     if (!(g26 > u26 && g26 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p27 = p0 - ((real3)(-R(0.8), R(0.0), R(1.1)));
+        real3 p31 = p0 - ((real3)(-R(1.7), R(0.0), R(1.4249999999999998)));
         /* .../b:translate/color/translate */
-        real3 p28 = p27 - ((real3)(R(0.0), -R(0.34), R(0.0)));
-        /* .../color/translate/rotate */
-        real3 p29 = (real3)((R(0.8253356149096783) * p28.x) - (R(0.5646424733950354) * p28.z), p28.y, (R(0.5646424733950354) * p28.x) + (R(0.8253356149096783) * p28.z));
-        /* .../translate/rotate/rhombus */
-        real d88 = sd_rhombus(p29, 0.36f, 0.22f, 0.06f, 0.04f);
-        real d26 = fmin(u30, d88);
+        real3 p32 = p31 - ((real3)(R(0.0), -R(0.1), R(0.0)));
+        /* .../color/translate/tri_prism */
+        real d95 = sd_tri_prism(p32, 0.17f, 0.3f);
+        real d26 = fmin(u30, d95);
         u26 = d26;
     }
     /* .../a:union/a:union: the second operand only within reach of its bound */
     real u22 = u26;
-    real g22 = (length(p0 - ((real3)(R(0.0), -R(0.1), R(1.1)))) * R(0.9999)) - R(0.45343136195018535);
+    real g22 = (length(p0 - ((real3)(-R(0.85), -R(0.2), R(1.4249999999999998)))) * R(0.9999)) - R(0.3440930106817051);
     if (!(g22 > u22 && g22 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p30 = p0 - ((real3)(R(0.0), R(0.0), R(1.1)));
+        real3 p33 = p0 - ((real3)(-R(0.85), R(0.0), R(1.4249999999999998)));
         /* .../b:translate/color/translate */
-        real3 p31 = p30 - ((real3)(R(0.0), -R(0.1), R(0.0)));
-        /* .../color/translate/tri_prism */
-        real d94 = sd_tri_prism(p31, 0.17f, 0.3f);
-        real d22 = fmin(u26, d94);
+        real3 p34 = p33 - ((real3)(R(0.0), -R(0.2), R(0.0)));
+        /* .../color/translate/rounded_cylinder */
+        real d100 = sd_rounded_cylinder(p34, 0.28f, 0.2f, 0.08f);
+        real d22 = fmin(u26, d100);
         u22 = d22;
     }
     /* .../a:union/a:union: the second operand only within reach of its bound */
     real u18 = u22;
-    real g18 = (length(p0 - ((real3)(R(0.8), -R(0.2), R(1.1)))) * R(0.9999)) - R(0.3440930106817051);
+    real g18 = (length(p0 - ((real3)(R(0.0), -R(0.09999999999999998), R(1.4249999999999998)))) * R(0.9999)) - R(0.41036569057366384);
     if (!(g18 > u18 && g18 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p32 = p0 - ((real3)(R(0.8), R(0.0), R(1.1)));
+        real3 p35 = p0 - ((real3)(R(0.0), R(0.0), R(1.4249999999999998)));
         /* .../b:translate/color/translate */
-        real3 p33 = p32 - ((real3)(R(0.0), -R(0.2), R(0.0)));
-        /* .../color/translate/rounded_cylinder */
-        real d99 = sd_rounded_cylinder(p33, 0.28f, 0.2f, 0.08f);
-        real d18 = fmin(u22, d99);
+        real3 p36 = p35 - ((real3)(R(0.0), R(0.2), R(0.0)));
+        /* .../color/translate/cone */
+        real d105 = sd_cone(p36, 0.28f, 0.6f);
+        real d18 = fmin(u22, d105);
         u18 = d18;
     }
     /* .../a:union/a:union: the second operand only within reach of its bound */
     real u14 = u18;
-    real g14 = (length(p0 - ((real3)(R(1.6), -R(0.09999999999999998), R(1.1)))) * R(0.9999)) - R(0.41036569057366384);
+    real g14 = (length(p0 - ((real3)(R(0.85), -R(0.06), R(1.4249999999999998)))) * R(0.9999)) - R(0.34);
     if (!(g14 > u14 && g14 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p34 = p0 - ((real3)(R(1.6), R(0.0), R(1.1)));
+        real3 p37 = p0 - ((real3)(R(0.85), R(0.0), R(1.4249999999999998)));
         /* .../b:translate/color/translate */
-        real3 p35 = p34 - ((real3)(R(0.0), R(0.2), R(0.0)));
-        /* .../color/translate/cone */
-        real d104 = sd_cone(p35, 0.28f, 0.6f);
-        real d14 = fmin(u18, d104);
+        real3 p38 = p37 - ((real3)(R(0.0), -R(0.06), R(0.0)));
+        /* .../color/translate/cut_hollow_sphere */
+        real d110 = sd_cut_hollow_sphere(p38, 0.32f, 0.12f, 0.02f);
+        real d14 = fmin(u18, d110);
         u14 = d14;
     }
     /* .../a:union/a:union: the second operand only within reach of its bound */
     real u10 = u14;
-    real g10 = (length(p0 - ((real3)(R(2.4000000000000004), -R(0.06), R(1.1)))) * R(0.9999)) - R(0.34);
+    real g10 = (length(p0 - ((real3)(R(1.7), -R(0.08), R(1.4249999999999998)))) * R(0.9999)) - R(0.32);
     if (!(g10 > u10 && g10 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p36 = p0 - ((real3)(R(2.4000000000000004), R(0.0), R(1.1)));
+        real3 p39 = p0 - ((real3)(R(1.7), R(0.0), R(1.4249999999999998)));
         /* .../b:translate/color/translate */
-        real3 p37 = p36 - ((real3)(R(0.0), -R(0.06), R(0.0)));
-        /* .../color/translate/cut_hollow_sphere */
-        real d109 = sd_cut_hollow_sphere(p37, 0.32f, 0.12f, 0.02f);
-        real d10 = fmin(u14, d109);
+        real3 p40 = p39 - ((real3)(R(0.0), -R(0.08), R(0.0)));
+        /* .../color/translate/rotate */
+        real3 p41 = (real3)(p40.z, p40.y, -p40.x);
+        /* .../translate/rotate/death_star */
+        real d115 = sd_death_star(p41, 0.32f, 0.25f, 0.3f);
+        real d10 = fmin(u14, d115);
         u10 = d10;
     }
     /* .../a:union/a:union: the second operand only within reach of its bound */
     real u6 = u10;
-    real g6 = (length(p0 - ((real3)(R(3.2), -R(0.08), R(1.1)))) * R(0.9999)) - R(0.32);
+    real g6 = (length(p0 - ((real3)(R(2.55), -R(0.12), R(1.4249999999999998)))) * R(0.9999)) - R(0.48497422611928565);
     if (!(g6 > u6 && g6 > R(0.0))) {
         /* union/a:union/b:translate */
-        real3 p38 = p0 - ((real3)(R(3.2), R(0.0), R(1.1)));
+        real3 p42 = p0 - ((real3)(R(2.55), R(0.0), R(1.4249999999999998)));
         /* .../b:translate/color/translate */
-        real3 p39 = p38 - ((real3)(R(0.0), -R(0.08), R(0.0)));
+        real3 p43 = p42 - ((real3)(R(0.0), -R(0.12), R(0.0)));
         /* .../color/translate/rotate */
-        real3 p40 = (real3)(p39.z, p39.y, -p39.x);
-        /* .../translate/rotate/death_star */
-        real d114 = sd_death_star(p40, 0.32f, 0.25f, 0.3f);
-        real d6 = fmin(u10, d114);
+        real3 p44 = (real3)((R(0.8775825618903728) * p43.x) - (R(0.479425538604203) * p43.z), p43.y, (R(0.479425538604203) * p43.x) + (R(0.8775825618903728) * p43.z));
+        /* .../translate/rotate/box_frame */
+        real d121 = sd_box_frame(p44, (real3)(0.28f), 0.05f);
+        real d6 = fmin(u10, d121);
         u6 = d6;
     }
     return u6;
@@ -846,312 +875,333 @@ real DE(real3 p0, __global const real* params) {
 real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     /* union */
     /* union/b:color/plane */
-    real d120 = sd_plane(p0, (real3)(0.0f, 1.0f, 0.0f), 0.4f);
+    real d127 = sd_plane(p0, (real3)(0.0f, 1.0f, 0.0f), 0.4f);
     /* union/b:color */
-    real3 c121 = (real3)(0.55f, 0.55f, 0.6f);
+    real3 c128 = (real3)(0.55f, 0.55f, 0.6f);
     /* union: the second operand only within reach of its bound */
-    real u122 = d120;
-    real3 uc122 = c121;
-    real ut122 = R(1.0);
-    real g122 = (length(p0 - ((real3)(-R(3.2), R(0.0), -R(1.1)))) * R(0.9999)) - R(0.35);
-    if (!(g122 > u122 && g122 > R(0.0))) {
+    real u129 = d127;
+    real3 uc129 = c128;
+    real ut129 = R(1.0);
+    real g129 = (length(p0 - ((real3)(-R(2.55), R(0.0), -R(1.4249999999999998)))) * R(0.9999)) - R(0.35);
+    if (!(g129 > u129 && g129 > R(0.0))) {
         /* .../a:union/a:union/a:translate */
-        real3 p1 = p0 - ((real3)(-R(3.2), R(0.0), -R(1.1)));
+        real3 p1 = p0 - ((real3)(-R(2.55), R(0.0), -R(1.4249999999999998)));
         /* .../a:translate/color/sphere */
         real d0 = sd_sphere(p1, 0.35f);
         /* .../a:union/a:translate/color */
         real3 c1 = (real3)(0.9f, 0.45f, 0.3f);
-        real d122 = fmin(d120, d0);
-        real3 c122 = d120 < d0 ? c121 : c1;
-        u122 = d122;
-        uc122 = c122;
-        ut122 = R(1.0);
+        real d129 = fmin(d127, d0);
+        real3 c129 = d127 < d0 ? c128 : c1;
+        u129 = d129;
+        uc129 = c129;
+        ut129 = R(1.0);
     }
     /* union/a:union: the second operand only within reach of its bound */
-    real u119 = u122;
-    real3 uc119 = uc122;
-    real ut119 = ut122;
-    real g119 = (length(p0 - ((real3)(-R(2.4000000000000004), R(0.0), -R(1.1)))) * R(0.9999)) - R(0.5196152422706632);
-    if (!(g119 > u119 && g119 > R(0.0))) {
+    real u126 = u129;
+    real3 uc126 = uc129;
+    real ut126 = ut129;
+    real g126 = (length(p0 - ((real3)(-R(1.7), R(0.0), -R(1.4249999999999998)))) * R(0.9999)) - R(0.5196152422706632);
+    if (!(g126 > u126 && g126 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p2 = p0 - ((real3)(-R(2.4000000000000004), R(0.0), -R(1.1)));
+        real3 p2 = p0 - ((real3)(-R(1.7), R(0.0), -R(1.4249999999999998)));
         /* .../b:translate/color/cuboid */
         real d3 = sd_box(p2, (real3)(0.3f));
         /* .../a:union/b:translate/color */
-        real3 c4 = (real3)(0.8769231f, 0.47692308f, 0.32307693f);
-        real d119 = fmin(u122, d3);
-        real3 c119 = u122 < d3 ? uc122 : c4;
-        real t119 = u122 < d3 ? ut122 : R(1.0);
-        u119 = d119;
-        uc119 = c119;
-        ut119 = t119;
+        real3 c4 = (real3)(0.87777776f, 0.47592592f, 0.32222223f);
+        real d126 = fmin(u129, d3);
+        real3 c126 = u129 < d3 ? uc129 : c4;
+        real t126 = u129 < d3 ? ut129 : R(1.0);
+        u126 = d126;
+        uc126 = c126;
+        ut126 = t126;
     }
     /* .../a:union/a:union: the second operand only within reach of its bound */
-    real u113 = u119;
-    real3 uc113 = uc119;
-    real ut113 = ut119;
-    real g113 = (length(p0 - ((real3)(-R(1.6), R(0.0), -R(1.1)))) * R(0.9999)) - R(0.5196152422706632);
-    if (!(g113 > u113 && g113 > R(0.0))) {
+    real u120 = u126;
+    real3 uc120 = uc126;
+    real ut120 = ut126;
+    real g120 = (length(p0 - ((real3)(-R(0.85), R(0.0), -R(1.4249999999999998)))) * R(0.9999)) - R(0.5196152422706632);
+    if (!(g120 > u120 && g120 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p3 = p0 - ((real3)(-R(1.6), R(0.0), -R(1.1)));
+        real3 p3 = p0 - ((real3)(-R(0.85), R(0.0), -R(1.4249999999999998)));
         /* .../b:translate/color/round_box */
         real d7 = sd_round_box(p3, (real3)(0.3f), 0.08f);
         /* .../a:union/b:translate/color */
-        real3 c8 = (real3)(0.85384613f, 0.50384617f, 0.34615386f);
-        real d113 = fmin(u119, d7);
-        real3 c113 = u119 < d7 ? uc119 : c8;
-        real t113 = u119 < d7 ? ut119 : R(1.0);
-        u113 = d113;
-        uc113 = c113;
-        ut113 = t113;
+        real3 c8 = (real3)(0.85555553f, 0.50185186f, 0.34444445f);
+        real d120 = fmin(u126, d7);
+        real3 c120 = u126 < d7 ? uc126 : c8;
+        real t120 = u126 < d7 ? ut126 : R(1.0);
+        u120 = d120;
+        uc120 = c120;
+        ut120 = t120;
     }
     /* .../a:union/a:union: the second operand only within reach of its bound */
-    real u108 = u113;
-    real3 uc108 = uc113;
-    real ut108 = ut113;
-    real g108 = (length(p0 - ((real3)(-R(0.8), R(0.0), -R(1.1)))) * R(0.9999)) - R(0.38);
-    if (!(g108 > u108 && g108 > R(0.0))) {
+    real u114 = u120;
+    real3 uc114 = uc120;
+    real ut114 = ut120;
+    real g114 = (length(p0 - ((real3)(R(0.0), R(0.0), -R(1.4249999999999998)))) * R(0.9999)) - R(0.38);
+    if (!(g114 > u114 && g114 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p4 = p0 - ((real3)(-R(0.8), R(0.0), -R(1.1)));
+        real3 p4 = p0 - ((real3)(R(0.0), R(0.0), -R(1.4249999999999998)));
         /* .../b:translate/color/torus */
         real d11 = sd_torus(p4, 0.28f, 0.1f);
         /* .../a:union/b:translate/color */
-        real3 c12 = (real3)(0.83076924f, 0.5307692f, 0.36923078f);
-        real d108 = fmin(u113, d11);
-        real3 c108 = u113 < d11 ? uc113 : c12;
-        real t108 = u113 < d11 ? ut113 : R(1.0);
-        u108 = d108;
-        uc108 = c108;
-        ut108 = t108;
+        real3 c12 = (real3)(0.8333333f, 0.5277778f, 0.36666667f);
+        real d114 = fmin(u120, d11);
+        real3 c114 = u120 < d11 ? uc120 : c12;
+        real t114 = u120 < d11 ? ut120 : R(1.0);
+        u114 = d114;
+        uc114 = c114;
+        ut114 = t114;
     }
     /* .../a:union/a:union: the second operand only within reach of its bound */
-    real u103 = u108;
-    real3 uc103 = uc108;
-    real ut103 = ut108;
-    real g103 = (length(p0 - ((real3)(R(0.0), R(0.0), -R(1.1)))) * R(0.9999)) - R(0.4301162633521313);
-    if (!(g103 > u103 && g103 > R(0.0))) {
+    real u109 = u114;
+    real3 uc109 = uc114;
+    real ut109 = ut114;
+    real g109 = (length(p0 - ((real3)(R(0.85), R(0.0), -R(1.4249999999999998)))) * R(0.9999)) - R(0.4301162633521313);
+    if (!(g109 > u109 && g109 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p5 = p0 - ((real3)(R(0.0), R(0.0), -R(1.1)));
+        real3 p5 = p0 - ((real3)(R(0.85), R(0.0), -R(1.4249999999999998)));
         /* .../b:translate/color/cylinder */
         real d15 = sd_cylinder(p5, 0.25f, 0.35f);
         /* .../a:union/b:translate/color */
-        real3 c16 = (real3)(0.8076923f, 0.5576923f, 0.3923077f);
-        real d103 = fmin(u108, d15);
-        real3 c103 = u108 < d15 ? uc108 : c16;
-        real t103 = u108 < d15 ? ut108 : R(1.0);
-        u103 = d103;
-        uc103 = c103;
-        ut103 = t103;
+        real3 c16 = (real3)(0.8111111f, 0.5537037f, 0.3888889f);
+        real d109 = fmin(u114, d15);
+        real3 c109 = u114 < d15 ? uc114 : c16;
+        real t109 = u114 < d15 ? ut114 : R(1.0);
+        u109 = d109;
+        uc109 = c109;
+        ut109 = t109;
     }
     /* .../a:union/a:union: the second operand only within reach of its bound */
-    real u98 = u103;
-    real3 uc98 = uc103;
-    real ut98 = ut103;
-    real g98 = (length(p0 - ((real3)(R(0.8), R(0.0), -R(1.1)))) * R(0.9999)) - R(0.38);
-    if (!(g98 > u98 && g98 > R(0.0))) {
+    real u104 = u109;
+    real3 uc104 = uc109;
+    real ut104 = ut109;
+    real g104 = (length(p0 - ((real3)(R(1.7), R(0.0), -R(1.4249999999999998)))) * R(0.9999)) - R(0.38);
+    if (!(g104 > u104 && g104 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p6 = p0 - ((real3)(R(0.8), R(0.0), -R(1.1)));
+        real3 p6 = p0 - ((real3)(R(1.7), R(0.0), -R(1.4249999999999998)));
         /* .../b:translate/color/capsule */
         real d19 = sd_capsule(p6, (real3)(0.0f, (-0.2f), 0.0f), (real3)(0.0f, 0.2f, 0.0f), 0.18f);
         /* .../a:union/b:translate/color */
-        real3 c20 = (real3)(0.7846154f, 0.5846154f, 0.41538462f);
-        real d98 = fmin(u103, d19);
-        real3 c98 = u103 < d19 ? uc103 : c20;
-        real t98 = u103 < d19 ? ut103 : R(1.0);
-        u98 = d98;
-        uc98 = c98;
-        ut98 = t98;
+        real3 c20 = (real3)(0.7888889f, 0.5796296f, 0.41111112f);
+        real d104 = fmin(u109, d19);
+        real3 c104 = u109 < d19 ? uc109 : c20;
+        real t104 = u109 < d19 ? ut109 : R(1.0);
+        u104 = d104;
+        uc104 = c104;
+        ut104 = t104;
     }
     /* .../a:union/a:union: the second operand only within reach of its bound */
-    real u93 = u98;
-    real3 uc93 = uc98;
-    real ut93 = ut98;
-    real g93 = (length(p0 - ((real3)(R(1.6), R(0.0), -R(1.1)))) * R(0.9999)) - R(0.4);
-    if (!(g93 > u93 && g93 > R(0.0))) {
+    real u99 = u104;
+    real3 uc99 = uc104;
+    real ut99 = ut104;
+    real g99 = (length(p0 - ((real3)(R(2.55), R(0.0), -R(1.4249999999999998)))) * R(0.9999)) - R(0.4);
+    if (!(g99 > u99 && g99 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p7 = p0 - ((real3)(R(1.6), R(0.0), -R(1.1)));
+        real3 p7 = p0 - ((real3)(R(2.55), R(0.0), -R(1.4249999999999998)));
         /* .../b:translate/color/octahedron */
         real d23 = sd_octahedron(p7, 0.4f);
         /* .../a:union/b:translate/color */
-        real3 c24 = (real3)(0.76153845f, 0.61153847f, 0.43846154f);
-        real d93 = fmin(u98, d23);
-        real3 c93 = u98 < d23 ? uc98 : c24;
-        real t93 = u98 < d23 ? ut98 : R(1.0);
-        u93 = d93;
-        uc93 = c93;
-        ut93 = t93;
+        real3 c24 = (real3)(0.76666665f, 0.60555553f, 0.43333334f);
+        real d99 = fmin(u104, d23);
+        real3 c99 = u104 < d23 ? uc104 : c24;
+        real t99 = u104 < d23 ? ut104 : R(1.0);
+        u99 = d99;
+        uc99 = c99;
+        ut99 = t99;
     }
     /* .../a:union/a:union: the second operand only within reach of its bound */
-    real u87 = u93;
-    real3 uc87 = uc93;
-    real ut87 = ut93;
-    real g87 = (length(p0 - ((real3)(R(2.4000000000000004), R(0.0), -R(1.1)))) * R(0.9999)) - R(0.4609772228646443);
-    if (!(g87 > u87 && g87 > R(0.0))) {
+    real u94 = u99;
+    real3 uc94 = uc99;
+    real ut94 = ut99;
+    real g94 = (length(p0 - ((real3)(-R(2.55), R(0.0), -R(0.475)))) * R(0.9999)) - R(0.4609772228646443);
+    if (!(g94 > u94 && g94 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p8 = p0 - ((real3)(R(2.4000000000000004), R(0.0), -R(1.1)));
+        real3 p8 = p0 - ((real3)(-R(2.55), R(0.0), -R(0.475)));
         /* .../b:translate/color/capped_cone */
         real d27 = sd_capped_cone(p8, 0.35f, 0.3f, 0.1f);
         /* .../a:union/b:translate/color */
-        real3 c28 = (real3)(0.73846155f, 0.63846153f, 0.46153846f);
-        real d87 = fmin(u93, d27);
-        real3 c87 = u93 < d27 ? uc93 : c28;
-        real t87 = u93 < d27 ? ut93 : R(1.0);
-        u87 = d87;
-        uc87 = c87;
-        ut87 = t87;
+        real3 c28 = (real3)(0.74444443f, 0.63148147f, 0.45555556f);
+        real d94 = fmin(u99, d27);
+        real3 c94 = u99 < d27 ? uc99 : c28;
+        real t94 = u99 < d27 ? ut99 : R(1.0);
+        u94 = d94;
+        uc94 = c94;
+        ut94 = t94;
     }
     /* .../a:union/a:union: the second operand only within reach of its bound */
-    real u81 = u87;
-    real3 uc81 = uc87;
-    real ut81 = ut87;
-    real g81 = R(0.5714285714285715) * ((length(p0 - ((real3)(R(3.2), R(0.0), -R(1.1)))) * R(0.9999)) - R(0.35));
-    if (!(g81 > u81 && g81 > R(0.0))) {
+    real u88 = u94;
+    real3 uc88 = uc94;
+    real ut88 = ut94;
+    real g88 = R(0.5714285714285715) * ((length(p0 - ((real3)(-R(1.7), R(0.0), -R(0.475)))) * R(0.9999)) - R(0.35));
+    if (!(g88 > u88 && g88 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p9 = p0 - ((real3)(R(3.2), R(0.0), -R(1.1)));
+        real3 p9 = p0 - ((real3)(-R(1.7), R(0.0), -R(0.475)));
         /* .../b:translate/color/ellipsoid */
         real d31 = sd_ellipsoid(p9, (real3)(0.35f, 0.2f, 0.25f));
         /* .../a:union/b:translate/color */
-        real3 c32 = (real3)(0.7153846f, 0.6653846f, 0.4846154f);
-        real d81 = fmin(u87, d31);
-        real3 c81 = u87 < d31 ? uc87 : c32;
-        real t81 = u87 < d31 ? ut87 : R(1.0);
-        u81 = d81;
-        uc81 = c81;
-        ut81 = t81;
+        real3 c32 = (real3)(0.7222222f, 0.6574074f, 0.47777778f);
+        real d88 = fmin(u94, d31);
+        real3 c88 = u94 < d31 ? uc94 : c32;
+        real t88 = u94 < d31 ? ut94 : R(1.0);
+        u88 = d88;
+        uc88 = c88;
+        ut88 = t88;
     }
     /* .../a:union/a:union: the second operand only within reach of its bound */
-    real u77 = u81;
-    real3 uc77 = uc81;
-    real ut77 = ut81;
-    real g77 = (length(p0 - ((real3)(-R(3.2), R(0.0), R(0.0)))) * R(0.9999)) - R(0.4410593308539491);
-    if (!(g77 > u77 && g77 > R(0.0))) {
+    real u82 = u88;
+    real3 uc82 = uc88;
+    real ut82 = ut88;
+    real g82 = (length(p0 - ((real3)(-R(0.85), R(0.0), -R(0.475)))) * R(0.9999)) - R(0.4410593308539491);
+    if (!(g82 > u82 && g82 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p10 = p0 - ((real3)(-R(3.2), R(0.0), R(0.0)));
+        real3 p10 = p0 - ((real3)(-R(0.85), R(0.0), -R(0.475)));
         /* .../b:translate/color/hex_prism */
         real d35 = sd_hex_prism(p10, 0.28f, 0.3f);
         /* .../a:union/b:translate/color */
-        real3 c36 = (real3)(0.6923077f, 0.6923077f, 0.50769234f);
-        real d77 = fmin(u81, d35);
-        real3 c77 = u81 < d35 ? uc81 : c36;
-        real t77 = u81 < d35 ? ut81 : R(1.0);
-        u77 = d77;
-        uc77 = c77;
-        ut77 = t77;
+        real3 c36 = (real3)(0.7f, 0.68333334f, 0.5f);
+        real d82 = fmin(u88, d35);
+        real3 c82 = u88 < d35 ? uc88 : c36;
+        real t82 = u88 < d35 ? ut88 : R(1.0);
+        u82 = d82;
+        uc82 = c82;
+        ut82 = t82;
     }
     /* .../a:union/a:union: the second operand only within reach of its bound */
-    real u72 = u77;
-    real3 uc72 = uc77;
-    real ut72 = ut77;
-    real g72 = (length(p0 - ((real3)(-R(2.4000000000000004), R(0.0), R(0.0)))) * R(0.9999)) - R(0.44);
-    if (!(g72 > u72 && g72 > R(0.0))) {
+    real u78 = u82;
+    real3 uc78 = uc82;
+    real ut78 = ut82;
+    real g78 = (length(p0 - ((real3)(R(0.0), R(0.0), -R(0.475)))) * R(0.9999)) - R(0.44);
+    if (!(g78 > u78 && g78 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p11 = p0 - ((real3)(-R(2.4000000000000004), R(0.0), R(0.0)));
+        real3 p11 = p0 - ((real3)(R(0.0), R(0.0), -R(0.475)));
         /* .../b:translate/color/round_cone */
         real d39 = sd_round_cone(p11, 0.22f, 0.22f, 0.1f);
         /* .../a:union/b:translate/color */
-        real3 c40 = (real3)(0.66923076f, 0.7192308f, 0.5307692f);
-        real d72 = fmin(u77, d39);
-        real3 c72 = u77 < d39 ? uc77 : c40;
-        real t72 = u77 < d39 ? ut77 : R(1.0);
-        u72 = d72;
-        uc72 = c72;
-        ut72 = t72;
+        real3 c40 = (real3)(0.67777777f, 0.7092593f, 0.5222222f);
+        real d78 = fmin(u82, d39);
+        real3 c78 = u82 < d39 ? uc82 : c40;
+        real t78 = u82 < d39 ? ut82 : R(1.0);
+        u78 = d78;
+        uc78 = c78;
+        ut78 = t78;
     }
     /* .../a:union/a:union: the second operand only within reach of its bound */
-    real u68 = u72;
-    real3 uc68 = uc72;
-    real ut68 = ut72;
-    real g68 = (length(p0 - ((real3)(-R(1.6), R(0.0), R(0.0)))) * R(0.9999)) - R(0.41000000000000003);
-    if (!(g68 > u68 && g68 > R(0.0))) {
+    real u73 = u78;
+    real3 uc73 = uc78;
+    real ut73 = ut78;
+    real g73 = (length(p0 - ((real3)(R(0.85), R(0.0), -R(0.475)))) * R(0.9999)) - R(0.41000000000000003);
+    if (!(g73 > u73 && g73 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p12 = p0 - ((real3)(-R(1.6), R(0.0), R(0.0)));
+        real3 p12 = p0 - ((real3)(R(0.85), R(0.0), -R(0.475)));
         /* .../b:translate/color/rotate */
         real3 p13 = (real3)((R(0.8775825618903728) * p12.x) - (R(0.479425538604203) * p12.z), p12.y, (R(0.479425538604203) * p12.x) + (R(0.8775825618903728) * p12.z));
         /* .../color/rotate/link */
         real d43 = sd_link(p13, 0.14f, 0.2f, 0.07f);
         /* .../a:union/b:translate/color */
-        real3 c45 = (real3)(0.64615387f, 0.74615383f, 0.5538462f);
-        real d68 = fmin(u72, d43);
-        real3 c68 = u72 < d43 ? uc72 : c45;
-        real t68 = u72 < d43 ? ut72 : R(1.0);
-        u68 = d68;
-        uc68 = c68;
-        ut68 = t68;
+        real3 c45 = (real3)(0.65555555f, 0.7351852f, 0.54444444f);
+        real d73 = fmin(u78, d43);
+        real3 c73 = u78 < d43 ? uc78 : c45;
+        real t73 = u78 < d43 ? ut78 : R(1.0);
+        u73 = d73;
+        uc73 = c73;
+        ut73 = t73;
     }
     /* .../a:union/a:union: the second operand only within reach of its bound */
-    real u64 = u68;
-    real3 uc64 = uc68;
-    real ut64 = ut68;
-    real g64 = (length(p0 - ((real3)(-R(0.8), R(0.05), R(0.0)))) * R(0.9999)) - R(0.35);
-    if (!(g64 > u64 && g64 > R(0.0))) {
+    real u69 = u73;
+    real3 uc69 = uc73;
+    real ut69 = ut73;
+    real g69 = (length(p0 - ((real3)(R(1.7), R(0.05), -R(0.475)))) * R(0.9999)) - R(0.35);
+    if (!(g69 > u69 && g69 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p14 = p0 - ((real3)(-R(0.8), R(0.0), R(0.0)));
+        real3 p14 = p0 - ((real3)(R(1.7), R(0.0), -R(0.475)));
         /* .../b:translate/color/translate */
         real3 p15 = p14 - ((real3)(R(0.0), R(0.05), R(0.0)));
         /* .../color/translate/cut_sphere */
         real d48 = sd_cut_sphere(p15, 0.35f, 0.15f);
         /* .../a:union/b:translate/color */
-        real3 c50 = (real3)(0.6230769f, 0.77307695f, 0.5769231f);
-        real d64 = fmin(u68, d48);
-        real3 c64 = u68 < d48 ? uc68 : c50;
-        real t64 = u68 < d48 ? ut68 : R(1.0);
-        u64 = d64;
-        uc64 = c64;
-        ut64 = t64;
+        real3 c50 = (real3)(0.6333333f, 0.76111114f, 0.56666666f);
+        real d69 = fmin(u73, d48);
+        real3 c69 = u73 < d48 ? uc73 : c50;
+        real t69 = u73 < d48 ? ut73 : R(1.0);
+        u69 = d69;
+        uc69 = c69;
+        ut69 = t69;
     }
     /* .../a:union/a:union: the second operand only within reach of its bound */
-    real u60 = u64;
-    real3 uc60 = uc64;
-    real ut60 = ut64;
-    real g60 = (length(p0 - ((real3)(R(0.0), -R(0.3), R(0.0)))) * R(0.9999)) - R(0.45);
-    if (!(g60 > u60 && g60 > R(0.0))) {
-        /* .../a:union/b:translate/translate */
-        real3 p16 = p0 - ((real3)(R(0.0), -R(0.3), R(0.0)));
-        /* .../b:translate/translate/solid_angle */
-        real d53 = sd_solid_angle(p16, 0.6f, 0.45f);
+    real u65 = u69;
+    real3 uc65 = uc69;
+    real ut65 = ut69;
+    real g65 = (length(p0 - ((real3)(R(2.55), -R(0.3), -R(0.475)))) * R(0.9999)) - R(0.45);
+    if (!(g65 > u65 && g65 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 c55 = (real3)(0.6f, 0.8f, 0.6f);
-        real d60 = fmin(u64, d53);
-        real3 c60 = u64 < d53 ? uc64 : c55;
-        real t60 = u64 < d53 ? ut64 : R(1.0);
-        u60 = d60;
-        uc60 = c60;
-        ut60 = t60;
-    }
-    /* .../a:union/a:union: the second operand only within reach of its bound */
-    real u56 = u60;
-    real3 uc56 = uc60;
-    real ut56 = ut60;
-    real g56 = (length(p0 - ((real3)(R(0.8), R(0.0), R(0.0)))) * R(0.9999)) - R(0.32);
-    if (!(g56 > u56 && g56 > R(0.0))) {
-        /* .../a:union/a:union/b:translate */
-        real3 p17 = p0 - ((real3)(R(0.8), R(0.0), R(0.0)));
-        /* .../b:translate/color/capped_torus */
-        real d57 = sd_capped_torus(p17, 2.2f, 0.25f, 0.07f);
+        real3 p16 = p0 - ((real3)(R(2.55), R(0.0), -R(0.475)));
+        /* .../b:translate/color/translate */
+        real3 p17 = p16 - ((real3)(R(0.0), -R(0.3), R(0.0)));
+        /* .../color/translate/solid_angle */
+        real d53 = sd_solid_angle(p17, 0.6f, 0.45f);
         /* .../a:union/b:translate/color */
-        real3 c58 = (real3)(0.5769231f, 0.77307695f, 0.6230769f);
-        real d56 = fmin(u60, d57);
-        real3 c56 = u60 < d57 ? uc60 : c58;
-        real t56 = u60 < d57 ? ut60 : R(1.0);
-        u56 = d56;
-        uc56 = c56;
-        ut56 = t56;
+        real3 c55 = (real3)(0.6111111f, 0.787037f, 0.5888889f);
+        real d65 = fmin(u69, d53);
+        real3 c65 = u69 < d53 ? uc69 : c55;
+        real t65 = u69 < d53 ? ut69 : R(1.0);
+        u65 = d65;
+        uc65 = c65;
+        ut65 = t65;
     }
     /* .../a:union/a:union: the second operand only within reach of its bound */
-    real u52 = u56;
-    real3 uc52 = uc56;
-    real ut52 = ut56;
-    real g52 = (length(p0 - ((real3)(R(1.5750000000000002), -R(0.024999999999999994), R(0.0)))) * R(0.9999)) - R(0.34734708865916814);
+    real u61 = u65;
+    real3 uc61 = uc65;
+    real ut61 = ut65;
+    real g61 = (length(p0 - ((real3)(-R(2.55), R(0.0), R(0.475)))) * R(0.9999)) - R(0.32);
+    if (!(g61 > u61 && g61 > R(0.0))) {
+        /* .../a:union/a:union/b:translate */
+        real3 p18 = p0 - ((real3)(-R(2.55), R(0.0), R(0.475)));
+        /* .../b:translate/color/capped_torus */
+        real d58 = sd_capped_torus(p18, 2.2f, 0.25f, 0.07f);
+        /* .../a:union/b:translate/color */
+        real3 c59 = (real3)(0.5888889f, 0.787037f, 0.6111111f);
+        real d61 = fmin(u65, d58);
+        real3 c61 = u65 < d58 ? uc65 : c59;
+        real t61 = u65 < d58 ? ut65 : R(1.0);
+        u61 = d61;
+        uc61 = c61;
+        ut61 = t61;
+    }
+    /* .../a:union/a:union: the second operand only within reach of its bound */
+    real u57 = u61;
+    real3 uc57 = uc61;
+    real ut57 = ut61;
+    real g57 = (length(p0 - ((real3)(-R(1.7249999999999999), -R(0.024999999999999994), R(0.475)))) * R(0.9999)) - R(0.34734708865916814);
+    if (!(g57 > u57 && g57 > R(0.0))) {
+        /* .../a:union/a:union/b:translate */
+        real3 p19 = p0 - ((real3)(-R(1.7), R(0.0), R(0.475)));
+        /* .../b:translate/color/cylinder_between */
+        real d62 = sd_cylinder_between(p19, (real3)((-0.2f), (-0.3f), 0.0f), (real3)(0.15f, 0.25f, 0.0f), 0.12f);
+        /* .../a:union/b:translate/color */
+        real3 c63 = (real3)(0.56666666f, 0.76111114f, 0.6333333f);
+        real d57 = fmin(u61, d62);
+        real3 c57 = u61 < d62 ? uc61 : c63;
+        real t57 = u61 < d62 ? ut61 : R(1.0);
+        u57 = d57;
+        uc57 = c57;
+        ut57 = t57;
+    }
+    /* .../a:union/a:union: the second operand only within reach of its bound */
+    real u52 = u57;
+    real3 uc52 = uc57;
+    real ut52 = ut57;
+    real g52 = (length(p0 - ((real3)(-R(0.825), R(0.024999999999999994), R(0.475)))) * R(0.9999)) - R(0.3932556420447137);
     if (!(g52 > u52 && g52 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p18 = p0 - ((real3)(R(1.6), R(0.0), R(0.0)));
-        /* .../b:translate/color/cylinder_between */
-        real d61 = sd_cylinder_between(p18, (real3)((-0.2f), (-0.3f), 0.0f), (real3)(0.15f, 0.25f, 0.0f), 0.12f);
+        real3 p20 = p0 - ((real3)(-R(0.85), R(0.0), R(0.475)));
+        /* .../b:translate/color/cone_between */
+        real d66 = sd_cone_between(p20, (real3)(0.2f, (-0.25f), 0.0f), (real3)((-0.15f), 0.3f, 0.0f), 0.22f, 0.05f);
         /* .../a:union/b:translate/color */
-        real3 c62 = (real3)(0.5538462f, 0.74615383f, 0.64615387f);
-        real d52 = fmin(u56, d61);
-        real3 c52 = u56 < d61 ? uc56 : c62;
-        real t52 = u56 < d61 ? ut56 : R(1.0);
+        real3 c67 = (real3)(0.54444444f, 0.7351852f, 0.65555555f);
+        real d52 = fmin(u57, d66);
+        real3 c52 = u57 < d66 ? uc57 : c67;
+        real t52 = u57 < d66 ? ut57 : R(1.0);
         u52 = d52;
         uc52 = c52;
         ut52 = t52;
@@ -1160,17 +1210,17 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     real u47 = u52;
     real3 uc47 = uc52;
     real ut47 = ut52;
-    real g47 = (length(p0 - ((real3)(R(2.4250000000000003), R(0.024999999999999994), R(0.0)))) * R(0.9999)) - R(0.3932556420447137);
+    real g47 = (length(p0 - ((real3)(R(0.02500000000000001), R(0.024999999999999994), R(0.475)))) * R(0.9999)) - R(0.4450438562747845);
     if (!(g47 > u47 && g47 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p19 = p0 - ((real3)(R(2.4000000000000004), R(0.0), R(0.0)));
-        /* .../b:translate/color/cone_between */
-        real d65 = sd_cone_between(p19, (real3)(0.2f, (-0.25f), 0.0f), (real3)((-0.15f), 0.3f, 0.0f), 0.22f, 0.05f);
+        real3 p21 = p0 - ((real3)(R(0.0), R(0.0), R(0.475)));
+        /* .../b:translate/color/round_cone_between */
+        real d70 = sd_round_cone_between(p21, (real3)((-0.15f), (-0.2f), 0.0f), (real3)(0.2f, 0.25f, 0.0f), 0.16f, 0.07f);
         /* .../a:union/b:translate/color */
-        real3 c66 = (real3)(0.5307692f, 0.7192308f, 0.66923076f);
-        real d47 = fmin(u52, d65);
-        real3 c47 = u52 < d65 ? uc52 : c66;
-        real t47 = u52 < d65 ? ut52 : R(1.0);
+        real3 c71 = (real3)(0.5222222f, 0.7092593f, 0.67777777f);
+        real d47 = fmin(u52, d70);
+        real3 c47 = u52 < d70 ? uc52 : c71;
+        real t47 = u52 < d70 ? ut52 : R(1.0);
         u47 = d47;
         uc47 = c47;
         ut47 = t47;
@@ -1179,17 +1229,19 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     real u42 = u47;
     real3 uc42 = uc47;
     real ut42 = ut47;
-    real g42 = (length(p0 - ((real3)(R(3.225), R(0.024999999999999994), R(0.0)))) * R(0.9999)) - R(0.4450438562747845);
+    real g42 = (length(p0 - ((real3)(R(0.85), -R(0.13333333333333333), R(0.475)))) * R(0.9999)) - R(0.4633333333333334);
     if (!(g42 > u42 && g42 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p20 = p0 - ((real3)(R(3.2), R(0.0), R(0.0)));
-        /* .../b:translate/color/round_cone_between */
-        real d69 = sd_round_cone_between(p20, (real3)((-0.15f), (-0.2f), 0.0f), (real3)(0.2f, 0.25f, 0.0f), 0.16f, 0.07f);
+        real3 p22 = p0 - ((real3)(R(0.85), R(0.0), R(0.475)));
+        /* .../b:translate/color/rotate */
+        real3 p23 = (real3)((R(0.9210609940028851) * p22.x) - (R(0.3894183423086505) * p22.z), p22.y, (R(0.3894183423086505) * p22.x) + (R(0.9210609940028851) * p22.z));
+        /* .../color/rotate/triangle */
+        real d74 = sd_triangle(p23, (real3)((-0.3f), (-0.35f), 0.0f), (real3)(0.3f, (-0.35f), 0.0f), (real3)(0.0f, 0.3f, 0.0f), 0.03f);
         /* .../a:union/b:translate/color */
-        real3 c70 = (real3)(0.50769234f, 0.6923077f, 0.6923077f);
-        real d42 = fmin(u47, d69);
-        real3 c42 = u47 < d69 ? uc47 : c70;
-        real t42 = u47 < d69 ? ut47 : R(1.0);
+        real3 c76 = (real3)(0.5f, 0.68333334f, 0.7f);
+        real d42 = fmin(u47, d74);
+        real3 c42 = u47 < d74 ? uc47 : c76;
+        real t42 = u47 < d74 ? ut47 : R(1.0);
         u42 = d42;
         uc42 = c42;
         ut42 = t42;
@@ -1198,19 +1250,17 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     real u38 = u42;
     real3 uc38 = uc42;
     real ut38 = ut42;
-    real g38 = (length(p0 - ((real3)(-R(3.2), -R(0.13333333333333333), R(1.1)))) * R(0.9999)) - R(0.4633333333333334);
+    real g38 = (length(p0 - ((real3)(R(1.7), -R(0.024999999999999994), R(0.46499999999999997)))) * R(0.9999)) - R(0.47286002303210883);
     if (!(g38 > u38 && g38 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p21 = p0 - ((real3)(-R(3.2), R(0.0), R(1.1)));
-        /* .../b:translate/color/rotate */
-        real3 p22 = (real3)((R(0.9210609940028851) * p21.x) - (R(0.3894183423086505) * p21.z), p21.y, (R(0.3894183423086505) * p21.x) + (R(0.9210609940028851) * p21.z));
-        /* .../color/rotate/triangle */
-        real d73 = sd_triangle(p22, (real3)((-0.3f), (-0.35f), 0.0f), (real3)(0.3f, (-0.35f), 0.0f), (real3)(0.0f, 0.3f, 0.0f), 0.03f);
+        real3 p24 = p0 - ((real3)(R(1.7), R(0.0), R(0.475)));
+        /* .../b:translate/color/quad */
+        real d79 = sd_quad(p24, (real3)((-0.28f), (-0.35f), (-0.12f)), (real3)(0.28f, (-0.35f), (-0.12f)), (real3)(0.2f, 0.3f, 0.1f), (real3)((-0.2f), 0.3f, 0.1f), 0.03f);
         /* .../a:union/b:translate/color */
-        real3 c75 = (real3)(0.4846154f, 0.6653846f, 0.7153846f);
-        real d38 = fmin(u42, d73);
-        real3 c38 = u42 < d73 ? uc42 : c75;
-        real t38 = u42 < d73 ? ut42 : R(1.0);
+        real3 c80 = (real3)(0.47777778f, 0.6574074f, 0.7222222f);
+        real d38 = fmin(u42, d79);
+        real3 c38 = u42 < d79 ? uc42 : c80;
+        real t38 = u42 < d79 ? ut42 : R(1.0);
         u38 = d38;
         uc38 = c38;
         ut38 = t38;
@@ -1219,17 +1269,21 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     real u34 = u38;
     real3 uc34 = uc38;
     real ut34 = ut38;
-    real g34 = (length(p0 - ((real3)(-R(2.4000000000000004), -R(0.024999999999999994), R(1.09)))) * R(0.9999)) - R(0.47286002303210883);
+    real g34 = (length(p0 - ((real3)(R(2.55), -R(0.4), R(0.475)))) * R(0.9999)) - R(0.55);
     if (!(g34 > u34 && g34 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p23 = p0 - ((real3)(-R(2.4000000000000004), R(0.0), R(1.1)));
-        /* .../b:translate/color/quad */
-        real d78 = sd_quad(p23, (real3)((-0.28f), (-0.35f), (-0.12f)), (real3)(0.28f, (-0.35f), (-0.12f)), (real3)(0.2f, 0.3f, 0.1f), (real3)((-0.2f), 0.3f, 0.1f), 0.03f);
+        real3 p25 = p0 - ((real3)(R(2.55), R(0.0), R(0.475)));
+        /* .../b:translate/color/translate */
+        real3 p26 = p25 - ((real3)(R(0.0), -R(0.4), R(0.0)));
+        /* .../color/translate/rotate */
+        real3 p27 = (real3)((R(0.8775825618903728) * p26.x) - (R(0.479425538604203) * p26.z), p26.y, (R(0.479425538604203) * p26.x) + (R(0.8775825618903728) * p26.z));
+        /* .../translate/rotate/pyramid */
+        real d83 = sd_pyramid(p27, 0.3f, 0.55f);
         /* .../a:union/b:translate/color */
-        real3 c79 = (real3)(0.46153846f, 0.63846153f, 0.73846155f);
-        real d34 = fmin(u38, d78);
-        real3 c34 = u38 < d78 ? uc38 : c79;
-        real t34 = u38 < d78 ? ut38 : R(1.0);
+        real3 c86 = (real3)(0.45555556f, 0.63148147f, 0.74444443f);
+        real d34 = fmin(u38, d83);
+        real3 c34 = u38 < d83 ? uc38 : c86;
+        real t34 = u38 < d83 ? ut38 : R(1.0);
         u34 = d34;
         uc34 = c34;
         ut34 = t34;
@@ -1238,21 +1292,21 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     real u30 = u34;
     real3 uc30 = uc34;
     real ut30 = ut34;
-    real g30 = (length(p0 - ((real3)(-R(1.6), -R(0.4), R(1.1)))) * R(0.9999)) - R(0.55);
+    real g30 = (length(p0 - ((real3)(-R(2.55), -R(0.34), R(1.4249999999999998)))) * R(0.9999)) - R(0.4044749683231337);
     if (!(g30 > u30 && g30 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p24 = p0 - ((real3)(-R(1.6), R(0.0), R(1.1)));
+        real3 p28 = p0 - ((real3)(-R(2.55), R(0.0), R(1.4249999999999998)));
         /* .../b:translate/color/translate */
-        real3 p25 = p24 - ((real3)(R(0.0), -R(0.4), R(0.0)));
+        real3 p29 = p28 - ((real3)(R(0.0), -R(0.34), R(0.0)));
         /* .../color/translate/rotate */
-        real3 p26 = (real3)((R(0.8775825618903728) * p25.x) - (R(0.479425538604203) * p25.z), p25.y, (R(0.479425538604203) * p25.x) + (R(0.8775825618903728) * p25.z));
-        /* .../translate/rotate/pyramid */
-        real d82 = sd_pyramid(p26, 0.3f, 0.55f);
+        real3 p30 = (real3)((R(0.8253356149096783) * p29.x) - (R(0.5646424733950354) * p29.z), p29.y, (R(0.5646424733950354) * p29.x) + (R(0.8253356149096783) * p29.z));
+        /* .../translate/rotate/rhombus */
+        real d89 = sd_rhombus(p30, 0.36f, 0.22f, 0.06f, 0.04f);
         /* .../a:union/b:translate/color */
-        real3 c85 = (real3)(0.43846154f, 0.61153847f, 0.76153845f);
-        real d30 = fmin(u34, d82);
-        real3 c30 = u34 < d82 ? uc34 : c85;
-        real t30 = u34 < d82 ? ut34 : R(1.0);
+        real3 c92 = (real3)(0.43333334f, 0.60555553f, 0.76666665f);
+        real d30 = fmin(u34, d89);
+        real3 c30 = u34 < d89 ? uc34 : c92;
+        real t30 = u34 < d89 ? ut34 : R(1.0);
         u30 = d30;
         uc30 = c30;
         ut30 = t30;
@@ -1261,21 +1315,19 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     real u26 = u30;
     real3 uc26 = uc30;
     real ut26 = ut30;
-    real g26 = (length(p0 - ((real3)(-R(0.8), -R(0.34), R(1.1)))) * R(0.9999)) - R(0.4044749683231337);
+    real g26 = (length(p0 - ((real3)(-R(1.7), -R(0.1), R(1.4249999999999998)))) * R(0.9999)) - R(0.45343136195018535);
     if (!(g26 > u26 && g26 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p27 = p0 - ((real3)(-R(0.8), R(0.0), R(1.1)));
+        real3 p31 = p0 - ((real3)(-R(1.7), R(0.0), R(1.4249999999999998)));
         /* .../b:translate/color/translate */
-        real3 p28 = p27 - ((real3)(R(0.0), -R(0.34), R(0.0)));
-        /* .../color/translate/rotate */
-        real3 p29 = (real3)((R(0.8253356149096783) * p28.x) - (R(0.5646424733950354) * p28.z), p28.y, (R(0.5646424733950354) * p28.x) + (R(0.8253356149096783) * p28.z));
-        /* .../translate/rotate/rhombus */
-        real d88 = sd_rhombus(p29, 0.36f, 0.22f, 0.06f, 0.04f);
+        real3 p32 = p31 - ((real3)(R(0.0), -R(0.1), R(0.0)));
+        /* .../color/translate/tri_prism */
+        real d95 = sd_tri_prism(p32, 0.17f, 0.3f);
         /* .../a:union/b:translate/color */
-        real3 c91 = (real3)(0.41538462f, 0.5846154f, 0.7846154f);
-        real d26 = fmin(u30, d88);
-        real3 c26 = u30 < d88 ? uc30 : c91;
-        real t26 = u30 < d88 ? ut30 : R(1.0);
+        real3 c97 = (real3)(0.41111112f, 0.5796296f, 0.7888889f);
+        real d26 = fmin(u30, d95);
+        real3 c26 = u30 < d95 ? uc30 : c97;
+        real t26 = u30 < d95 ? ut30 : R(1.0);
         u26 = d26;
         uc26 = c26;
         ut26 = t26;
@@ -1284,19 +1336,19 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     real u22 = u26;
     real3 uc22 = uc26;
     real ut22 = ut26;
-    real g22 = (length(p0 - ((real3)(R(0.0), -R(0.1), R(1.1)))) * R(0.9999)) - R(0.45343136195018535);
+    real g22 = (length(p0 - ((real3)(-R(0.85), -R(0.2), R(1.4249999999999998)))) * R(0.9999)) - R(0.3440930106817051);
     if (!(g22 > u22 && g22 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p30 = p0 - ((real3)(R(0.0), R(0.0), R(1.1)));
+        real3 p33 = p0 - ((real3)(-R(0.85), R(0.0), R(1.4249999999999998)));
         /* .../b:translate/color/translate */
-        real3 p31 = p30 - ((real3)(R(0.0), -R(0.1), R(0.0)));
-        /* .../color/translate/tri_prism */
-        real d94 = sd_tri_prism(p31, 0.17f, 0.3f);
+        real3 p34 = p33 - ((real3)(R(0.0), -R(0.2), R(0.0)));
+        /* .../color/translate/rounded_cylinder */
+        real d100 = sd_rounded_cylinder(p34, 0.28f, 0.2f, 0.08f);
         /* .../a:union/b:translate/color */
-        real3 c96 = (real3)(0.3923077f, 0.5576923f, 0.8076923f);
-        real d22 = fmin(u26, d94);
-        real3 c22 = u26 < d94 ? uc26 : c96;
-        real t22 = u26 < d94 ? ut26 : R(1.0);
+        real3 c102 = (real3)(0.3888889f, 0.5537037f, 0.8111111f);
+        real d22 = fmin(u26, d100);
+        real3 c22 = u26 < d100 ? uc26 : c102;
+        real t22 = u26 < d100 ? ut26 : R(1.0);
         u22 = d22;
         uc22 = c22;
         ut22 = t22;
@@ -1305,19 +1357,19 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     real u18 = u22;
     real3 uc18 = uc22;
     real ut18 = ut22;
-    real g18 = (length(p0 - ((real3)(R(0.8), -R(0.2), R(1.1)))) * R(0.9999)) - R(0.3440930106817051);
+    real g18 = (length(p0 - ((real3)(R(0.0), -R(0.09999999999999998), R(1.4249999999999998)))) * R(0.9999)) - R(0.41036569057366384);
     if (!(g18 > u18 && g18 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p32 = p0 - ((real3)(R(0.8), R(0.0), R(1.1)));
+        real3 p35 = p0 - ((real3)(R(0.0), R(0.0), R(1.4249999999999998)));
         /* .../b:translate/color/translate */
-        real3 p33 = p32 - ((real3)(R(0.0), -R(0.2), R(0.0)));
-        /* .../color/translate/rounded_cylinder */
-        real d99 = sd_rounded_cylinder(p33, 0.28f, 0.2f, 0.08f);
+        real3 p36 = p35 - ((real3)(R(0.0), R(0.2), R(0.0)));
+        /* .../color/translate/cone */
+        real d105 = sd_cone(p36, 0.28f, 0.6f);
         /* .../a:union/b:translate/color */
-        real3 c101 = (real3)(0.36923078f, 0.5307692f, 0.83076924f);
-        real d18 = fmin(u22, d99);
-        real3 c18 = u22 < d99 ? uc22 : c101;
-        real t18 = u22 < d99 ? ut22 : R(1.0);
+        real3 c107 = (real3)(0.36666667f, 0.5277778f, 0.8333333f);
+        real d18 = fmin(u22, d105);
+        real3 c18 = u22 < d105 ? uc22 : c107;
+        real t18 = u22 < d105 ? ut22 : R(1.0);
         u18 = d18;
         uc18 = c18;
         ut18 = t18;
@@ -1326,19 +1378,19 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     real u14 = u18;
     real3 uc14 = uc18;
     real ut14 = ut18;
-    real g14 = (length(p0 - ((real3)(R(1.6), -R(0.09999999999999998), R(1.1)))) * R(0.9999)) - R(0.41036569057366384);
+    real g14 = (length(p0 - ((real3)(R(0.85), -R(0.06), R(1.4249999999999998)))) * R(0.9999)) - R(0.34);
     if (!(g14 > u14 && g14 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p34 = p0 - ((real3)(R(1.6), R(0.0), R(1.1)));
+        real3 p37 = p0 - ((real3)(R(0.85), R(0.0), R(1.4249999999999998)));
         /* .../b:translate/color/translate */
-        real3 p35 = p34 - ((real3)(R(0.0), R(0.2), R(0.0)));
-        /* .../color/translate/cone */
-        real d104 = sd_cone(p35, 0.28f, 0.6f);
+        real3 p38 = p37 - ((real3)(R(0.0), -R(0.06), R(0.0)));
+        /* .../color/translate/cut_hollow_sphere */
+        real d110 = sd_cut_hollow_sphere(p38, 0.32f, 0.12f, 0.02f);
         /* .../a:union/b:translate/color */
-        real3 c106 = (real3)(0.34615386f, 0.50384617f, 0.85384613f);
-        real d14 = fmin(u18, d104);
-        real3 c14 = u18 < d104 ? uc18 : c106;
-        real t14 = u18 < d104 ? ut18 : R(1.0);
+        real3 c112 = (real3)(0.34444445f, 0.50185186f, 0.85555553f);
+        real d14 = fmin(u18, d110);
+        real3 c14 = u18 < d110 ? uc18 : c112;
+        real t14 = u18 < d110 ? ut18 : R(1.0);
         u14 = d14;
         uc14 = c14;
         ut14 = t14;
@@ -1347,19 +1399,21 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     real u10 = u14;
     real3 uc10 = uc14;
     real ut10 = ut14;
-    real g10 = (length(p0 - ((real3)(R(2.4000000000000004), -R(0.06), R(1.1)))) * R(0.9999)) - R(0.34);
+    real g10 = (length(p0 - ((real3)(R(1.7), -R(0.08), R(1.4249999999999998)))) * R(0.9999)) - R(0.32);
     if (!(g10 > u10 && g10 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
-        real3 p36 = p0 - ((real3)(R(2.4000000000000004), R(0.0), R(1.1)));
+        real3 p39 = p0 - ((real3)(R(1.7), R(0.0), R(1.4249999999999998)));
         /* .../b:translate/color/translate */
-        real3 p37 = p36 - ((real3)(R(0.0), -R(0.06), R(0.0)));
-        /* .../color/translate/cut_hollow_sphere */
-        real d109 = sd_cut_hollow_sphere(p37, 0.32f, 0.12f, 0.02f);
+        real3 p40 = p39 - ((real3)(R(0.0), -R(0.08), R(0.0)));
+        /* .../color/translate/rotate */
+        real3 p41 = (real3)(p40.z, p40.y, -p40.x);
+        /* .../translate/rotate/death_star */
+        real d115 = sd_death_star(p41, 0.32f, 0.25f, 0.3f);
         /* .../a:union/b:translate/color */
-        real3 c111 = (real3)(0.32307693f, 0.47692308f, 0.8769231f);
-        real d10 = fmin(u14, d109);
-        real3 c10 = u14 < d109 ? uc14 : c111;
-        real t10 = u14 < d109 ? ut14 : R(1.0);
+        real3 c118 = (real3)(0.32222223f, 0.47592592f, 0.87777776f);
+        real d10 = fmin(u14, d115);
+        real3 c10 = u14 < d115 ? uc14 : c118;
+        real t10 = u14 < d115 ? ut14 : R(1.0);
         u10 = d10;
         uc10 = c10;
         ut10 = t10;
@@ -1368,21 +1422,21 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     real u6 = u10;
     real3 uc6 = uc10;
     real ut6 = ut10;
-    real g6 = (length(p0 - ((real3)(R(3.2), -R(0.08), R(1.1)))) * R(0.9999)) - R(0.32);
+    real g6 = (length(p0 - ((real3)(R(2.55), -R(0.12), R(1.4249999999999998)))) * R(0.9999)) - R(0.48497422611928565);
     if (!(g6 > u6 && g6 > R(0.0))) {
         /* union/a:union/b:translate */
-        real3 p38 = p0 - ((real3)(R(3.2), R(0.0), R(1.1)));
+        real3 p42 = p0 - ((real3)(R(2.55), R(0.0), R(1.4249999999999998)));
         /* .../b:translate/color/translate */
-        real3 p39 = p38 - ((real3)(R(0.0), -R(0.08), R(0.0)));
+        real3 p43 = p42 - ((real3)(R(0.0), -R(0.12), R(0.0)));
         /* .../color/translate/rotate */
-        real3 p40 = (real3)(p39.z, p39.y, -p39.x);
-        /* .../translate/rotate/death_star */
-        real d114 = sd_death_star(p40, 0.32f, 0.25f, 0.3f);
+        real3 p44 = (real3)((R(0.8775825618903728) * p43.x) - (R(0.479425538604203) * p43.z), p43.y, (R(0.479425538604203) * p43.x) + (R(0.8775825618903728) * p43.z));
+        /* .../translate/rotate/box_frame */
+        real d121 = sd_box_frame(p44, (real3)(0.28f), 0.05f);
         /* .../a:union/b:translate/color */
-        real3 c117 = (real3)(0.3f, 0.45f, 0.9f);
-        real d6 = fmin(u10, d114);
-        real3 c6 = u10 < d114 ? uc10 : c117;
-        real t6 = u10 < d114 ? ut10 : R(1.0);
+        real3 c124 = (real3)(0.3f, 0.45f, 0.9f);
+        real d6 = fmin(u10, d121);
+        real3 c6 = u10 < d121 ? uc10 : c124;
+        real t6 = u10 < d121 ? ut10 : R(1.0);
         u6 = d6;
         uc6 = c6;
         ut6 = t6;

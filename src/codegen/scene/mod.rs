@@ -111,6 +111,7 @@ fn leaf_function(node: &IrNode) -> Option<(Helper, &'static str)> {
         Kind::InfiniteCone { .. } => (Helper::InfiniteCone, "sd_infinite_cone"),
         Kind::CutHollowSphere { .. } => (Helper::CutHollowSphere, "sd_cut_hollow_sphere"),
         Kind::DeathStar { .. } => (Helper::DeathStar, "sd_death_star"),
+        Kind::BoxFrame { .. } => (Helper::BoxFrame, "sd_box_frame"),
         Kind::CylinderBetween { .. } => (Helper::CylinderBetween, "sd_cylinder_between"),
         Kind::ConeBetween { .. } => (Helper::ConeBetween, "sd_cone_between"),
         Kind::RoundConeBetween { .. } => (Helper::RoundConeBetween, "sd_round_cone_between"),

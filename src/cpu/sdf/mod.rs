@@ -29,8 +29,8 @@ mod trap;
 
 pub use profile::{extrude, profile, revolve};
 pub use shapes::{
-    cone, cut_hollow_sphere, death_star, infinite_cone, infinite_cylinder, pyramid, quad, rhombus,
-    rounded_cylinder, tri_prism, triangle, triangle_unsigned,
+    box_frame, cone, cut_hollow_sphere, death_star, infinite_cone, infinite_cylinder, pyramid,
+    quad, rhombus, rounded_cylinder, tri_prism, triangle, triangle_unsigned,
 };
 
 pub use trap::TrapShape;

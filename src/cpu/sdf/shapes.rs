@@ -52,6 +52,25 @@ pub fn quad<T: Num>(p: V3<T>, a: V3<T>, b: V3<T>, c: V3<T>, d: V3<T>, t: T) -> T
     triangle_unsigned(p, a, b, c).min(triangle_unsigned(p, a, c, d)) - t
 }
 
+/// The distance to the twelve square bars of thickness `t` along the edges
+/// of the box of half extents `b` (Quilez's `sdBoxFrame`): folded to one
+/// octant, the nearest of the three bars there, each a box. Exact outside;
+/// inside, the depth in the deepest bar, a bound (where bars meet the
+/// frame can be deeper).
+#[must_use]
+pub fn box_frame<T: Num>(p: V3<T>, b: V3<T>, t: T) -> T {
+    let zero = T::zero();
+    let e = T::of(0.5) * t;
+    let p = p.abs() - b;
+    let q = (p + V3::splat(e)).abs() - V3::splat(e);
+    let bar = |x: T, y: T, z: T| {
+        T::length3(x.max(zero), y.max(zero), z.max(zero)) + x.max(y.max(z)).min(zero)
+    };
+    bar(p.x, q.y, q.z)
+        .min(bar(q.x, p.y, q.z))
+        .min(bar(q.x, q.y, p.z))
+}
+
 /// Exact distance to the pyramid on the square `|x|, |z| <= w` at `y = 0`
 /// with its apex at `(0, h, 0)`. Outside, the distance to the nearer of
 /// the base and the side facing the point (the point folded to `x >= z >=
