@@ -39,8 +39,8 @@ pub fn profile<T: Num>(x: T, y: T, profile: &Profile<T>) -> T {
 /// The vesica pointed at `(0, ±b)`, `w` wide each side of the y axis
 /// (Quilez's `sdVesica`): the overlap of the discs of radius `(b² + w²) /
 /// 2w` about `(∓d, 0)`, `d = (b² - w²) / 2w`. Folded to the first
-/// quadrant, a point beyond the line from the far centre through the
-/// point is nearest the point; elsewhere the arc is.
+/// quadrant, a point beyond the line from the far disc's centre through
+/// the tip is nearest the tip; elsewhere it is nearest the arc.
 fn vesica<T: Num>(x: T, y: T, b: T, w: T) -> T {
     let two_w = T::of(2.0) * w.max(T::tiny());
     let (d, r) = ((b * b - w * w) / two_w, (b * b + w * w) / two_w);
@@ -50,8 +50,8 @@ fn vesica<T: Num>(x: T, y: T, b: T, w: T) -> T {
     T::select(((y - b) * d).gt(x * b), tip, arc)
 }
 
-/// Bisection steps of the ellipse's root: the bracket shrinks by `2^-64`,
-/// below `f64`'s resolution of the root for every point.
+/// Bisection steps of the ellipse's root: the bracket shrinks by `2^-64`
+/// before two Newton steps finish the root.
 const ELLIPSE_STEPS: f64 = 64.0;
 
 /// The ellipse of semi-axes `a` along x and `b` along y (after Eberly,
