@@ -133,7 +133,11 @@ pub trait Num:
     /// `self^e`.
     #[must_use]
     fn powf(self, e: Self) -> Self;
-    /// `sqrt(self^2 + o^2)` without overflow.
+    /// `sqrt(self^2 + o^2)`, computed as written for the plain types (as
+    /// [`Num::length3`] is): the kernels print it as the length of a
+    /// 2-vector, which PoCL computes about twice as fast as its `hypot`,
+    /// and the two sides must round alike. The precisions' limits
+    /// ([`F32_LIMITS`](crate::math::F32_LIMITS)) keep every square finite.
     #[must_use]
     fn hypot(self, o: Self) -> Self;
     /// `sqrt(x^2 + y^2 + z^2)`: the length of a 3-vector (one operation,
@@ -310,7 +314,7 @@ macro_rules! plain {
                 <$t>::powf(self, e)
             }
             fn hypot(self, o: Self) -> Self {
-                <$t>::hypot(self, o)
+                (self * self + o * o).sqrt()
             }
             fn lt(self, o: Self) -> bool {
                 self < o

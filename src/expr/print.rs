@@ -710,7 +710,9 @@ fn binary(b: Binary, x: &str, y: &str) -> String {
         Binary::Max => format!("fmax({ax}, {ay})"),
         Binary::Atan2 => format!("atan2({ax}, {ay})"),
         Binary::Pow => format!("pow({ax}, {ay})"),
-        Binary::Hypot => format!("hypot({ax}, {ay})"),
+        // The length of a 2-vector, as the plain types compute it (see
+        // `Num::hypot`).
+        Binary::Hypot => format!("length((real2)({ax}, {ay}))"),
     }
 }
 

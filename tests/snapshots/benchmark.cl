@@ -99,14 +99,14 @@ real sd_box(real3 p, real3 b) {
 
 /* ---- torus ---- */
 real sd_torus(real3 p, real major, real minor) {
-    return hypot(hypot(p.x, p.z) - major, p.y) - minor;
+    return length((real2)(length((real2)(p.x, p.z)) - major, p.y)) - minor;
 }
 
 /* ---- cylinder ---- */
 real sd_cylinder(real3 p, real r, real h) {
-    real t0 = hypot(p.x, p.z) - r;
+    real t0 = length((real2)(p.x, p.z)) - r;
     real t1 = fabs(p.y) - h;
-    return fmin(fmax(t0, t1), R(0.0)) + hypot(fmax(t0, R(0.0)), fmax(t1, R(0.0)));
+    return fmin(fmax(t0, t1), R(0.0)) + length((real2)(fmax(t0, R(0.0)), fmax(t1, R(0.0))));
 }
 
 /* ---- plane ---- */
@@ -166,7 +166,7 @@ real2 mandelbulb_p8(real3 p, real iterations, real escape, real ball) {
         }
         real t5 = t4 * t4;
         real t6 = (t4 * t5) * (t5 * t5);
-        real t7 = hypot(ts0_0.x, ts0_0.y);
+        real t7 = length((real2)(ts0_0.x, ts0_0.y));
         real t8 = R(1.0) / fmax(t4, R(1e-30));
         real t9 = ts0_0.z * t8;
         real t10 = t7 * t8;

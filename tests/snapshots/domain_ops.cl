@@ -99,14 +99,14 @@ real sd_box(real3 p, real3 b) {
 
 /* ---- torus ---- */
 real sd_torus(real3 p, real major, real minor) {
-    return hypot(hypot(p.x, p.z) - major, p.y) - minor;
+    return length((real2)(length((real2)(p.x, p.z)) - major, p.y)) - minor;
 }
 
 /* ---- cylinder ---- */
 real sd_cylinder(real3 p, real r, real h) {
-    real t0 = hypot(p.x, p.z) - r;
+    real t0 = length((real2)(p.x, p.z)) - r;
     real t1 = fabs(p.y) - h;
-    return fmin(fmax(t0, t1), R(0.0)) + hypot(fmax(t0, R(0.0)), fmax(t1, R(0.0)));
+    return fmin(fmax(t0, t1), R(0.0)) + length((real2)(fmax(t0, R(0.0)), fmax(t1, R(0.0))));
 }
 
 /* ---- plane ---- */
@@ -137,9 +137,9 @@ real DE(real3 p0, __global const real* params) {
         real3 p2 = (real3)((e3_2 * p1.x) - (e3_1 * p1.z), p1.y, (e3_1 * p1.x) + (e3_2 * p1.z));
         /* .../intersect/a:twist/cuboid */
         real d0 = sd_box(p2, (real3)(0.25f, 0.6f, 0.25f));
-        real e4_0 = hypot(p1.x, p1.z);
-        real e4_1 = e4_0 + (fabs(d0) / (e4_0 + hypot(R(1.0), e4_0)));
-        real d1 = fmax(d0 / (e4_1 + hypot(R(1.0), e4_1)), length(p1) - R(0.9848857801796104));
+        real e4_0 = length((real2)(p1.x, p1.z));
+        real e4_1 = e4_0 + (fabs(d0) / (e4_0 + length((real2)(R(1.0), e4_0))));
+        real d1 = fmax(d0 / (e4_1 + length((real2)(R(1.0), e4_1))), length(p1) - R(0.9848857801796104));
         /* .../color/intersect/b:cylinder */
         real d2 = sd_cylinder(p1, 0.36f, 0.6f);
         /* .../a:translate/color/intersect */
@@ -160,7 +160,7 @@ real DE(real3 p0, __global const real* params) {
         real3 p4 = (real3)((e9_2 * p3.x) - (e9_1 * p3.y), (e9_1 * p3.x) + (e9_2 * p3.y), p3.z);
         /* .../intersect/a:bend/cuboid */
         real d6 = sd_box(p4, (real3)(0.6f, 0.1f, 0.2f));
-        real e10_0 = hypot(p3.x, p3.y);
+        real e10_0 = length((real2)(p3.x, p3.y));
         real d7 = fmax(d6 / (R(1.0) + (R(0.8) * (e10_0 + (fabs(d6) / (R(1.0) + (R(0.8) * e10_0)))))), length(p3) - R(0.9055385138137417));
         /* .../color/intersect/b:sphere */
         real d8 = sd_sphere(p3, 0.65f);
@@ -253,9 +253,9 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
         real3 p2 = (real3)((e34_2 * p1.x) - (e34_1 * p1.z), p1.y, (e34_1 * p1.x) + (e34_2 * p1.z));
         /* .../intersect/a:twist/cuboid */
         real d0 = sd_box(p2, (real3)(0.25f, 0.6f, 0.25f));
-        real e35_0 = hypot(p1.x, p1.z);
-        real e35_1 = e35_0 + (fabs(d0) / (e35_0 + hypot(R(1.0), e35_0)));
-        real d1 = fmax(d0 / (e35_1 + hypot(R(1.0), e35_1)), length(p1) - R(0.9848857801796104));
+        real e35_0 = length((real2)(p1.x, p1.z));
+        real e35_1 = e35_0 + (fabs(d0) / (e35_0 + length((real2)(R(1.0), e35_0))));
+        real d1 = fmax(d0 / (e35_1 + length((real2)(R(1.0), e35_1))), length(p1) - R(0.9848857801796104));
         /* .../color/intersect/b:cylinder */
         real d2 = sd_cylinder(p1, 0.36f, 0.6f);
         /* .../a:translate/color/intersect */
@@ -285,7 +285,7 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
         real3 p4 = (real3)((e40_2 * p3.x) - (e40_1 * p3.y), (e40_1 * p3.x) + (e40_2 * p3.y), p3.z);
         /* .../intersect/a:bend/cuboid */
         real d6 = sd_box(p4, (real3)(0.6f, 0.1f, 0.2f));
-        real e41_0 = hypot(p3.x, p3.y);
+        real e41_0 = length((real2)(p3.x, p3.y));
         real d7 = fmax(d6 / (R(1.0) + (R(0.8) * (e41_0 + (fabs(d6) / (R(1.0) + (R(0.8) * e41_0)))))), length(p3) - R(0.9055385138137417));
         /* .../color/intersect/b:sphere */
         real d8 = sd_sphere(p3, 0.65f);

@@ -250,7 +250,7 @@ real2 hybrid_1(real3 p, real iterations, real s0_0_limit, real s0_1_min_radius, 
         real t70 = length(t67);
         real t71 = t70 * t70;
         real t72 = fmin((t70 * t71) * (t71 * t71), R(1e18));
-        real t73 = hypot(t67.x, t67.y);
+        real t73 = length((real2)(t67.x, t67.y));
         real t74 = R(1.0) / fmax(t70, R(1e-30));
         real t75 = t67.z * t74;
         real t76 = t73 * t74;
@@ -271,7 +271,7 @@ real2 hybrid_1(real3 p, real iterations, real s0_0_limit, real s0_1_min_radius, 
         real t91 = fmin(t72 * t70, R(1e18));
         bool t92 = t69 < R(0.5);
         real3 t93 = t92 ? (((real3)(t89, t90, (t79 * t79) - (t80 * t80))) * t91) : t67;
-        real t94 = t92 ? fmin(((s1_0_power * t72) * fmax(fmin((hypot(t89, t90) * t70) / fmax(t73, R(1e-30)), s1_0_power), R(1.0))) * t68, R(1e30)) : t68;
+        real t94 = t92 ? fmin(((s1_0_power * t72) * fmax(fmin((length((real2)(t89, t90)) * t70) / fmax(t73, R(1e-30)), s1_0_power), R(1.0))) * t68, R(1e30)) : t68;
         real t95 = (t7 < (((t93.x * t93.x) + (t93.y * t93.y)) + (t93.z * t93.z))) ? R(1.0) : t69;
         bool t96 = t95 < R(0.5);
         real3 t97 = t96 ? (t93 + t29) : t93;

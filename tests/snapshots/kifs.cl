@@ -207,7 +207,7 @@ real2 kifs_icosahedral(real3 p, real iterations, real scale, real3 offset) {
 
 /* ---- kifs_menger ---- */
 real2 kifs_menger(real3 p, real iterations, real scale, real3 offset) {
-    real t0 = hypot(offset.x, offset.y) + fabs(offset.z);
+    real t0 = length((real2)(offset.x, offset.y)) + fabs(offset.z);
     real t1 = fmax(t0 * R(32.0), R(1e-30));
     real t2 = t1 * t1;
     real t3 = scale - R(1.0);
@@ -245,7 +245,7 @@ real2 kifs_menger(real3 p, real iterations, real scale, real3 offset) {
 
 /* ---- kifs_menger_turned ---- */
 real2 kifs_menger_turned(real3 p, real iterations, real scale, real3 offset, real3 before, real3 after) {
-    real t0 = hypot(offset.x, offset.y) + fabs(offset.z);
+    real t0 = length((real2)(offset.x, offset.y)) + fabs(offset.z);
     real t1 = fmax(t0 * R(32.0), R(1e-30));
     real t2 = t1 * t1;
     real t3 = scale - R(1.0);

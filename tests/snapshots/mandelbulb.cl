@@ -103,7 +103,7 @@ real2 mandelbulb_p8(real3 p, real iterations, real escape, real ball) {
         }
         real t5 = t4 * t4;
         real t6 = (t4 * t5) * (t5 * t5);
-        real t7 = hypot(ts0_0.x, ts0_0.y);
+        real t7 = length((real2)(ts0_0.x, ts0_0.y));
         real t8 = R(1.0) / fmax(t4, R(1e-30));
         real t9 = ts0_0.z * t8;
         real t10 = t7 * t8;

@@ -527,7 +527,7 @@ real2 mandelbulb_p8(real3 p, real iterations, real escape, real ball) {
         }
         real t5 = t4 * t4;
         real t6 = (t4 * t5) * (t5 * t5);
-        real t7 = hypot(ts0_0.x, ts0_0.y);
+        real t7 = length((real2)(ts0_0.x, ts0_0.y));
         real t8 = R(1.0) / fmax(t4, R(1e-30));
         real t9 = ts0_0.z * t8;
         real t10 = t7 * t8;
@@ -576,7 +576,7 @@ real2 mandelbulb_p8_trap(real3 p, real iterations, real escape, real ball, real3
         }
         real t_9 = t_8 * t_8;
         real t_10 = (t_8 * t_9) * (t_9 * t_9);
-        real t_11 = hypot(t_s0_0.x, t_s0_0.y);
+        real t_11 = length((real2)(t_s0_0.x, t_s0_0.y));
         real t_12 = R(1.0) / fmax(t_8, R(1e-30));
         real t_13 = t_s0_0.z * t_12;
         real t_14 = t_11 * t_12;

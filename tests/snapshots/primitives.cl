@@ -105,14 +105,14 @@ real sd_round_box(real3 p, real3 b, real r) {
 
 /* ---- torus ---- */
 real sd_torus(real3 p, real major, real minor) {
-    return hypot(hypot(p.x, p.z) - major, p.y) - minor;
+    return length((real2)(length((real2)(p.x, p.z)) - major, p.y)) - minor;
 }
 
 /* ---- cylinder ---- */
 real sd_cylinder(real3 p, real r, real h) {
-    real t0 = hypot(p.x, p.z) - r;
+    real t0 = length((real2)(p.x, p.z)) - r;
     real t1 = fabs(p.y) - h;
-    return fmin(fmax(t0, t1), R(0.0)) + hypot(fmax(t0, R(0.0)), fmax(t1, R(0.0)));
+    return fmin(fmax(t0, t1), R(0.0)) + length((real2)(fmax(t0, R(0.0)), fmax(t1, R(0.0))));
 }
 
 /* ---- capsule ---- */
@@ -146,7 +146,7 @@ real sd_octahedron(real3 p, real s) {
 
 /* ---- capped_cone ---- */
 real sd_capped_cone(real3 p, real h, real r1, real r2) {
-    real t0 = hypot(p.x, p.z);
+    real t0 = length((real2)(p.x, p.z));
     real t1 = r2 - r1;
     real t2 = R(2.0) * h;
     real t3 = t0 - fmin(t0, (p.y < R(0.0)) ? r1 : r2);
@@ -164,19 +164,19 @@ real sd_hex_prism(real3 p, real r, real h) {
     real t2 = t0.x - (t1 * (-R(0.8660254037844386)));
     real t3 = R(0.5773502691896258) * r;
     real t4 = (t0.z - (t1 * R(0.5))) - r;
-    real t5 = hypot(t2 - fmin(fmax(t2, -t3), t3), t4);
+    real t5 = length((real2)(t2 - fmin(fmax(t2, -t3), t3), t4));
     real t6 = (t4 < R(0.0)) ? (-t5) : t5;
     real t7 = t0.y - h;
-    return fmin(fmax(t6, t7), R(0.0)) + hypot(fmax(t6, R(0.0)), fmax(t7, R(0.0)));
+    return fmin(fmax(t6, t7), R(0.0)) + length((real2)(fmax(t6, R(0.0)), fmax(t7, R(0.0))));
 }
 
 /* ---- round_cone ---- */
 real sd_round_cone(real3 p, real h, real r1, real r2) {
     real t0 = R(2.0) * h;
-    real t1 = hypot(p.x, p.z);
+    real t1 = length((real2)(p.x, p.z));
     real t2 = p.y + h;
-    real t3 = hypot(t1, t2) - r1;
-    real t4 = hypot(t1, t2 - t0) - r2;
+    real t3 = length((real2)(t1, t2)) - r1;
+    real t4 = length((real2)(t1, t2 - t0)) - r2;
     real t5 = r1 - r2;
     real t6 = t5 / fmax(t0, R(1e-30));
     real t7 = sqrt(fmax(R(1.0) - (t6 * t6), R(0.0)));
@@ -186,29 +186,29 @@ real sd_round_cone(real3 p, real h, real r1, real r2) {
 
 /* ---- link ---- */
 real sd_link(real3 p, real le, real r1, real r2) {
-    return hypot(hypot(p.x, fmax(fabs(p.y) - le, R(0.0))) - r1, p.z) - r2;
+    return length((real2)(length((real2)(p.x, fmax(fabs(p.y) - le, R(0.0)))) - r1, p.z)) - r2;
 }
 
 /* ---- cut_sphere ---- */
 real sd_cut_sphere(real3 p, real r, real h) {
     real t0 = fmin(fmax(h, -r), r);
     real t1 = sqrt(fmax((r * r) - (t0 * t0), R(0.0)));
-    real t2 = hypot(p.x, p.z);
-    real t3 = hypot(t2, p.y);
+    real t2 = length((real2)(p.x, p.z));
+    real t3 = length((real2)(t2, p.y));
     real t4 = t3 - r;
     real t5 = p.y - t0;
-    return ((t3 <= r) && (p.y <= t0)) ? fmax(t4, t5) : (((t0 < p.y) && (t2 <= t1)) ? t5 : (((r <= t3) && ((r * p.y) <= (t0 * t3))) ? t4 : hypot(t2 - t1, t5)));
+    return ((t3 <= r) && (p.y <= t0)) ? fmax(t4, t5) : (((t0 < p.y) && (t2 <= t1)) ? t5 : (((r <= t3) && ((r * p.y) <= (t0 * t3))) ? t4 : length((real2)(t2 - t1, t5))));
 }
 
 /* ---- solid_angle ---- */
 real sd_solid_angle(real3 p, real angle, real r) {
     real t0 = sin(angle);
     real t1 = cos(angle);
-    real t2 = hypot(p.x, p.z);
-    real t3 = hypot(t2, p.y);
+    real t2 = length((real2)(p.x, p.z));
+    real t3 = length((real2)(t2, p.y));
     real t4 = (t2 * t0) + (p.y * t1);
     real t5 = fmin(fmax(t4, R(0.0)), r);
-    real t6 = hypot(t2 - (t0 * t5), p.y - (t1 * t5));
+    real t6 = length((real2)(t2 - (t0 * t5), p.y - (t1 * t5)));
     real t7 = (t1 * t2) - (t0 * p.y);
     bool t8 = (t7 < R(0.0)) || ((t7 <= R(0.0)) && (R(0.0) <= t4));
     return (t8 && (t3 <= r)) ? (-fmin(t6, r - t3)) : (t8 ? fmin(t6, t3 - r) : t6);
@@ -217,7 +217,7 @@ real sd_solid_angle(real3 p, real angle, real r) {
 /* ---- capped_torus ---- */
 real sd_capped_torus(real3 p, real angle, real ra, real rb) {
     real t0 = fabs(p.x);
-    real t1 = hypot(t0, p.y);
+    real t1 = length((real2)(t0, p.y));
     bool t2 = angle < atan2(t0, p.y);
     bool t3 = t1 <= R(1e-30);
     return length((real3)(t0 - (ra * (t2 ? sin(angle) : (t3 ? R(0.0) : (t0 / t1)))), p.y - (ra * (t2 ? cos(angle) : (t3 ? R(1.0) : (p.y / t1)))), p.z)) - rb;
@@ -310,7 +310,7 @@ real sd_pyramid(real3 p, real w, real h) {
     real3 t23 = (t9 * t22) - t13;
     real t24 = ((t14 * t11.x) + (t15 * t11.y)) + (t16 * t11.z);
     real t25 = t2 - w;
-    real t26 = ((h * t25) + (w * p.y)) / fmax(hypot(h, w), R(1e-30));
+    real t26 = ((h * t25) + (w * p.y)) / fmax(length((real2)(h, w)), R(1e-30));
     return ((t26 < R(0.0)) && (R(0.0) < p.y)) ? fmax(t26, -p.y) : fmin(sqrt(((((R(0.0) <= (((((t6.y * t16) - (t6.z * t15)) * t11.x) + (((t6.z * t14) - (t6.x * t16)) * t11.y)) + (((t6.x * t15) - (t6.y * t14)) * t11.z))) && (R(0.0) <= (((((t8.y * t16) - (t8.z * t15)) * t12.x) + (((t8.z * t14) - (t8.x * t16)) * t12.y)) + (((t8.x * t15) - (t8.y * t14)) * t12.z)))) && (R(0.0) <= (((((t9.y * t16) - (t9.z * t15)) * t13.x) + (((t9.z * t14) - (t9.x * t16)) * t13.y)) + (((t9.x * t15) - (t9.y * t14)) * t13.z)))) && (R(0.0) < t17)) ? ((t24 * t24) / fmax(t17, R(1e-30))) : fmin(fmin(((t19.x * t19.x) + (t19.y * t19.y)) + (t19.z * t19.z), ((t21.x * t21.x) + (t21.y * t21.y)) + (t21.z * t21.z)), ((t23.x * t23.x) + (t23.y * t23.y)) + (t23.z * t23.z))), length((real3)(fmax(t25, R(0.0)), p.y, fmax(t3 - w, R(0.0)))));
 }
 
@@ -359,7 +359,7 @@ real sd_rhombus(real3 p, real la, real lb, real h, real r) {
     real t40 = sqrt(fmin(fmin(fmin(fmin((p.x * p.x) + (t2 * t2), (t6 * t6) + (t7 * t7)), (t16 * t16) + (t17 * t17)), (t27 * t27) + (t28 * t28)), (t35 * t35) + (t36 * t36)));
     real t41 = (((t32 && (!t39)) || ((!t32) && t39)) ? (-t40) : t40) - r;
     real t42 = fabs(p.y) - h;
-    return fmin(fmax(t41, t42), R(0.0)) + hypot(fmax(t41, R(0.0)), fmax(t42, R(0.0)));
+    return fmin(fmax(t41, t42), R(0.0)) + length((real2)(fmax(t41, R(0.0)), fmax(t42, R(0.0))));
 }
 
 /* ---- tri_prism ---- */
@@ -402,21 +402,21 @@ real sd_tri_prism(real3 p, real r, real h) {
     real t35 = sqrt(fmin(fmin(fmin((t4 * t4) + (t5 * t5), (t9 * t9) + (t10 * t10)), (t20 * t20) + (t21 * t21)), (t31 * t31) + (t32 * t32)));
     real t36 = ((t27 && (!t34)) || ((!t27) && t34)) ? (-t35) : t35;
     real t37 = fabs(p.y) - h;
-    return fmin(fmax(t36, t37), R(0.0)) + hypot(fmax(t36, R(0.0)), fmax(t37, R(0.0)));
+    return fmin(fmax(t36, t37), R(0.0)) + length((real2)(fmax(t36, R(0.0)), fmax(t37, R(0.0))));
 }
 
 /* ---- rounded_cylinder ---- */
 real sd_rounded_cylinder(real3 p, real r, real h, real e) {
-    real t0 = fabs(hypot(p.x, p.z)) - (r - e);
+    real t0 = fabs(length((real2)(p.x, p.z))) - (r - e);
     real t1 = fabs(p.y) - (h - e);
-    return (hypot(fmax(t0, R(0.0)), fmax(t1, R(0.0))) + fmin(fmax(t0, t1), R(0.0))) - e;
+    return (length((real2)(fmax(t0, R(0.0)), fmax(t1, R(0.0)))) + fmin(fmax(t0, t1), R(0.0))) - e;
 }
 
 /* ---- cone ---- */
 real sd_cone(real3 p, real r, real h) {
     real t0 = R(0.5) * h;
     real t1 = p.y + t0;
-    real t2 = hypot(p.x, p.z);
+    real t2 = length((real2)(p.x, p.z));
     real t3 = R(0.0) - r;
     real t4 = R(2.0) * t0;
     real t5 = t2 - fmin(t2, (t1 < R(0.0)) ? r : R(0.0));
@@ -431,8 +431,8 @@ real sd_cone(real3 p, real r, real h) {
 real sd_cut_hollow_sphere(real3 p, real r, real h, real t) {
     real t_0 = fmin(fmax(h, -r), r);
     real t_1 = sqrt(fmax((r * r) - (t_0 * t_0), R(0.0)));
-    real t_2 = hypot(p.x, p.z);
-    return ((atan2(t_2, p.y) < atan2(t_1, t_0)) ? hypot(t_2 - t_1, p.y - t_0) : fabs(hypot(t_2, p.y) - r)) - t;
+    real t_2 = length((real2)(p.x, p.z));
+    return ((atan2(t_2, p.y) < atan2(t_1, t_0)) ? length((real2)(t_2 - t_1, p.y - t_0)) : fabs(length((real2)(t_2, p.y)) - r)) - t;
 }
 
 /* ---- death_star ---- */
@@ -441,8 +441,8 @@ real sd_death_star(real3 p, real ra, real rb, real d) {
     real t1 = ra * ra;
     real t2 = ((t1 - (rb * rb)) + (t0 * t0)) / (R(2.0) * t0);
     real t3 = sqrt(fmax(t1 - (t2 * t2), R(0.0)));
-    real t4 = hypot(p.y, p.z);
-    return ((t0 * fmax(t3 - t4, R(0.0))) < ((p.x * t3) - (t4 * t2))) ? hypot(p.x - t2, t4 - t3) : fmax(hypot(p.x, t4) - ra, rb - hypot(p.x - t0, t4));
+    real t4 = length((real2)(p.y, p.z));
+    return ((t0 * fmax(t3 - t4, R(0.0))) < ((p.x * t3) - (t4 * t2))) ? length((real2)(p.x - t2, t4 - t3)) : fmax(length((real2)(p.x, t4)) - ra, rb - length((real2)(p.x - t0, t4)));
 }
 
 /* ---- box_frame ---- */
@@ -465,9 +465,9 @@ real sd_cylinder_between(real3 p, real3 a, real3 b, real r) {
     real3 t3 = (R(1e-30) < t1) ? (t0 / t2) : ((real3)(R(0.0), R(1.0), R(0.0)));
     real3 t4 = p - ((a + b) * R(0.5));
     real t5 = ((t4.x * t3.x) + (t4.y * t3.y)) + (t4.z * t3.z);
-    real t6 = hypot(length(t4 - (t3 * t5)), R(0.0)) - r;
+    real t6 = length((real2)(length(t4 - (t3 * t5)), R(0.0))) - r;
     real t7 = fabs(t5) - (t1 * R(0.5));
-    return fmin(fmax(t6, t7), R(0.0)) + hypot(fmax(t6, R(0.0)), fmax(t7, R(0.0)));
+    return fmin(fmax(t6, t7), R(0.0)) + length((real2)(fmax(t6, R(0.0)), fmax(t7, R(0.0))));
 }
 
 /* ---- cone_between ---- */
@@ -479,7 +479,7 @@ real sd_cone_between(real3 p, real3 a, real3 b, real ra, real rb) {
     real3 t4 = p - ((a + b) * R(0.5));
     real t5 = ((t4.x * t3.x) + (t4.y * t3.y)) + (t4.z * t3.z);
     real t6 = t1 * R(0.5);
-    real t7 = hypot(length(t4 - (t3 * t5)), R(0.0));
+    real t7 = length((real2)(length(t4 - (t3 * t5)), R(0.0)));
     real t8 = rb - ra;
     real t9 = R(2.0) * t6;
     real t10 = t7 - fmin(t7, (t5 < R(0.0)) ? ra : rb);
@@ -500,10 +500,10 @@ real sd_round_cone_between(real3 p, real3 a, real3 b, real ra, real rb) {
     real t5 = ((t4.x * t3.x) + (t4.y * t3.y)) + (t4.z * t3.z);
     real t6 = t1 * R(0.5);
     real t7 = R(2.0) * t6;
-    real t8 = hypot(length(t4 - (t3 * t5)), R(0.0));
+    real t8 = length((real2)(length(t4 - (t3 * t5)), R(0.0)));
     real t9 = t5 + t6;
-    real t10 = hypot(t8, t9) - ra;
-    real t11 = hypot(t8, t9 - t7) - rb;
+    real t10 = length((real2)(t8, t9)) - ra;
+    real t11 = length((real2)(t8, t9 - t7)) - rb;
     real t12 = ra - rb;
     real t13 = t12 / fmax(t7, R(1e-30));
     real t14 = sqrt(fmax(R(1.0) - (t13 * t13), R(0.0)));

@@ -210,7 +210,7 @@ real DE(real3 p0, __global const real* params) {
         real e4_97 = sqrt(fmin(fmin(fmin(fmin(fmin(fmin(fmin(fmin(fmin(fmin((e4_0 * e4_0) + (e4_1 * e4_1), (e4_4 * e4_4) + (e4_5 * e4_5)), (e4_13 * e4_13) + (e4_14 * e4_14)), (e4_23 * e4_23) + (e4_24 * e4_24)), (e4_33 * e4_33) + (e4_34 * e4_34)), (e4_43 * e4_43) + (e4_44 * e4_44)), (e4_53 * e4_53) + (e4_54 * e4_54)), (e4_63 * e4_63) + (e4_64 * e4_64)), (e4_73 * e4_73) + (e4_74 * e4_74)), (e4_83 * e4_83) + (e4_84 * e4_84)), (e4_91 * e4_91) + (e4_92 * e4_92)));
         real e4_98 = ((e4_89 && (!e4_96)) || ((!e4_89) && e4_96)) ? (-e4_97) : e4_97;
         real e4_99 = fabs(p2.z) - R(0.06);
-        real d0 = fmin(fmax(e4_98, e4_99), R(0.0)) + hypot(fmax(e4_98, R(0.0)), fmax(e4_99, R(0.0)));
+        real d0 = fmin(fmax(e4_98, e4_99), R(0.0)) + length((real2)(fmax(e4_98, R(0.0)), fmax(e4_99, R(0.0))));
         real d28 = fmin(d26, d0);
         u28 = d28;
     }
@@ -221,7 +221,7 @@ real DE(real3 p0, __global const real* params) {
         /* .../a:union/a:union/b:translate */
         real3 p3 = p0 - ((real3)(-R(0.45), R(0.0), -R(0.6)));
         /* .../b:translate/color/revolve */
-        real e8_0 = hypot(p3.x, p3.z);
+        real e8_0 = length((real2)(p3.x, p3.z));
         real e8_1 = p3.y - R(0.06);
         real e8_2 = p3.y - (-R(0.45));
         real e8_3 = fmin(fmax(((e8_0 * R(0.0)) + (e8_2 * R(0.51))) / R(0.2601), R(0.0)), R(1.0));
@@ -325,10 +325,10 @@ real DE(real3 p0, __global const real* params) {
         /* .../a:union/a:union/b:translate */
         real3 p4 = p0 - ((real3)(R(0.5), -R(0.225), -R(0.55)));
         /* .../b:translate/color/revolve */
-        real e12_0 = hypot(p4.x, p4.z) - R(0.32);
+        real e12_0 = length((real2)(p4.x, p4.z)) - R(0.32);
         real e12_1 = p4.y - (-R(0.2));
         real e12_2 = fmin(fmax(((e12_0 * (-R(0.18))) + (e12_1 * R(0.4))) / R(0.19240000000000002), R(0.0)), R(1.0));
-        real d8 = hypot(e12_0 - ((-R(0.18)) * e12_2), e12_1 - (R(0.4) * e12_2)) - R(0.025);
+        real d8 = length((real2)(e12_0 - ((-R(0.18)) * e12_2), e12_1 - (R(0.4) * e12_2))) - R(0.025);
         real d21 = fmin(u25, d8);
         u21 = d21;
     }
@@ -341,9 +341,9 @@ real DE(real3 p0, __global const real* params) {
         /* .../a:union/b:translate/rotate */
         real3 p6 = (real3)(p5.x, (R(0.3623577544766736) * p5.y) + (R(0.9320390859672263) * p5.z), ((-R(0.9320390859672263)) * p5.y) + (R(0.3623577544766736) * p5.z));
         /* .../rotate/color/revolve */
-        real e17_0 = fabs(hypot(p6.x, p6.z) - R(0.3)) - R(0.06);
+        real e17_0 = fabs(length((real2)(p6.x, p6.z)) - R(0.3)) - R(0.06);
         real e17_1 = fabs(p6.y) - R(0.06);
-        real d12 = (hypot(fmax(e17_0, R(0.0)), fmax(e17_1, R(0.0))) + fmin(fmax(e17_0, e17_1), R(0.0))) - R(0.03);
+        real d12 = (length((real2)(fmax(e17_0, R(0.0)), fmax(e17_1, R(0.0)))) + fmin(fmax(e17_0, e17_1), R(0.0))) - R(0.03);
         real d16 = fmin(u21, d12);
         u16 = d16;
     }
@@ -422,7 +422,7 @@ real DE(real3 p0, __global const real* params) {
         real e22_63 = sqrt(fmin(fmin(fmin(fmin(fmin(fmin(fmin((e22_0 * e22_0) + (e22_1 * e22_1), (e22_4 * e22_4) + (e22_5 * e22_5)), (e22_14 * e22_14) + (e22_15 * e22_15)), (e22_24 * e22_24) + (e22_25 * e22_25)), (e22_33 * e22_33) + (e22_34 * e22_34)), (e22_42 * e22_42) + (e22_43 * e22_43)), (e22_50 * e22_50) + (e22_51 * e22_51)), (e22_59 * e22_59) + (e22_60 * e22_60)));
         real e22_64 = ((e22_57 && (!e22_62)) || ((!e22_57) && e22_62)) ? (-e22_63) : e22_63;
         real e22_65 = fabs(p8.z) - R(0.05);
-        real d17 = fmin(fmax(e22_64, e22_65), R(0.0)) + hypot(fmax(e22_64, R(0.0)), fmax(e22_65, R(0.0)));
+        real d17 = fmin(fmax(e22_64, e22_65), R(0.0)) + length((real2)(fmax(e22_64, R(0.0)), fmax(e22_65, R(0.0))));
         real d11 = fmin(u16, d17);
         u11 = d11;
     }
@@ -434,12 +434,12 @@ real DE(real3 p0, __global const real* params) {
         real3 p9 = p0 - ((real3)(-R(0.6), -R(0.13), R(0.6)));
         /* .../b:translate/color/revolve */
         real e26_0 = fabs(p9.y);
-        real e26_1 = fabs(hypot(p9.x, p9.z));
+        real e26_1 = fabs(length((real2)(p9.x, p9.z)));
         real e26_2 = e26_0 / R(0.32);
         real e26_3 = e26_1 / R(0.2);
         real e26_4 = R(2.5599999999999996) * e26_2;
         bool e26_5 = (((e26_2 * e26_2) + (e26_3 * e26_3)) - R(1.0)) < R(0.0);
-        real e26_6 = e26_5 ? R(1.0) : hypot(e26_4, e26_3);
+        real e26_6 = e26_5 ? R(1.0) : length((real2)(e26_4, e26_3));
         real e26_s0_0 = e26_3;
         real e26_s0_1 = e26_6;
         int e26_n0 = (int)clamp(ceil(R(64.0)), R(0.0), R(1048576.0));
@@ -468,7 +468,7 @@ real DE(real3 p0, __global const real* params) {
         real e26_25 = fmin(fmax(e26_19 - (((e26_23 + e26_24) - R(1.0)) / ((-R(2.0)) * ((e26_23 / e26_20) + (e26_24 / e26_19)))), e26_s0_0), e26_s0_1);
         real e26_26 = R(0.32) * e26_0;
         real e26_27 = e26_26 / R(0.0624);
-        real e26_28 = (R(0.0) < e26_1) ? hypot(e26_0 - ((R(2.5599999999999996) * e26_0) / (e26_25 + R(1.5599999999999996))), e26_1 - (e26_1 / e26_25)) : ((e26_26 < R(0.0624)) ? hypot((R(0.32) * e26_27) - e26_0, R(0.2) * sqrt(fmax(R(1.0) - (e26_27 * e26_27), R(0.0)))) : fabs(e26_0 - R(0.32)));
+        real e26_28 = (R(0.0) < e26_1) ? length((real2)(e26_0 - ((R(2.5599999999999996) * e26_0) / (e26_25 + R(1.5599999999999996))), e26_1 - (e26_1 / e26_25))) : ((e26_26 < R(0.0624)) ? length((real2)((R(0.32) * e26_27) - e26_0, R(0.2) * sqrt(fmax(R(1.0) - (e26_27 * e26_27), R(0.0))))) : fabs(e26_0 - R(0.32)));
         real d22 = e26_5 ? (-e26_28) : e26_28;
         real d7 = fmin(u11, d22);
         u7 = d7;
@@ -593,7 +593,7 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
         real e31_97 = sqrt(fmin(fmin(fmin(fmin(fmin(fmin(fmin(fmin(fmin(fmin((e31_0 * e31_0) + (e31_1 * e31_1), (e31_4 * e31_4) + (e31_5 * e31_5)), (e31_13 * e31_13) + (e31_14 * e31_14)), (e31_23 * e31_23) + (e31_24 * e31_24)), (e31_33 * e31_33) + (e31_34 * e31_34)), (e31_43 * e31_43) + (e31_44 * e31_44)), (e31_53 * e31_53) + (e31_54 * e31_54)), (e31_63 * e31_63) + (e31_64 * e31_64)), (e31_73 * e31_73) + (e31_74 * e31_74)), (e31_83 * e31_83) + (e31_84 * e31_84)), (e31_91 * e31_91) + (e31_92 * e31_92)));
         real e31_98 = ((e31_89 && (!e31_96)) || ((!e31_89) && e31_96)) ? (-e31_97) : e31_97;
         real e31_99 = fabs(p2.z) - R(0.06);
-        real d0 = fmin(fmax(e31_98, e31_99), R(0.0)) + hypot(fmax(e31_98, R(0.0)), fmax(e31_99, R(0.0)));
+        real d0 = fmin(fmax(e31_98, e31_99), R(0.0)) + length((real2)(fmax(e31_98, R(0.0)), fmax(e31_99, R(0.0))));
         /* .../a:translate/rotate/color */
         real3 c1 = (real3)(0.95f, 0.7f, 0.2f);
         real d28 = fmin(d26, d0);
@@ -611,7 +611,7 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
         /* .../a:union/a:union/b:translate */
         real3 p3 = p0 - ((real3)(-R(0.45), R(0.0), -R(0.6)));
         /* .../b:translate/color/revolve */
-        real e35_0 = hypot(p3.x, p3.z);
+        real e35_0 = length((real2)(p3.x, p3.z));
         real e35_1 = p3.y - R(0.06);
         real e35_2 = p3.y - (-R(0.45));
         real e35_3 = fmin(fmax(((e35_0 * R(0.0)) + (e35_2 * R(0.51))) / R(0.2601), R(0.0)), R(1.0));
@@ -723,10 +723,10 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
         /* .../a:union/a:union/b:translate */
         real3 p4 = p0 - ((real3)(R(0.5), -R(0.225), -R(0.55)));
         /* .../b:translate/color/revolve */
-        real e39_0 = hypot(p4.x, p4.z) - R(0.32);
+        real e39_0 = length((real2)(p4.x, p4.z)) - R(0.32);
         real e39_1 = p4.y - (-R(0.2));
         real e39_2 = fmin(fmax(((e39_0 * (-R(0.18))) + (e39_1 * R(0.4))) / R(0.19240000000000002), R(0.0)), R(1.0));
-        real d8 = hypot(e39_0 - ((-R(0.18)) * e39_2), e39_1 - (R(0.4) * e39_2)) - R(0.025);
+        real d8 = length((real2)(e39_0 - ((-R(0.18)) * e39_2), e39_1 - (R(0.4) * e39_2))) - R(0.025);
         /* .../a:union/b:translate/color */
         real3 c9 = (real3)(0.9f, 0.35f, 0.3f);
         real d21 = fmin(u25, d8);
@@ -747,9 +747,9 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
         /* .../a:union/b:translate/rotate */
         real3 p6 = (real3)(p5.x, (R(0.3623577544766736) * p5.y) + (R(0.9320390859672263) * p5.z), ((-R(0.9320390859672263)) * p5.y) + (R(0.3623577544766736) * p5.z));
         /* .../rotate/color/revolve */
-        real e44_0 = fabs(hypot(p6.x, p6.z) - R(0.3)) - R(0.06);
+        real e44_0 = fabs(length((real2)(p6.x, p6.z)) - R(0.3)) - R(0.06);
         real e44_1 = fabs(p6.y) - R(0.06);
-        real d12 = (hypot(fmax(e44_0, R(0.0)), fmax(e44_1, R(0.0))) + fmin(fmax(e44_0, e44_1), R(0.0))) - R(0.03);
+        real d12 = (length((real2)(fmax(e44_0, R(0.0)), fmax(e44_1, R(0.0)))) + fmin(fmax(e44_0, e44_1), R(0.0))) - R(0.03);
         /* .../b:translate/rotate/color */
         real3 c13 = (real3)(0.3f, 0.6f, 0.95f);
         real d16 = fmin(u21, d12);
@@ -836,7 +836,7 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
         real e49_63 = sqrt(fmin(fmin(fmin(fmin(fmin(fmin(fmin((e49_0 * e49_0) + (e49_1 * e49_1), (e49_4 * e49_4) + (e49_5 * e49_5)), (e49_14 * e49_14) + (e49_15 * e49_15)), (e49_24 * e49_24) + (e49_25 * e49_25)), (e49_33 * e49_33) + (e49_34 * e49_34)), (e49_42 * e49_42) + (e49_43 * e49_43)), (e49_50 * e49_50) + (e49_51 * e49_51)), (e49_59 * e49_59) + (e49_60 * e49_60)));
         real e49_64 = ((e49_57 && (!e49_62)) || ((!e49_57) && e49_62)) ? (-e49_63) : e49_63;
         real e49_65 = fabs(p8.z) - R(0.05);
-        real d17 = fmin(fmax(e49_64, e49_65), R(0.0)) + hypot(fmax(e49_64, R(0.0)), fmax(e49_65, R(0.0)));
+        real d17 = fmin(fmax(e49_64, e49_65), R(0.0)) + length((real2)(fmax(e49_64, R(0.0)), fmax(e49_65, R(0.0))));
         /* .../b:translate/rotate/color */
         real3 c18 = (real3)(0.4f, 0.8f, 0.45f);
         real d11 = fmin(u16, d17);
@@ -856,12 +856,12 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
         real3 p9 = p0 - ((real3)(-R(0.6), -R(0.13), R(0.6)));
         /* .../b:translate/color/revolve */
         real e53_0 = fabs(p9.y);
-        real e53_1 = fabs(hypot(p9.x, p9.z));
+        real e53_1 = fabs(length((real2)(p9.x, p9.z)));
         real e53_2 = e53_0 / R(0.32);
         real e53_3 = e53_1 / R(0.2);
         real e53_4 = R(2.5599999999999996) * e53_2;
         bool e53_5 = (((e53_2 * e53_2) + (e53_3 * e53_3)) - R(1.0)) < R(0.0);
-        real e53_6 = e53_5 ? R(1.0) : hypot(e53_4, e53_3);
+        real e53_6 = e53_5 ? R(1.0) : length((real2)(e53_4, e53_3));
         real e53_s0_0 = e53_3;
         real e53_s0_1 = e53_6;
         int e53_n0 = (int)clamp(ceil(R(64.0)), R(0.0), R(1048576.0));
@@ -890,7 +890,7 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
         real e53_25 = fmin(fmax(e53_19 - (((e53_23 + e53_24) - R(1.0)) / ((-R(2.0)) * ((e53_23 / e53_20) + (e53_24 / e53_19)))), e53_s0_0), e53_s0_1);
         real e53_26 = R(0.32) * e53_0;
         real e53_27 = e53_26 / R(0.0624);
-        real e53_28 = (R(0.0) < e53_1) ? hypot(e53_0 - ((R(2.5599999999999996) * e53_0) / (e53_25 + R(1.5599999999999996))), e53_1 - (e53_1 / e53_25)) : ((e53_26 < R(0.0624)) ? hypot((R(0.32) * e53_27) - e53_0, R(0.2) * sqrt(fmax(R(1.0) - (e53_27 * e53_27), R(0.0)))) : fabs(e53_0 - R(0.32)));
+        real e53_28 = (R(0.0) < e53_1) ? length((real2)(e53_0 - ((R(2.5599999999999996) * e53_0) / (e53_25 + R(1.5599999999999996))), e53_1 - (e53_1 / e53_25))) : ((e53_26 < R(0.0624)) ? length((real2)((R(0.32) * e53_27) - e53_0, R(0.2) * sqrt(fmax(R(1.0) - (e53_27 * e53_27), R(0.0))))) : fabs(e53_0 - R(0.32)));
         real d22 = e53_5 ? (-e53_28) : e53_28;
         /* .../a:union/b:translate/color */
         real3 c23 = (real3)(0.85f, 0.55f, 0.85f);
