@@ -48,6 +48,7 @@ pub fn all() -> Vec<(&'static str, Scene)> {
         ("mandelbox", mandelbox()),
         ("kifs", kifs()),
         ("hybrid", hybrid()),
+        ("bulb_variants", bulb_variants()),
         ("orbit_traps", orbit_traps()),
         ("profiles", profiles()),
     ]
@@ -396,6 +397,34 @@ pub fn hybrid() -> Scene {
     Scene::new(row.union(floor(1.0)))
         .with_camera(Camera::look_at(dvec3(0.0, 1.8, 4.4), dvec3(0.0, -0.2, 0.0)).fov(45.0))
         .with_lights(key_and_fill())
+}
+
+/// The two Mandelbulb variants written as hybrids: the classic power-2
+/// Mandelbulb ([`Hybrid::power2_mandelbulb`], its latitude doubled and its
+/// `z` negated) standing on its axis, and the quaternion Mandelbrot set
+/// ([`Hybrid::quaternion_mandelbrot`], the Mandelbrot set turned about its
+/// real axis) lying along `x`.
+#[must_use]
+pub fn bulb_variants() -> Scene {
+    let bulb = Node::from(Hybrid::power2_mandelbulb().iterations(10).bailout(4.0))
+        .rotate(DVec3::X, -FRAC_PI_2)
+        .scale(0.42)
+        .color(dvec3(0.85, 0.55, 0.3))
+        .translate(dvec3(-1.05, -0.15, 0.0));
+    let quaternion = Node::from(Hybrid::quaternion_mandelbrot().iterations(10).bailout(4.0))
+        .rotate(DVec3::Y, 0.2)
+        .scale(0.55)
+        .color(dvec3(0.4, 0.7, 0.9))
+        .translate(dvec3(1.05, -0.38, 0.2));
+    // Hard shadows: a soft shadow's penumbra comes from the estimate, and
+    // the power-2 bulb's is far below the distance (see the guide).
+    let lights: Vec<Light> = key_and_fill()
+        .into_iter()
+        .map(|l| l.softness(0.0))
+        .collect();
+    Scene::new(bulb.union(quaternion).union(floor(1.0)))
+        .with_camera(Camera::look_at(dvec3(0.0, 1.5, 4.6), dvec3(0.0, -0.2, 0.0)).fov(45.0))
+        .with_lights(lights)
 }
 
 /// Four fractals coloured by their orbits ([`Node::orbit_trap`]): the

@@ -79,6 +79,8 @@ pub(super) const NAMES: &[&str] = &[
     "PlaneFold",
     "Fold",
     "Power",
+    "BulbSquare",
+    "QuaternionSquare",
     "AddPoint",
     "AddConstant",
     "Translate",

@@ -709,6 +709,8 @@ pub(crate) fn costs(ir: &Ir) -> Vec<f64> {
                     .unrolled()
                     .map(|(_, _, op)| match op {
                         HybridOp::Power { .. } => 20.0,
+                        HybridOp::BulbSquare { .. } => 8.0,
+                        HybridOp::QuaternionSquare => 4.0,
                         HybridOp::Fold(KifsFold::Icosahedral) => 9.0,
                         _ => 3.0,
                     })

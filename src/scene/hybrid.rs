@@ -81,6 +81,29 @@ pub enum HybridOp<S = Param> {
         /// The power, in `[2, 16]`.
         power: S,
     },
+    /// The classic power-2 Mandelbulb's step (White and Nylander's, in
+    /// Cartesian form): the radius squared and the azimuth and the
+    /// *latitude* (the angle from the `xy` plane, where
+    /// [`Power`](HybridOp::Power) measures the angle from the `z` axis)
+    /// doubled, `z → ((x² − y²)·k, 2xy·k, s·2zρ)` with `ρ = √(x² + y²)`,
+    /// `k = 1 − z²/ρ²` and `s = −1` where `negate_z` (the classic sign; in
+    /// a scene file, *default* `true`), `+1` otherwise. On the `z` axis the
+    /// azimuth is 0. `dr → 2r · dr`, times the azimuth's stretch
+    /// `|ρ² − z²| / (r·ρ)` where it is above 1: it has no bound, for the
+    /// square sends a small circle about the `z` axis onto a circle of
+    /// radius `r²` (the map is not continuous on the axis), and a capped
+    /// stretch overestimates there.
+    BulbSquare {
+        /// Whether the new `z` is negated (the classic sign).
+        #[serde(default = "yes")]
+        negate_z: bool,
+    },
+    /// The square of the quaternion `x + y·i + z·j` (its fourth component
+    /// 0, which squaring keeps): `z → (x² − y² − z², 2xy, 2xz)`; with
+    /// [`AddPoint`](HybridOp::AddPoint), the quaternion Mandelbrot set's
+    /// slice through `w = 0`. `dr → 2r · dr`, the square's largest
+    /// stretch.
+    QuaternionSquare,
     /// `z → z + p`, the point the orbit started from (the Mandelbrot
     /// form); `dr → dr + 1`.
     AddPoint,
@@ -124,8 +147,8 @@ pub struct HybridStage<S = Param> {
 /// addition brings back). An orbit is followed until it
 /// passes [`HYBRID_FOLLOW`](crate::cpu::sdf::HYBRID_FOLLOW) times the
 /// bailout (or its iterations end), and with its radius `r` and running
-/// derivative `dr` there the estimate is, with a
-/// [`Power`](HybridOp::Power) step, the Mandelbulb's
+/// derivative `dr` there the estimate is, with a power step
+/// ([`HybridOp::is_power`]), the Mandelbulb's
 /// `0.5 · r · ln(r / bailout) / dr`, and without one `(r − bailout) / dr`,
 /// the form of the box fractals; it is negative exactly inside the set,
 /// and at least the distance to the ball. The running derivative takes
@@ -169,6 +192,11 @@ fn origin<S: From<f64>>() -> [S; 3] {
 /// A stage's default repeat count in a scene file.
 fn once() -> u32 {
     1
+}
+
+/// [`HybridOp::BulbSquare`]'s default sign in a scene file.
+fn yes() -> bool {
+    true
 }
 
 impl From<Hybrid> for Node {
@@ -243,6 +271,20 @@ impl Hybrid {
         )
     }
 
+    /// The classic power-2 Mandelbulb: [`HybridOp::bulb_square`], then add
+    /// the point.
+    #[must_use]
+    pub fn power2_mandelbulb() -> Self {
+        Hybrid::new().stage(1, [HybridOp::bulb_square(), HybridOp::AddPoint])
+    }
+
+    /// The quaternion Mandelbrot set's slice through `w = 0`:
+    /// [`HybridOp::QuaternionSquare`], then add the point.
+    #[must_use]
+    pub fn quaternion_mandelbrot() -> Self {
+        Hybrid::new().stage(1, [HybridOp::QuaternionSquare, HybridOp::AddPoint])
+    }
+
     /// Amazing Surf (Kali): the box fold on `x` and `y` at 1, a sphere
     /// fold with radii 0.5 and 1, scale by `scale`, add the point, then a
     /// turn by `angles`.
@@ -262,6 +304,12 @@ impl Hybrid {
 }
 
 impl HybridOp {
+    /// [`HybridOp::BulbSquare`] with the classic sign (`negate_z`).
+    #[must_use]
+    pub fn bulb_square() -> Self {
+        HybridOp::BulbSquare { negate_z: true }
+    }
+
     /// [`HybridOp::BoxFold`].
     #[must_use]
     pub fn box_fold(limit: impl Into<Param>) -> Self {
@@ -338,6 +386,16 @@ impl HybridOp {
 }
 
 impl<S> HybridOp<S> {
+    /// Whether the operation raises the point to a power (the orbit then
+    /// grows geometrically, and the estimate takes the logarithmic form).
+    #[must_use]
+    pub fn is_power(&self) -> bool {
+        matches!(
+            self,
+            HybridOp::Power { .. } | HybridOp::BulbSquare { .. } | HybridOp::QuaternionSquare
+        )
+    }
+
     /// The operation's name in a scene file (`BoxFold`).
     #[must_use]
     pub fn name(&self) -> &'static str {
@@ -351,6 +409,8 @@ impl<S> HybridOp<S> {
             HybridOp::PlaneFold { .. } => "PlaneFold",
             HybridOp::Fold(_) => "Fold",
             HybridOp::Power { .. } => "Power",
+            HybridOp::BulbSquare { .. } => "BulbSquare",
+            HybridOp::QuaternionSquare => "QuaternionSquare",
             HybridOp::AddPoint => "AddPoint",
             HybridOp::AddConstant { .. } => "AddConstant",
         }
@@ -368,13 +428,15 @@ impl<S> Hybrid<S> {
             .sum()
     }
 
-    /// Whether an iteration raises the point to a power (the estimate is
-    /// then the Mandelbulb's logarithmic form).
+    /// Whether an iteration raises the point to a power ([`Power`](HybridOp::Power),
+    /// [`BulbSquare`](HybridOp::BulbSquare) or
+    /// [`QuaternionSquare`](HybridOp::QuaternionSquare)): the estimate is
+    /// then the Mandelbulb's logarithmic form.
     #[must_use]
     pub fn has_power(&self) -> bool {
         self.stages
             .iter()
-            .any(|s| s.repeat > 0 && s.ops.iter().any(|o| matches!(o, HybridOp::Power { .. })))
+            .any(|s| s.repeat > 0 && s.ops.iter().any(HybridOp::is_power))
     }
 
     /// The operations of one iteration in the order they run, each with
@@ -435,6 +497,10 @@ impl<S> Hybrid<S> {
                     HybridOp::Power { power } => HybridOp::Power {
                         power: f(power, spec(&at("power"), Range(2.0, 16.0)))?,
                     },
+                    HybridOp::BulbSquare { negate_z } => HybridOp::BulbSquare {
+                        negate_z: *negate_z,
+                    },
+                    HybridOp::QuaternionSquare => HybridOp::QuaternionSquare,
                     HybridOp::AddPoint => HybridOp::AddPoint,
                     HybridOp::AddConstant { c } => HybridOp::AddConstant {
                         c: three(f, c, &at("c"), Finite)?,

@@ -433,6 +433,27 @@ pub fn hybrid_inside(p: DVec3, h: &crate::scene::Hybrid) -> bool {
                         theta.cos(),
                     )
             }
+            HybridOp::BulbSquare { negate_z } => {
+                let r = z.length();
+                if r == 0.0 {
+                    return z;
+                }
+                let latitude = 2.0 * (z.z / r).clamp(-1.0, 1.0).asin();
+                let azimuth = 2.0 * z.y.atan2(z.x);
+                let sign = if *negate_z { -1.0 } else { 1.0 };
+                r * r
+                    * DVec3::new(
+                        latitude.cos() * azimuth.cos(),
+                        latitude.cos() * azimuth.sin(),
+                        sign * latitude.sin(),
+                    )
+            }
+            HybridOp::QuaternionSquare => {
+                // glam's quaternions keep the real part in `w`.
+                let q = DQuat::from_xyzw(z.y, z.z, 0.0, z.x);
+                let q2 = q * q;
+                DVec3::new(q2.w, q2.x, q2.y)
+            }
             HybridOp::AddPoint => z + p,
             HybridOp::AddConstant { c } => z + three(c),
         }

@@ -1047,6 +1047,8 @@ pub fn hybrid_op() -> impl Strategy<Value = HybridOp> + Clone {
         }),
         fold.prop_map(HybridOp::Fold),
         scalar("hybrid.power", power).prop_map(|p| HybridOp::Power { power: p }),
+        any::<bool>().prop_map(|negate_z| HybridOp::BulbSquare { negate_z }),
+        Just(HybridOp::QuaternionSquare),
         Just(HybridOp::AddPoint),
         three("hybrid.c").prop_map(|c| HybridOp::AddConstant { c }),
     ]

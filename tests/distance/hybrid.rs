@@ -118,6 +118,26 @@ fn classics() -> Vec<(&'static str, Hybrid, f64)> {
             2.2,
         ),
         (
+            "power-2 Mandelbulb (White and Nylander's)",
+            Hybrid::power2_mandelbulb().iterations(8),
+            2.2,
+        ),
+        (
+            "power-2 Mandelbulb, z not negated",
+            Hybrid::new()
+                .stage(
+                    1,
+                    [HybridOp::BulbSquare { negate_z: false }, HybridOp::AddPoint],
+                )
+                .iterations(8),
+            2.2,
+        ),
+        (
+            "quaternion Mandelbrot (slice w = 0)",
+            Hybrid::quaternion_mandelbrot().iterations(8),
+            2.2,
+        ),
+        (
             "Julia bulb: power 8, add (0.4, −0.3, 0.2)",
             Hybrid::new()
                 .stage(
@@ -143,6 +163,14 @@ fn classics() -> Vec<(&'static str, Hybrid, f64)> {
             Hybrid::new()
                 .stage(1, bulb(2.0))
                 .stage(1, boxed(-1.5))
+                .iterations(8),
+            2.0,
+        ),
+        (
+            "box (scale −1.5) twice, then the power-2 bulb",
+            Hybrid::new()
+                .stage(2, boxed(-1.5))
+                .stage(1, [HybridOp::bulb_square(), HybridOp::AddPoint])
                 .iterations(8),
             2.0,
         ),

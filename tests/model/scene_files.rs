@@ -367,6 +367,27 @@ fn shorthand_forms_read_as_their_long_forms() {
     assert_eq!(file.effects, Effects::default());
 }
 
+/// The Mandelbulb variants' operations read with their defaults: the
+/// power-2 bulb's square negates `z` unless told not to.
+#[test]
+fn the_bulb_variants_read_with_their_defaults() {
+    use fractal_sdf::scene::{Hybrid, HybridOp};
+    let text = "(version: 1, geometry: Union([
+        Hybrid(stages: [(ops: [BulbSquare(), AddPoint])]),
+        Hybrid(stages: [(ops: [BulbSquare(negate_z: false), QuaternionSquare, AddPoint])]),
+    ]))";
+    let file = SceneFile::parse(text).unwrap();
+    let expected = Node::from(Hybrid::power2_mandelbulb()).union(Node::from(Hybrid::new().stage(
+        1,
+        [
+            HybridOp::BulbSquare { negate_z: false },
+            HybridOp::QuaternionSquare,
+            HybridOp::AddPoint,
+        ],
+    )));
+    assert_eq!(file.scene.geometry, Some(expected));
+}
+
 /// Orbit traps read in every form: each trap, each named palette, a
 /// gradient, the range's defaults; a palette the parser does not know is
 /// an error that names the word.
