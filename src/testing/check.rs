@@ -616,6 +616,8 @@ impl SplitMix {
 /// generator seeded from `p`. A point with `d(p) <= 0` (the field says
 /// "inside or on the surface") must itself be inside the set, give or take
 /// rounding: otherwise the field has the wrong sign there ([`Check::Sign`]).
+/// A positive distance within rounding of 0 ([`ROUNDING_ALLOWANCE`]) is on
+/// the surface too: its ball is too small to test.
 ///
 /// `inside` should be an independent description of the set, such as the
 /// membership tests in this module or a simpler field's sign. The property
@@ -670,6 +672,12 @@ pub fn check_never_overestimates<F: DistanceField + ?Sized>(
             } else {
                 signs.pass(0.0);
             }
+            continue;
+        }
+        if dp <= rounding(p, p, dp, 0.0) {
+            // Within rounding of the surface: a ball that small holds
+            // nothing a distance could be wrong about.
+            tally.pass(0.0);
             continue;
         }
         let descent = -gradient(&d, p, dp).unwrap_or(DVec3::ZERO);
