@@ -71,7 +71,7 @@ pub use device::{
 };
 pub use membership::{
     hybrid_inside, julia_inside, kifs_inside, mandelbox_inside, mandelbulb_inside, menger_inside,
-    sierpinski_inside,
+    pseudo_kleinian_inside, sierpinski_inside,
 };
 pub use sample::near_surface_points;
 pub use sites::{Site, parameter_sites, substitute};
@@ -82,8 +82,8 @@ pub use strategy::{
     exact_primitive, extrude_node, fractal_node, hex_prism_node, hybrid_node, hybrid_op,
     infinite_cone_node, infinite_cylinder_node, julia_node, kifs_node, link_node, mandelbox_node,
     mandelbulb_node, menger_node, octahedron_node, orbit_trap_node, palette, plane_node, point,
-    point_pair, profile, pyramid_node, quad_node, ray, repeated_node, revolve_node, rhombus_node,
-    rotation, round_box_node, round_cone_between_node, round_cone_node, rounded_cylinder_node,
-    scene_node, sierpinski_node, solid_angle_node, sphere_node, torus_node, trap, tri_prism_node,
-    triangle_node, unit_vector,
+    point_pair, profile, pseudo_kleinian_node, pyramid_node, quad_node, ray, repeated_node,
+    revolve_node, rhombus_node, rotation, round_box_node, round_cone_between_node, round_cone_node,
+    rounded_cylinder_node, scene_node, sierpinski_node, solid_angle_node, sphere_node, torus_node,
+    trap, tri_prism_node, triangle_node, unit_vector,
 };

@@ -5,7 +5,7 @@
 use crate::cpu::sdf::{self, Estimate, TrapShape};
 use crate::expr::{Num, OpenCl, Printer, Shape, Signature, Unprintable, Var, trace};
 use crate::math::{V3, v3};
-use crate::scene::{Hybrid, KifsFold, ParamSpec};
+use crate::scene::{Hybrid, KifsFold, ParamSpec, PseudoKleinian};
 
 use Shape::{Pair, Scalar, Vec3};
 
@@ -401,6 +401,32 @@ pub(crate) fn mandelbox(julia: bool, trap: bool) -> Result<String, Unprintable> 
         let m = sdf::MandelboxParams::new(a[4], a[5], a[6], a[7], julia.then(|| vector(a, 8)));
         sdf::mandelbox_estimate(vector(a, 0), a[3], &m, t)
     })
+}
+
+/// Knighty's pseudo-Kleinian fractal.
+pub(crate) fn pseudo_kleinian(trap: bool) -> Result<String, Unprintable> {
+    fractal(
+        "pseudo_kleinian",
+        &[
+            ("p", Vec3),
+            ("iterations", Scalar),
+            ("fold_size", Vec3),
+            ("inversion", Scalar),
+            ("offset", Vec3),
+            ("thickness", Scalar),
+        ],
+        trap,
+        |a, t| {
+            let k = PseudoKleinian {
+                fold_size: [a[4], a[5], a[6]],
+                inversion: a[7],
+                offset: [a[8], a[9], a[10]],
+                thickness: a[11],
+                iterations: 0,
+            };
+            sdf::pseudo_kleinian_estimate(vector(a, 0), a[3], &k, t)
+        },
+    )
 }
 
 /// A kaleidoscopic IFS of `fold`; with `turned`, the turns before and

@@ -47,13 +47,14 @@ pub(crate) enum Helper {
     Julia,
     Mandelbox,
     MandelboxJulia,
+    PseudoKleinian,
     /// A kaleidoscopic IFS of the fold, with turns (`true`) or without.
     Kifs(KifsFold, bool),
 }
 
 impl Helper {
     /// Every helper, in the order they are emitted.
-    pub(crate) const ALL: [Helper; 45] = [
+    pub(crate) const ALL: [Helper; 46] = [
         Helper::Sphere,
         Helper::Cuboid,
         Helper::RoundBox,
@@ -91,6 +92,7 @@ impl Helper {
         Helper::Julia,
         Helper::Mandelbox,
         Helper::MandelboxJulia,
+        Helper::PseudoKleinian,
         Helper::Kifs(KifsFold::Tetrahedral, false),
         Helper::Kifs(KifsFold::Tetrahedral, true),
         Helper::Kifs(KifsFold::Octahedral, false),
@@ -141,6 +143,7 @@ impl Helper {
             Helper::Julia => "julia",
             Helper::Mandelbox => "mandelbox",
             Helper::MandelboxJulia => "mandelbox_julia",
+            Helper::PseudoKleinian => "pseudo_kleinian",
             Helper::Kifs(fold, turned) => match (fold, turned) {
                 (KifsFold::Tetrahedral, false) => "kifs_tetrahedral",
                 (KifsFold::Tetrahedral, true) => "kifs_tetrahedral_turned",
@@ -194,6 +197,7 @@ impl Helper {
             | Helper::Julia
             | Helper::Mandelbox
             | Helper::MandelboxJulia
+            | Helper::PseudoKleinian
             | Helper::Kifs(..) => self.fractal_source(false).expect("a fractal's helper"),
         }
     }
@@ -208,6 +212,7 @@ impl Helper {
             Helper::Julia => formulas::julia(trap),
             Helper::Mandelbox => formulas::mandelbox(false, trap),
             Helper::MandelboxJulia => formulas::mandelbox(true, trap),
+            Helper::PseudoKleinian => formulas::pseudo_kleinian(trap),
             Helper::Kifs(fold, turned) => formulas::kifs(fold, turned, self.name(), trap),
             _ => return None,
         })

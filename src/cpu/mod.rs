@@ -518,7 +518,8 @@ impl Evaluator {
             | Kind::Sierpinski(_)
             | Kind::Kifs(_)
             | Kind::Hybrid(_)
-            | Kind::Mandelbox(_) => {
+            | Kind::Mandelbox(_)
+            | Kind::PseudoKleinian(_) => {
                 if self.trapped[id] {
                     // Its orbit trap evaluates it.
                     return Self::leaf(T::zero());
@@ -657,6 +658,9 @@ impl Evaluator {
                 &sdf::hybrid_integer_powers(h),
                 trap,
             ),
+            Kind::PseudoKleinian(f) => {
+                sdf::pseudo_kleinian_estimate(p, count(f.iterations), &f.map(|x| s(*x)), trap)
+            }
             Kind::Mandelbox(f) => sdf::mandelbox_estimate(
                 p,
                 count(f.iterations),

@@ -3,7 +3,7 @@
 use crate::error::Error;
 use crate::scene::{
     CsgOp, CustomShape, Hybrid, InsideShape, Kifs, Kind, Mandelbox, Mandelbulb, Menger, Node,
-    OrbitColoring, Param, QuaternionJulia, Sierpinski,
+    OrbitColoring, Param, PseudoKleinian, QuaternionJulia, Sierpinski,
 };
 
 use super::MAX_NESTING;
@@ -282,6 +282,19 @@ impl NodeRepr {
                 fold_limit,
                 iterations,
                 julia,
+            },
+            Kind::PseudoKleinian(PseudoKleinian {
+                fold_size,
+                inversion,
+                offset,
+                thickness,
+                iterations,
+            }) => NodeRepr::PseudoKleinian {
+                fold_size: Some(fold_size),
+                inversion: Some(inversion),
+                offset: Some(offset),
+                thickness: Some(thickness),
+                iterations: Some(iterations),
             },
             Kind::Kifs(Kifs {
                 fold,
@@ -746,6 +759,31 @@ impl Located<NodeRepr> {
                     .iterations(*iterations);
                 b.julia.clone_from(julia);
                 b.into()
+            }
+            NodeRepr::PseudoKleinian {
+                fold_size,
+                inversion,
+                offset,
+                thickness,
+                iterations,
+            } => {
+                let mut k = PseudoKleinian::new();
+                if let Some(size) = fold_size {
+                    k.fold_size.clone_from(size);
+                }
+                if let Some(inversion) = inversion {
+                    k.inversion = inversion.clone();
+                }
+                if let Some(offset) = offset {
+                    k.offset.clone_from(offset);
+                }
+                if let Some(thickness) = thickness {
+                    k.thickness = thickness.clone();
+                }
+                if let Some(n) = iterations {
+                    k.iterations = *n;
+                }
+                k.into()
             }
             NodeRepr::Kifs {
                 fold,

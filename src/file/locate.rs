@@ -69,6 +69,7 @@ pub(super) const NAMES: &[&str] = &[
     "Julia",
     "Sierpinski",
     "Mandelbox",
+    "PseudoKleinian",
     "Kifs",
     "Hybrid",
     "Stage",

@@ -600,6 +600,24 @@ pub(super) enum NodeRepr {
         #[serde(default, skip_serializing_if = "Option::is_none")]
         julia: Option<[Param; 3]>,
     },
+    /// Each setting left out takes the published preset's
+    /// ([`PseudoKleinian::new`](crate::scene::PseudoKleinian::new)).
+    PseudoKleinian {
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        fold_size: Option<[Param; 3]>,
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        inversion: Option<Param>,
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        offset: Option<[Param; 3]>,
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        thickness: Option<Param>,
+        #[serde(
+            default,
+            skip_serializing_if = "Option::is_none",
+            deserialize_with = "count::optional_iterations"
+        )]
+        iterations: Option<u32>,
+    },
     /// Each setting left out takes the classic one of the fold
     /// ([`Kifs::new`](crate::scene::Kifs::new)).
     Kifs {

@@ -488,6 +488,7 @@ pub(super) fn bound(node: &IrNode, done: &[Option<Bound>]) -> Option<Bound> {
         Kind::Bend { child, .. } => warp_ball(Axis::Z, of(child)?),
         // Unbounded.
         Kind::Plane { .. }
+        | Kind::PseudoKleinian(_)
         | Kind::InfiniteCylinder { .. }
         | Kind::InfiniteCone { .. }
         | Kind::Repeat { .. } => {
@@ -690,6 +691,7 @@ pub(crate) fn costs(ir: &Ir) -> Vec<f64> {
             Kind::Menger(f) => 4.0 * f64::from(f.iterations),
             Kind::Sierpinski(f) => 3.0 * f64::from(f.iterations),
             Kind::Mandelbox(f) => 6.0 * f64::from(f.iterations),
+            Kind::PseudoKleinian(f) => 5.0 * f64::from(f.iterations),
             Kind::Kifs(f) => {
                 let fold = if f.fold == KifsFold::Icosahedral {
                     9.0

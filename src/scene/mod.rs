@@ -9,6 +9,7 @@ mod custom;
 mod fractal;
 mod hybrid;
 mod inside;
+mod kleinian;
 mod material;
 pub(crate) mod names;
 mod node;
@@ -37,6 +38,7 @@ pub use inside::{
     BRUTE_MAX_STEPS, InsideShape, MANDELBOX_BAILOUT, MANDELBOX_HALF_SIDE, MANDELBULB_BAILOUT,
     mandelbox_contains, mandelbulb_contains,
 };
+pub use kleinian::{PseudoKleinian, pseudo_kleinian};
 pub(crate) use material::MATERIAL_SPECS;
 pub use material::{DEFAULT_MATERIAL, MATERIAL_LEN, Material};
 pub(crate) use node::Mapper;

@@ -11,6 +11,7 @@ use glam::DVec3;
 use super::custom::CustomShape;
 use super::fractal::{Kifs, Mandelbox, Mandelbulb, Menger, QuaternionJulia, Sierpinski};
 use super::hybrid::Hybrid;
+use super::kleinian::PseudoKleinian;
 use super::material::Material;
 use super::param::{Param, Param3};
 use super::profile::Profile;
@@ -389,6 +390,8 @@ pub enum Kind<S, V, C> {
     Sierpinski(Sierpinski<S>),
     /// See [`Mandelbox`].
     Mandelbox(Mandelbox<S>),
+    /// See [`PseudoKleinian`].
+    PseudoKleinian(PseudoKleinian<S>),
     /// See [`Kifs`].
     Kifs(Kifs<S>),
     /// See [`Hybrid`].
@@ -604,6 +607,7 @@ impl<S, V, C> Kind<S, V, C> {
             Kind::Julia(_) => "julia",
             Kind::Sierpinski(_) => "sierpinski",
             Kind::Mandelbox(_) => "mandelbox",
+            Kind::PseudoKleinian(_) => "pseudo_kleinian",
             Kind::Kifs(_) => "kifs",
             Kind::Hybrid(_) => "hybrid",
             Kind::Translate { .. } => "translate",
@@ -698,6 +702,7 @@ impl<S, V, C> Kind<S, V, C> {
             | Kind::Julia(_)
             | Kind::Sierpinski(_)
             | Kind::Mandelbox(_)
+            | Kind::PseudoKleinian(_)
             | Kind::Kifs(_)
             | Kind::Hybrid(_)
             | Kind::Custom { .. } => vec![],
@@ -729,6 +734,7 @@ impl<S, V, C> Kind<S, V, C> {
                 | Kind::Julia(_)
                 | Kind::Sierpinski(_)
                 | Kind::Mandelbox(_)
+                | Kind::PseudoKleinian(_)
                 | Kind::Kifs(_)
                 | Kind::Hybrid(_)
         )
@@ -743,6 +749,7 @@ impl<S, V, C> Kind<S, V, C> {
             Kind::Julia(j) => Some(j.iterations),
             Kind::Sierpinski(s) => Some(s.iterations),
             Kind::Mandelbox(b) => Some(b.iterations),
+            Kind::PseudoKleinian(k) => Some(k.iterations),
             Kind::Kifs(k) => Some(k.iterations),
             Kind::Hybrid(h) => Some(h.iterations),
             _ => None,
@@ -757,7 +764,7 @@ impl<S, V, C> Kind<S, V, C> {
                 Some((1, MAX_ESCAPE_ITERATIONS))
             }
             Kind::Menger(_) | Kind::Sierpinski(_) | Kind::Kifs(_) => Some((0, MAX_FOLD_ITERATIONS)),
-            Kind::Hybrid(_) => Some((0, MAX_ESCAPE_ITERATIONS)),
+            Kind::Hybrid(_) | Kind::PseudoKleinian(_) => Some((0, MAX_ESCAPE_ITERATIONS)),
             _ => None,
         }
     }
@@ -1026,6 +1033,22 @@ impl<S, V, C> Kind<S, V, C> {
                     None => None,
                 },
             }),
+            Kind::PseudoKleinian(f) => {
+                let three = |m: &mut M, v: &[S; 3], name: &str, rule| -> Result<[_; 3], M::E> {
+                    Ok([
+                        m.scalar(&v[0], spec(&format!("{name}.x"), rule))?,
+                        m.scalar(&v[1], spec(&format!("{name}.y"), rule))?,
+                        m.scalar(&v[2], spec(&format!("{name}.z"), rule))?,
+                    ])
+                };
+                Kind::PseudoKleinian(PseudoKleinian {
+                    fold_size: three(m, &f.fold_size, "fold_size", Positive)?,
+                    inversion: m.scalar(&f.inversion, spec("inversion", Range(0.05, 4.0)))?,
+                    offset: three(m, &f.offset, "offset", Finite)?,
+                    thickness: m.scalar(&f.thickness, spec("thickness", Range(1e-4, 2.0)))?,
+                    iterations: f.iterations,
+                })
+            }
             Kind::Kifs(f) => {
                 let scale = m.scalar(&f.scale, spec("scale", Range(1.1, 4.0)))?;
                 let mut three = |v: &[S; 3], names: [&str; 3], rule: Rule| {

@@ -300,6 +300,56 @@ pub fn kifs_inside(p: DVec3, k: &crate::scene::Kifs) -> bool {
     z.length() <= radius
 }
 
+/// Whether `p` is in Knighty's pseudo-Kleinian set `k` as drawn (its
+/// parameters' default values), from the definition in
+/// [`PseudoKleinian`](crate::scene::PseudoKleinian): after `iterations`
+/// steps of a reflection of each coordinate beyond the fold size, an
+/// inversion of a point within the sphere of squared radius `inversion`,
+/// and the offset added, the orbit ends where `√(x² + y²) · |z|` is below
+/// the thickness. Written by cases, with no code of the estimator.
+///
+/// ```
+/// use fractal_sdf::prelude::*;
+/// use fractal_sdf::scene::PseudoKleinian;
+/// use fractal_sdf::testing::pseudo_kleinian_inside;
+/// let k = PseudoKleinian::new();
+/// // The plane z = 0 and the z axis are in it; a point off both is not.
+/// assert!(pseudo_kleinian_inside(dvec3(0.3, 0.2, 0.0), &k));
+/// assert!(pseudo_kleinian_inside(dvec3(0.0, 0.0, 0.4), &k));
+/// assert!(!pseudo_kleinian_inside(dvec3(0.3, 0.2, 0.3), &k.clone().iterations(0)));
+/// ```
+#[must_use]
+pub fn pseudo_kleinian_inside(p: DVec3, k: &crate::scene::PseudoKleinian) -> bool {
+    let value = crate::scene::Param::default_value;
+    let three = |v: &[crate::scene::Param; 3]| DVec3::new(value(&v[0]), value(&v[1]), value(&v[2]));
+    let size = three(&k.fold_size);
+    let offset = three(&k.offset);
+    let inversion = value(&k.inversion);
+    let reflect = |v: f64, l: f64| {
+        if v > l {
+            2.0 * l - v
+        } else if v < -l {
+            -2.0 * l - v
+        } else {
+            v
+        }
+    };
+    let mut z = p;
+    for _ in 0..k.iterations {
+        z = DVec3::new(
+            reflect(z.x, size.x),
+            reflect(z.y, size.y),
+            reflect(z.z, size.z),
+        );
+        let r2 = z.length_squared();
+        if r2 > 0.0 && r2 < inversion {
+            z *= inversion / r2;
+        }
+        z += offset;
+    }
+    z.x.hypot(z.y) * z.z.abs() < value(&k.thickness)
+}
+
 /// Whether `p` is in the hybrid `h` as drawn (its parameters' default
 /// values), from the definition in [`Hybrid`](crate::scene::Hybrid): `p`
 /// is within the ball of radius `bailout`, and so is the orbit at the end

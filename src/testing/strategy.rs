@@ -11,11 +11,12 @@ use crate::cpu::Ray;
 use crate::scene::{
     Axis, CsgOp, Hybrid, HybridOp, Kifs, KifsFold, Kind, MAX_ESCAPE_ITERATIONS,
     MAX_FOLD_ITERATIONS, MAX_SOLID_ANGLE, Mandelbox, Mandelbulb, Menger, Node, OrbitColoring,
-    Palette, Param, Param3, Profile, QuaternionJulia, Sierpinski, Trap, box_frame, capped_cone,
-    capped_torus, capsule, cone, cone_between, cuboid, cut_hollow_sphere, cut_sphere, cylinder,
-    cylinder_between, death_star, ellipsoid, extrude, hex_prism, infinite_cone, infinite_cylinder,
-    link, octahedron, param, plane, pyramid, quad, revolve, rhombus, round_box, round_cone,
-    round_cone_between, rounded_cylinder, solid_angle, sphere, torus, tri_prism, triangle,
+    Palette, Param, Param3, Profile, PseudoKleinian, QuaternionJulia, Sierpinski, Trap, box_frame,
+    capped_cone, capped_torus, capsule, cone, cone_between, cuboid, cut_hollow_sphere, cut_sphere,
+    cylinder, cylinder_between, death_star, ellipsoid, extrude, hex_prism, infinite_cone,
+    infinite_cylinder, link, octahedron, param, plane, pyramid, quad, revolve, rhombus, round_box,
+    round_cone, round_cone_between, rounded_cylinder, solid_angle, sphere, torus, tri_prism,
+    triangle,
 };
 
 /// The largest size (radius, half extent, height) the primitive strategies
@@ -939,6 +940,36 @@ pub fn kifs_node() -> impl Strategy<Value = Node> + Clone {
         .boxed()
 }
 
+/// Knighty's pseudo-Kleinian fractal: often the published preset,
+/// otherwise fold sizes in `[0.5, 1.2]`, an inversion in `[0.3, 2]`, an
+/// offset in `[-0.3, 0.3]^3` one time in three, a thickness in `[0.005,
+/// 0.1]`; 0 to [`MAX_ESCAPE_ITERATIONS`] iterations, usually at most 10.
+pub fn pseudo_kleinian_node() -> impl Strategy<Value = Node> + Clone {
+    let size = || scalar("kleinian.size", 0.5..=1.2f64);
+    let component = || scalar("kleinian.offset", -0.3..=0.3f64);
+    let settings = (
+        [size(), size(), size()],
+        scalar("kleinian.inversion", 0.3..=2.0f64),
+        prop::option::weighted(0.3, [component(), component(), component()]),
+        scalar("kleinian.thickness", 0.005..=0.1f64),
+    );
+    (
+        prop::option::weighted(0.7, settings),
+        iterations(0, MAX_ESCAPE_ITERATIONS, 10),
+    )
+        .prop_map(|(settings, n)| {
+            let mut k = PseudoKleinian::new().iterations(n);
+            if let Some((size, inversion, offset, thickness)) = settings {
+                k = k.fold_size(size).inversion(inversion).thickness(thickness);
+                if let Some(c) = offset {
+                    k = k.offset(c);
+                }
+            }
+            k.into()
+        })
+        .boxed()
+}
+
 /// Any of the fractals with valid parameters (hybrids small and rare).
 pub fn fractal_node() -> impl Strategy<Value = Node> + Clone {
     prop_oneof![
@@ -948,6 +979,7 @@ pub fn fractal_node() -> impl Strategy<Value = Node> + Clone {
         4 => sierpinski_node(),
         4 => mandelbox_node(),
         4 => kifs_node(),
+        4 => pseudo_kleinian_node(),
         // Small and rare: every operation is written out in the kernel,
         // which an OpenCL compiler takes its time over, and whole scenes
         // hold many fractals ([`hybrid_node`] has the full range).

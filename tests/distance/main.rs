@@ -27,6 +27,8 @@ mod julia;
 #[cfg(feature = "proptest")]
 mod kifs;
 #[cfg(feature = "proptest")]
+mod kleinian;
+#[cfg(feature = "proptest")]
 mod lipschitz;
 #[cfg(feature = "proptest")]
 mod mandelbox;

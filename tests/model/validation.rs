@@ -268,6 +268,7 @@ fn iteration_counts_outside_their_range_are_rejected() {
 use fractal_sdf::cpu;
 use fractal_sdf::scene::Mandelbulb;
 use fractal_sdf::scene::Menger;
+use fractal_sdf::scene::PseudoKleinian;
 use fractal_sdf::scene::QuaternionJulia;
 use fractal_sdf::scene::Sierpinski;
 use fractal_sdf::scene::ellipsoid;
@@ -606,6 +607,18 @@ fn broken_node() -> impl Strategy<Value = (Node, &'static str)> {
                 .stage(n, [HybridOp::AbsFold, HybridOp::AddPoint])
                 .into(),
             "hybrid"
+        )),
+        bad_size().prop_map(|v| (
+            PseudoKleinian::new().fold_size([1.0, 1.0, v]).into(),
+            "pseudo_kleinian"
+        )),
+        outside(0.05, 4.0)
+            .prop_map(|v| (PseudoKleinian::new().inversion(v).into(), "pseudo_kleinian")),
+        outside(1e-4, 2.0)
+            .prop_map(|v| (PseudoKleinian::new().thickness(v).into(), "pseudo_kleinian")),
+        (257..=u32::MAX).prop_map(|n| (
+            PseudoKleinian::new().iterations(n).into(),
+            "pseudo_kleinian"
         )),
         bad_size().prop_map(|v| (cut_sphere(v, 0.5), "cut_sphere")),
         bad_size().prop_map(|v| (solid_angle(0.5, v), "solid_angle")),

@@ -687,6 +687,17 @@ impl<'a> SceneEmitter<'a> {
                     .clone();
                 Step::Done(self.fractal_call(id, &name, &args.join(", ")))
             }
+            Kind::PseudoKleinian(f) => {
+                let n = self.iterations(f.iterations, (0, MAX_ESCAPE_ITERATIONS));
+                let [bx, by, bz] = f.fold_size.map(|s| w(self, s));
+                let [cx, cy, cz] = f.offset.map(|s| w(self, s));
+                let args = format!(
+                    "{p}, {n}, (real3)({bx}, {by}, {bz}), {}, (real3)({cx}, {cy}, {cz}), {}",
+                    w(self, f.inversion),
+                    w(self, f.thickness)
+                );
+                Step::Done(self.fractal(id, Helper::PseudoKleinian, &args))
+            }
             Kind::Mandelbox(f) => {
                 let n = self.iterations(f.iterations, (1, MAX_ESCAPE_ITERATIONS));
                 let mut args = format!(

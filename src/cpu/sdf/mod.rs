@@ -23,10 +23,12 @@ use crate::math::{
 use crate::scene::{CsgOp, KifsFold};
 
 mod hybrid;
+mod kleinian;
 mod profile;
 mod shapes;
 mod trap;
 
+pub use kleinian::{PSEUDO_KLEINIAN_SAFETY, pseudo_kleinian, pseudo_kleinian_estimate};
 pub use profile::{extrude, profile, revolve};
 pub use shapes::{
     box_frame, cone, cut_hollow_sphere, death_star, infinite_cone, infinite_cylinder, pyramid,
