@@ -20,10 +20,10 @@ use crate::file::SceneFile;
 use crate::quality::{Effects, Glow, Quality};
 use crate::scene::{
     Axis, Camera, Hybrid, HybridOp, InsideShape, Kifs, KifsFold, Light, Mandelbulb, Material, Node,
-    OrbitColoring, Palette, Profile, QuaternionJulia, Scene, Trap, box_frame, capped_cone,
-    capped_torus, capsule, cone, cone_between, cuboid, cut_hollow_sphere, cut_sphere, cylinder,
-    cylinder_between, death_star, ellipsoid, extrude, hex_prism, julia, link, menger, octahedron,
-    param, param3, plane, pyramid, quad, revolve, rhombus, round_box, round_cone,
+    OrbitColoring, Palette, Profile, PseudoKleinian, QuaternionJulia, Scene, Trap, box_frame,
+    capped_cone, capped_torus, capsule, cone, cone_between, cuboid, cut_hollow_sphere, cut_sphere,
+    cylinder, cylinder_between, death_star, ellipsoid, extrude, hex_prism, julia, link, menger,
+    octahedron, param, param3, plane, pyramid, quad, revolve, rhombus, round_box, round_cone,
     round_cone_between, rounded_cylinder, sierpinski, solid_angle, sphere, torus, tri_prism,
     triangle,
 };
@@ -49,6 +49,7 @@ pub fn all() -> Vec<(&'static str, Scene)> {
         ("kifs", kifs()),
         ("hybrid", hybrid()),
         ("bulb_variants", bulb_variants()),
+        ("kleinian", kleinian()),
         ("orbit_traps", orbit_traps()),
         ("profiles", profiles()),
     ]
@@ -425,6 +426,25 @@ pub fn bulb_variants() -> Scene {
     Scene::new(bulb.union(quaternion).union(floor(1.0)))
         .with_camera(Camera::look_at(dvec3(0.0, 1.5, 4.6), dvec3(0.0, -0.2, 0.0)).fov(45.0))
         .with_lights(lights)
+}
+
+/// Knighty's pseudo-Kleinian fractal ([`PseudoKleinian`], his published
+/// preset) seen from inside, where its spheres nest in ever smaller
+/// circles, lit by a lamp beside the camera.
+#[must_use]
+pub fn kleinian() -> Scene {
+    let eye = dvec3(0.5, 0.4, 0.6);
+    let set = Node::from(PseudoKleinian::new().iterations(10)).color(dvec3(0.9, 0.78, 0.6));
+    Scene::new(set)
+        .with_camera(Camera::look_at(eye, dvec3(-1.0, -0.4, -0.5)).fov(50.0))
+        .with_lights([
+            Light::point(eye + dvec3(0.05, 0.1, 0.0))
+                .intensity(0.3)
+                .softness(0.02),
+            Light::directional(dvec3(-0.6, 0.35, -0.4))
+                .color(dvec3(0.6, 0.7, 1.0))
+                .intensity(0.25),
+        ])
 }
 
 /// Four fractals coloured by their orbits ([`Node::orbit_trap`]): the
