@@ -90,6 +90,12 @@ pub(crate) fn octahedron() -> Result<String, Unprintable> {
     })
 }
 
+pub(crate) fn octahedron_bound() -> Result<String, Unprintable> {
+    distance("sd_octahedron_bound", &[("s", Scalar)], |p, a| {
+        sdf::octahedron_bound(p, a[0])
+    })
+}
+
 pub(crate) fn capped_cone() -> Result<String, Unprintable> {
     distance(
         "sd_capped_cone",

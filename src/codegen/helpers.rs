@@ -18,6 +18,7 @@ pub(crate) enum Helper {
     Capsule,
     Plane,
     Octahedron,
+    OctahedronBound,
     CappedCone,
     HexPrism,
     RoundCone,
@@ -54,7 +55,7 @@ pub(crate) enum Helper {
 
 impl Helper {
     /// Every helper, in the order they are emitted.
-    pub(crate) const ALL: [Helper; 46] = [
+    pub(crate) const ALL: [Helper; 47] = [
         Helper::Sphere,
         Helper::Cuboid,
         Helper::RoundBox,
@@ -63,6 +64,7 @@ impl Helper {
         Helper::Capsule,
         Helper::Plane,
         Helper::Octahedron,
+        Helper::OctahedronBound,
         Helper::CappedCone,
         Helper::HexPrism,
         Helper::RoundCone,
@@ -114,6 +116,7 @@ impl Helper {
             Helper::Capsule => "capsule",
             Helper::Plane => "plane",
             Helper::Octahedron => "octahedron",
+            Helper::OctahedronBound => "octahedron_bound",
             Helper::CappedCone => "capped_cone",
             Helper::HexPrism => "hex_prism",
             Helper::RoundCone => "round_cone",
@@ -168,6 +171,7 @@ impl Helper {
             Helper::Capsule => formulas::capsule(),
             Helper::Plane => formulas::plane(),
             Helper::Octahedron => formulas::octahedron(),
+            Helper::OctahedronBound => formulas::octahedron_bound(),
             Helper::CappedCone => formulas::capped_cone(),
             Helper::HexPrism => formulas::hex_prism(),
             Helper::RoundCone => formulas::round_cone(),

@@ -361,6 +361,7 @@ impl Evaluator {
             Kind::Capsule { a, b, radius } => Self::leaf(sdf::capsule(p, v(*a), v(*b), s(*radius))),
             Kind::Plane { normal, offset } => Self::leaf(sdf::plane(p, v(*normal), s(*offset))),
             Kind::Octahedron { size } => Self::leaf(sdf::octahedron(p, s(*size))),
+            Kind::OctahedronBound { size } => Self::leaf(sdf::octahedron_bound(p, s(*size))),
             Kind::CappedCone {
                 half_height,
                 bottom_radius,

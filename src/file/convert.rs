@@ -97,6 +97,7 @@ impl NodeRepr {
             Kind::Capsule { a, b, radius } => NodeRepr::Capsule { a, b, radius },
             Kind::Plane { normal, offset } => NodeRepr::Plane { normal, offset },
             Kind::Octahedron { size } => NodeRepr::Octahedron { size },
+            Kind::OctahedronBound { size } => NodeRepr::OctahedronBound { size },
             Kind::CappedCone {
                 half_height,
                 bottom_radius,
@@ -510,6 +511,9 @@ impl Located<NodeRepr> {
             }
             .into(),
             NodeRepr::Octahedron { size } => Kind::Octahedron { size: size.clone() }.into(),
+            NodeRepr::OctahedronBound { size } => {
+                Kind::OctahedronBound { size: size.clone() }.into()
+            }
             NodeRepr::CappedCone {
                 half_height,
                 bottom_radius,

@@ -32,6 +32,7 @@ pub(super) const NAMES: &[&str] = &[
     "Capsule",
     "Plane",
     "Octahedron",
+    "OctahedronBound",
     "CappedCone",
     "HexPrism",
     "RoundCone",

@@ -442,6 +442,9 @@ pub(super) enum NodeRepr {
     Octahedron {
         size: Param,
     },
+    OctahedronBound {
+        size: Param,
+    },
     CappedCone {
         half_height: Param,
         bottom_radius: Param,

@@ -171,6 +171,11 @@ pub(super) fn bound(node: &IrNode, done: &[Option<Bound>]) -> Option<Bound> {
             Bound::sphere(centre, 0.5 * (b - a).length() + baked(*radius)?)
         }
         Kind::Octahedron { size } => Bound::sphere(origin, baked(*size)?),
+        // `|x| + |y| + |z| >= |p|`, so the bound is at least
+        // `(|p| − size) / √3`.
+        Kind::OctahedronBound { size } => {
+            Bound::sphere(origin, baked(*size)?).with_slope(1.0 / 3f64.sqrt())
+        }
         Kind::CappedCone {
             half_height,
             bottom_radius,

@@ -93,6 +93,14 @@ pub fn octahedron(size: impl Into<Param>) -> Node {
     Kind::Octahedron { size: size.into() }.into()
 }
 
+/// Quilez's cheap bound of the octahedron of [`octahedron`]: the distance
+/// to the nearest face's plane, below the true distance near the edges
+/// and vertices (see [`Kind::OctahedronBound`]).
+#[must_use]
+pub fn octahedron_bound(size: impl Into<Param>) -> Node {
+    Kind::OctahedronBound { size: size.into() }.into()
+}
+
 /// A hexagonal prism along y from `-half_height` to `+half_height`, its
 /// flat sides `radius` from the axis (two of them facing ±z).
 #[must_use]

@@ -26,8 +26,9 @@ pub use build::{
     box_frame, capped_cone, capped_torus, capsule, cone, cone_between, cuboid, cut_hollow_sphere,
     cut_sphere, cylinder, cylinder_between, death_star, ellipsoid, extrude, hex_prism,
     infinite_cone, infinite_cylinder, julia, kifs, link, mandelbox, mandelbulb, menger, octahedron,
-    plane, pyramid, quad, revolve, rhombus, round_box, round_cone, round_cone_between,
-    rounded_cylinder, sierpinski, solid_angle, sphere, torus, tri_prism, triangle,
+    octahedron_bound, plane, pyramid, quad, revolve, rhombus, round_box, round_cone,
+    round_cone_between, rounded_cylinder, sierpinski, solid_angle, sphere, torus, tri_prism,
+    triangle,
 };
 pub use custom::{
     CpuDistance, CpuInside, CustomShape, INSIDE_HUGE, InsideBounds, MAX_INSIDE_REACH,

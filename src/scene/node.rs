@@ -146,6 +146,14 @@ pub enum Kind<S, V, C> {
         /// Distance from the centre to each vertex, at least 0.
         size: S,
     },
+    /// Quilez's cheap bound of the octahedron `|x| + |y| + |z| <= size`:
+    /// `(|x| + |y| + |z| − size) / √3`, the distance to the nearest face's
+    /// plane. A bound: exact where the nearest point is inside a face,
+    /// below the distance near the edges and vertices.
+    OctahedronBound {
+        /// Distance from the centre to each vertex, at least 0.
+        size: S,
+    },
     /// A cone along y, cut at `±half_height`, with radius `bottom_radius` at
     /// `-half_height` and `top_radius` at `+half_height`. Exact.
     CappedCone {
@@ -577,6 +585,7 @@ impl<S, V, C> Kind<S, V, C> {
             Kind::Capsule { .. } => "capsule",
             Kind::Plane { .. } => "plane",
             Kind::Octahedron { .. } => "octahedron",
+            Kind::OctahedronBound { .. } => "octahedron_bound",
             Kind::CappedCone { .. } => "capped_cone",
             Kind::HexPrism { .. } => "hex_prism",
             Kind::RoundCone { .. } => "round_cone",
@@ -672,6 +681,7 @@ impl<S, V, C> Kind<S, V, C> {
             | Kind::Capsule { .. }
             | Kind::Plane { .. }
             | Kind::Octahedron { .. }
+            | Kind::OctahedronBound { .. }
             | Kind::CappedCone { .. }
             | Kind::HexPrism { .. }
             | Kind::RoundCone { .. }
@@ -815,6 +825,9 @@ impl<S, V, C> Kind<S, V, C> {
                 offset: m.scalar(offset, spec("offset", Finite))?,
             },
             Kind::Octahedron { size } => Kind::Octahedron {
+                size: m.scalar(size, spec("size", NonNegative))?,
+            },
+            Kind::OctahedronBound { size } => Kind::OctahedronBound {
                 size: m.scalar(size, spec("size", NonNegative))?,
             },
             Kind::CappedCone {

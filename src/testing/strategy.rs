@@ -14,9 +14,9 @@ use crate::scene::{
     Palette, Param, Param3, Profile, PseudoKleinian, QuaternionJulia, Sierpinski, Trap, box_frame,
     capped_cone, capped_torus, capsule, cone, cone_between, cuboid, cut_hollow_sphere, cut_sphere,
     cylinder, cylinder_between, death_star, ellipsoid, extrude, hex_prism, infinite_cone,
-    infinite_cylinder, link, octahedron, param, plane, pyramid, quad, revolve, rhombus, round_box,
-    round_cone, round_cone_between, rounded_cylinder, solid_angle, sphere, torus, tri_prism,
-    triangle,
+    infinite_cylinder, link, octahedron, octahedron_bound, param, plane, pyramid, quad, revolve,
+    rhombus, round_box, round_cone, round_cone_between, rounded_cylinder, solid_angle, sphere,
+    torus, tri_prism, triangle,
 };
 
 /// The largest size (radius, half extent, height) the primitive strategies
@@ -590,6 +590,11 @@ pub fn box_frame_node() -> impl Strategy<Value = Node> + Clone {
         .prop_map(|(b, t)| box_frame(b, t))
 }
 
+/// Quilez's octahedron bound (not exact) of size in `[0, 1.5]`.
+pub fn octahedron_bound_node() -> impl Strategy<Value = Node> + Clone {
+    scalar("octahedron.size", size(MAX_SIZE)).prop_map(octahedron_bound)
+}
+
 /// An ellipsoid (a distance bound, not exact) with semi-axes in
 /// `[0.05, 1.5]`.
 pub fn ellipsoid_node() -> impl Strategy<Value = Node> + Clone {
@@ -1123,6 +1128,7 @@ pub fn scene_node(depth: u32) -> impl Strategy<Value = Node> + Clone {
         6 => exact_node(),
         1 => ellipsoid_node(),
         1 => box_frame_node(),
+        1 => octahedron_bound_node(),
         2 => fractal_node(),
         1 => orbit_trap_node(),
     ];

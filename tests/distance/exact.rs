@@ -320,6 +320,36 @@ fn frame_bars(b: DVec3, t: f64) -> Vec<(DVec3, DVec3)> {
 }
 
 proptest! {
+    /// Quilez's octahedron bound: against the exact octahedron's oracle,
+    /// the same sign and never a larger magnitude; exact out from a face's
+    /// centre.
+    #[test]
+    fn octahedron_bound_never_exceeds_the_distance(
+        node in testing::octahedron_bound_node(),
+        points in prop::collection::vec(point(3.0), 48),
+    ) {
+        let Kind::OctahedronBound { size } = node.kind() else {
+            unreachable!("the strategy draws octahedron bounds")
+        };
+        let s = size.default_value();
+        let eval = cpu::Evaluator::new(&node)?;
+        for &p in &points {
+            let (d, oracle) = (eval.distance(p), analytic::octahedron_distance(p, s));
+            prop_assert!(
+                d * oracle > 0.0 || oracle.abs() <= TOLERANCE,
+                "sign at {p}: {d} against {oracle}"
+            );
+            prop_assert!(
+                d.abs() <= oracle.abs() + TOLERANCE,
+                "above the distance at {p}: {d} against {oracle}"
+            );
+        }
+        // Exact where the nearest point is inside a face: out from a
+        // face's centre along its normal.
+        let p = DVec3::splat(s / 3.0) + DVec3::ONE * (0.5 / 3f64.sqrt());
+        prop_assert!((eval.distance(p) - 0.5).abs() <= TOLERANCE);
+    }
+
     /// A box frame is the union of its twelve bars: outside, its distance
     /// is the nearest bar's (within the exact tolerance); inside, it never
     /// exceeds the depth to the nearest point outside every bar (sampled).

@@ -505,6 +505,7 @@ const NODE_FIELDS: &[(&str, &str)] = &[
     ("Plane(normal: @, offset: 0)", "normal"),
     ("Plane(normal: (0, 1, 0), offset: @)", "offset"),
     ("Octahedron(size: @)", "size"),
+    ("OctahedronBound(size: @)", "size"),
     (
         "CappedCone(half_height: @, bottom_radius: 1, top_radius: 0.5)",
         "half_height",

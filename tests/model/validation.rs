@@ -102,6 +102,13 @@ fn negative_sizes_are_out_of_range() {
     );
     assert_out_of_range(octahedron(-2.0), "octahedron", "size", -2.0, ">= 0");
     assert_out_of_range(
+        octahedron_bound(-2.0),
+        "octahedron_bound",
+        "size",
+        -2.0,
+        ">= 0",
+    );
+    assert_out_of_range(
         capped_cone(1.0, -1.0, 0.5),
         "capped_cone",
         "bottom_radius",
@@ -273,6 +280,7 @@ use fractal_sdf::scene::QuaternionJulia;
 use fractal_sdf::scene::Sierpinski;
 use fractal_sdf::scene::ellipsoid;
 use fractal_sdf::scene::octahedron;
+use fractal_sdf::scene::octahedron_bound;
 use fractal_sdf::scene::param3;
 use fractal_sdf::scene::{
     Hybrid, HybridOp, Kifs, KifsFold, MAX_SOLID_ANGLE, Profile, box_frame, capped_torus, cone,

@@ -93,6 +93,7 @@ fn leaf_function(node: &IrNode) -> Option<(Helper, &'static str)> {
         Kind::Capsule { .. } => (Helper::Capsule, "sd_capsule"),
         Kind::Plane { .. } => (Helper::Plane, "sd_plane"),
         Kind::Octahedron { .. } => (Helper::Octahedron, "sd_octahedron"),
+        Kind::OctahedronBound { .. } => (Helper::OctahedronBound, "sd_octahedron_bound"),
         Kind::CappedCone { .. } => (Helper::CappedCone, "sd_capped_cone"),
         Kind::HexPrism { .. } => (Helper::HexPrism, "sd_hex_prism"),
         Kind::RoundCone { .. } => (Helper::RoundCone, "sd_round_cone"),

@@ -49,6 +49,16 @@ pub fn sphere<T: Num>(p: V3<T>, r: T) -> T {
     p.length() - r
 }
 
+/// Quilez's cheap bound of the octahedron `|x| + |y| + |z| <= s`: the
+/// distance to the plane of the nearest face, `(|x| + |y| + |z| − s) /
+/// √3`. Exact where the nearest point lies inside a face, below the
+/// distance elsewhere.
+#[must_use]
+pub fn octahedron_bound<T: Num>(p: V3<T>, s: T) -> T {
+    let p = p.abs();
+    (p.x + p.y + p.z - s) * T::of(1.0 / 3f64.sqrt())
+}
+
 /// Exact distance to an axis-aligned box with half extents `b`.
 #[must_use]
 pub fn cuboid<T: Num>(p: V3<T>, b: V3<T>) -> T {
