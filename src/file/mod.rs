@@ -426,18 +426,17 @@ fn read(text: &str, file: &Path, shapes: &[CustomShape]) -> Result<SceneFile> {
             .unwrap_or(repr.geometry.site);
         located(site, e)
     })?;
-    let defaults = compiled.default_values();
+    // Each default set again within the limits: one copy of the values,
+    // each set to what it already holds.
+    let mut checked = compiled.default_values();
     for slot in compiled.params().slots() {
-        let value = defaults.get(&slot.name).unwrap_or(f64::NAN);
-        defaults
-            .clone()
-            .set_within(&slot.name, value, limits)
-            .map_err(|e| {
-                let site = sites
-                    .site_of(&scene, &repr, &e)
-                    .unwrap_or(repr.geometry.site);
-                located(site, e)
-            })?;
+        let value = checked.get(&slot.name).unwrap_or(f64::NAN);
+        checked.set_within(&slot.name, value, limits).map_err(|e| {
+            let site = sites
+                .site_of(&scene, &repr, &e)
+                .unwrap_or(repr.geometry.site);
+            located(site, e)
+        })?;
     }
     for motion in &repr.motions {
         motion
@@ -450,8 +449,8 @@ fn read(text: &str, file: &Path, shapes: &[CustomShape]) -> Result<SceneFile> {
                 let known = known.map(|s| s.name.clone()).collect();
                 return Err(located(motion.site, Error::UnknownParam { name, known }));
             }
-            defaults
-                .clone()
+            compiled
+                .default_values()
                 .set_within(&name, value, limits)
                 .map_err(|e| located(motion.site, e))?;
         }

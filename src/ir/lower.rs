@@ -7,7 +7,7 @@ use std::sync::Arc;
 use glam::{DQuat, DVec3};
 
 use super::params::{Constraint, ParamLayout, ParamSlot, Relation, check_rule};
-use super::{Ir, IrNode, NodeId, Scalar, Vector, baked3};
+use super::{Ir, IrNode, NodeId, NodePath, PathTree, Scalar, Vector, baked3};
 use crate::error::{Error, Result};
 use crate::math::{F64_LIMITS, normalize, reduce_angle};
 use crate::scene::{
@@ -37,6 +37,7 @@ pub(super) fn lower(geometry: &Node) -> Result<Ir> {
         slots: Vec::new(),
         constraints: Vec::new(),
         slot_by_name: HashMap::new(),
+        placed: Vec::new(),
         operand: None,
         customs: HashMap::new(),
     };
@@ -52,15 +53,23 @@ pub(super) fn lower(geometry: &Node) -> Result<Ir> {
         }
     }
     let root = l.visits[0].id.expect("the root is lowered last");
+    // Every slot's and constraint's path, in one tree of the visits.
+    let tree = Arc::new(PathTree::new(
+        l.visits.iter().map(|v| (v.label.clone(), v.parent)),
+    ));
+    for (place, v) in l.placed {
+        let path = NodePath::new(&tree, v);
+        match place {
+            Place::Slot(i) => l.slots[i].used_at.0 = path,
+            Place::Constraint(i) => l.constraints[i].node = path,
+        }
+    }
     let ir = Ir {
         nodes: l.nodes,
         labels: l.labels,
         parents: l.parents,
         root,
-        params: Arc::new(ParamLayout {
-            slots: l.slots,
-            constraints: l.constraints,
-        }),
+        params: Arc::new(ParamLayout::new(l.slots, l.constraints)),
     };
     // Every value was checked as it was met; folding multiplies and adds
     // them (nested scales, chained translations), so the folded values are
@@ -76,6 +85,13 @@ fn label(kind: &NodeKind) -> String {
         Kind::Custom { shape, .. } => shape.name().to_string(),
         other => other.name().to_string(),
     }
+}
+
+/// A slot or a constraint, by index, whose path is placed at the end.
+#[derive(Clone, Copy)]
+enum Place {
+    Slot(usize),
+    Constraint(usize),
 }
 
 #[derive(Clone, Copy)]
@@ -109,6 +125,9 @@ struct Lowering {
     /// Rules between parameters that read dynamic ones.
     constraints: Vec<Constraint>,
     slot_by_name: HashMap<String, u32>,
+    /// The slots and constraints met so far, each with the visit whose path
+    /// it takes once the tree of paths is built.
+    placed: Vec<(Place, usize)>,
     /// For a boolean being lowered: how many operands were met so far.
     operand: Option<usize>,
     /// The custom shapes met so far, by name.
@@ -218,7 +237,7 @@ impl Lowering {
             self.parents[child.index()] = Some(id);
         }
         self.nodes.push(folded);
-        self.labels.push(std::mem::take(&mut self.visits[v].label));
+        self.labels.push(self.visits[v].label.clone());
         self.parents.push(None);
         self.visits[v].id = Some(id);
         Ok(())
@@ -306,8 +325,8 @@ impl Lowering {
             _ => Vec::new(),
         };
         for (param, relation) in relations {
-            let mut constraint = Constraint {
-                node: String::new(),
+            let constraint = Constraint {
+                node: NodePath::pending(),
                 param,
                 relation,
             };
@@ -316,11 +335,10 @@ impl Lowering {
                 Scalar::Dynamic(slot) => self.slots[slot as usize].default,
             };
             let dynamic = constraint.is_dynamic();
-            if dynamic || constraint.check(defaults).is_err() {
-                constraint.node = self.path(v);
-                constraint.check(defaults)?;
-            }
+            constraint.check(defaults, || self.path(v))?;
             if dynamic {
+                self.placed
+                    .push((Place::Constraint(self.constraints.len()), v));
                 self.constraints.push(constraint);
             }
         }
@@ -503,11 +521,12 @@ impl Lowering {
                     return Ok(Scalar::Dynamic(slot));
                 }
                 let slot = u32::try_from(self.slots.len()).expect("fewer than 2^32 parameters");
+                self.placed.push((Place::Slot(self.slots.len()), v));
                 self.slots.push(ParamSlot {
                     name: name.clone(),
                     default: *default,
                     rule,
-                    used_at: (self.path(v), param.into()),
+                    used_at: (NodePath::pending(), param.into()),
                 });
                 self.slot_by_name.insert(name.clone(), slot);
                 Ok(Scalar::Dynamic(slot))

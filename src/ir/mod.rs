@@ -16,6 +16,7 @@ mod compiled;
 mod inside;
 mod lower;
 mod params;
+mod path;
 
 use std::sync::Arc;
 use std::sync::atomic::{AtomicU64, Ordering};
@@ -28,6 +29,8 @@ pub(crate) use bounds::{
 };
 pub use compiled::{CompiledScene, MAX_LIGHTS};
 pub use params::{Constraint, ParamLayout, ParamSlot, ParamValues, Relation};
+pub use path::NodePath;
+pub(crate) use path::PathTree;
 
 use crate::error::Result;
 use crate::math::Limits;

@@ -2,9 +2,10 @@
 //! values must keep (its own, and those that relate it to other
 //! parameters), and the values themselves, checked as they are set.
 
+use std::collections::HashMap;
 use std::sync::Arc;
 
-use super::{Scalar, Vector};
+use super::{NodePath, Scalar, Vector};
 use crate::error::{Error, Result, fmt_value};
 use crate::math::{F64_LIMITS, Limits, reduce_angle};
 use crate::scene::Rule;
@@ -19,8 +20,9 @@ pub struct ParamSlot {
     pub default: f64,
     /// What every value set later must satisfy.
     pub rule: Rule,
-    /// Where it was first used, for error messages (`node path`, `param`).
-    pub used_at: (String, String),
+    /// Where it was first used, for error messages (the node's path and
+    /// the parameter's name).
+    pub used_at: (NodePath, String),
 }
 
 /// A rule that relates several parameters of one node.
@@ -59,7 +61,7 @@ pub enum Relation {
 #[non_exhaustive]
 pub struct Constraint {
     /// The node's path, as in every validation error.
-    pub node: String,
+    pub node: NodePath,
     /// The parameter the error names.
     pub param: &'static str,
     /// What must hold.
@@ -68,8 +70,13 @@ pub struct Constraint {
 
 impl Constraint {
     /// Checks the relation with parameter values from `value`; the error is
-    /// the same whether the values are baked or dynamic.
-    pub(crate) fn check(&self, value: impl Fn(Scalar) -> f64) -> Result<()> {
+    /// the same whether the values are baked or dynamic, and names the
+    /// node by `node`.
+    pub(crate) fn check(
+        &self,
+        value: impl Fn(Scalar) -> f64,
+        node: impl Fn() -> String,
+    ) -> Result<()> {
         match &self.relation {
             Relation::AtMostSmallest {
                 value: v,
@@ -82,7 +89,7 @@ impl Constraint {
                 );
                 if v > smallest {
                     return Err(Error::OutOfRange {
-                        node: self.node.clone(),
+                        node: node(),
                         param: self.param.into(),
                         value: v,
                         expected: format!("<= the smallest {bound_name} ({})", fmt_value(smallest)),
@@ -92,7 +99,7 @@ impl Constraint {
             Relation::NonZero { vector } => {
                 if vector.iter().all(|s| value(*s) == 0.0) {
                     return Err(Error::ZeroVector {
-                        node: self.node.clone(),
+                        node: node(),
                         param: self.param.into(),
                     });
                 }
@@ -105,7 +112,7 @@ impl Constraint {
                 let (v, other) = (value(*v), value(*other));
                 if v == other {
                     return Err(Error::OutOfRange {
-                        node: self.node.clone(),
+                        node: node(),
                         param: self.param.into(),
                         value: v,
                         expected: format!("!= {other_name} ({})", fmt_value(other)),
@@ -144,9 +151,45 @@ impl Constraint {
 pub struct ParamLayout {
     pub(crate) slots: Vec<ParamSlot>,
     pub(crate) constraints: Vec<Constraint>,
+    /// Each slot's index by its parameter's name.
+    by_name: HashMap<String, u32>,
+    /// For each slot, the constraints that read it.
+    constraints_of: Vec<Vec<u32>>,
 }
 
 impl ParamLayout {
+    /// The layout of `slots` and `constraints`, indexed so that setting a
+    /// parameter costs the same in a scene of ten parameters as in one of
+    /// a hundred thousand.
+    pub(crate) fn new(slots: Vec<ParamSlot>, constraints: Vec<Constraint>) -> Self {
+        let by_name = slots
+            .iter()
+            .enumerate()
+            .map(|(i, s)| (s.name.clone(), u32::try_from(i).expect("slots in u32")))
+            .collect();
+        let mut constraints_of = vec![Vec::new(); slots.len()];
+        for (i, c) in constraints.iter().enumerate() {
+            let i = u32::try_from(i).expect("constraints in u32");
+            for slot in c.slots() {
+                let of = &mut constraints_of[slot as usize];
+                if of.last() != Some(&i) {
+                    of.push(i);
+                }
+            }
+        }
+        ParamLayout {
+            slots,
+            constraints,
+            by_name,
+            constraints_of,
+        }
+    }
+
+    /// The slot of the parameter `name`.
+    fn slot(&self, name: &str) -> Option<usize> {
+        self.by_name.get(name).map(|&s| s as usize)
+    }
+
     /// The slots, in buffer order.
     #[must_use]
     pub fn slots(&self) -> &[ParamSlot] {
@@ -200,18 +243,13 @@ impl ParamValues {
     /// As [`ParamValues::set`], and [`Error::Precision`] for a value beyond
     /// `limits`.
     pub fn set_within(&mut self, name: &str, value: f64, limits: &Limits) -> Result<()> {
-        let slot = self
-            .layout
-            .slots
-            .iter()
-            .position(|s| s.name == name)
-            .ok_or_else(|| Error::UnknownParam {
-                name: name.into(),
-                known: self.layout.slots.iter().map(|s| s.name.clone()).collect(),
-            })?;
+        let slot = self.layout.slot(name).ok_or_else(|| Error::UnknownParam {
+            name: name.into(),
+            known: self.layout.slots.iter().map(|s| s.name.clone()).collect(),
+        })?;
         let spec = &self.layout.slots[slot];
         check_rule(
-            || spec.used_at.0.clone(),
+            || spec.used_at.0.to_string(),
             &spec.used_at.1,
             value,
             spec.rule,
@@ -219,7 +257,7 @@ impl ParamValues {
         )?;
         let value = stored(spec.rule, value);
         check_limits(
-            || spec.used_at.0.clone(),
+            || spec.used_at.0.to_string(),
             &spec.used_at.1,
             value,
             spec.rule,
@@ -228,12 +266,10 @@ impl ParamValues {
         )?;
         let old = std::mem::replace(&mut self.values[slot], value);
         let slot = u32::try_from(slot).expect("slots are numbered in u32");
-        let broken = self
-            .layout
-            .constraints
+        let broken = self.layout.constraints_of[slot as usize]
             .iter()
-            .filter(|c| c.slots().any(|s| s == slot))
-            .try_for_each(|c| c.check(|s| self.value(s)));
+            .map(|&c| &self.layout.constraints[c as usize])
+            .try_for_each(|c| c.check(|s| self.value(s), || c.node.to_string()));
         if broken.is_err() {
             self.values[slot as usize] = old;
         }
@@ -249,7 +285,7 @@ impl ParamValues {
     pub fn check_within(&self, limits: &Limits) -> Result<()> {
         for (slot, &value) in self.layout.slots.iter().zip(&self.values) {
             let (node, param) = &slot.used_at;
-            check_limits(|| node.clone(), param, value, slot.rule, false, limits)?;
+            check_limits(|| node.to_string(), param, value, slot.rule, false, limits)?;
         }
         Ok(())
     }
@@ -258,8 +294,7 @@ impl ParamValues {
     /// a full turn).
     #[must_use]
     pub fn get(&self, name: &str) -> Option<f64> {
-        let slot = self.layout.slots.iter().position(|s| s.name == name)?;
-        Some(self.values[slot])
+        Some(self.values[self.layout.slot(name)?])
     }
 
     /// The value of a lowered scalar: its literal, or its slot's value.

@@ -38,9 +38,10 @@ fn the_fixture_declares_one_slot_per_name() {
     );
     let values = ir.default_values();
     assert_eq!(values.as_slice(), [0.2, 0.5, 0.0, 0.0, 0.8]);
+    let (node, param) = &ir.params()[4].used_at;
     assert_eq!(
-        ir.params()[4].used_at,
-        ("smooth_union/a:translate/sphere".into(), "radius".into())
+        (node.to_string().as_str(), param.as_str()),
+        ("smooth_union/a:translate/sphere", "radius")
     );
 }
 
@@ -138,4 +139,27 @@ proptest! {
         // in three other seeds); the tolerance is about 11 times the larger.
         prop_assert!(relative_eq!(before - after, grow, epsilon = 1e-14));
     }
+}
+
+/// Every parameter of a deep union chain names its own node's path, the
+/// whole way from the root, and an out-of-range value set later names it
+/// too: the paths are kept as one shared tree, not written out per slot.
+#[test]
+fn deep_parameters_name_their_whole_path() {
+    let n = 300;
+    let node = (0..n)
+        .map(|i| sphere(param(format!("r{i}"), 0.1)))
+        .reduce(Node::union)
+        .unwrap();
+    let ir = Scene::new(node).compile().unwrap();
+    let slots = ir.params().slots();
+    // The chain is left-deep: the first sphere is n − 1 unions down, the
+    // last one union down.
+    let first = slots[0].used_at.0.to_string();
+    assert_eq!(first, format!("union/{}a:sphere", "a:union/".repeat(n - 2)));
+    let last = slots[n - 1].used_at.0.to_string();
+    assert_eq!(last, "union/b:sphere");
+    let mut values = ir.default_values();
+    let err = values.set("r0", -1.0).unwrap_err().to_string();
+    assert!(err.contains(&first), "{err}");
 }
