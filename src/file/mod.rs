@@ -444,14 +444,15 @@ fn read(text: &str, file: &Path, shapes: &[CustomShape]) -> Result<SceneFile> {
             .validate()
             .map_err(|e| located(motion.site, e))?;
         for (name, value) in extremes(&motion.value) {
-            if !compiled.params().slots().iter().any(|s| s.name == name) {
+            let Some(default) = checked.get(&name) else {
                 let known = compiled.params().slots().iter();
                 let known = known.map(|s| s.name.clone()).collect();
                 return Err(located(motion.site, Error::UnknownParam { name, known }));
-            }
-            compiled
-                .default_values()
+            };
+            // Each extreme checked on the one copy, then the default back.
+            checked
                 .set_within(&name, value, limits)
+                .and_then(|()| checked.set_within(&name, default, limits))
                 .map_err(|e| located(motion.site, e))?;
         }
     }

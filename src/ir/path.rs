@@ -89,6 +89,7 @@ impl fmt::Debug for NodePath {
 
 impl PartialEq for NodePath {
     fn eq(&self, other: &Self) -> bool {
-        self.labels() == other.labels()
+        (Arc::ptr_eq(&self.tree, &other.tree) && self.at == other.at)
+            || self.labels() == other.labels()
     }
 }

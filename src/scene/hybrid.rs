@@ -153,7 +153,8 @@ pub struct HybridStage<S = Param> {
 /// the form of the box fractals; it is negative exactly inside the set,
 /// and at least the distance to the ball. The running derivative takes
 /// each operation's largest stretch (for a power, its stretch along the
-/// azimuth too, up to `power` times more near the poles).
+/// azimuth too: up to `power` times more near the poles, and for
+/// [`BulbSquare`](HybridOp::BulbSquare) with no bound).
 ///
 /// The estimate is not a proven bound; it is multiplied by a factor set
 /// from the largest ratio of estimate to distance measured against

@@ -15,9 +15,13 @@ use super::*;
 /// `z = 0` thinning away from the `z` axis, and a tube about that axis
 /// thinning away from the plane).
 ///
-/// The set is not bounded: far from the origin the folds only reflect, so
-/// it repeats its slabs and tubes through all of space. Frame it from
-/// inside, or intersect it with a shape.
+/// The set is not bounded: far from the origin the folds only reflect (each
+/// iteration brings a far coordinate at most twice the fold size nearer),
+/// the orbit never reaches the inversion sphere, and the set thins into
+/// the plane `z = 0` and the `z` axis. Its detail is near the origin:
+/// frame it from inside, or intersect it with a shape. A point within
+/// 1e-6 of the origin after a fold is inverted as if it were that far,
+/// so that its image stays finite in single precision.
 ///
 /// Distance estimate: Knighty's, `(ρ·|z| − thickness) / √(|z|² +
 /// thickness)` of the orbit's end over the running derivative (each

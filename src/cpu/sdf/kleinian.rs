@@ -25,7 +25,9 @@ pub fn pseudo_kleinian<T: Num>(p: V3<T>, iterations: u32, k: &PseudoKleinian<T>)
 /// offset, and the running derivative `dr` (the product of the
 /// inversions' stretches), give `(ρ·|z_z| − t) / √(|z|² + t) / dr` with
 /// `ρ = √(z_x² + z_y²)` and `t` the thickness, times
-/// [`PSEUDO_KLEINIAN_SAFETY`]. Negative exactly inside the set. The trap
+/// [`PSEUDO_KLEINIAN_SAFETY`]. Negative exactly inside the set (but for
+/// the points a fold brings within 1e-6 of the origin, inverted as if that
+/// far: see [`PseudoKleinian`]). The trap
 /// is the orbit's smallest radius over the inversion sphere's, at most 1.
 #[must_use]
 pub fn pseudo_kleinian_estimate<T: Num>(
