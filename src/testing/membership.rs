@@ -325,21 +325,12 @@ pub fn pseudo_kleinian_inside(p: DVec3, k: &crate::scene::PseudoKleinian) -> boo
     let size = three(&k.fold_size);
     let offset = three(&k.offset);
     let inversion = value(&k.inversion);
-    let reflect = |v: f64, l: f64| {
-        if v > l {
-            2.0 * l - v
-        } else if v < -l {
-            -2.0 * l - v
-        } else {
-            v
-        }
-    };
     let mut z = p;
     for _ in 0..k.iterations {
         z = DVec3::new(
-            reflect(z.x, size.x),
-            reflect(z.y, size.y),
-            reflect(z.z, size.z),
+            reflect_beyond(z.x, size.x),
+            reflect_beyond(z.y, size.y),
+            reflect_beyond(z.z, size.z),
         );
         let r2 = z.length_squared();
         if r2 > 0.0 && r2 < inversion {
@@ -382,15 +373,7 @@ pub fn hybrid_inside(p: DVec3, h: &crate::scene::Hybrid) -> bool {
         let d = z.dot(n) - at;
         if d < 0.0 { z - 2.0 * d * n } else { z }
     };
-    let box_fold = |v: f64, l: f64| {
-        if v > l {
-            2.0 * l - v
-        } else if v < -l {
-            -2.0 * l - v
-        } else {
-            v
-        }
-    };
+    let box_fold = reflect_beyond;
     let phi = (1.0 + 5f64.sqrt()) / 2.0;
     let step = |z: DVec3, op: &HybridOp| -> DVec3 {
         match op {
@@ -528,4 +511,16 @@ pub fn hybrid_inside(p: DVec3, h: &crate::scene::Hybrid) -> bool {
         }
     }
     true
+}
+
+/// A coordinate beyond `±l` reflected back across that limit (the box
+/// fold, by cases).
+fn reflect_beyond(v: f64, l: f64) -> f64 {
+    if v > l {
+        2.0 * l - v
+    } else if v < -l {
+        -2.0 * l - v
+    } else {
+        v
+    }
 }
