@@ -7,7 +7,10 @@
 //   types   real, real2, real3, real4 and the literal macro R(x)
 //   consts  REAL_TINY MAX_STEPS MAX_DISTANCE DETAIL HIT_EPSILON
 //           NORMAL_EPSILON OVER_RELAXATION SUPERSAMPLING GAMMA SKY_TOP
-//           SKY_BOTTOM
+//           SKY_BOTTOM EXPOSURE_SCALE
+//   display real3 display_color(real3 c, real scale, real inverse_gamma),
+//           the display transform (exposure, tone curve, gamma) printed
+//           from quality::display_formula
 //   scene   real DE(real3 p, __global const real* params)
 //           real DE_shade(real3 p, __global const real* params,
 //                         real3* color, real* trap)
@@ -28,9 +31,11 @@
 // Everything else arrives at run time, so moving the camera or the lights
 // and changing dynamic parameters never rebuilds the program. The header
 // defines the kernel's argument list (RENDER_TILE_ARGS) and the layouts of
-// the camera buffer (CAMERA_<field>: the offset of each field) and of the
-// light buffer (LIGHT_<field>, LIGHT_STRIDE reals per light), from the
-// tables the host packs them with (src/codegen/interface.rs).
+// the camera buffer (CAMERA_<field>: the offset of each field), of the
+// light buffer (LIGHT_<field>, LIGHT_STRIDE reals per light) and of the
+// shading layers (LAYER_<field>, LAYER_STRIDE floats per pixel, written
+// when write_aovs is WRITE_LAYERS), from the tables the host packs and
+// reads them with (src/codegen/interface.rs).
 //
 // Positions (the camera's origin, point lights) are relative to the
 // program's origin, the scene's outermost translation, which the host

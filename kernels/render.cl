@@ -210,7 +210,13 @@ real march_screen_occlusion(const MarchCamera* cam, __global const float* depths
 // and evaluations, every distance evaluation of them (primary march,
 // normal, DE_shade, occlusion and shadow rays, and the step onto the
 // surface of a ray that starts inside it). The extra march through the
-// pixel centre that AOVs need with supersampling or a lens is not counted.
+// pixel centre that AOVs need with supersampling or a lens is not counted,
+// nor are the shading layers' evaluations.
+//
+// With write_aovs at WRITE_LAYERS, every pass also writes linear: the
+// colour before the display transform (exposed, not clipped) and the
+// fraction of the samples that hit; and the first pass the shading
+// layers of the centre ray's hit (codegen::interface::layer).
 __kernel void render_tile(RENDER_TILE_ARGS) {
     int lx = (int)get_global_id(0);
     int ly = (int)get_global_id(1);
@@ -236,8 +242,12 @@ __kernel void render_tile(RENDER_TILE_ARGS) {
     real3 sum = (real3)(R(0.0));
     uint total_steps = 0;
     uint total_evals = 0;
+    uint hits = 0;
     MarchResult centre = {R(0.0), R(1.0), 0, 0};
     real3 centre_normal = (real3)(R(0.0));
+    // The ray the AOVs describe: the first sample's, or the pixel centre's.
+    real3 centre_ro = (real3)(R(0.0));
+    real3 centre_rd = (real3)(R(0.0));
     // Whether the rays come marched by brute_depths.
     int stored = 0;
     for (int s = 0; s < per_pass; ++s) {
@@ -268,6 +278,7 @@ __kernel void render_tile(RENDER_TILE_ARGS) {
         real3 color = background;
         real3 n = (real3)(R(0.0));
         if (m.hit) {
+            hits += 1u;
             real3 p = ro + rd * m.t;
             real footprint = march_footprint(&cam, m.t);
             real view_height = footprint * cam.image_h;
@@ -335,19 +346,28 @@ __kernel void render_tile(RENDER_TILE_ARGS) {
         if (s == 0) {
             centre = m;
             centre_normal = n;
+            centre_ro = ro;
+            centre_rd = rd;
         }
     }
     int idx = y * width + x;
     real3 color = sum / (real)per_pass;
+    real coverage = (real)hits / (real)per_pass;
     if (pass >= 0) {
+        // The spare fourth float sums the samples that hit.
         float4 total = pass == 0 ? (float4)(0.0f) : accumulation[idx];
-        total += (float4)(convert_float3(sum), 0.0f);
+        total += (float4)(convert_float3(sum), (float)hits);
         accumulation[idx] = total;
         if (pass > 0) {
-            color = (real3)(total.x, total.y, total.z) / ((real)(pass + 1) * (real)per_pass);
+            real samples = (real)(pass + 1) * (real)per_pass;
+            color = (real3)(total.x, total.y, total.z) / samples;
+            coverage = (real)total.w / samples;
         }
     }
-    real3 out = pow(clamp(color, R(0.0), R(1.0)), (real3)(R(1.0) / GAMMA));
+    if (write_aovs >= WRITE_LAYERS) {
+        linear[idx] = (float4)(convert_float3(color * EXPOSURE_SCALE), (float)coverage);
+    }
+    real3 out = display_color(color, EXPOSURE_SCALE, R(1.0) / GAMMA);
     rgba[idx] = (uchar4)(convert_uchar3_sat_rte(convert_float3(out) * 255.0f), (uchar)255);
 
     // Later passes leave the outputs of the first: the same rays.
@@ -361,6 +381,8 @@ __kernel void render_tile(RENDER_TILE_ARGS) {
             real3 rd;
             march_camera_ray(&cam, ((real)x + R(0.5)) * cam.pixel_scale,
                              ((real)y + R(0.5)) * cam.pixel_scale, &ro, &rd);
+            centre_ro = ro;
+            centre_rd = rd;
             centre = march_ray(ro, rd, start, &cam, R(1.0), params);
             centre_normal = (real3)(R(0.0));
             if (centre.hit) {
@@ -370,6 +392,34 @@ __kernel void render_tile(RENDER_TILE_ARGS) {
                     centre_normal = march_facing(centre_normal, rd);
                 }
             }
+        }
+        if (write_aovs >= WRITE_LAYERS) {
+            // What the centre ray's hit is made of (0 on a miss).
+            __global float* layer = layers + LAYER_STRIDE * idx;
+            real3 position = (real3)(R(0.0));
+            real3 albedo = (real3)(R(0.0));
+            real occlusion = R(0.0);
+            real trap = R(0.0);
+            real shadow = R(0.0);
+            if (centre.hit) {
+                real footprint = march_footprint(&cam, centre.t);
+                position = centre_ro + centre_rd * centre.t;
+                uint uncounted = 0u;
+                if (centre.t <= R(0.0) && !stored) {
+                    // A ray that starts inside a solid: the point shaded
+                    // is the nearest of the surface, as for the colour.
+                    position -= centre_normal * DE(position, params);
+                }
+                occlusion = march_occlusion(position, centre_normal, footprint * cam.image_h,
+                                            R(0.5), params, &uncounted);
+                march_layers(position, centre_normal, DETAIL * footprint, params, lights,
+                             light_count, &albedo, &trap, &shadow);
+            }
+            vstore3(convert_float3(position), 0, layer + LAYER_POSITION);
+            vstore3(convert_float3(albedo), 0, layer + LAYER_ALBEDO);
+            layer[LAYER_OCCLUSION] = (float)occlusion;
+            layer[LAYER_SHADOW] = (float)shadow;
+            layer[LAYER_TRAP] = (float)trap;
         }
         depth[idx] = centre.hit ? (float)centre.t : INFINITY;
         hit_mask[idx] = (uchar)centre.hit;

@@ -233,6 +233,25 @@ real march_occlusion(real3 p, real3 n, real view_height, real offset,
     return occlusion;
 }
 
+// The light l (LIGHT_STRIDE reals of the light buffer) as seen from p:
+// the unit direction towards it, how far it is (MAX_DISTANCE for a
+// directional light) and the radiance that arrives (a point light's falls
+// off with the squared distance).
+real3 march_light(__global const real* l, real3 p, real3* to_light, real* light_distance) {
+    real3 v = vload3(0, l + LIGHT_POSITION);
+    real3 radiance = vload3(0, l + LIGHT_RADIANCE);
+    *to_light = v;
+    *light_distance = MAX_DISTANCE;
+    if (l[LIGHT_KIND] > R(0.5)) {
+        real3 delta = v - p;
+        real dist2 = fmax(dot(delta, delta), REAL_TINY);
+        *light_distance = sqrt(dist2);
+        *to_light = delta / *light_distance;
+        radiance /= dist2;
+    }
+    return radiance;
+}
+
 // Lit colour of the surface point p with normal n, seen along rd, with the
 // sky's light scaled by occlusion (1: open). Adds its distance evaluations
 // (DE_shade, DE_material, shadow rays, thickness) to *evals.
@@ -276,17 +295,9 @@ real3 march_shade(real3 p, real3 n, real3 rd, real eps, real occlusion,
 #endif
     for (int i = 0; i < light_count; ++i) {
         __global const real* l = lights + LIGHT_STRIDE * i;
-        real3 v = vload3(0, l + LIGHT_POSITION);
-        real3 radiance = vload3(0, l + LIGHT_RADIANCE);
-        real3 to_light = v;
-        real light_distance = MAX_DISTANCE;
-        if (l[LIGHT_KIND] > R(0.5)) {
-            real3 delta = v - p;
-            real dist2 = fmax(dot(delta, delta), REAL_TINY);
-            light_distance = sqrt(dist2);
-            to_light = delta / light_distance;
-            radiance /= dist2;
-        }
+        real3 to_light;
+        real light_distance;
+        real3 radiance = march_light(l, p, &to_light, &light_distance);
         real ndl = dot(n, to_light);
 #ifdef ENABLE_MATERIALS
         if (ndl < R(0.0)) {
@@ -316,4 +327,38 @@ real3 march_shade(real3 p, real3 n, real3 rd, real eps, real occlusion,
         color += radiance * (albedo * (diffuse * ndl) + specular * ndl);
     }
     return color;
+}
+
+// The shading layers of the surface point p with normal n (see
+// codegen::interface::layer): its albedo with the orbit-trap tint, the
+// trap's value (1 on surfaces that are not fractals), and how lit it is: each
+// light that faces it weighted by the brightest channel of its radiance
+// times n.l, its shadow ray's visibility averaged (1 without shadows, or
+// with no light facing it). Shadow rays leave as march_shade's do.
+void march_layers(real3 p, real3 n, real eps, __global const real* params,
+                  __global const real* lights, int light_count, real3* albedo, real* trap,
+                  real* shadow) {
+    DE_shade(p, params, albedo, trap);
+    *albedo *= march_trap_tint(*trap);
+    real lit = R(0.0);
+    real weights = R(0.0);
+    uint evals = 0u;
+    for (int i = 0; i < light_count; ++i) {
+        __global const real* l = lights + LIGHT_STRIDE * i;
+        real3 to_light;
+        real light_distance;
+        real3 radiance = march_light(l, p, &to_light, &light_distance);
+        real weight = fmax(radiance.x, fmax(radiance.y, radiance.z)) * dot(n, to_light);
+        if (weight <= R(0.0)) {
+            continue;
+        }
+        real visible = R(1.0);
+#ifdef ENABLE_SHADOWS
+        visible = march_shadow(p + n * eps, to_light, light_distance, R(0.25) * eps, eps,
+                               l[LIGHT_SOFTNESS], R(1.0), params, &evals);
+#endif
+        lit += weight * visible;
+        weights += weight;
+    }
+    *shadow = weights > R(0.0) ? lit / weights : R(1.0);
 }

@@ -13,6 +13,7 @@ REQUIRED_PACKAGES=(
     pkg-config
     python3            # scripts/mutate_kernels.py (`make mutants`)
     jq                 # reads `cargo metadata` in scripts/msrv_check.sh
+    openimageio-tools  # oiiotool: reads the OpenEXR files the tests write, independently
     # The one-node Slurm cluster of scripts/slurm.sh and scripts/slurm-test.sh:
     slurm-wlm          # slurmctld, slurmd and the client commands (sbatch, squeue, ...)
     munge              # munged: the authentication Slurm's daemons and clients use

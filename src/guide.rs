@@ -16,26 +16,28 @@
 //!    speed against accuracy.
 //! 6. [Optics](optics): the lens, progressive and adaptive passes, stereo
 //!    and cuts.
-//! 7. [Materials](materials): shading models, reflections and glass.
-//! 8. [Animation](animation): motions, camera paths and frame sequences.
-//! 9. [Meshes and volumes](meshes): watertight meshes and signed-distance
-//!    grids.
-//! 10. [The command line](command_line): the `fractal-sdf` command and the
+//! 7. [Outputs](outputs): image formats, OpenEXR layers, exposure and
+//!    tone curves, and the camera for a 3D package.
+//! 8. [Materials](materials): shading models, reflections and glass.
+//! 9. [Animation](animation): motions, camera paths and frame sequences.
+//! 10. [Meshes and volumes](meshes): watertight meshes and signed-distance
+//!     grids.
+//! 11. [The command line](command_line): the `fractal-sdf` command and the
 //!     settings file.
-//! 11. [The viewer](viewer): the interactive window.
-//! 12. [Clusters](clusters): sequences as Slurm job arrays and Kubernetes
+//! 12. [The viewer](viewer): the interactive window.
+//! 13. [Clusters](clusters): sequences as Slurm job arrays and Kubernetes
 //!     Indexed Jobs.
-//! 13. [Custom shapes](custom_shapes): shapes of your own, and testing
+//! 14. [Custom shapes](custom_shapes): shapes of your own, and testing
 //!     them.
-//! 14. [Performance](performance): the benchmark, render speed, and what
+//! 15. [Performance](performance): the benchmark, render speed, and what
 //!     makes rendering faster at the same image.
-//! 15. [Reliability](reliability): hostile input, the values each
+//! 16. [Reliability](reliability): hostile input, the values each
 //!     precision holds, and numerical limits.
-//! 16. [How it is tested](how_it_is_tested): oracles, tolerances and
+//! 17. [How it is tested](how_it_is_tested): oracles, tolerances and
 //!     mutation testing.
-//! 17. [Packaging](packaging): the package, its check, docs.rs, the
+//! 18. [Packaging](packaging): the package, its check, docs.rs, the
 //!     minimum Rust and versions.
-//! 18. [Architecture](architecture): where the design is described.
+//! 19. [Architecture](architecture): where the design is described.
 
 // Chapters link to `render` (feature `opencl`) and `testing` (feature
 // `proptest`); without those features the links have no target.
@@ -61,6 +63,9 @@ pub mod quality {}
 
 #[doc = include_str!("../docs/guide/optics.md")]
 pub mod optics {}
+
+#[doc = include_str!("../docs/guide/outputs.md")]
+pub mod outputs {}
 
 #[doc = include_str!("../docs/guide/materials.md")]
 pub mod materials {}

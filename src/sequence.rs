@@ -17,13 +17,12 @@
 use std::ops::Range;
 use std::path::{Path, PathBuf};
 
+use crate::animation::CameraPath;
 use crate::error::{Error, Result, fmt_value};
+use crate::output::CameraExport;
+use crate::scene::Camera;
 #[cfg(feature = "opencl")]
-use crate::{
-    animation::{CameraPath, Motion},
-    render::Renderer,
-    view::FrameTiming,
-};
+use crate::{animation::Motion, render::Renderer, view::FrameTiming};
 
 /// The file name of frame `index`: `frame_00042.png`.
 #[must_use]
@@ -153,6 +152,32 @@ impl Sequence {
     #[must_use]
     pub fn time(&self, index: u32) -> f64 {
         f64::from(index) / self.fps
+    }
+
+    /// The camera of frame `index`: `base` moved along `path` to the
+    /// frame's time (counted from the path's first keyframe).
+    #[must_use]
+    pub fn camera(&self, path: &CameraPath, index: u32, base: &Camera) -> Camera {
+        path.camera_at(path.start() + self.time(index), base)
+    }
+
+    /// Every frame's camera, as [`CameraExport`]s with their frame and
+    /// time, for `width` × `height` frames.
+    ///
+    /// # Errors
+    /// As [`CameraExport::new`].
+    pub fn camera_exports(
+        &self,
+        path: &CameraPath,
+        base: &Camera,
+        size: (u32, u32),
+    ) -> Result<Vec<CameraExport>> {
+        (0..self.frames)
+            .map(|i| {
+                CameraExport::new(&self.camera(path, i, base), size)
+                    .map(|c| c.at_frame(u64::from(i), self.time(i)))
+            })
+            .collect()
     }
 
     /// The frames of `range` (clipped to the sequence) that are not on
@@ -298,7 +323,7 @@ impl Sequence {
         let base = *renderer.camera();
         for &index in indices {
             let t = self.time(index);
-            renderer.set_camera(path.camera_at(path.start() + t, &base))?;
+            renderer.set_camera(self.camera(path, index, &base))?;
             for motion in motions {
                 for (name, value) in motion.values(t) {
                     renderer.set_param(&name, value)?;

@@ -359,7 +359,47 @@ fn bad_input_is_a_clear_error_and_a_nonzero_exit() {
     std::fs::write(&bad, "(version: 1,\n  geometry: Sphere(radius: -2))").unwrap();
     let png = dir.join("x.png");
     let o = png.to_str().unwrap();
-    let cases: [(&[&str], &str, i32, &str); 10] = [
+    let jpg = dir.join("x.jpg");
+    let j = jpg.to_str().unwrap();
+    let exr = dir.join("x.exr");
+    let e = exr.to_str().unwrap();
+    let cases: [(&[&str], &str, i32, &str); 16] = [
+        (
+            &["render", "csg", "-o", o, "--aov", "depth,nrml"],
+            "",
+            2,
+            "`nrml` is not an output; the outputs are depth, normal",
+        ),
+        (
+            &["render", "csg", "-o", o, "--tonemap", "aces"],
+            "",
+            2,
+            "--tonemap `aces`: expected one of clip, reinhard, filmic",
+        ),
+        (
+            &["render", "csg", "-o", j, "--bits", "16"],
+            "",
+            2,
+            "holds 8 bits per channel",
+        ),
+        (
+            &["render", "csg", "-o", e, "--bits", "16"],
+            "",
+            2,
+            "holds 32-bit floats",
+        ),
+        (
+            &["render", "csg", "-o", e, "--stereo", "anaglyph"],
+            "",
+            2,
+            "--stereo writes an 8-bit composite",
+        ),
+        (
+            &["render", "csg", "-o", o, "--exposure", "40"],
+            "",
+            1,
+            "exposure",
+        ),
         (
             &["render", bad.to_str().unwrap(), "-o", o],
             "",
@@ -423,6 +463,10 @@ fn bad_input_is_a_clear_error_and_a_nonzero_exit() {
         assert!(stderr.contains(says), "{args:?}: {stderr}");
     }
     assert!(!png.exists(), "an image was written despite the errors");
+    assert!(
+        !jpg.exists() && !exr.exists(),
+        "an image was written despite the errors"
+    );
     // A bad settings file does not stop `devices`, which does not read it.
     if gpu::device().is_some() {
         let out = run(&dir, "presett = 1", &["devices"]);
@@ -581,7 +625,7 @@ fn the_image_format_follows_the_output_extension() {
     assert_eq!(out.status.code(), Some(2), "{}", text(&out));
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert!(
-        stderr.contains(".xyz") && stderr.contains(".png, .jpg, .jpeg"),
+        stderr.contains(".xyz") && stderr.contains(".png, .jpg, .jpeg, .tif, .tiff, .exr"),
         "{stderr}"
     );
     assert!(!xyz.exists());
@@ -591,6 +635,8 @@ fn the_image_format_follows_the_output_extension() {
     for (name, magic) in [
         ("out.jpg", &[0xff, 0xd8, 0xff][..]),
         ("out.PNG", b"\x89PNG"),
+        ("out.tif", b"II*\0"),
+        ("out.exr", &[0x76, 0x2f, 0x31, 0x01][..]),
     ] {
         let path = dir.join(name);
         let out = run(
@@ -785,4 +831,108 @@ fn a_reader_that_stops_early_ends_the_command_quietly() {
         assert!(out.status.success(), "{args:?}: {}", text(&out));
         assert!(out.stderr.is_empty(), "{args:?}: {}", text(&out));
     }
+}
+
+/// `--aov`, `--bits 16`, `--exposure`, `--tonemap` and `--camera-json`:
+/// an OpenEXR file whose layers an independent reader lists, a 16-bit PNG
+/// with an output PNG beside it, and cameras for one frame and for a whole
+/// sequence.
+#[test]
+fn render_writes_layers_deep_images_and_cameras() {
+    if gpu::device().is_none() || gpu::oiiotool().is_none() {
+        return;
+    }
+    let dir = scratch("layers");
+    let exr = dir.join("bulb.exr");
+    let camera = dir.join("bulb.json");
+    let small = ["--preset", "draft", "--size", "24x16"];
+    let mut args = vec![
+        "render",
+        "mandelbulb",
+        "-o",
+        exr.to_str().unwrap(),
+        "--aov",
+        "depth,normal,albedo",
+        "--exposure",
+        "-0.5",
+        "--tonemap",
+        "filmic",
+        "--camera-json",
+        camera.to_str().unwrap(),
+    ];
+    args.extend(small);
+    let out = run(&dir, "", &args);
+    assert!(out.status.success(), "{}", text(&out));
+    let (channels, pixels) = gpu::read_exr(&exr);
+    for name in [
+        "R", "G", "B", "A", "depth.Z", "normal.X", "normal.Z", "albedo.G",
+    ] {
+        assert!(channels.iter().any(|c| c == name), "{name} in {channels:?}");
+    }
+    assert_eq!(channels.len(), 11);
+    assert_eq!(pixels.len(), 24 * 16);
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&camera).unwrap()).unwrap();
+    assert_eq!(json["format"], "fractal-sdf camera");
+    assert_eq!(
+        (json["width"].as_u64(), json["height"].as_u64()),
+        (Some(24), Some(16))
+    );
+
+    let png = dir.join("deep.png");
+    let mut args = vec![
+        "render",
+        "mandelbulb",
+        "-o",
+        png.to_str().unwrap(),
+        "--bits",
+        "16",
+        "--aov",
+        "depth",
+    ];
+    args.extend(small);
+    let out = run(&dir, "", &args);
+    assert!(out.status.success(), "{}", text(&out));
+    assert!(String::from_utf8_lossy(&out.stdout).contains("deep.depth.png"));
+    let deep = image::open(&png).unwrap();
+    assert!(matches!(deep, image::DynamicImage::ImageRgba16(_)));
+    let depth = image::open(dir.join("deep.depth.png")).unwrap();
+    assert!(matches!(depth, image::DynamicImage::ImageLuma16(_)));
+
+    // A sequence's cameras: every frame's, whichever frames render.
+    let cameras = dir.join("cameras.json");
+    let frames = dir.join("frames");
+    let out = run(
+        &dir,
+        "",
+        &[
+            "sequence",
+            "csg",
+            "--fps",
+            "4",
+            "--seconds",
+            "1",
+            "--frames",
+            "0..1",
+            "--size",
+            "16x12",
+            "--preset",
+            "draft",
+            "--out",
+            frames.to_str().unwrap(),
+            "--no-video",
+            "--camera-json",
+            cameras.to_str().unwrap(),
+        ],
+    );
+    assert!(out.status.success(), "{}", text(&out));
+    let all: Vec<serde_json::Value> =
+        serde_json::from_str(&std::fs::read_to_string(&cameras).unwrap()).unwrap();
+    assert_eq!(all.len(), 4);
+    for (i, c) in all.iter().enumerate() {
+        assert_eq!(c["frame"].as_u64(), Some(i as u64));
+        assert_eq!(c["time"].as_f64(), Some(i as f64 / 4.0));
+    }
+    // An orbit: the camera moves from frame to frame.
+    assert_ne!(all[0]["position"], all[1]["position"]);
 }

@@ -5,6 +5,7 @@
 use crate::cpu::sdf::{self, Estimate, TrapShape};
 use crate::expr::{Num, OpenCl, Printer, Shape, Signature, Unprintable, Var, trace};
 use crate::math::{V3, v3};
+use crate::quality::{ToneMap, display_formula};
 use crate::scene::{Hybrid, KifsFold, ParamSpec, PseudoKleinian};
 
 use Shape::{Pair, Scalar, Vec3};
@@ -38,6 +39,21 @@ fn distance(
     let mut all = vec![("p", Vec3)];
     all.extend_from_slice(params);
     print(name, &all, Scalar, |a| vec![formula(vector(a, 0), &a[3..])])
+}
+
+/// The render kernel's display transform, `display_color(c, scale,
+/// inverse_gamma)`: exposure, `tone_map` and gamma
+/// ([`display_formula`]).
+pub(crate) fn display(tone_map: ToneMap) -> Result<String, Unprintable> {
+    print(
+        "display_color",
+        &[("c", Vec3), ("scale", Scalar), ("inverse_gamma", Scalar)],
+        Vec3,
+        |a| {
+            let out = display_formula(vector(a, 0), a[3], a[4], tone_map);
+            vec![out.x, out.y, out.z]
+        },
+    )
 }
 
 pub(crate) fn sphere() -> Result<String, Unprintable> {

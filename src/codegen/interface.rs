@@ -117,6 +117,38 @@ pub mod light {
     pub const KIND_POINT: f64 = 1.0;
 }
 
+/// One pixel's entry in the shading-layer buffer (`layers` argument of
+/// `render_tile`), repeated every [`STRIDE`](layer::STRIDE) floats: what
+/// the pixel-centre ray's hit is made of, written when `write_aovs` is
+/// [`WRITE_LAYERS`](layer::WRITE_LAYERS).
+pub mod layer {
+    use super::{Field, field};
+
+    /// World-space position of the hit, relative to the program's origin
+    /// (0 on a miss).
+    pub const POSITION: Field = field("POSITION", 0, 3);
+    /// Linear base colour at the hit, orbit-trap tint included (0 on a
+    /// miss).
+    pub const ALBEDO: Field = field("ALBEDO", 3, 3);
+    /// Ambient occlusion at the hit: 1 open, 0 fully occluded (1 without
+    /// the effect, 0 on a miss).
+    pub const OCCLUSION: Field = field("OCCLUSION", 6, 1);
+    /// The lights' visibility at the hit, weighted by what each could add:
+    /// 1 lit, 0 in shadow (1 without shadows or lights, 0 on a miss).
+    pub const SHADOW: Field = field("SHADOW", 7, 1);
+    /// The orbit-trap value at the hit that tints a fractal, 1 on other
+    /// surfaces (0 on a miss).
+    pub const TRAP: Field = field("TRAP", 8, 1);
+    /// Every field, in buffer order.
+    pub const FIELDS: [Field; 5] = [POSITION, ALBEDO, OCCLUSION, SHADOW, TRAP];
+    /// Floats per pixel.
+    pub const STRIDE: usize = 9;
+    /// `write_aovs` for the depth, hit, normal and cost outputs alone.
+    pub const WRITE_AOVS: i32 = 1;
+    /// `write_aovs` for those, the shading layers and the linear colour.
+    pub const WRITE_LAYERS: i32 = 2;
+}
+
 /// The arguments of the rendering kernel `render_tile`, in order.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 #[allow(missing_docs)] // Each is described by its declaration in `RENDER_TILE`.
@@ -146,6 +178,8 @@ pub enum RenderArg {
     Refine,
     BruteDepths,
     BruteSteps,
+    Linear,
+    Layers,
 }
 
 /// `render_tile`'s declarations, in argument order: the one list of its
@@ -155,8 +189,11 @@ pub enum RenderArg {
 /// With `refine_only` set, only the pixels `refine` marks are rendered
 /// (adaptive supersampling's further passes). `brute_depths` and
 /// `brute_steps` are what `brute_depths` left for this pass (read only by
-/// programs that march inside shapes by brute force).
-pub const RENDER_TILE: [(RenderArg, &str); 24] = [
+/// programs that march inside shapes by brute force). With `write_aovs`
+/// at [`layer::WRITE_LAYERS`], every pass writes the exposed linear colour
+/// and the fraction of samples that hit to `linear`, and the first the
+/// shading layers to `layers`.
+pub const RENDER_TILE: [(RenderArg, &str); 26] = [
     (RenderArg::Params, "__global const real* params"),
     (RenderArg::Camera, "__global const real* camera"),
     (RenderArg::Lights, "__global const real* lights"),
@@ -181,6 +218,8 @@ pub const RENDER_TILE: [(RenderArg, &str); 24] = [
     (RenderArg::Refine, "__global const uchar* refine"),
     (RenderArg::BruteDepths, "__global const float* brute_depths"),
     (RenderArg::BruteSteps, "__global const uint* brute_steps"),
+    (RenderArg::Linear, "__global float4* linear"),
+    (RenderArg::Layers, "__global float* layers"),
 ];
 
 /// The arguments of the coarse pass `cone_starts` (see
@@ -351,6 +390,11 @@ pub(crate) fn defines(target: super::Target) -> String {
                 let _ = writeln!(w, "#define LIGHT_{} {}", f.name, f.offset);
             }
             let _ = writeln!(w, "#define LIGHT_STRIDE {}", light::STRIDE);
+            for f in layer::FIELDS {
+                let _ = writeln!(w, "#define LAYER_{} {}", f.name, f.offset);
+            }
+            let _ = writeln!(w, "#define LAYER_STRIDE {}", layer::STRIDE);
+            let _ = writeln!(w, "#define WRITE_LAYERS {}", layer::WRITE_LAYERS);
         }
         super::Target::Evaluate => {
             let _ = writeln!(w, "#define EVAL_POINTS_ARGS \\\n    {}", args(&EVAL_POINTS));
@@ -397,6 +441,7 @@ mod tests {
         for (fields, len) in [
             (&camera::FIELDS[..], camera::LEN),
             (&light::FIELDS[..], light::STRIDE),
+            (&layer::FIELDS[..], layer::STRIDE),
         ] {
             let mut next = 0;
             for f in fields {

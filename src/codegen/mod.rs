@@ -637,6 +637,16 @@ fn finish(
         define_sphere(&mut w, what, "GLOW_BOUND", &b);
         w.line(format!("#define GLOW_BOUND_SLOPE {}", w.float(b.slope)));
     }
+    if options.target == Target::Render {
+        // The display transform the render kernel ends each pixel with.
+        let display = formulas::display(options.effects.tone_map).map_err(|e| Error::Invalid {
+            what: "formula",
+            reason: e.to_string(),
+        })?;
+        w.line("/* ---- display ---- */");
+        w.raw(&display);
+        w.line("");
+    }
     w.line(format!(
         "/* ---- kernel: {} ---- */",
         match options.target {
@@ -711,6 +721,7 @@ fn header(w: &mut writer::Writer, options: &Options, features: &Features) {
         ("OVER_RELAXATION", f(q.over_relaxation)),
         ("SUPERSAMPLING", q.supersampling.to_string()),
         ("GAMMA", f(e.gamma)),
+        ("EXPOSURE_SCALE", f(e.exposure_scale())),
         ("SKY_TOP", rgb(e.sky_top)),
         ("SKY_BOTTOM", rgb(e.sky_bottom)),
     ];

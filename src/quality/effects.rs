@@ -1,5 +1,6 @@
-//! Lighting effects: ambient occlusion, shadows, glow, fog, the sky and
-//! gamma, each compiled into the program only when it is on.
+//! Lighting effects: ambient occlusion, shadows, glow, fog, the sky, and
+//! the display transform (exposure, tone curve, gamma), each compiled into
+//! the program only when it is on.
 
 use super::*;
 
@@ -53,6 +54,15 @@ pub struct Effects {
     pub sky_bottom: DVec3,
     /// Output gamma (2.2 for sRGB-like output; 1 for linear).
     pub gamma: f64,
+    /// Exposure in stops: every linear colour is scaled by
+    /// `2^exposure` before anything else sees it (the 8- and 16-bit
+    /// images through the tone curve, and the linear beauty of an
+    /// OpenEXR file as it is). In `[-32, 32]`; 0 leaves colours as lit.
+    pub exposure: f64,
+    /// The curve that takes exposed linear colours into `[0, 1]` for
+    /// display ([`ToneMap`]; the default clips at 1). Linear outputs
+    /// (OpenEXR) are written before it.
+    pub tone_map: ToneMap,
 }
 
 impl Default for Effects {
@@ -68,6 +78,8 @@ impl Default for Effects {
             sky_top: DVec3::new(0.32, 0.42, 0.58),
             sky_bottom: DVec3::new(0.06, 0.07, 0.09),
             gamma: 2.2,
+            exposure: 0.0,
+            tone_map: ToneMap::Clip,
         }
     }
 }
@@ -160,6 +172,9 @@ impl Effects {
         if !(self.gamma.is_finite() && self.gamma > 0.0) {
             return Err(bad("gamma", self.gamma, "> 0"));
         }
+        if !(self.exposure.is_finite() && self.exposure.abs() <= MAX_EXPOSURE) {
+            return Err(bad("exposure", self.exposure, "in [-32, 32] stops"));
+        }
         Ok(())
     }
 }
@@ -241,4 +256,30 @@ impl Effects {
         self.gamma = gamma;
         self
     }
+
+    /// Sets the exposure in stops (in `[-32, 32]`): linear colours are
+    /// scaled by `2^stops`.
+    #[must_use]
+    pub fn exposure(mut self, stops: f64) -> Self {
+        self.exposure = stops;
+        self
+    }
+
+    /// Sets the tone curve that maps exposed linear colours into `[0, 1]`.
+    #[must_use]
+    pub fn tone_map(mut self, tone_map: ToneMap) -> Self {
+        self.tone_map = tone_map;
+        self
+    }
+
+    /// The factor [`Effects::exposure`] scales linear colours by:
+    /// `2^exposure`.
+    #[must_use]
+    pub fn exposure_scale(&self) -> f64 {
+        self.exposure.exp2()
+    }
 }
+
+/// The largest exposure, in stops, either way ([`Effects::exposure`]):
+/// `2^32` keeps every scaled colour within the `F32` kernel's limits.
+pub const MAX_EXPOSURE: f64 = 32.0;

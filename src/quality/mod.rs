@@ -13,8 +13,10 @@ use crate::error::{Error, Result};
 use crate::math::{F32_LIMITS, F64_LIMITS, Limits, Magnitude};
 
 mod effects;
+mod tone;
 
-pub use effects::{Effects, Glow};
+pub use effects::{Effects, Glow, MAX_EXPOSURE};
+pub use tone::{ToneMap, display, display_formula};
 
 /// Floating-point precision of the generated kernel.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default, Serialize, Deserialize)]

@@ -34,6 +34,65 @@ pub struct Frame {
     /// ([`Quality::cone_tile`](crate::quality::Quality::cone_tile)), 0
     /// without one.
     pub start: Vec<f32>,
+    /// The shading layers and the linear colour, where the frame was
+    /// rendered with them ([`Renderer::render_layers`](crate::render::Renderer::render_layers)).
+    pub layers: Option<Layers>,
+}
+
+/// What a frame's pixels are made of, for compositing: the colour before
+/// the display transform, and what the pixel-centre ray's hit is made of.
+///
+/// Every vector is row-major like [`Frame`]'s. A pixel whose centre ray
+/// missed has position, albedo, occlusion, shadow and trap 0. The layers
+/// other than the colour describe the pixel-centre ray, as the depth and
+/// normal do.
+#[derive(Debug, Clone, PartialEq)]
+#[non_exhaustive]
+pub struct Layers {
+    /// The pixel's linear colour scaled by the exposure
+    /// ([`Effects::exposure`](crate::quality::Effects::exposure)), before
+    /// the tone curve and gamma: the mean over its samples (and passes),
+    /// not clipped at 1, background included. `[3]` is the fraction of
+    /// those samples whose ray hit a surface (the coverage, a matte of
+    /// what is not background; the colour is not premultiplied by it).
+    pub linear: Vec<[f32; 4]>,
+    /// World-space position of the hit.
+    pub position: Vec<[f32; 3]>,
+    /// Linear base colour at the hit (the node's colour, orbit-trap tint
+    /// included), before any light.
+    pub albedo: Vec<[f32; 3]>,
+    /// Ambient occlusion at the hit: 1 open, towards 0 in creases (1 with
+    /// the effect off).
+    pub occlusion: Vec<f32>,
+    /// How lit the hit is by the lights that face it, each weighted by
+    /// the most it could add: 1 lit, 0 in shadow (1 with shadows off or
+    /// no light facing it).
+    pub shadow: Vec<f32>,
+    /// The orbit-trap value at the hit, in `[0, 1]`, that tints a
+    /// fractal's colour; 1 on surfaces that are not fractals.
+    pub trap: Vec<f32>,
+}
+
+/// Which outputs a launch writes, from least to most.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
+pub(crate) enum Outputs {
+    /// The 8-bit image alone.
+    Image,
+    /// With depth, hit, normal and the costs.
+    Aovs,
+    /// With those, the shading layers and the linear colour.
+    Layers,
+}
+
+impl Outputs {
+    /// The kernel's `write_aovs` argument.
+    pub(crate) fn write_aovs(self) -> i32 {
+        match self {
+            Outputs::Image => 0,
+            Outputs::Aovs => crate::codegen::interface::layer::WRITE_AOVS,
+            Outputs::Layers => crate::codegen::interface::layer::WRITE_LAYERS,
+        }
+    }
 }
 
 impl Frame {

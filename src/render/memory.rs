@@ -5,15 +5,21 @@
 use std::fs;
 use std::path::Path;
 
+use super::aov::Outputs;
 use super::device::{DeviceInfo, DeviceKind};
 use crate::error::{Error, Result};
 
 /// Bytes per pixel of the host copies of a frame's outputs: RGBA only, or
 /// with the AOVs (RGBA 4, depth 4, hit 1, normals 12, steps 4, evaluations
 /// 4), plus the hit mask as `bool`s and the normals as `[f32; 3]`s made
-/// while the flat copies are alive.
-const fn readback_per_pixel(aovs: bool) -> u64 {
-    if aovs { 29 + 1 + 12 } else { 4 }
+/// while the flat copies are alive; with the layers, their flat copies
+/// (linear 16, layers 36) and the vectors made from them (52).
+const fn readback_per_pixel(outputs: Outputs) -> u64 {
+    match outputs {
+        Outputs::Image => 4,
+        Outputs::Aovs => 29 + 1 + 12,
+        Outputs::Layers => 29 + 1 + 12 + 52 + 52,
+    }
 }
 
 /// The host memory a `width` × `height` frame needs, in bytes: the
@@ -24,11 +30,11 @@ pub(crate) fn frame_host_bytes(
     info: &DeviceInfo,
     width: u32,
     height: u32,
-    aovs: bool,
+    outputs: Outputs,
     device_buffers: Option<u64>,
 ) -> u64 {
     let pixels = u64::from(width) * u64::from(height);
-    let readback = pixels * readback_per_pixel(aovs);
+    let readback = pixels * readback_per_pixel(outputs);
     let on_host = match (info.kind, device_buffers) {
         (DeviceKind::Cpu, Some(bytes)) => bytes,
         _ => 0,
@@ -143,7 +149,7 @@ mod tests {
         let device = 29 * pixels;
         // With AOVs on a CPU device: 29 bytes per pixel of device buffers
         // and 42 of host copies, 17.75 GiB in all.
-        let needed = frame_host_bytes(&cpu, side, side, true, Some(device));
+        let needed = frame_host_bytes(&cpu, side, side, Outputs::Aovs, Some(device));
         assert_eq!(needed, 71 * pixels);
         assert_eq!(needed, 18176 << 20);
         let err = check_host_memory(side, side, needed, Some(16 * GIB)).unwrap_err();
@@ -164,13 +170,24 @@ mod tests {
         // Unknown: no check.
         check_host_memory(side, side, needed, None).unwrap();
         // Buffers already allocated, or on a GPU, are not counted again.
-        assert_eq!(frame_host_bytes(&cpu, side, side, true, None), 42 * pixels);
         assert_eq!(
-            frame_host_bytes(&gpu, side, side, true, Some(device)),
+            frame_host_bytes(&cpu, side, side, Outputs::Aovs, None),
+            42 * pixels
+        );
+        assert_eq!(
+            frame_host_bytes(&gpu, side, side, Outputs::Aovs, Some(device)),
             42 * pixels
         );
         // Colour only: 4 bytes per pixel, 1 GiB.
-        assert_eq!(frame_host_bytes(&gpu, side, side, false, None), GIB);
+        assert_eq!(
+            frame_host_bytes(&gpu, side, side, Outputs::Image, None),
+            GIB
+        );
+        // With the layers: 52 more bytes of flat copies and 52 of vectors.
+        assert_eq!(
+            frame_host_bytes(&gpu, side, side, Outputs::Layers, None),
+            146 * pixels
+        );
         check_host_memory(side, side, GIB, Some(GIB)).unwrap();
         assert!(check_host_memory(side, side, GIB + 1, Some(GIB)).is_err());
     }

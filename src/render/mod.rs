@@ -29,8 +29,8 @@
 //!   turns a literal into a `real` one;
 //! - `REAL_TINY`, `MAX_STEPS`, `MAX_DISTANCE`, `DETAIL`, `HIT_EPSILON` and
 //!   `NORMAL_EPSILON` (multiples of the pixel footprint), `OVER_RELAXATION`,
-//!   `SUPERSAMPLING` (N for N×N samples), `GAMMA`, `SKY_TOP`, `SKY_BOTTOM`
-//!   (`real3`), from [`Quality`](crate::quality::Quality) and
+//!   `SUPERSAMPLING` (N for N×N samples), `GAMMA`, `EXPOSURE_SCALE`,
+//!   `SKY_TOP`, `SKY_BOTTOM` (`real3`), from [`Quality`](crate::quality::Quality) and
 //!   [`Effects`](crate::quality::Effects);
 //! - only for the effects that are on: `ENABLE_AO` with `AO_SAMPLES` and
 //!   `AO_DISTANCE`; `ENABLE_SHADOWS` with `SHADOW_STEPS`; `ENABLE_GLOW` with
@@ -70,7 +70,7 @@ mod upscale;
 mod viewport;
 
 pub use adaptive::{AdaptiveFrame, EdgeThresholds, edges};
-pub use aov::Frame;
+pub use aov::{Frame, Layers};
 pub use cancel::CancelToken;
 pub use device::{DEVICE_ENV, DeviceInfo, DeviceKind, DeviceSelector, devices};
 pub use dispatch::{DEFAULT_TILE_SIZE, MAX_IMAGE_SIDE};

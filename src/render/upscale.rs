@@ -12,6 +12,7 @@
 use image::RgbaImage;
 
 use super::Frame;
+use super::aov::Layers;
 
 /// Two hits whose depths differ by less than this fraction of the nearer
 /// show the same surface.
@@ -123,6 +124,14 @@ pub(crate) fn frame(low: &Frame, width: u32, height: u32, scale: u32) -> Frame {
         steps: vec![0; n],
         evaluations: vec![0; n],
         start: Vec::with_capacity(n),
+        layers: low.layers.as_ref().map(|_| Layers {
+            linear: Vec::with_capacity(n),
+            position: Vec::with_capacity(n),
+            albedo: Vec::with_capacity(n),
+            occlusion: Vec::with_capacity(n),
+            shadow: Vec::with_capacity(n),
+            trap: Vec::with_capacity(n),
+        }),
     };
     let from = low.image.as_raw();
     for_each_tap(
@@ -137,6 +146,25 @@ pub(crate) fn frame(low: &Frame, width: u32, height: u32, scale: u32) -> Frame {
             out.hit.push(low.hit[i]);
             out.normal.push(low.normal[i]);
             out.start.push(low.start[i]);
+            if let (Some(to), Some(from)) = (&mut out.layers, &low.layers) {
+                // Colours blend as the image's do; what the hit is made
+                // of comes from the nearest ray, as its depth does.
+                let total: u32 = weight.iter().sum();
+                let mut linear = [0.0f32; 4];
+                for (k, w) in index.into_iter().zip(weight).filter(|&(_, w)| w > 0) {
+                    #[allow(clippy::cast_precision_loss)] // weights are small
+                    let w = w as f32 / total as f32;
+                    for (sum, v) in linear.iter_mut().zip(from.linear[k]) {
+                        *sum += w * v;
+                    }
+                }
+                to.linear.push(linear);
+                to.position.push(from.position[i]);
+                to.albedo.push(from.albedo[i]);
+                to.occlusion.push(from.occlusion[i]);
+                to.shadow.push(from.shadow[i]);
+                to.trap.push(from.trap[i]);
+            }
         },
     );
     for y in 0..lh {

@@ -176,3 +176,63 @@ pub fn assert_no_nan(frame: &Frame, what: &str) {
 pub fn plain(quality: Quality) -> Quality {
     quality.cone_tile(0).resolution_scale(1).fast_math(false)
 }
+
+/// The OpenImageIO command `oiiotool`, an OpenEXR reader independent of
+/// the library's writer; or `None` where it is not installed: the caller
+/// returns early and the skip is recorded. Where checks are [`required`]
+/// (`make test` installs it through `scripts/setup.sh`), its absence fails
+/// the test.
+pub fn oiiotool() -> Option<&'static str> {
+    let found = std::process::Command::new("oiiotool")
+        .arg("--version")
+        .output()
+        .is_ok_and(|out| out.status.success());
+    if !found {
+        assert!(
+            !required(),
+            "oiiotool is required here: scripts/setup.sh installs it (Debian's \
+             openimageio-tools)"
+        );
+        skipped("OpenEXR check", "oiiotool is not installed");
+        return None;
+    }
+    Some("oiiotool")
+}
+
+/// The channel names and every pixel's values of an OpenEXR file as
+/// `oiiotool` reads them (`--info -v` and `--dumpdata`), pixels in row
+/// order.
+pub fn read_exr(path: &std::path::Path) -> (Vec<String>, Vec<Vec<f32>>) {
+    let run = |args: &[&str]| {
+        let out = std::process::Command::new("oiiotool")
+            .args(args)
+            .arg(path)
+            .output()
+            .expect("oiiotool runs");
+        assert!(
+            out.status.success(),
+            "oiiotool {args:?}: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        String::from_utf8(out.stdout).expect("oiiotool prints text")
+    };
+    let info = run(&["--info", "-v"]);
+    let list = info
+        .lines()
+        .find_map(|l| l.trim().strip_prefix("channel list:"))
+        .unwrap_or_else(|| panic!("no channel list in:\n{info}"));
+    let channels: Vec<String> = list.split(',').map(|c| c.trim().to_string()).collect();
+    let dump = run(&["--dumpdata"]);
+    let pixels: Vec<Vec<f32>> = dump
+        .lines()
+        .filter_map(|l| l.trim().strip_prefix("Pixel ("))
+        .map(|l| {
+            let values = l.split_once("):").expect("Pixel (x, y): values").1;
+            values
+                .split_whitespace()
+                .map(|v| v.parse().unwrap_or_else(|_| panic!("value {v}")))
+                .collect()
+        })
+        .collect();
+    (channels, pixels)
+}

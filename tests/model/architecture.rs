@@ -16,7 +16,7 @@ const STAGES: &[(&str, &[&str])] = &[
     // `math`'s helpers and every later stage's formulas are written.
     ("expr", &[]),
     ("math", &["expr"]),
-    ("quality", &["error", "math"]),
+    ("quality", &["error", "math", "expr"]),
     ("scene", &["error", "math", "expr"]),
     ("ir", &["error", "math", "expr", "scene"]),
     ("cpu", &["error", "scene", "ir", "math", "expr"]),

@@ -551,8 +551,9 @@ fn setting_cases(t: &mut Tally) {
         ("over_relaxation", Quality::over_relaxation),
     ];
     type EffectsEdit = fn(Effects, f64) -> Effects;
-    let effects: [(&str, EffectsEdit); 7] = [
+    let effects: [(&str, EffectsEdit); 8] = [
         ("ao_distance", Effects::ao_distance),
+        ("exposure", Effects::exposure),
         ("fog_density", Effects::fog_density),
         ("gamma", Effects::gamma),
         ("glow", |e, v| e.glow(Glow::new(dvec3(0.5, 0.7, 1.0), v))),

@@ -909,6 +909,7 @@ fn every_node_field_given_a_hostile_value_is_refused_by_name_or_read() {
         ("camera: (position: (0, 0, @))", "position"),
         ("effects: (gamma: @)", "gamma"),
         ("effects: (fog_density: @)", "fog_density"),
+        ("effects: (exposure: @)", "exposure"),
         (
             "motions: [Oscillate(name: \"r\", center: 1, amplitude: 0.1, period: @)]",
             "period",

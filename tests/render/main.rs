@@ -18,6 +18,7 @@ mod march_bounds;
 mod materials;
 mod multi_device;
 mod optics;
+mod outputs;
 mod quality;
 mod sizes;
 mod speed_knobs;

@@ -17,6 +17,7 @@ typedef float4 real4;
 #define OVER_RELAXATION 1.0f
 #define SUPERSAMPLING 1
 #define GAMMA 2.2f
+#define EXPOSURE_SCALE 1.0f
 #define SKY_TOP (real3)(0.32f, 0.42f, 0.58f)
 #define SKY_BOTTOM (real3)(0.06f, 0.07f, 0.09f)
 #define AO_SAMPLES 5
@@ -50,7 +51,9 @@ typedef float4 real4;
     const int refine_only, \
     __global const uchar* refine, \
     __global const float* brute_depths, \
-    __global const uint* brute_steps
+    __global const uint* brute_steps, \
+    __global float4* linear, \
+    __global float* layers
 #define CONE_STARTS_ARGS \
     __global const real* params, \
     __global const real* camera, \
@@ -85,6 +88,13 @@ typedef float4 real4;
 #define LIGHT_RADIANCE 4
 #define LIGHT_SOFTNESS 7
 #define LIGHT_STRIDE 8
+#define LAYER_POSITION 0
+#define LAYER_ALBEDO 3
+#define LAYER_OCCLUSION 6
+#define LAYER_SHADOW 7
+#define LAYER_TRAP 8
+#define LAYER_STRIDE 9
+#define WRITE_LAYERS 2
 
 /* ---- sphere ---- */
 real sd_sphere(real3 p, real r) {
@@ -303,6 +313,11 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     *color = uc11;
     *trap = ut11;
     return u11;
+}
+
+/* ---- display ---- */
+real3 display_color(real3 c, real scale, real inverse_gamma) {
+    return (real3)(pow(fmin(fmax(c.x * scale, R(0.0)), R(1.0)), inverse_gamma), pow(fmin(fmax(c.y * scale, R(0.0)), R(1.0)), inverse_gamma), pow(fmin(fmax(c.z * scale, R(0.0)), R(1.0)), inverse_gamma));
 }
 
 /* ---- kernel: march.cl, shade.cl, optics.cl, render.cl ---- */

@@ -18,6 +18,7 @@ typedef double4 real4;
 #define OVER_RELAXATION 1.0
 #define SUPERSAMPLING 1
 #define GAMMA 2.2
+#define EXPOSURE_SCALE 1.0
 #define SKY_TOP (real3)(0.32, 0.42, 0.58)
 #define SKY_BOTTOM (real3)(0.06, 0.07, 0.09)
 #define AO_SAMPLES 8
@@ -50,7 +51,9 @@ typedef double4 real4;
     const int refine_only, \
     __global const uchar* refine, \
     __global const float* brute_depths, \
-    __global const uint* brute_steps
+    __global const uint* brute_steps, \
+    __global float4* linear, \
+    __global float* layers
 #define CONE_STARTS_ARGS \
     __global const real* params, \
     __global const real* camera, \
@@ -85,6 +88,13 @@ typedef double4 real4;
 #define LIGHT_RADIANCE 4
 #define LIGHT_SOFTNESS 7
 #define LIGHT_STRIDE 8
+#define LAYER_POSITION 0
+#define LAYER_ALBEDO 3
+#define LAYER_OCCLUSION 6
+#define LAYER_SHADOW 7
+#define LAYER_TRAP 8
+#define LAYER_STRIDE 9
+#define WRITE_LAYERS 2
 
 /* ---- mandelbulb_p8 ---- */
 real2 mandelbulb_p8(real3 p, real iterations, real escape, real ball) {
@@ -159,4 +169,9 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
 #define SCENE_BOUND_CENTRE (real3)(0.0, 0.0, 0.0)
 #define SCENE_BOUND_RADIUS 1.1040895136738123
 #define SCENE_BOUND_SLOPE 1.0
+/* ---- display ---- */
+real3 display_color(real3 c, real scale, real inverse_gamma) {
+    return (real3)(pow(fmin(fmax(c.x * scale, R(0.0)), R(1.0)), inverse_gamma), pow(fmin(fmax(c.y * scale, R(0.0)), R(1.0)), inverse_gamma), pow(fmin(fmax(c.z * scale, R(0.0)), R(1.0)), inverse_gamma));
+}
+
 /* ---- kernel: march.cl, shade.cl, optics.cl, render.cl ---- */

@@ -14,9 +14,12 @@ use fractal_sdf::animation::CameraPath;
 use fractal_sdf::codegen::{self, Options};
 use fractal_sdf::file::SceneFile;
 use fractal_sdf::gallery;
-use fractal_sdf::output::{image_extension, save_image, verify_png};
+use fractal_sdf::output::{
+    Aov, Bits, CameraExport, FrameOutput, image_extension, save_frame, save_image, verify_png,
+};
 use fractal_sdf::prelude::*;
 use fractal_sdf::quality::Preset;
+use fractal_sdf::quality::ToneMap;
 use fractal_sdf::render::{
     DeviceKind, DeviceSelector, EdgeThresholds, RenderOptions, Renderer, devices,
 };
@@ -142,10 +145,36 @@ fn parse_seconds(text: &str) -> std::result::Result<Duration, String> {
 struct RenderArgs {
     #[command(flatten)]
     scene: SceneArgs,
-    /// The image to write: `.png`, or `.jpg`/`.jpeg` (the extension
-    /// chooses the format; any other is refused before rendering).
+    /// The image to write: `.png`, `.jpg`/`.jpeg`, `.tif`/`.tiff`, or
+    /// `.exr` for OpenEXR with the linear colour and a layer per --aov
+    /// (the extension chooses the format; any other is refused before
+    /// rendering).
     #[arg(short, long, value_name = "FILE")]
     output: PathBuf,
+    /// Outputs to write besides the colour, comma-separated: depth,
+    /// normal, position, albedo, ao, shadow, trap, evaluations. Layers of
+    /// an `.exr` file; otherwise a 16-bit PNG each beside the image
+    /// (`out.png` gets `out.depth.png`, ...).
+    #[arg(long, value_name = "LIST", value_delimiter = ',', conflicts_with_all = ["stereo", "adaptive"])]
+    aov: Vec<String>,
+    /// Bits per channel of a `.png` or `.tif` image: 8, or 16 (the linear
+    /// colour through the tone curve on the host, without 8-bit rounding).
+    #[arg(long, value_name = "N", default_value = "8", value_parser = ["8", "16"],
+          conflicts_with_all = ["stereo", "adaptive"])]
+    bits: String,
+    /// Exposure in stops: linear colours are scaled by 2^STOPS before the
+    /// tone curve (default: the scene file's, else 0).
+    #[arg(long, value_name = "STOPS", allow_hyphen_values = true)]
+    exposure: Option<f64>,
+    /// The tone curve that maps exposed colours into the image: clip,
+    /// reinhard or filmic (default: the scene file's, else clip).
+    #[arg(long, value_name = "CURVE")]
+    tonemap: Option<String>,
+    /// Also writes the camera as JSON (position, orientation, field of
+    /// view, sensor and aspect; see the guide's chapter on outputs for
+    /// lining it up in a 3D package).
+    #[arg(long, value_name = "FILE")]
+    camera_json: Option<PathBuf>,
     /// Progressive passes: the image is the mean of N passes of the
     /// preset's samples, each at new points in the pixel and on the lens
     /// (default 1; a camera with a lens needs about 16 for a smooth blur,
@@ -239,6 +268,11 @@ struct SequenceArgs {
     /// The video to encode with ffmpeg (default: DIR.mp4).
     #[arg(long, value_name = "FILE")]
     video: Option<PathBuf>,
+    /// Also writes every frame's camera, the whole sequence's, as one
+    /// JSON array (each entry as `render --camera-json` writes one, with
+    /// its frame and time).
+    #[arg(long, value_name = "FILE")]
+    camera_json: Option<PathBuf>,
 }
 
 #[derive(Args)]
@@ -440,6 +474,12 @@ fn spinner(message: String) -> ProgressBar {
 fn render(args: &RenderArgs, settings: &Settings) -> Outcome {
     image_extension(&args.output).map_err(|e| usage(e.to_string()))?;
     let stereo = args.stereo()?;
+    let aovs = args
+        .aov
+        .iter()
+        .filter(|name| !name.trim().is_empty())
+        .map(|name| Aov::from_name(name).map_err(|e| usage(format!("--aov: {e}"))))
+        .collect::<Outcome<Vec<Aov>>>()?;
     let mut job = Job::new(&args.scene, settings)?;
     let camera = &mut job.file.scene.camera;
     if let Some(aperture) = args.aperture {
@@ -453,6 +493,46 @@ fn render(args: &RenderArgs, settings: &Settings) -> Outcome {
     }
     if let Some(step) = args.brute_step {
         job.options.quality.brute_step = step;
+    }
+    if let Some(stops) = args.exposure {
+        job.options.effects.exposure = stops;
+    }
+    if let Some(name) = &args.tonemap {
+        job.options.effects.tone_map = ToneMap::from_name(name).ok_or_else(|| {
+            let names: Vec<&str> = ToneMap::ALL.iter().map(|t| t.name()).collect();
+            usage(format!(
+                "--tonemap `{name}`: expected one of {}",
+                names.join(", ")
+            ))
+        })?;
+    }
+    let bits = if args.bits == "16" {
+        Bits::Sixteen
+    } else {
+        Bits::Eight
+    };
+    let output = FrameOutput::new(job.options.effects).aovs(aovs).bits(bits);
+    output
+        .check(&args.output)
+        .map_err(|e| usage(e.to_string()))?;
+    let layered = output.needs_layers(&args.output)?;
+    if layered && stereo.is_some() {
+        return Err(usage(format!(
+            "--stereo writes an 8-bit composite, which {} cannot hold: write a .png, .jpg or .tif",
+            args.output.display()
+        )));
+    }
+    if args.camera_json.is_some() && stereo.is_some() {
+        return Err(usage(
+            "--camera-json writes one camera, and --stereo renders two eyes: export each \
+             eye's view with its own render",
+        ));
+    }
+    if layered && args.adaptive.is_some() {
+        return Err(usage(format!(
+            "--adaptive refines the 8-bit image alone, which {} cannot hold: use --passes",
+            args.output.display()
+        )));
     }
     let passes = args.passes.unwrap_or(1);
     let plain = stereo.is_none() && args.adaptive.is_none();
@@ -468,34 +548,60 @@ fn render(args: &RenderArgs, settings: &Settings) -> Outcome {
     let bar = spinner(format!("rendering {width}x{height}"));
     let mut renderer = job.renderer()?;
     let mut refined = None;
-    let image = match (stereo, args.adaptive) {
-        (Some(stereo), _) => renderer.render_stereo(width, height, &stereo),
-        (None, Some(passes)) => renderer
-            .render_adaptive(width, height, passes, &EdgeThresholds::default())
-            .map(|frame| {
-                refined = Some(format!(
-                    "{:.1}% of the pixels refined by {passes} passes",
-                    100.0 * frame.refined_fraction()
-                ));
-                frame.image
-            }),
-        (None, None) if passes > 1 => progressive(&mut renderer, width, height, passes),
-        (None, None) => renderer.render(width, height),
+    let dimensions;
+    let written = if layered || output.needs_aovs() {
+        let mut frame = renderer.render_progressive_layers(width, height);
+        for _ in 1..passes {
+            frame = renderer.render_progressive_layers(width, height);
+        }
+        bar.finish_and_clear();
+        let frame = frame?;
+        dimensions = (frame.width(), frame.height());
+        save_frame(&frame, &args.output, &output)?
+    } else {
+        let image = match (stereo, args.adaptive) {
+            (Some(stereo), _) => renderer.render_stereo(width, height, &stereo),
+            (None, Some(passes)) => renderer
+                .render_adaptive(width, height, passes, &EdgeThresholds::default())
+                .map(|frame| {
+                    refined = Some(format!(
+                        "{:.1}% of the pixels refined by {passes} passes",
+                        100.0 * frame.refined_fraction()
+                    ));
+                    frame.image
+                }),
+            (None, None) if passes > 1 => progressive(&mut renderer, width, height, passes),
+            (None, None) => renderer.render(width, height),
+        };
+        bar.finish_and_clear();
+        let image = image?;
+        dimensions = image.dimensions();
+        save_image(&image, &args.output)?;
+        vec![args.output.clone()]
     };
-    bar.finish_and_clear();
-    let image = image?;
-    save_image(&image, &args.output)?;
+    if let Some(path) = &args.camera_json {
+        CameraExport::new(renderer.camera(), job.size)?.save(path)?;
+    }
     if let Some(refined) = refined {
         println!("{refined}");
     }
-    let (width, height) = image.dimensions();
     let passes = if passes > 1 && plain {
         format!(", {passes} passes")
     } else {
         String::new()
     };
+    let (width, height) = dimensions;
+    let others: Vec<String> = written[1..]
+        .iter()
+        .map(|p| p.display().to_string())
+        .collect();
+    let others = if others.is_empty() {
+        String::new()
+    } else {
+        format!(" (and {})", others.join(", "))
+    };
     println!(
-        "{}: {width}x{height}, {} quality{passes}, {:.2} s on {}",
+        "{}: {width}x{height}, {} quality{passes}, {:.2} s on {}{others}",
         args.output.display(),
         job.preset_name(),
         start.elapsed().as_secs_f64(),
@@ -604,6 +710,10 @@ fn sequence(args: &SequenceArgs, settings: &Settings) -> Outcome {
     };
     let shard = args.shard.as_deref().map(parse_shard).transpose()?;
     let mine = |i: &u32| shard.is_none_or(|(k, n)| i % n == k);
+    if let Some(file) = &args.camera_json {
+        let cameras = seq.camera_exports(&path, &job.file.scene.camera, job.size)?;
+        CameraExport::save_all(&cameras, file)?;
+    }
 
     if args.verify {
         let bad: Vec<String> = range

@@ -124,36 +124,61 @@ impl Renderer {
     /// As [`Renderer::render`]; after a failed pass the next call starts
     /// again from the first.
     pub fn render_progressive(&mut self, width: u32, height: u32) -> Result<RgbaImage> {
+        self.progressive(
+            width,
+            height,
+            Outputs::Image,
+            |r| r.render(width, height),
+            |image| Converged::Image(image.clone()),
+            |kept| match kept {
+                Converged::Image(image) => Some(image.clone()),
+                Converged::Frame(_) => None,
+            },
+        )
+    }
+
+    /// A progressive pass that renders with `render`, launching `outputs`.
+    /// Passes continue only those that wrote the same outputs (the image
+    /// passes run on every device, the others on this renderer's own).
+    /// Once the passes are all done, `keep` holds the result and `reuse`
+    /// gives it again.
+    fn progressive<T>(
+        &mut self,
+        width: u32,
+        height: u32,
+        outputs: Outputs,
+        render: impl FnOnce(&mut Self) -> Result<T>,
+        keep: impl FnOnce(&T) -> Converged,
+        reuse: impl FnOnce(&Converged) -> Option<T>,
+    ) -> Result<T> {
         let last = self.most_passes();
+        let (lw, lh) = self.rendered_size(width, height);
+        // Sums lost with buffers made anew (for another size, or more
+        // outputs) start again.
+        let kept = self.targets.fits(lw, lh, outputs, true);
         let done = match &self.progress {
-            Some(p) if (p.width, p.height) == (width, height) => {
-                if let Some(image) = &p.converged {
-                    return Ok(image.clone());
+            Some(p) if (p.width, p.height, p.outputs) == (width, height, outputs) && kept => {
+                if let Some(result) = p.converged.as_ref().and_then(reuse) {
+                    return Ok(result);
                 }
                 p.passes
             }
             _ => 0,
         };
-        // Sums lost with buffers made anew (for another size) start again.
-        let (lw, lh) = self.rendered_size(width, height);
-        let done = if self.targets.fits(lw, lh, false, true) {
-            done
-        } else {
-            0
-        };
         self.progress = None;
         self.set_pass(i32::try_from(done).expect("passes are at most 4096"));
-        let image = self.render(width, height);
+        let result = render(self);
         self.set_pass(-1);
-        let image = image?;
+        let result = result?;
         let passes = done + 1;
         self.progress = Some(Progress {
             width,
             height,
             passes,
-            converged: (passes == last).then(|| image.clone()),
+            outputs,
+            converged: (passes == last).then(|| keep(&result)),
         });
-        Ok(image)
+        Ok(result)
     }
 
     /// The progressive passes in the last image of
@@ -284,7 +309,12 @@ impl Renderer {
     pub(super) fn render_low(&mut self, width: u32, height: u32) -> Result<Rendered> {
         let start = Instant::now();
         let scaled = self.scale() > 1;
-        let kernel = self.run(width, height, scaled)?;
+        let outputs = if scaled {
+            Outputs::Aovs
+        } else {
+            Outputs::Image
+        };
+        let kernel = self.run(width, height, outputs)?;
         let read = Instant::now();
         let (lw, lh) = self.rendered_size(width, height);
         let mut rgba = host_vec::<u8>(lw, lh, 4)?;
@@ -316,9 +346,75 @@ impl Renderer {
     /// # Errors
     /// As [`Renderer::render`].
     pub fn render_with_aovs(&mut self, width: u32, height: u32) -> Result<Frame> {
+        self.render_outputs(width, height, Outputs::Aovs)
+    }
+
+    /// Renders a `width` × `height` image with every output: those of
+    /// [`Renderer::render_with_aovs`] and the shading [`Layers`] (the
+    /// exposed linear colour and coverage, world position, albedo,
+    /// occlusion, shadow and orbit-trap value), for writing an OpenEXR
+    /// file or compositing.
+    ///
+    /// ```no_run
+    /// use fractal_sdf::prelude::*;
+    /// use fractal_sdf::render::Renderer;
+    ///
+    /// let scene = Scene::new(sphere(1.0));
+    /// let mut renderer = Renderer::new(&scene, Quality::preview())?;
+    /// let frame = renderer.render_layers(64, 48)?;
+    /// let layers = frame.layers.as_ref().expect("rendered with layers");
+    /// let centre = frame.index(32, 24);
+    /// assert!(frame.hit[centre] && layers.linear[centre][3] == 1.0);
+    /// # Ok::<(), fractal_sdf::Error>(())
+    /// ```
+    ///
+    /// With [`Quality::resolution_scale`] above 1, the colour is blended
+    /// up as the image is, and the other layers come from the nearest
+    /// rendered pixel, as the depth does. A renderer with partner devices
+    /// renders layers on its own device alone.
+    ///
+    /// # Errors
+    /// As [`Renderer::render`].
+    pub fn render_layers(&mut self, width: u32, height: u32) -> Result<Frame> {
+        self.render_outputs(width, height, Outputs::Layers)
+    }
+
+    /// One more progressive pass, as [`Renderer::render_progressive`]
+    /// renders, with every output of [`Renderer::render_layers`]: the
+    /// linear colour and coverage are the mean of every pass so far; the
+    /// other outputs are the first pass's. Like `render_layers`, it runs on
+    /// this renderer's own device, not its partners'; its passes and
+    /// `render_progressive`'s do not continue each other.
+    ///
+    /// # Errors
+    /// As [`Renderer::render_progressive`].
+    pub fn render_progressive_layers(&mut self, width: u32, height: u32) -> Result<Frame> {
+        self.progressive(
+            width,
+            height,
+            Outputs::Layers,
+            |r| r.render_layers(width, height),
+            |frame| Converged::Frame(Box::new(frame.clone())),
+            |kept| match kept {
+                Converged::Frame(frame) => Some((**frame).clone()),
+                Converged::Image(_) => None,
+            },
+        )
+    }
+
+    /// Launches the frame and reads `outputs` back.
+    fn render_outputs(&mut self, width: u32, height: u32, outputs: Outputs) -> Result<Frame> {
         let start = Instant::now();
-        let kernel = self.run(width, height, true)?;
+        let kernel = self.run(width, height, outputs)?;
         let read = Instant::now();
+        let frame = self.read_frame(width, height, outputs)?;
+        self.record_timing(start, read, kernel);
+        Ok(frame)
+    }
+
+    /// Reads the last launch's `outputs` (at least the AOVs) back, scaled
+    /// up to `width` × `height`.
+    fn read_frame(&mut self, width: u32, height: u32, outputs: Outputs) -> Result<Frame> {
         let (image_w, image_h, scale) = (width, height, self.scale());
         let (width, height) = self.rendered_size(width, height);
         let t = &self.targets;
@@ -334,6 +430,15 @@ impl Renderer {
         t.normals.read(&mut normals).enq().map_err(opencl)?;
         t.steps.read(&mut steps).enq().map_err(opencl)?;
         t.evaluations.read(&mut evaluations).enq().map_err(opencl)?;
+        let layers = if outputs >= Outputs::Layers {
+            let mut linear = host_vec::<f32>(width, height, 4)?;
+            let mut flat = host_vec::<f32>(width, height, layer::STRIDE)?;
+            t.linear.read(&mut linear).enq().map_err(opencl)?;
+            t.layers.read(&mut flat).enq().map_err(opencl)?;
+            Some(layers_of(&linear, &flat, &hit, self.source.origin))
+        } else {
+            None
+        };
         let starts = self.starts(width, height)?;
         let frame = Frame {
             start: starts,
@@ -347,14 +452,13 @@ impl Renderer {
                 .collect(),
             steps,
             evaluations,
+            layers,
         };
-        let frame = if scale > 1 {
+        Ok(if scale > 1 {
             upscale::frame(&frame, image_w, image_h, scale)
         } else {
             frame
-        };
-        self.record_timing(start, read, kernel);
-        Ok(frame)
+        })
     }
 
     pub(super) fn record_timing(
@@ -477,7 +581,12 @@ impl Renderer {
 
     /// Uploads the frame's inputs, launches every tile and waits for them.
     /// Returns the kernel time and whether it comes from profiling events.
-    pub(super) fn run(&mut self, width: u32, height: u32, aovs: bool) -> Result<(Duration, bool)> {
+    pub(super) fn run(
+        &mut self,
+        width: u32,
+        height: u32,
+        outputs: Outputs,
+    ) -> Result<(Duration, bool)> {
         if self.abandoned {
             return Err(Error::OpenCl(
                 "an earlier frame's launch was abandoned at its deadline and may still be \
@@ -494,19 +603,19 @@ impl Renderer {
         let (width, height) = self.rendered_size(width, height);
         let info = &self.selected.info;
         let progressive = self.pass >= 0;
-        if self.targets.fits(width, height, aovs, progressive) {
-            let host = frame_host_bytes(info, width, height, aovs, None);
+        if self.targets.fits(width, height, outputs, progressive) {
+            let host = frame_host_bytes(info, width, height, outputs, None);
             check_host_memory(width, height, host, available_host_memory())?;
         } else {
             // Free the old buffers first so their memory can be reused.
-            self.targets = Targets::new(&self.queue, 1, 1, false, false)?;
-            check_device_memory(info, width, height, aovs, progressive)?;
-            let device = Targets::bytes(width, height, aovs, progressive)
+            self.targets = Targets::new(&self.queue, 1, 1, Outputs::Image, false)?;
+            check_device_memory(info, width, height, outputs, progressive)?;
+            let device = Targets::bytes(width, height, outputs, progressive)
                 .iter()
                 .sum();
-            let host = frame_host_bytes(info, width, height, aovs, Some(device));
+            let host = frame_host_bytes(info, width, height, outputs, Some(device));
             check_host_memory(width, height, host, available_host_memory())?;
-            self.targets = Targets::new(&self.queue, width, height, aovs, progressive)
+            self.targets = Targets::new(&self.queue, width, height, outputs, progressive)
                 .map_err(|e| too_large(width, height, &format!("{e}")))?;
         }
         check_frame_inputs(
@@ -531,7 +640,7 @@ impl Renderer {
             set(RenderArg::Width, width as i32)?;
             set(RenderArg::Height, height as i32)?;
         }
-        set(RenderArg::WriteAovs, i32::from(aovs))?;
+        set(RenderArg::WriteAovs, outputs.write_aovs())?;
         set(RenderArg::Pass, self.pass)?;
         set(RenderArg::RefineOnly, i32::from(self.refine_only))?;
         t.bind(k)?;
@@ -612,5 +721,34 @@ impl Renderer {
             Some(kernel) => (kernel, true),
             None => (launched.elapsed(), false),
         })
+    }
+}
+
+/// The shading layers from the kernel's flat `linear` (four floats a
+/// pixel) and `layers` ([`layer::STRIDE`] a pixel) outputs; the positions
+/// of hits move from the program's frame (about `origin`) to the scene's.
+fn layers_of(linear: &[f32], flat: &[f32], hit: &[u8], origin: DVec3) -> Layers {
+    let field = |f: Field| {
+        flat.chunks_exact(layer::STRIDE)
+            .map(move |px| &px[f.offset..f.offset + f.len])
+    };
+    #[allow(clippy::cast_possible_truncation)] // positions are within the kernel's limits
+    let moved = |p: &[f32]| {
+        let world = origin + DVec3::new(f64::from(p[0]), f64::from(p[1]), f64::from(p[2]));
+        [world.x as f32, world.y as f32, world.z as f32]
+    };
+    Layers {
+        linear: linear
+            .chunks_exact(4)
+            .map(|c| [c[0], c[1], c[2], c[3]])
+            .collect(),
+        position: field(layer::POSITION)
+            .zip(hit)
+            .map(|(p, &h)| if h == 0 { [0.0; 3] } else { moved(p) })
+            .collect(),
+        albedo: field(layer::ALBEDO).map(|c| [c[0], c[1], c[2]]).collect(),
+        occlusion: field(layer::OCCLUSION).map(|c| c[0]).collect(),
+        shadow: field(layer::SHADOW).map(|c| c[0]).collect(),
+        trap: field(layer::TRAP).map(|c| c[0]).collect(),
     }
 }

@@ -34,10 +34,10 @@ pub(super) fn check_device_memory(
     info: &DeviceInfo,
     width: u32,
     height: u32,
-    aovs: bool,
+    outputs: Outputs,
     progressive: bool,
 ) -> Result<()> {
-    let wanted = Targets::bytes(width, height, aovs, progressive);
+    let wanted = Targets::bytes(width, height, outputs, progressive);
     let largest = wanted.iter().copied().max().unwrap_or(0);
     let total: u64 = wanted.iter().sum();
     let mib = |b: u64| b.div_ceil(1 << 20);
@@ -357,6 +357,12 @@ pub(super) fn make_kernel(
             RenderArg::Refine => {
                 b.arg(&t.refine);
             }
+            RenderArg::Linear => {
+                b.arg(&t.linear);
+            }
+            RenderArg::Layers => {
+                b.arg(&t.layers);
+            }
             // Stand-ins of the right types until a brute-force pass binds
             // its own (only its programs read them).
             RenderArg::BruteDepths => {
@@ -460,7 +466,7 @@ impl Inputs {
 pub(super) struct Targets {
     pub(super) width: u32,
     pub(super) height: u32,
-    pub(super) aovs: bool,
+    pub(super) outputs: Outputs,
     pub(super) progressive: bool,
     pub(super) rgba: Buffer<u8>,
     pub(super) depth: Buffer<f32>,
@@ -476,6 +482,10 @@ pub(super) struct Targets {
     pub(super) accumulation: Buffer<f32>,
     /// The pixels adaptive supersampling refines, a byte per pixel.
     pub(super) refine: Buffer<u8>,
+    /// The exposed linear colour and coverage, four per pixel with layers.
+    pub(super) linear: Buffer<f32>,
+    /// The shading layers, [`layer::STRIDE`] per pixel with layers.
+    pub(super) layers: Buffer<f32>,
 }
 
 impl Targets {
@@ -483,17 +493,24 @@ impl Targets {
         queue: &Queue,
         width: u32,
         height: u32,
-        aovs: bool,
+        outputs: Outputs,
         progressive: bool,
     ) -> Result<Self> {
         let pixels = width as usize * height as usize;
-        let aov_pixels = if aovs { pixels } else { 1 };
+        let aov_pixels = if outputs >= Outputs::Aovs { pixels } else { 1 };
+        let layer_pixels = if outputs >= Outputs::Layers {
+            pixels
+        } else {
+            1
+        };
         let summed_pixels = if progressive { pixels } else { 1 };
         Ok(Targets {
             width,
             height,
-            aovs,
+            outputs,
             progressive,
+            linear: output(queue, layer_pixels * 4)?,
+            layers: output(queue, layer_pixels * layer::STRIDE)?,
             rgba: output(queue, pixels * 4)?,
             depth: output(queue, aov_pixels)?,
             hit: output(queue, aov_pixels)?,
@@ -522,9 +539,14 @@ impl Targets {
     }
 
     /// Bytes of each output buffer for an image.
-    pub(super) fn bytes(width: u32, height: u32, aovs: bool, progressive: bool) -> Vec<u64> {
+    pub(super) fn bytes(width: u32, height: u32, outputs: Outputs, progressive: bool) -> Vec<u64> {
         let pixels = u64::from(width) * u64::from(height);
-        let aov = if aovs { pixels } else { 1 };
+        let aov = if outputs >= Outputs::Aovs { pixels } else { 1 };
+        let layered = if outputs >= Outputs::Layers {
+            pixels
+        } else {
+            1
+        };
         let summed = if progressive { pixels } else { 1 };
         let starts = cone_tiles(width, height, MIN_CONE_TILE) as u64 * 4;
         vec![
@@ -537,6 +559,8 @@ impl Targets {
             starts,
             summed * 16,
             summed,
+            layered * 16,
+            layered * layer::STRIDE as u64 * 4,
         ]
     }
 
@@ -560,6 +584,10 @@ impl Targets {
             .map_err(opencl)?;
         k.set_arg(RenderArg::Refine.index(), &self.refine)
             .map_err(opencl)?;
+        k.set_arg(RenderArg::Linear.index(), &self.linear)
+            .map_err(opencl)?;
+        k.set_arg(RenderArg::Layers.index(), &self.layers)
+            .map_err(opencl)?;
         // Stand-ins until a brute-force pass binds its own.
         k.set_arg(RenderArg::BruteDepths.index(), &self.starts)
             .map_err(opencl)?;
@@ -567,10 +595,16 @@ impl Targets {
             .map_err(opencl)
     }
 
-    pub(super) fn fits(&self, width: u32, height: u32, aovs: bool, progressive: bool) -> bool {
+    pub(super) fn fits(
+        &self,
+        width: u32,
+        height: u32,
+        outputs: Outputs,
+        progressive: bool,
+    ) -> bool {
         self.width == width
             && self.height == height
-            && (self.aovs || !aovs)
+            && self.outputs >= outputs
             && (self.progressive || !progressive)
     }
 }

@@ -9,7 +9,7 @@ use ocl::enums::ProfilingInfo;
 use ocl::{Buffer, Context, Event, Kernel, MemFlags, Program, Queue};
 
 use super::adaptive::{self, AdaptiveFrame, EdgeThresholds};
-use super::aov::Frame;
+use super::aov::{Frame, Layers, Outputs};
 use super::buffer::RealBuffer;
 use super::cancel::CancelToken;
 use super::device::{self, DeviceInfo, DeviceSelector, Selected, opencl};
@@ -19,7 +19,7 @@ use super::program::{self, BuildInfo};
 use super::upscale;
 use super::viewport::{Viewport, check_frame_inputs, pack_lights};
 use crate::codegen::interface::{
-    BRUTE_DEPTHS, BruteArg, CONE_STARTS, ConeArg, RENDER_TILE, RenderArg, camera,
+    BRUTE_DEPTHS, BruteArg, CONE_STARTS, ConeArg, Field, RENDER_TILE, RenderArg, camera, layer,
 };
 use crate::codegen::{self, KernelSource};
 use crate::error::{Error, Result};
@@ -188,8 +188,18 @@ struct Progress {
     width: u32,
     height: u32,
     passes: u32,
-    /// The image once the passes reach the most samples per pixel.
-    converged: Option<RgbaImage>,
+    /// What the passes wrote: the image (on every device), or every
+    /// output (on this renderer's own).
+    outputs: Outputs,
+    /// The result once the passes reach the most samples per pixel.
+    converged: Option<Converged>,
+}
+
+/// A converged progressive result, returned again by later calls.
+#[derive(Debug, Clone)]
+enum Converged {
+    Image(RgbaImage),
+    Frame(Box<Frame>),
 }
 
 /// Where a renderer's `DE` and `DE_shade` come from.
@@ -293,7 +303,7 @@ impl Renderer {
         let context = program::context(&selected)?;
         let queue = profiling_queue(&context, &selected)?;
         let inputs = Inputs::new(&queue, &source, &values, scene.lights())?;
-        let targets = Targets::new(&queue, 1, 1, true, false)?;
+        let targets = Targets::new(&queue, 1, 1, Outputs::Aovs, false)?;
         let (program, build, compiled) = program::build(&selected, &context, &source)?;
         let kernel = make_kernel(&program, &queue, &inputs, &targets)?;
         let cone = make_cone(&program, &queue, &inputs, &targets, &source)?;
@@ -606,9 +616,9 @@ mod tests {
         device.max_allocation = 64 << 20;
         device.global_memory = 128 << 20;
         // 4K colour: 32 MiB in one buffer.
-        check_device_memory(&device, 3840, 2160, false, false).unwrap();
+        check_device_memory(&device, 3840, 2160, Outputs::Image, false).unwrap();
         // 8K colour: 127 MiB in one buffer.
-        let err = check_device_memory(&device, 7680, 4320, false, false).unwrap_err();
+        let err = check_device_memory(&device, 7680, 4320, Outputs::Image, false).unwrap_err();
         let text = err.to_string();
         assert!(
             matches!(err, Error::Resolution { width: 7680, .. }),
@@ -619,10 +629,10 @@ mod tests {
             "{text}"
         );
         // 4K with AOVs: 95 MiB of normals.
-        let err = check_device_memory(&device, 3840, 2160, true, false).unwrap_err();
+        let err = check_device_memory(&device, 3840, 2160, Outputs::Aovs, false).unwrap_err();
         assert!(err.to_string().contains("95 MiB"), "{err}");
         device.max_allocation = 1 << 30;
-        let err = check_device_memory(&device, 3840, 2160, true, false).unwrap_err();
+        let err = check_device_memory(&device, 3840, 2160, Outputs::Aovs, false).unwrap_err();
         assert!(
             err.to_string()
                 .contains("238 MiB but `Small / gpu` has 128 MiB"),

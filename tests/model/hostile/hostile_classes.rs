@@ -185,6 +185,7 @@ fn output_names(row: &mut Row) {
     let image = fractal_sdf::image::RgbaImage::new(3, 2);
     let png: &[u8] = b"\x89PNG";
     let jpeg: &[u8] = &[0xff, 0xd8, 0xff];
+    let tiff: &[u8] = b"II*\0";
     for (name, magic) in [
         ("a.png", Some(png)),
         ("a.PNG", Some(png)),
@@ -194,8 +195,8 @@ fn output_names(row: &mut Row) {
         ("a", Some(png)),
         ("a.tar.png", Some(png)),
         ("a.xyz", None),
-        ("a.exr", None),
-        ("a.tif", None),
+        ("a.tif", Some(tiff)),
+        ("a.TIFF", Some(tiff)),
         ("a.gif", None),
         ("a.png.bak", None),
         ("a.", None),
@@ -210,7 +211,7 @@ fn output_names(row: &mut Row) {
         row.case(&format!("output `{name}`"), || {
             let path = dir.join(name);
             match (fractal_sdf::output::save_image(&image, &path), magic) {
-                (Err(e), None) => refused(&e, ".png, .jpg, .jpeg"),
+                (Err(e), None) => refused(&e, ".png, .jpg, .jpeg, .tif, .tiff, .exr"),
                 (Ok(()), Some(magic)) => {
                     let bytes = std::fs::read(&path).map_err(|e| e.to_string())?;
                     if bytes.starts_with(magic) {
@@ -224,6 +225,16 @@ fn output_names(row: &mut Row) {
             }
         });
     }
+    // An OpenEXR file holds linear colour, which an 8-bit image has not:
+    // refused by name, towards the call that writes one.
+    row.case("output `a.exr`", || {
+        let path = dir.join("a.exr");
+        match fractal_sdf::output::save_image(&image, &path) {
+            Err(e) if path.exists() => Err(format!("refused ({e}) but written")),
+            Err(e) => refused(&e, "save_frame"),
+            Ok(()) => Err("an 8-bit image written as OpenEXR".into()),
+        }
+    });
     let _ = std::fs::remove_dir_all(dir);
 }
 

@@ -7,7 +7,10 @@
 //   types   real, real2, real3, real4 and the literal macro R(x)
 //   consts  REAL_TINY MAX_STEPS MAX_DISTANCE DETAIL HIT_EPSILON
 //           NORMAL_EPSILON OVER_RELAXATION SUPERSAMPLING GAMMA SKY_TOP
-//           SKY_BOTTOM
+//           SKY_BOTTOM EXPOSURE_SCALE
+//   display real3 display_color(real3 c, real scale, real inverse_gamma),
+//           the display transform (exposure, tone curve, gamma) printed
+//           from quality::display_formula
 //   scene   real DE(real3 p, __global const real* params)
 //           real DE_shade(real3 p, __global const real* params,
 //                         real3* color, real* trap)
@@ -28,9 +31,11 @@
 // Everything else arrives at run time, so moving the camera or the lights
 // and changing dynamic parameters never rebuilds the program. The header
 // defines the kernel's argument list (RENDER_TILE_ARGS) and the layouts of
-// the camera buffer (CAMERA_<field>: the offset of each field) and of the
-// light buffer (LIGHT_<field>, LIGHT_STRIDE reals per light), from the
-// tables the host packs them with (src/codegen/interface.rs).
+// the camera buffer (CAMERA_<field>: the offset of each field), of the
+// light buffer (LIGHT_<field>, LIGHT_STRIDE reals per light) and of the
+// shading layers (LAYER_<field>, LAYER_STRIDE floats per pixel, written
+// when write_aovs is WRITE_LAYERS), from the tables the host packs and
+// reads them with (src/codegen/interface.rs).
 //
 // Positions (the camera's origin, point lights) are relative to the
 // program's origin, the scene's outermost translation, which the host
@@ -462,6 +467,25 @@ real march_occlusion(real3 p, real3 n, real view_height, real offset,
     return occlusion;
 }
 
+// The light l (LIGHT_STRIDE reals of the light buffer) as seen from p:
+// the unit direction towards it, how far it is (MAX_DISTANCE for a
+// directional light) and the radiance that arrives (a point light's falls
+// off with the squared distance).
+real3 march_light(__global const real* l, real3 p, real3* to_light, real* light_distance) {
+    real3 v = vload3(0, l + LIGHT_POSITION);
+    real3 radiance = vload3(0, l + LIGHT_RADIANCE);
+    *to_light = v;
+    *light_distance = MAX_DISTANCE;
+    if (l[LIGHT_KIND] > R(0.5)) {
+        real3 delta = v - p;
+        real dist2 = fmax(dot(delta, delta), REAL_TINY);
+        *light_distance = sqrt(dist2);
+        *to_light = delta / *light_distance;
+        radiance /= dist2;
+    }
+    return radiance;
+}
+
 // Lit colour of the surface point p with normal n, seen along rd, with the
 // sky's light scaled by occlusion (1: open). Adds its distance evaluations
 // (DE_shade, DE_material, shadow rays, thickness) to *evals.
@@ -492,17 +516,9 @@ real3 march_shade(real3 p, real3 n, real3 rd, real eps, real occlusion,
     real3 lifted = p + n * eps;
     for (int i = 0; i < light_count; ++i) {
         __global const real* l = lights + LIGHT_STRIDE * i;
-        real3 v = vload3(0, l + LIGHT_POSITION);
-        real3 radiance = vload3(0, l + LIGHT_RADIANCE);
-        real3 to_light = v;
-        real light_distance = MAX_DISTANCE;
-        if (l[LIGHT_KIND] > R(0.5)) {
-            real3 delta = v - p;
-            real dist2 = fmax(dot(delta, delta), REAL_TINY);
-            light_distance = sqrt(dist2);
-            to_light = delta / light_distance;
-            radiance /= dist2;
-        }
+        real3 to_light;
+        real light_distance;
+        real3 radiance = march_light(l, p, &to_light, &light_distance);
         real ndl = dot(n, to_light);
         if (ndl <= R(0.0)) {
             continue;
@@ -522,6 +538,38 @@ real3 march_shade(real3 p, real3 n, real3 rd, real eps, real occlusion,
         color += radiance * (albedo * (diffuse * ndl) + specular * ndl);
     }
     return color;
+}
+
+// The shading layers of the surface point p with normal n (see
+// codegen::interface::layer): its albedo with the orbit-trap tint, the
+// trap's value (1 on surfaces that are not fractals), and how lit it is: each
+// light that faces it weighted by the brightest channel of its radiance
+// times n.l, its shadow ray's visibility averaged (1 without shadows, or
+// with no light facing it). Shadow rays leave as march_shade's do.
+void march_layers(real3 p, real3 n, real eps, __global const real* params,
+                  __global const real* lights, int light_count, real3* albedo, real* trap,
+                  real* shadow) {
+    DE_shade(p, params, albedo, trap);
+    *albedo *= march_trap_tint(*trap);
+    real lit = R(0.0);
+    real weights = R(0.0);
+    uint evals = 0u;
+    for (int i = 0; i < light_count; ++i) {
+        __global const real* l = lights + LIGHT_STRIDE * i;
+        real3 to_light;
+        real light_distance;
+        real3 radiance = march_light(l, p, &to_light, &light_distance);
+        real weight = fmax(radiance.x, fmax(radiance.y, radiance.z)) * dot(n, to_light);
+        if (weight <= R(0.0)) {
+            continue;
+        }
+        real visible = R(1.0);
+        visible = march_shadow(p + n * eps, to_light, light_distance, R(0.25) * eps, eps,
+                               l[LIGHT_SOFTNESS], R(1.0), params, &evals);
+        lit += weight * visible;
+        weights += weight;
+    }
+    *shadow = weights > R(0.0) ? lit / weights : R(1.0);
 }
 // optics.cl — reflections and transparency, and where each sample looks.
 //
@@ -659,7 +707,13 @@ void march_sample_ray(const MarchCamera* cam, int x, int y, uint pixel, uint j, 
 // and evaluations, every distance evaluation of them (primary march,
 // normal, DE_shade, occlusion and shadow rays, and the step onto the
 // surface of a ray that starts inside it). The extra march through the
-// pixel centre that AOVs need with supersampling or a lens is not counted.
+// pixel centre that AOVs need with supersampling or a lens is not counted,
+// nor are the shading layers' evaluations.
+//
+// With write_aovs at WRITE_LAYERS, every pass also writes linear: the
+// colour before the display transform (exposed, not clipped) and the
+// fraction of the samples that hit; and the first pass the shading
+// layers of the centre ray's hit (codegen::interface::layer).
 __kernel void render_tile(RENDER_TILE_ARGS) {
     int lx = (int)get_global_id(0);
     int ly = (int)get_global_id(1);
@@ -682,8 +736,12 @@ __kernel void render_tile(RENDER_TILE_ARGS) {
     real3 sum = (real3)(R(0.0));
     uint total_steps = 0;
     uint total_evals = 0;
+    uint hits = 0;
     MarchResult centre = {R(0.0), R(1.0), 0, 0};
     real3 centre_normal = (real3)(R(0.0));
+    // The ray the AOVs describe: the first sample's, or the pixel centre's.
+    real3 centre_ro = (real3)(R(0.0));
+    real3 centre_rd = (real3)(R(0.0));
     // Whether the rays come marched by brute_depths.
     int stored = 0;
     for (int s = 0; s < per_pass; ++s) {
@@ -703,6 +761,7 @@ __kernel void render_tile(RENDER_TILE_ARGS) {
         real3 color = background;
         real3 n = (real3)(R(0.0));
         if (m.hit) {
+            hits += 1u;
             real3 p = ro + rd * m.t;
             real footprint = march_footprint(&cam, m.t);
             real view_height = footprint * cam.image_h;
@@ -734,19 +793,28 @@ __kernel void render_tile(RENDER_TILE_ARGS) {
         if (s == 0) {
             centre = m;
             centre_normal = n;
+            centre_ro = ro;
+            centre_rd = rd;
         }
     }
     int idx = y * width + x;
     real3 color = sum / (real)per_pass;
+    real coverage = (real)hits / (real)per_pass;
     if (pass >= 0) {
+        // The spare fourth float sums the samples that hit.
         float4 total = pass == 0 ? (float4)(0.0f) : accumulation[idx];
-        total += (float4)(convert_float3(sum), 0.0f);
+        total += (float4)(convert_float3(sum), (float)hits);
         accumulation[idx] = total;
         if (pass > 0) {
-            color = (real3)(total.x, total.y, total.z) / ((real)(pass + 1) * (real)per_pass);
+            real samples = (real)(pass + 1) * (real)per_pass;
+            color = (real3)(total.x, total.y, total.z) / samples;
+            coverage = (real)total.w / samples;
         }
     }
-    real3 out = pow(clamp(color, R(0.0), R(1.0)), (real3)(R(1.0) / GAMMA));
+    if (write_aovs >= WRITE_LAYERS) {
+        linear[idx] = (float4)(convert_float3(color * EXPOSURE_SCALE), (float)coverage);
+    }
+    real3 out = display_color(color, EXPOSURE_SCALE, R(1.0) / GAMMA);
     rgba[idx] = (uchar4)(convert_uchar3_sat_rte(convert_float3(out) * 255.0f), (uchar)255);
 
     // Later passes leave the outputs of the first: the same rays.
@@ -760,6 +828,8 @@ __kernel void render_tile(RENDER_TILE_ARGS) {
             real3 rd;
             march_camera_ray(&cam, ((real)x + R(0.5)) * cam.pixel_scale,
                              ((real)y + R(0.5)) * cam.pixel_scale, &ro, &rd);
+            centre_ro = ro;
+            centre_rd = rd;
             centre = march_ray(ro, rd, start, &cam, R(1.0), params);
             centre_normal = (real3)(R(0.0));
             if (centre.hit) {
@@ -769,6 +839,34 @@ __kernel void render_tile(RENDER_TILE_ARGS) {
                     centre_normal = march_facing(centre_normal, rd);
                 }
             }
+        }
+        if (write_aovs >= WRITE_LAYERS) {
+            // What the centre ray's hit is made of (0 on a miss).
+            __global float* layer = layers + LAYER_STRIDE * idx;
+            real3 position = (real3)(R(0.0));
+            real3 albedo = (real3)(R(0.0));
+            real occlusion = R(0.0);
+            real trap = R(0.0);
+            real shadow = R(0.0);
+            if (centre.hit) {
+                real footprint = march_footprint(&cam, centre.t);
+                position = centre_ro + centre_rd * centre.t;
+                uint uncounted = 0u;
+                if (centre.t <= R(0.0) && !stored) {
+                    // A ray that starts inside a solid: the point shaded
+                    // is the nearest of the surface, as for the colour.
+                    position -= centre_normal * DE(position, params);
+                }
+                occlusion = march_occlusion(position, centre_normal, footprint * cam.image_h,
+                                            R(0.5), params, &uncounted);
+                march_layers(position, centre_normal, DETAIL * footprint, params, lights,
+                             light_count, &albedo, &trap, &shadow);
+            }
+            vstore3(convert_float3(position), 0, layer + LAYER_POSITION);
+            vstore3(convert_float3(albedo), 0, layer + LAYER_ALBEDO);
+            layer[LAYER_OCCLUSION] = (float)occlusion;
+            layer[LAYER_SHADOW] = (float)shadow;
+            layer[LAYER_TRAP] = (float)trap;
         }
         depth[idx] = centre.hit ? (float)centre.t : INFINITY;
         hit_mask[idx] = (uchar)centre.hit;

@@ -1,7 +1,21 @@
 //! Saving images to disk, and checking saved ones.
 //!
+//! The format follows the file's extension: PNG, JPEG and TIFF for images
+//! ([`save_image`]); with a rendered frame's layers ([`save_frame`]), also
+//! OpenEXR with named layers, 16-bit PNG and TIFF, and each arbitrary
+//! output value as a 16-bit PNG.
+//!
 //! Every error names the file the caller asked for (never a temporary
 //! file) and says what failed.
+
+mod camera;
+#[cfg(feature = "opencl")]
+mod layers;
+
+pub use camera::{CameraExport, SENSOR_HEIGHT_MM};
+
+#[cfg(feature = "opencl")]
+pub use layers::{Aov, Bits, FrameOutput, aov_path, save_frame};
 
 use std::collections::{HashMap, HashSet};
 use std::fs::{self, File, OpenOptions};
@@ -13,6 +27,7 @@ use std::time::{Duration, Instant, SystemTime};
 
 use image::codecs::jpeg::JpegEncoder;
 use image::codecs::png::PngEncoder;
+use image::codecs::tiff::TiffEncoder;
 use image::{ExtendedColorType, ImageEncoder, ImageError, RgbaImage};
 
 use crate::error::{Error, Result};
@@ -66,13 +81,18 @@ pub fn save_png(image: &RgbaImage, path: impl AsRef<Path>) -> Result<()> {
     write_atomic(target, "image", |file| encode(image, file))
 }
 
-/// The image formats [`save_image`] writes, by file extension.
-pub const IMAGE_EXTENSIONS: [&str; 3] = ["png", "jpg", "jpeg"];
+/// The image formats this library writes, by file extension: PNG, JPEG,
+/// TIFF and OpenEXR (OpenEXR only from a rendered frame's linear colour,
+/// through `save_frame`).
+pub const IMAGE_EXTENSIONS: [&str; 6] = ["png", "jpg", "jpeg", "tif", "tiff", "exr"];
 
-/// Saves `image` in the format its path's extension names (`.png`, or
-/// `.jpg`/`.jpeg` for a JPEG of quality 95 without the alpha channel),
-/// atomically as [`save_png`] writes; the extension's case does not matter,
-/// and a path without one (a device such as `/dev/stdout`) gets a PNG.
+/// Saves `image` in the format its path's extension names (`.png`;
+/// `.jpg`/`.jpeg` for a JPEG of quality 95 without the alpha channel;
+/// `.tif`/`.tiff` for an RGBA TIFF), atomically as [`save_png`] writes;
+/// the extension's case does not matter, and a path without one (a device
+/// such as `/dev/stdout`) gets a PNG. An OpenEXR file holds linear colour,
+/// which an 8-bit image no longer has: `save_frame` writes one from a
+/// frame rendered with its layers.
 ///
 /// ```
 /// use fractal_sdf::image::{Rgba, RgbaImage};
@@ -89,16 +109,59 @@ pub const IMAGE_EXTENSIONS: [&str; 3] = ["png", "jpg", "jpeg"];
 /// # Errors
 /// As [`save_png`]; an [`Error::Io`] of kind `Unsupported` naming the
 /// supported extensions for a path whose extension is none of
-/// [`IMAGE_EXTENSIONS`] (nothing is written).
+/// [`IMAGE_EXTENSIONS`] (nothing is written); [`Error::Invalid`] for an
+/// OpenEXR path.
 pub fn save_image(image: &RgbaImage, path: impl AsRef<Path>) -> Result<()> {
     let target = path.as_ref();
     let extension = image_extension(target)?;
     match extension.as_deref() {
         None | Some("png") => save_png(image, target),
+        Some("exr") => Err(Error::Invalid {
+            what: "output",
+            reason: format!(
+                "{} is an OpenEXR file, which holds linear colour: an 8-bit image has \
+                 none. Render the frame with Renderer::render_layers and write it with \
+                 output::save_frame, or choose .png, .jpg or .tif",
+                target.display()
+            ),
+        }),
+        Some("tif" | "tiff") => {
+            check_pixels(image, target, "a TIFF")?;
+            save_tiff(
+                target,
+                image.as_raw(),
+                image.dimensions(),
+                ExtendedColorType::Rgba8,
+            )
+        }
         _ => {
             check_pixels(image, target, "a JPEG")?;
             write_atomic(target, "image", |file| encode_jpeg(image, file))
         }
+    }
+}
+
+/// Writes `samples` (native-order bytes of `color`) as a TIFF, atomically.
+pub(crate) fn save_tiff(
+    target: &Path,
+    samples: &[u8],
+    (width, height): (u32, u32),
+    color: ExtendedColorType,
+) -> Result<()> {
+    // The TIFF encoder seeks: encode in memory, then write.
+    let mut encoded = io::Cursor::new(Vec::new());
+    TiffEncoder::new(&mut encoded)
+        .write_image(samples, width, height, color)
+        .map_err(|e| Error::io(target, "cannot encode the TIFF", io_error(e)))?;
+    let encoded = encoded.into_inner();
+    write_atomic(target, "image", |mut file| file.write_all(&encoded))
+}
+
+/// An encoder's error as an I/O error, so that callers name the file.
+pub(crate) fn io_error(e: ImageError) -> io::Error {
+    match e {
+        ImageError::IoError(e) => e,
+        other => io::Error::new(io::ErrorKind::InvalidData, other),
     }
 }
 
@@ -133,10 +196,16 @@ pub fn image_extension(target: &Path) -> Result<Option<String>> {
 /// An [`Error::Resolution`] for an image with a zero side, which `format`
 /// cannot hold.
 fn check_pixels(image: &RgbaImage, target: &Path, format: &str) -> Result<()> {
-    if image.width() == 0 || image.height() == 0 {
+    check_size(image.width(), image.height(), target, format)
+}
+
+/// An [`Error::Resolution`] for a `width` × `height` image with a zero
+/// side, which `format` cannot hold.
+pub(crate) fn check_size(width: u32, height: u32, target: &Path, format: &str) -> Result<()> {
+    if width == 0 || height == 0 {
         return Err(Error::Resolution {
-            width: image.width(),
-            height: image.height(),
+            width,
+            height,
             reason: format!(
                 "{format} needs at least 1 pixel on each side; nothing was written to {}",
                 target.display()
@@ -221,10 +290,7 @@ fn encode(image: &RgbaImage, out: impl Write) -> io::Result<()> {
             image.height(),
             ExtendedColorType::Rgba8,
         )
-        .map_err(|e| match e {
-            ImageError::IoError(e) => e,
-            other => io::Error::new(io::ErrorKind::InvalidData, other),
-        })?;
+        .map_err(io_error)?;
     writer.flush()
 }
 
@@ -239,10 +305,7 @@ fn encode_jpeg(image: &RgbaImage, out: impl Write) -> io::Result<()> {
             rgb.height(),
             ExtendedColorType::Rgb8,
         )
-        .map_err(|e| match e {
-            ImageError::IoError(e) => e,
-            other => io::Error::new(io::ErrorKind::InvalidData, other),
-        })?;
+        .map_err(io_error)?;
     writer.flush()
 }
 
