@@ -13,6 +13,7 @@ setup:
 demo: setup
 	@echo "==> demo: $(CARGO) run --release --example gallery"
 	$(CARGO) run --release --example gallery
+	$(CARGO) run --release --example keyframes
 
 test: setup
 	@bash scripts/test.sh

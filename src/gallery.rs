@@ -52,7 +52,73 @@ pub fn all() -> Vec<(&'static str, Scene)> {
         ("kleinian", kleinian()),
         ("orbit_traps", orbit_traps()),
         ("profiles", profiles()),
+        ("keyframes", keyframes()),
     ]
+}
+
+/// A Mandelbulb animated by keyframes alone: its `power` eases from 8 down
+/// to 5 and springs back up to 9, a plane whose offset `cut` steps from
+/// outside the fractal to through it opens it at 2 s, and the camera
+/// ([`keyframes_path`]) flies in, narrowing its view and rolling. Its
+/// first keyframe's camera is the scene's.
+#[must_use]
+pub fn keyframes() -> Scene {
+    let bulb = Node::from(Mandelbulb::new(param("power", 8.0)).iterations(8))
+        .rotate(DVec3::X, -FRAC_PI_2)
+        .color(dvec3(0.55, 0.75, 0.95))
+        .cut_plane(dvec3(0.4, 0.0, 1.0), param("cut", -1.5));
+    Scene::new(bulb.union(floor(1.15)))
+        .with_camera(Camera::look_at(dvec3(0.0, 1.2, 4.2), dvec3(0.0, -0.1, 0.0)).fov(50.0))
+        .with_lights(key_and_fill())
+}
+
+/// The `keyframes` scene's tracks ([`Motion::Keys`]): `power` eases from
+/// 8 to 5 over 2 s, then runs straight to 9 at 4 s; `cut` holds outside
+/// the fractal until 2 s, then steps to 0.35 and, at 3 s, to 0.
+#[must_use]
+pub fn keyframes_motions() -> Vec<Motion> {
+    use crate::animation::{Interpolation, Key};
+    vec![
+        Motion::Keys {
+            name: "power".into(),
+            keys: vec![
+                Key::new(0.0, 8.0).interpolation(Interpolation::EaseInOut),
+                Key::new(2.0, 5.0).interpolation(Interpolation::Linear),
+                Key::new(4.0, 9.0),
+            ],
+        },
+        Motion::Keys {
+            name: "cut".into(),
+            keys: vec![
+                Key::new(0.0, -1.5).interpolation(Interpolation::Step),
+                Key::new(2.0, 0.35).interpolation(Interpolation::Step),
+                Key::new(3.0, 0.0),
+            ],
+        },
+    ]
+}
+
+/// The `keyframes` scene's camera: from straight ahead at 50° it eases in
+/// and round to the side at 35°, rolling 12°, then swings up above on a
+/// spline as the roll eases back.
+///
+/// # Errors
+/// None in practice: the keyframes are constants that validate.
+pub fn keyframes_path() -> Result<CameraPath> {
+    use crate::animation::{Interpolation, Keyframe};
+    let target = dvec3(0.0, -0.1, 0.0);
+    CameraPath::new(vec![
+        Keyframe::new(0.0, dvec3(0.0, 1.2, 4.2), target)
+            .interpolation(Interpolation::EaseInOut)
+            .fov(50.0)
+            .roll(0.0),
+        Keyframe::new(2.0, dvec3(3.0, 1.0, 3.0), target)
+            .fov(38.0)
+            .roll(12.0),
+        Keyframe::new(4.0, dvec3(2.2, 3.4, -2.4), target)
+            .fov(44.0)
+            .roll(0.0),
+    ])
 }
 
 /// The animated dynamic parameters of the gallery scene `name` (empty for
@@ -89,6 +155,7 @@ pub fn motions(name: &str) -> Vec<Motion> {
             radius: 1.35,
             period: 5.0,
         }],
+        "keyframes" => keyframes_motions(),
         _ => Vec::new(),
     }
 }
@@ -97,7 +164,8 @@ pub fn motions(name: &str) -> Vec<Motion> {
 /// quality with 2×2 supersampling (4×4 for a camera with a lens, whose
 /// blur needs more samples; brute-force steps of 2 footprints for a scene
 /// with inside shapes), the default effects with a pale blue
-/// glow, its [`motions`], and for `benchmark` its [`benchmark_path`]. The
+/// glow, its [`motions`], and for `benchmark` its [`benchmark_path`] and
+/// for `keyframes` its [`keyframes_path`]. The
 /// crate's `scenes/` folder holds these files (`scenes/NAME.ron`), as
 /// [`SceneFile::to_text`] writes them.
 #[must_use]
@@ -114,7 +182,11 @@ pub fn file(name: &str) -> Option<SceneFile> {
         scene,
         quality: Some(quality),
         effects: Effects::default().glow(Glow::new(dvec3(0.6, 0.75, 1.0), 0.6)),
-        path: (name == "benchmark").then(|| benchmark_path().expect("a constant path")),
+        path: match name {
+            "benchmark" => Some(benchmark_path().expect("a constant path")),
+            "keyframes" => Some(keyframes_path().expect("a constant path")),
+            _ => None,
+        },
         motions: motions(name),
     })
 }

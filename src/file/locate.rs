@@ -120,6 +120,8 @@ pub(super) const NAMES: &[&str] = &[
     "Point",
     "Oscillate",
     "Orbit",
+    "Keys",
+    "Key",
     "Camera",
     "Light",
     "Glow",

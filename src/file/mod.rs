@@ -466,7 +466,8 @@ fn read(text: &str, file: &Path, shapes: &[CustomShape]) -> Result<SceneFile> {
 }
 
 /// The values a motion reaches at its extremes, per slot: an oscillation's
-/// `center ± amplitude`, an orbit's centre `± radius` across x and z.
+/// `center ± amplitude`, an orbit's centre `± radius` across x and z, a
+/// track's keys and samples between them.
 fn extremes(motion: &Motion) -> Vec<(String, f64)> {
     match motion {
         Motion::Oscillate {
@@ -490,6 +491,16 @@ fn extremes(motion: &Motion) -> Vec<(String, f64)> {
             (format!("{name}.z"), center.z - radius),
             (format!("{name}.z"), center.z + radius),
         ],
+        // Every key's value and, between keys, where a spline may
+        // overshoot them: 32 samples a segment.
+        Motion::Keys { keys, .. } => keys
+            .windows(2)
+            .flat_map(|w| {
+                (0..32).map(move |j| w[0].time + (w[1].time - w[0].time) * f64::from(j) / 32.0)
+            })
+            .chain(keys.iter().map(|k| k.time))
+            .flat_map(|t| motion.values(t))
+            .collect(),
     }
 }
 

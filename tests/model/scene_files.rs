@@ -667,3 +667,57 @@ fn the_formula_benchmark_scenes_load() {
     }
     assert!(count >= 13, "{count} scenes in {}", dir.display());
 }
+
+/// Keyframed tracks in a file: a parameter's keys and a path's optional
+/// camera fields read back as written; a track that takes a parameter out
+/// of its range between its keys (a spline's overshoot), keys out of
+/// order, and a camera field on some keyframes only are each refused where
+/// they are written.
+#[test]
+fn keyframed_tracks_read_back_and_bad_ones_are_located() {
+    use fractal_sdf::animation::{Interpolation, Motion};
+    let file = |motion: &str, path: &str| {
+        format!(
+            "(\n    version: 1,\n    geometry: Sphere(radius: param(\"r\", 0.5)),\n    \
+             motions: [\n        {motion},\n    ],\n    path: [\n{path}\n    ],\n)"
+        )
+    };
+    let keys = "Keys(name: \"r\", keys: [(time: 0, value: 0.5, interpolation: EaseInOut), \
+                (time: 2, value: 1), (time: 3, value: 0.8, interpolation: Step)])";
+    let path = "        (time: 0, position: (0, 0, 4), target: (0, 0, 0), fov_y_degrees: 40, \
+                roll_degrees: 0),\n        (time: 2, position: (0, 1, 3), target: (0, 0, 0), \
+                interpolation: Linear, fov_y_degrees: 30, roll_degrees: 10),";
+    let read = SceneFile::parse(&file(keys, path)).unwrap();
+    let Motion::Keys {
+        keys: read_keys, ..
+    } = &read.motions[0]
+    else {
+        panic!("{:?}", read.motions)
+    };
+    assert_eq!(read_keys.len(), 3);
+    assert_eq!(read_keys[0].interpolation, Interpolation::EaseInOut);
+    assert_eq!(read_keys[1].interpolation, Interpolation::CatmullRom);
+    assert_eq!(read.motions[0].values(1.0)[0].1, 0.75);
+    let path_read = read.path.as_ref().unwrap();
+    assert_eq!(path_read.keyframes()[1].roll_degrees, Some(10.0));
+    assert_eq!(SceneFile::parse(&read.to_text().unwrap()).unwrap(), read);
+
+    // Through 0.5, 0.05 and 0.5 on a spline: below 0 between the keys.
+    let dips = "Keys(name: \"r\", keys: [(time: 0, value: 0.5), (time: 1, value: 0.05), \
+                (time: 1.1, value: 0.5)])";
+    let (line, column, message) = error_at(&file(dips, path));
+    assert_eq!((line, column), (5, 9), "{message}");
+    assert!(message.contains("must be >= 0"), "{message}");
+    let backwards = "Keys(name: \"r\", keys: [(time: 1, value: 0.5), (time: 0, value: 1)])";
+    let (line, _, message) = error_at(&file(backwards, path));
+    assert_eq!(line, 5, "{message}");
+    assert!(message.contains("later than the key before"), "{message}");
+    let partly = path.replace(", fov_y_degrees: 30", "");
+    let err = SceneFile::parse(&file(keys, &partly))
+        .unwrap_err()
+        .to_string();
+    assert!(
+        err.contains("`fov_y_degrees` must be on every keyframe or on none"),
+        "{err}"
+    );
+}
