@@ -137,7 +137,7 @@ pub mod layer {
     /// 1 lit, 0 in shadow (1 without shadows or lights, 0 on a miss).
     pub const SHADOW: Field = field("SHADOW", 7, 1);
     /// The orbit-trap value at the hit that tints a fractal, 1 on other
-    /// surfaces (0 on a miss).
+    /// surfaces and on fractals coloured through a palette (0 on a miss).
     pub const TRAP: Field = field("TRAP", 8, 1);
     /// Every field, in buffer order.
     pub const FIELDS: [Field; 5] = [POSITION, ALBEDO, OCCLUSION, SHADOW, TRAP];

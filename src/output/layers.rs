@@ -34,7 +34,9 @@ pub enum Aov {
     Occlusion,
     /// The lights' visibility: 1 lit, 0 in shadow.
     Shadow,
-    /// The orbit-trap value that tints a fractal (1 on other surfaces).
+    /// The orbit-trap value that tints a fractal (1 on other surfaces,
+    /// and on fractals coloured through a palette, whose colour is in
+    /// [`Aov::Albedo`]).
     Trap,
     /// Distance evaluations the pixel's colour cost.
     Evaluations,

@@ -69,7 +69,9 @@ pub struct Layers {
     /// no light facing it).
     pub shadow: Vec<f32>,
     /// The orbit-trap value at the hit, in `[0, 1]`, that tints a
-    /// fractal's colour; 1 on surfaces that are not fractals.
+    /// fractal's colour; 1 on surfaces that are not fractals, and on
+    /// fractals an [`OrbitColoring`](crate::scene::OrbitColoring) paints
+    /// through a palette (their colour is in `albedo`).
     pub trap: Vec<f32>,
 }
 
