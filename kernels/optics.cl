@@ -20,11 +20,6 @@ typedef struct {
     int inside;      // whether it travels inside a transparent shape
 } MarchBranch;
 
-// The sky seen along rd, where a path leaves the scene or is cut off.
-real3 march_sky(real3 rd) {
-    return mix(SKY_BOTTOM, SKY_TOP, clamp(R(0.5) + R(0.5) * rd.y, R(0.0), R(1.0)));
-}
-
 // The share of light a clear surface reflects, arriving from index 1 at
 // an angle with cosine cos_i onto index ior: Fresnel's equations for
 // unpolarised light (0 for ior 1, 1 on total internal reflection).

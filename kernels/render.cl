@@ -1,6 +1,6 @@
 // render.cl — the kernels a render program runs.
 //
-// Follows optics.cl: the brute-force depth pass of inside shapes
+// Follows paths.cl: the brute-force depth pass of inside shapes
 // (ENABLE_BRUTE), the screen-space normals and occlusion of stored depths,
 // render_tile (one tile of pixels: march, shade, fog and glow) and the
 // coarse pass (ENABLE_CONE: cone_starts).
@@ -275,6 +275,10 @@ __kernel void render_tile(RENDER_TILE_ARGS) {
         total_evals += (uint)m.steps;
 
         real3 background = march_background(&cam, py);
+#ifdef ENABLE_GI
+        // The sky that lights the paths, seen along the ray.
+        background = march_sky(rd);
+#endif
         real3 color = background;
         real3 n = (real3)(R(0.0));
         if (m.hit) {
@@ -308,6 +312,7 @@ __kernel void render_tile(RENDER_TILE_ARGS) {
                     view_height = (real)INFINITY;
                 }
             }
+#ifdef ENABLE_DIRECT
             // Occlusion samples at the midpoints of their intervals.
             real offset = R(0.5);
 #ifdef ENABLE_BRUTE
@@ -332,6 +337,11 @@ __kernel void render_tile(RENDER_TILE_ARGS) {
 #ifdef ENABLE_MATERIALS
             color = march_paths(p, n, rd, DETAIL * footprint, m.t, &cam, color, params, lights,
                                 light_count, &total_evals);
+#endif
+#endif
+#ifdef ENABLE_GI
+            color = march_path(p, n, rd, fmax(m.t, R(0.0)), &cam, pixel, j, params, lights,
+                               light_count, &total_evals);
 #endif
 #ifdef ENABLE_FOG
             color = mix(background, color, exp(-FOG_DENSITY * m.t));

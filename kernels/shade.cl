@@ -171,6 +171,14 @@ real3 march_background(const MarchCamera* cam, real py) {
     real v = clamp(R(1.0) - py / cam->image_h, R(0.0), R(1.0));
     return mix(SKY_BOTTOM, SKY_TOP, v);
 }
+#ifdef ENABLE_SKY_RAYS
+
+// The sky seen along rd, where a path leaves the scene or is cut off:
+// SKY_BOTTOM straight down, SKY_TOP straight up.
+real3 march_sky(real3 rd) {
+    return mix(SKY_BOTTOM, SKY_TOP, clamp(R(0.5) + R(0.5) * rd.y, R(0.0), R(1.0)));
+}
+#endif
 
 #ifdef ENABLE_MATERIALS
 #define MARCH_SCATTER_SAMPLES 4 // DE calls of march_thinness

@@ -4,7 +4,7 @@
 //! The generated header turns these tables into `#define`s
 //! (`RENDER_TILE_ARGS`, `CAMERA_ORIGIN`, `LIGHT_STRIDE`, ...), which
 //! the render kernel (`kernels/march.cl`, `shade.cl`, `optics.cl`,
-//! `render.cl`) and `kernels/eval.cl` use in place of positions and
+//! `paths.cl`, `render.cl`) and `kernels/eval.cl` use in place of positions and
 //! offsets of their own, and the executor binds arguments and packs buffers
 //! from the same tables. Neither side can drift from the other.
 //!

@@ -49,7 +49,7 @@ use crate::scene::{BRUTE_MAX_STEPS, DEFAULT_MATERIAL, INSIDE_HUGE, Kind, MATERIA
 #[non_exhaustive]
 pub enum Target {
     /// The ray-marching renderer (`kernels/march.cl`, `shade.cl`,
-    /// `optics.cl` and `render.cl`).
+    /// `optics.cl`, `paths.cl` and `render.cl`).
     #[default]
     Render,
     /// A kernel `eval_points` that writes `DE` (and colour/trap) for a
@@ -103,15 +103,19 @@ pub enum Effect {
     Glow,
     /// Distance fog (`ENABLE_FOG`).
     Fog,
+    /// Path-traced global illumination in place of direct lighting
+    /// (`ENABLE_GI`, with `GI_BOUNCES`).
+    GlobalIllumination,
 }
 
 impl Effect {
     /// Every effect, in the order their switches appear in the header.
-    pub const ALL: [Effect; 4] = [
+    pub const ALL: [Effect; 5] = [
         Effect::AmbientOcclusion,
         Effect::Shadows,
         Effect::Glow,
         Effect::Fog,
+        Effect::GlobalIllumination,
     ];
 
     /// The preprocessor switch naming the effect's blocks.
@@ -122,6 +126,7 @@ impl Effect {
             Effect::Shadows => "ENABLE_SHADOWS",
             Effect::Glow => "ENABLE_GLOW",
             Effect::Fog => "ENABLE_FOG",
+            Effect::GlobalIllumination => "ENABLE_GI",
         }
     }
 
@@ -138,6 +143,7 @@ impl Effect {
                 Effect::Shadows => e.shadows && q.shadow_steps > 0,
                 Effect::Glow => e.glow.is_some_and(|g| g.strength > 0.0),
                 Effect::Fog => e.fog_density > 0.0,
+                Effect::GlobalIllumination => e.global_illumination.is_some(),
             })
             .collect()
     }
@@ -294,7 +300,9 @@ pub fn emit(scene: &CompiledScene, options: &Options) -> Result<KernelSource> {
 /// # Errors
 /// A validation error of the quality or effects;
 /// [`Error::Precision`] for a baked value beyond
-/// the precision's limits, with its node's path.
+/// the precision's limits, with its node's path;
+/// [`Error::InsideShape`] for global illumination over a scene with an
+/// inside shape, which has no normal away from the screen to bounce from.
 pub fn emit_ir(ir: &Ir, options: &Options) -> Result<KernelSource> {
     options.validate()?;
     let precision = options.quality.precision;
@@ -324,6 +332,9 @@ pub fn emit_ir(ir: &Ir, options: &Options) -> Result<KernelSource> {
             .iter()
             .any(|n| matches!(n, Kind::Material { .. }));
     emitter.emit(materials);
+    if options.target == Target::Render && options.effects.global_illumination.is_some() {
+        ir.check_paths()?;
+    }
     // Inside shapes are marched by brute force within their region.
     let features = Features {
         materials,
@@ -471,6 +482,16 @@ const MATERIALS: &str = "ENABLE_MATERIALS";
 /// rendering scenes with an inside shape.
 const BRUTE: &str = "ENABLE_BRUTE";
 
+/// The switch of direct lighting: ambient occlusion standing in for the
+/// sky and each light's shading at the first hit (on unless global
+/// illumination is).
+const DIRECT: &str = "ENABLE_DIRECT";
+
+/// The switch of the sky seen along a ray's direction (`march_sky`): on
+/// for programs that send rays past the first hit (materials, global
+/// illumination).
+const SKY_RAYS: &str = "ENABLE_SKY_RAYS";
+
 /// The switch of the march's glow test against the sphere around the
 /// shapes that glow ([`glow_bound`]).
 const GLOW_BOUND: &str = "ENABLE_GLOW_BOUND";
@@ -500,12 +521,13 @@ pub fn target_kernel(options: &Options) -> String {
     kernel_with(options, false, &Features::default())
 }
 
-/// The render program's kernel source: its four files, in order (see the
+/// The render program's kernel source: its five files, in order (see the
 /// header of `kernels/march.cl`).
 pub(crate) const RENDER_KERNEL: &str = concat!(
     include_str!("../../kernels/march.cl"),
     include_str!("../../kernels/shade.cl"),
     include_str!("../../kernels/optics.cl"),
+    include_str!("../../kernels/paths.cl"),
     include_str!("../../kernels/render.cl"),
 );
 
@@ -514,10 +536,15 @@ fn kernel_with(options: &Options, bounded: bool, features: &Features) -> String 
         Target::Render => RENDER_KERNEL,
         Target::Evaluate => include_str!("../../kernels/eval.cl"),
     };
-    let mut on: Vec<&str> = Effect::enabled(options)
-        .into_iter()
-        .map(Effect::switch)
-        .collect();
+    let effects = Effect::enabled(options);
+    let gi = effects.contains(&Effect::GlobalIllumination);
+    let mut on: Vec<&str> = effects.into_iter().map(Effect::switch).collect();
+    if !gi {
+        on.push(DIRECT);
+    }
+    if gi || features.materials {
+        on.push(SKY_RAYS);
+    }
     if bounded {
         on.push(SCENE_BOUND);
     }
@@ -650,7 +677,7 @@ fn finish(
     w.line(format!(
         "/* ---- kernel: {} ---- */",
         match options.target {
-            Target::Render => "march.cl, shade.cl, optics.cl, render.cl",
+            Target::Render => "march.cl, shade.cl, optics.cl, paths.cl, render.cl",
             Target::Evaluate => "eval.cl",
         }
     ));
@@ -739,6 +766,9 @@ fn header(w: &mut writer::Writer, options: &Options, features: &Features) {
     }
     if on.contains(&Effect::Fog) {
         defines.push(("FOG_DENSITY", f(e.fog_density)));
+    }
+    if let Some(gi) = e.global_illumination {
+        defines.push(("GI_BOUNCES", gi.max_bounces.to_string()));
     }
     if cone_tile(options, features) > 0 {
         defines.push(("CONE_TILE", q.cone_tile.to_string()));

@@ -25,6 +25,26 @@ impl Ir {
         (0..self.nodes().len()).any(|i| self.is_inside_leaf(i))
     }
 
+    /// Refuses path-traced global illumination for a scene with inside
+    /// shapes: a path bounces off a surface's normal at every hit, and an
+    /// inside shape has one only on screen.
+    pub(crate) fn check_paths(&self) -> Result<()> {
+        match (0..self.nodes().len()).find(|&i| self.is_inside_leaf(i)) {
+            Some(i) => Err(Error::InsideShape {
+                name: match &self.nodes()[i] {
+                    Kind::Custom { shape, .. } => shape.name().to_string(),
+                    _ => unreachable!("found as a custom shape"),
+                },
+                node: self.path(NodeId::from_index(i)),
+                reason: "global illumination bounces a path off the surface's normal at every \
+                         hit, which an inside shape has only on screen: light its scene \
+                         directly (no global_illumination)"
+                    .into(),
+            }),
+            None => Ok(()),
+        }
+    }
+
     fn is_inside_leaf(&self, i: usize) -> bool {
         matches!(&self.nodes()[i], Kind::Custom { shape, .. } if shape.inside_bounds().is_some())
     }

@@ -1,6 +1,6 @@
-//! Lighting effects: ambient occlusion, shadows, glow, fog, the sky, and
-//! the display transform (exposure, tone curve, gamma), each compiled into
-//! the program only when it is on.
+//! Lighting effects: ambient occlusion, shadows, glow, fog, the sky,
+//! global illumination, and the display transform (exposure, tone curve,
+//! gamma), each compiled into the program only when it is on.
 
 use super::*;
 
@@ -22,6 +22,54 @@ impl Glow {
         Glow { color, strength }
     }
 }
+
+/// Path-traced global illumination ([`Effects::global_illumination`]):
+/// light that bounces between surfaces and arrives from the whole sky.
+///
+/// Each sample follows one path from the camera. At every surface it
+/// meets, the lights are sampled directly through a shadow ray (next-event
+/// estimation), and the path goes on in a direction drawn from the
+/// surface's material: a cosine-weighted diffuse bounce (Lambert's, or
+/// Oren-Nayar's with a material's roughness), a normalised Phong lobe
+/// for the specular share, or a mirror or refracted ray for a material's
+/// reflectivity and transparency. A path that leaves the scene brings the
+/// sky's light along its direction (the gradient from
+/// [`Effects::sky_bottom`] to [`Effects::sky_top`]). After three bounces,
+/// Russian roulette ends paths in proportion to how little they can still
+/// bring, dividing the survivors' weight by their chance, so the mean is
+/// unchanged.
+///
+/// The estimate is unbiased for paths of up to `max_bounces` bounces:
+/// progressive passes ([`crate::render::Renderer::render_progressive`])
+/// converge on the image, their noise falling as one over the square root
+/// of the passes. Light that needs more bounces is lost. Inside shapes
+/// (brute-force marched) cannot be path traced, having no distance to
+/// bounce from; a material's subsurface light is left to direct lighting.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+#[non_exhaustive]
+pub struct GlobalIllumination {
+    /// The most bounces of a path, in `1..=`[`MAX_GI_BOUNCES`].
+    pub max_bounces: u32,
+}
+
+impl Default for GlobalIllumination {
+    /// Paths of up to 16 bounces.
+    fn default() -> Self {
+        GlobalIllumination { max_bounces: 16 }
+    }
+}
+
+impl GlobalIllumination {
+    /// Paths of up to `max_bounces` bounces.
+    #[must_use]
+    pub fn new(max_bounces: u32) -> Self {
+        GlobalIllumination { max_bounces }
+    }
+}
+
+/// The most bounces a path of [`GlobalIllumination`] may take.
+pub const MAX_GI_BOUNCES: u32 = 64;
 
 /// Lighting effects. Each one that is off is left out of the kernel.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -63,6 +111,11 @@ pub struct Effects {
     /// display ([`ToneMap`]; the default clips at 1). Linear outputs
     /// (OpenEXR) are written before it.
     pub tone_map: ToneMap,
+    /// Path-traced global illumination in place of direct lighting
+    /// ([`GlobalIllumination`]); `None` (the default) lights each hit
+    /// directly, with ambient occlusion standing in for the sky's light.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub global_illumination: Option<GlobalIllumination>,
 }
 
 impl Default for Effects {
@@ -80,6 +133,7 @@ impl Default for Effects {
             gamma: 2.2,
             exposure: 0.0,
             tone_map: ToneMap::Clip,
+            global_illumination: None,
         }
     }
 }
@@ -175,6 +229,15 @@ impl Effects {
         if !(self.exposure.is_finite() && self.exposure.abs() <= MAX_EXPOSURE) {
             return Err(bad("exposure", self.exposure, "in [-32, 32] stops"));
         }
+        if let Some(gi) = self.global_illumination
+            && !(1..=MAX_GI_BOUNCES).contains(&gi.max_bounces)
+        {
+            return Err(bad(
+                "global_illumination.max_bounces",
+                f64::from(gi.max_bounces),
+                "in [1, 64]",
+            ));
+        }
         Ok(())
     }
 }
@@ -269,6 +332,13 @@ impl Effects {
     #[must_use]
     pub fn tone_map(mut self, tone_map: ToneMap) -> Self {
         self.tone_map = tone_map;
+        self
+    }
+
+    /// Sets path-traced global illumination, or turns it off with `None`.
+    #[must_use]
+    pub fn global_illumination(mut self, gi: impl Into<Option<GlobalIllumination>>) -> Self {
+        self.global_illumination = gi.into();
         self
     }
 

@@ -15,7 +15,7 @@ use crate::math::{F32_LIMITS, F64_LIMITS, Limits, Magnitude};
 mod effects;
 mod tone;
 
-pub use effects::{Effects, Glow, MAX_EXPOSURE};
+pub use effects::{Effects, GlobalIllumination, Glow, MAX_EXPOSURE, MAX_GI_BOUNCES};
 pub use tone::{ToneMap, display, display_formula};
 
 /// Floating-point precision of the generated kernel.

@@ -21,7 +21,7 @@
 //! A program is one OpenCL C 1.2 source
 //! ([`KernelSource`](crate::codegen::KernelSource)): a header, the scene's
 //! distance functions, then the render kernel: `kernels/march.cl` (the
-//! marcher), `shade.cl`, `optics.cl` and `render.cl` (kernel
+//! marcher), `shade.cl`, `optics.cl`, `paths.cl` and `render.cl` (kernel
 //! `render_tile`). The header defines:
 //!
 //! - `real`, `real2`, `real3`, `real4` (`float*` or `double*`, the latter
@@ -76,7 +76,7 @@ pub use device::{DEVICE_ENV, DeviceInfo, DeviceKind, DeviceSelector, devices};
 pub use dispatch::{DEFAULT_TILE_SIZE, MAX_IMAGE_SIDE};
 pub use points::{PointEvaluator, PointSample};
 pub use program::{BuildInfo, PROGRAM_CACHE_CAPACITY, program_builds};
-pub use renderer::{RenderOptions, Renderer};
+pub use renderer::{ConvergedFrame, RenderOptions, Renderer, StopRule};
 pub use sampling::{SamplePoint, brute_phase, sample_point};
 pub use stereo::compose;
 pub use viewport::Viewport;

@@ -1,7 +1,7 @@
 //! Rendering through OpenCL: agreement with the CPU, cancelling, cuts,
-//! effects, errors, materials, optics, quality, sizes, frame-to-frame
-//! updates, the golden gallery, march bounds, several devices and the speed
-//! knobs.
+//! effects, errors, global illumination, materials, optics, quality,
+//! sizes, frame-to-frame updates, the golden gallery, march bounds, several
+//! devices and the speed knobs.
 //!
 //! One test binary per concern: each file here is a module.
 
@@ -13,6 +13,7 @@ mod cancel;
 mod cuts;
 mod effects;
 mod errors;
+mod gi;
 mod golden;
 mod march_bounds;
 mod materials;

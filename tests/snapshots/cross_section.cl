@@ -216,4 +216,4 @@ real3 display_color(real3 c, real scale, real inverse_gamma) {
     return (real3)(pow(fmin(fmax(c.x * scale, R(0.0)), R(1.0)), inverse_gamma), pow(fmin(fmax(c.y * scale, R(0.0)), R(1.0)), inverse_gamma), pow(fmin(fmax(c.z * scale, R(0.0)), R(1.0)), inverse_gamma));
 }
 
-/* ---- kernel: march.cl, shade.cl, optics.cl, render.cl ---- */
+/* ---- kernel: march.cl, shade.cl, optics.cl, paths.cl, render.cl ---- */

@@ -18,10 +18,9 @@ use fractal_sdf::output::{
     Aov, Bits, CameraExport, FrameOutput, image_extension, save_frame, save_image, verify_png,
 };
 use fractal_sdf::prelude::*;
-use fractal_sdf::quality::Preset;
-use fractal_sdf::quality::ToneMap;
+use fractal_sdf::quality::{GlobalIllumination, Preset, ToneMap};
 use fractal_sdf::render::{
-    DeviceKind, DeviceSelector, EdgeThresholds, RenderOptions, Renderer, devices,
+    DeviceKind, DeviceSelector, EdgeThresholds, RenderOptions, Renderer, StopRule, devices,
 };
 use fractal_sdf::scene::{CustomShape, Stereo, StereoLayout};
 use fractal_sdf::sequence::{Encoded, Sequence, parse_range};
@@ -182,6 +181,18 @@ struct RenderArgs {
     #[arg(long, value_name = "N",
           value_parser = clap::value_parser!(u32).range(1..=4096))]
     passes: Option<u32>,
+    /// Progressive passes until the image's estimated noise (the root mean
+    /// square error of its displayed colour, in [0, 1]: 0.004 is about one
+    /// 8-bit step) is at most NOISE, with at most --passes passes (default
+    /// 1024). The noise is estimated from the passes themselves, after 2,
+    /// 4, 8, ... of them.
+    #[arg(long, value_name = "NOISE", conflicts_with_all = ["stereo", "adaptive"])]
+    noise: Option<f64>,
+    /// Path-traced global illumination: light bounces between surfaces and
+    /// arrives from the whole sky, up to BOUNCES bounces a path (default
+    /// 16). Grainy in one pass: add --passes or --noise.
+    #[arg(long, value_name = "BOUNCES", num_args = 0..=1, default_missing_value = "16")]
+    gi: Option<u32>,
     /// Adaptive supersampling: N passes at the pixels that differ from a
     /// neighbour (edges, creases, shadow borders), one elsewhere.
     #[arg(long, value_name = "N", conflicts_with_all = ["passes", "stereo"],
@@ -497,6 +508,9 @@ fn render(args: &RenderArgs, settings: &Settings) -> Outcome {
     if let Some(stops) = args.exposure {
         job.options.effects.exposure = stops;
     }
+    if let Some(bounces) = args.gi {
+        job.options.effects.global_illumination = Some(GlobalIllumination::new(bounces));
+    }
     if let Some(name) = &args.tonemap {
         job.options.effects.tone_map = ToneMap::from_name(name).ok_or_else(|| {
             let names: Vec<&str> = ToneMap::ALL.iter().map(|t| t.name()).collect();
@@ -534,10 +548,13 @@ fn render(args: &RenderArgs, settings: &Settings) -> Outcome {
             args.output.display()
         )));
     }
-    let passes = args.passes.unwrap_or(1);
+    let stop = args
+        .noise
+        .map(|noise| StopRule::new(noise, args.passes.unwrap_or(NOISE_PASSES)));
+    let mut passes = args.passes.unwrap_or(1);
     let plain = stereo.is_none() && args.adaptive.is_none();
     let aperture = job.file.scene.camera.aperture;
-    if plain && passes == 1 && aperture > 0.0 {
+    if plain && stop.is_none() && passes == 1 && aperture > 0.0 {
         eprintln!(
             "note: the camera has a lens (aperture {aperture}), whose blur one pass leaves \
              grainy: --passes {LENS_PASSES} renders a smooth one in {LENS_PASSES} times the time"
@@ -549,13 +566,29 @@ fn render(args: &RenderArgs, settings: &Settings) -> Outcome {
     let mut renderer = job.renderer()?;
     let mut refined = None;
     let dimensions;
-    let written = if layered || output.needs_aovs() {
-        let mut frame = renderer.render_progressive_layers(width, height);
-        for _ in 1..passes {
-            frame = renderer.render_progressive_layers(width, height);
-        }
-        bar.finish_and_clear();
-        let frame = frame?;
+    let written = if layered || output.needs_aovs() || stop.is_some() {
+        let frame = if let Some(stop) = &stop {
+            let done = renderer.render_converged(width, height, stop);
+            bar.finish_and_clear();
+            let done = done?;
+            passes = done.passes;
+            refined = Some(if done.reached(stop) {
+                format!("noise {:.4} after {} passes", done.noise, done.passes)
+            } else {
+                format!(
+                    "noise {:.4} after {} passes, above --noise {}: more --passes would lower it",
+                    done.noise, done.passes, stop.noise
+                )
+            });
+            done.frame
+        } else {
+            let mut frame = renderer.render_progressive_layers(width, height);
+            for _ in 1..passes {
+                frame = renderer.render_progressive_layers(width, height);
+            }
+            bar.finish_and_clear();
+            frame?
+        };
         dimensions = (frame.width(), frame.height());
         save_frame(&frame, &args.output, &output)?
     } else {
@@ -609,6 +642,9 @@ fn render(args: &RenderArgs, settings: &Settings) -> Outcome {
     );
     Ok(())
 }
+
+/// The most progressive passes of `render --noise` without `--passes`.
+const NOISE_PASSES: u32 = 1024;
 
 /// The progressive passes the command suggests for a render through a
 /// lens: enough for the gallery's lens scene at its own quality to show a

@@ -28,8 +28,11 @@ use crate::quality::{Effects, Precision, Quality};
 use crate::scene::{Camera, Light, Scene};
 use crate::view::FrameTiming;
 
+mod converge;
 mod frame;
 mod launch;
+
+pub use converge::{ConvergedFrame, StopRule};
 
 use launch::*;
 

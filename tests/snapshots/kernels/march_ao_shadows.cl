@@ -1,9 +1,9 @@
 // march.cl — the reusable sphere tracer: camera rays, the march, the stop
 // at the scene's bound and the brute-force steps of inside shapes.
 //
-// The render program is march.cl, shade.cl, optics.cl and render.cl, in
-// that order, appended after the generated header and the scene's distance
-// functions. They use only:
+// The render program is march.cl, shade.cl, optics.cl, paths.cl and
+// render.cl, in that order, appended after the generated header and the
+// scene's distance functions. They use only:
 //   types   real, real2, real3, real4 and the literal macro R(x)
 //   consts  REAL_TINY MAX_STEPS MAX_DISTANCE DETAIL HIT_EPSILON
 //           NORMAL_EPSILON OVER_RELAXATION SUPERSAMPLING GAMMA SKY_TOP
@@ -18,12 +18,16 @@
 //           __global const real* params, real8* material), whose fields the
 //           header names MATERIAL_<value> (material.MATERIAL_IOR)
 //   effects: the code of each effect (ambient occlusion, shadows, glow,
-//           fog) sits in a conditional block named ENABLE_<effect>, with
-//           its constants defined by the header only when it is on, and so
+//           fog, global illumination: ENABLE_GI with GI_BOUNCES) sits in
+//           a conditional block named ENABLE_<effect>, with its
+//           constants defined by the header only when it is on, and so
 //           does the stop at the scene's bounding sphere
 //           (ENABLE_SCENE_BOUND: SCENE_BOUND_CENTRE, SCENE_BOUND_RADIUS,
-//           SCENE_BOUND_SLOPE), and the coarse pass (ENABLE_CONE:
-//           CONE_TILE, the cone_starts kernel and the starts it leaves).
+//           SCENE_BOUND_SLOPE), the coarse pass (ENABLE_CONE:
+//           CONE_TILE, the cone_starts kernel and the starts it leaves),
+//           direct lighting (ENABLE_DIRECT: on unless global illumination
+//           is) and the sky along a ray (ENABLE_SKY_RAYS: march_sky, for
+//           materials' rays and paths).
 //           Code generation resolves these blocks
 //           itself and leaves out every one that is off, so they are the
 //           only preprocessor conditionals allowed in these files.
@@ -681,9 +685,21 @@ void march_sample_ray(const MarchCamera* cam, int x, int y, uint pixel, uint j, 
     *py = ((real)y + jy) * cam->pixel_scale;
     march_lens_ray(cam, px, *py, lens, ro, rd);
 }
+// paths.cl — path-traced global illumination (ENABLE_GI).
+//
+// Follows optics.cl: each sample's first hit starts a path that bounces
+// through the scene, sampling the lights at every surface it meets and
+// bringing the sky's light where it leaves (quality::GlobalIllumination).
+//
+// Units: a light's radiance is the light a white Lambertian surface facing
+// it sends back, as in direct lighting, so a surface lit by one light has
+// the same colour in both modes; its irradiance is pi times that. The sky
+// along a direction is a radiance: under a sky of 1 everywhere, a white
+// surface is 1 (the white furnace).
+
 // render.cl — the kernels a render program runs.
 //
-// Follows optics.cl: the brute-force depth pass of inside shapes
+// Follows paths.cl: the brute-force depth pass of inside shapes
 // (ENABLE_BRUTE), the screen-space normals and occlusion of stored depths,
 // render_tile (one tile of pixels: march, shade, fog and glow) and the
 // coarse pass (ENABLE_CONE: cone_starts).

@@ -1,0 +1,240 @@
+// paths.cl — path-traced global illumination (ENABLE_GI).
+//
+// Follows optics.cl: each sample's first hit starts a path that bounces
+// through the scene, sampling the lights at every surface it meets and
+// bringing the sky's light where it leaves (quality::GlobalIllumination).
+//
+// Units: a light's radiance is the light a white Lambertian surface facing
+// it sends back, as in direct lighting, so a surface lit by one light has
+// the same colour in both modes; its irradiance is pi times that. The sky
+// along a direction is a radiance: under a sky of 1 everywhere, a white
+// surface is 1 (the white furnace).
+
+#ifdef ENABLE_GI
+// Bounces after which Russian roulette may end a path.
+#define GI_ROULETTE 3
+// The least and most chance a path has of surviving the roulette.
+#define GI_SURVIVE_MIN R(0.05)
+#define GI_SURVIVE_MAX R(0.95)
+#define GI_PI R(3.14159265358979324)
+
+// Random number k of bounce `bounce` of sample j of a pixel, in [0, 1):
+// independent of the numbers that place the sample in the pixel and on
+// the lens.
+real march_random(uint pixel, uint j, int bounce, uint k) {
+    return march_jitter(pixel, j, 16u + 8u * (uint)bounce + k);
+}
+
+// The unit vector at polar angle acos(cos_theta) from the unit vector n,
+// turned by 2 pi u about it (Duff et al.'s orthonormal basis, 2017).
+real3 march_around(real3 n, real cos_theta, real u) {
+    real s = n.z >= R(0.0) ? R(1.0) : R(-1.0);
+    real a = R(-1.0) / (s + n.z);
+    real c = n.x * n.y * a;
+    real3 t = (real3)(R(1.0) + s * n.x * n.x * a, s * c, -s * n.x);
+    real3 b = (real3)(c, s + n.y * n.y * a, -n.y);
+    real sin_theta = sqrt(fmax(R(1.0) - cos_theta * cos_theta, R(0.0)));
+    real phi = R(2.0) * GI_PI * u;
+    return t * (sin_theta * cos(phi)) + b * (sin_theta * sin(phi)) + n * cos_theta;
+}
+
+// Whether nothing blocks the segment from ro along the unit rd up to
+// max_t: the same march as the path's rays, with the footprint of a
+// pixel travelled `travelled` from the camera.
+int march_visible(real3 ro, real3 rd, real max_t, const MarchCamera* cam, real travelled,
+                  __global const real* params, uint* evals) {
+    MarchCamera along = *cam;
+    along.footprint_base = march_footprint(cam, travelled);
+    MarchResult m = march_ray(ro, rd, R(0.0), &along, R(1.0), params);
+    *evals += (uint)m.steps;
+    return !m.hit || m.t >= max_t;
+}
+
+// The surface's scattering, as a BRDF times pi: the diffuse share
+// (1 - ks) albedo (Oren-Nayar's factor for roughness sigma) plus the
+// specular share ks of a normalised Phong lobe of exponent s about the
+// mirror direction of the view, (s + 2) / 2 cos^s(alpha). n.l is left to
+// the caller.
+real3 march_brdf(real3 n, real3 to_light, real3 rd, real3 albedo, real ks, real shininess,
+                 real sigma, real ndl) {
+    real3 diffuse = albedo * (R(1.0) - ks);
+#ifdef ENABLE_MATERIALS
+    diffuse *= march_oren_nayar(sigma, n, to_light, -rd, ndl);
+#endif
+    real3 mirror = rd - R(2.0) * dot(rd, n) * n;
+    real lobe = pow(fmax(dot(mirror, to_light), R(0.0)), shininess);
+    return diffuse + ks * (shininess + R(2.0)) * R(0.5) * lobe;
+}
+
+// Next-event estimation at the surface point p (normal n facing the path,
+// hit threshold eps, `travelled` from the camera) reached along rd: the
+// light of every light that sees p, through the surface's scattering.
+real3 march_direct(real3 p, real3 n, real3 rd, real eps, real travelled, const MarchCamera* cam,
+                   real3 albedo, real ks, real shininess, real sigma,
+                   __global const real* params, __global const real* lights, int light_count,
+                   uint* evals) {
+    real3 sum = (real3)(R(0.0));
+    for (int i = 0; i < light_count; ++i) {
+        __global const real* l = lights + LIGHT_STRIDE * i;
+        real3 to_light;
+        real light_distance;
+        real3 radiance = march_light(l, p, &to_light, &light_distance);
+        real ndl = dot(n, to_light);
+        if (ndl <= R(0.0)) {
+            continue;
+        }
+        real3 lifted = p + n * (R(2.0) * eps);
+        if (march_visible(lifted, to_light, light_distance, cam, travelled, params, evals)) {
+            sum += radiance * march_brdf(n, to_light, rd, albedo, ks, shininess, sigma, ndl) * ndl;
+        }
+    }
+    return sum;
+}
+
+// The light a path brings to the camera from its first hit: the surface
+// point p (normal n, facing the ray) reached t along rd, for sample j of
+// the pixel. Each surface the path meets chooses, by chance in proportion
+// to its material's shares, a mirror reflection, a refraction into a
+// transparent shape, or its own scattering; the last adds the lights'
+// direct light and bounces on, diffusely (cosine-weighted) or into the
+// Phong lobe, with weights that keep the estimate's mean the integral.
+// Inside a transparent shape the path travels clear to where it leaves,
+// refracting out or reflecting back in on total internal reflection.
+// Adds its evaluations to *evals.
+real3 march_path(real3 p, real3 n, real3 rd, real t, const MarchCamera* cam, uint pixel, uint j,
+                 __global const real* params, __global const real* lights, int light_count,
+                 uint* evals) {
+    real3 radiance = (real3)(R(0.0));
+    real3 throughput = (real3)(R(1.0));
+    real travelled = t;
+    int inside = 0;
+    for (int bounce = 0;; ++bounce) {
+        real eps = DETAIL * march_footprint(cam, travelled);
+        real choose = march_random(pixel, j, bounce, 0u);
+        real3 next = rd;
+        real3 ro = p;
+        if (inside) {
+            // Leaving a transparent shape: n is its outward normal.
+            real ior = R(1.0);
+#ifdef ENABLE_MATERIALS
+            real8 material;
+            DE_material(p, params, &material);
+            *evals += 1u;
+            ior = material.MATERIAL_IOR;
+            next = march_refract(rd, -n, ior);
+#endif
+            if (dot(next, next) > R(0.0)) {
+                next = normalize(next);
+                ro = p + n * (R(2.0) * eps);
+                inside = 0;
+            } else {
+                next = rd - R(2.0) * dot(rd, n) * n;
+                ro = p - n * (R(2.0) * eps);
+            }
+        } else {
+            real3 albedo;
+            real trap;
+            DE_shade(p, params, &albedo, &trap);
+            *evals += 1u;
+            albedo *= march_trap_tint(trap);
+            real ks = MARCH_SPECULAR;
+            real shininess = MARCH_SHININESS;
+            real sigma = R(0.0);
+            // The shares of a mirror reflection and of a refraction.
+            real reflected = R(0.0);
+            real passed = R(0.0);
+            real3 bent = (real3)(R(0.0));
+#ifdef ENABLE_MATERIALS
+            real8 material;
+            DE_material(p, params, &material);
+            *evals += 1u;
+            ks = material.MATERIAL_SPECULAR;
+            shininess = material.MATERIAL_SHININESS;
+            sigma = material.MATERIAL_ROUGHNESS;
+            real r = material.MATERIAL_REFLECTIVITY;
+            real tau = material.MATERIAL_TRANSPARENCY;
+            reflected = r;
+            if (tau > R(0.0)) {
+                real ior = material.MATERIAL_IOR;
+                real fresnel = march_fresnel(clamp(-dot(n, rd), R(0.0), R(1.0)), ior);
+                bent = march_refract(rd, n, R(1.0) / ior);
+                if (dot(bent, bent) > R(0.0)) {
+                    passed = (R(1.0) - r) * tau * (R(1.0) - fresnel);
+                    reflected += (R(1.0) - r) * tau * fresnel;
+                } else {
+                    reflected += (R(1.0) - r) * tau;
+                }
+            }
+#endif
+            ks = clamp(ks, R(0.0), R(1.0));
+            if (choose < reflected) {
+                next = rd - R(2.0) * dot(rd, n) * n;
+                ro = p + n * (R(2.0) * eps);
+            } else if (choose < reflected + passed) {
+                next = normalize(bent);
+                ro = p - n * (R(2.0) * eps);
+                inside = 1;
+            } else {
+                radiance += throughput * march_direct(p, n, rd, eps, travelled, cam, albedo, ks,
+                                                      shininess, sigma, params, lights,
+                                                      light_count, evals);
+                if (bounce >= GI_BOUNCES) {
+                    break;
+                }
+                real u = march_random(pixel, j, bounce, 1u);
+                real v = march_random(pixel, j, bounce, 2u);
+                // The lobe by its share: each estimate is then the lobe's
+                // BRDF times n.l over its density, divided by the share.
+                if (march_random(pixel, j, bounce, 3u) < ks) {
+                    real3 mirror = rd - R(2.0) * dot(rd, n) * n;
+                    next = march_around(mirror, pow(u, R(1.0) / (shininess + R(1.0))), v);
+                    real ndl = dot(n, next);
+                    if (ndl <= R(0.0)) {
+                        break;
+                    }
+                    throughput *= (shininess + R(2.0)) / (shininess + R(1.0)) * ndl;
+                } else {
+                    next = march_around(n, sqrt(u), v);
+                    real3 diffuse = albedo;
+#ifdef ENABLE_MATERIALS
+                    diffuse *= march_oren_nayar(sigma, n, next, -rd, fmax(dot(n, next), R(1e-4)));
+#endif
+                    throughput *= diffuse;
+                }
+                ro = p + n * (R(2.0) * eps);
+            }
+        }
+        if (bounce >= GI_BOUNCES) {
+            break;
+        }
+        if (bounce >= GI_ROULETTE) {
+            real survive = clamp(fmax(throughput.x, fmax(throughput.y, throughput.z)),
+                                 GI_SURVIVE_MIN, GI_SURVIVE_MAX);
+            if (march_random(pixel, j, bounce, 4u) >= survive) {
+                break;
+            }
+            throughput /= survive;
+        }
+        MarchCamera along = *cam;
+        along.footprint_base = march_footprint(cam, travelled);
+        MarchResult m = march_ray(ro, next, R(0.0), &along, inside ? R(-1.0) : R(1.0), params);
+        *evals += (uint)m.steps;
+        if (!m.hit) {
+            if (!inside) {
+                radiance += throughput * march_sky(next);
+            }
+            break;
+        }
+        rd = next;
+        p = ro + rd * m.t;
+        travelled += m.t;
+        real footprint = march_footprint(&along, m.t);
+        n = march_normal(p, NORMAL_EPSILON * footprint, rd, params);
+        *evals += MARCH_NORMAL_EVALUATIONS;
+        if (!inside) {
+            n = march_facing(n, rd);
+        }
+    }
+    return radiance;
+}
+#endif
