@@ -45,12 +45,13 @@ real3 march_refract(real3 rd, real3 n, real eta) {
 // Adds a branch of `weight` to the stack, or, a bounce too deep, returns
 // the sky's share it brings instead (the cut-off). Branches too faint to
 // show are dropped.
-real3 march_branch(MarchBranch b, MarchBranch* stack, int* top) {
+real3 march_branch(MarchBranch b, MarchBranch* stack, int* top,
+                   __global const float* environment) {
     if (fmax(b.weight.x, fmax(b.weight.y, b.weight.z)) < MARCH_FAINT) {
         return (real3)(R(0.0));
     }
     if (b.depth > BOUNCES || *top >= BOUNCES + 2) {
-        return b.weight * march_sky(b.rd);
+        return b.weight * march_sky(b.rd, environment);
     }
     stack[(*top)++] = b;
     return (real3)(R(0.0));
@@ -67,7 +68,7 @@ real3 march_branch(MarchBranch b, MarchBranch* stack, int* top) {
 // Returns the colour it adds now; the rays go on the stack.
 real3 march_split(real3 p, real3 n, real3 rd, real eps, real t, real3 weight, int depth,
                   real3 own, __global const real* params, MarchBranch* stack, int* top,
-                  uint* evals) {
+                  __global const float* environment, uint* evals) {
     real8 material;
     DE_material(p, params, &material);
     *evals += 1u;
@@ -83,7 +84,7 @@ real3 march_split(real3 p, real3 n, real3 rd, real eps, real t, real3 weight, in
         if (dot(bent, bent) > R(0.0)) {
             MarchBranch b = {p - n * (R(2.0) * eps), normalize(bent), weight * passed, t,
                              depth + 1, 1};
-            color += march_branch(b, stack, top);
+            color += march_branch(b, stack, top, environment);
         } else {
             reflected += passed;
         }
@@ -92,7 +93,7 @@ real3 march_split(real3 p, real3 n, real3 rd, real eps, real t, real3 weight, in
     if (reflected > R(0.0)) {
         MarchBranch b = {p + n * (R(2.0) * eps), rd - R(2.0) * dot(rd, n) * n,
                          weight * reflected, t, depth + 1, 0};
-        color += march_branch(b, stack, top);
+        color += march_branch(b, stack, top, environment);
     }
     return color;
 }
@@ -108,11 +109,11 @@ real3 march_split(real3 p, real3 n, real3 rd, real eps, real t, real3 weight, in
 // evaluation to *evals.
 real3 march_paths(real3 p, real3 n, real3 rd, real eps, real t, const MarchCamera* cam,
                   real3 own, __global const real* params, __global const real* lights,
-                  int light_count, uint* evals) {
+                  int light_count, __global const float* environment, uint* evals) {
     MarchBranch stack[BOUNCES + 2];
     int top = 0;
     real3 color = march_split(p, n, rd, eps, t, (real3)(R(1.0)), 0, own, params, stack, &top,
-                              evals);
+                              environment, evals);
     while (top > 0) {
         MarchBranch b = stack[--top];
         // The footprint goes on growing along the path.
@@ -122,7 +123,7 @@ real3 march_paths(real3 p, real3 n, real3 rd, real eps, real t, const MarchCamer
                                   params);
         *evals += (uint)m.steps;
         if (!m.hit) {
-            color += b.weight * march_sky(b.rd);
+            color += b.weight * march_sky(b.rd, environment);
             continue;
         }
         real3 q = b.ro + b.rd * m.t;
@@ -143,13 +144,14 @@ real3 march_paths(real3 p, real3 n, real3 rd, real eps, real t, const MarchCamer
                 next.rd = b.rd - R(2.0) * dot(b.rd, nq) * nq;
                 next.inside = 1;
             }
-            color += march_branch(next, stack, &top);
+            color += march_branch(next, stack, &top, environment);
             continue;
         }
         real occlusion = march_occlusion(q, nq, footprint * cam->image_h, R(0.5), params, evals);
-        real3 lit = march_shade(q, nq, b.rd, eq, occlusion, params, lights, light_count, evals);
+        real3 lit = march_shade(q, nq, b.rd, eq, occlusion, params, lights, light_count,
+                                environment, evals);
         color += march_split(q, nq, b.rd, eq, travelled, b.weight, b.depth, lit, params, stack,
-                             &top, evals);
+                             &top, environment, evals);
     }
     return color;
 }

@@ -66,14 +66,133 @@ real3 march_brdf(real3 n, real3 to_light, real3 rd, real3 albedo, real ks, real 
     return diffuse + ks * (shininess + R(2.0)) * R(0.5) * lobe;
 }
 
+// The density, over solid angle, with which the surface's scattering
+// (march_path) sends a path leaving p (normal n, reached along rd) along
+// the unit direction d: the diffuse share's cosine lobe and the specular
+// share's Phong lobe.
+real march_brdf_pdf(real3 n, real3 rd, real3 d, real ks, real shininess) {
+    real ndl = dot(n, d);
+    if (ndl <= R(0.0)) {
+        return R(0.0);
+    }
+    real3 mirror = rd - R(2.0) * dot(rd, n) * n;
+    real lobe = pow(fmax(dot(mirror, d), R(0.0)), shininess);
+    return ((R(1.0) - ks) * ndl + ks * (shininess + R(1.0)) * R(0.5) * lobe) / GI_PI;
+}
+
+// The weight of a sample drawn with density a, where another strategy
+// would have drawn it with density b (Veach's power heuristic,
+// a^2 / (a^2 + b^2), by the ratio of the smaller to the larger: densities
+// near a pole of the environment overflow when squared).
+real march_power_heuristic(real a, real b) {
+    if (!(a > R(0.0))) {
+        return R(0.0);
+    }
+    if (a >= b) {
+        real r = b / a;
+        return R(1.0) / (R(1.0) + r * r);
+    }
+    real r = a / b;
+    return r * r / (R(1.0) + r * r);
+}
+
+#ifdef ENABLE_ENVIRONMENT
+// The environment image's texel (x, y) of row y's conditional distribution
+// and the marginal distribution of rows (codegen::interface::environment):
+// cumulative sums, 0 first and 1 last, of each texel's luminance times the
+// sine of its row's polar angle.
+int march_env_marginal(int w, int h) {
+    return ENV_TEXELS + 3 * w * h;
+}
+
+int march_env_conditional(int w, int h, int row) {
+    return march_env_marginal(w, h) + (h + 1) + row * (w + 1);
+}
+
+// The bin of the n + 1 cumulative sums at `at` that holds u, and where in
+// it u lies (in [0, 1)).
+int march_env_find(__global const float* env, int at, int n, real u, real* frac) {
+    int lo = 0;
+    int hi = n;
+    while (hi - lo > 1) {
+        int mid = (lo + hi) / 2;
+        if ((real)env[at + mid] <= u) {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    real width = (real)env[at + lo + 1] - (real)env[at + lo];
+    *frac = width > R(0.0) ? clamp((u - (real)env[at + lo]) / width, R(0.0), R(0.99999)) : R(0.5);
+    return lo;
+}
+
+// The density over solid angle with which march_env_sample draws the unit
+// direction d: its texel's probability times the texels per unit of
+// image area, over the area's solid angle 2 pi^2 sin(theta).
+real march_env_pdf(__global const float* env, real3 d) {
+    int w = (int)env[ENV_WIDTH];
+    int h = (int)env[ENV_HEIGHT];
+    real2 uv = march_env_uv(env, d);
+    int x = clamp((int)(uv.x * (real)w), 0, w - 1);
+    int y = clamp((int)(uv.y * (real)h), 0, h - 1);
+    int row = march_env_conditional(w, h, y);
+    int rows = march_env_marginal(w, h);
+    real p = ((real)env[rows + y + 1] - (real)env[rows + y])
+             * ((real)env[row + x + 1] - (real)env[row + x]);
+    real sin_theta = sqrt(fmax(R(1.0) - d.y * d.y, R(0.0)));
+    return p * (real)(w * h) / (R(2.0) * MARCH_PI * MARCH_PI * fmax(sin_theta, REAL_TINY));
+}
+
+// A direction drawn from the environment in proportion to its texels'
+// luminance, from the two uniform numbers u and v; its density in *pdf.
+real3 march_env_sample(__global const float* env, real u, real v, real* pdf) {
+    int w = (int)env[ENV_WIDTH];
+    int h = (int)env[ENV_HEIGHT];
+    real fy;
+    int y = march_env_find(env, march_env_marginal(w, h), h, u, &fy);
+    real fx;
+    int x = march_env_find(env, march_env_conditional(w, h, y), w, v, &fx);
+    real2 uv = (real2)(((real)x + fx) / (real)w, ((real)y + fy) / (real)h);
+    real phi = (uv.x - R(0.5)) * R(2.0) * MARCH_PI;
+    real theta = uv.y * MARCH_PI;
+    real3 own = (real3)(sin(theta) * sin(phi), cos(theta), -sin(theta) * cos(phi));
+    // Into the scene's frame: turned by the rotation about +Y.
+    real c = (real)env[ENV_ROTATION_COS];
+    real s = (real)env[ENV_ROTATION_SIN];
+    real3 d = (real3)(c * own.x + s * own.z, own.y, -s * own.x + c * own.z);
+    *pdf = march_env_pdf(env, d);
+    return d;
+}
+#endif
+
 // Next-event estimation at the surface point p (normal n facing the path,
 // hit threshold eps, `travelled` from the camera) reached along rd: the
-// light of every light that sees p, through the surface's scattering.
+// light of every light that sees p, through the surface's scattering, and
+// with an environment a direction drawn from it by importance (with the
+// uniform numbers u and v), weighted against the surface's own sampling
+// of the same direction by the power heuristic.
 real3 march_direct(real3 p, real3 n, real3 rd, real eps, real travelled, const MarchCamera* cam,
-                   real3 albedo, real ks, real shininess, real sigma,
+                   real3 albedo, real ks, real shininess, real sigma, real u, real v,
                    __global const real* params, __global const real* lights, int light_count,
-                   uint* evals) {
+                   __global const float* environment, uint* evals) {
     real3 sum = (real3)(R(0.0));
+#ifdef ENABLE_ENVIRONMENT
+    if (environment[ENV_TOTAL] > 0.0f) {
+        real pdf;
+        real3 d = march_env_sample(environment, u, v, &pdf);
+        real ndl = dot(n, d);
+        if (ndl > R(0.0) && pdf > R(0.0)) {
+            real3 lifted = p + n * (R(2.0) * eps);
+            if (march_visible(lifted, d, MAX_DISTANCE, cam, travelled, params, evals)) {
+                real weight = march_power_heuristic(pdf, march_brdf_pdf(n, rd, d, ks, shininess));
+                sum += march_environment_texel(environment, d)
+                       * march_brdf(n, d, rd, albedo, ks, shininess, sigma, ndl)
+                       * (ndl * weight / (GI_PI * pdf));
+            }
+        }
+    }
+#endif
     for (int i = 0; i < light_count; ++i) {
         __global const real* l = lights + LIGHT_STRIDE * i;
         real3 to_light;
@@ -103,16 +222,21 @@ real3 march_direct(real3 p, real3 n, real3 rd, real eps, real travelled, const M
 // Adds its evaluations to *evals.
 real3 march_path(real3 p, real3 n, real3 rd, real t, const MarchCamera* cam, uint pixel, uint j,
                  __global const real* params, __global const real* lights, int light_count,
-                 uint* evals) {
+                 __global const float* environment, uint* evals) {
     real3 radiance = (real3)(R(0.0));
     real3 throughput = (real3)(R(1.0));
     real travelled = t;
     int inside = 0;
+    // The density the surface's scattering drew the path's last direction
+    // with, 0 for a mirror or a refraction: where the path then leaves,
+    // the environment's light is weighted against its own sampling.
+    real drawn = R(0.0);
     for (int bounce = 0;; ++bounce) {
         real eps = DETAIL * march_footprint(cam, travelled);
         real choose = march_random(pixel, j, bounce, 0u);
         real3 next = rd;
         real3 ro = p;
+        drawn = R(0.0);
         if (inside) {
             // Leaving a transparent shape: n is its outward normal.
             real ior = R(1.0);
@@ -176,8 +300,10 @@ real3 march_path(real3 p, real3 n, real3 rd, real t, const MarchCamera* cam, uin
                 inside = 1;
             } else {
                 radiance += throughput * march_direct(p, n, rd, eps, travelled, cam, albedo, ks,
-                                                      shininess, sigma, params, lights,
-                                                      light_count, evals);
+                                                      shininess, sigma,
+                                                      march_random(pixel, j, bounce, 5u),
+                                                      march_random(pixel, j, bounce, 6u), params,
+                                                      lights, light_count, environment, evals);
                 if (bounce >= GI_BOUNCES) {
                     break;
                 }
@@ -201,6 +327,7 @@ real3 march_path(real3 p, real3 n, real3 rd, real t, const MarchCamera* cam, uin
 #endif
                     throughput *= diffuse;
                 }
+                drawn = march_brdf_pdf(n, rd, next, ks, shininess);
                 ro = p + n * (R(2.0) * eps);
             }
         }
@@ -221,7 +348,16 @@ real3 march_path(real3 p, real3 n, real3 rd, real t, const MarchCamera* cam, uin
         *evals += (uint)m.steps;
         if (!m.hit) {
             if (!inside) {
-                radiance += throughput * march_sky(next);
+                real3 sky = march_sky(next, environment);
+#ifdef ENABLE_ENVIRONMENT
+                // Light that a bounce off the surface found, where the
+                // lights' sampling could have found it too.
+                if (drawn > R(0.0) && environment[ENV_TOTAL] > 0.0f) {
+                    sky = march_environment_texel(environment, next)
+                          * march_power_heuristic(drawn, march_env_pdf(environment, next));
+                }
+#endif
+                radiance += throughput * sky;
             }
             break;
         }

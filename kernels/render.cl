@@ -275,9 +275,10 @@ __kernel void render_tile(RENDER_TILE_ARGS) {
         total_evals += (uint)m.steps;
 
         real3 background = march_background(&cam, py);
-#ifdef ENABLE_GI
-        // The sky that lights the paths, seen along the ray.
-        background = march_sky(rd);
+#ifdef ENABLE_SKY_BACKGROUND
+        // The sky that lights the paths, or the environment, seen along
+        // the ray.
+        background = march_sky(rd, environment);
 #endif
         real3 color = background;
         real3 n = (real3)(R(0.0));
@@ -333,15 +334,15 @@ __kernel void render_tile(RENDER_TILE_ARGS) {
 #endif
 #endif
             color = march_shade(p, n, rd, DETAIL * footprint, occlusion, params, lights,
-                                light_count, &total_evals);
+                                light_count, environment, &total_evals);
 #ifdef ENABLE_MATERIALS
             color = march_paths(p, n, rd, DETAIL * footprint, m.t, &cam, color, params, lights,
-                                light_count, &total_evals);
+                                light_count, environment, &total_evals);
 #endif
 #endif
 #ifdef ENABLE_GI
             color = march_path(p, n, rd, fmax(m.t, R(0.0)), &cam, pixel, j, params, lights,
-                               light_count, &total_evals);
+                               light_count, environment, &total_evals);
 #endif
 #ifdef ENABLE_FOG
             color = mix(background, color, exp(-FOG_DENSITY * m.t));

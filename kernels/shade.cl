@@ -171,12 +171,95 @@ real3 march_background(const MarchCamera* cam, real py) {
     real v = clamp(R(1.0) - py / cam->image_h, R(0.0), R(1.0));
     return mix(SKY_BOTTOM, SKY_TOP, v);
 }
+#ifdef ENABLE_ENVIRONMENT
+
+// The environment light (scene::Environment), from its buffer (the layout
+// of codegen::interface::environment): an equirectangular image, direction
+// d at u = 1/2 + atan2(d.x, -d.z) / 2 pi across and v = acos(d.y) / pi
+// down in the image's own frame, which is the scene's turned by the
+// rotation about +Y.
+#define MARCH_PI R(3.14159265358979324)
+
+// Texel (x, y) of the w x h image at `at` in the buffer.
+real3 march_env_texel(__global const float* env, int at, int w, int x, int y) {
+    int i = at + 3 * (y * w + x);
+    return (real3)((real)env[i], (real)env[i + 1], (real)env[i + 2]);
+}
+
+// The w x h image at `at` at (u, v), bilinear between texel centres,
+// wrapping across u and clamped in v (scene::EnvironmentMap::radiance).
+real3 march_env_bilinear(__global const float* env, int at, int w, int h, real2 uv) {
+    real fx = uv.x * (real)w - R(0.5);
+    real fy = clamp(uv.y * (real)h - R(0.5), R(0.0), (real)(h - 1));
+    real x0 = floor(fx);
+    real y0 = floor(fy);
+    real tx = fx - x0;
+    real ty = fy - y0;
+    int xa = (int)x0 % w;
+    xa += xa < 0 ? w : 0;
+    int xb = (xa + 1) % w;
+    int ya = (int)y0;
+    int yb = min(ya + 1, h - 1);
+    real3 a = march_env_texel(env, at, w, xa, ya);
+    real3 b = march_env_texel(env, at, w, xb, ya);
+    real3 c = march_env_texel(env, at, w, xa, yb);
+    real3 e = march_env_texel(env, at, w, xb, yb);
+    return mix(mix(a, b, tx), mix(c, e, tx), ty);
+}
+
+// The image coordinates of the unit direction d.
+real2 march_env_uv(__global const float* env, real3 d) {
+    real c = (real)env[ENV_ROTATION_COS];
+    real s = (real)env[ENV_ROTATION_SIN];
+    real3 turned = (real3)(c * d.x - s * d.z, d.y, s * d.x + c * d.z);
+    return (real2)(R(0.5) + atan2(turned.x, -turned.z) / (R(2.0) * MARCH_PI),
+                   acos(clamp(turned.y, R(-1.0), R(1.0))) / MARCH_PI);
+}
+
+// The environment's radiance along the unit direction d, as its texel
+// holds it: what lights a surface, constant over each texel as the
+// importance sampling of paths.cl draws them.
+real3 march_environment_texel(__global const float* env, real3 d) {
+    int w = (int)env[ENV_WIDTH];
+    int h = (int)env[ENV_HEIGHT];
+    real2 uv = march_env_uv(env, d);
+    int x = clamp((int)(uv.x * (real)w), 0, w - 1);
+    int y = clamp((int)(uv.y * (real)h), 0, h - 1);
+    return march_env_texel(env, ENV_TEXELS, w, x, y) * (real)env[ENV_INTENSITY];
+}
+
+// The environment's radiance along the unit direction d, bilinear between
+// texel centres: what the camera, mirrors and glass show.
+real3 march_environment(__global const float* env, real3 d) {
+    int w = (int)env[ENV_WIDTH];
+    int h = (int)env[ENV_HEIGHT];
+    return march_env_bilinear(env, ENV_TEXELS, w, h, march_env_uv(env, d))
+           * (real)env[ENV_INTENSITY];
+}
+
+// The environment's irradiance on a face turned along the unit normal n,
+// over pi: the radiance a white Lambertian face sends back under it,
+// unoccluded (precomputed by the host at a few texels).
+real3 march_environment_irradiance(__global const float* env, real3 n) {
+    int w = (int)env[ENV_WIDTH];
+    int h = (int)env[ENV_HEIGHT];
+    int at = ENV_TEXELS + 3 * w * h + (h + 1) + h * (w + 1);
+    return march_env_bilinear(env, at, (int)env[ENV_IRRADIANCE_WIDTH],
+                              (int)env[ENV_IRRADIANCE_HEIGHT], march_env_uv(env, n))
+           * (real)env[ENV_INTENSITY];
+}
+#endif
 #ifdef ENABLE_SKY_RAYS
 
-// The sky seen along rd, where a path leaves the scene or is cut off:
-// SKY_BOTTOM straight down, SKY_TOP straight up.
-real3 march_sky(real3 rd) {
-    return mix(SKY_BOTTOM, SKY_TOP, clamp(R(0.5) + R(0.5) * rd.y, R(0.0), R(1.0)));
+// The sky seen along rd, where a path leaves the scene or is cut off: the
+// environment light, or without one SKY_BOTTOM straight down and SKY_TOP
+// straight up.
+real3 march_sky(real3 rd, __global const float* environment) {
+    real3 sky = mix(SKY_BOTTOM, SKY_TOP, clamp(R(0.5) + R(0.5) * rd.y, R(0.0), R(1.0)));
+#ifdef ENABLE_ENVIRONMENT
+    sky = march_environment(environment, rd);
+#endif
+    return sky;
 }
 #endif
 
@@ -273,7 +356,7 @@ real3 march_light(__global const real* l, real3 p, real3* to_light, real* light_
 // MARCH_SPECULAR and MARCH_SHININESS, the default material's.
 real3 march_shade(real3 p, real3 n, real3 rd, real eps, real occlusion,
                   __global const real* params, __global const real* lights, int light_count,
-                  uint* evals) {
+                  __global const float* environment, uint* evals) {
     real3 albedo;
     real trap;
     DE_shade(p, params, &albedo, &trap);
@@ -294,6 +377,9 @@ real3 march_shade(real3 p, real3 n, real3 rd, real eps, real occlusion,
 #endif
 
     real3 sky = mix(SKY_BOTTOM, SKY_TOP, R(0.5) + R(0.5) * n.y);
+#ifdef ENABLE_ENVIRONMENT
+    sky = march_environment_irradiance(environment, n);
+#endif
     real3 color = albedo * sky * (MARCH_AMBIENT * occlusion);
 
 #ifdef ENABLE_SHADOWS

@@ -158,6 +158,13 @@ pub enum Error {
     /// The scene has no geometry.
     #[error("the scene is empty: add geometry with `Scene::new(node)` or `Scene::add`")]
     EmptyScene,
+    /// An environment light ([`Environment`](crate::scene::Environment))
+    /// or its image is invalid.
+    #[error("environment: {reason}")]
+    Environment {
+        /// What is wrong.
+        reason: String,
+    },
     /// The camera cannot form an image.
     #[error("degenerate camera: {reason}")]
     Camera {

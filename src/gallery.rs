@@ -17,15 +17,15 @@ use glam::{DVec3, dvec3};
 use crate::animation::{CameraPath, Motion};
 use crate::error::Result;
 use crate::file::SceneFile;
-use crate::quality::{Effects, Glow, Quality};
+use crate::quality::{Effects, GlobalIllumination, Glow, Quality};
 use crate::scene::{
-    Axis, Camera, Hybrid, HybridOp, InsideShape, Kifs, KifsFold, Light, Mandelbulb, Material, Node,
-    OrbitColoring, Palette, Profile, PseudoKleinian, QuaternionJulia, Scene, Trap, box_frame,
-    capped_cone, capped_torus, capsule, cone, cone_between, cuboid, cut_hollow_sphere, cut_sphere,
-    cylinder, cylinder_between, death_star, ellipsoid, extrude, hex_prism, julia, link, menger,
-    octahedron, param, param3, plane, pyramid, quad, revolve, rhombus, round_box, round_cone,
-    round_cone_between, rounded_cylinder, sierpinski, solid_angle, sphere, torus, tri_prism,
-    triangle,
+    Axis, Camera, Environment, EnvironmentMap, Hybrid, HybridOp, InsideShape, Kifs, KifsFold,
+    Light, Mandelbulb, Material, Node, OrbitColoring, Palette, Profile, PseudoKleinian,
+    QuaternionJulia, Scene, Trap, box_frame, capped_cone, capped_torus, capsule, cone,
+    cone_between, cuboid, cut_hollow_sphere, cut_sphere, cylinder, cylinder_between, death_star,
+    ellipsoid, extrude, hex_prism, julia, link, menger, octahedron, param, param3, plane, pyramid,
+    quad, revolve, rhombus, round_box, round_cone, round_cone_between, rounded_cylinder,
+    sierpinski, solid_angle, sphere, torus, tri_prism, triangle,
 };
 
 /// Every gallery scene by name.
@@ -53,7 +53,62 @@ pub fn all() -> Vec<(&'static str, Scene)> {
         ("orbit_traps", orbit_traps()),
         ("profiles", profiles()),
         ("keyframes", keyframes()),
+        ("gi", global_illumination()),
     ]
+}
+
+/// The direction of the sun in [`sky`]: low, from behind the subject and
+/// to its right, so that it rims the shapes and casts its shadows towards
+/// the camera.
+pub const SKY_SUN: DVec3 = DVec3::new(0.62, 0.5, 0.6);
+
+/// The size of [`sky`]'s image, in texels.
+pub const SKY_SIZE: (u32, u32) = (256, 128);
+
+/// The daylight sky the gallery's `gi` scene is lit by: the crate's
+/// `scenes/sky.hdr`, which [`EnvironmentMap::sky`] makes with the sun
+/// along [`SKY_SUN`] at [`SKY_SIZE`] (and the scene files name as
+/// `sky.hdr`, beside them).
+///
+/// # Panics
+/// Never: the image is part of the crate.
+#[must_use]
+pub fn sky() -> Environment {
+    let bytes = include_bytes!("../scenes/sky.hdr");
+    let map = EnvironmentMap::from_hdr_bytes(bytes).expect("the crate's sky is a valid image");
+    Environment::new(map).source("sky.hdr")
+}
+
+/// A Mandelbulb on a pale floor beside a white wall, a red ball and a
+/// glass ball, lit by nothing but [`sky`], with global illumination in
+/// its scene file: the wall takes the sky's light and the ball's red onto
+/// the floor and the fractal's shaded side, and the glass bends the sky.
+#[must_use]
+pub fn global_illumination() -> Scene {
+    let bulb = Node::from(Mandelbulb::new(8.0).iterations(8))
+        .rotate(DVec3::X, -FRAC_PI_2)
+        .scale(0.8)
+        .color(dvec3(0.95, 0.75, 0.5))
+        .translate(dvec3(-0.2, 0.0, 0.0));
+    let wall = round_box(dvec3(2.2, 1.2, 0.1), 0.04)
+        .color(dvec3(0.9, 0.9, 0.88))
+        .translate(dvec3(0.0, 0.4, -1.3));
+    let red = sphere(0.4)
+        .color(dvec3(0.85, 0.12, 0.08))
+        .material(Material::lambert())
+        .translate(dvec3(1.3, -0.4, -0.6));
+    let glass = sphere(0.32)
+        .material(Material::glass(1.5))
+        .translate(dvec3(-1.45, -0.48, 0.5));
+    let ground = plane(DVec3::Y, 0.8).color(dvec3(0.7, 0.68, 0.64));
+    let shapes = [bulb, wall, red, glass, ground]
+        .into_iter()
+        .reduce(Node::union)
+        .expect("five shapes");
+    Scene::new(shapes)
+        .with_camera(Camera::look_at(dvec3(0.6, 0.7, 4.2), dvec3(0.0, -0.15, -0.2)).fov(42.0))
+        .with_lights([])
+        .with_environment(sky())
 }
 
 /// A Mandelbulb animated by keyframes alone: its `power` eases from 8 down
@@ -178,10 +233,15 @@ pub fn file(name: &str) -> Option<SceneFile> {
         // a pixel average their noise.
         quality = quality.brute_step(2.0);
     }
+    let effects = match name {
+        // Lit by its sky alone: path traced, without the glow.
+        "gi" => Effects::default().global_illumination(GlobalIllumination::default()),
+        _ => Effects::default().glow(Glow::new(dvec3(0.6, 0.75, 1.0), 0.6)),
+    };
     Some(SceneFile {
         scene,
         quality: Some(quality),
-        effects: Effects::default().glow(Glow::new(dvec3(0.6, 0.75, 1.0), 0.6)),
+        effects,
         path: match name {
             "benchmark" => Some(benchmark_path().expect("a constant path")),
             "keyframes" => Some(keyframes_path().expect("a constant path")),

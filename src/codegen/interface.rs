@@ -149,6 +149,61 @@ pub mod layer {
     pub const WRITE_LAYERS: i32 = 2;
 }
 
+/// The environment buffer (`environment` argument of `render_tile`), in
+/// floats whatever the precision: the header's fields, then from
+/// [`TEXELS`](environment::TEXELS) the image's texels (RGB, row by row from
+/// the top), the marginal distribution of its rows (`height + 1`
+/// cumulative sums from 0 to 1 of each row's luminance times the sine of
+/// its polar angle), each row's conditional distribution of texels
+/// (`width + 1` cumulative sums from 0 to 1 each), and the irradiance
+/// map's texels (RGB). A scene without an environment passes the header
+/// alone, all zeros.
+pub mod environment {
+    use super::{Field, field};
+
+    /// The image's width in texels.
+    pub const WIDTH: Field = field("WIDTH", 0, 1);
+    /// The image's height in texels.
+    pub const HEIGHT: Field = field("HEIGHT", 1, 1);
+    /// The cosine of the image's turn about +Y.
+    pub const ROTATION_COS: Field = field("ROTATION_COS", 2, 1);
+    /// The sine of the image's turn about +Y.
+    pub const ROTATION_SIN: Field = field("ROTATION_SIN", 3, 1);
+    /// What every radiance is multiplied by.
+    pub const INTENSITY: Field = field("INTENSITY", 4, 1);
+    /// The sum of the texels' weights before normalising (0: nothing to
+    /// sample; the light is black).
+    pub const TOTAL: Field = field("TOTAL", 5, 1);
+    /// The irradiance map's width in texels.
+    pub const IRRADIANCE_WIDTH: Field = field("IRRADIANCE_WIDTH", 6, 1);
+    /// The irradiance map's height in texels.
+    pub const IRRADIANCE_HEIGHT: Field = field("IRRADIANCE_HEIGHT", 7, 1);
+    /// Every field, in buffer order.
+    pub const FIELDS: [Field; 8] = [
+        WIDTH,
+        HEIGHT,
+        ROTATION_COS,
+        ROTATION_SIN,
+        INTENSITY,
+        TOTAL,
+        IRRADIANCE_WIDTH,
+        IRRADIANCE_HEIGHT,
+    ];
+    /// Where the image's texels start: the header's length.
+    pub const TEXELS: usize = 8;
+
+    /// Floats in the buffer of a `width` × `height` image with an
+    /// `irradiance_width` × `irradiance_height` irradiance map.
+    #[must_use]
+    pub const fn len(width: usize, height: usize, irradiance: (usize, usize)) -> usize {
+        TEXELS
+            + 3 * width * height
+            + (height + 1)
+            + height * (width + 1)
+            + 3 * irradiance.0 * irradiance.1
+    }
+}
+
 /// The arguments of the rendering kernel `render_tile`, in order.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 #[allow(missing_docs)] // Each is described by its declaration in `RENDER_TILE`.
@@ -180,6 +235,7 @@ pub enum RenderArg {
     BruteSteps,
     Linear,
     Layers,
+    Environment,
 }
 
 /// `render_tile`'s declarations, in argument order: the one list of its
@@ -192,8 +248,9 @@ pub enum RenderArg {
 /// programs that march inside shapes by brute force). With `write_aovs`
 /// at [`layer::WRITE_LAYERS`], every pass writes the exposed linear colour
 /// and the fraction of samples that hit to `linear`, and the first the
-/// shading layers to `layers`.
-pub const RENDER_TILE: [(RenderArg, &str); 26] = [
+/// shading layers to `layers`. `environment` holds the environment light
+/// ([`environment`]).
+pub const RENDER_TILE: [(RenderArg, &str); 27] = [
     (RenderArg::Params, "__global const real* params"),
     (RenderArg::Camera, "__global const real* camera"),
     (RenderArg::Lights, "__global const real* lights"),
@@ -220,6 +277,7 @@ pub const RENDER_TILE: [(RenderArg, &str); 26] = [
     (RenderArg::BruteSteps, "__global const uint* brute_steps"),
     (RenderArg::Linear, "__global float4* linear"),
     (RenderArg::Layers, "__global float* layers"),
+    (RenderArg::Environment, "__global const float* environment"),
 ];
 
 /// The arguments of the coarse pass `cone_starts` (see
@@ -395,6 +453,10 @@ pub(crate) fn defines(target: super::Target) -> String {
             }
             let _ = writeln!(w, "#define LAYER_STRIDE {}", layer::STRIDE);
             let _ = writeln!(w, "#define WRITE_LAYERS {}", layer::WRITE_LAYERS);
+            for f in environment::FIELDS {
+                let _ = writeln!(w, "#define ENV_{} {}", f.name, f.offset);
+            }
+            let _ = writeln!(w, "#define ENV_TEXELS {}", environment::TEXELS);
         }
         super::Target::Evaluate => {
             let _ = writeln!(w, "#define EVAL_POINTS_ARGS \\\n    {}", args(&EVAL_POINTS));

@@ -67,6 +67,13 @@ pub struct Options {
     pub effects: Effects,
     /// Which kernel to append.
     pub target: Target,
+    /// Whether the scene has an environment light
+    /// ([`Scene::environment`](crate::scene::Scene::environment)): the
+    /// program then reads it (`ENABLE_ENVIRONMENT`) for the background, the
+    /// sky that rays and paths meet, and the ambient light. Its image,
+    /// rotation and intensity are a buffer: changing them never rebuilds
+    /// the program.
+    pub environment: bool,
 }
 
 impl Options {
@@ -87,6 +94,8 @@ setters!(Options {
     effects: Effects,
     /// Sets [`Options::target`].
     target: Target,
+    /// Sets [`Options::environment`].
+    environment: bool,
 });
 
 /// A lighting effect that can be compiled into the marcher. Each names an
@@ -492,6 +501,13 @@ const DIRECT: &str = "ENABLE_DIRECT";
 /// illumination).
 const SKY_RAYS: &str = "ENABLE_SKY_RAYS";
 
+/// The switch of the environment light ([`Options::environment`]).
+const ENVIRONMENT: &str = "ENABLE_ENVIRONMENT";
+
+/// The switch of a background that is the sky along each ray rather than
+/// a gradient down the image (global illumination, an environment).
+const SKY_BACKGROUND: &str = "ENABLE_SKY_BACKGROUND";
+
 /// The switch of the march's glow test against the sphere around the
 /// shapes that glow ([`glow_bound`]).
 const GLOW_BOUND: &str = "ENABLE_GLOW_BOUND";
@@ -539,11 +555,18 @@ fn kernel_with(options: &Options, bounded: bool, features: &Features) -> String 
     let effects = Effect::enabled(options);
     let gi = effects.contains(&Effect::GlobalIllumination);
     let mut on: Vec<&str> = effects.into_iter().map(Effect::switch).collect();
+    let environment = options.environment && options.target == Target::Render;
     if !gi {
         on.push(DIRECT);
     }
-    if gi || features.materials {
+    if gi || environment || features.materials {
         on.push(SKY_RAYS);
+    }
+    if gi || environment {
+        on.push(SKY_BACKGROUND);
+    }
+    if environment {
+        on.push(ENVIRONMENT);
     }
     if bounded {
         on.push(SCENE_BOUND);

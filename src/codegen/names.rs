@@ -128,9 +128,11 @@ fn library_texts() -> Vec<String> {
                     shadows: true,
                     glow: Some(Glow::new(DVec3::ONE, 1.0)),
                     fog_density: 1.0,
+                    global_illumination: Some(crate::quality::GlobalIllumination::default()),
                     ..Effects::default()
                 },
                 target,
+                environment: true,
             };
             let mut w = Writer::new(precision);
             let features = super::Features {

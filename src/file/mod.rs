@@ -87,13 +87,13 @@ pub use catalogue::{NodeCategory, NodeKindInfo, node_kinds};
 use convert::nesting;
 use layout::layout;
 use locate::{SiteMap, line_and_column, locate, unknown_name};
-use schema::{FileRepr, FormulaParam, FormulaRepr, NodeRepr, QualityRepr};
+use schema::{EnvironmentRepr, FileRepr, FormulaParam, FormulaRepr, NodeRepr, QualityRepr};
 use sites::{Located, Sites};
 
 use crate::animation::{CameraPath, Motion};
 use crate::error::{Error, Result};
 use crate::quality::{Effects, Precision, Quality};
-use crate::scene::{CustomShape, Kind, Node, Rule, Scene};
+use crate::scene::{CustomShape, Environment, EnvironmentMap, Kind, Node, Rule, Scene};
 
 /// The format version this library reads and writes.
 pub const FORMAT_VERSION: u32 = 1;
@@ -156,7 +156,17 @@ impl SceneFile {
     /// # Errors
     /// As [`SceneFile::parse`].
     pub fn parse_with(text: &str, shapes: &[CustomShape]) -> Result<Self> {
-        read(text, Path::new(TEXT), shapes)
+        read(text, Path::new(TEXT), Path::new(""), shapes)
+    }
+
+    /// Reads a scene file's text as if it lay in `folder`: the image of
+    /// its environment, named relative to the file, is found there (with
+    /// [`SceneFile::parse`], in the working directory).
+    ///
+    /// # Errors
+    /// As [`SceneFile::parse`].
+    pub fn parse_in(text: &str, folder: impl AsRef<Path>) -> Result<Self> {
+        read(text, Path::new(TEXT), folder.as_ref(), &[])
     }
 
     /// Reads the scene file at `path`.
@@ -177,7 +187,8 @@ impl SceneFile {
         let path = path.as_ref();
         let text = std::fs::read_to_string(path)
             .map_err(|source| Error::io(path, "cannot read the scene file", source))?;
-        read(&text, path, shapes)
+        let folder = path.parent().unwrap_or(Path::new(""));
+        read(&text, path, folder, shapes)
     }
 
     /// The scene file's text. Writing then reading gives back an equal
@@ -205,6 +216,25 @@ impl SceneFile {
             }
             None => self.effects.validate()?,
         }
+        let environment = match &self.scene.environment {
+            Some(e) => {
+                e.validate()?;
+                let image = e.source.clone().ok_or_else(|| {
+                    invalid(
+                        "its environment's image was made in memory, and a scene file names \
+                         an image file: write it with `EnvironmentMap::save_hdr` and name it \
+                         with `Environment::source`"
+                            .into(),
+                    )
+                })?;
+                Some(Located::new(EnvironmentRepr {
+                    image,
+                    rotation_degrees: e.rotation_degrees,
+                    intensity: e.intensity,
+                }))
+            }
+            None => None,
+        };
         let nesting = nesting(geometry);
         if nesting > MAX_NESTING {
             return Err(invalid(format!(
@@ -235,6 +265,7 @@ impl SceneFile {
                 .copied()
                 .map(Located::new)
                 .collect(),
+            environment,
             quality: self
                 .quality
                 .as_ref()
@@ -296,7 +327,7 @@ fn formulas(node: &Node) -> Vec<(CustomShape, String)> {
 // Reading
 
 /// Parses, converts and validates; every error located in `text`.
-fn read(text: &str, file: &Path, shapes: &[CustomShape]) -> Result<SceneFile> {
+fn read(text: &str, file: &Path, folder: &Path, shapes: &[CustomShape]) -> Result<SceneFile> {
     // A byte order mark some editors write is not part of the text.
     let text = text.strip_prefix('\u{feff}').unwrap_or(text);
     let at = |line: usize, column: usize, reason: String, cause: Option<Error>| Error::SceneFile {
@@ -386,10 +417,15 @@ fn read(text: &str, file: &Path, shapes: &[CustomShape]) -> Result<SceneFile> {
         .geometry
         .to_node(&all, &mut sites, 1)
         .map_err(|(site, e)| located(site, e))?;
+    let environment = match &repr.environment {
+        Some(e) => Some(read_environment(&e.value, folder).map_err(|err| located(e.site, err))?),
+        None => None,
+    };
     let scene = Scene {
         geometry: Some(geometry),
         lights: repr.lights.iter().map(|l| l.value).collect(),
         camera: repr.camera.value,
+        environment,
     };
     let compiled = scene.compile().map_err(|e| {
         let site = sites
@@ -463,6 +499,17 @@ fn read(text: &str, file: &Path, shapes: &[CustomShape]) -> Result<SceneFile> {
         path,
         motions: repr.motions.into_iter().map(|m| m.value).collect(),
     })
+}
+
+/// The environment a file names: its image read relative to `folder`,
+/// the file's, and named again as the file names it.
+fn read_environment(repr: &EnvironmentRepr, folder: &Path) -> Result<Environment> {
+    let environment = Environment::new(EnvironmentMap::load(folder.join(&repr.image))?)
+        .rotation_degrees(repr.rotation_degrees)
+        .intensity(repr.intensity)
+        .source(repr.image.clone());
+    environment.validate()?;
+    Ok(environment)
 }
 
 /// The values a motion reaches at its extremes, per slot: an oscillation's

@@ -29,6 +29,8 @@ pub(super) struct FileRepr {
     #[serde(default = "default_lights")]
     pub(super) lights: Vec<Located<Light>>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub(super) environment: Option<Located<EnvironmentRepr>>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub(super) quality: Option<Located<QualityRepr>>,
     #[serde(default)]
     pub(super) effects: Located<Effects>,
@@ -36,6 +38,22 @@ pub(super) struct FileRepr {
     pub(super) path: Option<Located<Vec<Keyframe>>>,
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub(super) motions: Vec<Located<Motion>>,
+}
+
+/// The environment light: an image file (relative to the scene file's
+/// folder, or absolute), its turn about +Y and its intensity.
+#[derive(Serialize, Deserialize)]
+#[serde(deny_unknown_fields, rename = "Environment")]
+pub(super) struct EnvironmentRepr {
+    pub(super) image: std::path::PathBuf,
+    #[serde(default)]
+    pub(super) rotation_degrees: f64,
+    #[serde(default = "unit")]
+    pub(super) intensity: f64,
+}
+
+fn unit() -> f64 {
+    1.0
 }
 
 /// A custom shape written as a text formula: `Custom(name: ..)` nodes use

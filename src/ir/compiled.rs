@@ -2,7 +2,7 @@
 
 use super::{Ir, ParamLayout, ParamValues};
 use crate::error::{Error, Result};
-use crate::scene::{Camera, Light, Scene};
+use crate::scene::{Camera, Environment, Light, Scene};
 
 /// A scene validated and lowered once: the geometry's [`Ir`] with its
 /// parameter layout (every rule, including those relating two
@@ -33,6 +33,7 @@ pub struct CompiledScene {
     ir: Ir,
     camera: Camera,
     lights: Vec<Light>,
+    environment: Option<Environment>,
 }
 
 impl CompiledScene {
@@ -86,6 +87,24 @@ impl CompiledScene {
         self.lights = lights;
         Ok(())
     }
+
+    /// The environment light.
+    #[must_use]
+    pub fn environment(&self) -> Option<&Environment> {
+        self.environment.as_ref()
+    }
+
+    /// Replaces the environment light, or removes it with `None`.
+    ///
+    /// # Errors
+    /// [`Error::Environment`] for one that does not validate.
+    pub fn set_environment(&mut self, environment: Option<Environment>) -> Result<()> {
+        if let Some(e) = &environment {
+            e.validate()?;
+        }
+        self.environment = environment;
+        Ok(())
+    }
 }
 
 impl Scene {
@@ -101,10 +120,14 @@ impl Scene {
         let ir = Ir::lower(geometry)?;
         self.camera.validate()?;
         validate_lights(&self.lights)?;
+        if let Some(environment) = &self.environment {
+            environment.validate()?;
+        }
         Ok(CompiledScene {
             ir,
             camera: self.camera,
             lights: self.lights.clone(),
+            environment: self.environment.clone(),
         })
     }
 

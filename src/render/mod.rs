@@ -60,6 +60,7 @@ mod cache;
 mod cancel;
 mod device;
 mod dispatch;
+mod environment;
 mod memory;
 mod points;
 mod program;

@@ -6,6 +6,7 @@
 
 mod build;
 mod custom;
+mod environment;
 mod fractal;
 mod hybrid;
 mod inside;
@@ -33,6 +34,8 @@ pub use build::{
 pub use custom::{
     CpuDistance, CpuInside, CustomShape, INSIDE_HUGE, InsideBounds, MAX_INSIDE_REACH,
 };
+pub(crate) use environment::direction as environment_direction;
+pub use environment::{Environment, EnvironmentMap, MAX_ENVIRONMENT_SIDE};
 pub use fractal::{Kifs, KifsFold, Mandelbox, Mandelbulb, Menger, QuaternionJulia, Sierpinski};
 pub use hybrid::{Hybrid, HybridOp, HybridStage, MAX_HYBRID_OPS};
 pub use inside::{
@@ -545,6 +548,9 @@ pub struct Scene {
     pub lights: Vec<Light>,
     /// The camera.
     pub camera: Camera,
+    /// Light from every direction, an HDR image around the scene; `None`
+    /// (the default) for the sky gradient of the effects.
+    pub environment: Option<Environment>,
 }
 
 impl Scene {
@@ -571,6 +577,7 @@ impl Scene {
                     .color(DVec3::new(0.7, 0.8, 1.0)),
             ],
             camera: Camera::default(),
+            environment: None,
         }
     }
 
@@ -597,6 +604,13 @@ impl Scene {
     #[must_use]
     pub fn with_lights(mut self, lights: impl IntoIterator<Item = Light>) -> Self {
         self.lights = lights.into_iter().collect();
+        self
+    }
+
+    /// Sets the environment light, or removes it with `None`.
+    #[must_use]
+    pub fn with_environment(mut self, environment: impl Into<Option<Environment>>) -> Self {
+        self.environment = environment.into();
         self
     }
 }

@@ -13,7 +13,7 @@ use fractal_sdf::file::MAX_NESTING;
 use fractal_sdf::file::SceneFile;
 use fractal_sdf::gallery;
 use fractal_sdf::prelude::*;
-use fractal_sdf::scene::{CustomShape, Rule};
+use fractal_sdf::scene::{CustomShape, Environment, EnvironmentMap, Rule};
 
 fn scenes_dir() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes")
@@ -24,7 +24,9 @@ fn every_gallery_scene_round_trips_to_an_equal_value() {
     for name in gallery::names() {
         let file = gallery::file(name).unwrap();
         let text = file.to_text().unwrap();
-        let back = SceneFile::parse(&text).unwrap_or_else(|e| panic!("{name}: {e}\n{text}"));
+        // Beside the crate's scene files: `gi` names its sky as `sky.hdr`.
+        let back = SceneFile::parse_in(&text, scenes_dir())
+            .unwrap_or_else(|e| panic!("{name}: {e}\n{text}"));
         assert_eq!(back, file, "{name}:\n{text}");
         // Writing is stable: the text of what was read is the same text.
         assert_eq!(back.to_text().unwrap(), text, "{name}");
@@ -56,7 +58,7 @@ fn a_round_trip_renders_the_identical_image() {
     };
     for name in gallery::names() {
         let file = gallery::file(name).unwrap();
-        let back = SceneFile::parse(&file.to_text().unwrap()).unwrap();
+        let back = SceneFile::parse_in(&file.to_text().unwrap(), scenes_dir()).unwrap();
         let render = |f: &SceneFile| {
             let options = fractal_sdf::render::RenderOptions::default()
                 .quality(Quality::draft())
@@ -720,4 +722,75 @@ fn keyframed_tracks_read_back_and_bad_ones_are_located() {
         err.contains("`fov_y_degrees` must be on every keyframe or on none"),
         "{err}"
     );
+}
+
+/// The crate's `scenes/sky.hdr` is the sky `EnvironmentMap::sky` makes for
+/// the gallery, to the precision of the file's shared exponents (1%);
+/// `UPDATE_SCENES=1` writes it again.
+#[test]
+fn the_shipped_sky_is_the_gallery_sky() {
+    let (w, h) = gallery::SKY_SIZE;
+    let made = EnvironmentMap::sky(w, h, gallery::SKY_SUN).unwrap();
+    let path = scenes_dir().join("sky.hdr");
+    if std::env::var_os("UPDATE_SCENES").is_some() {
+        made.save_hdr(&path).unwrap();
+    }
+    let shipped = EnvironmentMap::load(&path).unwrap();
+    assert_eq!((shipped.width(), shipped.height()), (w, h));
+    for (a, b) in made.texels().iter().zip(shipped.texels()) {
+        for c in 0..3 {
+            let scale = a.iter().fold(0.0f32, |m, v| m.max(*v));
+            assert!((a[c] - b[c]).abs() <= 0.01 * scale, "{a:?} vs {b:?}");
+        }
+    }
+    // The sun is where the gallery says, a thousand times the sky.
+    let sun = gallery::sky().radiance(gallery::SKY_SUN);
+    let beside = gallery::sky().radiance(DVec3::Y);
+    assert!(sun.x > 300.0 && beside.x < 0.5, "{sun} {beside}");
+}
+
+/// An environment's image is found beside the file that names it; a
+/// missing one, or a bad intensity, is an error at the `environment`
+/// field; an image made in memory has no name to write.
+#[test]
+fn an_environment_is_read_beside_its_file_and_errors_are_located() {
+    let dir = std::env::temp_dir().join(format!("fractal-sdf-env-{}", std::process::id()));
+    std::fs::create_dir_all(dir.join("maps")).unwrap();
+    let map = EnvironmentMap::new(4, 2, vec![[0.5, 1.0, 2.0]; 8]).unwrap();
+    map.save_hdr(dir.join("maps/small.hdr")).unwrap();
+    let text = |image: &str, intensity: &str| {
+        format!(
+            "(version: 1, geometry: Sphere(radius: 1.0),\n environment: (image: \"{image}\", \
+             rotation_degrees: 30.0, intensity: {intensity}))"
+        )
+    };
+    let path = dir.join("scene.ron");
+    std::fs::write(&path, text("maps/small.hdr", "2.0")).unwrap();
+    let file = SceneFile::load(&path).unwrap();
+    let env = file.scene.environment.as_ref().unwrap();
+    assert_eq!(env.source.as_deref(), Some(Path::new("maps/small.hdr")));
+    assert_eq!((env.rotation_degrees, env.intensity), (30.0, 2.0));
+    assert_eq!(env.map.texels()[0], [0.5, 1.0, 2.0]);
+    // Written back, it names the image as the file did.
+    assert!(
+        file.to_text()
+            .unwrap()
+            .contains("image: \"maps/small.hdr\"")
+    );
+    for (text, says) in [
+        (
+            text("maps/none.hdr", "1.0"),
+            "cannot read the environment image",
+        ),
+        (text("maps/small.hdr", "-1.0"), "intensity -1"),
+        (text("scene.ron", "1.0"), "`.hdr` or an OpenEXR `.exr`"),
+    ] {
+        std::fs::write(&path, &text).unwrap();
+        let err = SceneFile::load(&path).unwrap_err().to_string();
+        assert!(err.contains(":2:") && err.contains(says), "{err}");
+    }
+    let made = Scene::new(sphere(1.0)).with_environment(Environment::new(map));
+    let err = SceneFile::from(made).to_text().unwrap_err().to_string();
+    assert!(err.contains("EnvironmentMap::save_hdr"), "{err}");
+    std::fs::remove_dir_all(&dir).unwrap();
 }

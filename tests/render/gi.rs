@@ -1,7 +1,8 @@
 //! Path-traced global illumination: the white furnace (no light created or
 //! lost), units that agree with direct lighting, convergence at the rate of
-//! an unbiased estimator against an independent reference, and the noise
-//! estimate of the stopping rule against the true error.
+//! an unbiased estimator against an independent reference, the noise
+//! estimate of the stopping rule against the true error, and environment
+//! lights against closed forms and a brute-force integral.
 
 use crate::gpu;
 
@@ -12,7 +13,7 @@ use fractal_sdf::file::SceneFile;
 use fractal_sdf::prelude::*;
 use fractal_sdf::quality::{GlobalIllumination, display};
 use fractal_sdf::render::{Frame, Renderer, StopRule};
-use fractal_sdf::scene::{InsideBounds, InsideShape};
+use fractal_sdf::scene::{Environment, EnvironmentMap, InsideBounds, InsideShape};
 
 const W: u32 = 48;
 const H: u32 = 32;
@@ -377,4 +378,192 @@ fn global_illumination_refuses_inside_shapes() {
         "{text}"
     );
     codegen::emit(&compiled, &Options::default()).unwrap();
+}
+
+/// A sky of radiance 1 above the horizon and none below, `rows` texels
+/// high (even: the horizon falls between two rows).
+fn half_sky(rows: u32) -> EnvironmentMap {
+    let texels = (0..rows)
+        .flat_map(|y| std::iter::repeat_n(if y < rows / 2 { [1.0f32; 3] } else { [0.0; 3] }, 64))
+        .collect();
+    EnvironmentMap::new(64, rows, texels).unwrap()
+}
+
+/// Linear colours of the pixels wholly covered, and whose four neighbours
+/// are, with the normal through their centres.
+fn interior(frame: &Frame) -> Vec<([f32; 3], DVec3)> {
+    let l = linear(frame);
+    let w = W as usize;
+    (0..l.len())
+        .filter(|&i| {
+            let (x, y) = (i % w, i / w);
+            x > 0
+                && y > 0
+                && x + 1 < w
+                && y + 1 < H as usize
+                && [i, i - 1, i + 1, i - w, i + w]
+                    .iter()
+                    .all(|&j| l[j][3] >= 1.0)
+        })
+        .map(|i| {
+            let n = frame.normal[i];
+            (
+                [l[i][0], l[i][1], l[i][2]],
+                dvec3(f64::from(n[0]), f64::from(n[1]), f64::from(n[2])),
+            )
+        })
+        .collect()
+}
+
+/// A white sphere under a sky of radiance `r` over the upper half and
+/// black below sends back `r (1 + n.y) / 2` along normal `n` (the share
+/// of its cosine-weighted hemisphere above the horizon): a closed form
+/// the path tracer and its importance sampling of the environment must
+/// meet, turned and scaled, without bias (mean error within 1%) and with
+/// little noise (2,048 samples a pixel: 5% at most, rms).
+#[test]
+fn an_environment_lights_a_sphere_as_the_closed_form_says() {
+    let Some(_) = gpu::device() else { return };
+    let env = Environment::new(half_sky(32))
+        .rotation_degrees(40.0)
+        .intensity(2.0);
+    let scene = Scene::new(sphere(0.8).color(DVec3::ONE).material(Material::lambert()))
+        .with_camera(Camera::look_at(dvec3(0.0, 0.3, 3.0), DVec3::ZERO))
+        .with_lights([])
+        .with_environment(env);
+    let options = gpu::options(gpu::plain(Quality::preview()), gi(4).gamma(1.0));
+    let mut renderer = Renderer::with_options(&scene, &options).unwrap();
+    let frame = passes(&mut renderer, 2048);
+    let pixels = interior(&frame);
+    assert!(pixels.len() > 200, "{} pixels", pixels.len());
+    let (mut bias, mut square) = (0.0, 0.0);
+    for (c, n) in &pixels {
+        let want = 2.0 * (1.0 + n.y) / 2.0;
+        let error = (f64::from(c[1]) - want) / want.max(0.2);
+        bias += error;
+        square += error * error;
+    }
+    #[allow(clippy::cast_precision_loss)]
+    let count = pixels.len() as f64;
+    let (bias, rms) = (bias / count, (square / count).sqrt());
+    eprintln!("half sky: mean relative error {bias:.4}, rms {rms:.4}");
+    assert!(bias.abs() < 0.01, "mean relative error {bias}");
+    assert!(rms < 0.05, "rms relative error {rms}");
+}
+
+/// A sun as bright as the rest of the sky put together, in a single texel:
+/// the lights' sampling finds it by importance, so the sphere it lights
+/// is as quiet as under a smooth sky. Without importance sampling the
+/// error measured 0.57 (a few paths in a thousand find the sun).
+#[test]
+fn a_small_bright_sun_is_found_by_importance_sampling() {
+    let Some(_) = gpu::device() else { return };
+    let mut texels = vec![[0.2f32; 3]; 64 * 32];
+    texels[8 * 64 + 20] = [2000.0; 3];
+    let env = Environment::new(EnvironmentMap::new(64, 32, texels).unwrap());
+    let scene = Scene::new(sphere(0.8).color(DVec3::ONE).material(Material::lambert()))
+        .with_camera(Camera::look_at(dvec3(0.0, 0.3, 3.0), DVec3::ZERO))
+        .with_lights([])
+        .with_environment(env.clone());
+    let options = gpu::options(gpu::plain(Quality::preview()), gi(4).gamma(1.0));
+    let mut renderer = Renderer::with_options(&scene, &options).unwrap();
+    let frame = passes(&mut renderer, 256);
+    // The oracle: the texels' radiance, as constant patches, against the
+    // normal's cosine, summed over a fine grid of directions.
+    let map = &env.map;
+    let (mw, mh) = (map.width() as usize, map.height() as usize);
+    let texel = |d: DVec3| {
+        let u = 0.5 + d.x.atan2(-d.z) / std::f64::consts::TAU;
+        let v = d.y.clamp(-1.0, 1.0).acos() / std::f64::consts::PI;
+        #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss)]
+        let (x, y) = (
+            ((u * 64.0) as usize).min(mw - 1),
+            ((v * 32.0) as usize).min(mh - 1),
+        );
+        f64::from(map.texels()[y * mw + x][0])
+    };
+    let (mut square, mut count) = (0.0, 0.0);
+    for (c, n) in interior(&frame) {
+        let k = 256;
+        let mut sum = 0.0;
+        for a in 0..k {
+            for b in 0..2 * k {
+                #[allow(clippy::cast_precision_loss)]
+                let (theta, phi) = (
+                    (f64::from(a) + 0.5) / f64::from(k) * std::f64::consts::PI,
+                    (f64::from(b) + 0.5) / f64::from(2 * k) * std::f64::consts::TAU,
+                );
+                let d = dvec3(
+                    theta.sin() * phi.cos(),
+                    theta.cos(),
+                    theta.sin() * phi.sin(),
+                );
+                let cos = d.dot(n);
+                if cos > 0.0 {
+                    let solid = theta.sin() * (std::f64::consts::PI / f64::from(k)).powi(2);
+                    sum += texel(d) * cos * solid;
+                }
+            }
+        }
+        let want = sum / std::f64::consts::PI;
+        square += ((f64::from(c[0]) - want) / want).powi(2);
+        count += 1.0;
+    }
+    let rms = (square / count).sqrt();
+    eprintln!("sun: rms relative error {rms:.4} over {count} pixels");
+    assert!(rms < 0.06, "rms relative error {rms}");
+}
+
+/// Without global illumination an environment is the background along
+/// each ray, and its irradiance over pi (the sky gradient's share of it)
+/// the ambient light; a new intensity is a buffer, not a program.
+#[test]
+fn direct_light_shows_the_environment_and_takes_its_ambient_light() {
+    let Some(_) = gpu::device() else { return };
+    let env = Environment::new(EnvironmentMap::new(8, 4, vec![[0.6, 0.4, 0.2]; 32]).unwrap());
+    let scene = Scene::new(sphere(0.8).color(DVec3::ONE).material(Material::lambert()))
+        .with_camera(Camera::look_at(dvec3(0.0, 0.3, 3.0), DVec3::ZERO))
+        .with_lights([])
+        .with_environment(env.clone());
+    let effects = Effects::default().ambient_occlusion(false).shadows(false);
+    let options = gpu::options(gpu::plain(Quality::preview()), effects);
+    let mut renderer = Renderer::with_options(&scene, &options).unwrap();
+    let check = |frame: &Frame, scale: f32| {
+        for c in linear(frame) {
+            // A sky of one radiance everywhere: the background is that
+            // radiance, and a white face half of it (the ambient share)
+            // whichever way it faces.
+            let want = if c[3] == 0.0 {
+                1.0
+            } else if c[3] >= 1.0 {
+                0.5
+            } else {
+                continue;
+            };
+            for (v, r) in c[..3].iter().zip([0.6, 0.4, 0.2]) {
+                assert!((v - want * r * scale).abs() < 0.01 * scale, "{c:?}");
+            }
+        }
+    };
+    check(&renderer.render_layers(W, H).unwrap(), 1.0);
+    let builds = renderer.builds();
+    renderer.set_environment(Some(env.intensity(2.0))).unwrap();
+    check(&renderer.render_layers(W, H).unwrap(), 2.0);
+    assert_eq!(
+        renderer.builds(),
+        builds,
+        "a new intensity rebuilt the program"
+    );
+    // Removing it is a new program, back on the blue-grey sky gradient
+    // (the environment was orange).
+    renderer.set_environment(None).unwrap();
+    let plain = renderer.render_layers(W, H).unwrap();
+    assert!(!renderer.source().source.contains("march_environment"));
+    let background = linear(&plain).iter().filter(|c| c[3] == 0.0);
+    assert!(background.clone().count() > 100);
+    assert!(
+        background.clone().all(|c| c[2] > c[0]),
+        "{:?}",
+        background.collect::<Vec<_>>()
+    );
 }

@@ -53,7 +53,8 @@ typedef float4 real4;
     __global const float* brute_depths, \
     __global const uint* brute_steps, \
     __global float4* linear, \
-    __global float* layers
+    __global float* layers, \
+    __global const float* environment
 #define CONE_STARTS_ARGS \
     __global const real* params, \
     __global const real* camera, \
@@ -95,6 +96,15 @@ typedef float4 real4;
 #define LAYER_TRAP 8
 #define LAYER_STRIDE 9
 #define WRITE_LAYERS 2
+#define ENV_WIDTH 0
+#define ENV_HEIGHT 1
+#define ENV_ROTATION_COS 2
+#define ENV_ROTATION_SIN 3
+#define ENV_INTENSITY 4
+#define ENV_TOTAL 5
+#define ENV_IRRADIANCE_WIDTH 6
+#define ENV_IRRADIANCE_HEIGHT 7
+#define ENV_TEXELS 8
 
 /* ---- pseudo_kleinian ---- */
 real2 pseudo_kleinian(real3 p, real iterations, real3 fold_size, real inversion, real3 offset, real thickness) {

@@ -22,7 +22,7 @@ use fractal_sdf::quality::{GlobalIllumination, Preset, ToneMap};
 use fractal_sdf::render::{
     DeviceKind, DeviceSelector, EdgeThresholds, RenderOptions, Renderer, StopRule, devices,
 };
-use fractal_sdf::scene::{CustomShape, Stereo, StereoLayout};
+use fractal_sdf::scene::{CustomShape, Environment, Stereo, StereoLayout};
 use fractal_sdf::sequence::{Encoded, Sequence, parse_range};
 use fractal_sdf::settings::{CONFIG_ENV, Settings, parse_preset, parse_size};
 use indicatif::{ProgressBar, ProgressStyle};
@@ -112,6 +112,11 @@ struct SceneArgs {
     /// Set a dynamic parameter: NAME=VALUE (repeatable).
     #[arg(long = "set", value_name = "NAME=VALUE")]
     set: Vec<String>,
+    /// An environment light: an equirectangular HDR image (.hdr or .exr)
+    /// around the scene, its background and ambient light, which lights it
+    /// exactly with --gi (in place of the scene file's).
+    #[arg(long, value_name = "FILE")]
+    environment: Option<PathBuf>,
     /// A substring of the OpenCL device's name (default: the settings
     /// file's, else automatic).
     #[arg(long)]
@@ -410,7 +415,10 @@ struct Job {
 
 impl Job {
     fn new(args: &SceneArgs, settings: &Settings) -> Outcome<Job> {
-        let file = load_scene(&args.scene)?;
+        let mut file = load_scene(&args.scene)?;
+        if let Some(image) = &args.environment {
+            file.scene.environment = Some(Environment::load(image)?);
+        }
         let preset = match &args.preset {
             Some(name) => Some(parse_preset(name).map_err(|e| usage(e.to_string()))?),
             None => None,

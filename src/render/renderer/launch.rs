@@ -327,6 +327,9 @@ pub(super) fn make_kernel(
             RenderArg::Params => inputs.params.push_arg(&mut b),
             RenderArg::Camera => inputs.camera.push_arg(&mut b),
             RenderArg::Lights => inputs.lights.push_arg(&mut b),
+            RenderArg::Environment => {
+                b.arg(&inputs.environment);
+            }
             RenderArg::Rgba => {
                 b.arg(&t.rgba);
             }
@@ -407,6 +410,8 @@ pub(super) struct Inputs {
     pub(super) params: RealBuffer,
     pub(super) camera: RealBuffer,
     pub(super) lights: RealBuffer,
+    /// The environment light (floats at every precision).
+    pub(super) environment: Buffer<f32>,
 }
 
 impl Inputs {
@@ -417,6 +422,7 @@ impl Inputs {
         source: &KernelSource,
         values: &ParamValues,
         lights: &[Light],
+        environment: Option<&Environment>,
     ) -> Result<Self> {
         let precision = source.precision;
         Ok(Inputs {
@@ -424,6 +430,7 @@ impl Inputs {
             params: RealBuffer::new(queue, precision, &source.param_buffer(values.as_slice()))?,
             camera: RealBuffer::new(queue, precision, &[0.0; camera::LEN])?,
             lights: RealBuffer::new(queue, precision, &pack_lights(lights, DVec3::ZERO))?,
+            environment: environment_buffer(queue, environment)?,
         })
     }
 
@@ -457,6 +464,22 @@ impl Inputs {
             .set_arg(RenderArg::LightCount.index(), count)
             .map_err(opencl)
     }
+}
+
+/// The environment light's buffer on the device
+/// ([`environment::pack`](super::super::environment::pack)).
+pub(super) fn environment_buffer(
+    queue: &Queue,
+    environment: Option<&Environment>,
+) -> Result<Buffer<f32>> {
+    let packed = super::super::environment::pack(environment);
+    Buffer::builder()
+        .queue(queue.clone())
+        .flags(MemFlags::new().read_only())
+        .len(packed.len())
+        .copy_host_slice(&packed)
+        .build()
+        .map_err(opencl)
 }
 
 /// The per-pixel outputs on the device. Without AOVs, the AOV buffers hold

@@ -25,7 +25,7 @@ use crate::codegen::{self, KernelSource};
 use crate::error::{Error, Result};
 use crate::ir::{CompiledScene, ParamValues};
 use crate::quality::{Effects, Precision, Quality};
-use crate::scene::{Camera, Light, Scene};
+use crate::scene::{Camera, Environment, Light, Scene};
 use crate::view::FrameTiming;
 
 mod converge;
@@ -225,6 +225,7 @@ fn generate(
         quality: options.quality,
         effects: options.effects,
         target: codegen::Target::Render,
+        environment: scene.environment().is_some(),
     };
     match functions {
         SceneFunctions::Generated => codegen::emit(scene, &options),
@@ -305,7 +306,13 @@ impl Renderer {
         let selected = device::select(&options.device)?;
         let context = program::context(&selected)?;
         let queue = profiling_queue(&context, &selected)?;
-        let inputs = Inputs::new(&queue, &source, &values, scene.lights())?;
+        let inputs = Inputs::new(
+            &queue,
+            &source,
+            &values,
+            scene.lights(),
+            scene.environment(),
+        )?;
         let targets = Targets::new(&queue, 1, 1, Outputs::Aovs, false)?;
         let (program, build, compiled) = program::build(&selected, &context, &source)?;
         let kernel = make_kernel(&program, &queue, &inputs, &targets)?;
@@ -497,6 +504,29 @@ impl Renderer {
         self.scene.lights()
     }
 
+    /// Replaces the environment light, or removes it with `None`. A new
+    /// image, rotation or intensity is a new buffer; only adding the first
+    /// environment or removing the last changes the program.
+    ///
+    /// # Errors
+    /// [`Error::Environment`] for one that does not validate; else as
+    /// [`Renderer::set_effects`].
+    pub fn set_environment(&mut self, environment: Option<Environment>) -> Result<()> {
+        let had = self.scene.environment().is_some();
+        self.scene.set_environment(environment.clone())?;
+        self.inputs.environment =
+            launch::environment_buffer(&self.queue, self.scene.environment())?;
+        if had == environment.is_some() {
+            self.kernel
+                .set_arg(RenderArg::Environment.index(), &self.inputs.environment)
+                .map_err(device::opencl)?;
+        } else {
+            self.reprogram(self.options.clone())?;
+        }
+        self.progress = None;
+        self.for_partners(|p| p.set_environment(environment.clone()))
+    }
+
     /// The compiled scene this renderer draws, with the current camera and
     /// lights.
     #[must_use]
@@ -594,7 +624,13 @@ impl Renderer {
         let inputs_changed =
             source.precision != self.source.precision || source.constants != self.source.constants;
         if inputs_changed {
-            self.inputs = Inputs::new(&self.queue, &source, &self.values, self.scene.lights())?;
+            self.inputs = Inputs::new(
+                &self.queue,
+                &source,
+                &self.values,
+                self.scene.lights(),
+                self.scene.environment(),
+            )?;
         }
         self.kernel = make_kernel(&program, &self.queue, &self.inputs, &self.targets)?;
         self.cone = make_cone(&program, &self.queue, &self.inputs, &self.targets, &source)?;

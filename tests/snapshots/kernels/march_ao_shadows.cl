@@ -503,7 +503,7 @@ real3 march_light(__global const real* l, real3 p, real3* to_light, real* light_
 // MARCH_SPECULAR and MARCH_SHININESS, the default material's.
 real3 march_shade(real3 p, real3 n, real3 rd, real eps, real occlusion,
                   __global const real* params, __global const real* lights, int light_count,
-                  uint* evals) {
+                  __global const float* environment, uint* evals) {
     real3 albedo;
     real trap;
     DE_shade(p, params, &albedo, &trap);
@@ -803,7 +803,7 @@ __kernel void render_tile(RENDER_TILE_ARGS) {
             real offset = R(0.5);
             real occlusion = march_occlusion(p, n, view_height, offset, params, &total_evals);
             color = march_shade(p, n, rd, DETAIL * footprint, occlusion, params, lights,
-                                light_count, &total_evals);
+                                light_count, environment, &total_evals);
         }
         sum += color;
         if (s == 0) {
