@@ -9,10 +9,14 @@ fn main() -> std::process::ExitCode {
         let size = common::size_arg((640, 480));
         for (name, scene) in fractal_sdf::gallery::all() {
             let mut options = common::gallery_options();
-            // Scenes with inside shapes take their scene file's coarser
-            // brute-force step: the 2×2 samples average its noise.
-            if let Some(quality) = fractal_sdf::gallery::file(name).and_then(|f| f.quality) {
-                options.quality.brute_step = quality.brute_step;
+            if let Some(file) = fractal_sdf::gallery::file(name) {
+                // Scenes with inside shapes take their scene file's coarser
+                // brute-force step: the 2×2 samples average its noise.
+                if let Some(quality) = file.quality {
+                    options.quality.brute_step = quality.brute_step;
+                }
+                // And every scene its file's light: `gi` is path traced.
+                options.effects = file.effects;
             }
             common::render_to_png(name, &scene, &options, size)?;
         }

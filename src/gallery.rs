@@ -57,10 +57,10 @@ pub fn all() -> Vec<(&'static str, Scene)> {
     ]
 }
 
-/// The direction of the sun in [`sky`]: low, from behind the subject and
-/// to its right, so that it rims the shapes and casts its shadows towards
-/// the camera.
-pub const SKY_SUN: DVec3 = DVec3::new(0.62, 0.5, 0.6);
+/// The direction of the sun in [`sky`]: low on the right, a little in
+/// front of the subject, so that its shadows fall to the left across the
+/// floor and onto the wall behind.
+pub const SKY_SUN: DVec3 = DVec3::new(0.85, 0.4, 0.35);
 
 /// The size of [`sky`]'s image, in texels.
 pub const SKY_SIZE: (u32, u32) = (256, 128);

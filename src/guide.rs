@@ -19,25 +19,27 @@
 //! 7. [Outputs](outputs): image formats, OpenEXR layers, exposure and
 //!    tone curves, and the camera for a 3D package.
 //! 8. [Materials](materials): shading models, reflections and glass.
-//! 9. [Animation](animation): motions, camera paths and frame sequences.
-//! 10. [Meshes and volumes](meshes): watertight meshes and signed-distance
+//! 9. [Light](light): path-traced global illumination, environment
+//!    lights, and the stopping rule of progressive passes.
+//! 10. [Animation](animation): motions, camera paths and frame sequences.
+//! 11. [Meshes and volumes](meshes): watertight meshes and signed-distance
 //!     grids.
-//! 11. [The command line](command_line): the `fractal-sdf` command and the
+//! 12. [The command line](command_line): the `fractal-sdf` command and the
 //!     settings file.
-//! 12. [The viewer](viewer): the interactive window.
-//! 13. [Clusters](clusters): sequences as Slurm job arrays and Kubernetes
+//! 13. [The viewer](viewer): the interactive window.
+//! 14. [Clusters](clusters): sequences as Slurm job arrays and Kubernetes
 //!     Indexed Jobs.
-//! 14. [Custom shapes](custom_shapes): shapes of your own, and testing
+//! 15. [Custom shapes](custom_shapes): shapes of your own, and testing
 //!     them.
-//! 15. [Performance](performance): the benchmark, render speed, and what
+//! 16. [Performance](performance): the benchmark, render speed, and what
 //!     makes rendering faster at the same image.
-//! 16. [Reliability](reliability): hostile input, the values each
+//! 17. [Reliability](reliability): hostile input, the values each
 //!     precision holds, and numerical limits.
-//! 17. [How it is tested](how_it_is_tested): oracles, tolerances and
+//! 18. [How it is tested](how_it_is_tested): oracles, tolerances and
 //!     mutation testing.
-//! 18. [Packaging](packaging): the package, its check, docs.rs, the
+//! 19. [Packaging](packaging): the package, its check, docs.rs, the
 //!     minimum Rust and versions.
-//! 19. [Architecture](architecture): where the design is described.
+//! 20. [Architecture](architecture): where the design is described.
 
 // Chapters link to `render` (feature `opencl`) and `testing` (feature
 // `proptest`); without those features the links have no target.
@@ -69,6 +71,9 @@ pub mod outputs {}
 
 #[doc = include_str!("../docs/guide/materials.md")]
 pub mod materials {}
+
+#[doc = include_str!("../docs/guide/light.md")]
+pub mod light {}
 
 #[doc = include_str!("../docs/guide/animation.md")]
 pub mod animation {}

@@ -47,15 +47,24 @@ pub fn render_to_png(
     let mut renderer = Renderer::with_options(scene, options)?;
     let build = renderer.build_info().clone();
     let t = Instant::now();
-    // A lens's blur needs more samples than edges do: four passes.
-    let image = if scene.camera.aperture > 0.0 {
+    // A lens's blur needs more samples than edges do: four passes. Paths
+    // of light need more still: eight give a grainy first look (the
+    // `global_illumination` example renders until the noise is low).
+    let passes = if options.effects.global_illumination.is_some() {
+        8
+    } else if scene.camera.aperture > 0.0 {
+        4
+    } else {
+        1
+    };
+    let image = if passes == 1 {
+        renderer.render(size.0, size.1)?
+    } else {
         let mut image = renderer.render_progressive(size.0, size.1)?;
-        for _ in 1..4 {
+        for _ in 1..passes {
             image = renderer.render_progressive(size.0, size.1)?;
         }
         image
-    } else {
-        renderer.render(size.0, size.1)?
     };
     let render_time = t.elapsed();
     let path = format!("out/{name}.png");

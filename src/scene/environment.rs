@@ -18,8 +18,14 @@ use crate::error::{Error, Result};
 /// The largest side of an environment image, in texels.
 pub const MAX_ENVIRONMENT_SIDE: u32 = 8192;
 
-/// An equirectangular image of linear RGB radiance (see the
-/// [module](self) for its mapping), as an environment light.
+/// An equirectangular image of linear RGB radiance, as an environment
+/// light.
+///
+/// Direction `d` (a unit vector, +Y up) looks up the image at
+/// `u = 1/2 + atan2(d.x, -d.z) / 2π` across and `v = acos(d.y) / π` down:
+/// the top row is straight up, the bottom row straight down, and the
+/// centre of the image lies along −Z, straight ahead of a camera looking
+/// down −Z (the default camera's view).
 #[derive(Debug, Clone, PartialEq)]
 pub struct EnvironmentMap {
     width: u32,

@@ -1,22 +1,23 @@
 //! Progressive passes until the image is quiet enough: a stopping rule
 //! from the passes' own noise ([`Renderer::render_converged`]).
-//!
-//! The mean of `n` passes has an error whose spread falls as `1 / sqrt(n)`
-//! where the samples are independent (path-traced light, a lens, glow
-//! through a jittered pixel). The mean of all `n` less the mean of the
-//! first `m` is `(n - m) / n` times the difference of two independent
-//! means, of `m` and of `n - m` passes, whose variance is
-//! `σ² (1 / m + 1 / (n - m))`: its variance is `σ² (n - m) / (n m)`, and
-//! its root mean square over the image times `sqrt(m / (n - m))` (1 for
-//! `m = n / 2`) estimates the noise `σ / sqrt(n)` of the mean of `n`
-//! itself, with no reference image. It is taken on the displayed colour (exposure, tone curve and
-//! gamma applied), so the rule speaks of what the eye sees, in `[0, 1]`
-//! display units: `1 / 255` is one step of an 8-bit image.
 
 use super::{Error, Frame, Renderer, Result};
 use crate::quality::{Effects, display};
 
 /// When [`Renderer::render_converged`] stops adding passes.
+///
+/// The mean of `n` passes has an error whose spread falls as `1 / sqrt(n)`
+/// where the samples are independent (path-traced light, a lens, glow
+/// through a jittered pixel). The mean of all `n` less the mean of the
+/// first `m` is `(n - m) / n` times the difference of two independent
+/// means, of `m` and of `n - m` passes, whose variance is
+/// `σ² (1 / m + 1 / (n - m))`: its variance is `σ² (n - m) / (n m)`, and
+/// its root mean square over the image times `sqrt(m / (n - m))` (1 for
+/// `m = n / 2`) estimates the noise `σ / sqrt(n)` of the mean of `n`
+/// itself, with no reference image. It is taken on the displayed colour
+/// (exposure, tone curve and gamma applied), so the rule speaks of what
+/// the eye sees, in `[0, 1]` display units: `1 / 255` is one step of an
+/// 8-bit image.
 #[derive(Debug, Clone, Copy, PartialEq)]
 #[non_exhaustive]
 pub struct StopRule {
@@ -84,7 +85,7 @@ impl Renderer {
     /// `rule.max_passes` have run. The noise is estimated after 2, 4, 8,
     /// ... passes and after the last, from the difference between the
     /// mean of all the passes and the mean at the power of two before
-    /// (see the [module](self)): for independent samples it is the root
+    /// (see [`StopRule`]): for independent samples it is the root
     /// mean square error of the image, without a reference. It starts from
     /// the first pass, and continues no earlier passes.
     ///
