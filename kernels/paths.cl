@@ -166,21 +166,55 @@ real3 march_env_sample(__global const float* env, real u, real v, real* pdf) {
 }
 #endif
 
+// A direction towards the sphere light l (kind 2) seen from p,
+// drawn uniformly within the cone the ball fills from the two uniform
+// numbers u and v: the direction in *to_light, the distance to the ball's
+// near side along it in *light_distance, and the light it brings over the
+// density it was drawn with, over pi. The ball's radiance is the light's over its
+// radius squared, so that it lights a face as a point light of its
+// radiance at its centre would wherever the whole ball is in view. No
+// light from inside the ball.
+real3 march_sphere_light(__global const real* l, real3 p, real u, real v, real3* to_light,
+                         real* light_distance) {
+    real3 delta = vload3(0, l + LIGHT_POSITION) - p;
+    real r = l[LIGHT_RADIUS];
+    real d2 = dot(delta, delta);
+    *to_light = (real3)(R(0.0), R(1.0), R(0.0));
+    *light_distance = R(0.0);
+    if (d2 <= r * r) {
+        return (real3)(R(0.0));
+    }
+    real d = sqrt(d2);
+    real sin2 = r * r / d2;
+    real cos_max = sqrt(R(1.0) - sin2);
+    // 1 - cos_max, without cancelling for a small ball far away.
+    real solid = sin2 / (R(1.0) + cos_max);
+    real3 dir = march_around(delta / d, R(1.0) - u * solid, v);
+    real b = dot(dir, delta);
+    *to_light = dir;
+    *light_distance = b - sqrt(fmax(b * b - (d2 - r * r), R(0.0)));
+    // Over the density 1 / (2 pi solid), and over pi, as march_light's
+    // radiances are (see the units above).
+    return vload3(0, l + LIGHT_RADIANCE) / (r * r) * (R(2.0) * solid);
+}
+
 // Next-event estimation at the surface point p (normal n facing the path,
-// hit threshold eps, `travelled` from the camera) reached along rd: the
-// light of every light that sees p, through the surface's scattering, and
-// with an environment a direction drawn from it by importance (with the
-// uniform numbers u and v), weighted against the surface's own sampling
-// of the same direction by the power heuristic.
+// hit threshold eps, `travelled` from the camera) reached along rd on
+// bounce `bounce` of sample j of the pixel: the light of every light that
+// sees p, through the surface's scattering (a sphere light from a point
+// of it drawn at random), and with an environment a direction drawn from
+// it by importance, weighted against the surface's own sampling of the
+// same direction by the power heuristic.
 real3 march_direct(real3 p, real3 n, real3 rd, real eps, real travelled, const MarchCamera* cam,
-                   real3 albedo, real ks, real shininess, real sigma, real u, real v,
-                   __global const real* params, __global const real* lights, int light_count,
-                   __global const float* environment, uint* evals) {
+                   real3 albedo, real ks, real shininess, real sigma, uint pixel, uint j,
+                   int bounce, __global const real* params, __global const real* lights,
+                   int light_count, __global const float* environment, uint* evals) {
     real3 sum = (real3)(R(0.0));
 #ifdef ENABLE_ENVIRONMENT
     if (environment[ENV_TOTAL] > 0.0f) {
         real pdf;
-        real3 d = march_env_sample(environment, u, v, &pdf);
+        real3 d = march_env_sample(environment, march_random(pixel, j, bounce, 5u),
+                                   march_random(pixel, j, bounce, 6u), &pdf);
         real ndl = dot(n, d);
         if (ndl > R(0.0) && pdf > R(0.0)) {
             real3 lifted = p + n * (R(2.0) * eps);
@@ -198,6 +232,13 @@ real3 march_direct(real3 p, real3 n, real3 rd, real eps, real travelled, const M
         real3 to_light;
         real light_distance;
         real3 radiance = march_light(l, p, &to_light, &light_distance);
+        if (l[LIGHT_KIND] > R(1.5)) {
+            // Each light its own numbers: the sample's mixed with its index.
+            uint own = j ^ march_hash(0x9e3779b9u * (uint)(i + 1));
+            radiance = march_sphere_light(l, p, march_random(pixel, own, bounce, 5u),
+                                          march_random(pixel, own, bounce, 6u), &to_light,
+                                          &light_distance);
+        }
         real ndl = dot(n, to_light);
         if (ndl <= R(0.0)) {
             continue;
@@ -300,9 +341,7 @@ real3 march_path(real3 p, real3 n, real3 rd, real t, const MarchCamera* cam, uin
                 inside = 1;
             } else {
                 radiance += throughput * march_direct(p, n, rd, eps, travelled, cam, albedo, ks,
-                                                      shininess, sigma,
-                                                      march_random(pixel, j, bounce, 5u),
-                                                      march_random(pixel, j, bounce, 6u), params,
+                                                      shininess, sigma, pixel, j, bounce, params,
                                                       lights, light_count, environment, evals);
                 if (bounce >= GI_BOUNCES) {
                     break;

@@ -98,23 +98,28 @@ pub mod camera {
 pub mod light {
     use super::{Field, field};
 
-    /// The unit direction towards a directional light, or a point light's
-    /// position relative to the program's origin.
+    /// The unit direction towards a directional light, or a point or
+    /// sphere light's position relative to the program's origin.
     pub const POSITION: Field = field("POSITION", 0, 3);
-    /// [`KIND_DIRECTIONAL`] or [`KIND_POINT`].
+    /// [`KIND_DIRECTIONAL`], [`KIND_POINT`] or [`KIND_SPHERE`].
     pub const KIND: Field = field("KIND", 3, 1);
     /// Colour times intensity, linear RGB.
     pub const RADIANCE: Field = field("RADIANCE", 4, 3);
     /// The penumbra softness (0: hard shadows).
     pub const SOFTNESS: Field = field("SOFTNESS", 7, 1);
+    /// A sphere light's radius (0 for the others).
+    pub const RADIUS: Field = field("RADIUS", 8, 1);
     /// Every field, in buffer order.
-    pub const FIELDS: [Field; 4] = [POSITION, KIND, RADIANCE, SOFTNESS];
+    pub const FIELDS: [Field; 5] = [POSITION, KIND, RADIANCE, SOFTNESS, RADIUS];
     /// Reals per light.
-    pub const STRIDE: usize = 8;
+    pub const STRIDE: usize = 9;
     /// The `KIND` of a directional light.
     pub const KIND_DIRECTIONAL: f64 = 0.0;
     /// The `KIND` of a point light (falling off with `1/r²`).
     pub const KIND_POINT: f64 = 1.0;
+    /// The `KIND` of a sphere light: a point light to direct lighting, a
+    /// ball of light to global illumination.
+    pub const KIND_SPHERE: f64 = 2.0;
 }
 
 /// One pixel's entry in the shading-layer buffer (`layers` argument of

@@ -75,7 +75,8 @@ pub fn shade(eval: &Evaluator, p: DVec3, n: DVec3, rd: DVec3, lights: &[Light], 
         let mut radiance = light.color * light.intensity;
         let to_light = match light.source {
             LightSource::Directional { direction } => direction.normalize(),
-            LightSource::Point { position } => {
+            // Direct lighting takes a sphere light for a point light.
+            LightSource::Point { position } | LightSource::Sphere { position, .. } => {
                 let delta = position - p;
                 let dist2 = delta.length_squared().max(crate::math::REAL_TINY);
                 radiance /= dist2;

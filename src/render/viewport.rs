@@ -317,7 +317,10 @@ pub(crate) fn check_frame_inputs(
     for (i, (entry, l)) in packed.chunks_exact(light::STRIDE).zip(lights).enumerate() {
         let node = format!("light[{i}]");
         let at = |f: Field| &entry[f.offset..f.offset + f.len];
-        if matches!(l.source, LightSource::Point { .. }) {
+        if matches!(
+            l.source,
+            LightSource::Point { .. } | LightSource::Sphere { .. }
+        ) {
             check(
                 &node,
                 "position",
@@ -332,6 +335,7 @@ pub(crate) fn check_frame_inputs(
             Magnitude::Size,
         )?;
         check(&node, "softness", at(light::SOFTNESS), Magnitude::Size)?;
+        check(&node, "radius", at(light::RADIUS), Magnitude::Size)?;
     }
     Ok(())
 }
@@ -350,6 +354,10 @@ pub(crate) fn pack_lights(lights: &[Light], origin: DVec3) -> Vec<f64> {
                 light::KIND_DIRECTIONAL,
             ),
             LightSource::Point { position } => (position - origin, light::KIND_POINT),
+            LightSource::Sphere { position, radius } => {
+                put(entry, light::RADIUS, &[radius]);
+                (position - origin, light::KIND_SPHERE)
+            }
         };
         put(entry, light::POSITION, &v.to_array());
         put(entry, light::KIND, &[kind]);
@@ -427,16 +435,27 @@ mod tests {
         let lights = [
             Light::directional(dvec3(0.0, 2.0, 0.0)).intensity(2.0),
             Light::point(dvec3(1.0, 2.0, 3.0)).softness(0.0),
+            Light::sphere(dvec3(0.0, 4.0, 0.0), 0.5).softness(0.0),
         ];
         let packed = pack_lights(&lights, DVec3::ZERO);
-        assert_eq!(packed.len(), 2 * light::STRIDE);
-        assert_eq!(&packed[..8], &[0.0, 1.0, 0.0, 0.0, 2.0, 2.0, 2.0, 0.05]);
-        assert_eq!(&packed[8..], &[1.0, 2.0, 3.0, 1.0, 1.0, 1.0, 1.0, 0.0]);
+        assert_eq!(packed.len(), 3 * light::STRIDE);
+        assert_eq!(
+            &packed[..9],
+            &[0.0, 1.0, 0.0, 0.0, 2.0, 2.0, 2.0, 0.05, 0.0]
+        );
+        assert_eq!(
+            &packed[9..18],
+            &[1.0, 2.0, 3.0, 1.0, 1.0, 1.0, 1.0, 0.0, 0.0]
+        );
+        assert_eq!(
+            &packed[18..],
+            &[0.0, 4.0, 0.0, 2.0, 1.0, 1.0, 1.0, 0.0, 0.5]
+        );
         assert_eq!(pack_lights(&[], DVec3::ZERO).len(), light::STRIDE);
         // Into a frame far away: point lights move, directions do not.
         let origin = dvec3(1e7, -1e7, 3.0);
         let moved = pack_lights(&lights, origin);
-        assert_eq!(&moved[..8], &packed[..8]);
-        assert_eq!(&moved[8..11], &[1.0 - 1e7, 2.0 + 1e7, 0.0]);
+        assert_eq!(&moved[..9], &packed[..9]);
+        assert_eq!(&moved[9..12], &[1.0 - 1e7, 2.0 + 1e7, 0.0]);
     }
 }

@@ -376,6 +376,18 @@ pub enum LightSource {
         /// The light's position.
         position: DVec3,
     },
+    /// Light from a glowing ball: as bright as a point light of the same
+    /// intensity at its centre wherever the whole ball is in view (its
+    /// radiance is the intensity over the radius squared), with the soft
+    /// shadows of its size under global illumination. Direct lighting
+    /// treats it as that point light, with the light's `softness`. The
+    /// ball itself is not drawn.
+    Sphere {
+        /// The ball's centre.
+        position: DVec3,
+        /// The ball's radius, above 0.
+        radius: f64,
+    },
 }
 
 /// A light with colour, intensity and shadow softness.
@@ -442,6 +454,21 @@ impl Light {
         }
     }
 
+    /// A white ball of light of `radius` at `position`
+    /// ([`LightSource::Sphere`]).
+    #[must_use]
+    pub fn sphere(position: impl Into<DVec3>, radius: f64) -> Self {
+        Light {
+            source: LightSource::Sphere {
+                position: position.into(),
+                radius,
+            },
+            color: DVec3::ONE,
+            intensity: 1.0,
+            softness: Light::DEFAULT_SOFTNESS,
+        }
+    }
+
     /// Sets the colour.
     #[must_use]
     pub fn color(mut self, rgb: impl Into<DVec3>) -> Self {
@@ -491,6 +518,19 @@ impl Light {
             LightSource::Point { position } => {
                 vector("position", position, false)?;
                 within(&node, "position", position, Magnitude::Coordinate)?;
+            }
+            LightSource::Sphere { position, radius } => {
+                vector("position", position, false)?;
+                within(&node, "position", position, Magnitude::Coordinate)?;
+                if !(radius > 0.0 && radius.is_finite()) {
+                    return Err(Error::OutOfRange {
+                        node: node.clone(),
+                        param: "radius".into(),
+                        value: radius,
+                        expected: "> 0".into(),
+                    });
+                }
+                within_scalar(&node, "radius", radius, Magnitude::Size)?;
             }
         }
         vector("color", self.color, false)?;

@@ -568,3 +568,84 @@ fn direct_light_shows_the_environment_and_takes_its_ambient_light() {
         background.collect::<Vec<_>>()
     );
 }
+
+/// A ball of light lights a floor as a point light of its intensity at its
+/// centre would, wherever the whole ball is above the floor's horizon:
+/// `I cos(theta) / d^2` at distance `d` and angle `theta` (the closed form
+/// of a spherical source's irradiance), within 1% on average; and its
+/// shadow is soft where a point light's is hard.
+#[test]
+fn a_sphere_light_lights_as_its_closed_form_says() {
+    let Some(_) = gpu::device() else { return };
+    let centre = dvec3(0.3, 1.2, -0.2);
+    let floor = plane(DVec3::Y, 0.0)
+        .color(DVec3::ONE)
+        .material(Material::lambert());
+    let scene = Scene::new(floor)
+        .with_camera(Camera::look_at(dvec3(0.0, 2.5, 3.0), dvec3(0.0, 0.0, 0.0)))
+        .with_lights([Light::sphere(centre, 0.4).intensity(2.0)]);
+    let black = Effects::default()
+        .sky_top(DVec3::ZERO)
+        .sky_bottom(DVec3::ZERO)
+        .gamma(1.0);
+    let options = gpu::options(
+        gpu::plain(Quality::preview()),
+        black.global_illumination(GlobalIllumination::new(1)),
+    );
+    let mut renderer = Renderer::with_options(&scene, &options).unwrap();
+    let frame = passes(&mut renderer, 256);
+    let layers = frame.layers.as_ref().unwrap();
+    let (mut bias, mut count) = (0.0, 0.0);
+    for (i, c) in layers.linear.iter().enumerate() {
+        if c[3] < 1.0 {
+            continue;
+        }
+        let p = glam::Vec3::from(layers.position[i]).as_dvec3();
+        let delta = centre - p;
+        let want = 2.0 * delta.normalize().y / delta.length_squared();
+        bias += (f64::from(c[0]) - want) / want;
+        count += 1.0;
+    }
+    let bias = bias / count;
+    eprintln!("sphere light: mean relative error {bias:.4} over {count} pixels");
+    assert!(
+        count > 500.0 && bias.abs() < 0.01,
+        "mean relative error {bias}"
+    );
+    // A ball between the light and the floor: the pixels in part shadow
+    // (between a tenth and nine tenths of the light they would have).
+    let penumbra = |light: Light| {
+        let blocker = sphere(0.15).translate(dvec3(0.3, 0.7, -0.2));
+        let scene = scene.clone().add(blocker).with_lights([light]);
+        let mut renderer = Renderer::with_options(&scene, &options).unwrap();
+        let frame = passes(&mut renderer, 64);
+        let layers = frame.layers.as_ref().unwrap();
+        layers
+            .linear
+            .iter()
+            .zip(&layers.position)
+            .filter(|(c, p)| {
+                let delta = centre - glam::Vec3::from(**p).as_dvec3();
+                let open = 2.0 * delta.normalize().y / delta.length_squared();
+                let share = f64::from(c[0]) / open;
+                c[3] >= 1.0 && p[1] < 0.05 && share > 0.1 && share < 0.9
+            })
+            .count()
+    };
+    let (soft, hard) = (
+        penumbra(Light::sphere(centre, 0.4).intensity(2.0)),
+        penumbra(Light::point(centre).intensity(2.0)),
+    );
+    eprintln!("pixels in part shadow: {soft} under the ball of light, {hard} under the point");
+    assert!(soft > 3 * hard.max(5), "{soft} against {hard}");
+}
+
+/// A ball of light needs a radius above 0, finite.
+#[test]
+fn a_sphere_light_without_a_radius_is_refused() {
+    for radius in [0.0, -1.0, f64::NAN, f64::INFINITY] {
+        let scene = Scene::new(sphere(1.0)).with_lights([Light::sphere(DVec3::Y * 3.0, radius)]);
+        let err = scene.compile().unwrap_err().to_string();
+        assert!(err.contains("light[0]") && err.contains("radius"), "{err}");
+    }
+}

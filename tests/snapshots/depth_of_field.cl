@@ -88,7 +88,8 @@ typedef float4 real4;
 #define LIGHT_KIND 3
 #define LIGHT_RADIANCE 4
 #define LIGHT_SOFTNESS 7
-#define LIGHT_STRIDE 8
+#define LIGHT_RADIUS 8
+#define LIGHT_STRIDE 9
 #define LAYER_POSITION 0
 #define LAYER_ALBEDO 3
 #define LAYER_OCCLUSION 6
