@@ -198,11 +198,35 @@ real3 march_sphere_light(__global const real* l, real3 p, real u, real v, real3*
     return vload3(0, l + LIGHT_RADIANCE) / (r * r) * (R(2.0) * solid);
 }
 
+// A direction towards a point of the rectangle light l (kind 3) seen from
+// p, the point drawn uniformly over its area from the two uniform numbers
+// u and v: the direction in *to_light, the distance in *light_distance,
+// and the light it brings over the density it was drawn with, over pi.
+// The rectangle's radiance is pi times the light's over its area, so that
+// its estimate is the light's times the cosine it is seen at over the
+// squared distance: a point light at its centre, seen square on from far
+// away. It shines on the side u x v faces.
+real3 march_rect_light(__global const real* l, real3 p, real u, real v, real3* to_light,
+                       real* light_distance) {
+    real3 edge_u = vload3(0, l + LIGHT_EDGE_U);
+    real3 edge_v = vload3(0, l + LIGHT_EDGE_V);
+    real3 q = vload3(0, l + LIGHT_POSITION) + (R(2.0) * u - R(1.0)) * edge_u
+              + (R(2.0) * v - R(1.0)) * edge_v;
+    real3 delta = q - p;
+    real d2 = fmax(dot(delta, delta), REAL_TINY);
+    real d = sqrt(d2);
+    real3 face = cross(edge_u, edge_v);
+    *to_light = delta / d;
+    *light_distance = d;
+    real seen = -dot(face, *to_light) / fmax(length(face), REAL_TINY);
+    return seen > R(0.0) ? vload3(0, l + LIGHT_RADIANCE) * (seen / d2) : (real3)(R(0.0));
+}
+
 // Next-event estimation at the surface point p (normal n facing the path,
 // hit threshold eps, `travelled` from the camera) reached along rd on
 // bounce `bounce` of sample j of the pixel: the light of every light that
-// sees p, through the surface's scattering (a sphere light from a point
-// of it drawn at random), and with an environment a direction drawn from
+// sees p, through the surface's scattering (a sphere or rectangle light
+// from a point of it drawn at random), and with an environment a direction drawn from
 // it by importance, weighted against the surface's own sampling of the
 // same direction by the power heuristic.
 real3 march_direct(real3 p, real3 n, real3 rd, real eps, real travelled, const MarchCamera* cam,
@@ -232,9 +256,13 @@ real3 march_direct(real3 p, real3 n, real3 rd, real eps, real travelled, const M
         real3 to_light;
         real light_distance;
         real3 radiance = march_light(l, p, &to_light, &light_distance);
-        if (l[LIGHT_KIND] > R(1.5)) {
-            // Each light its own numbers: the sample's mixed with its index.
-            uint own = j ^ march_hash(0x9e3779b9u * (uint)(i + 1));
+        // Each light its own numbers: the sample's mixed with its index.
+        uint own = j ^ march_hash(0x9e3779b9u * (uint)(i + 1));
+        if (l[LIGHT_KIND] > R(2.5)) {
+            radiance = march_rect_light(l, p, march_random(pixel, own, bounce, 5u),
+                                        march_random(pixel, own, bounce, 6u), &to_light,
+                                        &light_distance);
+        } else if (l[LIGHT_KIND] > R(1.5)) {
             radiance = march_sphere_light(l, p, march_random(pixel, own, bounce, 5u),
                                           march_random(pixel, own, bounce, 6u), &to_light,
                                           &light_distance);

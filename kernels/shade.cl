@@ -327,7 +327,10 @@ real march_occlusion(real3 p, real3 n, real view_height, real offset,
 // The light l (LIGHT_STRIDE reals of the light buffer) as seen from p:
 // the unit direction towards it, how far it is (MAX_DISTANCE for a
 // directional light) and the radiance that arrives (a point light's falls
-// off with the squared distance).
+// off with the squared distance). Sphere and rectangle lights are taken
+// for point lights at their centres, a rectangle lighting its own side
+// only, dimmed by the cosine it is seen at (paths.cl samples their
+// areas).
 real3 march_light(__global const real* l, real3 p, real3* to_light, real* light_distance) {
     real3 v = vload3(0, l + LIGHT_POSITION);
     real3 radiance = vload3(0, l + LIGHT_RADIANCE);
@@ -339,6 +342,11 @@ real3 march_light(__global const real* l, real3 p, real3* to_light, real* light_
         *light_distance = sqrt(dist2);
         *to_light = delta / *light_distance;
         radiance /= dist2;
+        if (l[LIGHT_KIND] > R(2.5)) {
+            // A rectangle lights its own side, dimming with the angle.
+            real3 face = cross(vload3(0, l + LIGHT_EDGE_U), vload3(0, l + LIGHT_EDGE_V));
+            radiance *= fmax(dot(face, -*to_light), R(0.0)) / fmax(length(face), REAL_TINY);
+        }
     }
     return radiance;
 }

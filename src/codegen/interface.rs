@@ -101,7 +101,8 @@ pub mod light {
     /// The unit direction towards a directional light, or a point or
     /// sphere light's position relative to the program's origin.
     pub const POSITION: Field = field("POSITION", 0, 3);
-    /// [`KIND_DIRECTIONAL`], [`KIND_POINT`] or [`KIND_SPHERE`].
+    /// [`KIND_DIRECTIONAL`], [`KIND_POINT`], [`KIND_SPHERE`] or
+    /// [`KIND_RECT`].
     pub const KIND: Field = field("KIND", 3, 1);
     /// Colour times intensity, linear RGB.
     pub const RADIANCE: Field = field("RADIANCE", 4, 3);
@@ -109,10 +110,14 @@ pub mod light {
     pub const SOFTNESS: Field = field("SOFTNESS", 7, 1);
     /// A sphere light's radius (0 for the others).
     pub const RADIUS: Field = field("RADIUS", 8, 1);
+    /// A rectangle light's half side `u` (0 for the others).
+    pub const EDGE_U: Field = field("EDGE_U", 9, 3);
+    /// A rectangle light's half side `v`: it shines along `u × v`.
+    pub const EDGE_V: Field = field("EDGE_V", 12, 3);
     /// Every field, in buffer order.
-    pub const FIELDS: [Field; 5] = [POSITION, KIND, RADIANCE, SOFTNESS, RADIUS];
+    pub const FIELDS: [Field; 7] = [POSITION, KIND, RADIANCE, SOFTNESS, RADIUS, EDGE_U, EDGE_V];
     /// Reals per light.
-    pub const STRIDE: usize = 9;
+    pub const STRIDE: usize = 15;
     /// The `KIND` of a directional light.
     pub const KIND_DIRECTIONAL: f64 = 0.0;
     /// The `KIND` of a point light (falling off with `1/r²`).
@@ -120,6 +125,9 @@ pub mod light {
     /// The `KIND` of a sphere light: a point light to direct lighting, a
     /// ball of light to global illumination.
     pub const KIND_SPHERE: f64 = 2.0;
+    /// The `KIND` of a rectangle light: a point light on its lit side to
+    /// direct lighting, a rectangle of light to global illumination.
+    pub const KIND_RECT: f64 = 3.0;
 }
 
 /// One pixel's entry in the shading-layer buffer (`layers` argument of

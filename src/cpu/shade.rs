@@ -76,13 +76,19 @@ pub fn shade(eval: &Evaluator, p: DVec3, n: DVec3, rd: DVec3, lights: &[Light], 
         let to_light = match light.source {
             LightSource::Directional { direction } => direction.normalize(),
             // Direct lighting takes a sphere light for a point light.
-            LightSource::Point { position } | LightSource::Sphere { position, .. } => {
+            LightSource::Point { position }
+            | LightSource::Sphere { position, .. }
+            | LightSource::Rect { position, .. } => {
                 let delta = position - p;
                 let dist2 = delta.length_squared().max(crate::math::REAL_TINY);
                 radiance /= dist2;
                 delta / dist2.sqrt()
             }
         };
+        // A rectangle lights its own side, dimming with the angle.
+        if let LightSource::Rect { u, v, .. } = light.source {
+            radiance *= u.cross(v).normalize_or_zero().dot(-to_light).max(0.0);
+        }
         let ndl = n.dot(to_light);
         if ndl < 0.0 {
             color += radiance * albedo * (through * -ndl);

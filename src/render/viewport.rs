@@ -319,7 +319,7 @@ pub(crate) fn check_frame_inputs(
         let at = |f: Field| &entry[f.offset..f.offset + f.len];
         if matches!(
             l.source,
-            LightSource::Point { .. } | LightSource::Sphere { .. }
+            LightSource::Point { .. } | LightSource::Sphere { .. } | LightSource::Rect { .. }
         ) {
             check(
                 &node,
@@ -336,6 +336,8 @@ pub(crate) fn check_frame_inputs(
         )?;
         check(&node, "softness", at(light::SOFTNESS), Magnitude::Size)?;
         check(&node, "radius", at(light::RADIUS), Magnitude::Size)?;
+        check(&node, "u", at(light::EDGE_U), Magnitude::Size)?;
+        check(&node, "v", at(light::EDGE_V), Magnitude::Size)?;
     }
     Ok(())
 }
@@ -357,6 +359,11 @@ pub(crate) fn pack_lights(lights: &[Light], origin: DVec3) -> Vec<f64> {
             LightSource::Sphere { position, radius } => {
                 put(entry, light::RADIUS, &[radius]);
                 (position - origin, light::KIND_SPHERE)
+            }
+            LightSource::Rect { position, u, v } => {
+                put(entry, light::EDGE_U, &u.to_array());
+                put(entry, light::EDGE_V, &v.to_array());
+                (position - origin, light::KIND_RECT)
             }
         };
         put(entry, light::POSITION, &v.to_array());
@@ -439,23 +446,15 @@ mod tests {
         ];
         let packed = pack_lights(&lights, DVec3::ZERO);
         assert_eq!(packed.len(), 3 * light::STRIDE);
-        assert_eq!(
-            &packed[..9],
-            &[0.0, 1.0, 0.0, 0.0, 2.0, 2.0, 2.0, 0.05, 0.0]
-        );
-        assert_eq!(
-            &packed[9..18],
-            &[1.0, 2.0, 3.0, 1.0, 1.0, 1.0, 1.0, 0.0, 0.0]
-        );
-        assert_eq!(
-            &packed[18..],
-            &[0.0, 4.0, 0.0, 2.0, 1.0, 1.0, 1.0, 0.0, 0.5]
-        );
+        let at = |i: usize, n: usize| &packed[i * light::STRIDE..][..n];
+        assert_eq!(at(0, 9), &[0.0, 1.0, 0.0, 0.0, 2.0, 2.0, 2.0, 0.05, 0.0]);
+        assert_eq!(at(1, 9), &[1.0, 2.0, 3.0, 1.0, 1.0, 1.0, 1.0, 0.0, 0.0]);
+        assert_eq!(at(2, 9), &[0.0, 4.0, 0.0, 2.0, 1.0, 1.0, 1.0, 0.0, 0.5]);
         assert_eq!(pack_lights(&[], DVec3::ZERO).len(), light::STRIDE);
         // Into a frame far away: point lights move, directions do not.
         let origin = dvec3(1e7, -1e7, 3.0);
         let moved = pack_lights(&lights, origin);
-        assert_eq!(&moved[..9], &packed[..9]);
-        assert_eq!(&moved[9..12], &[1.0 - 1e7, 2.0 + 1e7, 0.0]);
+        assert_eq!(&moved[..9], at(0, 9));
+        assert_eq!(&moved[light::STRIDE..][..3], &[1.0 - 1e7, 2.0 + 1e7, 0.0]);
     }
 }

@@ -388,6 +388,22 @@ pub enum LightSource {
         /// The ball's radius, above 0.
         radius: f64,
     },
+    /// Light from a glowing rectangle, on the side its normal `u × v`
+    /// faces: seen square on from `d` away it is as bright as a point light
+    /// of the same intensity at its centre, and dims with the cosine of the
+    /// angle it is seen at (a Lambertian emitter of radiance
+    /// `π intensity / area`). Under global illumination its shadows have
+    /// the rectangle's size; direct lighting treats it as that point light
+    /// on its lit side, with the light's `softness`. The rectangle itself
+    /// is not drawn.
+    Rect {
+        /// The rectangle's centre.
+        position: DVec3,
+        /// Half of one side, from the centre to the middle of an edge.
+        u: DVec3,
+        /// Half of the other side, at right angles to `u`.
+        v: DVec3,
+    },
 }
 
 /// A light with colour, intensity and shadow softness.
@@ -469,6 +485,22 @@ impl Light {
         }
     }
 
+    /// A white rectangle of light centred at `position`, spanning `±u` and
+    /// `±v` from it and shining along `u × v` ([`LightSource::Rect`]).
+    #[must_use]
+    pub fn rect(position: impl Into<DVec3>, u: impl Into<DVec3>, v: impl Into<DVec3>) -> Self {
+        Light {
+            source: LightSource::Rect {
+                position: position.into(),
+                u: u.into(),
+                v: v.into(),
+            },
+            color: DVec3::ONE,
+            intensity: 1.0,
+            softness: Light::DEFAULT_SOFTNESS,
+        }
+    }
+
     /// Sets the colour.
     #[must_use]
     pub fn color(mut self, rgb: impl Into<DVec3>) -> Self {
@@ -531,6 +563,23 @@ impl Light {
                     });
                 }
                 within_scalar(&node, "radius", radius, Magnitude::Size)?;
+            }
+            LightSource::Rect { position, u, v } => {
+                vector("position", position, false)?;
+                within(&node, "position", position, Magnitude::Coordinate)?;
+                vector("u", u, true)?;
+                vector("v", v, true)?;
+                within(&node, "u", u, Magnitude::Size)?;
+                within(&node, "v", v, Magnitude::Size)?;
+                let cos = u.dot(v) / (u.length() * v.length());
+                if cos.abs() >= 1e-6 {
+                    return Err(Error::OutOfRange {
+                        node: node.clone(),
+                        param: "v".into(),
+                        value: cos,
+                        expected: "at right angles to u (its cosine with u is shown)".into(),
+                    });
+                }
             }
         }
         vector("color", self.color, false)?;

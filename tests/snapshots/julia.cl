@@ -89,7 +89,9 @@ typedef float4 real4;
 #define LIGHT_RADIANCE 4
 #define LIGHT_SOFTNESS 7
 #define LIGHT_RADIUS 8
-#define LIGHT_STRIDE 9
+#define LIGHT_EDGE_U 9
+#define LIGHT_EDGE_V 12
+#define LIGHT_STRIDE 15
 #define LAYER_POSITION 0
 #define LAYER_ALBEDO 3
 #define LAYER_OCCLUSION 6
