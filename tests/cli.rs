@@ -936,3 +936,91 @@ fn render_writes_layers_deep_images_and_cameras() {
     // An orbit: the camera moves from frame to frame.
     assert_ne!(all[0]["position"], all[1]["position"]);
 }
+
+/// `--gi`, `--environment`, `--noise` and `--srgb`: a path-traced render
+/// lit by the crate's sky that stops at its noise and says so, the furnace
+/// vanishing from the command line, the sRGB curve changing the image, and
+/// a missing environment image named in a clear error.
+#[test]
+fn render_path_traces_under_an_environment_until_quiet() {
+    if gpu::device().is_none() {
+        return;
+    }
+    let dir = scratch("gi");
+    let sky = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("scenes/sky.hdr")
+        .display()
+        .to_string();
+    let lit = dir.join("lit.png");
+    let small = ["--preset", "draft", "--size", "32x24"];
+    let mut args = vec![
+        "render",
+        "csg",
+        "-o",
+        lit.to_str().unwrap(),
+        "--gi",
+        "4",
+        "--environment",
+        &sky,
+        "--noise",
+        "0.05",
+        "--passes",
+        "64",
+    ];
+    args.extend(small);
+    let out = run(&dir, "", &args);
+    assert!(out.status.success(), "{}", text(&out));
+    assert!(text(&out).contains("noise 0.0"), "{}", text(&out));
+    assert!(lit.exists());
+
+    let furnace = dir.join("furnace.png");
+    let furnace_file = scene_path("furnace");
+    let out = run(
+        &dir,
+        "",
+        &[
+            "render",
+            &furnace_file,
+            "-o",
+            furnace.to_str().unwrap(),
+            "--size",
+            "24x16",
+        ],
+    );
+    assert!(out.status.success(), "{}", text(&out));
+    let image = image::open(&furnace).unwrap().to_rgba8();
+    assert!(
+        image.pixels().all(|p| p.0 == [255, 255, 255, 255]),
+        "the furnace shows"
+    );
+
+    let shade = |name: &str, extra: &[&str]| {
+        let path = dir.join(name);
+        let mut args = vec!["render", "csg", "-o", path.to_str().unwrap()];
+        args.extend(small);
+        args.extend(extra);
+        let out = run(&dir, "", &args);
+        assert!(out.status.success(), "{}", text(&out));
+        image::open(&path).unwrap().to_rgba8()
+    };
+    assert_ne!(shade("gamma.png", &[]), shade("srgb.png", &["--srgb"]));
+
+    let out = run(
+        &dir,
+        "",
+        &[
+            "render",
+            "csg",
+            "-o",
+            "x.png",
+            "--environment",
+            "nowhere.hdr",
+        ],
+    );
+    assert_eq!(out.status.code(), Some(1), "{}", text(&out));
+    assert!(
+        text(&out).contains("nowhere.hdr: cannot read the environment image"),
+        "{}",
+        text(&out)
+    );
+}

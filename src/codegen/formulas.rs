@@ -5,7 +5,7 @@
 use crate::cpu::sdf::{self, Estimate, TrapShape};
 use crate::expr::{Num, OpenCl, Printer, Shape, Signature, Unprintable, Var, trace};
 use crate::math::{V3, v3};
-use crate::quality::{ToneMap, display_formula};
+use crate::quality::{Encoding, ToneMap, display_formula};
 use crate::scene::{Hybrid, KifsFold, ParamSpec, PseudoKleinian};
 
 use Shape::{Pair, Scalar, Vec3};
@@ -42,15 +42,15 @@ fn distance(
 }
 
 /// The render kernel's display transform, `display_color(c, scale,
-/// inverse_gamma)`: exposure, `tone_map` and gamma
+/// inverse_gamma)`: exposure, `tone_map` and `encoding`
 /// ([`display_formula`]).
-pub(crate) fn display(tone_map: ToneMap) -> Result<String, Unprintable> {
+pub(crate) fn display(tone_map: ToneMap, encoding: Encoding) -> Result<String, Unprintable> {
     print(
         "display_color",
         &[("c", Vec3), ("scale", Scalar), ("inverse_gamma", Scalar)],
         Vec3,
         |a| {
-            let out = display_formula(vector(a, 0), a[3], a[4], tone_map);
+            let out = display_formula(vector(a, 0), a[3], a[4], tone_map, encoding);
             vec![out.x, out.y, out.z]
         },
     )

@@ -689,10 +689,11 @@ fn finish(
     }
     if options.target == Target::Render {
         // The display transform the render kernel ends each pixel with.
-        let display = formulas::display(options.effects.tone_map).map_err(|e| Error::Invalid {
-            what: "formula",
-            reason: e.to_string(),
-        })?;
+        let display = formulas::display(options.effects.tone_map, options.effects.encoding)
+            .map_err(|e| Error::Invalid {
+                what: "formula",
+                reason: e.to_string(),
+            })?;
         w.line("/* ---- display ---- */");
         w.raw(&display);
         w.line("");

@@ -111,6 +111,11 @@ pub struct Effects {
     /// display ([`ToneMap`]; the default clips at 1). Linear outputs
     /// (OpenEXR) are written before it.
     pub tone_map: ToneMap,
+    /// How displayed values are encoded after the tone curve
+    /// ([`Encoding`]): by [`Effects::gamma`] (the default), or by the exact
+    /// sRGB curve.
+    #[serde(skip_serializing_if = "Encoding::is_gamma")]
+    pub encoding: Encoding,
     /// Path-traced global illumination in place of direct lighting
     /// ([`GlobalIllumination`]); `None` (the default) lights each hit
     /// directly, with ambient occlusion standing in for the sky's light.
@@ -133,6 +138,7 @@ impl Default for Effects {
             gamma: 2.2,
             exposure: 0.0,
             tone_map: ToneMap::Clip,
+            encoding: Encoding::Gamma,
             global_illumination: None,
         }
     }
@@ -332,6 +338,14 @@ impl Effects {
     #[must_use]
     pub fn tone_map(mut self, tone_map: ToneMap) -> Self {
         self.tone_map = tone_map;
+        self
+    }
+
+    /// Sets how displayed values are encoded: by the gamma, or by the
+    /// exact sRGB curve.
+    #[must_use]
+    pub fn encoding(mut self, encoding: Encoding) -> Self {
+        self.encoding = encoding;
         self
     }
 

@@ -16,7 +16,7 @@ mod effects;
 mod tone;
 
 pub use effects::{Effects, GlobalIllumination, Glow, MAX_EXPOSURE, MAX_GI_BOUNCES};
-pub use tone::{ToneMap, display, display_formula};
+pub use tone::{Encoding, ToneMap, display, display_formula};
 
 /// Floating-point precision of the generated kernel.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default, Serialize, Deserialize)]

@@ -70,22 +70,61 @@ impl ToneMap {
     }
 }
 
+/// How a displayed value in `[0, 1]` is encoded in an image
+/// ([`Effects::encoding`]), after the tone curve.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default, Serialize, Deserialize)]
+#[non_exhaustive]
+pub enum Encoding {
+    /// `x^(1 / gamma)` with [`Effects::gamma`] (the default; 2.2 comes
+    /// within 0.0084 of sRGB for linear values above 0.05, and lifts the
+    /// darkest ones more: 0.001 shows as 0.043, where sRGB gives 0.013).
+    #[default]
+    Gamma,
+    /// The sRGB transfer function exactly (IEC 61966-2-1): `12.92 x` up to
+    /// `0.0031308`, `1.055 x^(1/2.4) - 0.055` above; [`Effects::gamma`] is
+    /// not used.
+    Srgb,
+}
+
+impl Encoding {
+    /// The encoded value of `x` in `[0, 1]`, `inverse_gamma` being
+    /// `1 / gamma` for [`Encoding::Gamma`].
+    pub fn apply<N: Num>(self, x: N, inverse_gamma: N) -> N {
+        match self {
+            Encoding::Gamma => x.powf(inverse_gamma),
+            Encoding::Srgb => N::select(
+                x.le(N::of(0.003_130_8)),
+                x * N::of(12.92),
+                x.powf(N::of(1.0 / 2.4)) * N::of(1.055) - N::of(0.055),
+            ),
+        }
+    }
+
+    /// Whether this is the default, [`Encoding::Gamma`] (scene files leave
+    /// it out).
+    pub(crate) fn is_gamma(&self) -> bool {
+        *self == Encoding::Gamma
+    }
+}
+
 /// The displayed value in `[0, 1]` of the linear colour `linear`: scaled
-/// by `scale` (`2^exposure`), through the tone curve, raised to
-/// `inverse_gamma`. The kernel's image and [`display`] both run this one
-/// definition (the kernel's helper `display_color` is printed from it).
+/// by `scale` (`2^exposure`), through the tone curve, then encoded (raised
+/// to `inverse_gamma`, or by the sRGB curve). The kernel's image and
+/// [`display`] both run this one definition (the kernel's helper
+/// `display_color` is printed from it).
 pub fn display_formula<N: Num>(
     linear: V3<N>,
     scale: N,
     inverse_gamma: N,
     tone_map: ToneMap,
+    encoding: Encoding,
 ) -> V3<N> {
-    let channel = |c: N| tone_map.apply(c * scale).powf(inverse_gamma);
+    let channel = |c: N| encoding.apply(tone_map.apply(c * scale), inverse_gamma);
     v3(channel(linear.x), channel(linear.y), channel(linear.z))
 }
 
 /// The displayed colour, in `[0, 1]`, of a linear colour under `effects`
-/// (their exposure, tone curve and gamma), in the kernel's `F32`
+/// (their exposure, tone curve and encoding), in the kernel's `F32`
 /// arithmetic: what the renderer's 8-bit image holds before rounding, and
 /// what 16-bit images hold.
 ///
@@ -104,7 +143,13 @@ pub fn display(linear: [f32; 3], effects: &Effects) -> [f32; 3] {
     #[allow(clippy::cast_possible_truncation)] // the kernel's F32 constants
     let (scale, gamma) = (effects.exposure_scale() as f32, effects.gamma as f32);
     let [x, y, z] = linear;
-    let out = display_formula(v3(x, y, z), scale, 1.0 / gamma, effects.tone_map);
+    let out = display_formula(
+        v3(x, y, z),
+        scale,
+        1.0 / gamma,
+        effects.tone_map,
+        effects.encoding,
+    );
     [out.x, out.y, out.z]
 }
 
@@ -113,6 +158,33 @@ mod tests {
     use super::*;
 
     /// Each curve against values worked by hand.
+    /// The sRGB curve against the standard's values, worked by hand: its
+    /// knee (where both pieces meet), mid-grey and the ends; the gamma
+    /// encoding as the power it is.
+    #[test]
+    fn encodings_at_known_points() {
+        let srgb = |x: f64| Encoding::Srgb.apply(x, 0.0);
+        for (x, want) in [
+            (0.0, 0.0),
+            (0.001, 0.012_92),
+            (0.003_130_8, 0.040_449_936),
+            (0.18, 0.461_356_129),
+            (0.5, 0.735_356_983),
+            (1.0, 1.0),
+        ] {
+            assert!((srgb(x) - want).abs() < 1e-8, "{x}: {} vs {want}", srgb(x));
+        }
+        // Continuous at the knee: the two pieces agree there.
+        let knee = 0.003_130_8f64;
+        assert!((knee * 12.92 - (1.055 * knee.powf(1.0 / 2.4) - 0.055)).abs() < 1e-7);
+        assert_eq!(Encoding::Gamma.apply(0.25, 0.5), 0.5);
+        // Through the display transform, for the host's 16-bit images.
+        let effects = Effects::default().encoding(Encoding::Srgb);
+        let shown = display([0.5, 0.18, 0.0], &effects);
+        assert!((f64::from(shown[0]) - 0.735_357).abs() < 1e-5);
+        assert!((f64::from(shown[1]) - 0.461_356).abs() < 1e-5);
+    }
+
     #[test]
     fn curves_at_known_points() {
         let filmic = |x: f64| (x * (2.51 * x + 0.03)) / (x * (2.43 * x + 0.59) + 0.14);

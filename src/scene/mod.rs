@@ -34,6 +34,7 @@ pub use build::{
 pub use custom::{
     CpuDistance, CpuInside, CustomShape, INSIDE_HUGE, InsideBounds, MAX_INSIDE_REACH,
 };
+#[cfg(feature = "opencl")]
 pub(crate) use environment::direction as environment_direction;
 pub use environment::{Environment, EnvironmentMap, MAX_ENVIRONMENT_SIDE};
 pub use fractal::{Kifs, KifsFold, Mandelbox, Mandelbulb, Menger, QuaternionJulia, Sierpinski};

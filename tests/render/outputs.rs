@@ -8,7 +8,7 @@ use crate::gpu;
 use fractal_sdf::cpu::Evaluator;
 use fractal_sdf::output::{Aov, Bits, CameraExport, FrameOutput, save_frame};
 use fractal_sdf::prelude::*;
-use fractal_sdf::quality::{Precision, ToneMap, display};
+use fractal_sdf::quality::{Encoding, Precision, ToneMap, display};
 use fractal_sdf::render::{Frame, Renderer, Viewport};
 use glam::dvec2;
 
@@ -59,6 +59,9 @@ fn the_image_is_the_linear_colour_through_one_display_transform() {
             .tone_map(ToneMap::Filmic)
             .gamma(1.8),
         Effects::none().gamma(1.0).exposure(2.0),
+        Effects::default()
+            .tone_map(ToneMap::Filmic)
+            .encoding(Encoding::Srgb),
     ];
     let mut plain_bright = 0.0;
     for effects in cases {

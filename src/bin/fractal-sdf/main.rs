@@ -18,7 +18,7 @@ use fractal_sdf::output::{
     Aov, Bits, CameraExport, FrameOutput, image_extension, save_frame, save_image, verify_png,
 };
 use fractal_sdf::prelude::*;
-use fractal_sdf::quality::{GlobalIllumination, Preset, ToneMap};
+use fractal_sdf::quality::{Encoding, GlobalIllumination, Preset, ToneMap};
 use fractal_sdf::render::{
     DeviceKind, DeviceSelector, EdgeThresholds, RenderOptions, Renderer, StopRule, devices,
 };
@@ -174,6 +174,9 @@ struct RenderArgs {
     /// reinhard or filmic (default: the scene file's, else clip).
     #[arg(long, value_name = "CURVE")]
     tonemap: Option<String>,
+    /// Encode the image by the exact sRGB curve instead of the gamma.
+    #[arg(long)]
+    srgb: bool,
     /// Also writes the camera as JSON (position, orientation, field of
     /// view, sensor and aspect; see the guide's chapter on outputs for
     /// lining it up in a 3D package).
@@ -515,6 +518,9 @@ fn render(args: &RenderArgs, settings: &Settings) -> Outcome {
     }
     if let Some(stops) = args.exposure {
         job.options.effects.exposure = stops;
+    }
+    if args.srgb {
+        job.options.effects.encoding = Encoding::Srgb;
     }
     if let Some(bounces) = args.gi {
         job.options.effects.global_illumination = Some(GlobalIllumination::new(bounces));
