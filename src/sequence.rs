@@ -41,6 +41,54 @@ pub struct Sequence {
     dir: PathBuf,
     fps: f64,
     frames: u32,
+    blur: MotionBlur,
+}
+
+/// Motion blur by shutter samples ([`Sequence::motion_blur`]): each frame
+/// the mean of `samples` moments spread evenly over the time its shutter
+/// is open, `shutter` of a frame's duration centred on the frame's time.
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[non_exhaustive]
+pub struct MotionBlur {
+    /// The moments a frame is the mean of; 1 is no blur.
+    pub samples: u32,
+    /// The fraction of a frame's duration the shutter is open, in `(0, 1]`
+    /// (0.5 is a film camera's 180° shutter).
+    pub shutter: f64,
+}
+
+impl MotionBlur {
+    /// The most moments a frame may be the mean of.
+    pub const MAX_SAMPLES: u32 = 256;
+
+    /// `samples` moments over `shutter` of each frame's duration.
+    #[must_use]
+    pub fn new(samples: u32, shutter: f64) -> Self {
+        MotionBlur { samples, shutter }
+    }
+
+    /// No blur: one moment, at the frame's time.
+    #[must_use]
+    pub fn none() -> Self {
+        MotionBlur::new(1, 0.5)
+    }
+
+    fn validate(&self) -> Result<()> {
+        if !(1..=Self::MAX_SAMPLES).contains(&self.samples) {
+            return Err(invalid(format!(
+                "motion blur takes 1 to {} samples a frame, got {}",
+                Self::MAX_SAMPLES,
+                self.samples
+            )));
+        }
+        if !(self.shutter > 0.0 && self.shutter <= 1.0) {
+            return Err(invalid(format!(
+                "the shutter is open for a fraction of a frame in (0, 1], got {}",
+                fmt_value(self.shutter)
+            )));
+        }
+        Ok(())
+    }
 }
 
 fn invalid(reason: String) -> Error {
@@ -88,7 +136,40 @@ impl Sequence {
             dir: dir.into(),
             fps,
             frames,
+            blur: MotionBlur::none(),
         })
+    }
+
+    /// The sequence with each frame blurred over the time its shutter is
+    /// open ([`MotionBlur`]).
+    ///
+    /// # Errors
+    /// [`Error::Invalid`] for a sample count outside `1..=`
+    /// [`MotionBlur::MAX_SAMPLES`] or a shutter outside `(0, 1]`.
+    pub fn motion_blur(mut self, blur: MotionBlur) -> Result<Self> {
+        blur.validate()?;
+        self.blur = blur;
+        Ok(self)
+    }
+
+    /// The moments frame `index` is the mean of, in seconds from the
+    /// start: its time alone without blur, else `samples` moments at the
+    /// middles of equal parts of the time the shutter is open, centred on
+    /// the frame's time.
+    #[must_use]
+    pub fn moments(&self, index: u32) -> Vec<f64> {
+        let t = self.time(index);
+        let open = self.blur.shutter / self.fps;
+        let n = f64::from(self.blur.samples);
+        (0..self.blur.samples)
+            .map(|k| {
+                if self.blur.samples == 1 {
+                    t
+                } else {
+                    t + open * ((f64::from(k) + 0.5) / n - 0.5)
+                }
+            })
+            .collect()
     }
 
     /// A sequence covering `seconds` at `fps`: `round(seconds × fps)`
@@ -292,8 +373,10 @@ impl Sequence {
     /// and saves each to [`Sequence::frame_path`] (atomically, so an
     /// interrupted run leaves only whole frames). Frame `i` shows the
     /// camera on `path` at `path.start() + time(i)` (with the renderer's
-    /// current camera's projection) and the `motions` at `time(i)`.
-    /// `on_frame` is called after each frame is saved.
+    /// current camera's projection) and the `motions` at `time(i)`; with
+    /// [`Sequence::motion_blur`], the mean of progressive passes at each of
+    /// its [`Sequence::moments`] instead, the camera and motions set for
+    /// each. `on_frame` is called after each frame is saved.
     ///
     /// Pass [`Sequence::remaining`] as `indices` to resume a sequence.
     ///
@@ -321,15 +404,23 @@ impl Sequence {
             motion.validate()?;
         }
         let base = *renderer.camera();
-        for &index in indices {
-            let t = self.time(index);
-            renderer.set_camera(self.camera(path, index, &base))?;
+        let at = |renderer: &mut Renderer, t: f64| -> Result<()> {
+            renderer.set_camera(path.camera_at(path.start() + t, &base))?;
             for motion in motions {
                 for (name, value) in motion.values(t) {
                     renderer.set_param(&name, value)?;
                 }
             }
-            let image = renderer.render(width, height)?;
+            Ok(())
+        };
+        for &index in indices {
+            let moments = self.moments(index);
+            let image = if let [t] = moments[..] {
+                at(renderer, t)?;
+                renderer.render(width, height)?
+            } else {
+                renderer.render_over_time(width, height, &moments, |r, &t| at(r, t))?
+            };
             let file = self.frame_path(index);
             crate::output::save_png(&image, &file)?;
             on_frame(&RenderedFrame {

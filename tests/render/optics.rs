@@ -528,3 +528,95 @@ fn adaptive_supersampling_refines_the_edges_as_uniform_passes_do() {
     let share = frame.refined_fraction();
     assert!(share > 0.05 && share < 0.6, "{share}");
 }
+
+/// Motion blur by shutter samples: a ball that crosses the view during a
+/// frame's open shutter smears along its path (it covers more pixels, none
+/// of them as fully as the ball at rest), and one sample is the frame
+/// without blur, exactly.
+#[test]
+fn a_moving_ball_blurs_over_the_open_shutter() {
+    use fractal_sdf::animation::{CameraPath, Interpolation, Key, Keyframe, Motion};
+    use fractal_sdf::sequence::{MotionBlur, Sequence};
+    let Some(_) = gpu::device() else { return };
+    let scene = Scene::new(sphere(0.3).translate(fractal_sdf::scene::param3("at", DVec3::ZERO)))
+        .with_camera(Camera::look_at(dvec3(0.0, 0.0, 4.0), DVec3::ZERO));
+    let keys = vec![
+        Key::new(0.0, -1.5).interpolation(Interpolation::Linear),
+        Key::new(1.0, 1.5),
+    ];
+    let motions = [Motion::Keys {
+        name: "at.x".into(),
+        keys,
+    }];
+    let (at, target) = (scene.camera.position, scene.camera.target);
+    let path = CameraPath::new(vec![
+        Keyframe::new(0.0, at, target),
+        Keyframe::new(1.0, at, target),
+    ])
+    .unwrap();
+    let dir = std::env::temp_dir().join(format!("fractal-sdf-blur-{}", std::process::id()));
+    let options = gpu::options(gpu::plain(Quality::preview()), Effects::none());
+    let frame = |blur: MotionBlur, name: &str| {
+        let seq = Sequence::new(dir.join(name), 2.0, 2)
+            .unwrap()
+            .motion_blur(blur)
+            .unwrap();
+        let mut renderer = Renderer::with_options(&scene, &options).unwrap();
+        seq.render(&mut renderer, &path, &motions, &[1], (64, 32), |_| {})
+            .unwrap();
+        image::open(seq.frame_path(1)).unwrap().to_rgba8()
+    };
+    let sharp = frame(MotionBlur::none(), "sharp");
+    let blurred = frame(MotionBlur::new(16, 1.0), "blurred");
+    // The background alone: the ball far out of view.
+    let empty = {
+        let mut renderer = Renderer::with_options(&scene, &options).unwrap();
+        renderer.set_param("at.x", 100.0).unwrap();
+        renderer.render(64, 32).unwrap()
+    };
+    let away = |image: &RgbaImage| -> Vec<u8> {
+        image
+            .pixels()
+            .zip(empty.pixels())
+            .map(|(p, q)| (0..3).map(|c| p[c].abs_diff(q[c])).max().unwrap())
+            .collect()
+    };
+    let touched = |image: &RgbaImage| away(image).into_iter().filter(|&d| d > 8).count();
+    let (sharp_count, blurred_count) = (touched(&sharp), touched(&blurred));
+    // Over the half second the shutter is open the ball moves 1.5 units,
+    // two and a half times its width.
+    assert!(sharp_count > 20, "{sharp_count} pixels of the ball");
+    assert!(
+        blurred_count > 2 * sharp_count,
+        "{blurred_count} against {sharp_count}"
+    );
+    // No pixel of the smear is as far from the background as the ball's
+    // at rest.
+    let far = |image: &RgbaImage| away(image).into_iter().max().unwrap();
+    assert!(
+        far(&blurred) < far(&sharp),
+        "{} against {}",
+        far(&blurred),
+        far(&sharp)
+    );
+    // One sample is the frame without blur.
+    let direct = {
+        let mut renderer = Renderer::with_options(&scene, &options).unwrap();
+        renderer.set_param("at.x", 0.0).unwrap();
+        renderer.render(64, 32).unwrap()
+    };
+    assert_eq!(sharp, direct);
+    for bad in [
+        MotionBlur::new(0, 0.5),
+        MotionBlur::new(4, 0.0),
+        MotionBlur::new(4, 1.5),
+    ] {
+        assert!(
+            Sequence::new(&dir, 2.0, 2)
+                .unwrap()
+                .motion_blur(bad)
+                .is_err()
+        );
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -23,7 +23,7 @@ use fractal_sdf::render::{
     DeviceKind, DeviceSelector, EdgeThresholds, RenderOptions, Renderer, StopRule, devices,
 };
 use fractal_sdf::scene::{CustomShape, Environment, Stereo, StereoLayout};
-use fractal_sdf::sequence::{Encoded, Sequence, parse_range};
+use fractal_sdf::sequence::{Encoded, MotionBlur, Sequence, parse_range};
 use fractal_sdf::settings::{CONFIG_ENV, Settings, parse_preset, parse_size};
 use indicatif::{ProgressBar, ProgressStyle};
 
@@ -292,6 +292,19 @@ struct SequenceArgs {
     /// its frame and time).
     #[arg(long, value_name = "FILE")]
     camera_json: Option<PathBuf>,
+    /// Motion blur: each frame the mean of N moments spread over the time
+    /// its shutter is open (1 to 256; 1 is none).
+    #[arg(long, value_name = "N", default_value_t = 1)]
+    motion_blur: u32,
+    /// The fraction of a frame's duration the shutter is open, centred on
+    /// the frame's time (0.5: a 180° shutter).
+    #[arg(
+        long,
+        value_name = "FRACTION",
+        default_value_t = 0.5,
+        requires = "motion_blur"
+    )]
+    shutter: f64,
 }
 
 #[derive(Args)]
@@ -753,7 +766,8 @@ fn sequence(args: &SequenceArgs, settings: &Settings) -> Outcome {
             )));
         }
     }
-    let seq = Sequence::for_duration(&args.out, args.fps, path.duration())?;
+    let seq = Sequence::for_duration(&args.out, args.fps, path.duration())?
+        .motion_blur(MotionBlur::new(args.motion_blur, args.shutter))?;
     let range = match &args.frames {
         Some(text) => parse_range(text, seq.frames())?,
         None => 0..seq.frames(),

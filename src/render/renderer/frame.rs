@@ -181,6 +181,46 @@ impl Renderer {
         Ok(result)
     }
 
+    /// Renders one image as the mean of a progressive pass at each of
+    /// `moments`, calling `set(self, moment)` before each pass to move the
+    /// camera, the lights or the parameters there: a frame blurred over
+    /// the changes, as a shutter open while they happen blurs it (see
+    /// [`crate::sequence::MotionBlur`]). Each pass takes new samples in the
+    /// pixel, on the lens and along paths, so the moments share no noise.
+    /// It leaves the progressive passes to start again.
+    ///
+    /// # Errors
+    /// [`Error::Quality`] for more moments than
+    /// [`Renderer::MAX_PROGRESSIVE_SAMPLES`] samples a pixel allow, or
+    /// none; else the first error of `set` or of a pass.
+    pub fn render_over_time<T>(
+        &mut self,
+        width: u32,
+        height: u32,
+        moments: &[T],
+        mut set: impl FnMut(&mut Self, &T) -> Result<()>,
+    ) -> Result<RgbaImage> {
+        let count = u32::try_from(moments.len()).unwrap_or(u32::MAX);
+        if count == 0 || count > self.most_passes() {
+            return Err(Error::Quality {
+                setting: "moments",
+                value: f64::from(count),
+                expected: format!("1 to {} for the quality's samples", self.most_passes()),
+            });
+        }
+        let mut image = None;
+        for (pass, moment) in (0i32..).zip(moments) {
+            let done = set(self, moment).and_then(|()| {
+                self.set_pass(pass);
+                self.render(width, height)
+            });
+            self.set_pass(-1);
+            image = Some(done?);
+        }
+        self.progress = None;
+        Ok(image.expect("at least one moment"))
+    }
+
     /// The progressive passes in the last image of
     /// [`Renderer::render_progressive`]: 0 before the first, or after
     /// anything that restarts it.
