@@ -62,7 +62,9 @@ real3 march_brdf(real3 n, real3 to_light, real3 rd, real3 albedo, real ks, real 
     diffuse *= march_oren_nayar(sigma, n, to_light, -rd, ndl);
 #endif
     real3 mirror = rd - R(2.0) * dot(rd, n) * n;
-    real lobe = pow(fmax(dot(mirror, to_light), R(0.0)), shininess);
+    // Nothing behind the mirror direction (pow(0, 0) is 1: shininess 0).
+    real c = dot(mirror, to_light);
+    real lobe = c > R(0.0) ? pow(c, shininess) : R(0.0);
     return diffuse + ks * (shininess + R(2.0)) * R(0.5) * lobe;
 }
 
@@ -76,7 +78,8 @@ real march_brdf_pdf(real3 n, real3 rd, real3 d, real ks, real shininess) {
         return R(0.0);
     }
     real3 mirror = rd - R(2.0) * dot(rd, n) * n;
-    real lobe = pow(fmax(dot(mirror, d), R(0.0)), shininess);
+    real c = dot(mirror, d);
+    real lobe = c > R(0.0) ? pow(c, shininess) : R(0.0);
     return ((R(1.0) - ks) * ndl + ks * (shininess + R(1.0)) * R(0.5) * lobe) / GI_PI;
 }
 
@@ -193,9 +196,10 @@ real3 march_sphere_light(__global const real* l, real3 p, real u, real v, real3*
     real b = dot(dir, delta);
     *to_light = dir;
     *light_distance = b - sqrt(fmax(b * b - (d2 - r * r), R(0.0)));
-    // Over the density 1 / (2 pi solid), and over pi, as march_light's
-    // radiances are (see the units above).
-    return vload3(0, l + LIGHT_RADIANCE) / (r * r) * (R(2.0) * solid);
+    // The radiance over r^2, over the density 1 / (2 pi solid), and over
+    // pi, as march_light's radiances are (see the units above): the r^2
+    // cancels, leaving no quotient to overflow for a tiny ball.
+    return vload3(0, l + LIGHT_RADIANCE) * (R(2.0) / (d2 * (R(1.0) + cos_max)));
 }
 
 // A direction towards a point of the rectangle light l (kind 3) seen from
@@ -215,10 +219,11 @@ real3 march_rect_light(__global const real* l, real3 p, real u, real v, real3* t
     real3 delta = q - p;
     real d2 = fmax(dot(delta, delta), REAL_TINY);
     real d = sqrt(d2);
-    real3 face = cross(edge_u, edge_v);
+    // The unit normal from the unit sides: no product of two tiny lengths.
+    real3 face = cross(normalize(edge_u), normalize(edge_v));
     *to_light = delta / d;
     *light_distance = d;
-    real seen = -dot(face, *to_light) / fmax(length(face), REAL_TINY);
+    real seen = -dot(face, *to_light);
     return seen > R(0.0) ? vload3(0, l + LIGHT_RADIANCE) * (seen / d2) : (real3)(R(0.0));
 }
 
@@ -228,7 +233,8 @@ real3 march_rect_light(__global const real* l, real3 p, real u, real v, real3* t
 // sees p, through the surface's scattering (a sphere or rectangle light
 // from a point of it drawn at random), and with an environment a direction drawn from
 // it by importance, weighted against the surface's own sampling of the
-// same direction by the power heuristic.
+// same direction by the power heuristic (march_path traces that sampling
+// at every surface, the last included).
 real3 march_direct(real3 p, real3 n, real3 rd, real eps, real travelled, const MarchCamera* cam,
                    real3 albedo, real ks, real shininess, real sigma, uint pixel, uint j,
                    int bounce, __global const real* params, __global const real* lights,
@@ -287,8 +293,10 @@ real3 march_direct(real3 p, real3 n, real3 rd, real eps, real travelled, const M
 // direct light and bounces on, diffusely (cosine-weighted) or into the
 // Phong lobe, with weights that keep the estimate's mean the integral.
 // Inside a transparent shape the path travels clear to where it leaves,
-// refracting out or reflecting back in on total internal reflection.
-// Adds its evaluations to *evals.
+// refracting out or reflecting back in on total internal reflection. The
+// path meets at most GI_BOUNCES surfaces after the first: each one's light
+// is counted (the lights' sampled at it, the sky's along its bounce), and
+// the path ends at the next surface. Adds its evaluations to *evals.
 real3 march_path(real3 p, real3 n, real3 rd, real t, const MarchCamera* cam, uint pixel, uint j,
                  __global const real* params, __global const real* lights, int light_count,
                  __global const float* environment, uint* evals) {
@@ -371,9 +379,6 @@ real3 march_path(real3 p, real3 n, real3 rd, real t, const MarchCamera* cam, uin
                 radiance += throughput * march_direct(p, n, rd, eps, travelled, cam, albedo, ks,
                                                       shininess, sigma, pixel, j, bounce, params,
                                                       lights, light_count, environment, evals);
-                if (bounce >= GI_BOUNCES) {
-                    break;
-                }
                 real u = march_random(pixel, j, bounce, 1u);
                 real v = march_random(pixel, j, bounce, 2u);
                 // The lobe by its share: each estimate is then the lobe's
@@ -397,9 +402,6 @@ real3 march_path(real3 p, real3 n, real3 rd, real t, const MarchCamera* cam, uin
                 drawn = march_brdf_pdf(n, rd, next, ks, shininess);
                 ro = p + n * (R(2.0) * eps);
             }
-        }
-        if (bounce >= GI_BOUNCES) {
-            break;
         }
         if (bounce >= GI_ROULETTE) {
             real survive = clamp(fmax(throughput.x, fmax(throughput.y, throughput.z)),
@@ -426,6 +428,11 @@ real3 march_path(real3 p, real3 n, real3 rd, real t, const MarchCamera* cam, uin
 #endif
                 radiance += throughput * sky;
             }
+            break;
+        }
+        // The last surface's light is counted (the lights' at it, and the
+        // sky's beyond it): a path ends at the surface after it.
+        if (bounce >= GI_BOUNCES) {
             break;
         }
         rd = next;

@@ -46,7 +46,9 @@ pub struct Sequence {
 
 /// Motion blur by shutter samples ([`Sequence::motion_blur`]): each frame
 /// the mean of `samples` moments spread evenly over the time its shutter
-/// is open, `shutter` of a frame's duration centred on the frame's time.
+/// is open, `shutter` of a frame's duration from the frame's time on (so
+/// every frame, the first included, stays within the path and is blurred
+/// alike).
 #[derive(Debug, Clone, Copy, PartialEq)]
 #[non_exhaustive]
 pub struct MotionBlur {
@@ -154,21 +156,18 @@ impl Sequence {
 
     /// The moments frame `index` is the mean of, in seconds from the
     /// start: its time alone without blur, else `samples` moments at the
-    /// middles of equal parts of the time the shutter is open, centred on
-    /// the frame's time.
+    /// middles of equal parts of the time the shutter is open, from the
+    /// frame's time on.
     #[must_use]
     pub fn moments(&self, index: u32) -> Vec<f64> {
         let t = self.time(index);
+        if self.blur.samples == 1 {
+            return vec![t];
+        }
         let open = self.blur.shutter / self.fps;
         let n = f64::from(self.blur.samples);
         (0..self.blur.samples)
-            .map(|k| {
-                if self.blur.samples == 1 {
-                    t
-                } else {
-                    t + open * ((f64::from(k) + 0.5) / n - 0.5)
-                }
-            })
+            .map(|k| t + open * (f64::from(k) + 0.5) / n)
             .collect()
     }
 
@@ -382,7 +381,9 @@ impl Sequence {
     ///
     /// # Errors
     /// [`Error::Invalid`], before anything is rendered, for an index that
-    /// is not a frame of the sequence, and [`Error::Motion`] for a motion
+    /// is not a frame of the sequence or more moments of motion blur than
+    /// progressive rendering holds at the quality's supersampling, and
+    /// [`Error::Motion`] for a motion
     /// that does not validate ([`Motion::validate`]); then the first render, parameter or
     /// file error; the frames saved before it stay on disk.
     pub fn render(
@@ -402,6 +403,20 @@ impl Sequence {
         }
         for motion in motions {
             motion.validate()?;
+        }
+        // Each moment a progressive pass of the quality's samples.
+        let samples = renderer.options().quality.supersampling.max(1).pow(2);
+        let most = Renderer::MAX_PROGRESSIVE_SAMPLES / samples;
+        if self.blur.samples > most {
+            return Err(invalid(format!(
+                "{} moments of motion blur take {} samples a pixel at {}x{} supersampling, \
+                 more than the {} progressive rendering holds: use at most {most} moments",
+                self.blur.samples,
+                self.blur.samples * samples,
+                renderer.options().quality.supersampling,
+                renderer.options().quality.supersampling,
+                Renderer::MAX_PROGRESSIVE_SAMPLES
+            )));
         }
         let base = *renderer.camera();
         let at = |renderer: &mut Renderer, t: f64| -> Result<()> {

@@ -39,7 +39,10 @@ impl Glow {
 /// bring, dividing the survivors' weight by their chance, so the mean is
 /// unchanged.
 ///
-/// The estimate is unbiased for paths of up to `max_bounces` bounces:
+/// A path meets at most `max_bounces` surfaces after its first hit, and
+/// the light each of them receives is counted: the lights' (sampled at
+/// it) and the sky's and environment's (along its bounce, the last
+/// surface's included). The estimate of that light is unbiased:
 /// progressive passes ([`crate::render::Renderer::render_progressive`])
 /// converge on the image, their noise falling as one over the square root
 /// of the passes. Light that needs more bounces is lost. Inside shapes

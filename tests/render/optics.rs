@@ -618,5 +618,22 @@ fn a_moving_ball_blurs_over_the_open_shutter() {
                 .is_err()
         );
     }
+    // 256 moments of 8x8 samples are more than progressive rendering
+    // holds: refused before a frame is rendered.
+    let many = Sequence::new(dir.join("many"), 2.0, 2)
+        .unwrap()
+        .motion_blur(MotionBlur::new(256, 0.5))
+        .unwrap();
+    let fine = gpu::options(
+        gpu::plain(Quality::preview().supersampling(8)),
+        Effects::none(),
+    );
+    let mut renderer = Renderer::with_options(&scene, &fine).unwrap();
+    let err = many
+        .render(&mut renderer, &path, &motions, &[0], (8, 8), |_| {})
+        .unwrap_err()
+        .to_string();
+    assert!(err.contains("at most 64 moments"), "{err}");
+    assert!(!many.frame_path(0).exists());
     let _ = std::fs::remove_dir_all(&dir);
 }

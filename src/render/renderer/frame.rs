@@ -208,6 +208,9 @@ impl Renderer {
                 expected: format!("1 to {} for the quality's samples", self.most_passes()),
             });
         }
+        // The accumulation is about to be overwritten: no earlier passes
+        // continue, even after an error.
+        self.progress = None;
         let mut image = None;
         for (pass, moment) in (0i32..).zip(moments) {
             let done = set(self, moment).and_then(|()| {
