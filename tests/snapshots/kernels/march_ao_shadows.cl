@@ -491,8 +491,9 @@ real3 march_light(__global const real* l, real3 p, real3* to_light, real* light_
         radiance /= dist2;
         if (l[LIGHT_KIND] > R(2.5)) {
             // A rectangle lights its own side, dimming with the angle.
-            real3 face = cross(vload3(0, l + LIGHT_EDGE_U), vload3(0, l + LIGHT_EDGE_V));
-            radiance *= fmax(dot(face, -*to_light), R(0.0)) / fmax(length(face), REAL_TINY);
+            real3 face = cross(normalize(vload3(0, l + LIGHT_EDGE_U)),
+                               normalize(vload3(0, l + LIGHT_EDGE_V)));
+            radiance *= fmax(dot(face, -*to_light), R(0.0));
         }
     }
     return radiance;
