@@ -15,7 +15,7 @@
 //           real DE_shade(real3 p, __global const real* params,
 //                         real3* color, real* trap)
 //           and, with materials (ENABLE_MATERIALS), void DE_material(real3 p,
-//           __global const real* params, real8* material), whose fields the
+//           __global const real* params, real16* material), whose fields the
 //           header names MATERIAL_<value> (material.MATERIAL_IOR)
 //   effects: the code of each effect (ambient occlusion, shadows, glow,
 //           fog, global illumination: ENABLE_GI with GI_BOUNCES) sits in

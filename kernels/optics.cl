@@ -69,7 +69,7 @@ real3 march_branch(MarchBranch b, MarchBranch* stack, int* top,
 real3 march_split(real3 p, real3 n, real3 rd, real eps, real t, real3 weight, int depth,
                   real3 own, __global const real* params, MarchBranch* stack, int* top,
                   __global const float* environment, uint* evals) {
-    real8 material;
+    real16 material;
     DE_material(p, params, &material);
     *evals += 1u;
     real r = material.MATERIAL_REFLECTIVITY;
@@ -133,7 +133,7 @@ real3 march_paths(real3 p, real3 n, real3 rd, real eps, real t, const MarchCamer
         real eq = DETAIL * footprint;
         real travelled = b.travelled + m.t;
         if (b.inside) {
-            real8 material;
+            real16 material;
             DE_material(q, params, &material);
             *evals += 1u;
             real3 out = march_refract(b.rd, -nq, material.MATERIAL_IOR);

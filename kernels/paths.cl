@@ -285,6 +285,24 @@ real3 march_direct(real3 p, real3 n, real3 rd, real eps, real travelled, const M
     return sum;
 }
 
+// The light the surface at p gives off: its albedo times its material's
+// emission (none without materials).
+real3 march_emission(real3 p, __global const real* params, uint* evals) {
+#ifdef ENABLE_MATERIALS
+    real16 material;
+    DE_material(p, params, &material);
+    *evals += 1u;
+    if (material.MATERIAL_EMISSION > R(0.0)) {
+        real3 albedo;
+        real trap;
+        DE_shade(p, params, &albedo, &trap);
+        *evals += 1u;
+        return albedo * march_trap_tint(trap) * material.MATERIAL_EMISSION;
+    }
+#endif
+    return (real3)(R(0.0));
+}
+
 // The light a path brings to the camera from its first hit: the surface
 // point p (normal n, facing the ray) reached t along rd, for sample j of
 // the pixel. Each surface the path meets chooses, by chance in proportion
@@ -295,8 +313,9 @@ real3 march_direct(real3 p, real3 n, real3 rd, real eps, real travelled, const M
 // Inside a transparent shape the path travels clear to where it leaves,
 // refracting out or reflecting back in on total internal reflection. The
 // path meets at most GI_BOUNCES surfaces after the first: each one's light
-// is counted (the lights' sampled at it, the sky's along its bounce), and
-// the path ends at the next surface. Adds its evaluations to *evals.
+// is counted (its emission, the lights' sampled at it, the sky's and the
+// next surface's emission along its bounce), and the path ends at the next
+// surface. Adds its evaluations to *evals.
 real3 march_path(real3 p, real3 n, real3 rd, real t, const MarchCamera* cam, uint pixel, uint j,
                  __global const real* params, __global const real* lights, int light_count,
                  __global const float* environment, uint* evals) {
@@ -318,7 +337,7 @@ real3 march_path(real3 p, real3 n, real3 rd, real t, const MarchCamera* cam, uin
             // Leaving a transparent shape: n is its outward normal.
             real ior = R(1.0);
 #ifdef ENABLE_MATERIALS
-            real8 material;
+            real16 material;
             DE_material(p, params, &material);
             *evals += 1u;
             ior = material.MATERIAL_IOR;
@@ -346,7 +365,7 @@ real3 march_path(real3 p, real3 n, real3 rd, real t, const MarchCamera* cam, uin
             real passed = R(0.0);
             real3 bent = (real3)(R(0.0));
 #ifdef ENABLE_MATERIALS
-            real8 material;
+            real16 material;
             DE_material(p, params, &material);
             *evals += 1u;
             ks = material.MATERIAL_SPECULAR;
@@ -355,6 +374,7 @@ real3 march_path(real3 p, real3 n, real3 rd, real t, const MarchCamera* cam, uin
             real r = material.MATERIAL_REFLECTIVITY;
             real tau = material.MATERIAL_TRANSPARENCY;
             reflected = r;
+            radiance += throughput * albedo * material.MATERIAL_EMISSION;
             if (tau > R(0.0)) {
                 real ior = material.MATERIAL_IOR;
                 real fresnel = march_fresnel(clamp(-dot(n, rd), R(0.0), R(1.0)), ior);
@@ -430,13 +450,17 @@ real3 march_path(real3 p, real3 n, real3 rd, real t, const MarchCamera* cam, uin
             }
             break;
         }
-        // The last surface's light is counted (the lights' at it, and the
-        // sky's beyond it): a path ends at the surface after it.
-        if (bounce >= GI_BOUNCES) {
-            break;
-        }
         rd = next;
         p = ro + rd * m.t;
+        // The last surface's light is counted (the lights' at it, and the
+        // sky's and emitters' beyond it): a path ends at the surface after
+        // it.
+        if (bounce >= GI_BOUNCES) {
+            if (!inside) {
+                radiance += throughput * march_emission(p, params, evals);
+            }
+            break;
+        }
         travelled += m.t;
         real footprint = march_footprint(&along, m.t);
         n = march_normal(p, NORMAL_EPSILON * footprint, rd, params);

@@ -345,13 +345,19 @@ __kernel void render_tile(RENDER_TILE_ARGS) {
                                light_count, environment, &total_evals);
 #endif
 #ifdef ENABLE_FOG
-            color = mix(background, color, exp(-FOG_DENSITY * m.t));
+            // What the fog takes away, the sky puts back.
+            color = mix(background, color, exp(-march_fog_depth(ro, rd, m.t)));
 #endif
         }
 #ifdef ENABLE_GLOW
         else {
             color += GLOW_COLOR * (GLOW_STRENGTH * exp(-MARCH_GLOW_FALLOFF * m.closest));
         }
+#endif
+#ifdef ENABLE_FOG_LIGHT
+        color += march_fog_light(ro, rd, m.hit ? fmax(m.t, R(0.0)) : (real)INFINITY,
+                                 march_jitter(pixel, j, 4u), &cam, params, lights, light_count,
+                                 &total_evals);
 #endif
         sum += color;
         if (s == 0) {

@@ -352,6 +352,83 @@ real3 march_light(__global const real* l, real3 p, real3* to_light, real* light_
     return radiance;
 }
 
+#ifdef ENABLE_FOG
+// The fog's optical depth from ro along the unit rd to distance t (which
+// may be INFINITY): FOG_DENSITY t for a uniform fog. With FOG_FALLOFF b,
+// the density is FOG_DENSITY exp(-b (y - FOG_HEIGHT)), and along the ray
+// (y = ro.y + rd.y s) the integral is A (1 - exp(-k t)) / k, with A the
+// density at ro and k = b rd.y (t itself where k t is tiny).
+real march_fog_depth(real3 ro, real3 rd, real t) {
+    real depth = FOG_DENSITY * t;
+#ifdef ENABLE_FOG_LIGHT
+    real at_ro = FOG_DENSITY * exp(clamp(-FOG_FALLOFF * (ro.y - FOG_HEIGHT), R(-80.0), R(80.0)));
+    real k = FOG_FALLOFF * rd.y;
+    real kt = k * t;
+    real span = t;
+    if (k != R(0.0)) {
+        span = fabs(kt) < R(1e-4) ? t * (R(1.0) - R(0.5) * kt) : -expm1(-kt) / k;
+    }
+    depth = at_ro * span;
+#endif
+    return depth;
+}
+#endif
+
+#ifdef ENABLE_FOG_LIGHT
+// The distance from ro along the unit rd at which the fog's optical depth
+// reaches depth (march_fog_depth inverted; depth below the ray's total).
+real march_fog_reach(real3 ro, real3 rd, real depth) {
+    real at_ro = FOG_DENSITY * exp(clamp(-FOG_FALLOFF * (ro.y - FOG_HEIGHT), R(-80.0), R(80.0)));
+    real q = depth / at_ro;
+    real k = FOG_FALLOFF * rd.y;
+    real kq = k * q;
+    if (fabs(kq) < R(1e-4)) {
+        return q * (R(1.0) + R(0.5) * kq);
+    }
+    return -log1p(-fmin(kq, R(1.0) - R(1e-7))) / k;
+}
+
+// The light the fog scatters towards the camera along ro + rd s, s from 0
+// to far (INFINITY on a miss), once (single scattering): the integral of
+// density x transmittance x each light's radiance x pi x the phase
+// function. Substituting u = 1 - exp(-depth(s)) makes the weight of every
+// stretch of the ray its u: FOG_SAMPLES points spread evenly in u over [0,
+// 1 - exp(-depth(far))], shifted together by jitter in [0, 1) (a new one
+// every pass), each lit by every light through a shadow ray. Henyey and
+// Greenstein's phase function for FOG_ANISOTROPY g, times pi:
+// (1 - g^2) / (4 (1 + g^2 - 2 g cos)^1.5). Adds the shadow rays'
+// evaluations to *evals.
+real3 march_fog_light(real3 ro, real3 rd, real far, real jitter, const MarchCamera* cam,
+                      __global const real* params, __global const real* lights,
+                      int light_count, uint* evals) {
+    real scattered = -expm1(-march_fog_depth(ro, rd, far));
+    real share = scattered / (real)FOG_SAMPLES;
+    real g = FOG_ANISOTROPY;
+    real3 sum = (real3)(R(0.0));
+    for (int k = 0; k < FOG_SAMPLES; ++k) {
+        real u = fmin(share * ((real)k + jitter), R(0.999999));
+        real s = fmin(march_fog_reach(ro, rd, -log1p(-u)), far);
+        real3 x = ro + rd * s;
+        for (int i = 0; i < light_count; ++i) {
+            __global const real* l = lights + LIGHT_STRIDE * i;
+            real3 to_light;
+            real light_distance;
+            real3 radiance = march_light(l, x, &to_light, &light_distance);
+            real bend = R(1.0) + g * g - R(2.0) * g * dot(to_light, rd);
+            radiance *= (R(1.0) - g * g) / (R(4.0) * bend * sqrt(bend)) * share;
+#ifdef ENABLE_SHADOWS
+            real eps = DETAIL * march_footprint(cam, s);
+            radiance *= march_shadow(x, to_light, light_distance, R(0.25) * eps, R(0.0),
+                                     l[LIGHT_SOFTNESS], fmax(radiance.x, fmax(radiance.y, radiance.z)),
+                                     params, evals);
+#endif
+            sum += radiance;
+        }
+    }
+    return sum;
+}
+#endif
+
 // Lit colour of the surface point p with normal n, seen along rd, with the
 // sky's light scaled by occlusion (1: open). Adds its distance evaluations
 // (DE_shade, DE_material, shadow rays, thickness) to *evals.
@@ -361,8 +438,9 @@ real3 march_light(__global const real* l, real3 p, real3* to_light, real* light_
 // or, with a material's roughness, Oren-Nayar's. With a material's
 // subsurface strength s, a light behind the surface (n.l < 0) adds
 // albedo * s * thinness * -n.l: it shows through thin parts, unshadowed
-// (the shape itself stands between). Without materials the highlight is
-// MARCH_SPECULAR and MARCH_SHININESS, the default material's.
+// (the shape itself stands between). A material's emission adds
+// albedo * emission, unlit and unshadowed. Without materials the highlight
+// is MARCH_SPECULAR and MARCH_SHININESS, the default material's.
 real3 march_shade(real3 p, real3 n, real3 rd, real eps, real occlusion,
                   __global const real* params, __global const real* lights, int light_count,
                   __global const float* environment, uint* evals) {
@@ -374,7 +452,7 @@ real3 march_shade(real3 p, real3 n, real3 rd, real eps, real occlusion,
     real specular_strength = MARCH_SPECULAR;
     real shininess = MARCH_SHININESS;
 #ifdef ENABLE_MATERIALS
-    real8 material;
+    real16 material;
     DE_material(p, params, &material);
     *evals += 1u;
     specular_strength = material.MATERIAL_SPECULAR;
@@ -390,6 +468,9 @@ real3 march_shade(real3 p, real3 n, real3 rd, real eps, real occlusion,
     sky = march_environment_irradiance(environment, n);
 #endif
     real3 color = albedo * sky * (MARCH_AMBIENT * occlusion);
+#ifdef ENABLE_MATERIALS
+    color += albedo * material.MATERIAL_EMISSION;
+#endif
 
 #ifdef ENABLE_SHADOWS
     // Shadow rays start one hit threshold off the surface and are blocked

@@ -19,8 +19,9 @@
 //! 7. [Outputs](outputs): image formats, OpenEXR layers, exposure and
 //!    tone curves, and the camera for a 3D package.
 //! 8. [Materials](materials): shading models, reflections and glass.
-//! 9. [Light](light): path-traced global illumination, environment
-//!    lights, and the stopping rule of progressive passes.
+//! 9. [Light](light): path-traced global illumination, environment,
+//!    area and emissive lights, the stopping rule of progressive passes,
+//!    and fog lit by the lights.
 //! 10. [Animation](animation): motions, camera paths and frame sequences.
 //! 11. [Meshes and volumes](meshes): watertight meshes and signed-distance
 //!     grids.

@@ -42,7 +42,9 @@ use crate::expr::Unprintable;
 use crate::ir::{Bound, CompiledScene, Ir, union_chain};
 use crate::math::{DEFAULT_COLOR, DERIVATIVE_CAP, MAGNITUDE_CAP, REAL_TINY};
 use crate::quality::{Effects, Precision, Quality, ScreenNormals};
-use crate::scene::{BRUTE_MAX_STEPS, DEFAULT_MATERIAL, INSIDE_HUGE, Kind, MATERIAL_SPECS};
+use crate::scene::{
+    BRUTE_MAX_STEPS, DEFAULT_MATERIAL, INSIDE_HUGE, Kind, MATERIAL_LEN, MATERIAL_SPECS,
+};
 
 /// What the generated program is for.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
@@ -356,6 +358,7 @@ pub fn emit_ir(ir: &Ir, options: &Options) -> Result<KernelSource> {
             Target::Evaluate => None,
         },
         glow: glow_bound(ir, options, origin),
+        origin,
     };
     let used = std::mem::take(&mut emitter.used);
     let trapped = std::mem::take(&mut emitter.trapped);
@@ -512,9 +515,22 @@ const SKY_BACKGROUND: &str = "ENABLE_SKY_BACKGROUND";
 /// shapes that glow ([`glow_bound`]).
 const GLOW_BOUND: &str = "ENABLE_GLOW_BOUND";
 
+/// The switch of the fog's light ([`crate::quality::Volumetric`]).
+const FOG_LIGHT: &str = "ENABLE_FOG_LIGHT";
+
+/// Whether `options` render fog as a lit medium.
+fn fog_light(options: &Options) -> bool {
+    options.target == Target::Render
+        && options.effects.volumetric.is_some()
+        && Effect::enabled(options).contains(&Effect::Fog)
+}
+
 /// What a scene asks of its program beyond the quality and effects.
 #[derive(Debug, Clone, Copy, Default)]
 pub(crate) struct Features {
+    /// Where the program's `DE` has its origin in the scene
+    /// ([`KernelSource::origin`]).
+    pub(crate) origin: DVec3,
     /// It sets a material (rendering only).
     pub(crate) materials: bool,
     /// It holds an inside shape, whose value is `±INSIDE_HUGE`.
@@ -583,7 +599,20 @@ fn kernel_with(options: &Options, bounded: bool, features: &Features) -> String 
     if features.glow.is_some() {
         on.push(GLOW_BOUND);
     }
+    if fog_light(options) {
+        on.push(FOG_LIGHT);
+    }
     select_blocks(kernel, &on)
+}
+
+/// A material's values as the `real16` the kernels carry, the lanes after
+/// the last value zero.
+pub(crate) fn material_vector(values: [String; MATERIAL_LEN], zero: &str) -> String {
+    const LANES: usize = 16;
+    const _: () = assert!(MATERIAL_LEN <= LANES);
+    let zeros = std::iter::repeat_n(zero.to_string(), LANES - MATERIAL_LEN);
+    let lanes: Vec<String> = values.into_iter().chain(zeros).collect();
+    format!("(real16)({})", lanes.join(", "))
 }
 
 /// The coarse pass's tile side: none for evaluation, nor where inside
@@ -741,7 +770,7 @@ fn header(w: &mut writer::Writer, options: &Options, features: &Features) {
             w.line("typedef float3 real3;");
             w.line("typedef float4 real4;");
             if materials {
-                w.line("typedef float8 real8;");
+                w.line("typedef float16 real16;");
             }
             w.line("#define R(x) x##f");
         }
@@ -752,7 +781,7 @@ fn header(w: &mut writer::Writer, options: &Options, features: &Features) {
             w.line("typedef double3 real3;");
             w.line("typedef double4 real4;");
             if materials {
-                w.line("typedef double8 real8;");
+                w.line("typedef double16 real16;");
             }
             w.line("#define R(x) x");
         }
@@ -791,6 +820,13 @@ fn header(w: &mut writer::Writer, options: &Options, features: &Features) {
     if on.contains(&Effect::Fog) {
         defines.push(("FOG_DENSITY", f(e.fog_density)));
     }
+    if let Some(fog) = e.volumetric.filter(|_| fog_light(options)) {
+        defines.push(("FOG_FALLOFF", f(fog.falloff)));
+        // Heights in the program's frame.
+        defines.push(("FOG_HEIGHT", f(fog.height - features.origin.y)));
+        defines.push(("FOG_SAMPLES", fog.samples.to_string()));
+        defines.push(("FOG_ANISOTROPY", f(fog.anisotropy)));
+    }
     if let Some(gi) = e.global_illumination {
         defines.push(("GI_BOUNCES", gi.max_bounces.to_string()));
     }
@@ -810,10 +846,9 @@ fn header(w: &mut writer::Writer, options: &Options, features: &Features) {
         defines.push(("SCREEN_NORMALS", method.to_string()));
     }
     if materials {
-        let values: Vec<String> = DEFAULT_MATERIAL.iter().map(|&v| f(v)).collect();
         defines.push((
             "DEFAULT_MATERIAL",
-            format!("(real8)({})", values.join(", ")),
+            material_vector(DEFAULT_MATERIAL.map(f), &f(0.0)),
         ));
         defines.push(("BOUNCES", q.bounces.to_string()));
     }
@@ -821,7 +856,7 @@ fn header(w: &mut writer::Writer, options: &Options, features: &Features) {
         w.line(format!("#define {name} {value}"));
     }
     if materials {
-        // A material is a `real8` of its values in `MATERIAL_SPECS` order:
+        // A material is a `real16` of its values in `MATERIAL_SPECS` order:
         // the kernel reads each by name (`material.MATERIAL_IOR`).
         for (i, spec) in MATERIAL_SPECS.iter().enumerate() {
             w.line(format!(

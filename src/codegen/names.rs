@@ -128,6 +128,7 @@ fn library_texts() -> Vec<String> {
                     shadows: true,
                     glow: Some(Glow::new(DVec3::ONE, 1.0)),
                     fog_density: 1.0,
+                    volumetric: Some(crate::quality::Volumetric::default()),
                     global_illumination: Some(crate::quality::GlobalIllumination::default()),
                     ..Effects::default()
                 },
@@ -148,6 +149,7 @@ fn library_texts() -> Vec<String> {
                     radius: 1.0,
                     slope: 1.0,
                 }),
+                origin: DVec3::ZERO,
             };
             header(&mut w, &options, &features);
             texts.push(w.finish());

@@ -65,7 +65,7 @@ pub fn shade(eval: &Evaluator, p: DVec3, n: DVec3, rd: DVec3, lights: &[Light], 
     let albedo = DVec3::from(sample.color) * trap_tint(sample.trap);
     let m: Material<f64> = Material::from_values(sample.material);
     let ambient = sky.bottom.lerp(sky.top, 0.5 + 0.5 * n.y);
-    let mut color = albedo * ambient * AMBIENT;
+    let mut color = albedo * ambient * AMBIENT + albedo * m.emission;
     let through = if m.subsurface > 0.0 && m.scatter_depth > 0.0 {
         m.subsurface * thinness(eval, p, n, m.scatter_depth)
     } else {

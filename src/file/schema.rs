@@ -341,6 +341,8 @@ pub(super) struct MaterialRepr {
     transparency: Option<Param>,
     #[serde(skip_serializing_if = "Option::is_none")]
     ior: Option<Param>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    emission: Option<Param>,
 }
 
 /// A palette: one of the named ones, or a gradient of `(position, (r,
@@ -390,7 +392,7 @@ impl PaletteRepr {
 impl MaterialRepr {
     pub(super) fn from_material(m: &Material) -> Self {
         let defaults = Material::default();
-        let [a, b, c, d, e, f, g, h] = std::array::from_fn(|i| {
+        let [a, b, c, d, e, f, g, h, i] = std::array::from_fn(|i| {
             let (value, default) = (m.values()[i], defaults.values()[i]);
             (value != default).then(|| value.clone())
         });
@@ -403,6 +405,7 @@ impl MaterialRepr {
             reflectivity: f,
             transparency: g,
             ior: h,
+            emission: i,
         }
     }
 
@@ -417,6 +420,7 @@ impl MaterialRepr {
             &self.reflectivity,
             &self.transparency,
             &self.ior,
+            &self.emission,
         ];
         Material::from_values(std::array::from_fn(|i| {
             given[i]

@@ -15,7 +15,9 @@ use crate::math::{F32_LIMITS, F64_LIMITS, Limits, Magnitude};
 mod effects;
 mod tone;
 
-pub use effects::{Effects, GlobalIllumination, Glow, MAX_EXPOSURE, MAX_GI_BOUNCES};
+pub use effects::{
+    Effects, GlobalIllumination, Glow, MAX_EXPOSURE, MAX_FOG_SAMPLES, MAX_GI_BOUNCES, Volumetric,
+};
 pub use tone::{Encoding, ToneMap, display, display_formula};
 
 /// Floating-point precision of the generated kernel.

@@ -1,6 +1,6 @@
 //! Surface materials: how a surface answers light.
 //!
-//! A [`Material`] is eight numbers, each a [`Param`] (so any of them can be
+//! A [`Material`] is nine numbers, each a [`Param`] (so any of them can be
 //! dynamic), that the renderer's one shading formula reads:
 //!
 //! - **diffuse**: Oren–Nayar with facet roughness σ ([`Material::roughness`],
@@ -12,7 +12,10 @@
 //! - **reflections and transparency**: a share of the surface's colour
 //!   comes from a reflected ray, and a share from a refracted one (index
 //!   [`Material::ior`], with Fresnel's reflectance), traced up to
-//!   [`Quality::bounces`](crate::quality::Quality::bounces) deep.
+//!   [`Quality::bounces`](crate::quality::Quality::bounces) deep;
+//! - **emission**: the surface gives off light of its own, its colour
+//!   times [`Material::emission`]: seen in every mode, and lighting the
+//!   scene under [global illumination](crate::quality::GlobalIllumination).
 //!
 //! The four shading models of the constructors are points in that space:
 //! [`Material::lambert`], [`Material::oren_nayar`], [`Material::blinn_phong`]
@@ -69,11 +72,19 @@ pub struct Material<S = Param> {
     /// Index of refraction (greater than 0; 1.5 for glass, 1.33 water, 1
     /// passes rays straight through).
     pub ior: S,
+    /// Light the surface gives off, as a multiple of its colour (at least
+    /// 0; 0: none): a white surface of emission 1 is as bright as a white
+    /// surface lit square on by a light of intensity 1. The camera,
+    /// mirrors and glass see it in every mode; it lights other surfaces
+    /// only under global illumination, where a path that meets it brings
+    /// its light back (emitters are found by the paths' bounces, not
+    /// sampled like lights: small bright ones are noisy).
+    pub emission: S,
 }
 
-/// How many numbers a material has: the length of the vector the kernels
-/// carry (`real8`), in [`Material::values`] order.
-pub const MATERIAL_LEN: usize = 8;
+/// How many numbers a material has, in [`Material::values`] order (the
+/// kernels carry them in a `real16`, the rest zero).
+pub const MATERIAL_LEN: usize = 9;
 
 impl Material {
     /// Lambert diffuse and nothing else: matte.
@@ -137,6 +148,16 @@ impl Material {
         }
     }
 
+    /// Lambert diffuse that also gives off its colour times `strength` as
+    /// light (see [`Material::emission`]).
+    #[must_use]
+    pub fn emissive(strength: impl Into<Param>) -> Self {
+        Material {
+            emission: strength.into(),
+            ..Self::lambert()
+        }
+    }
+
     /// The same material with roughness σ.
     #[must_use]
     pub fn roughness(mut self, sigma: impl Into<Param>) -> Self {
@@ -166,6 +187,13 @@ impl Material {
         self.ior = ior.into();
         self
     }
+
+    /// The same material, giving off its colour times `strength` as light.
+    #[must_use]
+    pub fn emission(mut self, strength: impl Into<Param>) -> Self {
+        self.emission = strength.into();
+        self
+    }
 }
 
 impl Default for Material {
@@ -176,7 +204,7 @@ impl Default for Material {
 
 /// [`Material::default`]'s values, in [`Material::values`] order: the
 /// kernels' `DEFAULT_MATERIAL` and the CPU reference's.
-pub const DEFAULT_MATERIAL: [f64; MATERIAL_LEN] = [0.0, 0.25, 32.0, 0.0, 0.0, 0.0, 0.0, 1.0];
+pub const DEFAULT_MATERIAL: [f64; MATERIAL_LEN] = [0.0, 0.25, 32.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0];
 
 /// Each value's name and rule, in [`Material::values`] order.
 pub(crate) const MATERIAL_SPECS: [ParamSpec<'static>; MATERIAL_LEN] = [
@@ -188,11 +216,13 @@ pub(crate) const MATERIAL_SPECS: [ParamSpec<'static>; MATERIAL_LEN] = [
     spec("reflectivity", Rule::Range(0.0, 1.0)),
     spec("transparency", Rule::Range(0.0, 1.0)),
     spec("ior", Rule::Positive),
+    spec("emission", Rule::NonNegative),
 ];
 
 impl<S> Material<S> {
     /// The values in a fixed order: roughness, specular, shininess,
-    /// subsurface, scatter depth, reflectivity, transparency, ior.
+    /// subsurface, scatter depth, reflectivity, transparency, ior,
+    /// emission.
     #[must_use]
     pub fn values(&self) -> [&S; MATERIAL_LEN] {
         [
@@ -204,6 +234,7 @@ impl<S> Material<S> {
             &self.reflectivity,
             &self.transparency,
             &self.ior,
+            &self.emission,
         ]
     }
 
@@ -219,6 +250,7 @@ impl<S> Material<S> {
             reflectivity,
             transparency,
             ior,
+            emission,
         ] = values;
         Material {
             roughness,
@@ -229,6 +261,7 @@ impl<S> Material<S> {
             reflectivity,
             transparency,
             ior,
+            emission,
         }
     }
 
@@ -261,7 +294,9 @@ mod tests {
         assert_eq!(values(&Material::blinn_phong(0.5, 8.0))[1..3], [0.5, 8.0]);
         assert_eq!(values(&Material::subsurface(0.7, 0.2))[3..5], [0.7, 0.2]);
         assert_eq!(values(&Material::mirror())[5], 1.0);
-        assert_eq!(values(&Material::glass(1.5))[6..], [1.0, 1.5]);
+        assert_eq!(values(&Material::glass(1.5))[6..8], [1.0, 1.5]);
+        assert_eq!(values(&Material::emissive(3.0))[8], 3.0);
+        assert_eq!(values(&Material::emissive(3.0))[1], 0.0);
         let round_trip = Material::from_values(Material::glass(1.33).values().map(Clone::clone));
         assert_eq!(round_trip, Material::glass(1.33));
     }

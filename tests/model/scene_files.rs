@@ -653,6 +653,27 @@ fn a_cut_plane_is_a_node_of_its_own() {
     assert!(err.contains("`normal`"), "{err}");
 }
 
+/// Every scene file the crate ships, gallery or not, loads and compiles.
+#[test]
+fn every_shipped_scene_file_loads() {
+    let mut count = 0;
+    for entry in std::fs::read_dir(scenes_dir()).unwrap() {
+        let path = entry.unwrap().path();
+        if path.extension().is_none_or(|e| e != "ron") {
+            continue;
+        }
+        let file = SceneFile::load(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+        file.scene
+            .compile()
+            .unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+        file.effects
+            .validate()
+            .unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+        count += 1;
+    }
+    assert!(count > gallery::names().len(), "{count} scene files");
+}
+
 /// The one-formula scenes of the guide's cost table (`benches/formulas`)
 /// load and compile.
 #[test]

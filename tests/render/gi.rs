@@ -640,6 +640,97 @@ fn a_sphere_light_lights_as_its_closed_form_says() {
     assert!(soft > 3 * hard.max(5), "{soft} against {hard}");
 }
 
+/// A ball that gives off light: the camera sees its colour times its
+/// emission without global illumination (no sky, no lights), and under
+/// it the ball lights a white floor as a sphere of that radiance does,
+/// `L (R / d)² cos θ` (its irradiance `π L sin²α cos θ` over π), found by
+/// the paths' bounces alone.
+#[test]
+fn an_emissive_ball_lights_the_floor_as_its_closed_form_says() {
+    let Some(_) = gpu::device() else { return };
+    let (centre, radius, emission) = (dvec3(0.2, 1.1, -0.3), 0.5, 3.0);
+    let color = dvec3(1.0, 0.8, 0.6);
+    let floor = plane(DVec3::Y, 0.0)
+        .color(DVec3::ONE)
+        .material(Material::lambert());
+    let ball = sphere(radius)
+        .translate(centre)
+        .color(color)
+        .material(Material::emissive(emission));
+    let eye = dvec3(0.0, 2.5, 3.0);
+    let scene = Scene::new(floor.union(ball))
+        .with_camera(Camera::look_at(eye, dvec3(0.0, 0.3, 0.0)))
+        .with_lights([]);
+    let black = Effects::default()
+        .sky_top(DVec3::ZERO)
+        .sky_bottom(DVec3::ZERO)
+        .ambient_occlusion(false)
+        .gamma(1.0);
+    let on_ball = |p: [f32; 3]| glam::Vec3::from(p).as_dvec3().distance(centre) < radius + 0.05;
+
+    let direct = gpu::options(gpu::plain(Quality::preview()), black);
+    let frame = Renderer::with_options(&scene, &direct)
+        .unwrap()
+        .render_layers(W, H)
+        .unwrap();
+    let layers = frame.layers.as_ref().unwrap();
+    let mut seen = 0;
+    for (c, p) in layers.linear.iter().zip(&layers.position) {
+        if c[3] >= 1.0 && on_ball(*p) {
+            let want = color * emission;
+            let got = dvec3(c[0].into(), c[1].into(), c[2].into());
+            assert!(
+                (got - want).abs().max_element() < 1e-3,
+                "{got} against {want} at {p:?}"
+            );
+            seen += 1;
+        } else if c[3] >= 1.0 {
+            assert!(
+                c[0].abs() < 1e-6,
+                "the floor is dark without global illumination"
+            );
+        }
+    }
+    assert!(seen > 20, "the ball covers {seen} pixels");
+
+    // Rays leave a surface a few hit thresholds off it: a fine threshold
+    // keeps that from bringing the floor measurably nearer the ball.
+    let options = gpu::options(
+        gpu::plain(Quality::preview().detail(0.01).hit_epsilon(0.01)),
+        black.global_illumination(GlobalIllumination::new(1)),
+    );
+    let mut renderer = Renderer::with_options(&scene, &options).unwrap();
+    let frame = passes(&mut renderer, 1024);
+    let layers = frame.layers.as_ref().unwrap();
+    let (mut got, mut wanted, mut count) = (0.0, 0.0, 0.0);
+    for (c, p) in layers.linear.iter().zip(&layers.position) {
+        // The floor's points near the ball (the hit threshold lifts them),
+        // where the ball is large enough for the bounces to find it often.
+        // Passes jitter the rays in their pixel: none of a pixel's may
+        // come near the ball.
+        let q = glam::Vec3::from(*p).as_dvec3();
+        let delta = centre - q;
+        let along = (q - eye).normalize();
+        let passing = (centre - eye).reject_from_normalized(along).length();
+        if c[3] < 1.0 || passing < radius + 0.4 || q.y > 0.3 || delta.length() > 2.5 {
+            continue;
+        }
+        for (channel, tint) in [(0, color.x), (2, color.z)] {
+            let want =
+                emission * tint * radius * radius / delta.length_squared() * delta.normalize().y;
+            got += f64::from(c[channel]);
+            wanted += want;
+            count += 1.0;
+        }
+    }
+    let bias = got / wanted - 1.0;
+    eprintln!("emissive ball: relative error of the mean {bias:.4} over {count} pixel channels");
+    assert!(
+        count > 500.0 && bias.abs() < 0.015,
+        "relative error of the mean {bias}"
+    );
+}
+
 /// A ball of light needs a radius above 0, finite; a rectangle two sides
 /// at right angles, neither zero.
 #[test]

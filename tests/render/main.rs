@@ -1,5 +1,5 @@
 //! Rendering through OpenCL: agreement with the CPU, cancelling, cuts,
-//! effects, errors, global illumination, materials, optics, quality,
+//! effects, errors, lit fog, global illumination, materials, optics, quality,
 //! sizes, frame-to-frame updates, the golden gallery, march bounds, several
 //! devices and the speed knobs.
 //!
@@ -13,6 +13,7 @@ mod cancel;
 mod cuts;
 mod effects;
 mod errors;
+mod fog;
 mod gi;
 mod golden;
 mod march_bounds;

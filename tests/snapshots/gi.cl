@@ -4,7 +4,7 @@ typedef float real;
 typedef float2 real2;
 typedef float3 real3;
 typedef float4 real4;
-typedef float8 real8;
+typedef float16 real16;
 #define R(x) x##f
 #define REAL_TINY 1e-30f
 #define DERIVATIVE_CAP 1e30f
@@ -25,7 +25,7 @@ typedef float8 real8;
 #define AO_DISTANCE 0.25f
 #define SHADOW_STEPS 96
 #define CONE_TILE 8
-#define DEFAULT_MATERIAL (real8)(0.0f, 0.25f, 32.0f, 0.0f, 0.0f, 0.0f, 0.0f, 1.0f)
+#define DEFAULT_MATERIAL (real16)(0.0f, 0.25f, 32.0f, 0.0f, 0.0f, 0.0f, 0.0f, 1.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f)
 #define BOUNCES 4
 #define MATERIAL_ROUGHNESS s0
 #define MATERIAL_SPECULAR s1
@@ -35,6 +35,7 @@ typedef float8 real8;
 #define MATERIAL_REFLECTIVITY s5
 #define MATERIAL_TRANSPARENCY s6
 #define MATERIAL_IOR s7
+#define MATERIAL_EMISSION s8
 #define ENABLE_AO
 #define ENABLE_SHADOWS
 #define ENABLE_MATERIALS
@@ -337,13 +338,13 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     return u8;
 }
 
-real DE_material(real3 p0, __global const real* params, real8* material) {
+real DE_material(real3 p0, __global const real* params, real16* material) {
     /* union */
     /* union/b:color/plane */
     real d18 = sd_plane(p0, (real3)(0.0f, 1.0f, 0.0f), 0.8f);
     /* union: the second operand only within reach of its bound */
     real u20 = d18;
-    real8 uc20 = DEFAULT_MATERIAL;
+    real16 uc20 = DEFAULT_MATERIAL;
     real g20 = (length(p0 - ((real3)(-R(0.2), R(0.0), R(0.0)))) * R(0.9999)) - R(0.8832716109390498);
     if (!(g20 > u20 && g20 > R(0.0))) {
         /* .../a:union/a:union/a:translate */
@@ -362,7 +363,7 @@ real DE_material(real3 p0, __global const real* params, real8* material) {
     }
     /* union/a:union: the second operand only within reach of its bound */
     real u17 = u20;
-    real8 uc17 = uc20;
+    real16 uc17 = uc20;
     real g17 = (length(p0 - ((real3)(R(0.0), R(0.4), -R(1.3)))) * R(0.9999)) - R(2.507987240796891);
     if (!(g17 > u17 && g17 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
@@ -370,13 +371,13 @@ real DE_material(real3 p0, __global const real* params, real8* material) {
         /* .../b:translate/color/round_box */
         real d5 = sd_round_box(p4, (real3)(2.2f, 1.2f, 0.1f), 0.04f);
         real d17 = fmin(u20, d5);
-        real8 c17 = u20 < d5 ? uc20 : DEFAULT_MATERIAL;
+        real16 c17 = u20 < d5 ? uc20 : DEFAULT_MATERIAL;
         u17 = d17;
         uc17 = c17;
     }
     /* .../a:union/a:union: the second operand only within reach of its bound */
     real u13 = u17;
-    real8 uc13 = uc17;
+    real16 uc13 = uc17;
     real g13 = (length(p0 - ((real3)(R(1.3), -R(0.4), -R(0.6)))) * R(0.9999)) - R(0.4);
     if (!(g13 > u13 && g13 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
@@ -384,15 +385,15 @@ real DE_material(real3 p0, __global const real* params, real8* material) {
         /* .../material/color/sphere */
         real d9 = sd_sphere(p5, 0.4f);
         /* .../a:union/b:translate/material */
-        real8 c11 = (real8)(0.0f, 0.0f, 32.0f, 0.0f, 0.0f, 0.0f, 0.0f, 1.0f);
+        real16 c11 = (real16)(0.0f, 0.0f, 32.0f, 0.0f, 0.0f, 0.0f, 0.0f, 1.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f);
         real d13 = fmin(u17, d9);
-        real8 c13 = u17 < d9 ? uc17 : c11;
+        real16 c13 = u17 < d9 ? uc17 : c11;
         u13 = d13;
         uc13 = c13;
     }
     /* .../a:union/a:union: the second operand only within reach of its bound */
     real u8 = u13;
-    real8 uc8 = uc13;
+    real16 uc8 = uc13;
     real g8 = (length(p0 - ((real3)(-R(1.45), -R(0.48), R(0.5)))) * R(0.9999)) - R(0.32);
     if (!(g8 > u8 && g8 > R(0.0))) {
         /* union/a:union/b:translate */
@@ -400,9 +401,9 @@ real DE_material(real3 p0, __global const real* params, real8* material) {
         /* .../b:translate/material/sphere */
         real d14 = sd_sphere(p6, 0.32f);
         /* .../a:union/b:translate/material */
-        real8 c15 = (real8)(0.0f, 0.25f, 32.0f, 0.0f, 0.0f, 0.0f, 1.0f, 1.5f);
+        real16 c15 = (real16)(0.0f, 0.25f, 32.0f, 0.0f, 0.0f, 0.0f, 1.0f, 1.5f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f);
         real d8 = fmin(u13, d14);
-        real8 c8 = u13 < d14 ? uc13 : c15;
+        real16 c8 = u13 < d14 ? uc13 : c15;
         u8 = d8;
         uc8 = c8;
     }

@@ -4,7 +4,7 @@ typedef float real;
 typedef float2 real2;
 typedef float3 real3;
 typedef float4 real4;
-typedef float8 real8;
+typedef float16 real16;
 #define R(x) x##f
 #define REAL_TINY 1e-30f
 #define DERIVATIVE_CAP 1e30f
@@ -25,7 +25,7 @@ typedef float8 real8;
 #define AO_DISTANCE 0.25f
 #define SHADOW_STEPS 96
 #define CONE_TILE 8
-#define DEFAULT_MATERIAL (real8)(0.0f, 0.25f, 32.0f, 0.0f, 0.0f, 0.0f, 0.0f, 1.0f)
+#define DEFAULT_MATERIAL (real16)(0.0f, 0.25f, 32.0f, 0.0f, 0.0f, 0.0f, 0.0f, 1.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f)
 #define BOUNCES 4
 #define MATERIAL_ROUGHNESS s0
 #define MATERIAL_SPECULAR s1
@@ -35,6 +35,7 @@ typedef float8 real8;
 #define MATERIAL_REFLECTIVITY s5
 #define MATERIAL_TRANSPARENCY s6
 #define MATERIAL_IOR s7
+#define MATERIAL_EMISSION s8
 #define ENABLE_AO
 #define ENABLE_SHADOWS
 #define ENABLE_MATERIALS
@@ -405,15 +406,15 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     return u8;
 }
 
-real DE_material(real3 p0, __global const real* params, real8* material) {
+real DE_material(real3 p0, __global const real* params, real16* material) {
     /* union */
     /* .../b:material/color/plane */
     real d29 = sd_plane(p0, (real3)(0.0f, 1.0f, 0.0f), 0.45f);
     /* union/b:material */
-    real8 c31 = (real8)(0.0f, 0.25f, 32.0f, 0.0f, 0.0f, 0.25f, 0.0f, 1.0f);
+    real16 c31 = (real16)(0.0f, 0.25f, 32.0f, 0.0f, 0.0f, 0.25f, 0.0f, 1.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f);
     /* union: the second operand only within reach of its bound */
     real u32 = d29;
-    real8 uc32 = c31;
+    real16 uc32 = c31;
     real g32 = (length(p0 - ((real3)(-R(1.9), R(0.0), R(0.2)))) * R(0.9999)) - R(0.42);
     if (!(g32 > u32 && g32 > R(0.0))) {
         /* .../a:union/a:union/a:translate */
@@ -421,15 +422,15 @@ real DE_material(real3 p0, __global const real* params, real8* material) {
         /* .../material/color/sphere */
         real d0 = sd_sphere(p1, 0.42f);
         /* .../a:union/a:translate/material */
-        real8 c2 = (real8)(0.9f, 0.0f, 32.0f, 0.0f, 0.0f, 0.0f, 0.0f, 1.0f);
+        real16 c2 = (real16)(0.9f, 0.0f, 32.0f, 0.0f, 0.0f, 0.0f, 0.0f, 1.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f);
         real d32 = fmin(d29, d0);
-        real8 c32 = d29 < d0 ? c31 : c2;
+        real16 c32 = d29 < d0 ? c31 : c2;
         u32 = d32;
         uc32 = c32;
     }
     /* union/a:union: the second operand only within reach of its bound */
     real u28 = u32;
-    real8 uc28 = uc32;
+    real16 uc28 = uc32;
     real g28 = (length(p0 - ((real3)(-R(0.95), R(0.0), R(0.2)))) * R(0.9999)) - R(0.42);
     if (!(g28 > u28 && g28 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
@@ -437,15 +438,15 @@ real DE_material(real3 p0, __global const real* params, real8* material) {
         /* .../material/color/sphere */
         real d4 = sd_sphere(p2, 0.42f);
         /* .../a:union/b:translate/material */
-        real8 c6 = (real8)(0.0f, 0.9f, 80.0f, 0.0f, 0.0f, 0.0f, 0.0f, 1.0f);
+        real16 c6 = (real16)(0.0f, 0.9f, 80.0f, 0.0f, 0.0f, 0.0f, 0.0f, 1.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f);
         real d28 = fmin(u32, d4);
-        real8 c28 = u32 < d4 ? uc32 : c6;
+        real16 c28 = u32 < d4 ? uc32 : c6;
         u28 = d28;
         uc28 = c28;
     }
     /* .../a:union/a:union: the second operand only within reach of its bound */
     real u22 = u28;
-    real8 uc22 = uc28;
+    real16 uc22 = uc28;
     real g22 = R(0.35555555555555557) * ((length(p0 - ((real3)(R(0.0), R(0.0), R(0.2)))) * R(0.9999)) - R(0.45));
     if (!(g22 > u22 && g22 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
@@ -455,15 +456,15 @@ real DE_material(real3 p0, __global const real* params, real8* material) {
         /* .../material/color/ellipsoid */
         real d9 = sd_ellipsoid(p4, (real3)(0.45f, 0.45f, 0.16f));
         /* .../b:translate/rotate/material */
-        real8 c11 = (real8)(0.0f, 0.0f, 32.0f, 1.0f, 0.3f, 0.0f, 0.0f, 1.0f);
+        real16 c11 = (real16)(0.0f, 0.0f, 32.0f, 1.0f, 0.3f, 0.0f, 0.0f, 1.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f);
         real d22 = fmin(u28, d9);
-        real8 c22 = u28 < d9 ? uc28 : c11;
+        real16 c22 = u28 < d9 ? uc28 : c11;
         u22 = d22;
         uc22 = c22;
     }
     /* .../a:union/a:union: the second operand only within reach of its bound */
     real u18 = u22;
-    real8 uc18 = uc22;
+    real16 uc18 = uc22;
     real g18 = (length(p0 - ((real3)(R(0.95), R(0.0), R(0.35)))) * R(0.9999)) - R(0.42);
     if (!(g18 > u18 && g18 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
@@ -471,15 +472,15 @@ real DE_material(real3 p0, __global const real* params, real8* material) {
         /* .../b:translate/material/sphere */
         real d15 = sd_sphere(p5, 0.42f);
         /* .../a:union/b:translate/material */
-        real8 c16 = (real8)(0.0f, 0.25f, 32.0f, 0.0f, 0.0f, 0.0f, 1.0f, params[0] /* ior */);
+        real16 c16 = (real16)(0.0f, 0.25f, 32.0f, 0.0f, 0.0f, 0.0f, 1.0f, params[0] /* ior */, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f);
         real d18 = fmin(u22, d15);
-        real8 c18 = u22 < d15 ? uc22 : c16;
+        real16 c18 = u22 < d15 ? uc22 : c16;
         u18 = d18;
         uc18 = c18;
     }
     /* .../a:union/a:union: the second operand only within reach of its bound */
     real u14 = u18;
-    real8 uc14 = uc18;
+    real16 uc14 = uc18;
     real g14 = (length(p0 - ((real3)(R(1.9), R(0.0), R(0.2)))) * R(0.9999)) - R(0.42);
     if (!(g14 > u14 && g14 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
@@ -487,15 +488,15 @@ real DE_material(real3 p0, __global const real* params, real8* material) {
         /* .../b:translate/material/sphere */
         real d19 = sd_sphere(p6, 0.42f);
         /* .../a:union/b:translate/material */
-        real8 c20 = (real8)(0.0f, 0.25f, 32.0f, 0.0f, 0.0f, 1.0f, 0.0f, 1.0f);
+        real16 c20 = (real16)(0.0f, 0.25f, 32.0f, 0.0f, 0.0f, 1.0f, 0.0f, 1.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f);
         real d14 = fmin(u18, d19);
-        real8 c14 = u18 < d19 ? uc18 : c20;
+        real16 c14 = u18 < d19 ? uc18 : c20;
         u14 = d14;
         uc14 = c14;
     }
     /* .../a:union/a:union: the second operand only within reach of its bound */
     real u8 = u14;
-    real8 uc8 = uc14;
+    real16 uc8 = uc14;
     real g8 = (length(p0 - ((real3)(R(0.5), R(0.25), -R(1.3)))) * R(0.9999)) - R(0.7728626595716686);
     if (!(g8 > u8 && g8 > R(0.0))) {
         /* union/a:union/b:translate */
@@ -509,7 +510,7 @@ real DE_material(real3 p0, __global const real* params, real8* material) {
         real d23 = f23.x;
         real d25 = d23 * R(0.7);
         real d8 = fmin(u14, d25);
-        real8 c8 = u14 < d25 ? uc14 : DEFAULT_MATERIAL;
+        real16 c8 = u14 < d25 ? uc14 : DEFAULT_MATERIAL;
         u8 = d8;
         uc8 = c8;
     }

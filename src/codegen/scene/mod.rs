@@ -253,7 +253,7 @@ impl<'a> SceneEmitter<'a> {
                     "real DE_shade(real3 p0, __global const real* params, real3* color, real* trap)"
                 }
                 (true, true) => {
-                    "real DE_material(real3 p0, __global const real* params, real8* material)"
+                    "real DE_material(real3 p0, __global const real* params, real16* material)"
                 }
             });
             let out = self.node(self.ir.root(), "p0", true);
@@ -286,7 +286,7 @@ impl<'a> SceneEmitter<'a> {
 
     /// The type of the surface values: a colour or a material.
     fn surface_type(&self) -> &'static str {
-        if self.material { "real8" } else { "real3" }
+        if self.material { "real16" } else { "real3" }
     }
 
     /// A fractal's iteration count under [`Quality::fractal_iterations`]
@@ -967,8 +967,9 @@ impl<'a> SceneEmitter<'a> {
                 }
                 self.label(id);
                 let v = vars(id);
-                let values = material.values().map(|s| self.w.scalar(*s)).join(", ");
-                self.w.line(format!("real8 {} = (real8)({values});", v.c));
+                let values = material.values().map(|s| self.w.scalar(*s));
+                let values = super::material_vector(values, &self.w.float(0.0));
+                self.w.line(format!("real16 {} = {values};", v.c));
                 Vars { c: v.c, ..c }
             }
             // Nodes that only move the point pass their child's result on.

@@ -15,7 +15,7 @@
 //           real DE_shade(real3 p, __global const real* params,
 //                         real3* color, real* trap)
 //           and, with materials (ENABLE_MATERIALS), void DE_material(real3 p,
-//           __global const real* params, real8* material), whose fields the
+//           __global const real* params, real16* material), whose fields the
 //           header names MATERIAL_<value> (material.MATERIAL_IOR)
 //   effects: the code of each effect (ambient occlusion, shadows, glow,
 //           fog, global illumination: ENABLE_GI with GI_BOUNCES) sits in
@@ -499,6 +499,8 @@ real3 march_light(__global const real* l, real3 p, real3* to_light, real* light_
     return radiance;
 }
 
+
+
 // Lit colour of the surface point p with normal n, seen along rd, with the
 // sky's light scaled by occlusion (1: open). Adds its distance evaluations
 // (DE_shade, DE_material, shadow rays, thickness) to *evals.
@@ -508,8 +510,9 @@ real3 march_light(__global const real* l, real3 p, real3* to_light, real* light_
 // or, with a material's roughness, Oren-Nayar's. With a material's
 // subsurface strength s, a light behind the surface (n.l < 0) adds
 // albedo * s * thinness * -n.l: it shows through thin parts, unshadowed
-// (the shape itself stands between). Without materials the highlight is
-// MARCH_SPECULAR and MARCH_SHININESS, the default material's.
+// (the shape itself stands between). A material's emission adds
+// albedo * emission, unlit and unshadowed. Without materials the highlight
+// is MARCH_SPECULAR and MARCH_SHININESS, the default material's.
 real3 march_shade(real3 p, real3 n, real3 rd, real eps, real occlusion,
                   __global const real* params, __global const real* lights, int light_count,
                   __global const float* environment, uint* evals) {
