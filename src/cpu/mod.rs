@@ -41,6 +41,14 @@ pub struct Sample<T> {
     /// The nearest surface's material, in
     /// [`Material::values`](crate::scene::Material::values) order.
     pub material: [T; MATERIAL_LEN],
+    /// The shape (a leaf of [`Ir`]: a primitive, a fractal, a custom or
+    /// inside shape) the nearest surface belongs to: the nearer operand's
+    /// across every boolean, smooth or not, and a cut's first.
+    pub object: Option<NodeId>,
+    /// The material node that sets the nearest surface's material (the
+    /// outermost above it, which paints over any inside), `None` where
+    /// the default material applies.
+    pub material_node: Option<NodeId>,
 }
 
 /// Evaluates one scene's geometry on the CPU.
@@ -68,6 +76,8 @@ pub struct Evaluator {
     /// The smooth unions that evaluate their second operand first
     /// (`ir::swaps`).
     swapped: Vec<bool>,
+    /// Whether each node is a leaf: a shape of its own.
+    leaves: Vec<bool>,
     /// The fractals an orbit trap colours: their parent evaluates them,
     /// once, with the trap.
     trapped: Vec<bool>,
@@ -137,16 +147,25 @@ impl Evaluator {
                 (r.parts.len() > 1 || r.parts[0].1 != 0.0).then_some((o.index(), r))
             })
             .collect();
+        let leaves = ir.nodes().iter().map(|n| n.children().is_empty()).collect();
         Evaluator {
             ir,
             values,
             bounds,
+            leaves,
             chains,
             reaches,
             swapped,
             trapped,
             prune: true,
         }
+    }
+
+    /// The same evaluator with the dynamic parameters at `values`.
+    #[must_use]
+    pub(crate) fn with_values(mut self, values: ParamValues) -> Self {
+        self.values = values;
+        self
     }
 
     /// Turns the pruning of unions and subtractions off or on (it is on,
@@ -257,6 +276,8 @@ impl Evaluator {
             color: V3::splat(T::of(DEFAULT_COLOR[0])),
             trap: T::one(),
             material: DEFAULT_MATERIAL.map(T::of),
+            object: None,
+            material_node: None,
         }
     }
 
@@ -287,6 +308,9 @@ impl Evaluator {
                 Some(operands) => self.chain_at(operands, points[i], &samples),
                 None => self.sample_at(i, node, points[i], &samples),
             };
+            if self.leaves[i] {
+                samples[i].object = Some(NodeId::from_index(i));
+            }
         }
         samples[self.ir.root().index()]
     }
@@ -591,6 +615,7 @@ impl Evaluator {
             },
             Kind::Material { material, child } => Sample {
                 material: material.values().map(|x| s(*x)),
+                material_node: Some(NodeId::from_index(id)),
                 ..of(child)
             },
             Kind::OrbitTrap { coloring, child } => {
@@ -601,6 +626,7 @@ impl Evaluator {
                 let t = Palette::position(e.trap, s(coloring.near), s(coloring.far));
                 Sample {
                     color: coloring.palette.at(t),
+                    object: Some(*child),
                     ..Self::leaf(e.distance)
                 }
             }
@@ -698,6 +724,8 @@ fn combine<T: Real>(op: CsgOp, k: Option<T>, a: Sample<T>, b: Sample<T>) -> Samp
         color: near.color.zip(far.color, mix),
         trap: mix(near.trap, far.trap),
         material: std::array::from_fn(|i| mix(near.material[i], far.material[i])),
+        object: near.object,
+        material_node: near.material_node,
     }
 }
 

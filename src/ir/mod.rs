@@ -139,6 +139,38 @@ impl Ir {
         self.parents[id.index()]
     }
 
+    /// The scene's shapes (its leaves: primitives, fractals, custom and
+    /// inside shapes) in the order the scene writes them (depth first,
+    /// operands in order): shape `k` of this list is object `k + 1` in a
+    /// frame's [`Layers::object`](crate::render::Layers::object).
+    #[must_use]
+    pub fn objects(&self) -> Vec<NodeId> {
+        self.preorder(|n| n.children().is_empty())
+    }
+
+    /// The scene's material nodes in the order the scene writes them:
+    /// node `k` of this list is material `k + 1` in a frame's
+    /// [`Layers::material`](crate::render::Layers::material).
+    #[must_use]
+    pub fn materials(&self) -> Vec<NodeId> {
+        self.preorder(|n| matches!(n, Kind::Material { .. }))
+    }
+
+    /// The nodes `keep` chooses, depth first from the root, each node's
+    /// children in order.
+    fn preorder(&self, keep: impl Fn(&IrNode) -> bool) -> Vec<NodeId> {
+        let mut out = Vec::new();
+        let mut stack = vec![self.root];
+        while let Some(id) = stack.pop() {
+            let node = self.node(id);
+            if keep(node) {
+                out.push(id);
+            }
+            stack.extend(node.children().into_iter().rev().copied());
+        }
+        out
+    }
+
     /// The path of a node, as validation errors name it
     /// (`union/b:torus`).
     #[must_use]

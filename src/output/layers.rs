@@ -43,11 +43,17 @@ pub enum Aov {
     /// The fraction of the pixel's samples (over every pass) whose ray
     /// hit a surface: a matte of what is not background.
     Coverage,
+    /// Which shape the hit belongs to ([`Layers::object`]: 1 for the
+    /// scene's first shape, 0 on a miss), for a matte of any object.
+    Object,
+    /// Which material the hit has ([`Layers::material`]: 1 for the scene's
+    /// first material node, 0 for the default material and on a miss).
+    Material,
 }
 
 impl Aov {
     /// Every output, in the order files list them.
-    pub const ALL: [Aov; 9] = [
+    pub const ALL: [Aov; 11] = [
         Aov::Depth,
         Aov::Normal,
         Aov::Position,
@@ -57,12 +63,14 @@ impl Aov {
         Aov::Trap,
         Aov::Evaluations,
         Aov::Coverage,
+        Aov::Object,
+        Aov::Material,
     ];
 
     /// The output's name: its layer in an OpenEXR file, the suffix of its
     /// PNG, and its name on the command line (`depth`, `normal`,
     /// `position`, `albedo`, `ao`, `shadow`, `trap`, `evaluations`,
-    /// `coverage`).
+    /// `coverage`, `object`, `material`).
     #[must_use]
     pub fn name(self) -> &'static str {
         match self {
@@ -75,6 +83,8 @@ impl Aov {
             Aov::Trap => "trap",
             Aov::Evaluations => "evaluations",
             Aov::Coverage => "coverage",
+            Aov::Object => "object",
+            Aov::Material => "material",
         }
     }
 
@@ -103,7 +113,13 @@ impl Aov {
             Aov::Depth => &["Z"],
             Aov::Normal | Aov::Position => &["X", "Y", "Z"],
             Aov::Albedo => &["R", "G", "B"],
-            Aov::Occlusion | Aov::Shadow | Aov::Trap | Aov::Evaluations | Aov::Coverage => &["Y"],
+            Aov::Occlusion
+            | Aov::Shadow
+            | Aov::Trap
+            | Aov::Evaluations
+            | Aov::Coverage
+            | Aov::Object
+            | Aov::Material => &["Y"],
         }
     }
 
@@ -131,6 +147,19 @@ impl Aov {
             (Aov::Shadow, Some(l)) => vec![l.shadow.clone()],
             (Aov::Trap, Some(l)) => vec![l.trap.clone()],
             (Aov::Coverage, Some(l)) => vec![l.linear.iter().map(|c| c[3]).collect()],
+            (Aov::Object | Aov::Material, Some(l)) if l.object.is_empty() => {
+                return Err(Error::Invalid {
+                    what: "output",
+                    reason: format!(
+                        "the frame has no object ids, which {} needs: fill them with \
+                         Renderer::identify",
+                        self.name()
+                    ),
+                });
+            }
+            // Ids far below 2^24: exact in a float.
+            (Aov::Object, Some(l)) => vec![l.object.iter().map(|&k| k as f32).collect()],
+            (Aov::Material, Some(l)) => vec![l.material.iter().map(|&k| k as f32).collect()],
             (_, None) => unreachable!("the layers were read above"),
         })
     }
@@ -224,6 +253,16 @@ impl FrameOutput {
         Ok(())
     }
 
+    /// Whether writing needs the frame's object and material ids
+    /// ([`Renderer::identify`](crate::render::Renderer::identify) fills
+    /// them).
+    #[must_use]
+    pub fn needs_ids(&self) -> bool {
+        self.aovs
+            .iter()
+            .any(|a| matches!(a, Aov::Object | Aov::Material))
+    }
+
     /// Whether writing needs the frame's depth and normal outputs at
     /// least ([`Renderer::render_with_aovs`](crate::render::Renderer::render_with_aovs)).
     #[must_use]
@@ -240,7 +279,8 @@ impl FrameOutput {
 ///   before the tone curve, background included, with `A` 1 (the image is
 ///   opaque, as its PNG is), and each output a layer of its own:
 ///   `depth.Z`, `normal.X`..`Z`, `position.X`..`Z`, `albedo.R`..`B`,
-///   `ao.Y`, `shadow.Y`, `trap.Y`, `evaluations.Y`, `coverage.Y`.
+///   `ao.Y`, `shadow.Y`, `trap.Y`, `evaluations.Y`, `coverage.Y`,
+///   `object.Y`, `material.Y`.
 /// - **`.png`, `.tif`/`.tiff`**: the colour at 8 or 16 bits
 ///   ([`FrameOutput::bits`]); **`.jpg`/`.jpeg`**: at 8 bits.
 /// - For every format but OpenEXR, each output is a 16-bit PNG beside the
@@ -249,7 +289,8 @@ impl FrameOutput {
 ///   (0 on a miss), normals as `0.5 + 0.5 n`, positions scaled into the
 ///   box of the frame's hits, albedo, occlusion, shadow, trap and coverage
 ///   clipped to `[0, 1]` (linear, no gamma), evaluations scaled by the
-///   frame's largest count.
+///   frame's largest count, object and material ids as the 16-bit values
+///   themselves (ids past 65,535 clip).
 ///
 /// Each file is written atomically, as [`save_png`](super::save_png)
 /// writes.
@@ -407,6 +448,11 @@ fn aov_png(frame: &Frame, aov: Aov) -> Result<(Vec<u16>, ExtendedColorType)> {
             vec![channels[0].iter().map(|v| v / most).collect()]
         }
         Aov::Albedo | Aov::Occlusion | Aov::Shadow | Aov::Trap | Aov::Coverage => channels,
+        // The ids themselves as 16-bit values (a matte is `value == k`).
+        Aov::Object | Aov::Material => channels
+            .iter()
+            .map(|c| c.iter().map(|v| v / 65535.0).collect())
+            .collect(),
     };
     let color = if mapped.len() == 3 {
         ExtendedColorType::Rgb16

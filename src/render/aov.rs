@@ -43,7 +43,8 @@ pub struct Frame {
 /// the display transform, and what the pixel-centre ray's hit is made of.
 ///
 /// Every vector is row-major like [`Frame`]'s. A pixel whose centre ray
-/// missed has position, albedo, occlusion, shadow and trap 0. The layers
+/// missed has position, albedo, occlusion, shadow, trap, object and
+/// material 0. The layers
 /// other than the colour describe the pixel-centre ray, as the depth and
 /// normal do.
 #[derive(Debug, Clone, PartialEq)]
@@ -73,6 +74,17 @@ pub struct Layers {
     /// fractals an [`OrbitColoring`](crate::scene::OrbitColoring) paints
     /// through a palette (their colour is in `albedo`).
     pub trap: Vec<f32>,
+    /// Which shape the hit belongs to: `k` for shape `k − 1` of
+    /// [`Ir::objects`](crate::ir::Ir::objects) (the shapes in the order
+    /// the scene writes them), 0 on a miss. Across a boolean the nearer
+    /// operand's shape, as the colour is the nearer operand's. Empty until
+    /// [`Renderer::identify`](crate::render::Renderer::identify) fills it.
+    pub object: Vec<u32>,
+    /// Which material the hit has: `k` for material node `k − 1` of
+    /// [`Ir::materials`](crate::ir::Ir::materials), 0 for the default
+    /// material and on a miss. Empty until
+    /// [`Renderer::identify`](crate::render::Renderer::identify) fills it.
+    pub material: Vec<u32>,
 }
 
 /// Which outputs a launch writes, from least to most.

@@ -131,6 +131,8 @@ pub(crate) fn frame(low: &Frame, width: u32, height: u32, scale: u32) -> Frame {
             occlusion: Vec::with_capacity(n),
             shadow: Vec::with_capacity(n),
             trap: Vec::with_capacity(n),
+            object: Vec::with_capacity(n),
+            material: Vec::with_capacity(n),
         }),
     };
     let from = low.image.as_raw();
@@ -164,6 +166,10 @@ pub(crate) fn frame(low: &Frame, width: u32, height: u32, scale: u32) -> Frame {
                 to.occlusion.push(from.occlusion[i]);
                 to.shadow.push(from.shadow[i]);
                 to.trap.push(from.trap[i]);
+                if !from.object.is_empty() {
+                    to.object.push(from.object[i]);
+                    to.material.push(from.material[i]);
+                }
             }
         },
     );

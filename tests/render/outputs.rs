@@ -304,7 +304,8 @@ fn openexr_layers_read_back_through_oiiotool() {
     let quality = gpu::quick().supersampling(2);
     let mut r = Renderer::with_options(&scene, &gpu::options(quality, Effects::default())).unwrap();
     let (w, h) = (24, 16);
-    let frame = r.render_layers(w, h).unwrap();
+    let mut frame = r.render_layers(w, h).unwrap();
+    r.identify(&mut frame).unwrap();
     let dir = std::env::temp_dir().join(format!("fractal-sdf-exr-{}", std::process::id()));
     let path = dir.join("frame.exr");
     let output = FrameOutput::new(Effects::default()).aovs(Aov::ALL);
@@ -340,6 +341,8 @@ fn openexr_layers_read_back_through_oiiotool() {
             "shadow" => layers.shadow[i],
             "trap" => layers.trap[i],
             "evaluations" => frame.evaluations[i] as f32,
+            "object" => layers.object[i] as f32,
+            "material" => layers.material[i] as f32,
             other => panic!("unexpected layer {other}"),
         }
     };
@@ -549,4 +552,75 @@ fn layer_passes_and_image_passes_start_each_other_again() {
     r.render_progressive(W, H).unwrap();
     r.render_progressive_layers(W, H).unwrap();
     assert_eq!(r.progressive_passes(), 1);
+}
+
+/// Object and material ids against the shapes' own distances: each hit
+/// belongs to the shape whose exact distance at its position is least
+/// (worked out here from the centres and sizes), numbered in the order
+/// the scene writes them, and has the material of the material node
+/// outermost above that shape.
+#[test]
+fn object_and_material_ids_name_the_shape_at_each_hit() {
+    let Some(_) = gpu::device() else { return };
+    let centres = [
+        dvec3(-1.2, 0.0, 0.0),
+        dvec3(0.0, 0.2, -0.4),
+        dvec3(1.2, 0.0, 0.0),
+    ];
+    let radii = [0.5, 0.6, 0.45];
+    let ball = |i: usize| sphere(radii[i]).translate(centres[i]);
+    // Written order: ball 0, ball 1 (smoothly joined to ball 0), ball 2,
+    // the floor. Materials: ball 1 a mirror; ball 2 inside two material
+    // nodes, the outer one (written first) painting over the inner.
+    let glossy = Material::blinn_phong(0.8, 64.0);
+    let scene = Scene::new(
+        ball(0)
+            .smooth_union(ball(1).material(Material::mirror()), 0.2)
+            .union(ball(2).material(Material::glass(1.5)).material(glossy))
+            .union(plane(DVec3::Y, 0.5)),
+    )
+    .with_camera(Camera::look_at(dvec3(0.0, 1.2, 4.0), dvec3(0.0, 0.0, 0.0)));
+    let options = gpu::options(gpu::plain(Quality::preview()), Effects::default());
+    let mut renderer = Renderer::with_options(&scene, &options).unwrap();
+    let mut frame = renderer.render_layers(W, H).unwrap();
+    let written = FrameOutput::new(Effects::default()).aovs([Aov::Object]);
+    let path = std::env::temp_dir().join(format!("fractal-sdf-ids-{}.exr", std::process::id()));
+    let err = save_frame(&frame, &path, &written).unwrap_err().to_string();
+    assert!(err.contains("Renderer::identify"), "{err}");
+    renderer.identify(&mut frame).unwrap();
+    let layers = frame.layers.as_ref().unwrap();
+    let compiled = scene.compile().unwrap();
+    let ir = compiled.ir();
+    assert_eq!(ir.objects().len(), 4, "three balls and a floor");
+    // The glass, painted over whole, is no node of its own.
+    assert_eq!(ir.materials().len(), 2);
+    let (mut agree, mut hits, mut seen) = (0, 0, [0u32; 5]);
+    for i in 0..frame.depth.len() {
+        if !frame.hit[i] {
+            assert_eq!((layers.object[i], layers.material[i]), (0, 0), "a miss");
+            continue;
+        }
+        hits += 1;
+        let p = glam::Vec3::from(layers.position[i]).as_dvec3();
+        let mut distances: Vec<f64> = (0..3).map(|k| p.distance(centres[k]) - radii[k]).collect();
+        distances.push(p.y + 0.5);
+        let nearest = (0..4)
+            .min_by(|&a, &b| distances[a].total_cmp(&distances[b]))
+            .unwrap();
+        // The materials in written order: the mirror (1), then the glossy
+        // node (2) outside the glass.
+        let material = [0, 1, 2, 0][nearest];
+        let want = (u32::try_from(nearest).unwrap() + 1, material);
+        seen[want.0 as usize] += 1;
+        if (layers.object[i], layers.material[i]) == want {
+            agree += 1;
+        }
+    }
+    let share = f64::from(agree) / f64::from(hits);
+    eprintln!("ids: {agree} of {hits} hits agree with the nearest shape; per shape {seen:?}");
+    assert!(
+        seen[1..].iter().all(|&n| n > 50),
+        "every shape seen: {seen:?}"
+    );
+    assert!(share > 0.99, "{share}");
 }

@@ -156,7 +156,9 @@ struct RenderArgs {
     #[arg(short, long, value_name = "FILE")]
     output: PathBuf,
     /// Outputs to write besides the colour, comma-separated: depth,
-    /// normal, position, albedo, ao, shadow, trap, evaluations. Layers of
+    /// normal, position, albedo, ao, shadow, trap, evaluations, coverage,
+    /// object, material (ids: 1 for the file's first shape or material,
+    /// in the order the file writes them; 0 on a miss). Layers of
     /// an `.exr` file; otherwise a 16-bit PNG each beside the image
     /// (`out.png` gets `out.depth.png`, ...).
     #[arg(long, value_name = "LIST", value_delimiter = ',', conflicts_with_all = ["stereo", "adaptive"])]
@@ -616,6 +618,10 @@ fn render(args: &RenderArgs, settings: &Settings) -> Outcome {
             bar.finish_and_clear();
             frame?
         };
+        let mut frame = frame;
+        if output.needs_ids() {
+            renderer.identify(&mut frame)?;
+        }
         dimensions = (frame.width(), frame.height());
         save_frame(&frame, &args.output, &output)?
     } else {

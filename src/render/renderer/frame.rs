@@ -504,6 +504,69 @@ impl Renderer {
         })
     }
 
+    /// Fills the frame's object and material ids ([`Layers::object`],
+    /// [`Layers::material`]): for each hit, the shape and the material
+    /// node nearest its position, as the CPU reference
+    /// ([`crate::cpu::Evaluator`]) finds them with the renderer's current
+    /// parameters, numbered as [`Ir::objects`](crate::ir::Ir::objects)
+    /// and [`Ir::materials`](crate::ir::Ir::materials) list them. It costs
+    /// one evaluation of the whole scene on the host per hit, shared among
+    /// the host's threads, so only the frames that need ids pay for it.
+    ///
+    /// # Errors
+    /// [`Error::Invalid`] for a frame without shading layers (render it
+    /// with [`Renderer::render_layers`]).
+    pub fn identify(&self, frame: &mut Frame) -> Result<()> {
+        let Some(layers) = frame.layers.as_mut() else {
+            return Err(Error::Invalid {
+                what: "frame",
+                reason: "object ids need the shading layers: render it with \
+                         Renderer::render_layers"
+                    .into(),
+            });
+        };
+        let ir = self.scene.ir();
+        let number = |list: Vec<crate::ir::NodeId>| {
+            let mut of = vec![0u32; ir.nodes().len()];
+            for (k, id) in list.into_iter().enumerate() {
+                of[id.index()] = u32::try_from(k + 1).expect("fewer than 2^32 nodes");
+            }
+            of
+        };
+        let (objects, materials) = (number(ir.objects()), number(ir.materials()));
+        let eval =
+            crate::cpu::Evaluator::from_compiled(&self.scene).with_values(self.values.clone());
+        let n = layers.position.len();
+        let threads = std::thread::available_parallelism().map_or(1, usize::from);
+        let chunk = n.div_ceil(threads).max(1);
+        let mut object = vec![0u32; n];
+        let mut material = vec![0u32; n];
+        std::thread::scope(|scope| {
+            for (((p, h), o), m) in layers
+                .position
+                .chunks(chunk)
+                .zip(frame.hit.chunks(chunk))
+                .zip(object.chunks_mut(chunk))
+                .zip(material.chunks_mut(chunk))
+            {
+                let (eval, objects, materials) = (&eval, &objects, &materials);
+                scope.spawn(move || {
+                    for (((p, &h), o), m) in p.iter().zip(h).zip(o).zip(m) {
+                        if h {
+                            let at = DVec3::new(p[0].into(), p[1].into(), p[2].into());
+                            let sample = eval.sample::<f64>(at.into());
+                            *o = sample.object.map_or(0, |id| objects[id.index()]);
+                            *m = sample.material_node.map_or(0, |id| materials[id.index()]);
+                        }
+                    }
+                });
+            }
+        });
+        layers.object = object;
+        layers.material = material;
+        Ok(())
+    }
+
     pub(super) fn record_timing(
         &mut self,
         start: Instant,
@@ -793,5 +856,7 @@ fn layers_of(linear: &[f32], flat: &[f32], hit: &[u8], origin: DVec3) -> Layers 
         occlusion: field(layer::OCCLUSION).map(|c| c[0]).collect(),
         shadow: field(layer::SHADOW).map(|c| c[0]).collect(),
         trap: field(layer::TRAP).map(|c| c[0]).collect(),
+        object: Vec::new(),
+        material: Vec::new(),
     }
 }
