@@ -1,7 +1,8 @@
-//! Frame sequences: a camera path rendered to numbered PNGs
-//! (`frame_00000.png`, `frame_00001.png`, ...) at a frame rate, resumable
-//! (whole frames already on disk are skipped; cut-short ones are rendered
-//! again) and renderable in sub-ranges.
+//! Frame sequences: a camera path rendered to numbered images
+//! (`frame_00000.png`, `frame_00001.png`, ...; or TIFF, JPEG or OpenEXR
+//! frames with their outputs, [`Sequence::format`]) at a frame rate,
+//! resumable (whole frames already on disk are skipped; cut-short ones
+//! are rendered again) and renderable in sub-ranges.
 //!
 //! ```
 //! use fractal_sdf::sequence::{Sequence, parse_range};
@@ -42,6 +43,12 @@ pub struct Sequence {
     fps: f64,
     frames: u32,
     blur: MotionBlur,
+    /// The frames' file extension, lower case: `png` unless
+    /// [`Sequence::format`] chose another.
+    extension: String,
+    /// The outputs written with each frame, where asked for.
+    #[cfg(feature = "opencl")]
+    output: Option<crate::output::FrameOutput>,
 }
 
 /// Motion blur by shutter samples ([`Sequence::motion_blur`]): each frame
@@ -139,6 +146,9 @@ impl Sequence {
             fps,
             frames,
             blur: MotionBlur::none(),
+            extension: "png".into(),
+            #[cfg(feature = "opencl")]
+            output: None,
         })
     }
 
@@ -222,10 +232,49 @@ impl Sequence {
         self.frames
     }
 
+    /// The sequence with its frames written in the format `extension`
+    /// names: `png` (the default), `tif`/`tiff`, `jpg`/`jpeg`, or `exr`
+    /// (OpenEXR, the linear colour with the outputs of
+    /// [`Sequence::outputs`] as layers). Frame 42 is then
+    /// `frame_00042.exr`.
+    ///
+    /// ```
+    /// use fractal_sdf::sequence::Sequence;
+    /// let seq = Sequence::new("out/seq", 24.0, 48)?.format("exr")?;
+    /// assert_eq!(seq.frame_path(7), std::path::Path::new("out/seq/frame_00007.exr"));
+    /// assert!(Sequence::new("out/seq", 24.0, 48)?.format("gif").is_err());
+    /// # Ok::<(), fractal_sdf::Error>(())
+    /// ```
+    ///
+    /// # Errors
+    /// [`Error::Invalid`] for an extension that is not one of
+    /// [`IMAGE_EXTENSIONS`](crate::output::IMAGE_EXTENSIONS).
+    pub fn format(mut self, extension: &str) -> Result<Self> {
+        let lower = extension
+            .trim()
+            .trim_start_matches('.')
+            .to_ascii_lowercase();
+        if !crate::output::IMAGE_EXTENSIONS.contains(&lower.as_str()) {
+            return Err(invalid(format!(
+                "`{extension}` is not a format this library writes frames in: {}",
+                crate::output::IMAGE_EXTENSIONS.join(", ")
+            )));
+        }
+        self.extension = lower;
+        Ok(self)
+    }
+
+    /// The frames' file extension (`png` by default).
+    #[must_use]
+    pub fn extension(&self) -> &str {
+        &self.extension
+    }
+
     /// Where frame `index` is stored.
     #[must_use]
     pub fn frame_path(&self, index: u32) -> PathBuf {
-        self.dir.join(frame_name(index))
+        self.dir
+            .join(format!("frame_{index:05}.{}", self.extension))
     }
 
     /// The time frame `index` shows, in seconds from the start.
@@ -261,15 +310,15 @@ impl Sequence {
     }
 
     /// The frames of `range` (clipped to the sequence) that are not on
-    /// disk as whole `width` × `height` PNGs, in order: missing frames, and
-    /// frames that [`verify_png`](crate::output::verify_png) rejects — cut
-    /// short (by a copy that was interrupted, a full disk), of another
-    /// size, not PNGs — which rendering writes again.
+    /// disk as whole `width` × `height` images, in order: missing frames,
+    /// and frames that [`verify_image`](crate::output::verify_image)
+    /// rejects — cut short (by a copy that was interrupted, a full disk),
+    /// of another size, not of the format — which rendering writes again.
     #[must_use]
     pub fn remaining(&self, range: Range<u32>, (width, height): (u32, u32)) -> Vec<u32> {
         let range = range.start..range.end.min(self.frames);
         range
-            .filter(|&i| crate::output::verify_png(self.frame_path(i), (width, height)).is_err())
+            .filter(|&i| crate::output::verify_image(self.frame_path(i), (width, height)).is_err())
             .collect()
     }
 
@@ -299,7 +348,8 @@ impl Sequence {
 
     /// The arguments of the `ffmpeg` command that encodes the frames into
     /// an H.264 MP4 at `output`:
-    /// `-y -framerate R -i DIR/frame_%05d.png -pix_fmt yuv420p OUTPUT`.
+    /// `-y -framerate R -i DIR/frame_%05d.png -pix_fmt yuv420p OUTPUT`
+    /// (the frames' own extension in place of `png`).
     #[must_use]
     pub fn ffmpeg_args(&self, output: &Path) -> Vec<String> {
         vec![
@@ -307,7 +357,10 @@ impl Sequence {
             "-framerate".into(),
             format!("{}", self.fps),
             "-i".into(),
-            self.dir.join(FRAME_PATTERN).display().to_string(),
+            self.dir
+                .join(format!("frame_%05d.{}", self.extension))
+                .display()
+                .to_string(),
             "-pix_fmt".into(),
             "yuv420p".into(),
             output.display().to_string(),
@@ -368,6 +421,18 @@ pub struct RenderedFrame {
 
 #[cfg(feature = "opencl")]
 impl Sequence {
+    /// The sequence with `output`'s outputs written with every frame
+    /// ([`FrameOutput::aovs`](crate::output::FrameOutput::aovs): layers of
+    /// an OpenEXR frame, 16-bit PNGs beside any other; and its
+    /// [`bits`](crate::output::FrameOutput::bits)), as
+    /// [`save_frame`](crate::output::save_frame) writes them. Its effects
+    /// are replaced by the renderer's when the frames are rendered.
+    #[must_use]
+    pub fn outputs(mut self, output: crate::output::FrameOutput) -> Self {
+        self.output = Some(output);
+        self
+    }
+
     /// Renders the frames `indices` of this sequence at `width` × `height`
     /// and saves each to [`Sequence::frame_path`] (atomically, so an
     /// interrupted run leaves only whole frames). Frame `i` shows the
@@ -375,7 +440,11 @@ impl Sequence {
     /// current camera's projection) and the `motions` at `time(i)`; with
     /// [`Sequence::motion_blur`], the mean of progressive passes at each of
     /// its [`Sequence::moments`] instead, the camera and motions set for
-    /// each. `on_frame` is called after each frame is saved.
+    /// each. Frames in a format that holds more than 8 bits (OpenEXR, or
+    /// 16 bits), or with [`Sequence::outputs`], are rendered with their
+    /// shading layers (and object ids where asked for) and written by
+    /// [`save_frame`](crate::output::save_frame). `on_frame` is called
+    /// after each frame is saved.
     ///
     /// Pass [`Sequence::remaining`] as `indices` to resume a sequence.
     ///
@@ -428,16 +497,37 @@ impl Sequence {
             }
             Ok(())
         };
+        let mut output = self
+            .output
+            .clone()
+            .unwrap_or_else(|| crate::output::FrameOutput::new(renderer.options().effects));
+        output.effects = renderer.options().effects;
+        let probe = self.frame_path(0);
+        output.check(&probe)?;
+        let layered = output.needs_layers(&probe)? || output.needs_aovs();
         for &index in indices {
             let moments = self.moments(index);
-            let image = if let [t] = moments[..] {
-                at(renderer, t)?;
-                renderer.render(width, height)?
-            } else {
-                renderer.render_over_time(width, height, &moments, |r, &t| at(r, t))?
-            };
             let file = self.frame_path(index);
-            crate::output::save_png(&image, &file)?;
+            if layered {
+                let mut frame = if let [t] = moments[..] {
+                    at(renderer, t)?;
+                    renderer.render_layers(width, height)?
+                } else {
+                    renderer.render_layers_over_time(width, height, &moments, |r, &t| at(r, t))?
+                };
+                if output.needs_ids() {
+                    renderer.identify(&mut frame)?;
+                }
+                crate::output::save_frame(&frame, &file, &output)?;
+            } else {
+                let image = if let [t] = moments[..] {
+                    at(renderer, t)?;
+                    renderer.render(width, height)?
+                } else {
+                    renderer.render_over_time(width, height, &moments, |r, &t| at(r, t))?
+                };
+                crate::output::save_image(&image, &file)?;
+            }
             on_frame(&RenderedFrame {
                 index,
                 path: file,

@@ -162,6 +162,7 @@ impl Evaluator {
     }
 
     /// The same evaluator with the dynamic parameters at `values`.
+    #[cfg(feature = "opencl")]
     #[must_use]
     pub(crate) fn with_values(mut self, values: ParamValues) -> Self {
         self.values = values;

@@ -485,6 +485,71 @@ fn sweep_stale_temporaries(dir: &Path) {
     }
 }
 
+/// Checks that `path` holds a whole image of `width` × `height` pixels in
+/// the format its extension names: a PNG as [`verify_png`] checks it
+/// (without decoding), any other format by reading it whole (an OpenEXR
+/// file's every channel, with the `opencl` feature that brings its
+/// reader).
+///
+/// # Errors
+/// [`Error::Io`] if the file cannot be read; [`Error::Invalid`] saying
+/// what is wrong with it.
+pub fn verify_image(path: impl AsRef<Path>, (width, height): (u32, u32)) -> Result<()> {
+    let path = path.as_ref();
+    let extension = image_extension(path)?;
+    let bad = |reason: String| Error::Invalid {
+        what: "image file",
+        reason: format!("{}: {reason}", path.display()),
+    };
+    let size = match extension.as_deref() {
+        None | Some("png") => return verify_png(path, (width, height)),
+        Some("exr") => exr_size(path).map_err(bad)?,
+        Some(_) => {
+            let image = image::ImageReader::open(path)
+                .map_err(|e| Error::io(path, "cannot read the image", e))?
+                .with_guessed_format()
+                .map_err(|e| Error::io(path, "cannot read the image", e))?
+                .decode()
+                .map_err(|e| bad(e.to_string()))?;
+            (image.width(), image.height())
+        }
+    };
+    if size == (width, height) {
+        Ok(())
+    } else {
+        Err(bad(format!(
+            "{}x{} pixels, not {width}x{height}",
+            size.0, size.1
+        )))
+    }
+}
+
+/// The size of the OpenEXR image at `path`, read whole.
+#[cfg(feature = "opencl")]
+fn exr_size(path: &Path) -> std::result::Result<(u32, u32), String> {
+    use exr::prelude::{ReadChannels, ReadLayers};
+    let image = exr::prelude::read()
+        .no_deep_data()
+        .largest_resolution_level()
+        .all_channels()
+        .all_layers()
+        .all_attributes()
+        .from_file(path)
+        .map_err(|e| e.to_string())?;
+    let layer = image.layer_data.first().ok_or("no layers")?;
+    let size = layer.size;
+    Ok((
+        u32::try_from(size.0).map_err(|e| e.to_string())?,
+        u32::try_from(size.1).map_err(|e| e.to_string())?,
+    ))
+}
+
+/// Without the `opencl` feature there is no OpenEXR reader.
+#[cfg(not(feature = "opencl"))]
+fn exr_size(_path: &Path) -> std::result::Result<(u32, u32), String> {
+    Err("reading OpenEXR files needs the `opencl` feature".into())
+}
+
 /// Checks that `path` holds a whole PNG image of `width` × `height`
 /// pixels, without decoding it: the PNG signature, an `IHDR` chunk of that
 /// size first, and a chain of chunks, with image data, that ends with

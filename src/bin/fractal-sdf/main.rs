@@ -15,7 +15,7 @@ use fractal_sdf::codegen::{self, Options};
 use fractal_sdf::file::SceneFile;
 use fractal_sdf::gallery;
 use fractal_sdf::output::{
-    Aov, Bits, CameraExport, FrameOutput, image_extension, save_frame, save_image, verify_png,
+    Aov, Bits, CameraExport, FrameOutput, image_extension, save_frame, save_image, verify_image,
 };
 use fractal_sdf::prelude::*;
 use fractal_sdf::quality::{Encoding, GlobalIllumination, Preset, ToneMap};
@@ -45,9 +45,9 @@ struct Cli {
 
 #[derive(Subcommand)]
 enum Command {
-    /// Render one image to a PNG or JPEG (by the output's extension).
+    /// Render one image to a PNG, JPEG, TIFF or OpenEXR file (by the output's extension).
     Render(RenderArgs),
-    /// Render a camera path to numbered PNG frames (resumable), then a video.
+    /// Render a camera path to numbered frames (PNG, TIFF, JPEG or OpenEXR; resumable), then a video.
     Sequence(SequenceArgs),
     /// Print the generated OpenCL C of a scene.
     Emit(EmitArgs),
@@ -265,6 +265,14 @@ struct SequenceArgs {
     /// The frames' directory (frame_00000.png, ...).
     #[arg(long, value_name = "DIR")]
     out: PathBuf,
+    /// The frames' format: png, tif, jpg, or exr (OpenEXR with the linear
+    /// colour and a layer per --aov; no video is made of them).
+    #[arg(long, value_name = "EXT", default_value = "png")]
+    format: String,
+    /// Outputs to write with every frame, as `render --aov` writes them:
+    /// layers of an .exr frame, else a 16-bit PNG each beside it.
+    #[arg(long, value_name = "LIST", value_delimiter = ',')]
+    aov: Vec<String>,
     /// A camera path file in TOML (default: the scene file's path, else one
     /// orbit around the camera's target).
     #[arg(long, value_name = "FILE")]
@@ -298,8 +306,8 @@ struct SequenceArgs {
     /// its shutter is open (1 to 256; 1 is none).
     #[arg(long, value_name = "N", default_value_t = 1)]
     motion_blur: u32,
-    /// The fraction of a frame's duration the shutter is open, centred on
-    /// the frame's time (0.5: a 180° shutter).
+    /// The fraction of a frame's duration the shutter is open, from the
+    /// frame's time on (0.5: a 180° shutter).
     #[arg(
         long,
         value_name = "FRACTION",
@@ -772,8 +780,17 @@ fn sequence(args: &SequenceArgs, settings: &Settings) -> Outcome {
             )));
         }
     }
+    let aovs = args
+        .aov
+        .iter()
+        .filter(|name| !name.trim().is_empty())
+        .map(|name| Aov::from_name(name).map_err(|e| usage(format!("--aov: {e}"))))
+        .collect::<Outcome<Vec<Aov>>>()?;
     let seq = Sequence::for_duration(&args.out, args.fps, path.duration())?
-        .motion_blur(MotionBlur::new(args.motion_blur, args.shutter))?;
+        .motion_blur(MotionBlur::new(args.motion_blur, args.shutter))?
+        .format(&args.format)
+        .map_err(|e| usage(format!("--format: {e}")))?
+        .outputs(FrameOutput::new(job.options.effects).aovs(aovs));
     let range = match &args.frames {
         Some(text) => parse_range(text, seq.frames())?,
         None => 0..seq.frames(),
@@ -790,7 +807,7 @@ fn sequence(args: &SequenceArgs, settings: &Settings) -> Outcome {
             .clone()
             .filter(mine)
             .filter_map(|i| {
-                verify_png(seq.frame_path(i), job.size)
+                verify_image(seq.frame_path(i), job.size)
                     .err()
                     .map(|e| format!("  frame {i}: {e}"))
             })
@@ -863,7 +880,11 @@ fn sequence(args: &SequenceArgs, settings: &Settings) -> Outcome {
         )?;
         bar.finish();
     }
-    if !args.no_video && seq.remaining(0..seq.frames(), job.size).is_empty() {
+    if seq.extension() == "exr" {
+        if !args.no_video {
+            println!("no video of OpenEXR frames: their colour is linear, before the tone curve");
+        }
+    } else if !args.no_video && seq.remaining(0..seq.frames(), job.size).is_empty() {
         let video = match (&args.video, args.out.file_name()) {
             (Some(video), _) => video.clone(),
             (None, Some(_)) => args.out.with_extension("mp4"),

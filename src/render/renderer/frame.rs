@@ -198,8 +198,35 @@ impl Renderer {
         width: u32,
         height: u32,
         moments: &[T],
-        mut set: impl FnMut(&mut Self, &T) -> Result<()>,
+        set: impl FnMut(&mut Self, &T) -> Result<()>,
     ) -> Result<RgbaImage> {
+        self.over_time(moments, set, |r| r.render(width, height))
+    }
+
+    /// As [`Renderer::render_over_time`], with every output of
+    /// [`Renderer::render_layers`]: the linear colour and coverage the
+    /// mean over the moments, the other outputs the first moment's.
+    ///
+    /// # Errors
+    /// As [`Renderer::render_over_time`].
+    pub fn render_layers_over_time<T>(
+        &mut self,
+        width: u32,
+        height: u32,
+        moments: &[T],
+        set: impl FnMut(&mut Self, &T) -> Result<()>,
+    ) -> Result<Frame> {
+        self.over_time(moments, set, |r| r.render_layers(width, height))
+    }
+
+    /// A progressive pass of `render` at each of `moments`, `set` before
+    /// each: the last pass's result, the mean of them all.
+    fn over_time<T, R>(
+        &mut self,
+        moments: &[T],
+        mut set: impl FnMut(&mut Self, &T) -> Result<()>,
+        mut render: impl FnMut(&mut Self) -> Result<R>,
+    ) -> Result<R> {
         let count = u32::try_from(moments.len()).unwrap_or(u32::MAX);
         if count == 0 || count > self.most_passes() {
             return Err(Error::Quality {
@@ -211,17 +238,17 @@ impl Renderer {
         // The accumulation is about to be overwritten: no earlier passes
         // continue, even after an error.
         self.progress = None;
-        let mut image = None;
+        let mut last = None;
         for (pass, moment) in (0i32..).zip(moments) {
             let done = set(self, moment).and_then(|()| {
                 self.set_pass(pass);
-                self.render(width, height)
+                render(self)
             });
             self.set_pass(-1);
-            image = Some(done?);
+            last = Some(done?);
         }
         self.progress = None;
-        Ok(image.expect("at least one moment"))
+        Ok(last.expect("at least one moment"))
     }
 
     /// The progressive passes in the last image of
