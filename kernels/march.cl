@@ -64,6 +64,9 @@ typedef struct {
     real closest;   // smallest d / (t + d) seen: the angle of the nearest miss
     int steps;      // distance evaluations
     int hit;        // 1 if the surface was reached
+#ifdef ENABLE_NODE_GLOW
+    real glow_closest[GLOW_NODES]; // the same angle for each glow node's shape
+#endif
 } MarchResult;
 
 typedef struct {
@@ -219,6 +222,10 @@ real march_refine(real3 ro, real3 rd, const MarchCamera* cam, real t0, real g0, 
 real march_glow_slope(void) {
 #ifdef ENABLE_GLOW
     real brightest = fmax(GLOW_COLOR.x, fmax(GLOW_COLOR.y, GLOW_COLOR.z)) * GLOW_STRENGTH;
+#ifdef ENABLE_NODE_GLOW
+    // The brightest glow node's halo, as the program was built.
+    brightest += NODE_GLOW_BRIGHTEST;
+#endif
     real angle = log(fmax(R(510.0) * brightest, R(1.0))) / MARCH_GLOW_FALLOFF;
     return angle < R(1.0) ? angle / (R(1.0) - angle) : (real)INFINITY;
 #endif
@@ -329,6 +336,13 @@ MarchResult march_ray(real3 ro, real3 rd, real start, const MarchCamera* cam, re
     r.closest = R(1.0);
     r.steps = 0;
     r.hit = 0;
+#ifdef ENABLE_NODE_GLOW
+    for (int k = 0; k < GLOW_NODES; ++k) {
+        r.glow_closest[k] = R(1.0);
+    }
+    // The angle beyond which no glow node's halo shows (march_glow_slope).
+    const real glow_reach = log(fmax(R(510.0) * NODE_GLOW_BRIGHTEST, R(1.0))) / MARCH_GLOW_FALLOFF;
+#endif
     const real lipschitz = R(1.0) + DETAIL * cam->footprint_per_unit;
     real omega = OVER_RELAXATION;
     int relaxed = 0; // whether the last step was longer than a plain one
@@ -364,6 +378,17 @@ MarchResult march_ray(real3 ro, real3 rd, real start, const MarchCamera* cam, re
                                                - GLOW_BOUND_RADIUS));
 #endif
             r.closest = fmin(r.closest, near / (r.t + near));
+#ifdef ENABLE_NODE_GLOW
+            // Each glow node's own shape, where the nearest surface is
+            // close enough for a halo to show (no shape is nearer than it).
+            if (d / (r.t + d) < glow_reach) {
+                for (int k = 0; k < GLOW_NODES; ++k) {
+                    real dk = fmax(glow_distance(k, ro + rd * r.t, params), R(0.0));
+                    r.glow_closest[k] = fmin(r.glow_closest[k], dk / (r.t + dk));
+                }
+                r.steps += GLOW_NODES;
+            }
+#endif
         }
         if (g <= R(0.0)) {
             r.hit = 1;

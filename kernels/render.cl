@@ -352,6 +352,13 @@ __kernel void render_tile(RENDER_TILE_ARGS) {
 #ifdef ENABLE_GLOW
         else {
             color += GLOW_COLOR * (GLOW_STRENGTH * exp(-MARCH_GLOW_FALLOFF * m.closest));
+#ifdef ENABLE_NODE_GLOW
+            // Each glow node's halo, from the angle the ray passed its
+            // shape at (none where the rays came marched by brute force).
+            for (int k = 0; k < GLOW_NODES && !stored; ++k) {
+                color += glow_color(k, params) * exp(-MARCH_GLOW_FALLOFF * m.glow_closest[k]);
+            }
+#endif
         }
 #endif
 #ifdef ENABLE_FOG_LIGHT

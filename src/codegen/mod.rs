@@ -39,7 +39,7 @@ use glam::DVec3;
 
 use crate::error::{Error, Result};
 use crate::expr::Unprintable;
-use crate::ir::{Bound, CompiledScene, Ir, union_chain};
+use crate::ir::{Bound, CompiledScene, Ir, Scalar, union_chain};
 use crate::math::{DEFAULT_COLOR, DERIVATIVE_CAP, MAGNITUDE_CAP, REAL_TINY};
 use crate::quality::{Effects, Precision, Quality, ScreenNormals};
 use crate::scene::{
@@ -343,6 +343,21 @@ pub fn emit_ir(ir: &Ir, options: &Options) -> Result<KernelSource> {
             .iter()
             .any(|n| matches!(n, Kind::Material { .. }));
     emitter.emit(materials);
+    let count = ir.glows().len();
+    if options.target == Target::Render && count > MAX_GLOW_NODES {
+        return Err(Error::Invalid {
+            what: "scene",
+            reason: format!(
+                "{count} glow nodes, more than the {MAX_GLOW_NODES} a scene may have (each halo \
+                 is traced on its own): give their union one glow instead"
+            ),
+        });
+    }
+    let glows = if options.target == Target::Render {
+        emitter.emit_glows()
+    } else {
+        0
+    };
     if options.target == Target::Render && options.effects.global_illumination.is_some() {
         ir.check_paths()?;
     }
@@ -359,6 +374,7 @@ pub fn emit_ir(ir: &Ir, options: &Options) -> Result<KernelSource> {
         },
         glow: glow_bound(ir, options, origin),
         origin,
+        node_glow: (glows > 0).then(|| (glows, node_glow(ir))),
     };
     let used = std::mem::take(&mut emitter.used);
     let trapped = std::mem::take(&mut emitter.trapped);
@@ -525,12 +541,45 @@ fn fog_light(options: &Options) -> bool {
         && Effect::enabled(options).contains(&Effect::Fog)
 }
 
+/// The most glow nodes ([`crate::scene::Node::glow`]) a rendered scene
+/// may have: each halo is traced on its own, at every step near a surface.
+pub const MAX_GLOW_NODES: usize = 16;
+
+/// The switch of glow nodes' halos ([`crate::scene::Node::glow`]).
+const NODE_GLOW: &str = "ENABLE_NODE_GLOW";
+
+/// The brightest channel of the brightest glow node's halo, with the
+/// values the program is built with (a dynamic colour or strength at its
+/// default). The march stops early only where no halo that bright can
+/// still change a pixel: a dynamic glow raised above it later may lose
+/// the faint end of its halo beyond the scene's bounding sphere.
+fn node_glow(ir: &Ir) -> f64 {
+    let values = ir.default_values();
+    let value = |s: Scalar| match s {
+        Scalar::Baked(v) => v,
+        Scalar::Dynamic(slot) => values.as_slice()[slot as usize],
+    };
+    ir.nodes()
+        .iter()
+        .filter_map(|n| match n {
+            Kind::Glow {
+                color, strength, ..
+            } => Some(color.map(value).into_iter().fold(0.0, f64::max) * value(*strength)),
+            _ => None,
+        })
+        .fold(0.0, f64::max)
+}
+
 /// What a scene asks of its program beyond the quality and effects.
 #[derive(Debug, Clone, Copy, Default)]
 pub(crate) struct Features {
     /// Where the program's `DE` has its origin in the scene
     /// ([`KernelSource::origin`]).
     pub(crate) origin: DVec3,
+    /// The glow nodes' halos: how many (each with its `DE_glow` function),
+    /// and the brightest channel of the brightest as the program is built
+    /// ([`node_glow`]); `None` without glow nodes.
+    pub(crate) node_glow: Option<(usize, f64)>,
     /// It sets a material (rendering only).
     pub(crate) materials: bool,
     /// It holds an inside shape, whose value is `±INSIDE_HUGE`.
@@ -601,6 +650,12 @@ fn kernel_with(options: &Options, bounded: bool, features: &Features) -> String 
     }
     if fog_light(options) {
         on.push(FOG_LIGHT);
+    }
+    if features.node_glow.is_some() {
+        on.push(NODE_GLOW);
+        if !on.contains(&Effect::Glow.switch()) {
+            on.push(Effect::Glow.switch());
+        }
     }
     select_blocks(kernel, &on)
 }
@@ -816,6 +871,14 @@ fn header(w: &mut writer::Writer, options: &Options, features: &Features) {
     if let Some(glow) = e.glow.filter(|_| on.contains(&Effect::Glow)) {
         defines.push(("GLOW_COLOR", rgb(glow.color)));
         defines.push(("GLOW_STRENGTH", f(glow.strength)));
+    } else if features.node_glow.is_some() {
+        // Glow nodes glow, and nothing else does.
+        defines.push(("GLOW_COLOR", rgb(DVec3::ZERO)));
+        defines.push(("GLOW_STRENGTH", f(0.0)));
+    }
+    if let Some((count, brightest)) = features.node_glow {
+        defines.push(("GLOW_NODES", count.to_string()));
+        defines.push(("NODE_GLOW_BRIGHTEST", f(brightest)));
     }
     if on.contains(&Effect::Fog) {
         defines.push(("FOG_DENSITY", f(e.fog_density)));
@@ -865,8 +928,14 @@ fn header(w: &mut writer::Writer, options: &Options, features: &Features) {
             ));
         }
     }
-    for effect in on {
+    for effect in &on {
         w.line(format!("#define {}", effect.switch()));
+    }
+    if features.node_glow.is_some() {
+        if !on.contains(&Effect::Glow) {
+            w.line(format!("#define {}", Effect::Glow.switch()));
+        }
+        w.line(format!("#define {NODE_GLOW}"));
     }
     if materials {
         w.line(format!("#define {MATERIALS}"));

@@ -150,6 +150,7 @@ fn library_texts() -> Vec<String> {
                     slope: 1.0,
                 }),
                 origin: DVec3::ZERO,
+                node_glow: Some((1, 1.0)),
             };
             header(&mut w, &options, &features);
             texts.push(w.finish());

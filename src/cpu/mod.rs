@@ -614,6 +614,7 @@ impl Evaluator {
                 color: v(*color),
                 ..of(child)
             },
+            Kind::Glow { child, .. } => of(child),
             Kind::Material { material, child } => Sample {
                 material: material.values().map(|x| s(*x)),
                 material_node: Some(NodeId::from_index(id)),

@@ -384,6 +384,15 @@ impl NodeRepr {
                 color,
                 child: child(&c),
             },
+            Kind::Glow {
+                color,
+                strength,
+                child: c,
+            } => NodeRepr::Glow {
+                color,
+                strength,
+                child: child(&c),
+            },
             Kind::Material { material, child: c } => NodeRepr::Material {
                 material: MaterialRepr::from_material(&material),
                 child: child(&c),
@@ -893,6 +902,16 @@ impl Located<NodeRepr> {
             .into(),
             NodeRepr::Color { color, child: c } => Kind::Color {
                 color: color.clone(),
+                child: child(c)?,
+            }
+            .into(),
+            NodeRepr::Glow {
+                color,
+                strength,
+                child: c,
+            } => Kind::Glow {
+                color: color.clone(),
+                strength: strength.clone(),
                 child: child(c)?,
             }
             .into(),

@@ -97,6 +97,7 @@ pub(super) const NAMES: &[&str] = &[
     "Twist",
     "Bend",
     "Color",
+    "Glow",
     "Material",
     "OrbitTrap",
     "Line",

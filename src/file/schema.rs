@@ -722,6 +722,11 @@ pub(super) enum NodeRepr {
         color: Param3,
         child: Child,
     },
+    Glow {
+        color: Param3,
+        strength: Param,
+        child: Child,
+    },
     Material {
         material: MaterialRepr,
         child: Child,

@@ -457,6 +457,7 @@ pub(super) fn bound(node: &IrNode, done: &[Option<Bound>]) -> Option<Bound> {
         // thickness, so its absolute value is itself.
         Kind::Onion { thickness, child } => of(child)?.grow(baked(*thickness)?),
         Kind::Color { child, .. }
+        | Kind::Glow { child, .. }
         | Kind::Material { child, .. }
         | Kind::OrbitTrap { child, .. } => of(child)?,
         Kind::Csg {
@@ -658,6 +659,7 @@ pub(crate) fn reach(ir: &Ir, id: NodeId, bounds: &[Option<Bound>]) -> Option<Rea
             }
             (
                 Kind::Color { child, .. }
+                | Kind::Glow { child, .. }
                 | Kind::Material { child, .. }
                 | Kind::OrbitTrap { child, .. },
                 _,

@@ -156,6 +156,13 @@ impl Ir {
         self.preorder(|n| matches!(n, Kind::Material { .. }))
     }
 
+    /// The scene's glow nodes ([`Node::glow`](crate::scene::Node::glow))
+    /// in the order the scene writes them.
+    #[must_use]
+    pub fn glows(&self) -> Vec<NodeId> {
+        self.preorder(|n| matches!(n, Kind::Glow { .. }))
+    }
+
     /// The nodes `keep` chooses, depth first from the root, each node's
     /// children in order.
     fn preorder(&self, keep: impl Fn(&IrNode) -> bool) -> Vec<NodeId> {
@@ -207,7 +214,9 @@ impl Ir {
         let mut id = self.root;
         loop {
             match self.node(id) {
-                Kind::Color { child, .. } | Kind::Material { child, .. } => id = *child,
+                Kind::Color { child, .. }
+                | Kind::Glow { child, .. }
+                | Kind::Material { child, .. } => id = *child,
                 Kind::Translate { offset, .. } => return baked3(*offset).map(|o| (o, id)),
                 _ => return None,
             }

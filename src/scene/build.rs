@@ -888,6 +888,27 @@ impl Node {
         .into()
     }
 
+    /// A halo of `color` (linear RGB) and `strength` around the node:
+    /// rays that pass near it and hit nothing take its colour, fading
+    /// with the angle they pass it at (see
+    /// [`Effects::glow`](crate::quality::Effects::glow), the same for the
+    /// whole scene). Halos of several nodes add up.
+    ///
+    /// ```
+    /// use fractal_sdf::prelude::*;
+    /// let lamp = sphere(0.3).glow(dvec3(1.0, 0.6, 0.2), 1.5);
+    /// # let _ = lamp;
+    /// ```
+    #[must_use]
+    pub fn glow(self, color: impl Into<Param3>, strength: impl Into<Param>) -> Node {
+        Kind::Glow {
+            color: color.into(),
+            strength: strength.into(),
+            child: self,
+        }
+        .into()
+    }
+
     /// Gives the node a material: how its surfaces answer light (see
     /// [`Material`]). An outer material replaces an inner one, as an outer
     /// colour does.

@@ -538,6 +538,18 @@ pub enum Kind<S, V, C> {
         /// The painted node.
         child: C,
     },
+    /// A halo around the child: rays that pass near its surfaces and hit
+    /// nothing take `color` times `strength`, fading with the angle they
+    /// pass at, as [`Effects::glow`](crate::quality::Effects::glow) does
+    /// for the whole scene. The distance is the child's.
+    Glow {
+        /// Linear RGB, each at least 0.
+        color: V,
+        /// How bright, at least 0 (0.5 subtle, 2 strong).
+        strength: S,
+        /// The node that glows.
+        child: C,
+    },
     /// Gives the child (every surface below this node) a material: how it
     /// answers light (see [`Material`]).
     Material {
@@ -642,6 +654,7 @@ impl<S, V, C> Kind<S, V, C> {
             },
             Kind::Custom { .. } => "custom",
             Kind::Color { .. } => "color",
+            Kind::Glow { .. } => "glow",
             Kind::Material { .. } => "material",
             Kind::OrbitTrap { .. } => "orbit_trap",
         }
@@ -662,6 +675,7 @@ impl<S, V, C> Kind<S, V, C> {
             | Kind::Twist { child, .. }
             | Kind::Bend { child, .. }
             | Kind::Color { child, .. }
+            | Kind::Glow { child, .. }
             | Kind::Material { child, .. }
             | Kind::OrbitTrap { child, .. } => vec![child],
             Kind::Csg { a, b, .. } => vec![a, b],
@@ -728,6 +742,7 @@ impl<S, V, C> Kind<S, V, C> {
             | Kind::Twist { child, .. }
             | Kind::Bend { child, .. }
             | Kind::Color { child, .. }
+            | Kind::Glow { child, .. }
             | Kind::Material { child, .. }
             | Kind::OrbitTrap { child, .. } => vec![child],
             Kind::Csg { a, b, .. } => vec![a, b],
@@ -1164,6 +1179,15 @@ impl<S, V, C> Kind<S, V, C> {
             },
             Kind::Color { color, child } => Kind::Color {
                 color: m.vector(color, spec("color", NonNegative))?,
+                child: m.child(child)?,
+            },
+            Kind::Glow {
+                color,
+                strength,
+                child,
+            } => Kind::Glow {
+                color: m.vector(color, spec("color", NonNegative))?,
+                strength: m.scalar(strength, spec("strength", NonNegative))?,
                 child: m.child(child)?,
             },
             Kind::Material { material, child } => Kind::Material {

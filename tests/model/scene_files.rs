@@ -815,3 +815,22 @@ fn an_environment_is_read_beside_its_file_and_errors_are_located() {
     assert!(err.contains("EnvironmentMap::save_hdr"), "{err}");
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// A glow node in a file: read as `Node::glow` builds it, written back
+/// the same, and its bad values located.
+#[test]
+fn glow_nodes_read_back_and_bad_ones_are_located() {
+    let text = "(version: 1, geometry: Glow(color: (1, 0.5, 0.2), strength: param(\"g\", 1.5), \
+                child: Sphere(radius: 1)))";
+    let file = SceneFile::parse(text).unwrap();
+    let built = sphere(1.0).glow(dvec3(1.0, 0.5, 0.2), param("g", 1.5));
+    assert_eq!(file.scene.geometry, Some(built));
+    let again = SceneFile::parse(&file.to_text().unwrap()).unwrap();
+    assert_eq!(again, file);
+    let err = SceneFile::parse(
+        "(version: 1, geometry: Glow(color: (1, 0.5, 0.2), strength: -1, child: Sphere(radius: 1)))",
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(err.contains("strength"), "{err}");
+}

@@ -505,3 +505,143 @@ fn occlusion_leaves_no_pure_black_pixel_on_a_fractal() {
     let black = image.pixels().filter(|p| p.0[..3] == [0, 0, 0]).count();
     assert_eq!(black, 0, "{black} pure black pixels");
 }
+
+/// The unit direction of the ray through the centre of each pixel, from
+/// the camera's exported frame, row by row.
+fn pixel_rays(camera: &Camera, (w, h): (u32, u32)) -> Vec<DVec3> {
+    let e = fractal_sdf::output::CameraExport::new(camera, (w, h)).unwrap();
+    let half_h = (e.fov_y_degrees.unwrap().to_radians() / 2.0).tan();
+    let half_w = half_h * e.aspect;
+    let (forward, right, up) = (
+        DVec3::from(e.forward),
+        DVec3::from(e.right),
+        DVec3::from(e.up),
+    );
+    let mut out = Vec::new();
+    for j in 0..h {
+        for i in 0..w {
+            let u = ((f64::from(i) + 0.5) / (f64::from(w) / 2.0) - 1.0) * half_w;
+            let v = (1.0 - (f64::from(j) + 0.5) / (f64::from(h) / 2.0)) * half_h;
+            out.push((forward + right * u + up * v).normalize());
+        }
+    }
+    out
+}
+
+/// Glow nodes: a glowing ball beside a plain one. A ray that misses both
+/// takes the glowing ball's colour times its strength times
+/// `exp(−24 θ)`, θ the smallest `d / (t + d)` of the ball's exact
+/// distance along the ray (found here by sampling the ray densely; the
+/// march's own samples are its steps, so its halo may fall short, never
+/// over), and nothing of the plain ball however near it passes; a glow
+/// node at the root is the scene-wide glow of the same colour and
+/// strength.
+#[test]
+fn glow_nodes_give_each_shape_its_own_halo() {
+    let Some(_) = gpu::device() else { return };
+    let eye = dvec3(0.0, 0.3, 4.0);
+    let camera = Camera::look_at(eye, DVec3::ZERO);
+    let (centre, radius) = (dvec3(-0.7, 0.0, 0.0), 0.4);
+    let (color, strength) = (dvec3(1.0, 0.4, 0.1), 1.2);
+    // The glowing ball is placed by a scale above its glow, and the path
+    // to it passes a subtraction: its halo is its own shape's as placed.
+    let glowing = sphere(radius / 2.0)
+        .translate(centre / 2.0)
+        .glow(color, strength)
+        .scale(2.0);
+    let far_box = cuboid(dvec3(0.1, 0.1, 0.1)).translate(dvec3(0.0, 0.0, -40.0));
+    let scene = Scene::new(
+        glowing
+            .union(sphere(0.4).translate(dvec3(0.7, 0.0, 0.0)))
+            .subtract(far_box),
+    )
+    .with_camera(camera);
+    let black = Effects::none()
+        .sky_top(DVec3::ZERO)
+        .sky_bottom(DVec3::ZERO)
+        .gamma(1.0);
+    let quality = gpu::plain(Quality::production());
+    let mut r = Renderer::with_options(&scene, &gpu::options(quality, black)).unwrap();
+    let frame = r.render_layers(W, H).unwrap();
+    let linear = &frame.layers.as_ref().unwrap().linear;
+    let (mut got, mut want, mut misses) = (0.0, 0.0, 0);
+    for (i, rd) in pixel_rays(&camera, (W, H)).into_iter().enumerate() {
+        if frame.hit[i] {
+            continue;
+        }
+        let angle = (0..40_000)
+            .map(|k| {
+                let t = f64::from(k) * 2e-4 * 20.0;
+                let d = ((eye + rd * t).distance(centre) - radius).max(0.0);
+                d / (t + d)
+            })
+            .fold(1.0, f64::min);
+        let halo = color * strength * (-24.0 * angle).exp();
+        let c = linear[i];
+        for (channel, w) in [(0, halo.x), (1, halo.y)] {
+            got += f64::from(c[channel]);
+            want += w;
+        }
+        // Blue is 0.1 of red: the plain ball adds nothing of its own.
+        assert!(
+            (f64::from(c[2]) - halo.z).abs() < 0.01 + 0.05 * halo.z,
+            "pixel {i}: blue {} against {}",
+            c[2],
+            halo.z
+        );
+        misses += 1;
+    }
+    let error = got / want - 1.0;
+    eprintln!(
+        "glow node: halo {got:.2} against {want:.2} ({error:+.4}) over {misses} missed pixels"
+    );
+    assert!(misses > 2000, "{misses}");
+    // The march sees the distance at its steps only, so the smallest angle
+    // it finds is at least the exact one: the halo is never brighter.
+    assert!(error < 1e-3 && error > -0.04, "relative error {error}");
+
+    // At the root, a glow node is the scene's glow.
+    let ball = sphere(0.5);
+    let node = Scene::new(ball.clone().glow(color, strength)).with_camera(camera);
+    let global = Scene::new(ball).with_camera(camera);
+    let layered = |scene: &Scene, effects: Effects| {
+        let mut r = Renderer::with_options(scene, &gpu::options(quality, effects)).unwrap();
+        r.render_layers(W, H).unwrap()
+    };
+    let a = layered(&node, black);
+    let b = layered(&global, black.glow(Glow::new(color, strength)));
+    let (la, lb) = (
+        &a.layers.as_ref().unwrap().linear,
+        &b.layers.as_ref().unwrap().linear,
+    );
+    let worst = la
+        .iter()
+        .zip(lb)
+        .map(|(x, y)| (0..3).map(|c| (x[c] - y[c]).abs()).fold(0.0f32, f32::max))
+        .fold(0.0f32, f32::max);
+    eprintln!("glow node at the root against the scene's glow: largest difference {worst:.2e}");
+    // A node's halo is looked for only where it could reach half an 8-bit
+    // step: the scene's glow keeps fainter ends.
+    assert!(worst <= 0.5 / 255.0, "{worst}");
+}
+
+/// More glow nodes than a scene may have are refused, saying what to do.
+#[test]
+fn too_many_glow_nodes_are_refused() {
+    let many = (0..17)
+        .map(|i| {
+            sphere(0.1)
+                .translate(dvec3(f64::from(i), 0.0, 0.0))
+                .glow(DVec3::ONE, 1.0)
+        })
+        .reduce(Node::union)
+        .unwrap();
+    let compiled = Scene::new(many).compile().unwrap();
+    let err = fractal_sdf::codegen::emit(&compiled, &fractal_sdf::codegen::Options::default())
+        .unwrap_err()
+        .to_string();
+    assert!(
+        err.contains("17 glow nodes") && err.contains("union"),
+        "{err}"
+    );
+}

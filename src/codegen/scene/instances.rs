@@ -225,6 +225,7 @@ pub(super) fn instance(ir: &Ir, root: NodeId) -> Option<Instance> {
             Kind::Translate { .. }
                 | Kind::Scale { .. }
                 | Kind::Color { .. }
+                | Kind::Glow { .. }
                 | Kind::Material { .. }
                 | Kind::Round { .. }
                 | Kind::Onion { .. }

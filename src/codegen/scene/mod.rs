@@ -269,6 +269,105 @@ impl<'a> SceneEmitter<'a> {
         }
     }
 
+    /// Writes `DE_glow0`, `DE_glow1`, ...: for each glow node of the scene
+    /// (in the order [`Ir::glows`] lists them) the distance to its shape
+    /// where the scene places it, whatever the booleans above it do with
+    /// it (a glow's halo is its own shape's). Each walks the path from the
+    /// root, moving the point as every node on it does and leaving out the
+    /// other operands of the booleans it passes, and sizes the distance on
+    /// the way back as the nodes above do (a scale). Returns how many it
+    /// wrote. The instance tables of their loops go after the scene's.
+    pub(crate) fn emit_glows(&mut self) -> usize {
+        self.shade = false;
+        self.material = false;
+        let glows = self.ir.glows();
+        for (j, &glow) in glows.iter().enumerate() {
+            self.points = 0;
+            self.w.open(format!(
+                "real DE_glow{j}(real3 p0, __global const real* params)"
+            ));
+            self.w
+                .comment(&format!("the halo of {}", self.ir.path_tail(glow, 3)));
+            // The path from the root, outermost first.
+            let mut path = vec![glow];
+            while let Some(parent) = self.ir.parent(*path.last().expect("the path has a node")) {
+                path.push(parent);
+            }
+            path.reverse();
+            let mut p = "p0".to_string();
+            // The single-child nodes passed, to leave on the way back.
+            let mut passed: Vec<(NodeId, String)> = Vec::new();
+            for pair in path.windows(2) {
+                let (node, next) = (pair[0], pair[1]);
+                if matches!(
+                    self.ir.node(node),
+                    Kind::Csg {
+                        op: CsgOp::Union,
+                        smoothing: None,
+                        ..
+                    }
+                ) {
+                    // A hard union moves nothing.
+                    continue;
+                }
+                let Step::Descend(children) = self.enter(node, &p, false) else {
+                    unreachable!("a node above another has children")
+                };
+                let single = children.len() == 1;
+                let (_, q, _) = children
+                    .into_iter()
+                    .find(|(c, _, _)| *c == next)
+                    .expect("the path goes through a child");
+                if single {
+                    passed.push((node, p.clone()));
+                }
+                p = q;
+            }
+            let mut v = self.node(glow, &p, false);
+            for (node, at) in passed.into_iter().rev() {
+                v = self.leave(node, &at, false, vec![v]);
+            }
+            self.w.line(format!("return {};", v.d));
+            self.w.close();
+            self.w.line("");
+        }
+        if glows.is_empty() {
+            return 0;
+        }
+        // Node j's distance and its halo's colour times its strength.
+        self.w
+            .open("real glow_distance(int j, real3 p, __global const real* params)");
+        self.w.open("switch (j)");
+        for j in 0..glows.len() {
+            self.w
+                .line(format!("case {j}: return DE_glow{j}(p, params);"));
+        }
+        self.w.close();
+        self.w.line("return (real)INFINITY;");
+        self.w.close();
+        self.w.line("");
+        self.w
+            .open("real3 glow_color(int j, __global const real* params)");
+        self.w.open("switch (j)");
+        for (j, &glow) in glows.iter().enumerate() {
+            let Kind::Glow {
+                color, strength, ..
+            } = self.ir.node(glow)
+            else {
+                unreachable!("glows lists glow nodes")
+            };
+            let [r, g, b] = color.map(|c| self.w.scalar(c));
+            let k = self.w.scalar(*strength);
+            self.w
+                .line(format!("case {j}: return (real3)({r}, {g}, {b}) * {k};"));
+        }
+        self.w.close();
+        self.w.line("return (real3)(R(0.0));");
+        self.w.close();
+        self.w.line("");
+        glows.len()
+    }
+
     /// Whether the function being written computes orbit traps.
     fn traps(&self) -> bool {
         self.shade && !self.material
@@ -582,6 +681,7 @@ impl<'a> SceneEmitter<'a> {
             node,
             Kind::Csg { .. }
                 | Kind::Color { .. }
+                | Kind::Glow { .. }
                 | Kind::Material { .. }
                 | Kind::OrbitTrap { .. }
                 | Kind::Round { .. }
@@ -812,6 +912,7 @@ impl<'a> SceneEmitter<'a> {
                 let needs = !self.material && needs_color;
                 Step::Descend(vec![(*child, p.to_string(), needs)])
             }
+            Kind::Glow { child, .. } => Step::Descend(vec![(*child, p.to_string(), needs_color)]),
             Kind::OrbitTrap { coloring, child } => {
                 if self.traps() && needs_color {
                     let trap = self.trap_shape(&coloring.trap);
