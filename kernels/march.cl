@@ -223,7 +223,8 @@ real march_glow_slope(void) {
 #ifdef ENABLE_GLOW
     real brightest = fmax(GLOW_COLOR.x, fmax(GLOW_COLOR.y, GLOW_COLOR.z)) * GLOW_STRENGTH;
 #ifdef ENABLE_NODE_GLOW
-    // The brightest glow node's halo, as the program was built.
+    // The glow nodes' halos, as bright as they add up to as the program
+    // was built.
     brightest += NODE_GLOW_BRIGHTEST;
 #endif
     real angle = log(fmax(R(510.0) * brightest, R(1.0))) / MARCH_GLOW_FALLOFF;
@@ -379,8 +380,9 @@ MarchResult march_ray(real3 ro, real3 rd, real start, const MarchCamera* cam, re
 #endif
             r.closest = fmin(r.closest, near / (r.t + near));
 #ifdef ENABLE_NODE_GLOW
-            // Each glow node's own shape, where the nearest surface is
-            // close enough for a halo to show (no shape is nearer than it).
+            // Each glow node's own shape, where the scene's surface is
+            // close enough for a halo to show (a shape in a union is no
+            // nearer than it).
             if (d / (r.t + d) < glow_reach) {
                 for (int k = 0; k < GLOW_NODES; ++k) {
                     real dk = fmax(glow_distance(k, ro + rd * r.t, params), R(0.0));

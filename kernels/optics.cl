@@ -64,18 +64,19 @@ real3 march_branch(MarchBranch b, MarchBranch* stack, int* top,
 //   the surface's own colour, own: (1 - r)(1 - tau),
 //   a reflected ray: r + (1 - r) tau F,
 //   a refracted ray: (1 - r) tau (1 - F) (reflected too, on total
-//   internal reflection).
+//   internal reflection);
+// and the light the surface gives off, emitted, whole.
 // Returns the colour it adds now; the rays go on the stack.
 real3 march_split(real3 p, real3 n, real3 rd, real eps, real t, real3 weight, int depth,
-                  real3 own, __global const real* params, MarchBranch* stack, int* top,
-                  __global const float* environment, uint* evals) {
+                  real3 own, real3 emitted, __global const real* params, MarchBranch* stack,
+                  int* top, __global const float* environment, uint* evals) {
     real16 material;
     DE_material(p, params, &material);
     *evals += 1u;
     real r = material.MATERIAL_REFLECTIVITY;
     real tau = material.MATERIAL_TRANSPARENCY;
     real ior = material.MATERIAL_IOR;
-    real3 color = weight * ((R(1.0) - r) * (R(1.0) - tau)) * own;
+    real3 color = weight * (((R(1.0) - r) * (R(1.0) - tau)) * own + emitted);
     real reflected = r;
     if (tau > R(0.0)) {
         real fresnel = march_fresnel(clamp(-dot(n, rd), R(0.0), R(1.0)), ior);
@@ -99,8 +100,9 @@ real3 march_split(real3 p, real3 n, real3 rd, real eps, real t, real3 weight, in
 }
 
 // The colour of a pixel's path that first meets the surface at p (normal
-// n, hit threshold eps) t along rd, whose own lit colour is own: own
-// weighted by the surface's share, plus what its reflected and refracted
+// n, hit threshold eps) t along rd, whose own lit colour is own and whose
+// emission is emitted: own weighted by the surface's share, emitted
+// whole, plus what its reflected and refracted
 // rays bring, each marched like a primary ray (its footprint grows with
 // the whole path's length) and lit with the same occlusion and shadows,
 // depth first, at most BOUNCES deep. A ray inside a transparent shape
@@ -108,12 +110,13 @@ real3 march_split(real3 p, real3 n, real3 rd, real eps, real t, real3 weight, in
 // in on total internal reflection; the inside is clear. Adds every
 // evaluation to *evals.
 real3 march_paths(real3 p, real3 n, real3 rd, real eps, real t, const MarchCamera* cam,
-                  real3 own, __global const real* params, __global const real* lights,
-                  int light_count, __global const float* environment, uint* evals) {
+                  real3 own, real3 emitted, __global const real* params,
+                  __global const real* lights, int light_count,
+                  __global const float* environment, uint* evals) {
     MarchBranch stack[BOUNCES + 2];
     int top = 0;
-    real3 color = march_split(p, n, rd, eps, t, (real3)(R(1.0)), 0, own, params, stack, &top,
-                              environment, evals);
+    real3 color = march_split(p, n, rd, eps, t, (real3)(R(1.0)), 0, own, emitted, params,
+                              stack, &top, environment, evals);
     while (top > 0) {
         MarchBranch b = stack[--top];
         // The footprint goes on growing along the path.
@@ -148,10 +151,11 @@ real3 march_paths(real3 p, real3 n, real3 rd, real eps, real t, const MarchCamer
             continue;
         }
         real occlusion = march_occlusion(q, nq, footprint * cam->image_h, R(0.5), params, evals);
+        real3 emitted;
         real3 lit = march_shade(q, nq, b.rd, eq, occlusion, params, lights, light_count,
-                                environment, evals);
-        color += march_split(q, nq, b.rd, eq, travelled, b.weight, b.depth, lit, params, stack,
-                             &top, environment, evals);
+                                environment, &emitted, evals);
+        color += march_split(q, nq, b.rd, eq, travelled, b.weight, b.depth, lit, emitted,
+                             params, stack, &top, environment, evals);
     }
     return color;
 }

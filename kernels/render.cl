@@ -333,11 +333,12 @@ __kernel void render_tile(RENDER_TILE_ARGS) {
                                                 n, footprint, view_height);
 #endif
 #endif
+            real3 emitted;
             color = march_shade(p, n, rd, DETAIL * footprint, occlusion, params, lights,
-                                light_count, environment, &total_evals);
+                                light_count, environment, &emitted, &total_evals);
 #ifdef ENABLE_MATERIALS
-            color = march_paths(p, n, rd, DETAIL * footprint, m.t, &cam, color, params, lights,
-                                light_count, environment, &total_evals);
+            color = march_paths(p, n, rd, DETAIL * footprint, m.t, &cam, color, emitted, params,
+                                lights, light_count, environment, &total_evals);
 #endif
 #endif
 #ifdef ENABLE_GI

@@ -355,20 +355,26 @@ real3 march_light(__global const real* l, real3 p, real3* to_light, real* light_
 #ifdef ENABLE_FOG
 // The fog's optical depth from ro along the unit rd to distance t (which
 // may be INFINITY): FOG_DENSITY t for a uniform fog. With FOG_FALLOFF b,
-// the density is FOG_DENSITY exp(-b (y - FOG_HEIGHT)), and along the ray
-// (y = ro.y + rd.y s) the integral is A (1 - exp(-k t)) / k, with A the
-// density at ro and k = b rd.y (t itself where k t is tiny).
+// the density is FOG_DENSITY exp(a) with a = -b (y - FOG_HEIGHT), and
+// along the ray a falls by k = b rd.y per unit: the depth is the density's
+// fall from ro to the end over k, FOG_DENSITY (exp(a0) - exp(a0 - k t)) / k
+// (the density times t, less half its slope's share, where k t is tiny).
+// The exponents are capped from above only, so a camera high above a
+// thin ground fog sees through it, and one far below a thick one none.
 real march_fog_depth(real3 ro, real3 rd, real t) {
     real depth = FOG_DENSITY * t;
 #ifdef ENABLE_FOG_LIGHT
-    real at_ro = FOG_DENSITY * exp(clamp(-FOG_FALLOFF * (ro.y - FOG_HEIGHT), R(-80.0), R(80.0)));
+    real a0 = -FOG_FALLOFF * (ro.y - FOG_HEIGHT);
     real k = FOG_FALLOFF * rd.y;
     real kt = k * t;
-    real span = t;
-    if (k != R(0.0)) {
-        span = fabs(kt) < R(1e-4) ? t * (R(1.0) - R(0.5) * kt) : -expm1(-kt) / k;
+    if (k == R(0.0)) {
+        // Level (k t would be 0 times INFINITY on a miss).
+        depth = FOG_DENSITY * exp(fmin(a0, R(80.0))) * t;
+    } else if (fabs(kt) < R(1e-4)) {
+        depth = FOG_DENSITY * exp(fmin(a0, R(80.0))) * t * (R(1.0) - R(0.5) * kt);
+    } else {
+        depth = FOG_DENSITY * (exp(fmin(a0, R(80.0))) - exp(fmin(a0 - kt, R(80.0)))) / k;
     }
-    depth = at_ro * span;
 #endif
     return depth;
 }
@@ -376,16 +382,22 @@ real march_fog_depth(real3 ro, real3 rd, real t) {
 
 #ifdef ENABLE_FOG_LIGHT
 // The distance from ro along the unit rd at which the fog's optical depth
-// reaches depth (march_fog_depth inverted; depth below the ray's total).
+// reaches depth (march_fog_depth inverted, for a depth the ray reaches):
+// with q = depth / FOG_DENSITY, exp(a0) - exp(a0 - k s) = k q, so
+// s = -log1p(-k q exp(-a0)) / k upwards and (log(exp(a0) + |k| q) - a0) / |k|
+// downwards, q exp(-a0) near level.
 real march_fog_reach(real3 ro, real3 rd, real depth) {
-    real at_ro = FOG_DENSITY * exp(clamp(-FOG_FALLOFF * (ro.y - FOG_HEIGHT), R(-80.0), R(80.0)));
-    real q = depth / at_ro;
+    real a0 = -FOG_FALLOFF * (ro.y - FOG_HEIGHT);
     real k = FOG_FALLOFF * rd.y;
-    real kq = k * q;
-    if (fabs(kq) < R(1e-4)) {
-        return q * (R(1.0) + R(0.5) * kq);
+    real q = depth / FOG_DENSITY;
+    real level = q * exp(fmin(-a0, R(80.0)));
+    if (fabs(k * level) < R(1e-4)) {
+        return level * (R(1.0) + R(0.5) * k * level);
     }
-    return -log1p(-fmin(kq, R(1.0) - R(1e-7))) / k;
+    if (k > R(0.0)) {
+        return -log1p(-fmin(k * level, R(1.0) - R(1e-7))) / k;
+    }
+    return (log(exp(fmin(a0, R(80.0))) - k * q) - a0) / -k;
 }
 
 // The light the fog scatters towards the camera along ro + rd s, s from 0
@@ -402,6 +414,9 @@ real3 march_fog_light(real3 ro, real3 rd, real far, real jitter, const MarchCame
                       __global const real* params, __global const real* lights,
                       int light_count, uint* evals) {
     real scattered = -expm1(-march_fog_depth(ro, rd, far));
+    if (!(scattered > R(0.0))) {
+        return (real3)(R(0.0));
+    }
     real share = scattered / (real)FOG_SAMPLES;
     real g = FOG_ANISOTROPY;
     real3 sum = (real3)(R(0.0));
@@ -418,7 +433,7 @@ real3 march_fog_light(real3 ro, real3 rd, real far, real jitter, const MarchCame
             radiance *= (R(1.0) - g * g) / (R(4.0) * bend * sqrt(bend)) * share;
 #ifdef ENABLE_SHADOWS
             real eps = DETAIL * march_footprint(cam, s);
-            radiance *= march_shadow(x, to_light, light_distance, R(0.25) * eps, R(0.0),
+            radiance *= march_shadow(x, to_light, light_distance, R(0.25) * eps, eps,
                                      l[LIGHT_SOFTNESS], fmax(radiance.x, fmax(radiance.y, radiance.z)),
                                      params, evals);
 #endif
@@ -438,12 +453,15 @@ real3 march_fog_light(real3 ro, real3 rd, real far, real jitter, const MarchCame
 // or, with a material's roughness, Oren-Nayar's. With a material's
 // subsurface strength s, a light behind the surface (n.l < 0) adds
 // albedo * s * thinness * -n.l: it shows through thin parts, unshadowed
-// (the shape itself stands between). A material's emission adds
-// albedo * emission, unlit and unshadowed. Without materials the highlight
-// is MARCH_SPECULAR and MARCH_SHININESS, the default material's.
+// (the shape itself stands between). A material's emission, albedo *
+// emission, is not in the lit colour: it goes to *emitted (0 without
+// materials), which no share of reflection or transparency dims. Without
+// materials the highlight is MARCH_SPECULAR and MARCH_SHININESS, the
+// default material's.
 real3 march_shade(real3 p, real3 n, real3 rd, real eps, real occlusion,
                   __global const real* params, __global const real* lights, int light_count,
-                  __global const float* environment, uint* evals) {
+                  __global const float* environment, real3* emitted, uint* evals) {
+    *emitted = (real3)(R(0.0));
     real3 albedo;
     real trap;
     DE_shade(p, params, &albedo, &trap);
@@ -469,7 +487,7 @@ real3 march_shade(real3 p, real3 n, real3 rd, real eps, real occlusion,
 #endif
     real3 color = albedo * sky * (MARCH_AMBIENT * occlusion);
 #ifdef ENABLE_MATERIALS
-    color += albedo * material.MATERIAL_EMISSION;
+    *emitted = albedo * material.MATERIAL_EMISSION;
 #endif
 
 #ifdef ENABLE_SHADOWS

@@ -516,6 +516,8 @@ impl Sequence {
                     renderer.render_layers_over_time(width, height, &moments, |r, &t| at(r, t))?
                 };
                 if output.needs_ids() {
+                    // The layers are the first moment's: so are the ids.
+                    at(renderer, moments[0])?;
                     renderer.identify(&mut frame)?;
                 }
                 crate::output::save_frame(&frame, &file, &output)?;

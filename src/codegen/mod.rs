@@ -344,6 +344,15 @@ pub fn emit_ir(ir: &Ir, options: &Options) -> Result<KernelSource> {
             .any(|n| matches!(n, Kind::Material { .. }));
     emitter.emit(materials);
     let count = ir.glows().len();
+    if options.target == Target::Render && count > 0 && ir.has_inside_shapes() {
+        return Err(Error::Invalid {
+            what: "scene",
+            reason: "glow nodes need the distance to their shapes along each ray, which a \
+                     scene with inside shapes (marched by brute force) does not have: use \
+                     the scene's glow (Effects::glow) instead"
+                .into(),
+        });
+    }
     if options.target == Target::Render && count > MAX_GLOW_NODES {
         return Err(Error::Invalid {
             what: "scene",
@@ -548,9 +557,9 @@ pub const MAX_GLOW_NODES: usize = 16;
 /// The switch of glow nodes' halos ([`crate::scene::Node::glow`]).
 const NODE_GLOW: &str = "ENABLE_NODE_GLOW";
 
-/// The brightest channel of the brightest glow node's halo, with the
-/// values the program is built with (a dynamic colour or strength at its
-/// default). The march stops early only where no halo that bright can
+/// The brightest the glow nodes' halos can add up to: the sum of each
+/// one's brightest channel, with the values the program is built with (a
+/// dynamic colour or strength at its default). The march stops early only where no halo that bright can
 /// still change a pixel: a dynamic glow raised above it later may lose
 /// the faint end of its halo beyond the scene's bounding sphere.
 fn node_glow(ir: &Ir) -> f64 {
@@ -567,7 +576,7 @@ fn node_glow(ir: &Ir) -> f64 {
             } => Some(color.map(value).into_iter().fold(0.0, f64::max) * value(*strength)),
             _ => None,
         })
-        .fold(0.0, f64::max)
+        .sum()
 }
 
 /// What a scene asks of its program beyond the quality and effects.

@@ -325,11 +325,20 @@ pub fn save_frame(
         return Err(missing("outputs besides the colour", "AOVs"));
     }
     output.check(path)?;
+    if extension.as_deref() == Some("exr") {
+        write_exr(frame, path, &output.aovs)?;
+        return Ok(vec![path.to_path_buf()]);
+    }
+    // The outputs beside the image go first: where the image is on disk,
+    // so are they (a sequence resumes by its frames' images).
+    let mut beside = Vec::with_capacity(output.aovs.len());
+    for &aov in &output.aovs {
+        let target = aov_path(path, aov);
+        let (pixels, color) = aov_png(frame, aov)?;
+        write_png16(&target, frame.width(), frame.height(), &pixels, color)?;
+        beside.push(target);
+    }
     match extension.as_deref() {
-        Some("exr") => {
-            write_exr(frame, path, &output.aovs)?;
-            return Ok(vec![path.to_path_buf()]);
-        }
         Some("tif" | "tiff") => write_tiff(frame, path, output)?,
         _ if output.bits == Bits::Sixteen => {
             let rgba = sixteen_bit(frame, &output.effects)?;
@@ -344,12 +353,7 @@ pub fn save_frame(
         _ => save_image(&frame.image, path)?,
     }
     let mut written = vec![path.to_path_buf()];
-    for &aov in &output.aovs {
-        let target = aov_path(path, aov);
-        let (pixels, color) = aov_png(frame, aov)?;
-        write_png16(&target, frame.width(), frame.height(), &pixels, color)?;
-        written.push(target);
-    }
+    written.extend(beside);
     Ok(written)
 }
 

@@ -763,6 +763,7 @@ fn lipschitz_ops(inner: BoxedStrategy<Node>) -> impl Strategy<Value = Node> {
         (inner.clone(), 0.0..=0.2f64).prop_map(|(n, t)| n.onion(t)),
         (inner.clone(), vector(0.0..=0.5f64)).prop_map(|(n, e)| n.elongate(e)),
         (inner.clone(), color()).prop_map(|(n, c)| n.color(c)),
+        (inner.clone(), color(), 0.0..=2.0f64).prop_map(|(n, c, s)| n.glow(c, s)),
         (inner.clone(), inner, 0u8..3, smoothing()).prop_map(|(a, b, op, k)| csg(a, b, op, k)),
     ]
 }
@@ -770,7 +771,8 @@ fn lipschitz_ops(inner: BoxedStrategy<Node>) -> impl Strategy<Value = Node> {
 /// Nodes whose distance is a 1-Lipschitz bound, so it never overestimates:
 /// exact primitives and bounded repetitions ([`repeated_node`]) as leaves,
 /// combined to depth 3 by transforms, twist and bend (rates in `[-3, 3]`),
-/// mirror, round, onion, elongate, colour and hard and smooth booleans.
+/// mirror, round, onion, elongate, colour, glow and hard and smooth
+/// booleans.
 ///
 /// The ellipsoid is not here: outside it is a bound, but not a 1-Lipschitz
 /// one near thin ellipsoids.

@@ -625,9 +625,36 @@ fn glow_nodes_give_each_shape_its_own_halo() {
     assert!(worst <= 0.5 / 255.0, "{worst}");
 }
 
-/// More glow nodes than a scene may have are refused, saying what to do.
+/// More glow nodes than a scene may have are refused, saying what to do,
+/// and so are glow nodes beside an inside shape (which has no distance
+/// for a halo).
 #[test]
 fn too_many_glow_nodes_are_refused() {
+    use fractal_sdf::scene::{InsideBounds, InsideShape};
+    let shape = InsideShape::new(
+        "ball",
+        &[],
+        InsideBounds::sphere(DVec3::ZERO, 1.5),
+        |p, _| p.length() < 1.0,
+        "return length(p) < 1.0f;",
+    )
+    .unwrap();
+    let scene = Scene::new(
+        shape
+            .node::<f64>([])
+            .union(sphere(0.2).glow(DVec3::ONE, 1.0)),
+    );
+    let err = fractal_sdf::codegen::emit(
+        &scene.compile().unwrap(),
+        &fractal_sdf::codegen::Options::default(),
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(
+        err.contains("inside shapes") && err.contains("Effects::glow"),
+        "{err}"
+    );
+
     let many = (0..17)
         .map(|i| {
             sphere(0.1)

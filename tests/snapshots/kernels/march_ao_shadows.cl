@@ -510,12 +510,15 @@ real3 march_light(__global const real* l, real3 p, real3* to_light, real* light_
 // or, with a material's roughness, Oren-Nayar's. With a material's
 // subsurface strength s, a light behind the surface (n.l < 0) adds
 // albedo * s * thinness * -n.l: it shows through thin parts, unshadowed
-// (the shape itself stands between). A material's emission adds
-// albedo * emission, unlit and unshadowed. Without materials the highlight
-// is MARCH_SPECULAR and MARCH_SHININESS, the default material's.
+// (the shape itself stands between). A material's emission, albedo *
+// emission, is not in the lit colour: it goes to *emitted (0 without
+// materials), which no share of reflection or transparency dims. Without
+// materials the highlight is MARCH_SPECULAR and MARCH_SHININESS, the
+// default material's.
 real3 march_shade(real3 p, real3 n, real3 rd, real eps, real occlusion,
                   __global const real* params, __global const real* lights, int light_count,
-                  __global const float* environment, uint* evals) {
+                  __global const float* environment, real3* emitted, uint* evals) {
+    *emitted = (real3)(R(0.0));
     real3 albedo;
     real trap;
     DE_shade(p, params, &albedo, &trap);
@@ -814,8 +817,9 @@ __kernel void render_tile(RENDER_TILE_ARGS) {
             // Occlusion samples at the midpoints of their intervals.
             real offset = R(0.5);
             real occlusion = march_occlusion(p, n, view_height, offset, params, &total_evals);
+            real3 emitted;
             color = march_shade(p, n, rd, DETAIL * footprint, occlusion, params, lights,
-                                light_count, environment, &total_evals);
+                                light_count, environment, &emitted, &total_evals);
         }
         sum += color;
         if (s == 0) {
