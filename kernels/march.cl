@@ -13,7 +13,9 @@
 //           from quality::display_formula
 //   scene   real DE(real3 p, __global const real* params)
 //           real DE_shade(real3 p, __global const real* params,
-//                         real3* color, real* trap)
+//                         real3* color, real2* trap), trap.x the orbit
+//                         trap that tints the colour and trap.y the trap
+//                         the layers show (a palette's too)
 //           and, with materials (ENABLE_MATERIALS), void DE_material(real3 p,
 //           __global const real* params, real16* material), whose fields the
 //           header names MATERIAL_<value> (material.MATERIAL_IOR)

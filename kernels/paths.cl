@@ -294,10 +294,10 @@ real3 march_emission(real3 p, __global const real* params, uint* evals) {
     *evals += 1u;
     if (material.MATERIAL_EMISSION > R(0.0)) {
         real3 albedo;
-        real trap;
+        real2 trap;
         DE_shade(p, params, &albedo, &trap);
         *evals += 1u;
-        return albedo * march_trap_tint(trap) * material.MATERIAL_EMISSION;
+        return albedo * march_trap_tint(trap.x) * material.MATERIAL_EMISSION;
     }
 #endif
     return (real3)(R(0.0));
@@ -353,10 +353,10 @@ real3 march_path(real3 p, real3 n, real3 rd, real t, const MarchCamera* cam, uin
             }
         } else {
             real3 albedo;
-            real trap;
+            real2 trap;
             DE_shade(p, params, &albedo, &trap);
             *evals += 1u;
-            albedo *= march_trap_tint(trap);
+            albedo *= march_trap_tint(trap.x);
             real ks = MARCH_SPECULAR;
             real shininess = MARCH_SHININESS;
             real sigma = R(0.0);

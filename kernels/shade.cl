@@ -463,10 +463,10 @@ real3 march_shade(real3 p, real3 n, real3 rd, real eps, real occlusion,
                   __global const float* environment, real3* emitted, uint* evals) {
     *emitted = (real3)(R(0.0));
     real3 albedo;
-    real trap;
+    real2 trap;
     DE_shade(p, params, &albedo, &trap);
     *evals += 1u;
-    albedo *= march_trap_tint(trap);
+    albedo *= march_trap_tint(trap.x);
     real specular_strength = MARCH_SPECULAR;
     real shininess = MARCH_SHININESS;
 #ifdef ENABLE_MATERIALS
@@ -533,15 +533,18 @@ real3 march_shade(real3 p, real3 n, real3 rd, real eps, real occlusion,
 
 // The shading layers of the surface point p with normal n (see
 // codegen::interface::layer): its albedo with the orbit-trap tint, the
-// trap's value (1 on surfaces that are not fractals), and how lit it is: each
+// trap's value (1 on surfaces that are not fractals; on a fractal a palette
+// paints, the trap its palette reads), and how lit it is: each
 // light that faces it weighted by the brightest channel of its radiance
 // times n.l, its shadow ray's visibility averaged (1 without shadows, or
 // with no light facing it). Shadow rays leave as march_shade's do.
 void march_layers(real3 p, real3 n, real eps, __global const real* params,
                   __global const real* lights, int light_count, real3* albedo, real* trap,
                   real* shadow) {
-    DE_shade(p, params, albedo, trap);
-    *albedo *= march_trap_tint(*trap);
+    real2 traps;
+    DE_shade(p, params, albedo, &traps);
+    *albedo *= march_trap_tint(traps.x);
+    *trap = traps.y;
     real lit = R(0.0);
     real weights = R(0.0);
     uint evals = 0u;

@@ -149,8 +149,9 @@ pub mod layer {
     /// The lights' visibility at the hit, weighted by what each could add:
     /// 1 lit, 0 in shadow (1 without shadows or lights, 0 on a miss).
     pub const SHADOW: Field = field("SHADOW", 7, 1);
-    /// The orbit-trap value at the hit that tints a fractal, 1 on other
-    /// surfaces and on fractals coloured through a palette (0 on a miss).
+    /// The orbit-trap value at the hit that tints a fractal, or that a
+    /// palette reads on a fractal it paints; 1 on other surfaces (0 on a
+    /// miss).
     pub const TRAP: Field = field("TRAP", 8, 1);
     /// Every field, in buffer order.
     pub const FIELDS: [Field; 5] = [POSITION, ALBEDO, OCCLUSION, SHADOW, TRAP];
@@ -408,8 +409,8 @@ pub const EVAL_DISTANCES: [(EvalArg, &str); 4] = [
     (EvalArg::Count, "const uint count"),
 ];
 
-/// Reals `eval_points` writes per point: `(DE, DE_shade, trap, 0)` then
-/// `(colour, 0)`.
+/// Reals `eval_points` writes per point: `(DE, DE_shade, trap, orbit)`
+/// (the trap that tints, and the trap the layers show) then `(colour, 0)`.
 pub const EVAL_OUT_STRIDE: usize = 8;
 
 /// The arguments of the grid-evaluation kernel `eval_grid`, in order: `DE`

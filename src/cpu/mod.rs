@@ -36,8 +36,12 @@ pub struct Sample<T> {
     pub distance: T,
     /// Linear RGB colour of the nearest surface.
     pub color: V3<T>,
-    /// Orbit trap in `[0, 1]` (1 for non-fractal surfaces).
+    /// Orbit trap in `[0, 1]` that tints the colour (1 for non-fractal
+    /// surfaces, and for fractals a palette paints).
     pub trap: T,
+    /// Orbit trap in `[0, 1]` that the shading layers show: `trap`, or on
+    /// a fractal a palette paints, the trap the palette reads.
+    pub orbit: T,
     /// The nearest surface's material, in
     /// [`Material::values`](crate::scene::Material::values) order.
     pub material: [T; MATERIAL_LEN],
@@ -276,6 +280,7 @@ impl Evaluator {
             distance,
             color: V3::splat(T::of(DEFAULT_COLOR[0])),
             trap: T::one(),
+            orbit: T::one(),
             material: DEFAULT_MATERIAL.map(T::of),
             object: None,
             material_node: None,
@@ -285,6 +290,7 @@ impl Evaluator {
     fn fractal<T: Real>(e: Estimate<T>) -> Sample<T> {
         Sample {
             trap: e.trap,
+            orbit: e.trap,
             ..Self::leaf(e.distance)
         }
     }
@@ -628,6 +634,7 @@ impl Evaluator {
                 let t = Palette::position(e.trap, s(coloring.near), s(coloring.far));
                 Sample {
                     color: coloring.palette.at(t),
+                    orbit: e.trap,
                     object: Some(*child),
                     ..Self::leaf(e.distance)
                 }
@@ -725,6 +732,7 @@ fn combine<T: Real>(op: CsgOp, k: Option<T>, a: Sample<T>, b: Sample<T>) -> Samp
         distance: c.distance,
         color: near.color.zip(far.color, mix),
         trap: mix(near.trap, far.trap),
+        orbit: mix(near.orbit, far.orbit),
         material: std::array::from_fn(|i| mix(near.material[i], far.material[i])),
         object: near.object,
         material_node: near.material_node,

@@ -34,9 +34,8 @@ pub enum Aov {
     Occlusion,
     /// The lights' visibility: 1 lit, 0 in shadow.
     Shadow,
-    /// The orbit-trap value that tints a fractal (1 on other surfaces,
-    /// and on fractals coloured through a palette, whose colour is in
-    /// [`Aov::Albedo`]).
+    /// The orbit-trap value that tints a fractal, or that a palette
+    /// reads on a fractal it paints (1 on other surfaces).
     Trap,
     /// Distance evaluations the pixel's colour cost.
     Evaluations,

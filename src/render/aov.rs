@@ -69,10 +69,12 @@ pub struct Layers {
     /// the most it could add: 1 lit, 0 in shadow (1 with shadows off or
     /// no light facing it).
     pub shadow: Vec<f32>,
-    /// The orbit-trap value at the hit, in `[0, 1]`, that tints a
-    /// fractal's colour; 1 on surfaces that are not fractals, and on
-    /// fractals an [`OrbitColoring`](crate::scene::OrbitColoring) paints
-    /// through a palette (their colour is in `albedo`).
+    /// The orbit-trap value at the hit: the one in `[0, 1]` that tints a
+    /// fractal's colour, or on a fractal an
+    /// [`OrbitColoring`](crate::scene::OrbitColoring) paints through a
+    /// palette, the trap value the palette reads (the orbit's nearest
+    /// approach to its trap, before the palette's range); 1 on surfaces
+    /// that are not fractals.
     pub trap: Vec<f32>,
     /// Which shape the hit belongs to: `k` for shape `k − 1` of
     /// [`Ir::objects`](crate::ir::Ir::objects) (the shapes in the order

@@ -28,8 +28,11 @@ pub struct PointSample {
     pub shade_distance: f64,
     /// The colour `DE_shade` returned.
     pub color: DVec3,
-    /// The orbit trap `DE_shade` returned.
+    /// The orbit trap `DE_shade` returned, that tints the colour.
     pub trap: f64,
+    /// The orbit trap the shading layers show
+    /// ([`cpu::Sample::orbit`](crate::cpu::Sample::orbit)).
+    pub orbit: f64,
 }
 
 /// Runs a scene's generated distance functions on an OpenCL device.
@@ -146,6 +149,7 @@ impl PointEvaluator {
                 distance: c[0],
                 shade_distance: c[1],
                 trap: c[2],
+                orbit: c[3],
                 color: DVec3::new(c[4], c[5], c[6]),
             })
             .collect())

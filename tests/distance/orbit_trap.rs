@@ -77,12 +77,18 @@ fn painted(fractal: &Node, shape: Shape, p: DVec3) -> f64 {
     let node = fractal
         .clone()
         .orbit_coloring(OrbitColoring::new(shape.trap(), ramp).range(0.0, FAR));
-    let color: DVec3 = Evaluator::new(&node)
-        .unwrap()
-        .sample::<f64>(p.into())
-        .color
-        .into();
+    let sample = Evaluator::new(&node).unwrap().sample::<f64>(p.into());
+    let color: DVec3 = sample.color.into();
     assert!(color.x == color.y && color.y == color.z, "{color:?}");
+    // The trap the shading layers show is the one the palette reads.
+    if color.x > 0.0 && color.x < 1.0 {
+        assert!(
+            (sample.orbit - color.x * FAR).abs() <= 1e-9,
+            "orbit {} against painted {}",
+            sample.orbit,
+            color.x * FAR
+        );
+    }
     color.x * FAR
 }
 
@@ -333,4 +339,35 @@ fn the_range_places_trap_values_on_the_palette() {
             );
         }
     }
+}
+
+/// On the device, the trap the layers show for a fractal a palette paints
+/// (the fourth value `eval_points` writes) is the CPU reference's, and the
+/// trap that tints its colour stays 1.
+#[test]
+fn the_device_reports_the_trap_a_palette_reads() {
+    use fractal_sdf::quality::Precision;
+    use fractal_sdf::render::{DeviceSelector, PointEvaluator};
+    let Some(_) = crate::gpu::device() else {
+        return;
+    };
+    let shape = Shape::Sphere(DVec3::new(0.0, 0.2, 0.0), 0.7);
+    let node = menger(4).orbit_coloring(OrbitColoring::new(shape.trap(), Palette::fire()));
+    let cpu = Evaluator::new(&node).unwrap();
+    let points = random_points(400, 1.4, 0x7a9);
+    let device = PointEvaluator::new(&node, Precision::F32, &DeviceSelector::auto())
+        .unwrap()
+        .eval(&points)
+        .unwrap();
+    let mut worst: f64 = 0.0;
+    for (p, s) in points.iter().zip(&device) {
+        let want = cpu.sample::<f64>((*p).into()).orbit;
+        worst = worst.max((s.orbit - want).abs() / want.abs().max(1.0));
+        assert_eq!(s.trap, 1.0, "a palette's fractal is not tinted");
+    }
+    eprintln!(
+        "trap the layers show: largest difference from the CPU {worst:.1e} over {} points",
+        points.len()
+    );
+    assert!(worst < 1e-4, "{worst}");
 }

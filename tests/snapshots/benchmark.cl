@@ -301,7 +301,7 @@ real DE(real3 p0, __global const real* params) {
     return u11;
 }
 
-real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
+real DE_shade(real3 p0, __global const real* params, real3* color, real2* trap) {
     /* union */
     /* union/a:union/b:translate */
     real3 p1 = p0 - ((real3)(params[0] /* orbit.x */, params[1] /* orbit.y */, params[2] /* orbit.z */));
@@ -318,7 +318,7 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     /* union/a:union: the second operand only within reach of its bound */
     real u26 = d29;
     real3 uc26 = c29;
-    real ut26 = R(1.0);
+    real2 ut26 = (real2)(R(1.0));
     real g26 = (length(p0 - ((real3)(R(0.0), R(0.05), R(0.0)))) * R(0.9999)) - R(0.6624537082042873);
     if (!(g26 > u26 && g26 > R(0.0))) {
         /* .../a:union/a:union/a:translate */
@@ -330,13 +330,13 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
         /* .../scale/rotate/mandelbulb */
         real2 f0 = mandelbulb_p8(p4, 8, R(2.0), 1.1040895f);
         real d0 = f0.x;
-        real t0 = f0.y;
+        real2 t0 = (real2)(f0.y);
         real d2 = d0 * R(0.6);
         /* .../a:union/a:translate/color */
         real3 c3 = (real3)(0.9f, 0.6f, 0.35f);
         real d26 = fmin(d29, d2);
         real3 c26 = d29 < d2 ? c29 : c3;
-        real t26 = d29 < d2 ? R(1.0) : t0;
+        real2 t26 = d29 < d2 ? (real2)(R(1.0)) : t0;
         u26 = d26;
         uc26 = c26;
         ut26 = t26;
@@ -344,7 +344,7 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     /* .../a:union/a:union: the second operand only within reach of its bound */
     real u22 = u26;
     real3 uc22 = uc26;
-    real ut22 = ut26;
+    real2 ut22 = ut26;
     real g22 = (length(p0 - ((real3)(R(0.0), -R(0.95), R(0.0)))) * R(0.9999)) - R(0.7213723439378912);
     if (!(g22 > u22 && g22 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
@@ -353,7 +353,7 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
         real d5 = sd_cylinder(p5, 0.35f, 0.2f);
         /* .../color/smooth_union: the second operand only within reach of its bound */
         real u8 = d5;
-        real ut8 = R(1.0);
+        real2 ut8 = (real2)(R(1.0));
         real g8 = (length(p5 - ((real3)(R(0.0), -R(0.2), R(0.0)))) * R(0.9999)) - R(0.7088723439378912);
         if (!(g8 > u8 + 0.05f && g8 > R(0.0))) {
             /* .../color/smooth_union/b:translate */
@@ -365,13 +365,13 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
             real e39_1 = (e39_0 * e39_0) * R(0.5);
             real d8 = fmin(d5, d6) - ((e39_1 * R(0.05)) * R(0.5));
             u8 = d8;
-            ut8 = R(1.0);
+            ut8 = (real2)(R(1.0));
         }
         /* .../a:union/b:translate/color */
         real3 c9 = (real3)(0.5f, 0.5f, 0.55f);
         real d22 = fmin(u26, u8);
         real3 c22 = u26 < u8 ? uc26 : c9;
-        real t22 = u26 < u8 ? ut26 : ut8;
+        real2 t22 = u26 < u8 ? ut26 : ut8;
         u22 = d22;
         uc22 = c22;
         ut22 = t22;
@@ -379,7 +379,7 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     /* .../a:union/a:union: the second operand only within reach of its bound */
     real u17 = u22;
     real3 uc17 = uc22;
-    real ut17 = ut22;
+    real2 ut17 = ut22;
     real g17 = (length(p0 - ((real3)(-R(1.5), -R(0.55), -R(0.3)))) * R(0.9999)) - R(0.6928203230275509);
     if (!(g17 > u17 && g17 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
@@ -391,13 +391,13 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
         /* .../rotate/scale/menger */
         real2 f12 = menger(p9, 3, 3.0f);
         real d12 = f12.x;
-        real t12 = f12.y;
+        real2 t12 = (real2)(f12.y);
         real d13 = d12 * R(0.4);
         /* .../a:union/b:translate/color */
         real3 c15 = (real3)(0.85f, 0.85f, 0.8f);
         real d17 = fmin(u22, d13);
         real3 c17 = u22 < d13 ? uc22 : c15;
-        real t17 = u22 < d13 ? ut22 : t12;
+        real2 t17 = u22 < d13 ? ut22 : t12;
         u17 = d17;
         uc17 = c17;
         ut17 = t17;
@@ -405,7 +405,7 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     /* .../a:union/a:union: the second operand only within reach of its bound */
     real u11 = u17;
     real3 uc11 = uc17;
-    real ut11 = ut17;
+    real2 ut11 = ut17;
     real g11 = (length(p0 - ((real3)(R(1.5), -R(0.5), -R(0.2)))) * R(0.9999)) - R(0.44999999999999996);
     if (!(g11 > u11 && g11 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
@@ -418,7 +418,7 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
         real3 c20 = (real3)(0.4f, 0.75f, 0.95f);
         real d11 = fmin(u17, d18);
         real3 c11 = u17 < d18 ? uc17 : c20;
-        real t11 = u17 < d18 ? ut17 : R(1.0);
+        real2 t11 = u17 < d18 ? ut17 : (real2)(R(1.0));
         u11 = d11;
         uc11 = c11;
         ut11 = t11;

@@ -260,7 +260,7 @@ real DE(real3 p0, __global const real* params) {
     return u10;
 }
 
-real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
+real DE_shade(real3 p0, __global const real* params, real3* color, real2* trap) {
     /* union */
     /* union/b:color/plane */
     real d11 = sd_plane(p0, (real3)(0.0f, 1.0f, 0.0f), 1.0f);
@@ -269,7 +269,7 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     /* union: the second operand only within reach of its bound */
     real u13 = d11;
     real3 uc13 = c12;
-    real ut13 = R(1.0);
+    real2 ut13 = (real2)(R(1.0));
     real g13 = (length(p0 - ((real3)(-R(1.05), -R(0.15), R(0.0)))) * R(0.9999)) - R(1.68);
     if (!(g13 > u13 && g13 > R(0.0))) {
         /* union/a:union/a:translate */
@@ -281,13 +281,13 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
         /* .../scale/rotate/hybrid */
         real2 f0 = hybrid_0(p3, 10, 4.0f);
         real d0 = f0.x;
-        real t0 = f0.y;
+        real2 t0 = (real2)(f0.y);
         real d2 = d0 * R(0.42);
         /* .../a:union/a:translate/color */
         real3 c3 = (real3)(0.85f, 0.55f, 0.3f);
         real d13 = fmin(d11, d2);
         real3 c13 = d11 < d2 ? c12 : c3;
-        real t13 = d11 < d2 ? R(1.0) : t0;
+        real2 t13 = d11 < d2 ? (real2)(R(1.0)) : t0;
         u13 = d13;
         uc13 = c13;
         ut13 = t13;
@@ -295,7 +295,7 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     /* union/a:union: the second operand only within reach of its bound */
     real u10 = u13;
     real3 uc10 = uc13;
-    real ut10 = ut13;
+    real2 ut10 = ut13;
     real g10 = (length(p0 - ((real3)(R(1.05), -R(0.38), R(0.2)))) * R(0.9999)) - R(2.2);
     if (!(g10 > u10 && g10 > R(0.0))) {
         /* union/a:union/b:translate */
@@ -307,13 +307,13 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
         /* .../scale/rotate/hybrid */
         real2 f5 = hybrid_1(p6, 10, 4.0f);
         real d5 = f5.x;
-        real t5 = f5.y;
+        real2 t5 = (real2)(f5.y);
         real d7 = d5 * R(0.55);
         /* .../a:union/b:translate/color */
         real3 c8 = (real3)(0.4f, 0.7f, 0.9f);
         real d10 = fmin(u13, d7);
         real3 c10 = u13 < d7 ? uc13 : c8;
-        real t10 = u13 < d7 ? ut13 : t5;
+        real2 t10 = u13 < d7 ? ut13 : t5;
         u10 = d10;
         uc10 = c10;
         ut10 = t10;

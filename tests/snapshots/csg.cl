@@ -215,7 +215,7 @@ real DE(real3 p0, __global const real* params) {
     return u11;
 }
 
-real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
+real DE_shade(real3 p0, __global const real* params, real3* color, real2* trap) {
     /* union */
     /* union/b:color/plane */
     real d21 = sd_plane(p0, (real3)(0.0f, 1.0f, 0.0f), 0.6f);
@@ -224,7 +224,7 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     /* union: the second operand only within reach of its bound */
     real u23 = d21;
     real3 uc23 = c22;
-    real ut23 = R(1.0);
+    real2 ut23 = (real2)(R(1.0));
     real g23 = (length(p0 - ((real3)(-R(1.0468911086754467), R(0.0), R(0.0)))) * R(0.9999)) - R(0.8656088913245535);
     if (!(g23 > u23 && g23 > R(0.0))) {
         /* .../a:union/a:union/a:translate */
@@ -233,7 +233,7 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
         real d0 = sd_sphere(p1, 0.55f);
         /* .../color/smooth_union: the second operand only within reach of its bound */
         real u3 = d0;
-        real ut3 = R(1.0);
+        real2 ut3 = (real2)(R(1.0));
         real g3 = (length(p1 - ((real3)(R(0.45), R(0.0), R(0.0)))) * R(0.9999)) - R(0.606217782649107);
         if (!(g3 > u3 + 0.25f && g3 > R(0.0))) {
             /* .../color/smooth_union/b:translate */
@@ -245,13 +245,13 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
             real e23_1 = (e23_0 * e23_0) * R(0.5);
             real d3 = fmin(d0, d1) - ((e23_1 * R(0.25)) * R(0.5));
             u3 = d3;
-            ut3 = R(1.0);
+            ut3 = (real2)(R(1.0));
         }
         /* .../a:union/a:translate/color */
         real3 c4 = (real3)(0.95f, 0.45f, 0.2f);
         real d23 = fmin(d21, u3);
         real3 c23 = d21 < u3 ? c22 : c4;
-        real t23 = d21 < u3 ? R(1.0) : ut3;
+        real2 t23 = d21 < u3 ? (real2)(R(1.0)) : ut3;
         u23 = d23;
         uc23 = c23;
         ut23 = t23;
@@ -259,7 +259,7 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     /* union/a:union: the second operand only within reach of its bound */
     real u20 = u23;
     real3 uc20 = uc23;
-    real ut20 = ut23;
+    real2 ut20 = ut23;
     real g20 = (length(p0) * R(0.9999)) - R(0.8660254037844386);
     if (!(g20 > u20 && g20 > R(0.0))) {
         /* .../a:union/a:union/b:rotate */
@@ -268,7 +268,7 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
         real d6 = sd_round_box(p3, (real3)(0.5f), 0.08f);
         /* .../color/smooth_subtract: the second operand only within reach of its bound */
         real u8 = d6;
-        real ut8 = R(1.0);
+        real2 ut8 = (real2)(R(1.0));
         real g8 = (length(p3) * R(0.9999)) - R(0.62);
         if (!(g8 > -u8 + 0.08f && g8 > R(0.0))) {
             /* .../color/smooth_subtract/b:sphere */
@@ -279,13 +279,13 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
             real e28_2 = (e28_1 * e28_1) * R(0.5);
             real d8 = -(fmin(e28_0, d7) - ((e28_2 * R(0.08)) * R(0.5)));
             u8 = d8;
-            ut8 = R(1.0);
+            ut8 = (real2)(R(1.0));
         }
         /* .../a:union/b:rotate/color */
         real3 c9 = (real3)(0.3f, 0.65f, 0.95f);
         real d20 = fmin(u23, u8);
         real3 c20 = u23 < u8 ? uc23 : c9;
-        real t20 = u23 < u8 ? ut23 : ut8;
+        real2 t20 = u23 < u8 ? ut23 : ut8;
         u20 = d20;
         uc20 = c20;
         ut20 = t20;
@@ -293,7 +293,7 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     /* .../a:union/a:union: the second operand only within reach of its bound */
     real u11 = u20;
     real3 uc11 = uc20;
-    real ut11 = ut20;
+    real2 ut11 = ut20;
     real g11 = (length(p0 - ((real3)(R(1.3), -R(0.234998072888245), R(0.18648299048119932)))) * R(0.9999)) - R(0.6);
     if (!(g11 > u11 && g11 > R(0.0))) {
         /* union/a:union/b:translate */
@@ -318,7 +318,7 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
         real3 c17 = (real3)(0.4f, 0.85f, 0.45f);
         real d11 = fmin(u20, d16);
         real3 c11 = u20 < d16 ? uc20 : c17;
-        real t11 = u20 < d16 ? ut20 : R(1.0);
+        real2 t11 = u20 < d16 ? ut20 : (real2)(R(1.0));
         u11 = d11;
         uc11 = c11;
         ut11 = t11;

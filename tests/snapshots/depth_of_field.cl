@@ -238,7 +238,7 @@ real DE(real3 p0, __global const real* params) {
     return u10;
 }
 
-real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
+real DE_shade(real3 p0, __global const real* params, real3* color, real2* trap) {
     /* union */
     /* union/b:color/plane */
     real d27 = sd_plane(p0, (real3)(0.0f, 1.0f, 0.0f), 0.36f);
@@ -247,7 +247,7 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     /* union: the second operand only within reach of its bound */
     real u29 = d27;
     real3 uc29 = c28;
-    real ut29 = R(1.0);
+    real2 ut29 = (real2)(R(1.0));
     real g29 = (length(p0 - ((real3)(-R(1.24), R(0.0), R(1.9)))) * R(0.9999)) - R(0.6235382907247957);
     if (!(g29 > u29 && g29 > R(0.0))) {
         /* .../a:union/a:union/a:translate */
@@ -259,13 +259,13 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
         /* .../scale/rotate/menger */
         real2 f0 = menger(p3, 3, 3.0f);
         real d0 = f0.x;
-        real t0 = f0.y;
+        real2 t0 = (real2)(f0.y);
         real d2 = d0 * R(0.36);
         /* .../a:union/a:translate/color */
         real3 c3 = (real3)(0.35f, 0.6f, 0.95f);
         real d29 = fmin(d27, d2);
         real3 c29 = d27 < d2 ? c28 : c3;
-        real t29 = d27 < d2 ? R(1.0) : t0;
+        real2 t29 = d27 < d2 ? (real2)(R(1.0)) : t0;
         u29 = d29;
         uc29 = c29;
         ut29 = t29;
@@ -273,7 +273,7 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     /* union/a:union: the second operand only within reach of its bound */
     real u26 = u29;
     real3 uc26 = uc29;
-    real ut26 = ut29;
+    real2 ut26 = ut29;
     real g26 = (length(p0 - ((real3)(-R(0.62), R(0.0), R(0.95)))) * R(0.9999)) - R(0.6235382907247957);
     if (!(g26 > u26 && g26 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
@@ -285,13 +285,13 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
         /* .../scale/rotate/menger */
         real2 f5 = menger(p6, 3, 3.0f);
         real d5 = f5.x;
-        real t5 = f5.y;
+        real2 t5 = (real2)(f5.y);
         real d7 = d5 * R(0.36);
         /* .../a:union/b:translate/color */
         real3 c8 = (real3)(0.5f, 0.7f, 0.9f);
         real d26 = fmin(u29, d7);
         real3 c26 = u29 < d7 ? uc29 : c8;
-        real t26 = u29 < d7 ? ut29 : t5;
+        real2 t26 = u29 < d7 ? ut29 : t5;
         u26 = d26;
         uc26 = c26;
         ut26 = t26;
@@ -299,7 +299,7 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     /* .../a:union/a:union: the second operand only within reach of its bound */
     real u20 = u26;
     real3 uc20 = uc26;
-    real ut20 = ut26;
+    real2 ut20 = ut26;
     real g20 = (length(p0) * R(0.9999)) - R(0.6235382907247957);
     if (!(g20 > u20 && g20 > R(0.0))) {
         /* .../a:union/b:translate/scale */
@@ -307,13 +307,13 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
         /* .../b:translate/scale/rotate */
         real2 f11 = menger(p7, 3, 3.0f);
         real d11 = f11.x;
-        real t11 = f11.y;
+        real2 t11 = (real2)(f11.y);
         real d12 = d11 * R(0.36);
         /* .../a:union/a:union/b:translate */
         real3 c13 = (real3)(0.85f, 0.85f, 0.8f);
         real d20 = fmin(u26, d12);
         real3 c20 = u26 < d12 ? uc26 : c13;
-        real t20 = u26 < d12 ? ut26 : t11;
+        real2 t20 = u26 < d12 ? ut26 : t11;
         u20 = d20;
         uc20 = c20;
         ut20 = t20;
@@ -321,7 +321,7 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     /* .../a:union/a:union: the second operand only within reach of its bound */
     real u14 = u20;
     real3 uc14 = uc20;
-    real ut14 = ut20;
+    real2 ut14 = ut20;
     real g14 = (length(p0 - ((real3)(R(0.62), R(0.0), -R(0.95)))) * R(0.9999)) - R(0.6235382907247957);
     if (!(g14 > u14 && g14 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
@@ -333,13 +333,13 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
         /* .../scale/rotate/menger */
         real2 f15 = menger(p10, 3, 3.0f);
         real d15 = f15.x;
-        real t15 = f15.y;
+        real2 t15 = (real2)(f15.y);
         real d17 = d15 * R(0.36);
         /* .../a:union/b:translate/color */
         real3 c18 = (real3)(0.95f, 0.75f, 0.5f);
         real d14 = fmin(u20, d17);
         real3 c14 = u20 < d17 ? uc20 : c18;
-        real t14 = u20 < d17 ? ut20 : t15;
+        real2 t14 = u20 < d17 ? ut20 : t15;
         u14 = d14;
         uc14 = c14;
         ut14 = t14;
@@ -347,7 +347,7 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     /* .../a:union/a:union: the second operand only within reach of its bound */
     real u10 = u14;
     real3 uc10 = uc14;
-    real ut10 = ut14;
+    real2 ut10 = ut14;
     real g10 = (length(p0 - ((real3)(R(1.24), R(0.0), -R(1.9)))) * R(0.9999)) - R(0.6235382907247957);
     if (!(g10 > u10 && g10 > R(0.0))) {
         /* union/a:union/b:translate */
@@ -359,13 +359,13 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
         /* .../scale/rotate/menger */
         real2 f21 = menger(p13, 3, 3.0f);
         real d21 = f21.x;
-        real t21 = f21.y;
+        real2 t21 = (real2)(f21.y);
         real d23 = d21 * R(0.36);
         /* .../a:union/b:translate/color */
         real3 c24 = (real3)(0.95f, 0.55f, 0.35f);
         real d10 = fmin(u14, d23);
         real3 c10 = u14 < d23 ? uc14 : c24;
-        real t10 = u14 < d23 ? ut14 : t21;
+        real2 t10 = u14 < d23 ? ut14 : t21;
         u10 = d10;
         uc10 = c10;
         ut10 = t10;

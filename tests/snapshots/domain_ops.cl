@@ -255,7 +255,7 @@ real DE(real3 p0, __global const real* params) {
     return u12;
 }
 
-real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
+real DE_shade(real3 p0, __global const real* params, real3* color, real2* trap) {
     /* union */
     /* union/b:color/plane */
     real d35 = sd_plane(p0, (real3)(0.0f, 1.0f, 0.0f), 0.6f);
@@ -264,7 +264,7 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     /* union: the second operand only within reach of its bound */
     real u37 = d35;
     real3 uc37 = c36;
-    real ut37 = R(1.0);
+    real2 ut37 = (real2)(R(1.0));
     real g37 = (length(p0 - ((real3)(-R(1.5), R(0.0), R(0.0)))) * R(0.9999)) - R(0.6997142273814361);
     if (!(g37 > u37 && g37 > R(0.0))) {
         /* .../a:union/a:union/a:translate */
@@ -291,12 +291,12 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
         real3 c37 = d35 < d3 ? c36 : c4;
         u37 = d37;
         uc37 = c37;
-        ut37 = R(1.0);
+        ut37 = (real2)(R(1.0));
     }
     /* union/a:union: the second operand only within reach of its bound */
     real u34 = u37;
     real3 uc34 = uc37;
-    real ut34 = ut37;
+    real2 ut34 = ut37;
     real g34 = (length(p0 - ((real3)(-R(0.4), R(0.0), R(0.0)))) * R(0.9999)) - R(0.65);
     if (!(g34 > u34 && g34 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
@@ -320,7 +320,7 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
         real3 c10 = (real3)(0.4f, 0.9f, 0.5f);
         real d34 = fmin(u37, d9);
         real3 c34 = u37 < d9 ? uc37 : c10;
-        real t34 = u37 < d9 ? ut37 : R(1.0);
+        real2 t34 = u37 < d9 ? ut37 : (real2)(R(1.0));
         u34 = d34;
         uc34 = c34;
         ut34 = t34;
@@ -328,7 +328,7 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     /* .../a:union/a:union: the second operand only within reach of its bound */
     real u26 = u34;
     real3 uc26 = uc34;
-    real ut26 = ut34;
+    real2 ut26 = ut34;
     real g26 = (length(p0 - ((real3)(R(0.65), R(0.0), R(0.0)))) * R(0.9999)) - R(0.49);
     if (!(g26 > u26 && g26 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
@@ -339,7 +339,7 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
         real d14 = fabs(d13) - R(0.04);
         /* .../color/subtract: the second operand only within reach of its bound */
         real u17 = d14;
-        real ut17 = R(1.0);
+        real2 ut17 = (real2)(R(1.0));
         real g17 = (length(p5 - ((real3)(R(0.0), R(1.2), R(0.0)))) * R(0.9999)) - R(1.7320508075688772);
         if (!(g17 > -u17 && g17 > R(0.0))) {
             /* .../color/subtract/b:translate */
@@ -350,13 +350,13 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
             real e49_0 = -d14;
             real d17 = -fmin(e49_0, d15);
             u17 = d17;
-            ut17 = R(1.0);
+            ut17 = (real2)(R(1.0));
         }
         /* .../a:union/b:translate/color */
         real3 c18 = (real3)(0.4f, 0.6f, 0.95f);
         real d26 = fmin(u34, u17);
         real3 c26 = u34 < u17 ? uc34 : c18;
-        real t26 = u34 < u17 ? ut34 : ut17;
+        real2 t26 = u34 < u17 ? ut34 : ut17;
         u26 = d26;
         uc26 = c26;
         ut26 = t26;
@@ -364,7 +364,7 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     /* .../a:union/a:union: the second operand only within reach of its bound */
     real u20 = u26;
     real3 uc20 = uc26;
-    real ut20 = ut26;
+    real2 ut20 = ut26;
     real g20 = (length(p0 - ((real3)(R(1.6), -R(0.25), R(0.0)))) * R(0.9999)) - R(0.7649747468305832);
     if (!(g20 > u20 && g20 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
@@ -380,7 +380,7 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
         real3 c24 = (real3)(0.95f, 0.8f, 0.3f);
         real d20 = fmin(u26, d21);
         real3 c20 = u26 < d21 ? uc26 : c24;
-        real t20 = u26 < d21 ? ut26 : R(1.0);
+        real2 t20 = u26 < d21 ? ut26 : (real2)(R(1.0));
         u20 = d20;
         uc20 = c20;
         ut20 = t20;
@@ -388,7 +388,7 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     /* .../a:union/a:union: the second operand only within reach of its bound */
     real u12 = u20;
     real3 uc12 = uc20;
-    real ut12 = ut20;
+    real2 ut12 = ut20;
     real g12 = (length(p0 - ((real3)(R(0.0), R(0.85), -R(0.8)))) * R(0.9999)) - R(0.77);
     if (!(g12 > u12 && g12 > R(0.0))) {
         /* union/a:union/b:translate */
@@ -407,7 +407,7 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
         real3 c32 = (real3)(0.8f, 0.5f, 0.9f);
         real d12 = fmin(u20, d31);
         real3 c12 = u20 < d31 ? uc20 : c32;
-        real t12 = u20 < d31 ? ut20 : R(1.0);
+        real2 t12 = u20 < d31 ? ut20 : (real2)(R(1.0));
         u12 = d12;
         uc12 = c12;
         ut12 = t12;

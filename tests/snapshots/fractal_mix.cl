@@ -407,7 +407,7 @@ real DE(real3 p0, __global const real* params) {
     return u24;
 }
 
-real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
+real DE_shade(real3 p0, __global const real* params, real3* color, real2* trap) {
     /* union */
     /* union/b:color/plane */
     real d22 = sd_plane(p0, (real3)(0.0f, 1.0f, 0.0f), 0.55f);
@@ -416,7 +416,7 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     /* union: the second operand only within reach of its bound */
     real u24 = d22;
     real3 uc24 = c23;
-    real ut24 = R(1.0);
+    real2 ut24 = (real2)(R(1.0));
     real g24 = fmin(fmin(fmin(((length(p0 - ((real3)(-R(1.1), R(0.0), R(0.0)))) * R(0.9999)) - R(1.0)) - R(0.07500000000000001), ((length(p0 - ((real3)(R(0.0), R(0.0), -R(0.6)))) * R(0.9999)) - R(0.7794228634059948)) - R(0.07500000000000001)), (R(0.9) * ((length(p0 - ((real3)(R(1.1), R(0.0), R(0.0)))) * R(0.9999)) - R(1.1032420145137176))) - R(0.05)), (R(0.3333333333333333) * ((length(p0 - ((real3)(R(0.0), R(0.0), R(0.7)))) * R(0.9999)) - R(0.606217782649107))) - R(0.025));
     if (!(g24 > u24 && g24 > R(0.0))) {
         /* union/a:smooth_union/b:translate */
@@ -426,14 +426,14 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
         /* .../color/scale/sierpinski */
         real2 f17 = sierpinski(p2, 5, 2.0f);
         real d17 = f17.x;
-        real t17 = f17.y;
+        real2 t17 = (real2)(f17.y);
         real d18 = d17 * R(0.35);
         /* .../a:smooth_union/b:translate/color */
         real3 c19 = (real3)(0.95f, 0.8f, 0.4f);
         /* union/a:smooth_union: the second operand only within reach of its bound */
         real u21 = d18;
         real3 uc21 = c19;
-        real ut21 = t17;
+        real2 ut21 = t17;
         real g21 = fmin(fmin(((length(p0 - ((real3)(-R(1.1), R(0.0), R(0.0)))) * R(0.9999)) - R(1.0)) - R(0.05), ((length(p0 - ((real3)(R(0.0), R(0.0), -R(0.6)))) * R(0.9999)) - R(0.7794228634059948)) - R(0.05)), (R(0.9) * ((length(p0 - ((real3)(R(1.1), R(0.0), R(0.0)))) * R(0.9999)) - R(1.1032420145137176))) - R(0.025));
         if (!(g21 > u21 + 0.1f && g21 > R(0.0))) {
             /* .../a:smooth_union/a:smooth_union/b:translate */
@@ -443,14 +443,14 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
             /* .../color/scale/julia */
             real2 f12 = julia(p4, (-0.2f), 0.6f, 0.2f, 0.2f, 0.0f, 12, 4.0f);
             real d12 = f12.x;
-            real t12 = f12.y;
+            real2 t12 = (real2)(f12.y);
             real d13 = d12 * R(0.5);
             /* .../a:smooth_union/b:translate/color */
             real3 c14 = (real3)(0.4f, 0.7f, 0.95f);
             /* .../a:smooth_union/a:smooth_union: the second operand only within reach of its bound */
             real u16 = d13;
             real3 uc16 = c14;
-            real ut16 = t12;
+            real2 ut16 = t12;
             real g16 = fmin(((length(p0 - ((real3)(-R(1.1), R(0.0), R(0.0)))) * R(0.9999)) - R(1.0)) - R(0.025), ((length(p0 - ((real3)(R(0.0), R(0.0), -R(0.6)))) * R(0.9999)) - R(0.7794228634059948)) - R(0.025));
             if (!(g16 > u16 + 0.1f && g16 > R(0.0))) {
                 /* .../a:smooth_union/a:smooth_union/b:translate */
@@ -460,11 +460,11 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
                 /* .../smooth_subtract/a:scale/menger */
                 real2 f5 = menger(p6, 3, 3.0f);
                 real d5 = f5.x;
-                real t5 = f5.y;
+                real2 t5 = (real2)(f5.y);
                 real d6 = d5 * R(0.45);
                 /* .../color/smooth_subtract: the second operand only within reach of its bound */
                 real u8 = d6;
-                real ut8 = t5;
+                real2 ut8 = t5;
                 real g8 = (length(p5) * R(0.9999)) - R(0.55);
                 if (!(g8 > -u8 + 0.05f && g8 > R(0.0))) {
                     /* .../color/smooth_subtract/b:sphere */
@@ -474,7 +474,7 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
                     real e39_1 = fmax(R(0.05) - fabs(e39_0 - d7), R(0.0)) / R(0.05);
                     real e39_2 = (e39_1 * e39_1) * R(0.5);
                     real d8 = -(fmin(e39_0, d7) - ((e39_2 * R(0.05)) * R(0.5)));
-                    real t8 = e39_0 < d7 ? mix(t5, R(1.0), e39_2) : mix(R(1.0), t5, e39_2);
+                    real2 t8 = e39_0 < d7 ? mix(t5, (real2)(R(1.0)), e39_2) : mix((real2)(R(1.0)), t5, e39_2);
                     u8 = d8;
                     ut8 = t8;
                 }
@@ -483,7 +483,7 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
                 /* .../a:smooth_union/a:smooth_union: the second operand only within reach of its bound */
                 real u11 = u8;
                 real3 uc11 = c9;
-                real ut11 = ut8;
+                real2 ut11 = ut8;
                 real g11 = (length(p0 - ((real3)(-R(1.1), R(0.0), R(0.0)))) * R(0.9999)) - R(1.0);
                 if (!(g11 > u11 + 0.1f && g11 > R(0.0))) {
                     /* .../a:smooth_union/a:smooth_union/a:translate */
@@ -495,7 +495,7 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
                     /* .../scale/rotate/mandelbulb */
                     real2 f0 = mandelbulb(p9, params[0] /* power */, 8, fmin(R(2.0), pow(R(1e18), R(1.0) / params[0] /* power */)), pow(R(2.0), R(1.0) / (params[0] /* power */ - R(1.0))));
                     real d0 = f0.x;
-                    real t0 = f0.y;
+                    real2 t0 = (real2)(f0.y);
                     real d2 = d0 * R(0.5);
                     /* .../a:smooth_union/a:translate/color */
                     real3 c3 = (real3)(0.9f, 0.55f, 0.3f);
@@ -504,7 +504,7 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
                     real e47_1 = (e47_0 * e47_0) * R(0.5);
                     real d11 = fmin(u8, d2) - ((e47_1 * R(0.1)) * R(0.5));
                     real3 c11 = u8 < d2 ? mix(c9, c3, e47_1) : mix(c3, c9, e47_1);
-                    real t11 = u8 < d2 ? mix(ut8, t0, e47_1) : mix(t0, ut8, e47_1);
+                    real2 t11 = u8 < d2 ? mix(ut8, t0, e47_1) : mix(t0, ut8, e47_1);
                     u11 = d11;
                     uc11 = c11;
                     ut11 = t11;
@@ -514,7 +514,7 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
                 real e48_1 = (e48_0 * e48_0) * R(0.5);
                 real d16 = fmin(d13, u11) - ((e48_1 * R(0.1)) * R(0.5));
                 real3 c16 = d13 < u11 ? mix(c14, uc11, e48_1) : mix(uc11, c14, e48_1);
-                real t16 = d13 < u11 ? mix(t12, ut11, e48_1) : mix(ut11, t12, e48_1);
+                real2 t16 = d13 < u11 ? mix(t12, ut11, e48_1) : mix(ut11, t12, e48_1);
                 u16 = d16;
                 uc16 = c16;
                 ut16 = t16;
@@ -524,14 +524,14 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
             real e49_1 = (e49_0 * e49_0) * R(0.5);
             real d21 = fmin(d18, u16) - ((e49_1 * R(0.1)) * R(0.5));
             real3 c21 = d18 < u16 ? mix(c19, uc16, e49_1) : mix(uc16, c19, e49_1);
-            real t21 = d18 < u16 ? mix(t17, ut16, e49_1) : mix(ut16, t17, e49_1);
+            real2 t21 = d18 < u16 ? mix(t17, ut16, e49_1) : mix(ut16, t17, e49_1);
             u21 = d21;
             uc21 = c21;
             ut21 = t21;
         }
         real d24 = fmin(d22, u21);
         real3 c24 = d22 < u21 ? c23 : uc21;
-        real t24 = d22 < u21 ? R(1.0) : ut21;
+        real2 t24 = d22 < u21 ? (real2)(R(1.0)) : ut21;
         u24 = d24;
         uc24 = c24;
         ut24 = t24;

@@ -246,7 +246,7 @@ real DE(real3 p0, __global const real* params) {
     return u8;
 }
 
-real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
+real DE_shade(real3 p0, __global const real* params, real3* color, real2* trap) {
     /* union */
     /* union/b:color/plane */
     real d18 = sd_plane(p0, (real3)(0.0f, 1.0f, 0.0f), 0.8f);
@@ -255,7 +255,7 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     /* union: the second operand only within reach of its bound */
     real u20 = d18;
     real3 uc20 = c19;
-    real ut20 = R(1.0);
+    real2 ut20 = (real2)(R(1.0));
     real g20 = (length(p0 - ((real3)(-R(0.2), R(0.0), R(0.0)))) * R(0.9999)) - R(0.8832716109390498);
     if (!(g20 > u20 && g20 > R(0.0))) {
         /* .../a:union/a:union/a:translate */
@@ -267,13 +267,13 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
         /* .../scale/rotate/mandelbulb */
         real2 f0 = mandelbulb_p8(p3, 8, R(2.0), 1.1040895f);
         real d0 = f0.x;
-        real t0 = f0.y;
+        real2 t0 = (real2)(f0.y);
         real d2 = d0 * R(0.8);
         /* .../a:union/a:translate/color */
         real3 c3 = (real3)(0.95f, 0.75f, 0.5f);
         real d20 = fmin(d18, d2);
         real3 c20 = d18 < d2 ? c19 : c3;
-        real t20 = d18 < d2 ? R(1.0) : t0;
+        real2 t20 = d18 < d2 ? (real2)(R(1.0)) : t0;
         u20 = d20;
         uc20 = c20;
         ut20 = t20;
@@ -281,7 +281,7 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     /* union/a:union: the second operand only within reach of its bound */
     real u17 = u20;
     real3 uc17 = uc20;
-    real ut17 = ut20;
+    real2 ut17 = ut20;
     real g17 = (length(p0 - ((real3)(R(0.0), R(0.4), -R(1.3)))) * R(0.9999)) - R(2.507987240796891);
     if (!(g17 > u17 && g17 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
@@ -292,7 +292,7 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
         real3 c6 = (real3)(0.9f, 0.9f, 0.88f);
         real d17 = fmin(u20, d5);
         real3 c17 = u20 < d5 ? uc20 : c6;
-        real t17 = u20 < d5 ? ut20 : R(1.0);
+        real2 t17 = u20 < d5 ? ut20 : (real2)(R(1.0));
         u17 = d17;
         uc17 = c17;
         ut17 = t17;
@@ -300,7 +300,7 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     /* .../a:union/a:union: the second operand only within reach of its bound */
     real u13 = u17;
     real3 uc13 = uc17;
-    real ut13 = ut17;
+    real2 ut13 = ut17;
     real g13 = (length(p0 - ((real3)(R(1.3), -R(0.4), -R(0.6)))) * R(0.9999)) - R(0.4);
     if (!(g13 > u13 && g13 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
@@ -311,7 +311,7 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
         real3 c10 = (real3)(0.85f, 0.12f, 0.08f);
         real d13 = fmin(u17, d9);
         real3 c13 = u17 < d9 ? uc17 : c10;
-        real t13 = u17 < d9 ? ut17 : R(1.0);
+        real2 t13 = u17 < d9 ? ut17 : (real2)(R(1.0));
         u13 = d13;
         uc13 = c13;
         ut13 = t13;
@@ -319,7 +319,7 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     /* .../a:union/a:union: the second operand only within reach of its bound */
     real u8 = u13;
     real3 uc8 = uc13;
-    real ut8 = ut13;
+    real2 ut8 = ut13;
     real g8 = (length(p0 - ((real3)(-R(1.45), -R(0.48), R(0.5)))) * R(0.9999)) - R(0.32);
     if (!(g8 > u8 && g8 > R(0.0))) {
         /* union/a:union/b:translate */
@@ -328,7 +328,7 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
         real d14 = sd_sphere(p6, 0.32f);
         real d8 = fmin(u13, d14);
         real3 c8 = u13 < d14 ? uc13 : DEFAULT_COLOR;
-        real t8 = u13 < d14 ? ut13 : R(1.0);
+        real2 t8 = u13 < d14 ? ut13 : (real2)(R(1.0));
         u8 = d8;
         uc8 = c8;
         ut8 = t8;

@@ -445,7 +445,7 @@ real DE(real3 p0, __global const real* params) {
     return u9;
 }
 
-real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
+real DE_shade(real3 p0, __global const real* params, real3* color, real2* trap) {
     /* union */
     /* union/b:color/plane */
     real d19 = sd_plane(p0, (real3)(0.0f, 1.0f, 0.0f), 1.0f);
@@ -454,7 +454,7 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     /* union: the second operand only within reach of its bound */
     real u21 = d19;
     real3 uc21 = c20;
-    real ut21 = R(1.0);
+    real2 ut21 = (real2)(R(1.0));
     real g21 = (length(p0 - ((real3)(-R(1.7), R(0.0), R(0.0)))) * R(0.9999)) - R(5.333333333333333);
     if (!(g21 > u21 && g21 > R(0.0))) {
         /* .../a:union/a:union/a:translate */
@@ -466,13 +466,13 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
         /* .../rotate/scale/hybrid */
         real2 f0 = hybrid_0(p3, 12, 1.0f, 0.5f, 1.0f, (-1.5f), 0.0f, 0.0f, 0.0f, 0.15f, 0.3f, 0.0f, 16.0f);
         real d0 = f0.x;
-        real t0 = f0.y;
+        real2 t0 = (real2)(f0.y);
         real d1 = d0 * R(0.3333333333333333);
         /* .../a:union/a:translate/color */
         real3 c3 = (real3)(0.85f, 0.55f, 0.3f);
         real d21 = fmin(d19, d1);
         real3 c21 = d19 < d1 ? c20 : c3;
-        real t21 = d19 < d1 ? R(1.0) : t0;
+        real2 t21 = d19 < d1 ? (real2)(R(1.0)) : t0;
         u21 = d21;
         uc21 = c21;
         ut21 = t21;
@@ -480,7 +480,7 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     /* union/a:union: the second operand only within reach of its bound */
     real u18 = u21;
     real3 uc18 = uc21;
-    real ut18 = ut21;
+    real2 ut18 = ut21;
     real g18 = (length(p0) * R(0.9999)) - R(4.8);
     if (!(g18 > u18 && g18 > R(0.0))) {
         /* .../a:union/b:translate/rotate */
@@ -490,13 +490,13 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
         /* .../rotate/scale/hybrid */
         real2 f5 = hybrid_1(p5, 8, 1.0f, 0.5f, 1.0f, (-1.5f), 0.0f, 0.0f, 0.0f, 8.0f, 16.0f);
         real d5 = f5.x;
-        real t5 = f5.y;
+        real2 t5 = (real2)(f5.y);
         real d6 = d5 * R(0.3);
         /* .../a:union/a:union/b:translate */
         real3 c8 = (real3)(0.4f, 0.7f, 0.9f);
         real d18 = fmin(u21, d6);
         real3 c18 = u21 < d6 ? uc21 : c8;
-        real t18 = u21 < d6 ? ut21 : t5;
+        real2 t18 = u21 < d6 ? ut21 : t5;
         u18 = d18;
         uc18 = c18;
         ut18 = t18;
@@ -504,7 +504,7 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     /* .../a:union/a:union: the second operand only within reach of its bound */
     real u9 = u18;
     real3 uc9 = uc18;
-    real ut9 = ut18;
+    real2 ut9 = ut18;
     real g9 = (length(p0 - ((real3)(R(1.7), R(0.0), R(0.0)))) * R(0.9999)) - R(1.224744871391589);
     if (!(g9 > u9 && g9 > R(0.0))) {
         /* union/a:union/b:translate */
@@ -518,20 +518,20 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
         /* .../rotate/intersect/a:hybrid */
         real2 f10 = hybrid_2(p9, 10, 1.0f, 1.0f, 0.5f, 1.0f, 1.5f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.3f, 16.0f);
         real d10 = f10.x;
-        real t10 = f10.y;
+        real2 t10 = (real2)(f10.y);
         /* .../rotate/intersect/b:cuboid */
         real d11 = sd_box(p9, (real3)(2.5f, 2.5f, 1.0f));
         /* .../scale/rotate/intersect */
         real e36_0 = -d10;
         real e36_1 = -d11;
         real d12 = -fmin(e36_0, e36_1);
-        real t12 = e36_0 < e36_1 ? t10 : R(1.0);
+        real2 t12 = e36_0 < e36_1 ? t10 : (real2)(R(1.0));
         real d14 = d12 * R(0.3333333333333333);
         /* .../a:union/b:translate/color */
         real3 c16 = (real3)(0.6f, 0.85f, 0.45f);
         real d9 = fmin(u18, d14);
         real3 c9 = u18 < d14 ? uc18 : c16;
-        real t9 = u18 < d14 ? ut18 : t12;
+        real2 t9 = u18 < d14 ? ut18 : t12;
         u9 = d9;
         uc9 = c9;
         ut9 = t9;

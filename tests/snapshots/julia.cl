@@ -229,11 +229,11 @@ real DE(real3 p0, __global const real* params) {
     return d0;
 }
 
-real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
+real DE_shade(real3 p0, __global const real* params, real3* color, real2* trap) {
     /* color/julia */
     real2 f0 = julia(p0, (-0.2f), 0.6f, 0.2f, 0.2f, 0.0f, 11, 4.0f);
     real d0 = f0.x;
-    real t0 = f0.y;
+    real2 t0 = (real2)(f0.y);
     /* color */
     real3 c1 = (real3)(0.45f, 0.7f, 0.95f);
     *color = c1;

@@ -174,7 +174,7 @@ real DE(real3 p0, __global const real* params) {
     return u7;
 }
 
-real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
+real DE_shade(real3 p0, __global const real* params, real3* color, real2* trap) {
     /* union */
     /* union/b:color/plane */
     real d5 = sd_plane(p0, (real3)(0.0f, 1.0f, 0.0f), 1.15f);
@@ -183,7 +183,7 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     /* union: the second operand only within reach of its bound */
     real u7 = d5;
     real3 uc7 = c6;
-    real ut7 = R(1.0);
+    real2 ut7 = (real2)(R(1.0));
     real g7 = (length(p0) * R(0.9999)) - R(2.0);
     if (!(g7 > u7 && g7 > R(0.0))) {
         /* .../a:cut/a:color/rotate */
@@ -191,7 +191,7 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
         /* .../a:color/rotate/mandelbulb */
         real2 f0 = mandelbulb(p1, params[0] /* power */, 8, fmin(R(2.0), pow(R(1e18), R(1.0) / params[0] /* power */)), pow(R(2.0), R(1.0) / (params[0] /* power */ - R(1.0))));
         real d0 = f0.x;
-        real t0 = f0.y;
+        real2 t0 = (real2)(f0.y);
         /* union/a:cut/a:color */
         real3 c2 = (real3)(0.55f, 0.75f, 0.95f);
         /* union/a:cut/b:plane */
@@ -200,7 +200,7 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
         real d4 = -fmin(-d0, -d3);
         real d7 = fmin(d5, d4);
         real3 c7 = d5 < d4 ? c6 : c2;
-        real t7 = d5 < d4 ? R(1.0) : t0;
+        real2 t7 = d5 < d4 ? (real2)(R(1.0)) : t0;
         u7 = d7;
         uc7 = c7;
         ut7 = t7;

@@ -414,7 +414,7 @@ real DE(real3 p0, __global const real* params) {
     return u10;
 }
 
-real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
+real DE_shade(real3 p0, __global const real* params, real3* color, real2* trap) {
     /* union */
     /* union/b:color/plane */
     real d28 = sd_plane(p0, (real3)(0.0f, 1.0f, 0.0f), 0.6f);
@@ -423,7 +423,7 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     /* union: the second operand only within reach of its bound */
     real u30 = d28;
     real3 uc30 = c29;
-    real ut30 = R(1.0);
+    real2 ut30 = (real2)(R(1.0));
     real g30 = (length(p0 - ((real3)(-R(1.9500000000000002), R(0.0), -R(0.5)))) * R(0.9999)) - R(0.5715767664977295);
     if (!(g30 > u30 && g30 > R(0.0))) {
         /* .../a:union/a:union/a:translate */
@@ -435,13 +435,13 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
         /* .../rotate/scale/kifs */
         real2 f0 = kifs_tetrahedral(p3, 12, 2.0f, (real3)(1.0f, 1.0f, 1.0f));
         real d0 = f0.x;
-        real t0 = f0.y;
+        real2 t0 = (real2)(f0.y);
         real d1 = d0 * R(0.33);
         /* .../a:union/a:translate/color */
         real3 c3 = (real3)(0.9f, 0.55f, 0.3f);
         real d30 = fmin(d28, d1);
         real3 c30 = d28 < d1 ? c29 : c3;
-        real t30 = d28 < d1 ? R(1.0) : t0;
+        real2 t30 = d28 < d1 ? (real2)(R(1.0)) : t0;
         u30 = d30;
         uc30 = c30;
         ut30 = t30;
@@ -449,7 +449,7 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     /* union/a:union: the second operand only within reach of its bound */
     real u27 = u30;
     real3 uc27 = uc30;
-    real ut27 = ut30;
+    real2 ut27 = ut30;
     real g27 = (length(p0 - ((real3)(-R(0.65), R(0.0), -R(0.5)))) * R(0.9999)) - R(0.55);
     if (!(g27 > u27 && g27 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
@@ -461,13 +461,13 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
         /* .../rotate/scale/kifs */
         real2 f5 = kifs_octahedral(p6, 12, 2.0f, (real3)(1.0f, 0.0f, 0.0f));
         real d5 = f5.x;
-        real t5 = f5.y;
+        real2 t5 = (real2)(f5.y);
         real d6 = d5 * R(0.55);
         /* .../a:union/b:translate/color */
         real3 c8 = (real3)(0.55f, 0.8f, 0.4f);
         real d27 = fmin(u30, d6);
         real3 c27 = u30 < d6 ? uc30 : c8;
-        real t27 = u30 < d6 ? ut30 : t5;
+        real2 t27 = u30 < d6 ? ut30 : t5;
         u27 = d27;
         uc27 = c27;
         ut27 = t27;
@@ -475,7 +475,7 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     /* .../a:union/a:union: the second operand only within reach of its bound */
     real u22 = u27;
     real3 uc22 = uc27;
-    real ut22 = ut27;
+    real2 ut22 = ut27;
     real g22 = (length(p0 - ((real3)(R(0.65), R(0.0), -R(0.5)))) * R(0.9999)) - R(0.5499999999999999);
     if (!(g22 > u22 && g22 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
@@ -487,13 +487,13 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
         /* .../rotate/scale/kifs */
         real2 f11 = kifs_icosahedral(p9, 12, 2.618034f, (real3)(0.8506508f, 0.5257311f, 0.0f));
         real d11 = f11.x;
-        real t11 = f11.y;
+        real2 t11 = (real2)(f11.y);
         real d12 = d11 * R(0.55);
         /* .../a:union/b:translate/color */
         real3 c14 = (real3)(0.35f, 0.65f, 0.9f);
         real d22 = fmin(u27, d12);
         real3 c22 = u27 < d12 ? uc27 : c14;
-        real t22 = u27 < d12 ? ut27 : t11;
+        real2 t22 = u27 < d12 ? ut27 : t11;
         u22 = d22;
         uc22 = c22;
         ut22 = t22;
@@ -501,7 +501,7 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     /* .../a:union/a:union: the second operand only within reach of its bound */
     real u16 = u22;
     real3 uc16 = uc22;
-    real ut16 = ut22;
+    real2 ut16 = ut22;
     real g16 = (length(p0 - ((real3)(R(1.9500000000000002), R(0.0), -R(0.5)))) * R(0.9999)) - R(0.7725483399593904);
     if (!(g16 > u16 && g16 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
@@ -513,13 +513,13 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
         /* .../rotate/scale/kifs */
         real2 f17 = kifs_menger(p12, 8, 3.0f, (real3)(1.0f, 1.0f, 1.0f));
         real d17 = f17.x;
-        real t17 = f17.y;
+        real2 t17 = (real2)(f17.y);
         real d18 = d17 * R(0.32);
         /* .../a:union/b:translate/color */
         real3 c20 = (real3)(0.75f, 0.45f, 0.85f);
         real d16 = fmin(u22, d18);
         real3 c16 = u22 < d18 ? uc22 : c20;
-        real t16 = u22 < d18 ? ut22 : t17;
+        real2 t16 = u22 < d18 ? ut22 : t17;
         u16 = d16;
         uc16 = c16;
         ut16 = t16;
@@ -527,7 +527,7 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     /* .../a:union/a:union: the second operand only within reach of its bound */
     real u10 = u16;
     real3 uc10 = uc16;
-    real ut10 = ut16;
+    real2 ut10 = ut16;
     real g10 = (length(p0 - ((real3)(R(0.0), -R(0.1), R(0.9)))) * R(0.9999)) - R(0.7242640687119285);
     if (!(g10 > u10 && g10 > R(0.0))) {
         /* union/a:union/b:translate */
@@ -537,13 +537,13 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
         /* .../color/scale/kifs */
         real2 f23 = kifs_menger_turned(p14, 8, 3.0f, (real3)(1.0f, 1.0f, 1.0f), (real3)(0.2f, 0.1f, 0.0f), (real3)(0.0f, 0.0f, 0.2f));
         real d23 = f23.x;
-        real t23 = f23.y;
+        real2 t23 = (real2)(f23.y);
         real d24 = d23 * R(0.3);
         /* .../a:union/b:translate/color */
         real3 c25 = (real3)(0.95f, 0.8f, 0.35f);
         real d10 = fmin(u16, d24);
         real3 c10 = u16 < d24 ? uc16 : c25;
-        real t10 = u16 < d24 ? ut16 : t23;
+        real2 t10 = u16 < d24 ? ut16 : t23;
         u10 = d10;
         uc10 = c10;
         ut10 = t10;

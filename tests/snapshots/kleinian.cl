@@ -139,11 +139,11 @@ real DE(real3 p0, __global const real* params) {
     return d0;
 }
 
-real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
+real DE_shade(real3 p0, __global const real* params, real3* color, real2* trap) {
     /* color/pseudo_kleinian */
     real2 f0 = pseudo_kleinian(p0, 10, (real3)(0.92436f, 0.90756f, 0.92436f), 1.0f, (real3)(0.0f, 0.0f, 0.0f), 0.01f);
     real d0 = f0.x;
-    real t0 = f0.y;
+    real2 t0 = (real2)(f0.y);
     /* color */
     real3 c1 = (real3)(0.9f, 0.78f, 0.6f);
     *color = c1;

@@ -183,7 +183,7 @@ real DE(real3 p0, __global const real* params) {
     return u6;
 }
 
-real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
+real DE_shade(real3 p0, __global const real* params, real3* color, real2* trap) {
     /* union */
     /* union/b:color/plane */
     real d4 = sd_plane(p0, (real3)(0.0f, 1.0f, 0.0f), 1.0f);
@@ -192,7 +192,7 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     /* union: the second operand only within reach of its bound */
     real u6 = d4;
     real3 uc6 = c5;
-    real ut6 = R(1.0);
+    real2 ut6 = (real2)(R(1.0));
     real g6 = (length(p0) * R(0.9999)) - R(1.7320508075688772);
     if (!(g6 > u6 && g6 > R(0.0))) {
         /* union/a:color/scale */
@@ -202,13 +202,13 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
         /* .../scale/rotate/mandelbox */
         real2 f0 = mandelbox(p2, 16, 2.0f, 0.5f, 1.0f, 1.0f);
         real d0 = f0.x;
-        real t0 = f0.y;
+        real2 t0 = (real2)(f0.y);
         real d2 = d0 * R(0.16666666666666666);
         /* union/a:color */
         real3 c3 = (real3)(0.5f, 0.62f, 0.85f);
         real d6 = fmin(d4, d2);
         real3 c6 = d4 < d2 ? c5 : c3;
-        real t6 = d4 < d2 ? R(1.0) : t0;
+        real2 t6 = d4 < d2 ? (real2)(R(1.0)) : t0;
         u6 = d6;
         uc6 = c6;
         ut6 = t6;

@@ -147,7 +147,7 @@ real DE(real3 p0, __global const real* params) {
     return d0;
 }
 
-real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
+real DE_shade(real3 p0, __global const real* params, real3* color, real2* trap) {
     /* color/rotate */
     real3 p1 = (real3)(p0.x, -p0.z, p0.y);
     /* color/rotate/mandelbulb_escape */
@@ -155,7 +155,7 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     /* color */
     real3 c2 = (real3)(0.9f, 0.6f, 0.35f);
     *color = c2;
-    *trap = R(1.0);
+    *trap = (real2)(R(1.0));
     return d0;
 }
 

@@ -164,13 +164,13 @@ real DE(real3 p0, __global const real* params) {
     return d0;
 }
 
-real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
+real DE_shade(real3 p0, __global const real* params, real3* color, real2* trap) {
     /* color/rotate */
     real3 p1 = (real3)(p0.x, -p0.z, p0.y);
     /* color/rotate/mandelbulb */
     real2 f0 = mandelbulb_p8(p1, 10, R(2.0), 1.1040895136738123);
     real d0 = f0.x;
-    real t0 = f0.y;
+    real2 t0 = (real2)(f0.y);
     /* color */
     real3 c2 = (real3)(0.9, 0.6, 0.35);
     *color = c2;

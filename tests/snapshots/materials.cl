@@ -277,7 +277,7 @@ real DE(real3 p0, __global const real* params) {
     return u8;
 }
 
-real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
+real DE_shade(real3 p0, __global const real* params, real3* color, real2* trap) {
     /* union */
     /* .../b:material/color/plane */
     real d29 = sd_plane(p0, (real3)(0.0f, 1.0f, 0.0f), 0.45f);
@@ -286,7 +286,7 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     /* union: the second operand only within reach of its bound */
     real u32 = d29;
     real3 uc32 = c30;
-    real ut32 = R(1.0);
+    real2 ut32 = (real2)(R(1.0));
     real g32 = (length(p0 - ((real3)(-R(1.9), R(0.0), R(0.2)))) * R(0.9999)) - R(0.42);
     if (!(g32 > u32 && g32 > R(0.0))) {
         /* .../a:union/a:union/a:translate */
@@ -299,12 +299,12 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
         real3 c32 = d29 < d0 ? c30 : c1;
         u32 = d32;
         uc32 = c32;
-        ut32 = R(1.0);
+        ut32 = (real2)(R(1.0));
     }
     /* union/a:union: the second operand only within reach of its bound */
     real u28 = u32;
     real3 uc28 = uc32;
-    real ut28 = ut32;
+    real2 ut28 = ut32;
     real g28 = (length(p0 - ((real3)(-R(0.95), R(0.0), R(0.2)))) * R(0.9999)) - R(0.42);
     if (!(g28 > u28 && g28 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
@@ -315,7 +315,7 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
         real3 c5 = (real3)(0.25f, 0.45f, 0.9f);
         real d28 = fmin(u32, d4);
         real3 c28 = u32 < d4 ? uc32 : c5;
-        real t28 = u32 < d4 ? ut32 : R(1.0);
+        real2 t28 = u32 < d4 ? ut32 : (real2)(R(1.0));
         u28 = d28;
         uc28 = c28;
         ut28 = t28;
@@ -323,7 +323,7 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     /* .../a:union/a:union: the second operand only within reach of its bound */
     real u22 = u28;
     real3 uc22 = uc28;
-    real ut22 = ut28;
+    real2 ut22 = ut28;
     real g22 = R(0.35555555555555557) * ((length(p0 - ((real3)(R(0.0), R(0.0), R(0.2)))) * R(0.9999)) - R(0.45));
     if (!(g22 > u22 && g22 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
@@ -336,7 +336,7 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
         real3 c10 = (real3)(0.95f, 0.8f, 0.5f);
         real d22 = fmin(u28, d9);
         real3 c22 = u28 < d9 ? uc28 : c10;
-        real t22 = u28 < d9 ? ut28 : R(1.0);
+        real2 t22 = u28 < d9 ? ut28 : (real2)(R(1.0));
         u22 = d22;
         uc22 = c22;
         ut22 = t22;
@@ -344,7 +344,7 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     /* .../a:union/a:union: the second operand only within reach of its bound */
     real u18 = u22;
     real3 uc18 = uc22;
-    real ut18 = ut22;
+    real2 ut18 = ut22;
     real g18 = (length(p0 - ((real3)(R(0.95), R(0.0), R(0.35)))) * R(0.9999)) - R(0.42);
     if (!(g18 > u18 && g18 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
@@ -353,7 +353,7 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
         real d15 = sd_sphere(p5, 0.42f);
         real d18 = fmin(u22, d15);
         real3 c18 = u22 < d15 ? uc22 : DEFAULT_COLOR;
-        real t18 = u22 < d15 ? ut22 : R(1.0);
+        real2 t18 = u22 < d15 ? ut22 : (real2)(R(1.0));
         u18 = d18;
         uc18 = c18;
         ut18 = t18;
@@ -361,7 +361,7 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     /* .../a:union/a:union: the second operand only within reach of its bound */
     real u14 = u18;
     real3 uc14 = uc18;
-    real ut14 = ut18;
+    real2 ut14 = ut18;
     real g14 = (length(p0 - ((real3)(R(1.9), R(0.0), R(0.2)))) * R(0.9999)) - R(0.42);
     if (!(g14 > u14 && g14 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
@@ -370,7 +370,7 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
         real d19 = sd_sphere(p6, 0.42f);
         real d14 = fmin(u18, d19);
         real3 c14 = u18 < d19 ? uc18 : DEFAULT_COLOR;
-        real t14 = u18 < d19 ? ut18 : R(1.0);
+        real2 t14 = u18 < d19 ? ut18 : (real2)(R(1.0));
         u14 = d14;
         uc14 = c14;
         ut14 = t14;
@@ -378,7 +378,7 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     /* .../a:union/a:union: the second operand only within reach of its bound */
     real u8 = u14;
     real3 uc8 = uc14;
-    real ut8 = ut14;
+    real2 ut8 = ut14;
     real g8 = (length(p0 - ((real3)(R(0.5), R(0.25), -R(1.3)))) * R(0.9999)) - R(0.7728626595716686);
     if (!(g8 > u8 && g8 > R(0.0))) {
         /* union/a:union/b:translate */
@@ -390,13 +390,13 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
         /* .../scale/rotate/mandelbulb */
         real2 f23 = mandelbulb_p8(p9, 8, R(2.0), 1.1040895f);
         real d23 = f23.x;
-        real t23 = f23.y;
+        real2 t23 = (real2)(f23.y);
         real d25 = d23 * R(0.7);
         /* .../a:union/b:translate/color */
         real3 c26 = (real3)(0.95f, 0.7f, 0.45f);
         real d8 = fmin(u14, d25);
         real3 c8 = u14 < d25 ? uc14 : c26;
-        real t8 = u14 < d25 ? ut14 : t23;
+        real2 t8 = u14 < d25 ? ut14 : t23;
         u8 = d8;
         uc8 = c8;
         ut8 = t8;

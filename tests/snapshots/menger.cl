@@ -169,7 +169,7 @@ real DE(real3 p0, __global const real* params) {
     return u5;
 }
 
-real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
+real DE_shade(real3 p0, __global const real* params, real3* color, real2* trap) {
     /* union */
     /* union/b:color/plane */
     real d3 = sd_plane(p0, (real3)(0.0f, 1.0f, 0.0f), 1.0f);
@@ -178,7 +178,7 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     /* union: the second operand only within reach of its bound */
     real u5 = d3;
     real3 uc5 = c4;
-    real ut5 = R(1.0);
+    real2 ut5 = (real2)(R(1.0));
     real g5 = (length(p0) * R(0.9999)) - R(1.7320508075688772);
     if (!(g5 > u5 && g5 > R(0.0))) {
         /* union/a:color/rotate */
@@ -186,12 +186,12 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
         /* .../a:color/rotate/menger */
         real2 f0 = menger(p1, 4, 3.0f);
         real d0 = f0.x;
-        real t0 = f0.y;
+        real2 t0 = (real2)(f0.y);
         /* union/a:color */
         real3 c2 = (real3)(0.85f, 0.85f, 0.8f);
         real d5 = fmin(d3, d0);
         real3 c5 = d3 < d0 ? c4 : c2;
-        real t5 = d3 < d0 ? R(1.0) : t0;
+        real2 t5 = d3 < d0 ? (real2)(R(1.0)) : t0;
         u5 = d5;
         uc5 = c5;
         ut5 = t5;

@@ -704,7 +704,7 @@ real DE(real3 p0, __global const real* params) {
     return u10;
 }
 
-real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
+real DE_shade(real3 p0, __global const real* params, real3* color, real2* trap) {
     /* union */
     /* union/b:color/plane */
     real d22 = sd_plane(p0, (real3)(0.0f, 1.0f, 0.0f), 0.7f);
@@ -713,7 +713,7 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     /* union: the second operand only within reach of its bound */
     real u24 = d22;
     real3 uc24 = c23;
-    real ut24 = R(1.0);
+    real2 ut24 = (real2)(R(1.0));
     real g24 = (length(p0 - ((real3)(-R(0.95), R(0.0), R(0.75)))) * R(0.9999)) - R(0.6072492325205968);
     if (!(g24 > u24 && g24 > R(0.0))) {
         /* .../a:union/a:union/a:translate */
@@ -725,9 +725,9 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
         /* .../rotate/orbit_trap/mandelbulb */
         real2 f0 = mandelbulb_p8_trap(p3, 10, R(2.0), 1.1040895f, (real3)((-0.0f), (-0.0f), (-0.0f)), (real3)(0.0f, 0.0f, 1.0f), 0.0f, 1.0f, 0.0f, 0.0f);
         real d0 = f0.x;
-        real t0 = f0.y;
+        real2 t0 = (real2)(f0.y);
         /* .../scale/rotate/orbit_trap */
-        real e30_0 = fmin(fmax(t0 / R(0.8), R(0.0)), R(1.0));
+        real e30_0 = fmin(fmax((t0).x / R(0.8), R(0.0)), R(1.0));
         real e30_1 = fmin(fmax(e30_0 * R(3.3333333333333335), R(0.0)), R(1.0));
         real e30_2 = fmin(fmax((e30_0 - R(0.3)) * R(3.3333333333333335), R(0.0)), R(1.0));
         real e30_3 = fmin(fmax((e30_0 - R(0.6)) * R(4.0), R(0.0)), R(1.0));
@@ -736,14 +736,15 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
         real d3 = d0 * R(0.55);
         real d24 = fmin(d22, d3);
         real3 c24 = d22 < d3 ? c23 : c1;
+        real2 t24 = d22 < d3 ? (real2)(R(1.0)) : (real2)(R(1.0), (t0).x);
         u24 = d24;
         uc24 = c24;
-        ut24 = R(1.0);
+        ut24 = t24;
     }
     /* union/a:union: the second operand only within reach of its bound */
     real u21 = u24;
     real3 uc21 = uc24;
-    real ut21 = ut24;
+    real2 ut21 = ut24;
     real g21 = (length(p0 - ((real3)(-R(0.75), R(0.0), -R(0.95)))) * R(0.9999)) - R(1.143153532995459);
     if (!(g21 > u21 && g21 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
@@ -755,9 +756,9 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
         /* .../rotate/orbit_trap/mandelbox */
         real2 f5 = mandelbox_trap(p6, 16, 2.0f, 0.5f, 1.0f, 1.0f, (real3)(0.0f, 0.0f, 0.0f), (real3)(0.0f, 0.0f, 0.0f), 1.0f, 0.0f, 2.0f, 0.0f);
         real d5 = f5.x;
-        real t5 = f5.y;
+        real2 t5 = (real2)(f5.y);
         /* .../scale/rotate/orbit_trap */
-        real e37_0 = fmin(fmax(t5 / R(2.0), R(0.0)), R(1.0));
+        real e37_0 = fmin(fmax((t5).x / R(2.0), R(0.0)), R(1.0));
         real e37_1 = fmin(fmax(e37_0 * R(4.0), R(0.0)), R(1.0));
         real e37_2 = fmin(fmax((e37_0 - R(0.25)) * R(4.0), R(0.0)), R(1.0));
         real e37_3 = fmin(fmax((e37_0 - R(0.5)) * R(4.0), R(0.0)), R(1.0));
@@ -766,7 +767,7 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
         real d8 = d5 * R(0.11);
         real d21 = fmin(u24, d8);
         real3 c21 = u24 < d8 ? uc24 : c6;
-        real t21 = u24 < d8 ? ut24 : R(1.0);
+        real2 t21 = u24 < d8 ? ut24 : (real2)(R(1.0), (t5).x);
         u21 = d21;
         uc21 = c21;
         ut21 = t21;
@@ -774,7 +775,7 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     /* .../a:union/a:union: the second operand only within reach of its bound */
     real u15 = u21;
     real3 uc15 = uc21;
-    real ut15 = ut21;
+    real2 ut15 = ut21;
     real g15 = R(0.9) * ((length(p0 - ((real3)(R(0.85), -R(0.1), R(0.8)))) * R(0.9999)) - R(1.3238904174164612));
     if (!(g15 > u15 && g15 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
@@ -784,9 +785,9 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
         /* .../scale/orbit_trap/julia */
         real2 f11 = julia_trap(p8, (-0.2f), 0.6f, 0.2f, 0.2f, 0.0f, 12, 4.0f, (real3)(0.0f, 0.0f, 0.0f), (real3)(1.0f, 0.0f, 0.0f), 1.0f, (-1.0f), 0.0f, 0.0f);
         real d11 = f11.x;
-        real t11 = f11.y;
+        real2 t11 = (real2)(f11.y);
         /* .../b:translate/scale/orbit_trap */
-        real e43_0 = fmin(fmax(t11 / R(0.9), R(0.0)), R(1.0));
+        real e43_0 = fmin(fmax((t11).x / R(0.9), R(0.0)), R(1.0));
         real e43_1 = fmin(fmax(e43_0 * R(2.857142857142857), R(0.0)), R(1.0));
         real e43_2 = fmin(fmax((e43_0 - R(0.35)) * R(2.857142857142857), R(0.0)), R(1.0));
         real e43_3 = fmin(fmax((e43_0 - R(0.7)) * R(3.333333333333333), R(0.0)), R(1.0));
@@ -794,7 +795,7 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
         real d13 = d11 * R(0.6);
         real d15 = fmin(u21, d13);
         real3 c15 = u21 < d13 ? uc21 : c12;
-        real t15 = u21 < d13 ? ut21 : R(1.0);
+        real2 t15 = u21 < d13 ? ut21 : (real2)(R(1.0), (t11).x);
         u15 = d15;
         uc15 = c15;
         ut15 = t15;
@@ -802,7 +803,7 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     /* .../a:union/a:union: the second operand only within reach of its bound */
     real u10 = u15;
     real3 uc10 = uc15;
-    real ut10 = ut15;
+    real2 ut10 = ut15;
     real g10 = (length(p0 - ((real3)(R(1.05), R(0.0), -R(0.95)))) * R(0.9999)) - R(0.5999999999999999);
     if (!(g10 > u10 && g10 > R(0.0))) {
         /* union/a:union/b:translate */
@@ -814,9 +815,9 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
         /* .../rotate/orbit_trap/kifs */
         real2 f16 = kifs_icosahedral_trap(p11, 12, 2.618034f, (real3)(0.8506508f, 0.5257311f, 0.0f), (real3)(0.0f, 0.0f, 0.0f), (real3)(0.0f, 0.0f, 0.0f), 1.0f, 0.0f, 0.0f, 0.0f);
         real d16 = f16.x;
-        real t16 = f16.y;
+        real2 t16 = (real2)(f16.y);
         /* .../scale/rotate/orbit_trap */
-        real e50_0 = fmin(fmax((t16 - R(0.3)) / R(1.3), R(0.0)), R(1.0));
+        real e50_0 = fmin(fmax(((t16).x - R(0.3)) / R(1.3), R(0.0)), R(1.0));
         real e50_1 = fmin(fmax(e50_0 * R(4.0), R(0.0)), R(1.0));
         real e50_2 = fmin(fmax((e50_0 - R(0.25)) * R(4.0), R(0.0)), R(1.0));
         real e50_3 = fmin(fmax((e50_0 - R(0.5)) * R(4.0), R(0.0)), R(1.0));
@@ -825,7 +826,7 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
         real d19 = d16 * R(0.6);
         real d10 = fmin(u15, d19);
         real3 c10 = u15 < d19 ? uc15 : c17;
-        real t10 = u15 < d19 ? ut15 : R(1.0);
+        real2 t10 = u15 < d19 ? ut15 : (real2)(R(1.0), (t16).x);
         u10 = d10;
         uc10 = c10;
         ut10 = t10;

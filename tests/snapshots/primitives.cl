@@ -895,7 +895,7 @@ real DE(real3 p0, __global const real* params) {
     return u6;
 }
 
-real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
+real DE_shade(real3 p0, __global const real* params, real3* color, real2* trap) {
     /* union */
     /* union/b:color/plane */
     real d127 = sd_plane(p0, (real3)(0.0f, 1.0f, 0.0f), 0.4f);
@@ -904,7 +904,7 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     /* union: the second operand only within reach of its bound */
     real u129 = d127;
     real3 uc129 = c128;
-    real ut129 = R(1.0);
+    real2 ut129 = (real2)(R(1.0));
     real g129 = (length(p0 - ((real3)(-R(2.55), R(0.0), -R(1.4249999999999998)))) * R(0.9999)) - R(0.35);
     if (!(g129 > u129 && g129 > R(0.0))) {
         /* .../a:union/a:union/a:translate */
@@ -917,12 +917,12 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
         real3 c129 = d127 < d0 ? c128 : c1;
         u129 = d129;
         uc129 = c129;
-        ut129 = R(1.0);
+        ut129 = (real2)(R(1.0));
     }
     /* union/a:union: the second operand only within reach of its bound */
     real u126 = u129;
     real3 uc126 = uc129;
-    real ut126 = ut129;
+    real2 ut126 = ut129;
     real g126 = (length(p0 - ((real3)(-R(1.7), R(0.0), -R(1.4249999999999998)))) * R(0.9999)) - R(0.5196152422706632);
     if (!(g126 > u126 && g126 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
@@ -933,7 +933,7 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
         real3 c4 = (real3)(0.87777776f, 0.47592592f, 0.32222223f);
         real d126 = fmin(u129, d3);
         real3 c126 = u129 < d3 ? uc129 : c4;
-        real t126 = u129 < d3 ? ut129 : R(1.0);
+        real2 t126 = u129 < d3 ? ut129 : (real2)(R(1.0));
         u126 = d126;
         uc126 = c126;
         ut126 = t126;
@@ -941,7 +941,7 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     /* .../a:union/a:union: the second operand only within reach of its bound */
     real u120 = u126;
     real3 uc120 = uc126;
-    real ut120 = ut126;
+    real2 ut120 = ut126;
     real g120 = (length(p0 - ((real3)(-R(0.85), R(0.0), -R(1.4249999999999998)))) * R(0.9999)) - R(0.5196152422706632);
     if (!(g120 > u120 && g120 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
@@ -952,7 +952,7 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
         real3 c8 = (real3)(0.85555553f, 0.50185186f, 0.34444445f);
         real d120 = fmin(u126, d7);
         real3 c120 = u126 < d7 ? uc126 : c8;
-        real t120 = u126 < d7 ? ut126 : R(1.0);
+        real2 t120 = u126 < d7 ? ut126 : (real2)(R(1.0));
         u120 = d120;
         uc120 = c120;
         ut120 = t120;
@@ -960,7 +960,7 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     /* .../a:union/a:union: the second operand only within reach of its bound */
     real u114 = u120;
     real3 uc114 = uc120;
-    real ut114 = ut120;
+    real2 ut114 = ut120;
     real g114 = (length(p0 - ((real3)(R(0.0), R(0.0), -R(1.4249999999999998)))) * R(0.9999)) - R(0.38);
     if (!(g114 > u114 && g114 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
@@ -971,7 +971,7 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
         real3 c12 = (real3)(0.8333333f, 0.5277778f, 0.36666667f);
         real d114 = fmin(u120, d11);
         real3 c114 = u120 < d11 ? uc120 : c12;
-        real t114 = u120 < d11 ? ut120 : R(1.0);
+        real2 t114 = u120 < d11 ? ut120 : (real2)(R(1.0));
         u114 = d114;
         uc114 = c114;
         ut114 = t114;
@@ -979,7 +979,7 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     /* .../a:union/a:union: the second operand only within reach of its bound */
     real u109 = u114;
     real3 uc109 = uc114;
-    real ut109 = ut114;
+    real2 ut109 = ut114;
     real g109 = (length(p0 - ((real3)(R(0.85), R(0.0), -R(1.4249999999999998)))) * R(0.9999)) - R(0.4301162633521313);
     if (!(g109 > u109 && g109 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
@@ -990,7 +990,7 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
         real3 c16 = (real3)(0.8111111f, 0.5537037f, 0.3888889f);
         real d109 = fmin(u114, d15);
         real3 c109 = u114 < d15 ? uc114 : c16;
-        real t109 = u114 < d15 ? ut114 : R(1.0);
+        real2 t109 = u114 < d15 ? ut114 : (real2)(R(1.0));
         u109 = d109;
         uc109 = c109;
         ut109 = t109;
@@ -998,7 +998,7 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     /* .../a:union/a:union: the second operand only within reach of its bound */
     real u104 = u109;
     real3 uc104 = uc109;
-    real ut104 = ut109;
+    real2 ut104 = ut109;
     real g104 = (length(p0 - ((real3)(R(1.7), R(0.0), -R(1.4249999999999998)))) * R(0.9999)) - R(0.38);
     if (!(g104 > u104 && g104 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
@@ -1009,7 +1009,7 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
         real3 c20 = (real3)(0.7888889f, 0.5796296f, 0.41111112f);
         real d104 = fmin(u109, d19);
         real3 c104 = u109 < d19 ? uc109 : c20;
-        real t104 = u109 < d19 ? ut109 : R(1.0);
+        real2 t104 = u109 < d19 ? ut109 : (real2)(R(1.0));
         u104 = d104;
         uc104 = c104;
         ut104 = t104;
@@ -1017,7 +1017,7 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     /* .../a:union/a:union: the second operand only within reach of its bound */
     real u99 = u104;
     real3 uc99 = uc104;
-    real ut99 = ut104;
+    real2 ut99 = ut104;
     real g99 = (length(p0 - ((real3)(R(2.55), R(0.0), -R(1.4249999999999998)))) * R(0.9999)) - R(0.4);
     if (!(g99 > u99 && g99 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
@@ -1028,7 +1028,7 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
         real3 c24 = (real3)(0.76666665f, 0.60555553f, 0.43333334f);
         real d99 = fmin(u104, d23);
         real3 c99 = u104 < d23 ? uc104 : c24;
-        real t99 = u104 < d23 ? ut104 : R(1.0);
+        real2 t99 = u104 < d23 ? ut104 : (real2)(R(1.0));
         u99 = d99;
         uc99 = c99;
         ut99 = t99;
@@ -1036,7 +1036,7 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     /* .../a:union/a:union: the second operand only within reach of its bound */
     real u94 = u99;
     real3 uc94 = uc99;
-    real ut94 = ut99;
+    real2 ut94 = ut99;
     real g94 = (length(p0 - ((real3)(-R(2.55), R(0.0), -R(0.475)))) * R(0.9999)) - R(0.4609772228646443);
     if (!(g94 > u94 && g94 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
@@ -1047,7 +1047,7 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
         real3 c28 = (real3)(0.74444443f, 0.63148147f, 0.45555556f);
         real d94 = fmin(u99, d27);
         real3 c94 = u99 < d27 ? uc99 : c28;
-        real t94 = u99 < d27 ? ut99 : R(1.0);
+        real2 t94 = u99 < d27 ? ut99 : (real2)(R(1.0));
         u94 = d94;
         uc94 = c94;
         ut94 = t94;
@@ -1055,7 +1055,7 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     /* .../a:union/a:union: the second operand only within reach of its bound */
     real u88 = u94;
     real3 uc88 = uc94;
-    real ut88 = ut94;
+    real2 ut88 = ut94;
     real g88 = R(0.5714285714285715) * ((length(p0 - ((real3)(-R(1.7), R(0.0), -R(0.475)))) * R(0.9999)) - R(0.35));
     if (!(g88 > u88 && g88 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
@@ -1066,7 +1066,7 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
         real3 c32 = (real3)(0.7222222f, 0.6574074f, 0.47777778f);
         real d88 = fmin(u94, d31);
         real3 c88 = u94 < d31 ? uc94 : c32;
-        real t88 = u94 < d31 ? ut94 : R(1.0);
+        real2 t88 = u94 < d31 ? ut94 : (real2)(R(1.0));
         u88 = d88;
         uc88 = c88;
         ut88 = t88;
@@ -1074,7 +1074,7 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     /* .../a:union/a:union: the second operand only within reach of its bound */
     real u82 = u88;
     real3 uc82 = uc88;
-    real ut82 = ut88;
+    real2 ut82 = ut88;
     real g82 = (length(p0 - ((real3)(-R(0.85), R(0.0), -R(0.475)))) * R(0.9999)) - R(0.4410593308539491);
     if (!(g82 > u82 && g82 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
@@ -1085,7 +1085,7 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
         real3 c36 = (real3)(0.7f, 0.68333334f, 0.5f);
         real d82 = fmin(u88, d35);
         real3 c82 = u88 < d35 ? uc88 : c36;
-        real t82 = u88 < d35 ? ut88 : R(1.0);
+        real2 t82 = u88 < d35 ? ut88 : (real2)(R(1.0));
         u82 = d82;
         uc82 = c82;
         ut82 = t82;
@@ -1093,7 +1093,7 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     /* .../a:union/a:union: the second operand only within reach of its bound */
     real u78 = u82;
     real3 uc78 = uc82;
-    real ut78 = ut82;
+    real2 ut78 = ut82;
     real g78 = (length(p0 - ((real3)(R(0.0), R(0.0), -R(0.475)))) * R(0.9999)) - R(0.44);
     if (!(g78 > u78 && g78 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
@@ -1104,7 +1104,7 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
         real3 c40 = (real3)(0.67777777f, 0.7092593f, 0.5222222f);
         real d78 = fmin(u82, d39);
         real3 c78 = u82 < d39 ? uc82 : c40;
-        real t78 = u82 < d39 ? ut82 : R(1.0);
+        real2 t78 = u82 < d39 ? ut82 : (real2)(R(1.0));
         u78 = d78;
         uc78 = c78;
         ut78 = t78;
@@ -1112,7 +1112,7 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     /* .../a:union/a:union: the second operand only within reach of its bound */
     real u73 = u78;
     real3 uc73 = uc78;
-    real ut73 = ut78;
+    real2 ut73 = ut78;
     real g73 = (length(p0 - ((real3)(R(0.85), R(0.0), -R(0.475)))) * R(0.9999)) - R(0.41000000000000003);
     if (!(g73 > u73 && g73 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
@@ -1125,7 +1125,7 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
         real3 c45 = (real3)(0.65555555f, 0.7351852f, 0.54444444f);
         real d73 = fmin(u78, d43);
         real3 c73 = u78 < d43 ? uc78 : c45;
-        real t73 = u78 < d43 ? ut78 : R(1.0);
+        real2 t73 = u78 < d43 ? ut78 : (real2)(R(1.0));
         u73 = d73;
         uc73 = c73;
         ut73 = t73;
@@ -1133,7 +1133,7 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     /* .../a:union/a:union: the second operand only within reach of its bound */
     real u69 = u73;
     real3 uc69 = uc73;
-    real ut69 = ut73;
+    real2 ut69 = ut73;
     real g69 = (length(p0 - ((real3)(R(1.7), R(0.05), -R(0.475)))) * R(0.9999)) - R(0.35);
     if (!(g69 > u69 && g69 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
@@ -1146,7 +1146,7 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
         real3 c50 = (real3)(0.6333333f, 0.76111114f, 0.56666666f);
         real d69 = fmin(u73, d48);
         real3 c69 = u73 < d48 ? uc73 : c50;
-        real t69 = u73 < d48 ? ut73 : R(1.0);
+        real2 t69 = u73 < d48 ? ut73 : (real2)(R(1.0));
         u69 = d69;
         uc69 = c69;
         ut69 = t69;
@@ -1154,7 +1154,7 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     /* .../a:union/a:union: the second operand only within reach of its bound */
     real u65 = u69;
     real3 uc65 = uc69;
-    real ut65 = ut69;
+    real2 ut65 = ut69;
     real g65 = (length(p0 - ((real3)(R(2.55), -R(0.3), -R(0.475)))) * R(0.9999)) - R(0.45);
     if (!(g65 > u65 && g65 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
@@ -1167,7 +1167,7 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
         real3 c55 = (real3)(0.6111111f, 0.787037f, 0.5888889f);
         real d65 = fmin(u69, d53);
         real3 c65 = u69 < d53 ? uc69 : c55;
-        real t65 = u69 < d53 ? ut69 : R(1.0);
+        real2 t65 = u69 < d53 ? ut69 : (real2)(R(1.0));
         u65 = d65;
         uc65 = c65;
         ut65 = t65;
@@ -1175,7 +1175,7 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     /* .../a:union/a:union: the second operand only within reach of its bound */
     real u61 = u65;
     real3 uc61 = uc65;
-    real ut61 = ut65;
+    real2 ut61 = ut65;
     real g61 = (length(p0 - ((real3)(-R(2.55), R(0.0), R(0.475)))) * R(0.9999)) - R(0.32);
     if (!(g61 > u61 && g61 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
@@ -1186,7 +1186,7 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
         real3 c59 = (real3)(0.5888889f, 0.787037f, 0.6111111f);
         real d61 = fmin(u65, d58);
         real3 c61 = u65 < d58 ? uc65 : c59;
-        real t61 = u65 < d58 ? ut65 : R(1.0);
+        real2 t61 = u65 < d58 ? ut65 : (real2)(R(1.0));
         u61 = d61;
         uc61 = c61;
         ut61 = t61;
@@ -1194,7 +1194,7 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     /* .../a:union/a:union: the second operand only within reach of its bound */
     real u57 = u61;
     real3 uc57 = uc61;
-    real ut57 = ut61;
+    real2 ut57 = ut61;
     real g57 = (length(p0 - ((real3)(-R(1.7249999999999999), -R(0.024999999999999994), R(0.475)))) * R(0.9999)) - R(0.34734708865916814);
     if (!(g57 > u57 && g57 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
@@ -1205,7 +1205,7 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
         real3 c63 = (real3)(0.56666666f, 0.76111114f, 0.6333333f);
         real d57 = fmin(u61, d62);
         real3 c57 = u61 < d62 ? uc61 : c63;
-        real t57 = u61 < d62 ? ut61 : R(1.0);
+        real2 t57 = u61 < d62 ? ut61 : (real2)(R(1.0));
         u57 = d57;
         uc57 = c57;
         ut57 = t57;
@@ -1213,7 +1213,7 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     /* .../a:union/a:union: the second operand only within reach of its bound */
     real u52 = u57;
     real3 uc52 = uc57;
-    real ut52 = ut57;
+    real2 ut52 = ut57;
     real g52 = (length(p0 - ((real3)(-R(0.825), R(0.024999999999999994), R(0.475)))) * R(0.9999)) - R(0.3932556420447137);
     if (!(g52 > u52 && g52 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
@@ -1224,7 +1224,7 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
         real3 c67 = (real3)(0.54444444f, 0.7351852f, 0.65555555f);
         real d52 = fmin(u57, d66);
         real3 c52 = u57 < d66 ? uc57 : c67;
-        real t52 = u57 < d66 ? ut57 : R(1.0);
+        real2 t52 = u57 < d66 ? ut57 : (real2)(R(1.0));
         u52 = d52;
         uc52 = c52;
         ut52 = t52;
@@ -1232,7 +1232,7 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     /* .../a:union/a:union: the second operand only within reach of its bound */
     real u47 = u52;
     real3 uc47 = uc52;
-    real ut47 = ut52;
+    real2 ut47 = ut52;
     real g47 = (length(p0 - ((real3)(R(0.02500000000000001), R(0.024999999999999994), R(0.475)))) * R(0.9999)) - R(0.4450438562747845);
     if (!(g47 > u47 && g47 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
@@ -1243,7 +1243,7 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
         real3 c71 = (real3)(0.5222222f, 0.7092593f, 0.67777777f);
         real d47 = fmin(u52, d70);
         real3 c47 = u52 < d70 ? uc52 : c71;
-        real t47 = u52 < d70 ? ut52 : R(1.0);
+        real2 t47 = u52 < d70 ? ut52 : (real2)(R(1.0));
         u47 = d47;
         uc47 = c47;
         ut47 = t47;
@@ -1251,7 +1251,7 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     /* .../a:union/a:union: the second operand only within reach of its bound */
     real u42 = u47;
     real3 uc42 = uc47;
-    real ut42 = ut47;
+    real2 ut42 = ut47;
     real g42 = (length(p0 - ((real3)(R(0.85), -R(0.13333333333333333), R(0.475)))) * R(0.9999)) - R(0.4633333333333334);
     if (!(g42 > u42 && g42 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
@@ -1264,7 +1264,7 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
         real3 c76 = (real3)(0.5f, 0.68333334f, 0.7f);
         real d42 = fmin(u47, d74);
         real3 c42 = u47 < d74 ? uc47 : c76;
-        real t42 = u47 < d74 ? ut47 : R(1.0);
+        real2 t42 = u47 < d74 ? ut47 : (real2)(R(1.0));
         u42 = d42;
         uc42 = c42;
         ut42 = t42;
@@ -1272,7 +1272,7 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     /* .../a:union/a:union: the second operand only within reach of its bound */
     real u38 = u42;
     real3 uc38 = uc42;
-    real ut38 = ut42;
+    real2 ut38 = ut42;
     real g38 = (length(p0 - ((real3)(R(1.7), -R(0.024999999999999994), R(0.46499999999999997)))) * R(0.9999)) - R(0.47286002303210883);
     if (!(g38 > u38 && g38 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
@@ -1283,7 +1283,7 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
         real3 c80 = (real3)(0.47777778f, 0.6574074f, 0.7222222f);
         real d38 = fmin(u42, d79);
         real3 c38 = u42 < d79 ? uc42 : c80;
-        real t38 = u42 < d79 ? ut42 : R(1.0);
+        real2 t38 = u42 < d79 ? ut42 : (real2)(R(1.0));
         u38 = d38;
         uc38 = c38;
         ut38 = t38;
@@ -1291,7 +1291,7 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     /* .../a:union/a:union: the second operand only within reach of its bound */
     real u34 = u38;
     real3 uc34 = uc38;
-    real ut34 = ut38;
+    real2 ut34 = ut38;
     real g34 = (length(p0 - ((real3)(R(2.55), -R(0.4), R(0.475)))) * R(0.9999)) - R(0.55);
     if (!(g34 > u34 && g34 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
@@ -1306,7 +1306,7 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
         real3 c86 = (real3)(0.45555556f, 0.63148147f, 0.74444443f);
         real d34 = fmin(u38, d83);
         real3 c34 = u38 < d83 ? uc38 : c86;
-        real t34 = u38 < d83 ? ut38 : R(1.0);
+        real2 t34 = u38 < d83 ? ut38 : (real2)(R(1.0));
         u34 = d34;
         uc34 = c34;
         ut34 = t34;
@@ -1314,7 +1314,7 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     /* .../a:union/a:union: the second operand only within reach of its bound */
     real u30 = u34;
     real3 uc30 = uc34;
-    real ut30 = ut34;
+    real2 ut30 = ut34;
     real g30 = (length(p0 - ((real3)(-R(2.55), -R(0.34), R(1.4249999999999998)))) * R(0.9999)) - R(0.4044749683231337);
     if (!(g30 > u30 && g30 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
@@ -1329,7 +1329,7 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
         real3 c92 = (real3)(0.43333334f, 0.60555553f, 0.76666665f);
         real d30 = fmin(u34, d89);
         real3 c30 = u34 < d89 ? uc34 : c92;
-        real t30 = u34 < d89 ? ut34 : R(1.0);
+        real2 t30 = u34 < d89 ? ut34 : (real2)(R(1.0));
         u30 = d30;
         uc30 = c30;
         ut30 = t30;
@@ -1337,7 +1337,7 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     /* .../a:union/a:union: the second operand only within reach of its bound */
     real u26 = u30;
     real3 uc26 = uc30;
-    real ut26 = ut30;
+    real2 ut26 = ut30;
     real g26 = (length(p0 - ((real3)(-R(1.7), -R(0.1), R(1.4249999999999998)))) * R(0.9999)) - R(0.45343136195018535);
     if (!(g26 > u26 && g26 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
@@ -1350,7 +1350,7 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
         real3 c97 = (real3)(0.41111112f, 0.5796296f, 0.7888889f);
         real d26 = fmin(u30, d95);
         real3 c26 = u30 < d95 ? uc30 : c97;
-        real t26 = u30 < d95 ? ut30 : R(1.0);
+        real2 t26 = u30 < d95 ? ut30 : (real2)(R(1.0));
         u26 = d26;
         uc26 = c26;
         ut26 = t26;
@@ -1358,7 +1358,7 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     /* .../a:union/a:union: the second operand only within reach of its bound */
     real u22 = u26;
     real3 uc22 = uc26;
-    real ut22 = ut26;
+    real2 ut22 = ut26;
     real g22 = (length(p0 - ((real3)(-R(0.85), -R(0.2), R(1.4249999999999998)))) * R(0.9999)) - R(0.3440930106817051);
     if (!(g22 > u22 && g22 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
@@ -1371,7 +1371,7 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
         real3 c102 = (real3)(0.3888889f, 0.5537037f, 0.8111111f);
         real d22 = fmin(u26, d100);
         real3 c22 = u26 < d100 ? uc26 : c102;
-        real t22 = u26 < d100 ? ut26 : R(1.0);
+        real2 t22 = u26 < d100 ? ut26 : (real2)(R(1.0));
         u22 = d22;
         uc22 = c22;
         ut22 = t22;
@@ -1379,7 +1379,7 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     /* .../a:union/a:union: the second operand only within reach of its bound */
     real u18 = u22;
     real3 uc18 = uc22;
-    real ut18 = ut22;
+    real2 ut18 = ut22;
     real g18 = (length(p0 - ((real3)(R(0.0), -R(0.09999999999999998), R(1.4249999999999998)))) * R(0.9999)) - R(0.41036569057366384);
     if (!(g18 > u18 && g18 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
@@ -1392,7 +1392,7 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
         real3 c107 = (real3)(0.36666667f, 0.5277778f, 0.8333333f);
         real d18 = fmin(u22, d105);
         real3 c18 = u22 < d105 ? uc22 : c107;
-        real t18 = u22 < d105 ? ut22 : R(1.0);
+        real2 t18 = u22 < d105 ? ut22 : (real2)(R(1.0));
         u18 = d18;
         uc18 = c18;
         ut18 = t18;
@@ -1400,7 +1400,7 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     /* .../a:union/a:union: the second operand only within reach of its bound */
     real u14 = u18;
     real3 uc14 = uc18;
-    real ut14 = ut18;
+    real2 ut14 = ut18;
     real g14 = (length(p0 - ((real3)(R(0.85), -R(0.06), R(1.4249999999999998)))) * R(0.9999)) - R(0.34);
     if (!(g14 > u14 && g14 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
@@ -1413,7 +1413,7 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
         real3 c112 = (real3)(0.34444445f, 0.50185186f, 0.85555553f);
         real d14 = fmin(u18, d110);
         real3 c14 = u18 < d110 ? uc18 : c112;
-        real t14 = u18 < d110 ? ut18 : R(1.0);
+        real2 t14 = u18 < d110 ? ut18 : (real2)(R(1.0));
         u14 = d14;
         uc14 = c14;
         ut14 = t14;
@@ -1421,7 +1421,7 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     /* .../a:union/a:union: the second operand only within reach of its bound */
     real u10 = u14;
     real3 uc10 = uc14;
-    real ut10 = ut14;
+    real2 ut10 = ut14;
     real g10 = (length(p0 - ((real3)(R(1.7), -R(0.08), R(1.4249999999999998)))) * R(0.9999)) - R(0.32);
     if (!(g10 > u10 && g10 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
@@ -1436,7 +1436,7 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
         real3 c118 = (real3)(0.32222223f, 0.47592592f, 0.87777776f);
         real d10 = fmin(u14, d115);
         real3 c10 = u14 < d115 ? uc14 : c118;
-        real t10 = u14 < d115 ? ut14 : R(1.0);
+        real2 t10 = u14 < d115 ? ut14 : (real2)(R(1.0));
         u10 = d10;
         uc10 = c10;
         ut10 = t10;
@@ -1444,7 +1444,7 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     /* .../a:union/a:union: the second operand only within reach of its bound */
     real u6 = u10;
     real3 uc6 = uc10;
-    real ut6 = ut10;
+    real2 ut6 = ut10;
     real g6 = (length(p0 - ((real3)(R(2.55), -R(0.12), R(1.4249999999999998)))) * R(0.9999)) - R(0.48497422611928565);
     if (!(g6 > u6 && g6 > R(0.0))) {
         /* union/a:union/b:translate */
@@ -1459,7 +1459,7 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
         real3 c124 = (real3)(0.3f, 0.45f, 0.9f);
         real d6 = fmin(u10, d121);
         real3 c6 = u10 < d121 ? uc10 : c124;
-        real t6 = u10 < d121 ? ut10 : R(1.0);
+        real2 t6 = u10 < d121 ? ut10 : (real2)(R(1.0));
         u6 = d6;
         uc6 = c6;
         ut6 = t6;

@@ -499,7 +499,7 @@ real DE(real3 p0, __global const real* params) {
     return u7;
 }
 
-real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
+real DE_shade(real3 p0, __global const real* params, real3* color, real2* trap) {
     /* union */
     /* union/b:color/plane */
     real d26 = sd_plane(p0, (real3)(0.0f, 1.0f, 0.0f), 0.45f);
@@ -508,7 +508,7 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     /* union: the second operand only within reach of its bound */
     real u28 = d26;
     real3 uc28 = c27;
-    real ut28 = R(1.0);
+    real2 ut28 = (real2)(R(1.0));
     real g28 = (length(p0 - ((real3)(-R(1.3), -R(0.03), -R(0.45)))) * R(0.9999)) - R(0.42426406871192857);
     if (!(g28 > u28 && g28 > R(0.0))) {
         /* .../a:union/a:union/a:translate */
@@ -623,12 +623,12 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
         real3 c28 = d26 < d0 ? c27 : c1;
         u28 = d28;
         uc28 = c28;
-        ut28 = R(1.0);
+        ut28 = (real2)(R(1.0));
     }
     /* union/a:union: the second operand only within reach of its bound */
     real u25 = u28;
     real3 uc25 = uc28;
-    real ut25 = ut28;
+    real2 ut25 = ut28;
     real g25 = (length(p0 - ((real3)(-R(0.45), R(0.0), -R(0.6)))) * R(0.9999)) - R(0.5580322571321482);
     if (!(g25 > u25 && g25 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
@@ -732,7 +732,7 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
         real3 c5 = (real3)(0.75f, 0.85f, 0.95f);
         real d25 = fmin(u28, d4);
         real3 c25 = u28 < d4 ? uc28 : c5;
-        real t25 = u28 < d4 ? ut28 : R(1.0);
+        real2 t25 = u28 < d4 ? ut28 : (real2)(R(1.0));
         u25 = d25;
         uc25 = c25;
         ut25 = t25;
@@ -740,7 +740,7 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     /* .../a:union/a:union: the second operand only within reach of its bound */
     real u21 = u25;
     real3 uc21 = uc25;
-    real ut21 = ut25;
+    real2 ut21 = ut25;
     real g21 = (length(p0 - ((real3)(R(0.5), -R(0.225), -R(0.55)))) * R(0.9999)) - R(0.4023592452822642);
     if (!(g21 > u21 && g21 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
@@ -754,7 +754,7 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
         real3 c9 = (real3)(0.9f, 0.35f, 0.3f);
         real d21 = fmin(u25, d8);
         real3 c21 = u25 < d8 ? uc25 : c9;
-        real t21 = u25 < d8 ? ut25 : R(1.0);
+        real2 t21 = u25 < d8 ? ut25 : (real2)(R(1.0));
         u21 = d21;
         uc21 = c21;
         ut21 = t21;
@@ -762,7 +762,7 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     /* .../a:union/a:union: the second operand only within reach of its bound */
     real u16 = u21;
     real3 uc16 = uc21;
-    real ut16 = ut21;
+    real2 ut16 = ut21;
     real g16 = (length(p0 - ((real3)(R(1.3), -R(0.085), -R(0.45)))) * R(0.9999)) - R(0.42727922061357854);
     if (!(g16 > u16 && g16 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
@@ -777,7 +777,7 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
         real3 c13 = (real3)(0.3f, 0.6f, 0.95f);
         real d16 = fmin(u21, d12);
         real3 c16 = u21 < d12 ? uc21 : c13;
-        real t16 = u21 < d12 ? ut21 : R(1.0);
+        real2 t16 = u21 < d12 ? ut21 : (real2)(R(1.0));
         u16 = d16;
         uc16 = c16;
         ut16 = t16;
@@ -785,7 +785,7 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     /* .../a:union/a:union: the second operand only within reach of its bound */
     real u11 = u16;
     real3 uc11 = uc16;
-    real ut11 = ut16;
+    real2 ut11 = ut16;
     real g11 = (length(p0 - ((real3)(R(0.5), -R(0.4), R(0.5)))) * R(0.9999)) - R(0.5073460357586329);
     if (!(g11 > u11 && g11 > R(0.0))) {
         /* .../a:union/a:union/b:translate */
@@ -864,7 +864,7 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
         real3 c18 = (real3)(0.4f, 0.8f, 0.45f);
         real d11 = fmin(u16, d17);
         real3 c11 = u16 < d17 ? uc16 : c18;
-        real t11 = u16 < d17 ? ut16 : R(1.0);
+        real2 t11 = u16 < d17 ? ut16 : (real2)(R(1.0));
         u11 = d11;
         uc11 = c11;
         ut11 = t11;
@@ -872,7 +872,7 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     /* .../a:union/a:union: the second operand only within reach of its bound */
     real u7 = u11;
     real3 uc7 = uc11;
-    real ut7 = ut11;
+    real2 ut7 = ut11;
     real g7 = (length(p0 - ((real3)(-R(0.6), -R(0.13), R(0.6)))) * R(0.9999)) - R(0.32);
     if (!(g7 > u7 && g7 > R(0.0))) {
         /* union/a:union/b:translate */
@@ -919,7 +919,7 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
         real3 c23 = (real3)(0.85f, 0.55f, 0.85f);
         real d7 = fmin(u11, d22);
         real3 c7 = u11 < d22 ? uc11 : c23;
-        real t7 = u11 < d22 ? ut11 : R(1.0);
+        real2 t7 = u11 < d22 ? ut11 : (real2)(R(1.0));
         u7 = d7;
         uc7 = c7;
         ut7 = t7;

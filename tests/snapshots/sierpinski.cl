@@ -159,7 +159,7 @@ real DE(real3 p0, __global const real* params) {
     return u4;
 }
 
-real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
+real DE_shade(real3 p0, __global const real* params, real3* color, real2* trap) {
     /* union */
     /* union/b:color/plane */
     real d2 = sd_plane(p0, (real3)(0.0f, 1.0f, 0.0f), 1.0f);
@@ -168,18 +168,18 @@ real DE_shade(real3 p0, __global const real* params, real3* color, real* trap) {
     /* union: the second operand only within reach of its bound */
     real u4 = d2;
     real3 uc4 = c3;
-    real ut4 = R(1.0);
+    real2 ut4 = (real2)(R(1.0));
     real g4 = R(0.3333333333333333) * ((length(p0) * R(0.9999)) - R(1.7320508075688772));
     if (!(g4 > u4 && g4 > R(0.0))) {
         /* union/a:color/sierpinski */
         real2 f0 = sierpinski(p0, 7, 2.0f);
         real d0 = f0.x;
-        real t0 = f0.y;
+        real2 t0 = (real2)(f0.y);
         /* union/a:color */
         real3 c1 = (real3)(0.95f, 0.75f, 0.45f);
         real d4 = fmin(d2, d0);
         real3 c4 = d2 < d0 ? c3 : c1;
-        real t4 = d2 < d0 ? R(1.0) : t0;
+        real2 t4 = d2 < d0 ? (real2)(R(1.0)) : t0;
         u4 = d4;
         uc4 = c4;
         ut4 = t4;

@@ -188,7 +188,7 @@ impl<'a> SceneEmitter<'a> {
             v.c
         };
         let t = if self.traps() {
-            self.choose("real", &v.t, &near, (&a.t, &b.t), blend.as_deref())
+            self.choose("real2", &v.t, &near, (&a.t, &b.t), blend.as_deref())
         } else {
             "R(1.0)".into()
         };

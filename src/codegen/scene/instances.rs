@@ -104,7 +104,7 @@ impl<'a> SceneEmitter<'a> {
             self.w.line(format!("{ty} {c} = {default};"));
         }
         if self.traps() {
-            self.w.line(format!("real {t} = R(1.0);"));
+            self.w.line(format!("real2 {t} = {};", super::NO_TRAP));
         }
         self.w
             .open(format!("for (uint i = 0u; i < {}u; i++)", members.len()));

@@ -45,6 +45,10 @@ mod instances;
 pub use instances::MIN_INSTANCES;
 use instances::*;
 
+/// The trap of a surface that has none (a `real2`: the trap that tints
+/// its colour, and the trap the shading layers show).
+const NO_TRAP: &str = "(real2)(R(1.0))";
+
 /// One node's result: the variable holding its distance, and expressions
 /// for its colour and orbit trap (a variable only where one is computed,
 /// so `DE_shade` declares nothing it does not read).
@@ -250,7 +254,7 @@ impl<'a> SceneEmitter<'a> {
             self.w.open(match (shade, material) {
                 (false, _) => "real DE(real3 p0, __global const real* params)",
                 (true, false) => {
-                    "real DE_shade(real3 p0, __global const real* params, real3* color, real* trap)"
+                    "real DE_shade(real3 p0, __global const real* params, real3* color, real2* trap)"
                 }
                 (true, true) => {
                     "real DE_material(real3 p0, __global const real* params, real16* material)"
@@ -420,7 +424,7 @@ impl<'a> SceneEmitter<'a> {
         Vars {
             d,
             c: self.default_surface(),
-            t: "R(1.0)".into(),
+            t: NO_TRAP.into(),
         }
     }
 
@@ -469,7 +473,8 @@ impl<'a> SceneEmitter<'a> {
         }
         self.w.line(format!("real {} = {pair}.x;", v.d));
         let t = if self.traps() {
-            self.w.line(format!("real {} = {pair}.y;", v.t));
+            // The trap tints the colour, and is the trap the layers show.
+            self.w.line(format!("real2 {} = (real2)({pair}.y);", v.t));
             v.t
         } else {
             "R(1.0)".into()
@@ -600,7 +605,7 @@ impl<'a> SceneEmitter<'a> {
             self.w.line(format!("{ty} uc{i} = {};", a.c));
         }
         if self.traps() {
-            self.w.line(format!("real ut{i} = {};", a.t));
+            self.w.line(format!("real2 ut{i} = {};", a.t));
         }
         let first = match op {
             CsgOp::Subtract => format!("-u{i}"),
@@ -1041,15 +1046,17 @@ impl<'a> SceneEmitter<'a> {
                 if !self.traps() {
                     return c;
                 }
-                // The fractal's own trap tints no colour here.
-                let t = "R(1.0)".to_string();
+                // The fractal's own trap tints no colour here; the layers
+                // still show it.
+                let raw = format!("({}).x", c.t);
+                let t = format!("(real2)(R(1.0), {raw})");
                 if !needs_color {
                     return Vars { t, ..c };
                 }
                 self.label(id);
                 let palette = &coloring.palette;
                 let args = [
-                    Arg::Value(&c.t),
+                    Arg::Value(&raw),
                     Arg::Scalar(coloring.near),
                     Arg::Scalar(coloring.far),
                 ];
