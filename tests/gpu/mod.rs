@@ -236,3 +236,40 @@ pub fn read_exr(path: &std::path::Path) -> (Vec<String>, Vec<Vec<f32>>) {
         .collect();
     (channels, pixels)
 }
+
+/// The unit direction of the ray through the centre of each pixel of a
+/// `width` × `height` image, row by row, from the camera's exported frame
+/// (an independent statement of the renderer's projection).
+pub fn pixel_rays(camera: &Camera, (width, height): (u32, u32)) -> Vec<DVec3> {
+    let e = fractal_sdf::output::CameraExport::new(camera, (width, height)).unwrap();
+    let half_h = (e.fov_y_degrees.unwrap().to_radians() / 2.0).tan();
+    let half_w = half_h * e.aspect;
+    let (forward, right, up) = (
+        DVec3::from(e.forward),
+        DVec3::from(e.right),
+        DVec3::from(e.up),
+    );
+    let mut out = Vec::new();
+    for j in 0..height {
+        for i in 0..width {
+            let u = ((f64::from(i) + 0.5) / (f64::from(width) / 2.0) - 1.0) * half_w;
+            let v = (1.0 - (f64::from(j) + 0.5) / (f64::from(height) / 2.0)) * half_h;
+            out.push((forward + right * u + up * v).normalize());
+        }
+    }
+    out
+}
+
+/// An inside shape: the ball of radius 1 at the origin, known only by its
+/// membership test, in a sphere of radius 1.5.
+pub fn inside_ball() -> fractal_sdf::scene::InsideShape {
+    use fractal_sdf::scene::{InsideBounds, InsideShape};
+    InsideShape::new(
+        "ball",
+        &[],
+        InsideBounds::sphere(DVec3::ZERO, 1.5),
+        |p, _| p.length() < 1.0,
+        "return length(p) < 1.0f;",
+    )
+    .unwrap()
+}

@@ -506,28 +506,6 @@ fn occlusion_leaves_no_pure_black_pixel_on_a_fractal() {
     assert_eq!(black, 0, "{black} pure black pixels");
 }
 
-/// The unit direction of the ray through the centre of each pixel, from
-/// the camera's exported frame, row by row.
-fn pixel_rays(camera: &Camera, (w, h): (u32, u32)) -> Vec<DVec3> {
-    let e = fractal_sdf::output::CameraExport::new(camera, (w, h)).unwrap();
-    let half_h = (e.fov_y_degrees.unwrap().to_radians() / 2.0).tan();
-    let half_w = half_h * e.aspect;
-    let (forward, right, up) = (
-        DVec3::from(e.forward),
-        DVec3::from(e.right),
-        DVec3::from(e.up),
-    );
-    let mut out = Vec::new();
-    for j in 0..h {
-        for i in 0..w {
-            let u = ((f64::from(i) + 0.5) / (f64::from(w) / 2.0) - 1.0) * half_w;
-            let v = (1.0 - (f64::from(j) + 0.5) / (f64::from(h) / 2.0)) * half_h;
-            out.push((forward + right * u + up * v).normalize());
-        }
-    }
-    out
-}
-
 /// Glow nodes: a glowing ball beside a plain one. A ray that misses both
 /// takes the glowing ball's colour times its strength times
 /// `exp(−24 θ)`, θ the smallest `d / (t + d)` of the ball's exact
@@ -565,7 +543,7 @@ fn glow_nodes_give_each_shape_its_own_halo() {
     let frame = r.render_layers(W, H).unwrap();
     let linear = &frame.layers.as_ref().unwrap().linear;
     let (mut got, mut want, mut misses) = (0.0, 0.0, 0);
-    for (i, rd) in pixel_rays(&camera, (W, H)).into_iter().enumerate() {
+    for (i, rd) in gpu::pixel_rays(&camera, (W, H)).into_iter().enumerate() {
         if frame.hit[i] {
             continue;
         }
@@ -630,15 +608,7 @@ fn glow_nodes_give_each_shape_its_own_halo() {
 /// for a halo).
 #[test]
 fn too_many_glow_nodes_are_refused() {
-    use fractal_sdf::scene::{InsideBounds, InsideShape};
-    let shape = InsideShape::new(
-        "ball",
-        &[],
-        InsideBounds::sphere(DVec3::ZERO, 1.5),
-        |p, _| p.length() < 1.0,
-        "return length(p) < 1.0f;",
-    )
-    .unwrap();
+    let shape = gpu::inside_ball();
     let scene = Scene::new(
         shape
             .node::<f64>([])

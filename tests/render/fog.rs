@@ -7,7 +7,6 @@
 
 use crate::gpu;
 
-use fractal_sdf::output::CameraExport;
 use fractal_sdf::prelude::*;
 use fractal_sdf::quality::Volumetric;
 use fractal_sdf::render::{Frame, Renderer};
@@ -38,28 +37,6 @@ fn render(scene: &Scene, effects: Effects, count: u32) -> Frame {
     frame
 }
 
-/// The unit direction of the ray through the centre of each pixel, row by
-/// row, from the camera's exported frame.
-fn rays(camera: &Camera) -> Vec<DVec3> {
-    let e = CameraExport::new(camera, (W, H)).unwrap();
-    let half_h = (e.fov_y_degrees.unwrap().to_radians() / 2.0).tan();
-    let half_w = half_h * e.aspect;
-    let (forward, right, up) = (
-        DVec3::from(e.forward),
-        DVec3::from(e.right),
-        DVec3::from(e.up),
-    );
-    let mut out = Vec::new();
-    for j in 0..H {
-        for i in 0..W {
-            let u = ((f64::from(i) + 0.5) / (f64::from(W) / 2.0) - 1.0) * half_w;
-            let v = (1.0 - (f64::from(j) + 0.5) / (f64::from(H) / 2.0)) * half_h;
-            out.push((forward + right * u + up * v).normalize());
-        }
-    }
-    out
-}
-
 /// Henyey and Greenstein's phase function times π, for `g` and the cosine
 /// between the light's direction of travel and the ray towards the camera.
 fn phase_pi(g: f64, cos: f64) -> f64 {
@@ -82,7 +59,7 @@ fn a_uniform_fog_scatters_a_lights_closed_form() {
     let scene = Scene::new(sphere(0.5).translate(dvec3(0.0, 0.0, 50.0)))
         .with_camera(camera)
         .with_lights([Light::directional(to_light).intensity(2.0)]);
-    let dirs = rays(&camera);
+    let dirs = gpu::pixel_rays(&camera, (W, H));
     for (density, g) in [(1.0, 0.0), (0.05, 0.0), (0.3, 0.6), (0.3, -0.4)] {
         let frame = render(
             &scene,
@@ -141,7 +118,7 @@ fn a_fog_thinning_with_height_matches_its_integral() {
         let layers = foggy.layers.as_ref().unwrap();
         let (mut worst, mut misses, mut hits): (f64, u32, u32) = (0.0, 0, 0);
         let mut darkest: f64 = 1.0;
-        for (i, rd) in rays(&camera).into_iter().enumerate() {
+        for (i, rd) in gpu::pixel_rays(&camera, (W, H)).into_iter().enumerate() {
             let hit = layers.linear[i][3] >= 1.0;
             let far = if hit {
                 (DVec3::from(layers.position[i].map(f64::from)) - eye).length()
@@ -191,7 +168,7 @@ fn shadows_cut_shafts_in_the_fog() {
     let linear = &frame.layers.as_ref().unwrap().linear;
     let open = 0.25;
     let (mut error, mut count, mut shaded) = (0.0, 0, 0);
-    for (i, rd) in rays(&camera).into_iter().enumerate() {
+    for (i, rd) in gpu::pixel_rays(&camera, (W, H)).into_iter().enumerate() {
         if linear[i][3] > 0.0 {
             continue;
         }

@@ -13,7 +13,7 @@ use fractal_sdf::file::SceneFile;
 use fractal_sdf::prelude::*;
 use fractal_sdf::quality::{GlobalIllumination, display};
 use fractal_sdf::render::{Frame, Renderer, StopRule};
-use fractal_sdf::scene::{Environment, EnvironmentMap, InsideBounds, InsideShape};
+use fractal_sdf::scene::{Environment, EnvironmentMap};
 
 const W: u32 = 48;
 const H: u32 = 32;
@@ -359,14 +359,7 @@ fn the_stopping_rule_estimates_the_true_noise() {
 /// on screen: the program is refused, naming the shape.
 #[test]
 fn global_illumination_refuses_inside_shapes() {
-    let shape = InsideShape::new(
-        "ball",
-        &[],
-        InsideBounds::sphere(DVec3::ZERO, 1.5),
-        |p, _| p.length() < 1.0,
-        "return length(p) < 1.0f;",
-    )
-    .unwrap();
+    let shape = gpu::inside_ball();
     let scene = Scene::new(shape.node::<f64>([]).union(plane(DVec3::Y, -1.0)));
     let compiled = scene.compile().unwrap();
     let options = Options::default().effects(gi(8));

@@ -516,15 +516,19 @@ fn spinner(message: String) -> ProgressBar {
     bar
 }
 
-fn render(args: &RenderArgs, settings: &Settings) -> Outcome {
-    image_extension(&args.output).map_err(|e| usage(e.to_string()))?;
-    let stereo = args.stereo()?;
-    let aovs = args
-        .aov
+/// The outputs `--aov` names, empty names skipped.
+fn parse_aovs(names: &[String]) -> Outcome<Vec<Aov>> {
+    names
         .iter()
         .filter(|name| !name.trim().is_empty())
         .map(|name| Aov::from_name(name).map_err(|e| usage(format!("--aov: {e}"))))
-        .collect::<Outcome<Vec<Aov>>>()?;
+        .collect()
+}
+
+fn render(args: &RenderArgs, settings: &Settings) -> Outcome {
+    image_extension(&args.output).map_err(|e| usage(e.to_string()))?;
+    let stereo = args.stereo()?;
+    let aovs = parse_aovs(&args.aov)?;
     let mut job = Job::new(&args.scene, settings)?;
     let camera = &mut job.file.scene.camera;
     if let Some(aperture) = args.aperture {
@@ -780,12 +784,7 @@ fn sequence(args: &SequenceArgs, settings: &Settings) -> Outcome {
             )));
         }
     }
-    let aovs = args
-        .aov
-        .iter()
-        .filter(|name| !name.trim().is_empty())
-        .map(|name| Aov::from_name(name).map_err(|e| usage(format!("--aov: {e}"))))
-        .collect::<Outcome<Vec<Aov>>>()?;
+    let aovs = parse_aovs(&args.aov)?;
     let seq = Sequence::for_duration(&args.out, args.fps, path.duration())?
         .motion_blur(MotionBlur::new(args.motion_blur, args.shutter))?
         .format(&args.format)
