@@ -227,14 +227,68 @@ real3 march_rect_light(__global const real* l, real3 p, real u, real v, real3* t
     return seen > R(0.0) ? vload3(0, l + LIGHT_RADIANCE) * (seen / d2) : (real3)(R(0.0));
 }
 
+// The light the surface at p gives off: its albedo times its material's
+// emission (none without materials).
+real3 march_emission(real3 p, __global const real* params, uint* evals) {
+#ifdef ENABLE_MATERIALS
+    real16 material;
+    DE_material(p, params, &material);
+    *evals += 1u;
+    if (material.MATERIAL_EMISSION > R(0.0)) {
+        real3 albedo;
+        real2 trap;
+        DE_shade(p, params, &albedo, &trap);
+        *evals += 1u;
+        return albedo * march_trap_tint(trap.x) * material.MATERIAL_EMISSION;
+    }
+#endif
+    return (real3)(R(0.0));
+}
+
+#ifdef ENABLE_EMITTERS
+// The cone of emitter e's bounding sphere (EMITTER_BOUNDS) seen from o:
+// its unit axis, and 1 - cos of its half-angle (as sin^2 / (1 + cos), no
+// cancellation for a small one); 0 where o is inside the sphere.
+int march_emitter_cone(int e, real3 o, real3* axis, real* one_minus_cos) {
+    real4 b = EMITTER_BOUNDS[e];
+    real3 to = b.xyz - o;
+    real d2 = dot(to, to);
+    real r2 = b.w * b.w;
+    if (d2 <= r2) {
+        return 0;
+    }
+    real sin2 = r2 / d2;
+    *axis = to / sqrt(d2);
+    *one_minus_cos = sin2 / (R(1.0) + sqrt(R(1.0) - sin2));
+    return 1;
+}
+
+// The sum of the squares of the densities with which the emitters'
+// sampling (one direction in each one's cone) draws the direction d from
+// o: what the power heuristic weighs a direction against.
+real march_emitters_pdf2(real3 o, real3 d) {
+    real sum = R(0.0);
+    for (int e = 0; e < EMITTERS; ++e) {
+        real3 axis;
+        real omc;
+        if (march_emitter_cone(e, o, &axis, &omc) && dot(d, axis) >= R(1.0) - omc) {
+            real pdf = R(1.0) / (R(2.0) * GI_PI * omc);
+            sum += pdf * pdf;
+        }
+    }
+    return sum;
+}
+#endif
+
 // Next-event estimation at the surface point p (normal n facing the path,
 // hit threshold eps, `travelled` from the camera) reached along rd on
 // bounce `bounce` of sample j of the pixel: the light of every light that
 // sees p, through the surface's scattering (a sphere or rectangle light
-// from a point of it drawn at random), and with an environment a direction drawn from
-// it by importance, weighted against the surface's own sampling of the
-// same direction by the power heuristic (march_path traces that sampling
-// at every surface, the last included).
+// from a point of it drawn at random), with an environment a direction drawn from
+// it by importance, and with emissive shapes (ENABLE_EMITTERS) a direction
+// in each one's bounding cone, each weighted against the surface's own
+// sampling of the same direction by the power heuristic (march_path traces
+// that sampling at every surface, the last included).
 real3 march_direct(real3 p, real3 n, real3 rd, real eps, real travelled, const MarchCamera* cam,
                    real3 albedo, real ks, real shininess, real sigma, uint pixel, uint j,
                    int bounce, __global const real* params, __global const real* lights,
@@ -255,6 +309,43 @@ real3 march_direct(real3 p, real3 n, real3 rd, real eps, real travelled, const M
                        * (ndl * weight / (GI_PI * pdf));
             }
         }
+    }
+#endif
+#ifdef ENABLE_EMITTERS
+    // Each emissive shape's bounding sphere: a direction drawn in its cone,
+    // and whatever gives off light where that ray hits, weighted against
+    // the surface's own sampling and the other emitters' by the power
+    // heuristic.
+    for (int e = 0; e < EMITTERS; ++e) {
+        real3 axis;
+        real omc;
+        if (!march_emitter_cone(e, p, &axis, &omc)) {
+            continue;
+        }
+        uint own = j ^ march_hash(0x85ebca6bu * (uint)(e + 1));
+        real cos_t = R(1.0) - march_random(pixel, own, bounce, 5u) * omc;
+        real3 d = march_around(axis, cos_t, march_random(pixel, own, bounce, 6u));
+        real ndl = dot(n, d);
+        if (ndl <= R(0.0)) {
+            continue;
+        }
+        real3 lifted = p + n * (R(2.0) * eps);
+        MarchCamera along = *cam;
+        along.footprint_base = march_footprint(cam, travelled);
+        MarchResult m = march_ray(lifted, d, R(0.0), &along, R(1.0), params);
+        *evals += (uint)m.steps;
+        if (!m.hit) {
+            continue;
+        }
+        real3 emitted = march_emission(lifted + d * m.t, params, evals);
+        if (!(emitted.x + emitted.y + emitted.z > R(0.0))) {
+            continue;
+        }
+        real pdf = R(1.0) / (R(2.0) * GI_PI * omc);
+        real drawn = march_brdf_pdf(n, rd, d, ks, shininess);
+        real others = sqrt(fmax(drawn * drawn + march_emitters_pdf2(p, d) - pdf * pdf, R(0.0)));
+        sum += emitted * march_brdf(n, d, rd, albedo, ks, shininess, sigma, ndl)
+               * (ndl * march_power_heuristic(pdf, others) / (GI_PI * pdf));
     }
 #endif
     for (int i = 0; i < light_count; ++i) {
@@ -285,24 +376,6 @@ real3 march_direct(real3 p, real3 n, real3 rd, real eps, real travelled, const M
     return sum;
 }
 
-// The light the surface at p gives off: its albedo times its material's
-// emission (none without materials).
-real3 march_emission(real3 p, __global const real* params, uint* evals) {
-#ifdef ENABLE_MATERIALS
-    real16 material;
-    DE_material(p, params, &material);
-    *evals += 1u;
-    if (material.MATERIAL_EMISSION > R(0.0)) {
-        real3 albedo;
-        real2 trap;
-        DE_shade(p, params, &albedo, &trap);
-        *evals += 1u;
-        return albedo * march_trap_tint(trap.x) * material.MATERIAL_EMISSION;
-    }
-#endif
-    return (real3)(R(0.0));
-}
-
 // The light a path brings to the camera from its first hit: the surface
 // point p (normal n, facing the ray) reached t along rd, for sample j of
 // the pixel. Each surface the path meets chooses, by chance in proportion
@@ -327,11 +400,17 @@ real3 march_path(real3 p, real3 n, real3 rd, real t, const MarchCamera* cam, uin
     // with, 0 for a mirror or a refraction: where the path then leaves,
     // the environment's light is weighted against its own sampling.
     real drawn = R(0.0);
+    // Where the ray that reached p left from.
+    real3 from = p;
     for (int bounce = 0;; ++bounce) {
         real eps = DETAIL * march_footprint(cam, travelled);
         real choose = march_random(pixel, j, bounce, 0u);
         real3 next = rd;
         real3 ro = p;
+        // The surface point the next ray scatters from.
+        real3 at = p;
+        // The density the surface before drew the ray to p with.
+        real arrived = drawn;
         drawn = R(0.0);
         if (inside) {
             // Leaving a transparent shape: n is its outward normal.
@@ -374,7 +453,14 @@ real3 march_path(real3 p, real3 n, real3 rd, real t, const MarchCamera* cam, uin
             real r = material.MATERIAL_REFLECTIVITY;
             real tau = material.MATERIAL_TRANSPARENCY;
             reflected = r;
-            radiance += throughput * albedo * material.MATERIAL_EMISSION;
+            real3 emitted = albedo * material.MATERIAL_EMISSION;
+#ifdef ENABLE_EMITTERS
+            // Light the emitters' sampling could have found too.
+            if (arrived > R(0.0)) {
+                emitted *= march_power_heuristic(arrived, sqrt(march_emitters_pdf2(from, rd)));
+            }
+#endif
+            radiance += throughput * emitted;
             if (tau > R(0.0)) {
                 real ior = material.MATERIAL_IOR;
                 real fresnel = march_fresnel(clamp(-dot(n, rd), R(0.0), R(1.0)), ior);
@@ -457,10 +543,17 @@ real3 march_path(real3 p, real3 n, real3 rd, real t, const MarchCamera* cam, uin
         // it.
         if (bounce >= GI_BOUNCES) {
             if (!inside) {
-                radiance += throughput * march_emission(p, params, evals);
+                real3 emitted = march_emission(p, params, evals);
+#ifdef ENABLE_EMITTERS
+                if (drawn > R(0.0)) {
+                    emitted *= march_power_heuristic(drawn, sqrt(march_emitters_pdf2(at, rd)));
+                }
+#endif
+                radiance += throughput * emitted;
             }
             break;
         }
+        from = at;
         travelled += m.t;
         real footprint = march_footprint(&along, m.t);
         n = march_normal(p, NORMAL_EPSILON * footprint, rd, params);

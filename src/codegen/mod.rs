@@ -384,6 +384,7 @@ pub fn emit_ir(ir: &Ir, options: &Options) -> Result<KernelSource> {
         glow: glow_bound(ir, options, origin),
         origin,
         node_glow: (glows > 0).then(|| (glows, node_glow(ir))),
+        emitters: emitters(ir, options, origin),
     };
     let used = std::mem::take(&mut emitter.used);
     let trapped = std::mem::take(&mut emitter.trapped);
@@ -554,6 +555,42 @@ fn fog_light(options: &Options) -> bool {
 /// may have: each halo is traced on its own, at every step near a surface.
 pub const MAX_GLOW_NODES: usize = 16;
 
+/// The switch of the sampling of emissive shapes under global
+/// illumination ([`emitters`]).
+const EMITTERS: &str = "ENABLE_EMITTERS";
+
+/// The most emissive shapes a path-traced program samples: more are still
+/// lit by, and light, the paths that meet them.
+const MAX_EMITTERS: usize = 16;
+
+/// For a path-traced rendering program, the bounding spheres (in the
+/// program's frame, about `origin`) of the material nodes that give off
+/// light (an emission above 0, or a dynamic one) and have a bound the
+/// precision can hold: next-event estimation draws a direction in each
+/// one's cone at every bounce. Emitters beyond [`MAX_EMITTERS`], or
+/// without a bound, are found by the paths' bounces alone (their light is
+/// exact all the same, only noisier).
+fn emitters(ir: &Ir, options: &Options, origin: DVec3) -> Vec<Bound> {
+    if options.target != Target::Render || options.effects.global_illumination.is_none() {
+        return Vec::new();
+    }
+    let bounds = ir.bounds();
+    ir.materials()
+        .into_iter()
+        .filter(|&id| match ir.node(id) {
+            Kind::Material { material, .. } => material.emission != Scalar::Baked(0.0),
+            _ => false,
+        })
+        .filter_map(|id| bounds[id.index()])
+        .map(|b| Bound {
+            centre: b.centre - origin,
+            ..b
+        })
+        .filter(|b| b.fits(options.quality.precision.limits()))
+        .take(MAX_EMITTERS)
+        .collect()
+}
+
 /// The switch of glow nodes' halos ([`crate::scene::Node::glow`]).
 const NODE_GLOW: &str = "ENABLE_NODE_GLOW";
 
@@ -580,8 +617,11 @@ fn node_glow(ir: &Ir) -> f64 {
 }
 
 /// What a scene asks of its program beyond the quality and effects.
-#[derive(Debug, Clone, Copy, Default)]
+#[derive(Debug, Clone, Default)]
 pub(crate) struct Features {
+    /// The bounding spheres of the shapes that give off light, in the
+    /// program's frame, for a path-traced program to sample ([`emitters`]).
+    pub(crate) emitters: Vec<Bound>,
     /// Where the program's `DE` has its origin in the scene
     /// ([`KernelSource::origin`]).
     pub(crate) origin: DVec3,
@@ -665,6 +705,9 @@ fn kernel_with(options: &Options, bounded: bool, features: &Features) -> String 
         if !on.contains(&Effect::Glow.switch()) {
             on.push(Effect::Glow.switch());
         }
+    }
+    if !features.emitters.is_empty() {
+        on.push(EMITTERS);
     }
     select_blocks(kernel, &on)
 }
@@ -951,6 +994,28 @@ fn header(w: &mut writer::Writer, options: &Options, features: &Features) {
     }
     if features.brute.is_some() {
         w.line(format!("#define {BRUTE}"));
+    }
+    if !features.emitters.is_empty() {
+        w.line("/* The bounding spheres of the shapes that give off light. */");
+        w.line(format!("#define EMITTERS {}", features.emitters.len()));
+        let spheres: Vec<String> = features
+            .emitters
+            .iter()
+            .map(|b| {
+                let c = b.centre;
+                format!(
+                    "(real4)({}, {}, {}, {})",
+                    w.float(c.x),
+                    w.float(c.y),
+                    w.float(c.z),
+                    w.float(b.radius)
+                )
+            })
+            .collect();
+        w.line(format!(
+            "__constant real4 EMITTER_BOUNDS[EMITTERS] = {{{}}};",
+            spheres.join(", ")
+        ));
     }
     w.line("/* The kernel interface (src/codegen/interface.rs). */");
     w.raw(&interface::defines(options.target));

@@ -151,6 +151,11 @@ fn library_texts() -> Vec<String> {
                 }),
                 origin: DVec3::ZERO,
                 node_glow: Some((1, 1.0)),
+                emitters: vec![crate::ir::Bound {
+                    centre: DVec3::ZERO,
+                    radius: 1.0,
+                    slope: 1.0,
+                }],
             };
             header(&mut w, &options, &features);
             texts.push(w.finish());

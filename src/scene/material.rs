@@ -76,9 +76,10 @@ pub struct Material<S = Param> {
     /// 0; 0: none): a white surface of emission 1 is as bright as a white
     /// surface lit square on by a light of intensity 1. The camera,
     /// mirrors and glass see it in every mode; it lights other surfaces
-    /// only under global illumination, where a path that meets it brings
-    /// its light back (emitters are found by the paths' bounces, not
-    /// sampled like lights: small bright ones are noisy).
+    /// only under global illumination, where every bounce of a path also
+    /// draws a direction towards each emissive shape's bounding sphere
+    /// (up to 16 shapes with a bound; others are found by the bounces
+    /// alone), weighted against the bounce's own by the power heuristic.
     pub emission: S,
 }
 

@@ -651,7 +651,7 @@ fn an_emissive_ball_lights_the_floor_as_its_closed_form_says() {
         .color(color)
         .material(Material::emissive(emission));
     let eye = dvec3(0.0, 2.5, 3.0);
-    let scene = Scene::new(floor.union(ball))
+    let scene = Scene::new(floor.clone().union(ball))
         .with_camera(Camera::look_at(eye, dvec3(0.0, 0.3, 0.0)))
         .with_lights([]);
     let black = Effects::default()
@@ -718,6 +718,46 @@ fn an_emissive_ball_lights_the_floor_as_its_closed_form_says() {
     }
     let bias = got / wanted - 1.0;
     eprintln!("emissive ball: relative error of the mean {bias:.4} over {count} pixel channels");
+    // Sixteen passes: the emitter is sampled at every bounce (its bounding
+    // sphere's cone), against the same ball repeated every 1,000 units (no
+    // bound, so only the bounces find it): the floor's noise.
+    let noise = |scene: &Scene| {
+        let mut renderer = Renderer::with_options(scene, &options).unwrap();
+        let frame = passes(&mut renderer, 16);
+        let layers = frame.layers.as_ref().unwrap();
+        let (mut squares, mut n) = (0.0, 0.0);
+        for (c, p) in layers.linear.iter().zip(&layers.position) {
+            let q = glam::Vec3::from(*p).as_dvec3();
+            let delta = centre - q;
+            let along = (q - eye).normalize();
+            let passing = (centre - eye).reject_from_normalized(along).length();
+            if c[3] < 1.0 || passing < radius + 0.4 || q.y > 0.3 || delta.length() > 2.5 {
+                continue;
+            }
+            let want =
+                emission * color.x * radius * radius / delta.length_squared() * delta.normalize().y;
+            squares += ((f64::from(c[0]) - want) / want).powi(2);
+            n += 1.0;
+        }
+        (squares / n).sqrt()
+    };
+    let sampled = noise(&scene);
+    let unbounded = sphere(radius)
+        .repeat(dvec3(1000.0, 1000.0, 1000.0))
+        .translate(centre)
+        .color(color)
+        .material(Material::emissive(emission));
+    let mut alone = scene.clone();
+    alone.geometry = Some(floor.union(unbounded));
+    let found = noise(&alone);
+    eprintln!(
+        "emissive ball: relative RMS error of a floor pixel at 16 passes {sampled:.4} \
+         sampled, {found:.4} found by bounces alone"
+    );
+    assert!(
+        sampled < 0.1 && sampled < 0.5 * found,
+        "{sampled} against {found}"
+    );
     assert!(
         count > 500.0 && bias.abs() < 0.015,
         "relative error of the mean {bias}"
