@@ -693,26 +693,28 @@ fn an_emissive_ball_lights_the_floor_as_its_closed_form_says() {
         black.global_illumination(GlobalIllumination::new(1)),
     );
     let mut renderer = Renderer::with_options(&scene, &options).unwrap();
+    // The closed form at the floor's points near the ball (the hit
+    // threshold lifts them), for a pixel wholly on the floor whose rays
+    // (jittered in the pixel by the passes) none come near the ball: the
+    // factor of the ball's radiance the floor reflects there.
+    let floor_share = |c: [f32; 4], p: [f32; 3]| {
+        let q = glam::Vec3::from(p).as_dvec3();
+        let delta = centre - q;
+        let along = (q - eye).normalize();
+        let passing = (centre - eye).reject_from_normalized(along).length();
+        let near = c[3] >= 1.0 && passing >= radius + 0.4 && q.y <= 0.3 && delta.length() <= 2.5;
+        near.then(|| radius * radius / delta.length_squared() * delta.normalize().y)
+    };
     let frame = passes(&mut renderer, 1024);
     let layers = frame.layers.as_ref().unwrap();
     let (mut got, mut wanted, mut count) = (0.0, 0.0, 0.0);
     for (c, p) in layers.linear.iter().zip(&layers.position) {
-        // The floor's points near the ball (the hit threshold lifts them),
-        // where the ball is large enough for the bounces to find it often.
-        // Passes jitter the rays in their pixel: none of a pixel's may
-        // come near the ball.
-        let q = glam::Vec3::from(*p).as_dvec3();
-        let delta = centre - q;
-        let along = (q - eye).normalize();
-        let passing = (centre - eye).reject_from_normalized(along).length();
-        if c[3] < 1.0 || passing < radius + 0.4 || q.y > 0.3 || delta.length() > 2.5 {
+        let Some(share) = floor_share(*c, *p) else {
             continue;
-        }
+        };
         for (channel, tint) in [(0, color.x), (2, color.z)] {
-            let want =
-                emission * tint * radius * radius / delta.length_squared() * delta.normalize().y;
             got += f64::from(c[channel]);
-            wanted += want;
+            wanted += emission * tint * share;
             count += 1.0;
         }
     }
@@ -727,15 +729,10 @@ fn an_emissive_ball_lights_the_floor_as_its_closed_form_says() {
         let layers = frame.layers.as_ref().unwrap();
         let (mut squares, mut n) = (0.0, 0.0);
         for (c, p) in layers.linear.iter().zip(&layers.position) {
-            let q = glam::Vec3::from(*p).as_dvec3();
-            let delta = centre - q;
-            let along = (q - eye).normalize();
-            let passing = (centre - eye).reject_from_normalized(along).length();
-            if c[3] < 1.0 || passing < radius + 0.4 || q.y > 0.3 || delta.length() > 2.5 {
+            let Some(share) = floor_share(*c, *p) else {
                 continue;
-            }
-            let want =
-                emission * color.x * radius * radius / delta.length_squared() * delta.normalize().y;
+            };
+            let want = emission * color.x * share;
             squares += ((f64::from(c[0]) - want) / want).powi(2);
             n += 1.0;
         }
