@@ -23,6 +23,7 @@
 //! # Ok::<(), fractal_sdf::Error>(())
 //! ```
 
+mod bvh;
 mod formulas;
 mod helpers;
 pub(crate) mod interface;
@@ -30,7 +31,8 @@ pub(crate) mod names;
 mod scene;
 mod writer;
 
-pub use scene::MIN_INSTANCES;
+pub use bvh::InstanceTables;
+pub use scene::{MIN_HIERARCHY, MIN_INSTANCES};
 pub use writer::literal;
 
 use std::sync::atomic::{AtomicU64, Ordering};
@@ -205,6 +207,10 @@ pub struct KernelSource {
     /// dynamic values followed by these. Like dynamic values, they never
     /// change the source or its hash.
     pub constants: Vec<f64>,
+    /// Which entries of [`constants`](Self::constants) copy a dynamic
+    /// value, and the hierarchies over instances fitted again when one
+    /// changes: [`param_buffer`](Self::param_buffer) applies them.
+    pub tables: InstanceTables,
 }
 
 /// Where a custom shape's OpenCL function lies in a generated program: its
@@ -242,6 +248,9 @@ impl KernelSource {
         let mut buffer = Vec::with_capacity(values.len() + self.constants.len());
         buffer.extend_from_slice(values);
         buffer.extend_from_slice(&self.constants);
+        if !self.tables.is_baked() {
+            self.tables.fill(&mut buffer[values.len()..], values);
+        }
         buffer
     }
 
@@ -393,6 +402,7 @@ pub fn emit_ir(ir: &Ir, options: &Options) -> Result<KernelSource> {
     let mut hybrids: Vec<_> = std::mem::take(&mut emitter.hybrids).into_values().collect();
     hybrids.sort_by(|a, b| a.0.cmp(&b.0));
     let constants = std::mem::take(&mut emitter.constants);
+    let tables = std::mem::take(&mut emitter.tables);
 
     let mut w = writer::Writer::new(precision);
     header(&mut w, options, &features);
@@ -468,6 +478,7 @@ pub fn emit_ir(ir: &Ir, options: &Options) -> Result<KernelSource> {
     )?;
     kernel.custom_regions = custom_regions;
     kernel.constants = constants;
+    kernel.tables = tables;
     Ok(kernel)
 }
 
@@ -856,6 +867,7 @@ fn finish(
         kernel_start,
         custom_regions: Vec::new(),
         constants: Vec::new(),
+        tables: InstanceTables::default(),
     })
 }
 

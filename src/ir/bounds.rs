@@ -146,7 +146,7 @@ impl Ir {
 }
 
 /// The bound of one node from its children's.
-pub(super) fn bound(node: &IrNode, done: &[Option<Bound>]) -> Option<Bound> {
+pub(crate) fn bound(node: &IrNode, done: &[Option<Bound>]) -> Option<Bound> {
     let of = |c: &NodeId| done[c.index()];
     let baked = Scalar::baked;
     let origin = DVec3::ZERO;

@@ -25,7 +25,7 @@ use glam::DVec3;
 
 pub use bounds::{Bound, SHRINK};
 pub(crate) use bounds::{
-    Reach, UnionChain, constant, costs, is_hard_union, reach, swaps, union_chain,
+    Reach, UnionChain, bound, constant, costs, is_hard_union, reach, swaps, union_chain,
 };
 pub use compiled::{CompiledScene, MAX_LIGHTS};
 pub use params::{Constraint, ParamLayout, ParamSlot, ParamValues, Relation};

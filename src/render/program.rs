@@ -307,6 +307,7 @@ mod tests {
             origin: DVec3::ZERO,
             kernel_start: 0,
             constants: Vec::new(),
+            tables: crate::codegen::InstanceTables::default(),
             // Signature on line 9, body on lines 10 and 11, brace on 12.
             custom_regions: vec![CustomRegion {
                 shape: "gyroid".into(),

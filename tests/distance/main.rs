@@ -23,6 +23,8 @@ mod fractals;
 #[cfg(feature = "proptest")]
 mod hybrid;
 #[cfg(feature = "proptest")]
+mod instances;
+#[cfg(feature = "proptest")]
 mod julia;
 #[cfg(feature = "proptest")]
 mod kifs;

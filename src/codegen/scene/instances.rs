@@ -1,7 +1,9 @@
 //! Instancing: the operands of one tree of hard unions that differ only in
 //! baked values become one loop over a table of those values.
 
+use super::super::bvh::{Bvh, NODE_LEN, Refit, STACK, chain_bound};
 use super::*;
+use crate::ir::SHRINK;
 
 impl<'a> SceneEmitter<'a> {
     /// Enters the union tree under `id` as one: its operands that differ
@@ -37,14 +39,24 @@ impl<'a> SceneEmitter<'a> {
         }
         // Operands grouped by shape, groups in the order they first appear.
         let mut order: Vec<String> = Vec::new();
-        let mut groups: HashMap<String, Vec<(NodeId, Vec<f64>)>> = HashMap::new();
+        let mut groups: HashMap<String, Vec<Member>> = HashMap::new();
         for &operand in &operands {
-            if let Some(Instance { shape, values, .. }) = instance(ir, operand) {
+            if let Some(Instance {
+                shape,
+                values,
+                copies,
+                ..
+            }) = instance(ir, operand, &self.defaults)
+            {
                 let group = groups.entry(shape.clone()).or_insert_with(|| {
                     order.push(shape);
                     Vec::new()
                 });
-                group.push((operand, values));
+                group.push(Member {
+                    id: operand,
+                    values,
+                    copies,
+                });
             }
         }
         order.retain(|shape| groups[shape].len() >= MIN_INSTANCES);
@@ -55,7 +67,7 @@ impl<'a> SceneEmitter<'a> {
         let mut results = Vec::new();
         for shape in &order {
             let members = &groups[shape];
-            looped.extend(members.iter().map(|(operand, _)| *operand));
+            looped.extend(members.iter().map(|m| m.id));
             results.push(self.instance_loop(members, p, needs_color));
         }
         self.clusters.insert(
@@ -74,30 +86,29 @@ impl<'a> SceneEmitter<'a> {
     /// One loop over a group of instances: the first member's code, reading
     /// each member's values from its row of the table. Keeps the nearest
     /// member's colour and trap (the later one on a tie, as the unrolled
-    /// unions would).
-    pub(super) fn instance_loop(
-        &mut self,
-        members: &[(NodeId, Vec<f64>)],
-        p: &str,
-        needs_color: bool,
-    ) -> Vars {
-        let (first, _) = members[0];
-        let chain = instance(self.ir, first)
+    /// unions would). A group of at least [`MIN_HIERARCHY`] members that
+    /// all have bounds is walked through a bounding volume hierarchy
+    /// instead ([`bvh`](super::bvh)), which skips the members too far away
+    /// to change the minimum.
+    pub(super) fn instance_loop(&mut self, members: &[Member], p: &str, needs_color: bool) -> Vars {
+        let first = members[0].id;
+        let chain = instance(self.ir, first, &self.defaults)
             .expect("members are instances")
             .chain;
-        let stride = members[0].1.len();
-        let start = self.slots + self.constants.len();
-        for (_, values) in members {
-            self.constants.extend_from_slice(values);
-        }
+        let template = template(&chain);
+        let stride = members[0].values.len();
+        let hierarchy = if members.len() >= MIN_HIERARCHY {
+            let bounds: Option<Vec<Bound>> = members
+                .iter()
+                .map(|m| chain_bound(&template, &m.values))
+                .collect();
+            bounds.and_then(|b| Bvh::build(&b))
+        } else {
+            None
+        };
         let r = first.index();
         let (d, c, t) = (format!("dg{r}"), format!("cg{r}"), format!("tg{r}"));
         let colour = self.shade && needs_color;
-        self.w.comment(&format!(
-            "{} instances of {}: {stride} values each from params[{start}]",
-            members.len(),
-            self.ir.path_tail(first, 2)
-        ));
         self.w.line(format!("real {d} = INFINITY;"));
         if colour {
             let (ty, default) = (self.surface_type(), self.default_surface());
@@ -106,16 +117,40 @@ impl<'a> SceneEmitter<'a> {
         if self.traps() {
             self.w.line(format!("real2 {t} = {};", super::NO_TRAP));
         }
-        self.w
-            .open(format!("for (uint i = 0u; i < {}u; i++)", members.len()));
+        let (start, row) = match &hierarchy {
+            Some(bvh) => self.hierarchy_open(members, bvh, template, stride, r, p),
+            None => {
+                let start = self.slots + self.constants.len();
+                for m in members {
+                    self.table_row(m);
+                }
+                self.w.comment(&format!(
+                    "{} instances of {}: {stride} values each from params[{start}]",
+                    members.len(),
+                    self.ir.path_tail(first, 2)
+                ));
+                self.w
+                    .open(format!("for (uint i = 0u; i < {}u; i++)", members.len()));
+                (start, stride)
+            }
+        };
         self.w.line(format!(
-            "__global const real* q = params + {start}u + i * {stride}u;"
+            "__global const real* q = params + {start}u + i * {row}u;"
         ));
         self.instance = chain.into_iter().collect();
         let v = self.node(first, p, needs_color);
         self.instance.clear();
         if self.shade {
-            self.w.open(format!("if ({} <= {d})", v.d));
+            // The later member on a tie: by its place in the union, which
+            // a hierarchy's table keeps after the member's values.
+            let nearer = match &hierarchy {
+                Some(_) => {
+                    self.w.line(format!("uint k = (uint)q[{stride}];"));
+                    format!("{} < {d} || ({} == {d} && k >= kg{r})", v.d, v.d)
+                }
+                None => format!("{} <= {d}", v.d),
+            };
+            self.w.open(format!("if ({nearer})"));
             self.w.line(format!("{d} = {};", v.d));
             if colour {
                 self.w.line(format!("{c} = {};", v.c));
@@ -123,44 +158,185 @@ impl<'a> SceneEmitter<'a> {
             if self.traps() {
                 self.w.line(format!("{t} = {};", v.t));
             }
+            if hierarchy.is_some() {
+                self.w.line(format!("kg{r} = k;"));
+            }
             self.w.close();
         } else {
             self.w.line(format!("{d} = fmin({d}, {});", v.d));
         }
         self.w.close();
+        if hierarchy.is_some() {
+            self.hierarchy_close(r, &d);
+        }
         Vars {
             d,
             c: if colour { c } else { self.default_surface() },
             t: if self.traps() { t } else { "R(1.0)".into() },
         }
     }
+
+    /// Lays out a hierarchy's table (each member's values, then its place
+    /// in the union, in the order of the leaves) and its nodes, and opens
+    /// the walk down to the loop over a leaf's members. Returns where the
+    /// table starts and its row length.
+    fn hierarchy_open(
+        &mut self,
+        members: &[Member],
+        bvh: &Bvh,
+        template: Vec<IrNode>,
+        stride: usize,
+        r: usize,
+        p: &str,
+    ) -> (usize, usize) {
+        let table = self.constants.len();
+        let start = self.slots + table;
+        for &i in &bvh.order {
+            self.table_row(&members[i]);
+            self.constants.push(i as f64);
+        }
+        let nodes = self.slots + self.constants.len();
+        let row = stride + 1;
+        if members.iter().any(|m| !m.copies.is_empty()) {
+            self.tables.refits.push(Refit {
+                table,
+                row,
+                members: members.len(),
+                nodes: self.constants.len(),
+                count: bvh.len(),
+                chain: template,
+                slope: bvh.slope,
+            });
+        }
+        self.constants.extend_from_slice(&bvh.nodes);
+        self.w.comment(&format!(
+            "{} instances of {}: {stride} values and a place each from params[{start}] - \
+             walked through {} boxes from params[{nodes}]",
+            members.len(),
+            self.ir.path_tail(members[0].id, 2),
+            bvh.len()
+        ));
+        let (n, stack, gaps, sp) = (
+            format!("bn{r}"),
+            format!("bs{r}"),
+            format!("bd{r}"),
+            format!("bp{r}"),
+        );
+        if self.shade {
+            self.w.line(format!("uint kg{r} = 0u;"));
+        }
+        // A node's gap: the distance from the point to its box, times the
+        // smallest slope and shortened as bounds are (`Bound::distance`).
+        let scale = self.w.float(bvh.slope * SHRINK);
+        let gap = |node: &str| {
+            format!(
+                "{scale} * length(fmax(fmax(vload3(0, params + {nodes}u + {node} * \
+                 {NODE_LEN}u) - {p}, {p} - vload3(1, params + {nodes}u + {node} * {NODE_LEN}u)), \
+                 (real3)(R(0.0))))"
+            )
+        };
+        // Whether a node may hold a member nearer than the minimum so far:
+        // inside its box, or nearer than the minimum.
+        let open = |g: &str| format!("({g} <= R(0.0) || {g} < dg{r})");
+        self.w.line(format!("uint {stack}[{STACK}];"));
+        self.w.line(format!("real {gaps}[{STACK}];"));
+        self.w.line(format!("uint {sp} = 0u, {n} = 0u;"));
+        self.w.open("for (;;)");
+        self.w.line(format!(
+            "__global const real* node = params + {nodes}u + {n} * {NODE_LEN}u;"
+        ));
+        self.w
+            .line("uint first = (uint)node[6], count = (uint)node[7];");
+        self.w.open("if (count == 0u)");
+        self.w.line(format!("real ga = {};", gap("first")));
+        self.w.line(format!("real gb = {};", gap("(first + 1u)")));
+        self.w
+            .line(format!("bool va = {}, vb = {};", open("ga"), open("gb")));
+        self.w.open("if (va && vb)");
+        self.w.line("bool a_first = ga <= gb;");
+        self.w
+            .line(format!("{stack}[{sp}] = a_first ? first + 1u : first;"));
+        self.w.line(format!("{gaps}[{sp}] = fmax(ga, gb);"));
+        self.w.line(format!("{sp}++;"));
+        self.w.line(format!("{n} = a_first ? first : first + 1u;"));
+        self.w.line("continue;");
+        self.w.close();
+        self.w.open("if (va || vb)");
+        self.w.line(format!("{n} = va ? first : first + 1u;"));
+        self.w.line("continue;");
+        self.w.close();
+        self.w.close();
+        self.w.open("else");
+        self.w.open("for (uint i = first; i < first + count; i++)");
+        (start, row)
+    }
+
+    /// Appends a member's row of values to the tables, noting the entries
+    /// that copy a dynamic parameter.
+    fn table_row(&mut self, m: &Member) {
+        let at = self.constants.len();
+        self.tables
+            .copies
+            .extend(m.copies.iter().map(|&(entry, slot)| (at + entry, slot)));
+        self.constants.extend_from_slice(&m.values);
+    }
+
+    /// Closes a leaf's loop and the walk: the next node from the stack
+    /// that may still hold a nearer member, or the end.
+    fn hierarchy_close(&mut self, r: usize, d: &str) {
+        let (n, stack, gaps, sp) = (
+            format!("bn{r}"),
+            format!("bs{r}"),
+            format!("bd{r}"),
+            format!("bp{r}"),
+        );
+        // The `else` around the leaf.
+        self.w.close();
+        self.w.line(format!(
+            "while ({sp} > 0u && {gaps}[{sp} - 1u] > R(0.0) && {gaps}[{sp} - 1u] >= {d}) {sp}--;"
+        ));
+        self.w.line(format!("if ({sp} == 0u) break;"));
+        self.w.line(format!("{sp}--;"));
+        self.w.line(format!("{n} = {stack}[{sp}];"));
+        self.w.close();
+    }
 }
+
+/// The fewest members of an instanced group walked through a bounding
+/// volume hierarchy rather than looped over.
+pub const MIN_HIERARCHY: usize = 32;
 
 /// The fewest operands of one tree of hard unions, alike but for their
 /// baked values, that code generation emits as one loop over a table of
 /// those values (see [`KernelSource::constants`](crate::codegen::KernelSource)).
 pub const MIN_INSTANCES: usize = 16;
 
-/// Rewrites a node's baked values as entries of an instance's table row,
-/// in `try_map` order, and collects the values.
-pub(super) struct Rewrite {
+/// Rewrites a node's values as entries of an instance's table row, in
+/// `try_map` order, and collects them: a baked value as itself, a dynamic
+/// one as its default, noted as a copy of its slot.
+pub(super) struct Rewrite<'a> {
     pub(super) values: Vec<f64>,
+    /// `(entry, slot)` for each entry that holds a dynamic value.
+    pub(super) copies: Vec<(usize, u32)>,
+    /// Every dynamic parameter's default, by slot.
+    pub(super) defaults: &'a [f64],
 }
 
-impl Rewrite {
+impl Rewrite<'_> {
     pub(super) fn slot(&mut self, s: Scalar) -> Scalar {
+        let entry = self.values.len();
         match s {
-            Scalar::Baked(v) => {
-                let entry = u32::try_from(self.values.len()).unwrap_or(u32::MAX);
-                self.values.push(v);
-                Scalar::Dynamic(INSTANCE_SLOT.saturating_add(entry))
+            Scalar::Baked(v) => self.values.push(v),
+            Scalar::Dynamic(slot) => {
+                self.copies.push((entry, slot));
+                self.values.push(self.defaults[slot as usize]);
             }
-            dynamic @ Scalar::Dynamic(_) => dynamic,
         }
+        Scalar::Dynamic(INSTANCE_SLOT.saturating_add(u32::try_from(entry).unwrap_or(u32::MAX)))
     }
 }
 
-impl Mapper<Scalar, Vector, NodeId> for Rewrite {
+impl Mapper<Scalar, Vector, NodeId> for Rewrite<'_> {
     type S2 = Scalar;
     type V2 = Vector;
     type C2 = NodeId;
@@ -209,13 +385,29 @@ pub(super) struct Instance {
     pub(super) chain: Vec<(NodeId, IrNode)>,
     /// Its shape: equal for operands that differ only in baked values.
     pub(super) shape: String,
-    /// Its baked values, in the order of the table row.
+    /// Its values, in the order of the table row (a dynamic value's
+    /// default in its entry).
     pub(super) values: Vec<f64>,
+    /// `(entry, slot)` for each entry of the row that holds a dynamic value.
+    pub(super) copies: Vec<(usize, u32)>,
 }
 
-/// The operand under `root` as an instance, if it is one.
-pub(super) fn instance(ir: &Ir, root: NodeId) -> Option<Instance> {
-    let mut rewrite = Rewrite { values: Vec::new() };
+/// One operand of an instanced group: its node, its row of values, and
+/// the entries of the row that copy a dynamic parameter.
+pub(super) struct Member {
+    pub(super) id: NodeId,
+    pub(super) values: Vec<f64>,
+    pub(super) copies: Vec<(usize, u32)>,
+}
+
+/// The operand under `root` as an instance, if it is one; `defaults` are
+/// the dynamic parameters' defaults, by slot.
+pub(super) fn instance(ir: &Ir, root: NodeId, defaults: &[f64]) -> Option<Instance> {
+    let mut rewrite = Rewrite {
+        values: Vec::new(),
+        copies: Vec::new(),
+        defaults,
+    };
     let (mut chain, mut shape) = (Vec::new(), String::new());
     let mut at = Some(root);
     while let Some(id) = at {
@@ -245,7 +437,44 @@ pub(super) fn instance(ir: &Ir, root: NodeId) -> Option<Instance> {
         chain,
         shape,
         values: rewrite.values,
+        copies: rewrite.copies,
     })
+}
+
+/// An instance's chain (root first) from the leaf up, each node's child
+/// renumbered to the node before it: what [`chain_bound`] bounds.
+fn template(chain: &[(NodeId, IrNode)]) -> Vec<IrNode> {
+    chain
+        .iter()
+        .rev()
+        .enumerate()
+        .map(|(i, (_, node))| {
+            let Ok(renumbered) = node.try_map(&mut Renumber(i));
+            renumbered
+        })
+        .collect()
+}
+
+/// Renumbers the child of the node at place `.0` of a leaf-first chain.
+struct Renumber(usize);
+
+impl Mapper<Scalar, Vector, NodeId> for Renumber {
+    type S2 = Scalar;
+    type V2 = Vector;
+    type C2 = NodeId;
+    type E = Infallible;
+
+    fn scalar(&mut self, s: &Scalar, _: ParamSpec<'_>) -> Result<Scalar, Infallible> {
+        Ok(*s)
+    }
+
+    fn vector(&mut self, v: &Vector, _: ParamSpec<'_>) -> Result<Vector, Infallible> {
+        Ok(*v)
+    }
+
+    fn child(&mut self, _: &NodeId) -> Result<NodeId, Infallible> {
+        Ok(NodeId::from_index(self.0 - 1))
+    }
 }
 
 /// A union tree entered as one: its union nodes (whose names the results

@@ -21,6 +21,7 @@ use std::collections::{BTreeMap, BTreeSet, HashMap};
 use std::convert::Infallible;
 use std::fmt::Write as _;
 
+use super::bvh::InstanceTables;
 use super::formulas::vector;
 use super::helpers::Helper;
 use super::writer::{INSTANCE_SLOT, Writer};
@@ -42,8 +43,8 @@ use crate::scene::{
 mod inline;
 mod instances;
 
-pub use instances::MIN_INSTANCES;
 use instances::*;
+pub use instances::{MIN_HIERARCHY, MIN_INSTANCES};
 
 /// The trap of a surface that has none (a `real2`: the trap that tints
 /// its colour, and the trap the shading layers show).
@@ -187,6 +188,11 @@ pub(crate) struct SceneEmitter<'a> {
     traps: HashMap<NodeId, String>,
     /// The instances' table rows, read from `params[slots + i]`.
     pub(crate) constants: Vec<f64>,
+    /// How the tables follow the dynamic values.
+    pub(crate) tables: InstanceTables,
+    /// Every dynamic parameter's default, by slot: the table entries that
+    /// copy one start as it.
+    defaults: Vec<f64>,
     /// How many slots the dynamic parameters take before the tables.
     slots: usize,
     /// While a loop body is emitted: its nodes, reading the table row.
@@ -229,6 +235,8 @@ impl<'a> SceneEmitter<'a> {
             trapped: BTreeSet::new(),
             traps: HashMap::new(),
             constants: Vec::new(),
+            tables: InstanceTables::default(),
+            defaults: ir.default_values().as_slice().to_vec(),
             slots: ir.params().len(),
             instance: HashMap::new(),
             clusters: HashMap::new(),
@@ -251,6 +259,7 @@ impl<'a> SceneEmitter<'a> {
             self.points = 0;
             // Every function lays out the same tables.
             self.constants.clear();
+            self.tables = InstanceTables::default();
             self.w.open(match (shade, material) {
                 (false, _) => "real DE(real3 p0, __global const real* params)",
                 (true, false) => {

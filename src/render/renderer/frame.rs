@@ -763,7 +763,7 @@ impl Renderer {
             &view.pack(self.source.origin, scale),
             &self.values,
             self.scene.lights(),
-            self.source.origin,
+            &self.source,
         )?;
         let k = &self.kernel;
         let t = &self.targets;

@@ -412,6 +412,9 @@ pub(super) struct Inputs {
     pub(super) lights: RealBuffer,
     /// The environment light (floats at every precision).
     pub(super) environment: Buffer<f32>,
+    /// The dynamic values the instance tables in `params` were last
+    /// filled with, where some of their entries copy one.
+    filled: Option<Vec<f64>>,
 }
 
 impl Inputs {
@@ -431,6 +434,7 @@ impl Inputs {
             camera: RealBuffer::new(queue, precision, &[0.0; camera::LEN])?,
             lights: RealBuffer::new(queue, precision, &pack_lights(lights, DVec3::ZERO))?,
             environment: environment_buffer(queue, environment)?,
+            filled: (!source.tables.is_baked()).then(|| values.as_slice().to_vec()),
         })
     }
 
@@ -443,10 +447,21 @@ impl Inputs {
         camera: &[f64; camera::LEN],
         values: &ParamValues,
         lights: &[Light],
-        origin: DVec3,
+        source: &KernelSource,
     ) -> Result<()> {
-        // The dynamic values only: the constants after them stay.
-        self.params.write(values.as_slice())?;
+        let origin = source.origin;
+        // The dynamic values only: the constants after them stay, unless
+        // their tables copy a value that changed (then they are filled and
+        // their hierarchies fitted again).
+        match &mut self.filled {
+            None => self.params.write(values.as_slice())?,
+            Some(filled) if filled.as_slice() != values.as_slice() => {
+                self.params.write(&source.param_buffer(values.as_slice()))?;
+                filled.clear();
+                filled.extend_from_slice(values.as_slice());
+            }
+            Some(_) => {}
+        }
         self.camera.write(camera)?;
         let packed = pack_lights(lights, origin);
         if packed.len() == self.lights.len() {

@@ -460,6 +460,12 @@ impl Renderer {
         self.values.get(name)
     }
 
+    /// Every dynamic parameter's current value.
+    #[must_use]
+    pub fn values(&self) -> &ParamValues {
+        &self.values
+    }
+
     /// Moves the camera (no recompilation).
     ///
     /// # Errors
@@ -621,8 +627,9 @@ impl Renderer {
     /// cache).
     fn load(&mut self, source: KernelSource) -> Result<()> {
         let (program, build, compiled) = program::build(&self.selected, &self.context, &source)?;
-        let inputs_changed =
-            source.precision != self.source.precision || source.constants != self.source.constants;
+        let inputs_changed = source.precision != self.source.precision
+            || source.constants != self.source.constants
+            || source.tables != self.source.tables;
         if inputs_changed {
             self.inputs = Inputs::new(
                 &self.queue,

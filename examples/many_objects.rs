@@ -1,0 +1,148 @@
+//! Scenes of many objects: `N` coloured spheres scattered through a cube
+//! over a floor, their positions baked or dynamic. Such a union compiles
+//! to one loop over a table of the spheres, walked through a bounding
+//! volume hierarchy, so compiling, memory and frames grow slowly with
+//! `N`, and moving every sphere is a buffer update.
+//!
+//! Prints a Markdown table: compiling (validation, lowering, OpenCL C and
+//! the program's build), the process's peak memory, a 640×480 production
+//! frame (median of three, after one that compiles the kernels), its
+//! distance evaluations per pixel, and for dynamic positions the time to
+//! set all of them and to fill the tables and fit the hierarchy again.
+//! Each row runs in a process of its own, so that its peak memory is its
+//! own (Linux, from `/proc/self/status`).
+//!
+//! `cargo run --release --example many_objects` (1,000, 10,000 and 100,000
+//! spheres, baked and dynamic), or `-- N baked|dynamic` for one row; the
+//! 100,000 baked spheres' frame is written to `out/many_objects.png`.
+
+use std::process::Command;
+use std::time::Instant;
+
+use fractal_sdf::prelude::*;
+use fractal_sdf::render::{RenderOptions, Renderer};
+use fractal_sdf::scene::{Param3, param3};
+
+const HEADER: &str = "| spheres | positions | compile | peak memory | 640×480 production frame | evaluations / pixel | set every position | fill the tables and refit |\n|---:|---|---:|---:|---:|---:|---:|---:|";
+
+fn main() -> fractal_sdf::Result<()> {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    if let [n, mode] = args.as_slice() {
+        let n: usize = n.parse().expect("a sphere count");
+        println!("{}", row(n, mode == "dynamic")?);
+        return Ok(());
+    }
+    println!("{HEADER}");
+    let me = std::env::current_exe().expect("the example's path");
+    for n in [1_000, 10_000, 100_000] {
+        for mode in ["baked", "dynamic"] {
+            let out = Command::new(&me)
+                .args([n.to_string(), mode.to_string()])
+                .output()
+                .expect("the example runs");
+            let text = String::from_utf8_lossy(&out.stdout);
+            match text.lines().last() {
+                Some(line) if out.status.success() => println!("{line}"),
+                _ => println!(
+                    "| {n} | {mode} | failed: {} |",
+                    String::from_utf8_lossy(&out.stderr).trim()
+                ),
+            }
+        }
+    }
+    Ok(())
+}
+
+/// The centre, radius and colour of sphere `i` of `n`: a jittered grid
+/// filling the cube `[-1, 1]³`.
+#[allow(clippy::cast_precision_loss)]
+fn placed(i: usize, n: usize) -> (DVec3, f64, DVec3) {
+    let side = (1..).find(|s| s * s * s >= n).unwrap_or(1);
+    let cell = 2.0 / side as f64;
+    let (x, y, z) = (i % side, (i / side) % side, i / (side * side));
+    let hash = |k: usize| ((i * 2_654_435_761 + k * 40_503) % 1000) as f64 / 1000.0 - 0.5;
+    let grid = dvec3(x as f64, y as f64, z as f64) + 0.5 + 0.5 * dvec3(hash(1), hash(2), hash(3));
+    let centre = grid * cell - 1.0;
+    let radius = cell * (0.2 + 0.15 * (hash(4) + 0.5));
+    let colour = (centre * 0.5 + 0.5).clamp(DVec3::splat(0.05), DVec3::ONE);
+    (centre, radius, colour)
+}
+
+fn scene(n: usize, dynamic: bool) -> Scene {
+    let spheres = (0..n)
+        .map(|i| {
+            let (centre, radius, colour) = placed(i, n);
+            let at: Param3 = if dynamic {
+                param3(&format!("s{i}"), centre)
+            } else {
+                centre.into()
+            };
+            sphere(radius).translate(at).color(colour)
+        })
+        .reduce(Node::union)
+        .expect("at least one sphere");
+    Scene::new(spheres.union(plane(DVec3::Y, 1.05)))
+        .with_camera(Camera::look_at(dvec3(2.4, 1.6, 3.2), dvec3(0.0, -0.1, 0.0)))
+}
+
+fn row(n: usize, dynamic: bool) -> fractal_sdf::Result<String> {
+    let ms = |t: Instant| t.elapsed().as_secs_f64() * 1e3;
+    let scene = scene(n, dynamic);
+    let t = Instant::now();
+    let compiled = scene.compile()?;
+    let options = RenderOptions::default().quality(Quality::production());
+    let mut renderer = Renderer::from_compiled(compiled, &options)?;
+    let compile = ms(t);
+    let (w, h) = (640, 480);
+    let frame = renderer.render_with_aovs(w, h)?;
+    let evaluations: f64 =
+        frame.evaluations.iter().map(|&e| f64::from(e)).sum::<f64>() / f64::from(w * h);
+    let mut times = Vec::new();
+    for _ in 0..3 {
+        let t = Instant::now();
+        let image = renderer.render(w, h)?;
+        times.push(ms(t));
+        if n == 100_000 && !dynamic {
+            std::fs::create_dir_all("out").ok();
+            fractal_sdf::output::save_png(&image, "out/many_objects.png")?;
+        }
+    }
+    times.sort_by(f64::total_cmp);
+    let (set, refit) = if dynamic {
+        let t = Instant::now();
+        for i in 0..n {
+            let (centre, ..) = placed(i, n);
+            let moved = centre + dvec3(0.0, 0.1 * (i as f64 * 0.37).sin(), 0.0);
+            for (axis, v) in ["x", "y", "z"].iter().zip(moved.to_array()) {
+                renderer.set_param(&format!("s{i}.{axis}"), v)?;
+            }
+        }
+        let set = ms(t);
+        let t = Instant::now();
+        let buffer = renderer.source().param_buffer(renderer.values().as_slice());
+        let refit = ms(t);
+        assert!(!buffer.is_empty());
+        (format!("{set:.0} ms"), format!("{refit:.1} ms"))
+    } else {
+        ("(a new program)".into(), String::new())
+    };
+    Ok(format!(
+        "| {n} | {} | {compile:.0} ms | {} | {:.0} ms | {evaluations:.1} | {set} | {refit} |",
+        if dynamic { "dynamic" } else { "baked" },
+        peak_memory(),
+        times[1],
+    ))
+}
+
+/// The process's peak resident memory, where the system says it.
+fn peak_memory() -> String {
+    std::fs::read_to_string("/proc/self/status")
+        .ok()
+        .and_then(|s| {
+            s.lines()
+                .find(|l| l.starts_with("VmHWM:"))
+                .and_then(|l| l.split_whitespace().nth(1))
+                .and_then(|kb| kb.parse::<u64>().ok())
+        })
+        .map_or_else(|| "n/a".into(), |kb| format!("{} MB", kb / 1024))
+}
