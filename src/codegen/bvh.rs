@@ -2,15 +2,18 @@
 //! into the parameter buffer so that a kernel walks it with a fixed stack
 //! and evaluates only the instances near a point.
 //!
-//! Each node is [`NODE_LEN`] values: the box's low corner, its high corner,
-//! then `first` and `count`. A leaf (`count > 0`) holds the instances
-//! `first .. first + count` of the reordered table; an inner node
-//! (`count == 0`) has its two children at nodes `first` and `first + 1`.
-//! Boxes hold their instances' bounding spheres, so the distance from a
-//! point to a node's box, times the smallest slope of its instances'
-//! bounds, is at most any of their estimates wherever it is positive
-//! ([`Bound`]): a node that far beyond the nearest estimate found so far
-//! cannot change the union's minimum, and is skipped.
+//! Each node has [`WIDTH`] entries and takes [`NODE_LEN`] values, laid out
+//! so that a kernel loads each coordinate of all four entries' boxes as one
+//! vector: the low corners' x, y and z, the high corners' x, y and z (four
+//! values each), then each entry's `first` and each entry's `count`. An
+//! entry with `count > 0` is a leaf: the instances `first .. first +
+//! count` of the reordered table; `count == 0` is the node numbered
+//! `first`; `count < 0` is empty. Boxes hold their instances' bounding
+//! spheres, so the distance from a point to an entry's box, times the
+//! smallest slope of its instances' bounds, is at most any of their
+//! estimates wherever it is positive ([`Bound`]): an entry that far beyond
+//! the nearest estimate found so far cannot change the union's minimum,
+//! and is skipped.
 
 use std::convert::Infallible;
 
@@ -21,31 +24,36 @@ use crate::ir::{Bound, IrNode, NodeId, Scalar, Vector, bound};
 use crate::math::F32_LIMITS;
 use crate::scene::{Mapper, ParamSpec};
 
-/// Values per node: low corner, high corner, `first`, `count`.
-pub(crate) const NODE_LEN: usize = 8;
+/// Entries per node.
+pub(crate) const WIDTH: usize = 4;
+
+/// Values per node: six corner coordinates, `first` and `count`, each for
+/// [`WIDTH`] entries.
+pub(crate) const NODE_LEN: usize = 8 * WIDTH;
 
 /// The most instances a leaf holds.
-const LEAF_SIZE: usize = 4;
+const LEAF_SIZE: usize = 8;
 
-/// The deepest tree a kernel's fixed stack walks: median splits make a
-/// tree of `n` instances about `log2(n / LEAF_SIZE) + 1` deep, so this is
-/// reached only past `2^33` instances, far beyond [`MAX_INSTANCES`].
+/// The kernel's stack: a node's visit takes one entry off it and puts at
+/// most [`WIDTH`] on, so a walk of a tree `depth` nodes deep holds at most
+/// `(WIDTH − 1) · depth + 1`. Median splits make a tree of `n` instances
+/// about `log4(n / LEAF_SIZE)` deep: 10 levels hold [`MAX_INSTANCES`].
 pub(crate) const STACK: usize = 32;
 
 /// The most instances a hierarchy indexes: node and instance numbers are
-/// stored as `real`s, exact in `f32` up to `2^24`, and a tree has fewer
-/// than two nodes per instance.
+/// stored as `real`s, exact in `f32` up to `2^24`.
 pub(crate) const MAX_INSTANCES: usize = 1 << 22;
 
 /// A flattened hierarchy.
 #[derive(Debug, Clone, PartialEq)]
 pub(crate) struct Bvh {
-    /// [`NODE_LEN`] values per node, the root first.
+    /// [`NODE_LEN`] values per node, the root first; a node's children
+    /// follow it.
     pub(crate) nodes: Vec<f64>,
     /// The instances in the order the leaves hold them (indices into the
     /// bounds it was built from).
     pub(crate) order: Vec<usize>,
-    /// The number of nodes on the longest path from the root to a leaf.
+    /// The number of nodes on the longest path from the root down.
     pub(crate) depth: usize,
     /// The smallest slope of the instances' bounds.
     pub(crate) slope: f64,
@@ -95,8 +103,9 @@ impl Aabb {
 
 impl Bvh {
     /// Builds the hierarchy over `bounds` by median splits along the
-    /// longest side of each node's box of centres, without recursion.
-    /// `None` for fewer than two bounds or more than [`MAX_INSTANCES`].
+    /// longest side of each range's box of centres, two splits a node,
+    /// without recursion. `None` for fewer than two bounds, more than
+    /// [`MAX_INSTANCES`], or a tree deeper than the kernel's stack walks.
     pub(crate) fn build(bounds: &[Bound]) -> Option<Bvh> {
         if bounds.len() < 2 || bounds.len() > MAX_INSTANCES {
             return None;
@@ -109,40 +118,44 @@ impl Bvh {
         let mut work = vec![(0usize, 0usize, bounds.len(), 1usize)];
         while let Some((node, first, end, level)) = work.pop() {
             depth = depth.max(level);
-            let members = &mut order[first..end];
-            let all = members
-                .iter()
-                .fold(Aabb::EMPTY, |acc, &i| acc.join(boxes[i]));
-            let at = node * NODE_LEN;
-            nodes[at..at + 3].copy_from_slice(&all.lo.to_array());
-            nodes[at + 3..at + 6].copy_from_slice(&all.hi.to_array());
-            if members.len() <= LEAF_SIZE {
-                nodes[at + 6] = first as f64;
-                nodes[at + 7] = members.len() as f64;
-                continue;
+            // Up to `WIDTH` parts: the range halved, and each part halved
+            // again while it is more than a leaf, `log2(WIDTH)` times.
+            let mut parts = vec![(first, end)];
+            for _ in 0..WIDTH.trailing_zeros() {
+                let mut halves = Vec::with_capacity(WIDTH);
+                for (a, b) in parts {
+                    if b - a > LEAF_SIZE {
+                        halves.extend(split(&mut order, &boxes, a, b));
+                    } else {
+                        halves.push((a, b));
+                    }
+                }
+                parts = halves;
             }
-            let centres = members.iter().fold(Aabb::EMPTY, |acc, &i| {
-                let c = boxes[i].centre();
-                acc.join(Aabb { lo: c, hi: c })
-            });
-            let extent = centres.hi - centres.lo;
-            let axis = if extent.x >= extent.y && extent.x >= extent.z {
-                0
-            } else if extent.y >= extent.z {
-                1
-            } else {
-                2
-            };
-            let half = members.len() / 2;
-            members.select_nth_unstable_by(half, |&a, &b| {
-                boxes[a].centre()[axis].total_cmp(&boxes[b].centre()[axis])
-            });
-            let child = nodes.len() / NODE_LEN;
-            nodes.resize(nodes.len() + 2 * NODE_LEN, 0.0);
-            nodes[at + 6] = child as f64;
-            nodes[at + 7] = 0.0;
-            work.push((child + 1, first + half, end, level + 1));
-            work.push((child, first, first + half, level + 1));
+            let at = node * NODE_LEN;
+            for j in 0..WIDTH {
+                let Some(&(a, b)) = parts.get(j) else {
+                    nodes[at + 7 * WIDTH + j] = -1.0;
+                    continue;
+                };
+                let all = order[a..b]
+                    .iter()
+                    .fold(Aabb::EMPTY, |acc, &i| acc.join(boxes[i]));
+                put_box(&mut nodes[at..at + NODE_LEN], j, all);
+                if b - a <= LEAF_SIZE {
+                    nodes[at + 6 * WIDTH + j] = a as f64;
+                    nodes[at + 7 * WIDTH + j] = (b - a) as f64;
+                } else {
+                    let child = nodes.len() / NODE_LEN;
+                    nodes.resize(nodes.len() + NODE_LEN, 0.0);
+                    nodes[at + 6 * WIDTH + j] = child as f64;
+                    nodes[at + 7 * WIDTH + j] = 0.0;
+                    work.push((child, a, b, level + 1));
+                }
+            }
+        }
+        if (WIDTH - 1) * depth + 1 > STACK {
+            return None;
         }
         let slope = bounds.iter().map(|b| b.slope).fold(1.0, f64::min);
         Some(Bvh {
@@ -156,6 +169,47 @@ impl Bvh {
     /// The number of nodes.
     pub(crate) fn len(&self) -> usize {
         self.nodes.len() / NODE_LEN
+    }
+}
+
+/// Splits `order[first..end]` at its median along the longest side of its
+/// box of centres: the two halves' ranges.
+fn split(order: &mut [usize], boxes: &[Aabb], first: usize, end: usize) -> [(usize, usize); 2] {
+    let members = &mut order[first..end];
+    let centres = members.iter().fold(Aabb::EMPTY, |acc, &i| {
+        let c = boxes[i].centre();
+        acc.join(Aabb { lo: c, hi: c })
+    });
+    let extent = centres.hi - centres.lo;
+    let axis = if extent.x >= extent.y && extent.x >= extent.z {
+        0
+    } else if extent.y >= extent.z {
+        1
+    } else {
+        2
+    };
+    let half = members.len() / 2;
+    members.select_nth_unstable_by(half, |&a, &b| {
+        boxes[a].centre()[axis].total_cmp(&boxes[b].centre()[axis])
+    });
+    [(first, first + half), (first + half, end)]
+}
+
+/// Writes entry `j`'s box into a node's values.
+fn put_box(node: &mut [f64], j: usize, b: Aabb) {
+    for k in 0..3 {
+        node[k * WIDTH + j] = b.lo[k];
+        node[(3 + k) * WIDTH + j] = b.hi[k];
+    }
+}
+
+/// Entry `j`'s box in a node's values.
+#[cfg(test)]
+fn get_box(node: &[f64], j: usize) -> Aabb {
+    let corner = |c: usize| DVec3::from_array(std::array::from_fn(|k| node[(c + k) * WIDTH + j]));
+    Aabb {
+        lo: corner(0),
+        hi: corner(3),
     }
 }
 
@@ -231,25 +285,26 @@ impl Refit {
                     .map_or(Aabb::EVERYWHERE, |b| Aabb::around(&b))
             })
             .collect();
+        // Each node's box around all its entries, children first.
+        let mut totals = vec![Aabb::EMPTY; self.count];
         for n in (0..self.count).rev() {
             let at = self.nodes + n * NODE_LEN;
-            let (first, count) = (tables[at + 6] as usize, tables[at + 7] as usize);
-            let fitted = if count > 0 {
-                boxes[first..first + count]
-                    .iter()
-                    .fold(Aabb::EMPTY, |acc, b| acc.join(*b))
-            } else {
-                let child = |c: usize| {
-                    let v = &tables[self.nodes + c * NODE_LEN..];
-                    Aabb {
-                        lo: DVec3::new(v[0], v[1], v[2]),
-                        hi: DVec3::new(v[3], v[4], v[5]),
-                    }
+            let node = &mut tables[at..at + NODE_LEN];
+            let mut total = Aabb::EMPTY;
+            for j in 0..WIDTH {
+                let (first, count) = (node[6 * WIDTH + j], node[7 * WIDTH + j]);
+                let fitted = if count < 0.0 {
+                    continue;
+                } else if count > 0.0 {
+                    let (a, b) = (first as usize, (first + count) as usize);
+                    boxes[a..b].iter().fold(Aabb::EMPTY, |acc, b| acc.join(*b))
+                } else {
+                    totals[first as usize]
                 };
-                child(first).join(child(first + 1))
-            };
-            tables[at..at + 3].copy_from_slice(&fitted.lo.to_array());
-            tables[at + 3..at + 6].copy_from_slice(&fitted.hi.to_array());
+                put_box(node, j, fitted);
+                total = total.join(fitted);
+            }
+            totals[n] = total;
         }
     }
 }
@@ -327,43 +382,50 @@ mod tests {
             .collect()
     }
 
-    /// Every instance is in exactly one leaf, and every node's box holds
+    /// Every instance is in exactly one leaf, and every entry's box holds
     /// the spheres of every instance under it.
     #[test]
     fn leaves_partition_the_instances_and_boxes_hold_them() {
-        for n in [2, 3, 5, 16, 17, 100, 1000] {
+        for n in [2, 3, 5, 16, 17, 100, 1000, 5000] {
             let bounds = scattered(n);
             let bvh = Bvh::build(&bounds).expect("a hierarchy");
             let mut seen = vec![0; n];
-            let mut stack = vec![(0usize, Vec::<usize>::new())];
+            // (node, the boxes above it, its level)
+            let mut stack = vec![(0usize, Vec::<Aabb>::new(), 1usize)];
             let mut deepest = 0;
-            while let Some((node, mut above)) = stack.pop() {
-                above.push(node);
-                deepest = deepest.max(above.len());
+            while let Some((node, above, level)) = stack.pop() {
+                deepest = deepest.max(level);
                 let v = &bvh.nodes[node * NODE_LEN..(node + 1) * NODE_LEN];
-                let (first, count) = (v[6] as usize, v[7] as usize);
-                if count == 0 {
-                    stack.push((first, above.clone()));
-                    stack.push((first + 1, above));
-                    continue;
-                }
-                assert!(count <= LEAF_SIZE);
-                for &i in &bvh.order[first..first + count] {
-                    seen[i] += 1;
-                    let b = bounds[i];
-                    for &a in &above {
-                        let w = &bvh.nodes[a * NODE_LEN..a * NODE_LEN + 6];
-                        for k in 0..3 {
-                            assert!(w[k] <= b.centre[k] - b.radius);
-                            assert!(w[k + 3] >= b.centre[k] + b.radius);
+                for j in 0..WIDTH {
+                    let (first, count) = (v[6 * WIDTH + j], v[7 * WIDTH + j]);
+                    if count < 0.0 {
+                        continue;
+                    }
+                    let mut boxes = above.clone();
+                    boxes.push(get_box(v, j));
+                    if count == 0.0 {
+                        assert!(first as usize > node, "children follow their parent");
+                        stack.push((first as usize, boxes, level + 1));
+                        continue;
+                    }
+                    assert!(count as usize <= LEAF_SIZE);
+                    let (a, b) = (first as usize, (first + count) as usize);
+                    for &i in &bvh.order[a..b] {
+                        seen[i] += 1;
+                        let s = bounds[i];
+                        for w in &boxes {
+                            for k in 0..3 {
+                                assert!(w.lo[k] <= s.centre[k] - s.radius);
+                                assert!(w.hi[k] >= s.centre[k] + s.radius);
+                            }
                         }
                     }
                 }
             }
             assert!(seen.iter().all(|&s| s == 1), "{n}: {seen:?}");
             assert_eq!(deepest, bvh.depth);
-            assert!(bvh.depth <= STACK);
-            let balanced = (n as f64 / LEAF_SIZE as f64).log2().ceil().max(0.0) as usize + 1;
+            assert!((WIDTH - 1) * bvh.depth < STACK);
+            let balanced = (n as f64 / LEAF_SIZE as f64).log(4.0).ceil().max(1.0) as usize;
             assert!(bvh.depth <= balanced + 1, "{n}: depth {}", bvh.depth);
         }
     }

@@ -163,12 +163,16 @@ fn a_hundred_thousand_added_spheres_render() {
         "{} bytes",
         source.source.len()
     );
-    // The table: four values and a place per sphere, then the boxes of a
-    // hierarchy over them (eight values each; with two to four spheres a
-    // leaf, fewer boxes than spheres).
-    let boxes = (source.constants.len() - 5 * 100_000) / 8;
-    assert_eq!(source.constants.len(), 5 * 100_000 + 8 * boxes);
-    assert!((100_000 / 4..100_000).contains(&boxes), "{boxes} boxes");
+    // The table: four values and a place per sphere, then the nodes of a
+    // hierarchy over them (32 values each: four boxes and their contents;
+    // with up to eight spheres a leaf, fewer nodes than a tenth of the
+    // spheres).
+    let nodes = (source.constants.len() - 5 * 100_000) / 32;
+    assert_eq!(source.constants.len(), 5 * 100_000 + 32 * nodes);
+    assert!(
+        (100_000 / 32..100_000 / 10).contains(&nodes),
+        "{nodes} nodes"
+    );
     let quality = gpu::plain(Quality::draft());
     let options = gpu::options(quality, Effects::none());
     let mut renderer = Renderer::from_compiled(compiled, &options).unwrap();

@@ -308,18 +308,34 @@ fn wide_unions_become_one_loop_over_a_table() {
         |scene: Scene| codegen::emit(&scene.compile().unwrap(), &Options::default()).unwrap();
     let small = emit(added_spheres(1_000));
     let large = emit(added_spheres(5_000));
-    // The code is one operand's, whatever the count: only the loop's bound
-    // and the digits of node numbers in names differ.
+    // The code is one operand's, whatever the count: only numbers (the
+    // table's and the nodes' places, and node numbers in names) differ.
     assert!(large.source.len() - small.source.len() < 100);
     assert!(
-        small.source.contains("for (uint i = 0u; i < 999u; i++)"),
+        small.source.contains("walked through") && small.source.contains("while (bp"),
         "{}",
         small.scene_part()
     );
-    // Every member's values, in order: colour, offset, radius.
-    assert_eq!(small.constants.len(), 7 * 999);
+    // Every member's values (colour, offset, radius) and its place in the
+    // union, in the order of the hierarchy's leaves, then its nodes.
+    let rows: Vec<&[f64]> = small.constants[..8 * 999].chunks(8).collect();
+    let mut places: Vec<usize> = rows.iter().map(|r| r[7] as usize).collect();
+    places.sort_unstable();
+    assert!(places.iter().copied().eq(0..999));
     let t = 1.0 / 1000.0;
-    assert_eq!(&small.constants[..7], &[t, 0.5, 0.5, t, 0.0, -t, 0.1 + t]);
+    let first = rows.iter().find(|r| r[7] == 0.0).unwrap();
+    assert_eq!(&first[..7], &[t, 0.5, 0.5, t, 0.0, -t, 0.1 + t]);
+    assert_eq!((small.constants.len() - 8 * 999) % 32, 0);
+    // A group smaller than MIN_HIERARCHY is looped over, in order.
+    let looped = emit(added_spheres(20));
+    assert!(
+        looped.source.contains("for (uint i = 0u; i < 19u; i++)"),
+        "{}",
+        looped.scene_part()
+    );
+    let t = 1.0 / 20.0;
+    assert_eq!(looped.constants.len(), 7 * 19);
+    assert_eq!(&looped.constants[..7], &[t, 0.5, 0.5, t, 0.0, -t, 0.1 + t]);
     // Fewer than MIN_INSTANCES alike operands are written out.
     let few = emit(added_spheres(
         u32::try_from(codegen::MIN_INSTANCES).unwrap(),

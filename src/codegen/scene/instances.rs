@@ -1,7 +1,7 @@
 //! Instancing: the operands of one tree of hard unions that differ only in
 //! baked values become one loop over a table of those values.
 
-use super::super::bvh::{Bvh, NODE_LEN, Refit, STACK, chain_bound};
+use super::super::bvh::{Bvh, NODE_LEN, Refit, STACK, WIDTH, chain_bound};
 use super::*;
 use crate::ir::SHRINK;
 
@@ -167,7 +167,7 @@ impl<'a> SceneEmitter<'a> {
         }
         self.w.close();
         if hierarchy.is_some() {
-            self.hierarchy_close(r, &d);
+            self.hierarchy_close();
         }
         Vars {
             d,
@@ -211,63 +211,103 @@ impl<'a> SceneEmitter<'a> {
         self.constants.extend_from_slice(&bvh.nodes);
         self.w.comment(&format!(
             "{} instances of {}: {stride} values and a place each from params[{start}] - \
-             walked through {} boxes from params[{nodes}]",
+             walked through {} nodes of {WIDTH} boxes from params[{nodes}]",
             members.len(),
             self.ir.path_tail(members[0].id, 2),
             bvh.len()
         ));
-        let (n, stack, gaps, sp) = (
-            format!("bn{r}"),
+        let (refs, counts, gaps, sp) = (
             format!("bs{r}"),
+            format!("bc{r}"),
             format!("bd{r}"),
             format!("bp{r}"),
         );
+        let d = format!("dg{r}");
         if self.shade {
             self.w.line(format!("uint kg{r} = 0u;"));
         }
-        // A node's gap: the distance from the point to its box, times the
-        // smallest slope and shortened as bounds are (`Bound::distance`).
-        let scale = self.w.float(bvh.slope * SHRINK);
-        let gap = |node: &str| {
-            format!(
-                "{scale} * length(fmax(fmax(vload3(0, params + {nodes}u + {node} * \
-                 {NODE_LEN}u) - {p}, {p} - vload3(1, params + {nodes}u + {node} * {NODE_LEN}u)), \
-                 (real3)(R(0.0))))"
-            )
-        };
-        // Whether a node may hold a member nearer than the minimum so far:
-        // inside its box, or nearer than the minimum.
-        let open = |g: &str| format!("({g} <= R(0.0) || {g} < dg{r})");
-        self.w.line(format!("uint {stack}[{STACK}];"));
+        // An entry may hold a member nearer than the minimum so far where
+        // its gap (the squared distance from the point to its box, times
+        // the squared smallest slope, shortened as bounds are:
+        // `Bound::distance`) is zero or below the minimum's square.
+        let k = bvh.slope * SHRINK;
+        let k2 = self.w.float(k * k);
+        let open = |g: &str| format!("({g} <= R(0.0) || ({d} > R(0.0) && {g} < {d} * {d}))");
+        self.w.line(format!("uint {refs}[{STACK}];"));
+        self.w.line(format!("int {counts}[{STACK}];"));
         self.w.line(format!("real {gaps}[{STACK}];"));
-        self.w.line(format!("uint {sp} = 0u, {n} = 0u;"));
-        self.w.open("for (;;)");
         self.w.line(format!(
-            "__global const real* node = params + {nodes}u + {n} * {NODE_LEN}u;"
+            "{refs}[0] = 0u; {counts}[0] = 0; {gaps}[0] = R(0.0);"
         ));
+        self.w.line(format!("uint {sp} = 1u;"));
+        self.w.open(format!("while ({sp} > 0u)"));
+        self.w.line(format!("{sp}--;"));
+        self.w.line(format!(
+            "if (!{}) continue;",
+            open(&format!("{gaps}[{sp}]"))
+        ));
+        self.w.line(format!(
+            "uint first = {refs}[{sp}]; int count = {counts}[{sp}];"
+        ));
+        self.w.open("if (count == 0)");
+        self.w.line(format!(
+            "__global const real* node = params + {nodes}u + first * {NODE_LEN}u;"
+        ));
+        // One vector lane per entry.
+        let v = format!("real{WIDTH}");
+        for (axis, c) in ["x", "y", "z"].iter().enumerate() {
+            self.w.line(format!(
+                "{v} g{c} = fmax(fmax(vload{WIDTH}({axis}, node) - {p}.{c}, \
+                 {p}.{c} - vload{WIDTH}({}, node)), ({v})(R(0.0)));",
+                axis + 3
+            ));
+        }
         self.w
-            .line("uint first = (uint)node[6], count = (uint)node[7];");
-        self.w.open("if (count == 0u)");
-        self.w.line(format!("real ga = {};", gap("first")));
-        self.w.line(format!("real gb = {};", gap("(first + 1u)")));
+            .line(format!("{v} gap = {k2} * (gx * gx + gy * gy + gz * gz);"));
+        self.w.line(format!(
+            "{v} to = vload{WIDTH}(6, node), n = vload{WIDTH}(7, node);"
+        ));
+        let lanes: Vec<String> = (0..WIDTH).map(|j| format!("s{j}")).collect();
+        for (j, l) in lanes.iter().enumerate() {
+            self.w.line(format!(
+                "bool o{j} = n.{l} >= R(0.0) && {};",
+                open(&format!("gap.{l}"))
+            ));
+        }
+        // The open entries go on the stack, the nearest last: it is taken
+        // off first.
+        self.w.line(format!("uint m = {WIDTH}u;"));
+        self.w.line("real mg = INFINITY;");
+        for (j, l) in lanes.iter().enumerate() {
+            self.w.line(format!(
+                "if (o{j} && gap.{l} < mg) {{ m = {j}u; mg = gap.{l}; }}"
+            ));
+        }
+        for (j, l) in lanes.iter().enumerate() {
+            self.w.line(format!(
+                "if (o{j} && m != {j}u) {{ {refs}[{sp}] = (uint)to.{l}; {counts}[{sp}] = (int)n.{l}; \
+                 {gaps}[{sp}] = gap.{l}; {sp}++; }}"
+            ));
+        }
+        self.w.open(format!("if (m < {WIDTH}u)"));
+        let pick = |v: &str| {
+            let mut chain = format!("{v}.s{}", WIDTH - 1);
+            for j in (0..WIDTH - 1).rev() {
+                chain = format!("m == {j}u ? {v}.s{j} : {chain}");
+            }
+            chain
+        };
         self.w
-            .line(format!("bool va = {}, vb = {};", open("ga"), open("gb")));
-        self.w.open("if (va && vb)");
-        self.w.line("bool a_first = ga <= gb;");
+            .line(format!("{refs}[{sp}] = (uint)({});", pick("to")));
         self.w
-            .line(format!("{stack}[{sp}] = a_first ? first + 1u : first;"));
-        self.w.line(format!("{gaps}[{sp}] = fmax(ga, gb);"));
+            .line(format!("{counts}[{sp}] = (int)({});", pick("n")));
+        self.w.line(format!("{gaps}[{sp}] = mg;"));
         self.w.line(format!("{sp}++;"));
-        self.w.line(format!("{n} = a_first ? first : first + 1u;"));
+        self.w.close();
         self.w.line("continue;");
         self.w.close();
-        self.w.open("if (va || vb)");
-        self.w.line(format!("{n} = va ? first : first + 1u;"));
-        self.w.line("continue;");
-        self.w.close();
-        self.w.close();
-        self.w.open("else");
-        self.w.open("for (uint i = first; i < first + count; i++)");
+        self.w
+            .open("for (uint i = first; i < first + (uint)count; i++)");
         (start, row)
     }
 
@@ -281,23 +321,8 @@ impl<'a> SceneEmitter<'a> {
         self.constants.extend_from_slice(&m.values);
     }
 
-    /// Closes a leaf's loop and the walk: the next node from the stack
-    /// that may still hold a nearer member, or the end.
-    fn hierarchy_close(&mut self, r: usize, d: &str) {
-        let (n, stack, gaps, sp) = (
-            format!("bn{r}"),
-            format!("bs{r}"),
-            format!("bd{r}"),
-            format!("bp{r}"),
-        );
-        // The `else` around the leaf.
-        self.w.close();
-        self.w.line(format!(
-            "while ({sp} > 0u && {gaps}[{sp} - 1u] > R(0.0) && {gaps}[{sp} - 1u] >= {d}) {sp}--;"
-        ));
-        self.w.line(format!("if ({sp} == 0u) break;"));
-        self.w.line(format!("{sp}--;"));
-        self.w.line(format!("{n} = {stack}[{sp}];"));
+    /// Closes a leaf's loop and the walk.
+    fn hierarchy_close(&mut self) {
         self.w.close();
     }
 }
