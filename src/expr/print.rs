@@ -410,6 +410,21 @@ impl OpenClWriter {
     /// Writes the statements of the block's live values; with `split`,
     /// first those `split` needs, then `if (split) break;`, then the rest.
     fn block(&mut self, b: &mut Block<'_>, split: Option<ValueId>) -> Result<(), Unprintable> {
+        self.split_block(b, split.map(|v| (v, Exit::Break)))
+    }
+
+    /// [`OpenClWriter::block`] with the way out at the split: a loop's
+    /// `break`, or a function's early `return` of the values where the
+    /// split holds (which the first statements compute too).
+    fn split_block(
+        &mut self,
+        b: &mut Block<'_>,
+        split: Option<(ValueId, Exit)>,
+    ) -> Result<(), Unprintable> {
+        let (split, exit) = match split {
+            Some((v, exit)) => (Some(v), Some(exit)),
+            None => (None, None),
+        };
         let program = b.program;
         let uses = printed_uses(program);
         let live = program.live();
@@ -427,6 +442,11 @@ impl OpenClWriter {
             Some(v) => {
                 let mut need = vec![false; program.ops.len()];
                 need[v.index()] = true;
+                if let Some(Exit::Return(_, early)) = &exit {
+                    for e in early {
+                        need[e.index()] = true;
+                    }
+                }
                 for i in (0..program.ops.len()).rev() {
                     if need[i] {
                         for o in program.ops[i].operands(&program.loops) {
@@ -453,8 +473,14 @@ impl OpenClWriter {
             }
             if pass && let Some(v) = split {
                 let cond = unwrap(b.atom(v)).to_string();
+                let leave = match &exit {
+                    Some(Exit::Return(shape, early)) => {
+                        format!("return {};", unwrap(&b.result(*shape, early)))
+                    }
+                    _ => "break;".to_string(),
+                };
                 self.line(b.indent, &format!("if ({cond}) {{"));
-                self.line(b.indent + 1, "break;");
+                self.line(b.indent + 1, &leave);
                 self.line(b.indent, "}");
             }
         }
@@ -754,6 +780,51 @@ fn unwrap(text: &str) -> &str {
     inner
 }
 
+/// How a split block leaves at its split.
+enum Exit {
+    /// A loop's `break`.
+    Break,
+    /// A function's `return` of these values, of this shape.
+    Return(Shape, Vec<ValueId>),
+}
+
+/// Where every output of `program` is `select(c, a, b)` with one condition
+/// `c` that needs no loop (so it is cheap to know first): `c`, the `a`s and
+/// the `b`s. A function then returns the `a`s early where `c` holds.
+fn early_return(program: &Program) -> Option<(ValueId, Vec<ValueId>, Vec<ValueId>)> {
+    let mut cond = None;
+    let (mut first, mut late) = (Vec::new(), Vec::new());
+    for &out in &program.outputs {
+        let (Op::Select(c, a, b) | Op::Select3(c, a, b)) = program.ops[out.index()] else {
+            return None;
+        };
+        if cond.is_some_and(|k| k != c) {
+            return None;
+        }
+        cond = Some(c);
+        first.push(a);
+        late.push(b);
+    }
+    let c = cond?;
+    // The condition and the early values must not wait for a loop.
+    let mut need = vec![false; program.ops.len()];
+    need[c.index()] = true;
+    for a in &first {
+        need[a.index()] = true;
+    }
+    for i in (0..program.ops.len()).rev() {
+        if need[i] {
+            if let Op::Loop(_) = program.ops[i] {
+                return None;
+            }
+            for o in program.ops[i].operands(&program.loops) {
+                need[o.index()] = true;
+            }
+        }
+    }
+    Some((c, first, late))
+}
+
 impl Printer for OpenCl {
     fn function(
         &self,
@@ -792,13 +863,24 @@ impl Printer for OpenCl {
             states: HashMap::new(),
             indent: 1,
         };
-        w.block(&mut block, None)?;
+        // A result that is one value where a condition holds and another
+        // elsewhere, for every output (a fractal's far field), returns
+        // early: the other values are computed only where they count.
+        let early = early_return(program);
+        let outputs = match &early {
+            Some((_, _, late)) => late.clone(),
+            None => program.outputs.clone(),
+        };
+        w.split_block(
+            &mut block,
+            early.map(|(c, first, _)| (c, Exit::Return(signature.result, first))),
+        )?;
         let ty = match signature.result {
             Shape::Scalar => "real",
             Shape::Pair => "real2",
             Shape::Vec3 => "real3",
         };
-        let result = unwrap(&block.result(signature.result, &program.outputs)).to_string();
+        let result = unwrap(&block.result(signature.result, &outputs)).to_string();
         let params: Vec<String> = signature
             .params
             .iter()

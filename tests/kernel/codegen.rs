@@ -437,3 +437,22 @@ fn a_custom_parameter_named_like_the_program_s_own_functions_is_refused() {
         "{err}"
     );
 }
+
+/// A fractal's helper returns its far-field value before its iterations:
+/// a point outside the ball that holds the set costs one length, not the
+/// loops and logarithms of the estimate (which the printed formula would
+/// otherwise compute and then discard).
+#[test]
+fn fractal_helpers_return_early_in_their_far_field() {
+    let bulb = mandelbulb(param("power", 8.0));
+    let julia = julia([-0.2, 0.6, 0.2, 0.2]);
+    for (name, node) in [("real2 mandelbulb(", bulb), ("real2 julia(", julia)] {
+        let text = source(node, &Options::default());
+        let start = text.find(name).unwrap_or_else(|| panic!("{name} in\n{text}"));
+        let body = &text[start..start + text[start..].find("\n}\n").unwrap()];
+        let early = body.find("return").expect("a return");
+        let first_loop = body.find("for (").expect("a loop");
+        assert!(early < first_loop, "{body}");
+        assert_eq!(body.matches("return").count(), 2, "{body}");
+    }
+}

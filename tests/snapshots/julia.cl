@@ -119,6 +119,9 @@ real2 julia(real3 p, real cx, real cy, real cz, real cw, real w, real iterations
     real t5 = (((p.x * p.x) + (p.y * p.y)) + (p.z * p.z)) + (w * w);
     real t6 = sqrt(t5);
     bool t7 = (R(1.5) * t4) < t6;
+    if (t7) {
+        return (real2)(R(0.9) * (t6 - t4), R(1.0));
+    }
     real t8 = bailout * bailout;
     real t9 = t7 ? R(0.0) : iterations;
     real ts0_0 = p.x;
@@ -218,7 +221,7 @@ real2 julia(real3 p, real cx, real cy, real cz, real cw, real w, real iterations
         ts2_7 = t33;
         ts2_8 = t45;
     }
-    return (real2)(t7 ? (R(0.9) * (t6 - t4)) : (t29 ? fmin(t21, ts2_8) : t21), t7 ? R(1.0) : fmin(sqrt(ts0_6), R(1.0)));
+    return (real2)(t29 ? fmin(t21, ts2_8) : t21, fmin(sqrt(ts0_6), R(1.0)));
 }
 
 /* ---- scene ---- */

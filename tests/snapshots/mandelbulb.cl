@@ -114,6 +114,9 @@ real2 mandelbulb_p8(real3 p, real iterations, real escape, real ball) {
     real t0 = length(p);
     real t1 = t0 - ball;
     bool t2 = (R(1.5) * ball) < t0;
+    if (t2) {
+        return (real2)(t1, R(1.0));
+    }
     real t3 = t2 ? R(0.0) : iterations;
     real3 ts0_0 = p;
     real ts0_3 = R(1.0);
@@ -151,7 +154,7 @@ real2 mandelbulb_p8(real3 p, real iterations, real escape, real ball) {
         ts0_4 = t26;
     }
     real t27 = length(ts0_0);
-    return (real2)(t2 ? t1 : fmax(((R(0.5) * log(fmax(t27, R(1e-30)))) * t27) / ts0_3, t1), t2 ? R(1.0) : ts0_4);
+    return (real2)(fmax(((R(0.5) * log(fmax(t27, R(1e-30)))) * t27) / ts0_3, t1), ts0_4);
 }
 
 /* ---- scene ---- */

@@ -143,11 +143,14 @@ real sd_ellipsoid(real3 p, real3 r) {
     real3 t1 = fabs(t0);
     real t2 = fmax(fmax(t1.x, t1.y), t1.z);
     real t3 = ((R(0.0) < t2) && isfinite(t2)) ? (t2 * length(t0 / t2)) : length(t0);
-    real3 t4 = (t0 / t3) / r;
-    real3 t5 = fabs(t4);
-    real t6 = fmax(fmax(t5.x, t5.y), t5.z);
-    real t7 = t3 - R(1.0);
-    return (t3 < R(1.0)) ? (t7 * fmin(fmin(r.x, r.y), r.z)) : (t7 / fmax(((R(0.0) < t6) && isfinite(t6)) ? (t6 * length(t4 / t6)) : length(t4), R(1e-30)));
+    real t4 = t3 - R(1.0);
+    if (t3 < R(1.0)) {
+        return t4 * fmin(fmin(r.x, r.y), r.z);
+    }
+    real3 t5 = (t0 / t3) / r;
+    real3 t6 = fabs(t5);
+    real t7 = fmax(fmax(t6.x, t6.y), t6.z);
+    return t4 / fmax(((R(0.0) < t7) && isfinite(t7)) ? (t7 * length(t5 / t7)) : length(t5), R(1e-30));
 }
 
 /* ---- mandelbulb_p8 ---- */
@@ -155,6 +158,9 @@ real2 mandelbulb_p8(real3 p, real iterations, real escape, real ball) {
     real t0 = length(p);
     real t1 = t0 - ball;
     bool t2 = (R(1.5) * ball) < t0;
+    if (t2) {
+        return (real2)(t1, R(1.0));
+    }
     real t3 = t2 ? R(0.0) : iterations;
     real3 ts0_0 = p;
     real ts0_3 = R(1.0);
@@ -192,7 +198,7 @@ real2 mandelbulb_p8(real3 p, real iterations, real escape, real ball) {
         ts0_4 = t26;
     }
     real t27 = length(ts0_0);
-    return (real2)(t2 ? t1 : fmax(((R(0.5) * log(fmax(t27, R(1e-30)))) * t27) / ts0_3, t1), t2 ? R(1.0) : ts0_4);
+    return (real2)(fmax(((R(0.5) * log(fmax(t27, R(1e-30)))) * t27) / ts0_3, t1), ts0_4);
 }
 
 /* ---- scene ---- */

@@ -129,6 +129,9 @@ real2 julia(real3 p, real cx, real cy, real cz, real cw, real w, real iterations
     real t5 = (((p.x * p.x) + (p.y * p.y)) + (p.z * p.z)) + (w * w);
     real t6 = sqrt(t5);
     bool t7 = (R(1.5) * t4) < t6;
+    if (t7) {
+        return (real2)(R(0.9) * (t6 - t4), R(1.0));
+    }
     real t8 = bailout * bailout;
     real t9 = t7 ? R(0.0) : iterations;
     real ts0_0 = p.x;
@@ -228,7 +231,7 @@ real2 julia(real3 p, real cx, real cy, real cz, real cw, real w, real iterations
         ts2_7 = t33;
         ts2_8 = t45;
     }
-    return (real2)(t7 ? (R(0.9) * (t6 - t4)) : (t29 ? fmin(t21, ts2_8) : t21), t7 ? R(1.0) : fmin(sqrt(ts0_6), R(1.0)));
+    return (real2)(t29 ? fmin(t21, ts2_8) : t21, fmin(sqrt(ts0_6), R(1.0)));
 }
 
 /* ---- julia_trap ---- */
@@ -538,6 +541,9 @@ real2 mandelbulb_p8(real3 p, real iterations, real escape, real ball) {
     real t0 = length(p);
     real t1 = t0 - ball;
     bool t2 = (R(1.5) * ball) < t0;
+    if (t2) {
+        return (real2)(t1, R(1.0));
+    }
     real t3 = t2 ? R(0.0) : iterations;
     real3 ts0_0 = p;
     real ts0_3 = R(1.0);
@@ -575,7 +581,7 @@ real2 mandelbulb_p8(real3 p, real iterations, real escape, real ball) {
         ts0_4 = t26;
     }
     real t27 = length(ts0_0);
-    return (real2)(t2 ? t1 : fmax(((R(0.5) * log(fmax(t27, R(1e-30)))) * t27) / ts0_3, t1), t2 ? R(1.0) : ts0_4);
+    return (real2)(fmax(((R(0.5) * log(fmax(t27, R(1e-30)))) * t27) / ts0_3, t1), ts0_4);
 }
 
 /* ---- mandelbulb_p8_trap ---- */

@@ -164,7 +164,10 @@ real sd_octahedron(real3 p, real s) {
     bool t3 = (R(3.0) * t0.y) < t1;
     real3 t4 = t2 ? t0 : (t3 ? ((real3)(t0.y, t0.z, t0.x)) : ((real3)(t0.z, t0.x, t0.y)));
     real t5 = fmin(fmax(R(0.5) * ((t4.z - t4.y) + s), R(0.0)), s);
-    return ((t2 || t3) || ((R(3.0) * t0.z) < t1)) ? length((real3)(t4.x, (t4.y - s) + t5, t4.z - t5)) : (t1 * R(0.5773502691896258));
+    if ((t2 || t3) || ((R(3.0) * t0.z) < t1)) {
+        return length((real3)(t4.x, (t4.y - s) + t5, t4.z - t5));
+    }
+    return t1 * R(0.5773502691896258);
 }
 
 /* ---- capped_cone ---- */
@@ -201,10 +204,13 @@ real sd_round_cone(real3 p, real h, real r1, real r2) {
     real t3 = length((real2)(t1, t2)) - r1;
     real t4 = length((real2)(t1, t2 - t0)) - r2;
     real t5 = r1 - r2;
+    if (t0 <= fabs(t5)) {
+        return fmin(t3, t4);
+    }
     real t6 = t5 / fmax(t0, R(1e-30));
     real t7 = sqrt(fmax(R(1.0) - (t6 * t6), R(0.0)));
     real t8 = ((-t6) * t1) + (t7 * t2);
-    return (t0 <= fabs(t5)) ? fmin(t3, t4) : ((t8 < R(0.0)) ? t3 : (((t7 * t0) < t8) ? t4 : (((t7 * t1) + (t6 * t2)) - r1)));
+    return (t8 < R(0.0)) ? t3 : (((t7 * t0) < t8) ? t4 : (((t7 * t1) + (t6 * t2)) - r1));
 }
 
 /* ---- link ---- */
@@ -215,12 +221,15 @@ real sd_link(real3 p, real le, real r1, real r2) {
 /* ---- cut_sphere ---- */
 real sd_cut_sphere(real3 p, real r, real h) {
     real t0 = fmin(fmax(h, -r), r);
-    real t1 = sqrt(fmax((r * r) - (t0 * t0), R(0.0)));
-    real t2 = length((real2)(p.x, p.z));
-    real t3 = length((real2)(t2, p.y));
-    real t4 = t3 - r;
-    real t5 = p.y - t0;
-    return ((t3 <= r) && (p.y <= t0)) ? fmax(t4, t5) : (((t0 < p.y) && (t2 <= t1)) ? t5 : (((r <= t3) && ((r * p.y) <= (t0 * t3))) ? t4 : length((real2)(t2 - t1, t5))));
+    real t1 = length((real2)(p.x, p.z));
+    real t2 = length((real2)(t1, p.y));
+    real t3 = t2 - r;
+    real t4 = p.y - t0;
+    if ((t2 <= r) && (p.y <= t0)) {
+        return fmax(t3, t4);
+    }
+    real t5 = sqrt(fmax((r * r) - (t0 * t0), R(0.0)));
+    return ((t0 < p.y) && (t1 <= t5)) ? t4 : (((r <= t2) && ((r * p.y) <= (t0 * t2))) ? t3 : length((real2)(t1 - t5, t4)));
 }
 
 /* ---- solid_angle ---- */
@@ -234,7 +243,10 @@ real sd_solid_angle(real3 p, real angle, real r) {
     real t6 = length((real2)(t2 - (t0 * t5), p.y - (t1 * t5)));
     real t7 = (t1 * t2) - (t0 * p.y);
     bool t8 = (t7 < R(0.0)) || ((t7 <= R(0.0)) && (R(0.0) <= t4));
-    return (t8 && (t3 <= r)) ? (-fmin(t6, r - t3)) : (t8 ? fmin(t6, t3 - r) : t6);
+    if (t8 && (t3 <= r)) {
+        return -fmin(t6, r - t3);
+    }
+    return t8 ? fmin(t6, t3 - r) : t6;
 }
 
 /* ---- capped_torus ---- */
@@ -310,31 +322,34 @@ real sd_pyramid(real3 p, real w, real h) {
     real t0 = fabs(p.x);
     real t1 = fabs(p.z);
     real t2 = fmax(t0, t1);
-    real t3 = fmin(t0, t1);
-    real3 t4 = (real3)(w, R(0.0), -w);
-    real3 t5 = (real3)(w, R(0.0), w);
-    real3 t6 = t4 - t5;
-    real3 t7 = (real3)(R(0.0), h, R(0.0));
-    real3 t8 = t7 - t4;
-    real3 t9 = t5 - t7;
-    real3 t10 = (real3)(t2, p.y, t3);
-    real3 t11 = t10 - t5;
-    real3 t12 = t10 - t4;
-    real3 t13 = t10 - t7;
-    real t14 = (t6.y * t9.z) - (t6.z * t9.y);
-    real t15 = (t6.z * t9.x) - (t6.x * t9.z);
-    real t16 = (t6.x * t9.y) - (t6.y * t9.x);
-    real t17 = ((t14 * t14) + (t15 * t15)) + (t16 * t16);
-    real t18 = fmin(fmax((((t11.x * t6.x) + (t11.y * t6.y)) + (t11.z * t6.z)) / fmax(((t6.x * t6.x) + (t6.y * t6.y)) + (t6.z * t6.z), R(1e-30)), R(0.0)), R(1.0));
-    real3 t19 = (t6 * t18) - t11;
-    real t20 = fmin(fmax((((t12.x * t8.x) + (t12.y * t8.y)) + (t12.z * t8.z)) / fmax(((t8.x * t8.x) + (t8.y * t8.y)) + (t8.z * t8.z), R(1e-30)), R(0.0)), R(1.0));
-    real3 t21 = (t8 * t20) - t12;
-    real t22 = fmin(fmax((((t13.x * t9.x) + (t13.y * t9.y)) + (t13.z * t9.z)) / fmax(((t9.x * t9.x) + (t9.y * t9.y)) + (t9.z * t9.z), R(1e-30)), R(0.0)), R(1.0));
-    real3 t23 = (t9 * t22) - t13;
-    real t24 = ((t14 * t11.x) + (t15 * t11.y)) + (t16 * t11.z);
-    real t25 = t2 - w;
-    real t26 = ((h * t25) + (w * p.y)) / fmax(length((real2)(h, w)), R(1e-30));
-    return ((t26 < R(0.0)) && (R(0.0) < p.y)) ? fmax(t26, -p.y) : fmin(sqrt(((((R(0.0) <= (((((t6.y * t16) - (t6.z * t15)) * t11.x) + (((t6.z * t14) - (t6.x * t16)) * t11.y)) + (((t6.x * t15) - (t6.y * t14)) * t11.z))) && (R(0.0) <= (((((t8.y * t16) - (t8.z * t15)) * t12.x) + (((t8.z * t14) - (t8.x * t16)) * t12.y)) + (((t8.x * t15) - (t8.y * t14)) * t12.z)))) && (R(0.0) <= (((((t9.y * t16) - (t9.z * t15)) * t13.x) + (((t9.z * t14) - (t9.x * t16)) * t13.y)) + (((t9.x * t15) - (t9.y * t14)) * t13.z)))) && (R(0.0) < t17)) ? ((t24 * t24) / fmax(t17, R(1e-30))) : fmin(fmin(((t19.x * t19.x) + (t19.y * t19.y)) + (t19.z * t19.z), ((t21.x * t21.x) + (t21.y * t21.y)) + (t21.z * t21.z)), ((t23.x * t23.x) + (t23.y * t23.y)) + (t23.z * t23.z))), length((real3)(fmax(t25, R(0.0)), p.y, fmax(t3 - w, R(0.0)))));
+    real t3 = t2 - w;
+    real t4 = ((h * t3) + (w * p.y)) / fmax(length((real2)(h, w)), R(1e-30));
+    if ((t4 < R(0.0)) && (R(0.0) < p.y)) {
+        return fmax(t4, -p.y);
+    }
+    real t5 = fmin(t0, t1);
+    real3 t6 = (real3)(w, R(0.0), -w);
+    real3 t7 = (real3)(w, R(0.0), w);
+    real3 t8 = t6 - t7;
+    real3 t9 = (real3)(R(0.0), h, R(0.0));
+    real3 t10 = t9 - t6;
+    real3 t11 = t7 - t9;
+    real3 t12 = (real3)(t2, p.y, t5);
+    real3 t13 = t12 - t7;
+    real3 t14 = t12 - t6;
+    real3 t15 = t12 - t9;
+    real t16 = (t8.y * t11.z) - (t8.z * t11.y);
+    real t17 = (t8.z * t11.x) - (t8.x * t11.z);
+    real t18 = (t8.x * t11.y) - (t8.y * t11.x);
+    real t19 = ((t16 * t16) + (t17 * t17)) + (t18 * t18);
+    real t20 = fmin(fmax((((t13.x * t8.x) + (t13.y * t8.y)) + (t13.z * t8.z)) / fmax(((t8.x * t8.x) + (t8.y * t8.y)) + (t8.z * t8.z), R(1e-30)), R(0.0)), R(1.0));
+    real3 t21 = (t8 * t20) - t13;
+    real t22 = fmin(fmax((((t14.x * t10.x) + (t14.y * t10.y)) + (t14.z * t10.z)) / fmax(((t10.x * t10.x) + (t10.y * t10.y)) + (t10.z * t10.z), R(1e-30)), R(0.0)), R(1.0));
+    real3 t23 = (t10 * t22) - t14;
+    real t24 = fmin(fmax((((t15.x * t11.x) + (t15.y * t11.y)) + (t15.z * t11.z)) / fmax(((t11.x * t11.x) + (t11.y * t11.y)) + (t11.z * t11.z), R(1e-30)), R(0.0)), R(1.0));
+    real3 t25 = (t11 * t24) - t15;
+    real t26 = ((t16 * t13.x) + (t17 * t13.y)) + (t18 * t13.z);
+    return fmin(sqrt(((((R(0.0) <= (((((t8.y * t18) - (t8.z * t17)) * t13.x) + (((t8.z * t16) - (t8.x * t18)) * t13.y)) + (((t8.x * t17) - (t8.y * t16)) * t13.z))) && (R(0.0) <= (((((t10.y * t18) - (t10.z * t17)) * t14.x) + (((t10.z * t16) - (t10.x * t18)) * t14.y)) + (((t10.x * t17) - (t10.y * t16)) * t14.z)))) && (R(0.0) <= (((((t11.y * t18) - (t11.z * t17)) * t15.x) + (((t11.z * t16) - (t11.x * t18)) * t15.y)) + (((t11.x * t17) - (t11.y * t16)) * t15.z)))) && (R(0.0) < t19)) ? ((t26 * t26) / fmax(t19, R(1e-30))) : fmin(fmin(((t21.x * t21.x) + (t21.y * t21.y)) + (t21.z * t21.z), ((t23.x * t23.x) + (t23.y * t23.y)) + (t23.z * t23.z)), ((t25.x * t25.x) + (t25.y * t25.y)) + (t25.z * t25.z))), length((real3)(fmax(t3, R(0.0)), p.y, fmax(t5 - w, R(0.0)))));
 }
 
 /* ---- rhombus ---- */
@@ -465,7 +480,10 @@ real sd_death_star(real3 p, real ra, real rb, real d) {
     real t2 = ((t1 - (rb * rb)) + (t0 * t0)) / (R(2.0) * t0);
     real t3 = sqrt(fmax(t1 - (t2 * t2), R(0.0)));
     real t4 = length((real2)(p.y, p.z));
-    return ((t0 * fmax(t3 - t4, R(0.0))) < ((p.x * t3) - (t4 * t2))) ? length((real2)(p.x - t2, t4 - t3)) : fmax(length((real2)(p.x, t4)) - ra, rb - length((real2)(p.x - t0, t4)));
+    if ((t0 * fmax(t3 - t4, R(0.0))) < ((p.x * t3) - (t4 * t2))) {
+        return length((real2)(p.x - t2, t4 - t3));
+    }
+    return fmax(length((real2)(p.x, t4)) - ra, rb - length((real2)(p.x - t0, t4)));
 }
 
 /* ---- box_frame ---- */
@@ -528,10 +546,13 @@ real sd_round_cone_between(real3 p, real3 a, real3 b, real ra, real rb) {
     real t10 = length((real2)(t8, t9)) - ra;
     real t11 = length((real2)(t8, t9 - t7)) - rb;
     real t12 = ra - rb;
+    if (t7 <= fabs(t12)) {
+        return fmin(t10, t11);
+    }
     real t13 = t12 / fmax(t7, R(1e-30));
     real t14 = sqrt(fmax(R(1.0) - (t13 * t13), R(0.0)));
     real t15 = ((-t13) * t8) + (t14 * t9);
-    return (t7 <= fabs(t12)) ? fmin(t10, t11) : ((t15 < R(0.0)) ? t10 : (((t14 * t7) < t15) ? t11 : (((t14 * t8) + (t13 * t9)) - ra)));
+    return (t15 < R(0.0)) ? t10 : (((t14 * t7) < t15) ? t11 : (((t14 * t8) + (t13 * t9)) - ra));
 }
 
 /* ---- ellipsoid ---- */
@@ -540,11 +561,14 @@ real sd_ellipsoid(real3 p, real3 r) {
     real3 t1 = fabs(t0);
     real t2 = fmax(fmax(t1.x, t1.y), t1.z);
     real t3 = ((R(0.0) < t2) && isfinite(t2)) ? (t2 * length(t0 / t2)) : length(t0);
-    real3 t4 = (t0 / t3) / r;
-    real3 t5 = fabs(t4);
-    real t6 = fmax(fmax(t5.x, t5.y), t5.z);
-    real t7 = t3 - R(1.0);
-    return (t3 < R(1.0)) ? (t7 * fmin(fmin(r.x, r.y), r.z)) : (t7 / fmax(((R(0.0) < t6) && isfinite(t6)) ? (t6 * length(t4 / t6)) : length(t4), R(1e-30)));
+    real t4 = t3 - R(1.0);
+    if (t3 < R(1.0)) {
+        return t4 * fmin(fmin(r.x, r.y), r.z);
+    }
+    real3 t5 = (t0 / t3) / r;
+    real3 t6 = fabs(t5);
+    real t7 = fmax(fmax(t6.x, t6.y), t6.z);
+    return t4 / fmax(((R(0.0) < t7) && isfinite(t7)) ? (t7 * length(t5 / t7)) : length(t5), R(1e-30));
 }
 
 /* ---- scene ---- */
