@@ -201,11 +201,13 @@ pub struct KernelSource {
     /// a line of the shape's body.
     pub custom_regions: Vec<CustomRegion>,
     /// Values the program reads from its parameter buffer after the
-    /// dynamic parameters (whose values fill the first slots): the baked
-    /// values of instanced union operands, one row per instance (see
-    /// [`MIN_INSTANCES`]). The parameter buffer a host passes holds the
-    /// dynamic values followed by these. Like dynamic values, they never
-    /// change the source or its hash.
+    /// dynamic parameters (whose values fill the first slots): the values
+    /// of instanced union operands, one row per instance (see
+    /// [`MIN_INSTANCES`]; an entry that copies a dynamic value holds its
+    /// default), and the nodes of the hierarchies over them (see
+    /// [`MIN_HIERARCHY`]). The parameter buffer a host passes is
+    /// [`param_buffer`](Self::param_buffer). Like dynamic values, they
+    /// never change the source or its hash.
     pub constants: Vec<f64>,
     /// Which entries of [`constants`](Self::constants) copy a dynamic
     /// value, and the hierarchies over instances fitted again when one

@@ -9,12 +9,15 @@
 //! every node's parameters.
 //!
 //! Wide unions are instanced: the operands of one tree of hard unions that
-//! differ only in baked values (at least [`MIN_INSTANCES`] of them, such as
+//! differ only in their values (at least [`MIN_INSTANCES`] of them, such as
 //! thousands of coloured spheres placed with `Scene::add`) become one loop
 //! over a table of those values, which the program reads from the
-//! parameter buffer after the dynamic parameters. The code stays the size
-//! of one operand however many there are, and computes what the unrolled
-//! code would.
+//! parameter buffer after the dynamic parameters (a dynamic value is an
+//! entry the host copies in). The code stays the size of one operand
+//! however many there are, and computes what the unrolled code would; a
+//! group of at least [`MIN_HIERARCHY`] is walked through a bounding volume
+//! hierarchy (`codegen::bvh`) that skips the members too far away to
+//! matter.
 
 use std::cell::RefCell;
 use std::collections::{BTreeMap, BTreeSet, HashMap};
