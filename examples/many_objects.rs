@@ -17,6 +17,8 @@
 //! spheres, baked and dynamic), or `-- N baked|dynamic` for one row; the
 //! 100,000 baked spheres' frame is written to `out/many_objects.png`.
 
+mod common;
+
 use std::process::Command;
 use std::time::Instant;
 
@@ -135,20 +137,7 @@ fn row(n: usize, dynamic: bool) -> fractal_sdf::Result<String> {
     Ok(format!(
         "| {n} | {} | {compile:.0} ms | {} | {:.0} ms | {evaluations:.1} | {set} | {refit} |",
         if dynamic { "dynamic" } else { "baked" },
-        peak_memory(),
+        common::peak_memory(),
         times[1],
     ))
-}
-
-/// The process's peak resident memory, where the system says it.
-fn peak_memory() -> String {
-    std::fs::read_to_string("/proc/self/status")
-        .ok()
-        .and_then(|s| {
-            s.lines()
-                .find(|l| l.starts_with("VmHWM:"))
-                .and_then(|l| l.split_whitespace().nth(1))
-                .and_then(|kb| kb.parse::<u64>().ok())
-        })
-        .map_or_else(|| "n/a".into(), |kb| format!("{} MB", kb / 1024))
 }

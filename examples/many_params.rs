@@ -6,6 +6,8 @@
 //!
 //! `cargo run --release --example many_params [-- N]` (default 16,000)
 
+mod common;
+
 use std::time::Instant;
 
 use fractal_sdf::codegen::{self, Options};
@@ -57,20 +59,7 @@ fn main() -> fractal_sdf::Result<()> {
         "| {n} | {build:.0} ms | {compile:.0} ms | {emit:.0} ms ({} kB) | {write:.0} ms ({} kB) | {read_ms:.0} ms | {set_all:.0} ms | {} |",
         source.source.len() / 1000,
         text.len() / 1000,
-        peak_memory()
+        common::peak_memory()
     );
     Ok(())
-}
-
-/// The process's peak resident memory, where the system says it.
-fn peak_memory() -> String {
-    std::fs::read_to_string("/proc/self/status")
-        .ok()
-        .and_then(|s| {
-            s.lines()
-                .find(|l| l.starts_with("VmHWM:"))
-                .and_then(|l| l.split_whitespace().nth(1))
-                .and_then(|kb| kb.parse::<u64>().ok())
-        })
-        .map_or_else(|| "n/a".into(), |kb| format!("{} MB", kb / 1024))
 }

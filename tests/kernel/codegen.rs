@@ -448,7 +448,9 @@ fn fractal_helpers_return_early_in_their_far_field() {
     let julia = julia([-0.2, 0.6, 0.2, 0.2]);
     for (name, node) in [("real2 mandelbulb(", bulb), ("real2 julia(", julia)] {
         let text = source(node, &Options::default());
-        let start = text.find(name).unwrap_or_else(|| panic!("{name} in\n{text}"));
+        let start = text
+            .find(name)
+            .unwrap_or_else(|| panic!("{name} in\n{text}"));
         let body = &text[start..start + text[start..].find("\n}\n").unwrap()];
         let early = body.find("return").expect("a return");
         let first_loop = body.find("for (").expect("a loop");
