@@ -72,11 +72,12 @@ impl Aabb {
         hi: DVec3::NEG_INFINITY,
     };
 
-    /// A box that holds every point a kernel computes with: for an
+    /// A box that holds every finite point of single precision (local
+    /// points beyond the precisions' limits come of scales): for an
     /// instance without a bound at its current values.
     const EVERYWHERE: Aabb = Aabb {
-        lo: DVec3::splat(-F32_LIMITS.max),
-        hi: DVec3::splat(F32_LIMITS.max),
+        lo: DVec3::splat(-(f32::MAX as f64)),
+        hi: DVec3::splat(f32::MAX as f64),
     };
 
     /// The box around a bounding sphere, padded outwards so that rounding
@@ -233,6 +234,16 @@ impl InstanceTables {
     #[must_use]
     pub fn is_baked(&self) -> bool {
         self.copies.is_empty()
+    }
+
+    /// Whether the tables copy a dynamic value that differs between
+    /// `old` and `new` (both by slot): only then must they be filled
+    /// again.
+    pub(crate) fn differ(&self, old: &[f64], new: &[f64]) -> bool {
+        self.copies.iter().any(|&(_, slot)| {
+            let s = slot as usize;
+            old[s].to_bits() != new[s].to_bits()
+        })
     }
 
     /// Writes the dynamic `values` into `tables` (the entries after the

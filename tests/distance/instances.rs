@@ -226,3 +226,34 @@ fn a_thousand_spheres_are_one_walked_loop() {
         assert_eq!(source.tables.is_baked(), !dynamic);
     }
 }
+
+/// Far out, under a scale that makes the walk's coordinates huge (beyond
+/// the precisions' limits, up to where the spheres' own lengths would
+/// overflow single precision), the walked union is still the plain union:
+/// finite, and the CPU reference's value.
+#[test]
+fn a_walked_union_under_a_tiny_scale_is_finite_far_out() {
+    let Some(device) = gpu::device() else { return };
+    let node = (0..40)
+        .map(|i| {
+            let t = f64::from(i) / 40.0 * std::f64::consts::TAU;
+            sphere(0.1).translate(dvec3(t.cos(), t.sin(), 0.0))
+        })
+        .reduce(Node::union)
+        .expect("spheres")
+        .scale(1e-6);
+    let points = [
+        dvec3(1e13, 0.0, 0.0),
+        dvec3(-1e12, 3e12, 0.5),
+        dvec3(0.0, 0.0, 1.0),
+    ];
+    let tolerance = tolerance(Precision::F32, device.kind);
+    let tested = check_device_matches_cpu(
+        &node,
+        &DeviceSelector::auto(),
+        Precision::F32,
+        &points,
+        tolerance,
+    );
+    assert!(tested.is_ok(), "{}", tested.unwrap_err());
+}

@@ -254,12 +254,15 @@ impl<'a> SceneEmitter<'a> {
         self.w.line(format!(
             "__global const real* node = params + {nodes}u + first * {NODE_LEN}u;"
         ));
-        // One vector lane per entry.
+        // One vector lane per entry. Each axis's gap is capped at 1e18
+        // (the precisions' largest magnitude), so that its square stays
+        // finite at any point a scale makes huge: a smaller gap only opens
+        // more entries.
         let v = format!("real{WIDTH}");
         for (axis, c) in ["x", "y", "z"].iter().enumerate() {
             self.w.line(format!(
-                "{v} g{c} = fmax(fmax(vload{WIDTH}({axis}, node) - {p}.{c}, \
-                 {p}.{c} - vload{WIDTH}({}, node)), ({v})(R(0.0)));",
+                "{v} g{c} = clamp(fmax(vload{WIDTH}({axis}, node) - {p}.{c}, \
+                 {p}.{c} - vload{WIDTH}({}, node)), R(0.0), R(1e18));",
                 axis + 3
             ));
         }

@@ -452,15 +452,19 @@ impl Inputs {
         let origin = source.origin;
         // The dynamic values only: the constants after them stay, unless
         // their tables copy a value that changed (then they are filled and
-        // their hierarchies fitted again).
+        // their hierarchies fitted again; a change elsewhere leaves them).
         match &mut self.filled {
-            None => self.params.write(values.as_slice())?,
-            Some(filled) if filled.as_slice() != values.as_slice() => {
+            Some(filled) if source.tables.differ(filled, values.as_slice()) => {
                 self.params.write(&source.param_buffer(values.as_slice()))?;
                 filled.clear();
                 filled.extend_from_slice(values.as_slice());
             }
-            Some(_) => {}
+            Some(filled) => {
+                self.params.write(values.as_slice())?;
+                filled.clear();
+                filled.extend_from_slice(values.as_slice());
+            }
+            None => self.params.write(values.as_slice())?,
         }
         self.camera.write(camera)?;
         let packed = pack_lights(lights, origin);
