@@ -402,6 +402,24 @@ fn devices_and_bench_report_the_device() {
         report.contains("distance evaluations per pixel"),
         "{report}"
     );
+    // The rate is the frame's evaluations over its median time (within
+    // the rounding of the printed numbers).
+    let before = |marker: &str| -> f64 {
+        let head = &report[..report.find(marker).expect(marker)];
+        let word = head.split_whitespace().last().expect("a number");
+        word.parse()
+            .unwrap_or_else(|_| panic!("{word} before {marker}"))
+    };
+    let (ms, per_pixel) = (before("ms/frame"), before("distance evaluations per pixel"));
+    let rate = before("million evaluations a second");
+    // Each printed number is rounded to a tenth.
+    let pixels = 32.0 * 24.0 / 1e3;
+    let low = (per_pixel - 0.05) * pixels / (ms + 0.05) - 0.05;
+    let high = (per_pixel + 0.05) * pixels / (ms - 0.05).max(0.01) + 0.05;
+    assert!(
+        (low..=high).contains(&rate),
+        "{rate} outside {low}..{high}: {report}"
+    );
 }
 
 #[test]

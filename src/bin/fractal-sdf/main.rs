@@ -981,11 +981,12 @@ fn bench(args: &BenchArgs, settings: &Settings) -> Outcome {
         on_devices(&renderer)
     );
     println!(
-        "  {:.1} ms/frame median of {} (min {low:.1}, max {high:.1}); {:.1} distance evaluations per pixel ({:.1} in the primary march)",
+        "  {:.1} ms/frame median of {} (min {low:.1}, max {high:.1}); {:.1} distance evaluations per pixel ({:.1} in the primary march); {:.1} million evaluations a second",
         median,
         times.len(),
         evaluations / pixels,
-        primary / pixels
+        primary / pixels,
+        evaluations / median / 1e3
     );
     Ok(())
 }
