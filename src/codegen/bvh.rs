@@ -239,6 +239,7 @@ impl InstanceTables {
     /// Whether the tables copy a dynamic value that differs between
     /// `old` and `new` (both by slot): only then must they be filled
     /// again.
+    #[cfg(feature = "opencl")]
     pub(crate) fn differ(&self, old: &[f64], new: &[f64]) -> bool {
         self.copies.iter().any(|&(_, slot)| {
             let s = slot as usize;
