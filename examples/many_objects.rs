@@ -9,7 +9,9 @@
 //! memory, a 640×480 production frame (median of three, after one that
 //! compiles the kernels), its distance evaluations per pixel, and for
 //! dynamic positions the time to set all of them and to fill the tables
-//! and fit the hierarchy again.
+//! and fit the hierarchy again; last, the time the CPU reference takes to
+//! name the object under every pixel of a frame (`Renderer::identify`,
+//! which walks the same hierarchy on the host's threads).
 //! Each row runs in a process of its own, so that its peak memory is its
 //! own (Linux, from `/proc/self/status`).
 //!
@@ -26,7 +28,7 @@ use fractal_sdf::prelude::*;
 use fractal_sdf::render::{RenderOptions, Renderer};
 use fractal_sdf::scene::{Param3, param3};
 
-const HEADER: &str = "| spheres | positions | compile | peak memory | 640×480 production frame | evaluations / pixel | set every position | fill the tables and refit |\n|---:|---|---:|---:|---:|---:|---:|---:|";
+const HEADER: &str = "| spheres | positions | compile | peak memory | 640×480 production frame | evaluations / pixel | set every position | fill the tables and refit | object ids (CPU) |\n|---:|---|---:|---:|---:|---:|---:|---:|---:|";
 
 fn main() -> fractal_sdf::Result<()> {
     let args: Vec<String> = std::env::args().skip(1).collect();
@@ -134,10 +136,16 @@ fn row(n: usize, dynamic: bool) -> fractal_sdf::Result<String> {
     } else {
         ("(a new program)".into(), String::new())
     };
+    // Read before the layered frame's buffers add to it.
+    let peak = common::peak_memory();
+    let mut layered = renderer.render_layers(w, h)?;
+    let t = Instant::now();
+    renderer.identify(&mut layered)?;
+    let ids = ms(t);
     Ok(format!(
-        "| {n} | {} | {compile:.0} ms | {} | {:.0} ms | {evaluations:.1} | {set} | {refit} |",
+        "| {n} | {} | {compile:.0} ms | {} | {:.0} ms | {evaluations:.1} | {set} | {refit} | {ids:.0} ms |",
         if dynamic { "dynamic" } else { "baked" },
-        common::peak_memory(),
+        peak,
         times[1],
     ))
 }

@@ -23,16 +23,16 @@
 //! # Ok::<(), fractal_sdf::Error>(())
 //! ```
 
-mod bvh;
 mod formulas;
 mod helpers;
 pub(crate) mod interface;
 pub(crate) mod names;
 mod scene;
+mod tables;
 mod writer;
 
-pub use bvh::InstanceTables;
 pub use scene::{MIN_HIERARCHY, MIN_INSTANCES};
+pub use tables::InstanceTables;
 pub use writer::literal;
 
 use std::sync::atomic::{AtomicU64, Ordering};

@@ -5,6 +5,7 @@
 //! test compares against. It is written for clarity and exactness, not
 //! speed.
 
+mod hierarchy;
 pub mod sdf;
 pub mod shade;
 
@@ -14,6 +15,7 @@ use crate::math::{
     DEFAULT_COLOR, escape_radius, integer_power, mandelbulb_radius, normalize, rotation_rows,
 };
 use crate::math::{Real, V3, v3};
+use hierarchy::{Hierarchy, Walk};
 use sdf::Estimate;
 
 use crate::error::Result;
@@ -80,12 +82,32 @@ pub struct Evaluator {
     /// The smooth unions that evaluate their second operand first
     /// (`ir::swaps`).
     swapped: Vec<bool>,
-    /// Whether each node is a leaf: a shape of its own.
-    leaves: Vec<bool>,
-    /// The fractals an orbit trap colours: their parent evaluates them,
-    /// once, with the trap.
-    trapped: Vec<bool>,
+    /// The chains of at least [`MIN_HIERARCHY`](crate::codegen::MIN_HIERARCHY)
+    /// operands with bounds at the current values, by root: their bounded
+    /// operands are found through a hierarchy of boxes, as in the kernels.
+    hierarchies: HashMap<usize, Hierarchy>,
     prune: bool,
+}
+
+/// One step of [`Evaluator::eval`]: tasks wait on a stack, samples on
+/// another.
+enum Task<T> {
+    /// Evaluate a node at the point it sees; push its sample.
+    Visit(NodeId, V3<T>),
+    /// Replace the child's sample with the node's.
+    Finish(NodeId, V3<T>),
+    /// With the first operand's sample on top, evaluate a boolean's second
+    /// operand unless pruning skips it.
+    Second(NodeId, V3<T>),
+    /// Combine a boolean's two operands' samples.
+    Join(NodeId),
+    /// With a union tree's sample so far on top, evaluate its operand of
+    /// this place unless pruning skips it.
+    Chain(usize, usize, V3<T>),
+    /// Combine a union tree's sample so far with its next operand's.
+    Union,
+    /// Go on walking a union tree's hierarchy.
+    Walk(Box<Walk<T>>),
 }
 
 impl Evaluator {
@@ -138,12 +160,6 @@ impl Evaluator {
                 tested.push(if swapped[i] { *a } else { *b });
             }
         }
-        let mut trapped = vec![false; ir.nodes().len()];
-        for node in ir.nodes() {
-            if let Kind::OrbitTrap { child, .. } = node {
-                trapped[child.index()] = true;
-            }
-        }
         let reaches = tested
             .into_iter()
             .filter_map(|o| {
@@ -151,17 +167,41 @@ impl Evaluator {
                 (r.parts.len() > 1 || r.parts[0].1 != 0.0).then_some((o.index(), r))
             })
             .collect();
-        let leaves = ir.nodes().iter().map(|n| n.children().is_empty()).collect();
-        Evaluator {
+        let mut eval = Evaluator {
             ir,
             values,
             bounds,
-            leaves,
             chains,
             reaches,
             swapped,
-            trapped,
+            hierarchies: HashMap::new(),
             prune: true,
+        };
+        eval.index();
+        eval
+    }
+
+    /// Builds the hierarchies of the large union trees over their
+    /// operands' bounds at the current values.
+    fn index(&mut self) {
+        self.hierarchies.clear();
+        if self
+            .chains
+            .values()
+            .all(|o| o.len() < crate::ir::bvh::MIN_HIERARCHY)
+        {
+            return;
+        }
+        let bounds: Vec<Option<Bound>> = self
+            .ir
+            .bounds_at(self.values.as_slice())
+            .into_iter()
+            .map(|b| b.filter(|b| b.fits(&F32_LIMITS)))
+            .collect();
+        for (&root, operands) in &self.chains {
+            if let Some(h) = Hierarchy::build(operands, &bounds) {
+                self.hierarchies.insert(root, h);
+            }
         }
     }
 
@@ -170,6 +210,7 @@ impl Evaluator {
     #[must_use]
     pub(crate) fn with_values(mut self, values: ParamValues) -> Self {
         self.values = values;
+        self.index();
         self
     }
 
@@ -230,7 +271,9 @@ impl Evaluator {
     /// # Errors
     /// See [`ParamValues::set`].
     pub fn set_param(&mut self, name: &str, value: f64) -> Result<()> {
-        self.values.set(name, value)
+        self.values.set(name, value)?;
+        self.index();
+        Ok(())
     }
 
     /// Distance at `p` in `f64`.
@@ -295,44 +338,129 @@ impl Evaluator {
         }
     }
 
-    /// Evaluates the scene at `p` without recursion, whatever its depth,
-    /// in two passes over the arena (children come before parents): from
-    /// the root down, the point each node sees; from the leaves up, each
-    /// node's sample from its children's.
+    /// Evaluates the scene at `p` without recursion, whatever its depth:
+    /// a stack of tasks visits each node the result needs, from the root
+    /// down, and a stack of samples carries their results up. An operand
+    /// that pruning skips is never visited, and a large union walks its
+    /// hierarchy (`hierarchy`).
     fn eval<T: Real>(&self, p: V3<T>) -> Sample<T> {
-        let nodes = self.ir.nodes();
-        let mut points = vec![p; nodes.len()];
-        for (i, node) in nodes.iter().enumerate().rev() {
-            let q = self.child_point(node, points[i]);
-            for child in node.children() {
-                points[child.index()] = q;
+        let mut tasks = vec![Task::Visit(self.ir.root(), p)];
+        let mut out: Vec<Sample<T>> = Vec::new();
+        while let Some(task) = tasks.pop() {
+            match task {
+                Task::Visit(id, p) => self.visit(id, p, &mut tasks, &mut out),
+                Task::Finish(id, p) => {
+                    let child = out.pop().expect("the child's sample");
+                    let node = self.ir.node(id);
+                    out.push(self.sample_at(id.index(), node, p, Some(child)));
+                }
+                Task::Second(id, p) => {
+                    let Kind::Csg {
+                        op,
+                        smoothing,
+                        a,
+                        b,
+                        ..
+                    } = self.ir.node(id)
+                    else {
+                        unreachable!("only booleans have a second operand")
+                    };
+                    let second = if self.prune && self.swapped[id.index()] {
+                        a
+                    } else {
+                        b
+                    };
+                    let k = smoothing.map_or_else(T::zero, |k| self.scalar(k));
+                    let first = out.last().expect("the first operand's sample");
+                    if !self.skips(*op, k, first.distance, *second, p) {
+                        tasks.push(Task::Join(id));
+                        tasks.push(Task::Visit(*second, p));
+                    }
+                }
+                Task::Join(id) => {
+                    let Kind::Csg { op, smoothing, .. } = self.ir.node(id) else {
+                        unreachable!("only booleans join two operands")
+                    };
+                    let second = out.pop().expect("the second operand's sample");
+                    let first = out.pop().expect("the first operand's sample");
+                    let k = smoothing.map(|k| self.scalar(k));
+                    out.push(combine(*op, k, first, second));
+                }
+                Task::Chain(root, next, p) => {
+                    let operands = &self.chains[&root];
+                    let Some(&o) = operands.get(next) else {
+                        continue;
+                    };
+                    tasks.push(Task::Chain(root, next + 1, p));
+                    let acc = out.last().expect("the first operand's sample");
+                    if !self.skips(CsgOp::Union, T::zero(), acc.distance, o, p) {
+                        tasks.push(Task::Union);
+                        tasks.push(Task::Visit(o, p));
+                    }
+                }
+                Task::Union => {
+                    let b = out.pop().expect("the operand's sample");
+                    let a = out.pop().expect("the union's sample so far");
+                    out.push(combine(CsgOp::Union, None, a, b));
+                }
+                Task::Walk(mut walk) => {
+                    if walk.waits() {
+                        walk.give(out.pop().expect("the operand's sample"));
+                    }
+                    match walk.next(&self.hierarchies[&walk.root]) {
+                        Some(o) => {
+                            let p = walk.p;
+                            tasks.push(Task::Walk(walk));
+                            tasks.push(Task::Visit(o, p));
+                        }
+                        None => out.push(walk.result()),
+                    }
+                }
             }
         }
-        let unset = Self::leaf(T::zero());
-        let mut samples = vec![unset; nodes.len()];
-        for (i, node) in nodes.iter().enumerate() {
-            samples[i] = match self.chains.get(&i) {
-                Some(operands) => self.chain_at(operands, points[i], &samples),
-                None => self.sample_at(i, node, points[i], &samples),
-            };
-            if self.leaves[i] {
-                samples[i].object = Some(NodeId::from_index(i));
-            }
-        }
-        samples[self.ir.root().index()]
+        out.pop().expect("the root's sample")
     }
 
-    /// A tree of hard unions at `p`, from its operands' samples: their
-    /// minimum, in the kernels' order, skipping the operands whose bound
-    /// is beyond the minimum so far.
-    fn chain_at<T: Real>(&self, operands: &[NodeId], p: V3<T>, done: &[Sample<T>]) -> Sample<T> {
-        let mut acc = done[operands[0].index()];
-        for &o in &operands[1..] {
-            if !self.skips(CsgOp::Union, T::zero(), acc.distance, o, p) {
-                acc = combine(CsgOp::Union, None, acc, done[o.index()]);
-            }
+    /// Starts the evaluation of node `id` at the point `p` it sees: a leaf
+    /// at once, any other node after the children it needs.
+    fn visit<T: Real>(
+        &self,
+        id: NodeId,
+        p: V3<T>,
+        tasks: &mut Vec<Task<T>>,
+        out: &mut Vec<Sample<T>>,
+    ) {
+        let i = id.index();
+        if self.prune && self.hierarchies.contains_key(&i) {
+            tasks.push(Task::Walk(Box::new(Walk::new(i, p))));
+            return;
         }
-        acc
+        if let Some(operands) = self.chains.get(&i) {
+            tasks.push(Task::Chain(i, 1, p));
+            tasks.push(Task::Visit(operands[0], p));
+            return;
+        }
+        let node = self.ir.node(id);
+        match node {
+            Kind::Csg { a, b, .. } => {
+                let first = if self.prune && self.swapped[i] { b } else { a };
+                tasks.push(Task::Second(id, p));
+                tasks.push(Task::Visit(*first, p));
+            }
+            // Its orbit trap evaluates the fractal.
+            Kind::OrbitTrap { .. } => out.push(self.sample_at(i, node, p, None)),
+            _ => match node.children().first() {
+                Some(&&child) => {
+                    tasks.push(Task::Finish(id, p));
+                    tasks.push(Task::Visit(child, self.child_point(node, p)));
+                }
+                None => {
+                    let mut sample = self.sample_at(i, node, p, None);
+                    sample.object = Some(id);
+                    out.push(sample);
+                }
+            },
+        }
     }
 
     /// The point a node's children see, for the point `p` it sees.
@@ -361,19 +489,20 @@ impl Evaluator {
         }
     }
 
-    /// A node's sample at the point `p` it sees, from its children's
-    /// samples (already in `done`).
+    /// A node's sample at the point `p` it sees, from its only child's
+    /// `sample` where it has one (booleans and unions of many are combined
+    /// in [`Evaluator::eval`]).
     #[allow(clippy::too_many_lines)]
     fn sample_at<T: Real>(
         &self,
         id: usize,
         node: &IrNode,
         p: V3<T>,
-        done: &[Sample<T>],
+        child: Option<Sample<T>>,
     ) -> Sample<T> {
         let s = |x: Scalar| self.scalar::<T>(x);
         let v = |x: [Scalar; 3]| self.vector::<T>(x);
-        let of = |c: &NodeId| done[c.index()];
+        let of = |_: &NodeId| child.expect("a node with a child gets its sample");
         match node {
             Kind::Sphere { radius } => Self::leaf(sdf::sphere(p, s(*radius))),
             Kind::Cuboid { half_extents } => Self::leaf(sdf::cuboid(p, v(*half_extents))),
@@ -551,16 +680,10 @@ impl Evaluator {
             | Kind::Kifs(_)
             | Kind::Hybrid(_)
             | Kind::Mandelbox(_)
-            | Kind::PseudoKleinian(_) => {
-                if self.trapped[id] {
-                    // Its orbit trap evaluates it.
-                    return Self::leaf(T::zero());
-                }
-                Self::fractal(
-                    self.fractal_estimate(node, p, None)
-                        .expect("a fractal has an estimate"),
-                )
-            }
+            | Kind::PseudoKleinian(_) => Self::fractal(
+                self.fractal_estimate(node, p, None)
+                    .expect("a fractal has an estimate"),
+            ),
             Kind::Translate { child, .. }
             | Kind::Rotate { child, .. }
             | Kind::Mirror { child, .. }
@@ -594,23 +717,7 @@ impl Evaluator {
                 self.warp_floor(id, &mut out.distance, p);
                 out
             }
-            Kind::Csg {
-                op,
-                smoothing,
-                a,
-                b,
-            } => {
-                let k = smoothing.map(s);
-                let (a, b) = if self.prune && self.swapped[id] {
-                    (b, a)
-                } else {
-                    (a, b)
-                };
-                if self.skips(*op, k.unwrap_or_else(T::zero), of(a).distance, *b, p) {
-                    return of(a);
-                }
-                combine(*op, k, of(a), of(b))
-            }
+            Kind::Csg { .. } => unreachable!("booleans are combined as they are evaluated"),
             Kind::Custom { shape, args } => {
                 let args: Vec<f64> = args.iter().map(|a| self.scalar::<f64>(*a)).collect();
                 let q = p.cast::<f64>().into();

@@ -22,12 +22,14 @@
 
 use glam::DVec3;
 
-use super::{Ir, IrNode, NodeId, Scalar, baked3};
+use std::convert::Infallible;
+
+use super::{Ir, IrNode, NodeId, Scalar, Vector, baked3};
 use crate::math::{
     JULIA_FAR_FIELD, JULIA_FAR_FIELD_SLOPE, Limits, Num, V3, julia_radius, kifs_radius,
     mandelbox_extent, mandelbulb_radius, rotation_rows,
 };
-use crate::scene::{Axis, CsgOp, HybridOp, KifsFold, Kind, Profile};
+use crate::scene::{Axis, CsgOp, HybridOp, KifsFold, Kind, Mapper, ParamSpec, Profile};
 
 /// A conservative bounding sphere of a node, in the coordinates the node
 /// sees: wherever `slope · (|p − centre| − radius) > 0`, the node's
@@ -142,6 +144,52 @@ impl Ir {
             out.push(b);
         }
         out
+    }
+
+    /// Every node's bound at the dynamic parameters' `values` (by slot):
+    /// [`Ir::bounds`] with each dynamic value read as if it were baked. It
+    /// holds for those values only.
+    pub(crate) fn bounds_at(&self, values: &[f64]) -> Vec<Option<Bound>> {
+        let mut read = Baking(|slot: u32| values.get(slot as usize).copied());
+        let mut out: Vec<Option<Bound>> = Vec::with_capacity(self.nodes().len());
+        for node in self.nodes() {
+            let Ok(baked) = node.try_map(&mut read);
+            let b = bound(&baked, &out);
+            out.push(b);
+        }
+        out
+    }
+}
+
+/// Reads a node's dynamic values as baked ones: `Baking(f)` turns
+/// `Dynamic(slot)` into `Baked(v)` where `f(slot)` is `Some(v)`.
+pub(crate) struct Baking<F>(pub(crate) F);
+
+impl<F: Fn(u32) -> Option<f64>> Baking<F> {
+    fn read(&self, s: Scalar) -> Scalar {
+        match s {
+            Scalar::Dynamic(slot) => (self.0)(slot).map_or(s, Scalar::Baked),
+            Scalar::Baked(_) => s,
+        }
+    }
+}
+
+impl<F: Fn(u32) -> Option<f64>> Mapper<Scalar, Vector, NodeId> for Baking<F> {
+    type S2 = Scalar;
+    type V2 = Vector;
+    type C2 = NodeId;
+    type E = Infallible;
+
+    fn scalar(&mut self, s: &Scalar, _: ParamSpec<'_>) -> Result<Scalar, Infallible> {
+        Ok(self.read(*s))
+    }
+
+    fn vector(&mut self, v: &Vector, _: ParamSpec<'_>) -> Result<Vector, Infallible> {
+        Ok(v.map(|s| self.read(s)))
+    }
+
+    fn child(&mut self, c: &NodeId) -> Result<NodeId, Infallible> {
+        Ok(*c)
     }
 }
 

@@ -12,6 +12,7 @@
 //! ([`crate::codegen`]) and the renderer read it, never the scene tree.
 
 mod bounds;
+pub(crate) mod bvh;
 mod compiled;
 mod inside;
 mod lower;
@@ -23,10 +24,10 @@ use std::sync::atomic::{AtomicU64, Ordering};
 
 use glam::DVec3;
 
-pub use bounds::{Bound, SHRINK};
 pub(crate) use bounds::{
-    Reach, UnionChain, bound, constant, costs, is_hard_union, reach, swaps, union_chain,
+    Baking, Reach, UnionChain, bound, constant, costs, is_hard_union, reach, swaps, union_chain,
 };
+pub use bounds::{Bound, SHRINK};
 pub use compiled::{CompiledScene, MAX_LIGHTS};
 pub use params::{Constraint, ParamLayout, ParamSlot, ParamValues, Relation};
 pub use path::NodePath;

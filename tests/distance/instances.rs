@@ -1,9 +1,10 @@
-//! Instanced unions walked through a bounding volume hierarchy: on random
-//! sets of instances the device's distance and colour are the plain
-//! union's, which the CPU reference computes operand by operand with no
-//! hierarchy; instances moved by dynamic parameters are found where they
-//! moved to (the hierarchy fitted again); and the program holds one copy
-//! of an instance's code however many there are.
+//! Unions of many alike shapes walked through a bounding volume hierarchy,
+//! in the kernels and in the CPU reference: on random sets of instances
+//! both give the plain union's distance and colour, which the CPU reference
+//! computes operand by operand with pruning off; instances moved by
+//! dynamic parameters are found where they moved to (the hierarchies
+//! fitted or built again); and the program holds one copy of an
+//! instance's code however many there are.
 
 use crate::gpu;
 
@@ -83,16 +84,19 @@ proptest! {
         (kind, set) in instances(),
         seed in 0u64..1000,
     ) {
-        let Some(device) = gpu::device() else { return Ok(()) };
         let node = set
             .iter()
             .map(|&placed| shape(kind, placed))
             .reduce(Node::union)
             .expect("instances");
+        let points = points_near(&set, seed);
+        let walked = cpu::Evaluator::new(&node).unwrap();
+        let tested = walks_like_plain(&walked, &points);
+        prop_assert!(tested.is_ok(), "{}", tested.unwrap_err());
+        let Some(device) = gpu::device() else { return Ok(()) };
         let source = codegen::emit(&Scene::new(node.clone()).compile().unwrap(), &Options::default())
             .unwrap();
         prop_assert!(source.source.contains("walked through"), "no hierarchy");
-        let points = points_near(&set, seed);
         for precision in [Precision::F32, Precision::F64] {
             if precision == Precision::F64 && !gpu::fp64(&device) {
                 continue;
@@ -108,6 +112,28 @@ proptest! {
             prop_assert!(tested.is_ok(), "{precision:?}: {}", tested.unwrap_err());
         }
     }
+}
+
+/// The CPU reference's walk of `walked`'s unions gives, at every point,
+/// in both precisions, the very sample (distance, colour, object,
+/// material) that evaluating every operand in turn gives.
+fn walks_like_plain(walked: &cpu::Evaluator, points: &[DVec3]) -> Result<(), String> {
+    let plain = walked.clone().with_pruning(false);
+    for p in points {
+        let (a, b) = (
+            walked.sample::<f64>((*p).into()),
+            plain.sample::<f64>((*p).into()),
+        );
+        if a != b {
+            return Err(format!("F64 at {p}: walked {a:?}, plain {b:?}"));
+        }
+        let q = p.as_vec3().into();
+        let (a, b) = (walked.sample::<f32>(q), plain.sample::<f32>(q));
+        if a != b {
+            return Err(format!("F32 at {p}: walked {a:?}, plain {b:?}"));
+        }
+    }
+    Ok(())
 }
 
 /// Spheres on a ring, each placed by a dynamic parameter of its own.
@@ -129,13 +155,27 @@ fn moving(n: usize) -> (Node, Vec<DVec3>) {
 
 /// Instances whose positions are dynamic share one loop and one hierarchy;
 /// moved anywhere (scattered, gathered, swapped far across the tree), the
-/// device finds each where it now is: its distances are the CPU
-/// reference's at the new values, which evaluates every sphere.
+/// CPU reference's hierarchy, built again at the new values, finds each
+/// where it now is (its samples are those of every sphere evaluated in
+/// turn), and so does the device's, fitted again: its distances are the
+/// CPU reference's.
 #[test]
 fn moved_instances_are_found_where_they_moved() {
-    let Some(device) = gpu::device() else { return };
     let n = 200;
     let (node, at) = moving(n);
+    let mut cpu = cpu::Evaluator::new(&node).unwrap();
+    let scattered = random_points(n, 2.0, 7);
+    for (round, to) in [at[..].to_vec(), scattered.clone()].iter().enumerate() {
+        let mut points = random_points(500, 3.5, 3 + round as u64);
+        for (i, c) in to.iter().enumerate() {
+            for (axis, v) in ["x", "y", "z"].iter().zip(c.to_array()) {
+                cpu.set_param(&format!("c{i}.{axis}"), v).unwrap();
+            }
+            points.extend([*c, *c + unit_vector_at(i) * 0.06]);
+        }
+        walks_like_plain(&cpu, &points).unwrap();
+    }
+    let Some(device) = gpu::device() else { return };
     let compiled = Scene::new(node.clone()).compile().unwrap();
     let source = codegen::emit(&compiled, &Options::default()).unwrap();
     assert!(source.source.contains("walked through"), "no hierarchy");
@@ -148,8 +188,6 @@ fn moved_instances_are_found_where_they_moved() {
     let precision = Precision::F32;
     let tolerance = tolerance(precision, device.kind);
     let mut gpu = PointEvaluator::new(&node, precision, &DeviceSelector::auto()).unwrap();
-    let mut cpu = cpu::Evaluator::new(&node).unwrap();
-    let scattered = random_points(n, 2.0, 7);
     let moves: [Box<dyn Fn(usize) -> DVec3>; 4] = [
         Box::new(|i| at[i]),
         Box::new(|i| scattered[i]),

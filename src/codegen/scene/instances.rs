@@ -2,9 +2,10 @@
 //! their values become one loop over a table of those values, walked
 //! through a bounding volume hierarchy where the group is large.
 
-use super::super::bvh::{Bvh, NODE_LEN, Refit, STACK, WIDTH, chain_bound};
+use super::super::tables::{Refit, chain_bound};
 use super::*;
 use crate::ir::SHRINK;
+use crate::ir::bvh::{Bvh, MIN_HIERARCHY, NODE_LEN, STACK, WIDTH};
 
 impl<'a> SceneEmitter<'a> {
     /// Enters the union tree under `id` as one: its operands that differ
@@ -330,12 +331,6 @@ impl<'a> SceneEmitter<'a> {
         self.w.close();
     }
 }
-
-/// The fewest members of an instanced group walked through a bounding
-/// volume hierarchy rather than looped over (all of them need a bound).
-/// Measured: 16 spheres cost the same either way (a 640×480 production
-/// frame 616 against 642 ms), 32 take 735 ms walked against 970 looped.
-pub const MIN_HIERARCHY: usize = 32;
 
 /// The fewest operands of one tree of hard unions, alike but for their
 /// values, that code generation emits as one loop over a table of

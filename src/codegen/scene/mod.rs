@@ -24,9 +24,9 @@ use std::collections::{BTreeMap, BTreeSet, HashMap};
 use std::convert::Infallible;
 use std::fmt::Write as _;
 
-use super::bvh::InstanceTables;
 use super::formulas::vector;
 use super::helpers::Helper;
+use super::tables::InstanceTables;
 use super::writer::{INSTANCE_SLOT, Writer};
 use crate::cpu::sdf::{self, TrapShape};
 use crate::expr::{Num, OpenCl, Printer, Shape, Var, trace};
@@ -46,8 +46,9 @@ use crate::scene::{
 mod inline;
 mod instances;
 
+pub use crate::ir::bvh::MIN_HIERARCHY;
+pub use instances::MIN_INSTANCES;
 use instances::*;
-pub use instances::{MIN_HIERARCHY, MIN_INSTANCES};
 
 /// The trap of a surface that has none (a `real2`: the trap that tints
 /// its colour, and the trap the shading layers show).
