@@ -393,6 +393,7 @@ fn devices_and_bench_report_the_device() {
             "draft",
             "--frames",
             "2",
+            "--stages",
         ],
     );
     assert!(out.status.success(), "{}", text(&out));
@@ -420,6 +421,24 @@ fn devices_and_bench_report_the_device() {
         (low..=high).contains(&rate),
         "{rate} outside {low}..{high}: {report}"
     );
+    // The operations a second are the rate times the operations an
+    // evaluation, and their share of the measured peak what it says.
+    let (ops, gflops) = (before("operations an evaluation"), before("GFLOP/s, "));
+    assert!(ops > 10.0, "{report}");
+    let expected = rate * ops / 1e3;
+    assert!(
+        (gflops - expected).abs() <= 0.005 + 0.06 * ops / 1e3 + 0.001 * expected,
+        "{gflops} GFLOP/s against {rate} million evaluations of {ops}: {report}"
+    );
+    let share = before("% of the");
+    let peak = before("GFLOP/s this device reaches");
+    assert!(peak > 0.0, "{report}");
+    assert!(
+        (share - 100.0 * gflops / peak).abs() <= 0.05 + 100.0 * 0.005 / peak + 0.01 * share,
+        "{share}% of {peak}: {report}"
+    );
+    // The stages: the march alone first, its time and evaluations.
+    assert!(report.contains("march, normals and shading"), "{report}");
 }
 
 #[test]

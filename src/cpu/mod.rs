@@ -959,7 +959,18 @@ pub struct Hit {
 /// of regula falsi.
 #[must_use]
 pub fn march(eval: &Evaluator, ray: Ray, settings: &MarchSettings) -> Hit {
-    march_with(eval, ray, settings, None)
+    march_with(eval, ray, settings, None, &mut |_| {})
+}
+
+/// [`march`], calling `visit` with every point where it evaluates the
+/// distance.
+pub(crate) fn march_visiting(
+    eval: &Evaluator,
+    ray: Ray,
+    settings: &MarchSettings,
+    visit: &mut dyn FnMut(DVec3),
+) -> Hit {
+    march_with(eval, ray, settings, None, visit)
 }
 
 /// Brute-force marching of a scene with inside shapes (see
@@ -1012,7 +1023,7 @@ impl Brute {
 /// by bisection.
 #[must_use]
 pub fn march_brute(eval: &Evaluator, ray: Ray, settings: &MarchSettings, brute: &Brute) -> Hit {
-    march_with(eval, ray, settings, Some(brute))
+    march_with(eval, ray, settings, Some(brute), &mut |_| {})
 }
 
 /// The kernel's `march_brute_step`: a step from `t` of at most `step` that
@@ -1036,9 +1047,20 @@ fn brute_step(t: f64, step: f64, span: (f64, f64), h: f64, phase: f64, next: &mu
     to_next
 }
 
-fn march_with(eval: &Evaluator, ray: Ray, settings: &MarchSettings, brute: Option<&Brute>) -> Hit {
+fn march_with(
+    eval: &Evaluator,
+    ray: Ray,
+    settings: &MarchSettings,
+    brute: Option<&Brute>,
+    visit: &mut dyn FnMut(DVec3),
+) -> Hit {
     let surface = |t: f64| settings.detail * settings.footprint(t);
-    let level = |t: f64| eval.distance(ray.origin + ray.direction * t) - surface(t);
+    let visit = std::cell::RefCell::new(visit);
+    let distance = |p: DVec3| {
+        (visit.borrow_mut())(p);
+        eval.distance(p)
+    };
+    let level = |t: f64| distance(ray.origin + ray.direction * t) - surface(t);
     let lipschitz = 1.0 + settings.detail * settings.footprint_per_unit;
     let mut omega = settings.over_relaxation;
     let mut relaxed = false;
@@ -1059,7 +1081,7 @@ fn march_with(eval: &Evaluator, ray: Ray, settings: &MarchSettings, brute: Optio
     let mut i = 0;
     while i < settings.max_steps {
         i += 1;
-        let d = eval.distance(ray.origin + ray.direction * t);
+        let d = distance(ray.origin + ray.direction * t);
         let g = d - surface(t);
         steps += 1;
         if relaxed && (g < 0.0 || prev_g + g < lipschitz * (t - prev_t)) {

@@ -37,6 +37,7 @@
 //! ```
 
 mod bound;
+mod count;
 mod interval;
 mod num;
 mod ops;
@@ -47,6 +48,7 @@ mod trace;
 mod vector;
 
 pub use bound::surface_box;
+pub use count::{CALL_FLOPS, Counted, Operations, counting};
 
 /// A distance formula written once, for custom shapes
 /// ([`CustomShape::formula`](crate::scene::CustomShape::formula)): one

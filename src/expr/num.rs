@@ -245,7 +245,7 @@ pub trait Num:
 
 /// A loop in plain numbers: at most `count` steps (and
 /// [`MAX_LOOP_STEPS`]), stopping where a step says so.
-fn plain_loop<N: Num<Bool = bool> + PartialOrd, S>(
+pub(super) fn plain_loop<N: Num<Bool = bool> + PartialOrd, S>(
     count: N,
     index: impl Fn(u32) -> N,
     mut state: S,

@@ -27,6 +27,13 @@ impl Real for f64 {
     }
 }
 
+/// Counts the CPU reference's operations (see [`counting`](crate::expr::counting)).
+impl Real for crate::expr::Counted {
+    fn to_f64(self) -> f64 {
+        self.value()
+    }
+}
+
 impl<T: Real> V3<T> {
     /// Converts to the other precision.
     #[must_use]

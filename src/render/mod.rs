@@ -77,7 +77,7 @@ pub use device::{DEVICE_ENV, DeviceInfo, DeviceKind, DeviceSelector, devices};
 pub use dispatch::{DEFAULT_TILE_SIZE, MAX_IMAGE_SIDE};
 pub use points::{PointEvaluator, PointSample};
 pub use program::{BuildInfo, PROGRAM_CACHE_CAPACITY, program_builds};
-pub use renderer::{ConvergedFrame, RenderOptions, Renderer, StopRule};
+pub use renderer::{ConvergedFrame, EvaluationCost, RenderOptions, Renderer, StopRule};
 pub use sampling::{SamplePoint, brute_phase, sample_point};
 pub use stereo::compose;
 pub use viewport::Viewport;

@@ -5,8 +5,9 @@
 
 use crate::gpu;
 
+use fractal_sdf::cpu;
 use fractal_sdf::expr::V3;
-use fractal_sdf::expr::{Distance, Formula, Interval, Num, Program};
+use fractal_sdf::expr::{Counted, Distance, Formula, Interval, Num, Program, counting};
 use fractal_sdf::mesh::{GridOptions, Sampler, extract};
 use fractal_sdf::prelude::*;
 use fractal_sdf::quality::Precision;
@@ -370,4 +371,44 @@ fn the_deepest_formulas_are_refused_or_evaluated_without_overflowing() {
     let d = shape.distance(DVec3::new(2.0, 0.0, 0.0), &[0.5]);
     assert!((d - 1.5).abs() < 1e-12, "{d}");
     assert!(shape.surface_box(&[0.5]).is_some());
+}
+
+/// The CPU reference's whole scene runs on a number that counts its
+/// operations: a sphere is the hand count of `|p| − r` (three products,
+/// two sums, a square root, a difference), a translation three
+/// differences more; its values are `f64`'s; pruning saves operations,
+/// and a fractal costs less far away, where it returns early, than on its
+/// surface.
+#[test]
+fn operations_are_counted_on_the_whole_scene() {
+    let count = |eval: &cpu::Evaluator, p: DVec3| {
+        let (sample, ops) =
+            counting(|| eval.sample::<Counted>(V3::from_array(p.to_array().map(Counted::of))));
+        assert_eq!(sample.distance.value(), eval.distance(p), "at {p}");
+        ops
+    };
+    let p = dvec3(0.3, -1.2, 2.0);
+    let ball = cpu::Evaluator::new(&sphere(1.0)).unwrap();
+    assert_eq!((count(&ball, p).arithmetic, count(&ball, p).calls), (7, 0));
+    let moved = cpu::Evaluator::new(&sphere(1.0).translate(dvec3(1.0, 2.0, 3.0))).unwrap();
+    assert_eq!(count(&moved, p).arithmetic, 10);
+
+    let pair = sphere(0.5)
+        .translate(dvec3(-3.0, 0.0, 0.0))
+        .union(sphere(0.5).translate(dvec3(3.0, 0.0, 0.0)));
+    let pruned = cpu::Evaluator::new(&pair).unwrap();
+    let unpruned = pruned.clone().with_pruning(false);
+    let near_one = dvec3(-3.0, 0.6, 0.0);
+    assert!(count(&pruned, near_one).flops() < count(&unpruned, near_one).flops());
+
+    let bulb = cpu::Evaluator::new(&mandelbulb(8.0)).unwrap();
+    let (far, surface) = (
+        count(&bulb, dvec3(0.0, 0.0, 5.0)),
+        count(&bulb, dvec3(0.0, 0.0, 1.0)),
+    );
+    assert!(
+        far.flops() * 4 < surface.flops(),
+        "far {far:?}, surface {surface:?}"
+    );
+    assert!(surface.calls > 0);
 }

@@ -28,7 +28,7 @@ const STAGES: &[(&str, &[&str])] = &[
     (
         "render",
         &[
-            "error", "scene", "ir", "math", "quality", "cpu", "codegen", "view",
+            "error", "scene", "ir", "math", "expr", "quality", "cpu", "codegen", "view",
         ],
     ),
     (

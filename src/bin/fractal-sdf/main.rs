@@ -12,6 +12,7 @@ use std::time::{Duration, Instant};
 use clap::{Args, Parser, Subcommand};
 use fractal_sdf::animation::CameraPath;
 use fractal_sdf::codegen::{self, Options};
+use fractal_sdf::expr::CALL_FLOPS;
 use fractal_sdf::file::SceneFile;
 use fractal_sdf::gallery;
 use fractal_sdf::output::{
@@ -333,6 +334,12 @@ struct BenchArgs {
     /// Frames to time after one warm-up frame.
     #[arg(long, default_value_t = 10, value_parser = clap::value_parser!(u32).range(1..))]
     frames: u32,
+    /// Also time the frame stage by stage: the march with normals and
+    /// shading alone, then with each of ambient occlusion, shadows and
+    /// glow that the scene and preset have added one after the other
+    /// (each a program of its own).
+    #[arg(long)]
+    stages: bool,
 }
 
 /// A failure and the exit code it gets: 2 for a command line that cannot
@@ -951,17 +958,33 @@ fn list_devices() -> Outcome {
     Ok(())
 }
 
-fn bench(args: &BenchArgs, settings: &Settings) -> Outcome {
-    let job = Job::new(&args.scene, settings)?;
-    let (width, height) = job.size;
-    let mut renderer = job.renderer()?;
+/// A timed frame: its median time, the fastest and slowest, and its
+/// evaluations per pixel, all and in the primary march.
+struct Timed {
+    times: Vec<f64>,
+    evaluations: f64,
+    primary: f64,
+}
+
+impl Timed {
+    fn median(&self) -> f64 {
+        self.times
+            .get(self.times.len() / 2)
+            .copied()
+            .unwrap_or(f64::NAN)
+    }
+}
+
+/// Counts one frame's evaluations, then times `frames` more.
+fn time_frames(renderer: &mut Renderer, size: (u32, u32), frames: u32) -> Result<Timed, Failure> {
+    let (width, height) = size;
     let frame = renderer.render_with_aovs(width, height)?;
     let pixels = f64::from(width) * f64::from(height);
     let evaluations: f64 = frame.evaluations.iter().map(|&e| f64::from(e)).sum();
     let primary: f64 = frame.steps.iter().map(|&e| f64::from(e)).sum();
     let mut times = Vec::new();
-    let bar = ProgressBar::new(u64::from(args.frames));
-    for _ in 0..args.frames {
+    let bar = ProgressBar::new(u64::from(frames));
+    for _ in 0..frames {
         let start = Instant::now();
         renderer.render(width, height)?;
         times.push(start.elapsed().as_secs_f64() * 1e3);
@@ -969,10 +992,26 @@ fn bench(args: &BenchArgs, settings: &Settings) -> Outcome {
     }
     bar.finish_and_clear();
     times.sort_by(f64::total_cmp);
-    let median = times.get(times.len() / 2).copied().unwrap_or(f64::NAN);
+    Ok(Timed {
+        times,
+        evaluations: evaluations / pixels,
+        primary: primary / pixels,
+    })
+}
+
+/// One pixel in this many, each way, has its primary march's evaluations
+/// counted for the cost of an evaluation.
+const COUNTED_EVERY: u32 = 8;
+
+fn bench(args: &BenchArgs, settings: &Settings) -> Outcome {
+    let job = Job::new(&args.scene, settings)?;
+    let (width, height) = job.size;
+    let mut renderer = job.renderer()?;
+    let timed = time_frames(&mut renderer, job.size, args.frames)?;
+    let median = timed.median();
     let (low, high) = (
-        times.first().copied().unwrap_or(f64::NAN),
-        times.last().copied().unwrap_or(f64::NAN),
+        timed.times.first().copied().unwrap_or(f64::NAN),
+        timed.times.last().copied().unwrap_or(f64::NAN),
     );
     println!(
         "{}: {width}x{height}, {} quality on {}",
@@ -980,14 +1019,71 @@ fn bench(args: &BenchArgs, settings: &Settings) -> Outcome {
         job.preset_name(),
         on_devices(&renderer)
     );
+    let pixels = f64::from(width) * f64::from(height);
+    let rate = timed.evaluations * pixels / median / 1e3;
     println!(
-        "  {:.1} ms/frame median of {} (min {low:.1}, max {high:.1}); {:.1} distance evaluations per pixel ({:.1} in the primary march); {:.1} million evaluations a second",
+        "  {:.1} ms/frame median of {} (min {low:.1}, max {high:.1}); {:.1} distance evaluations per pixel ({:.1} in the primary march); {rate:.1} million evaluations a second",
         median,
-        times.len(),
-        evaluations / pixels,
-        primary / pixels,
-        evaluations / median / 1e3
+        timed.times.len(),
+        timed.evaluations,
+        timed.primary,
     );
+    let cost = renderer.evaluation_cost(width, height, COUNTED_EVERY)?;
+    let peak = renderer.peak_flops()?;
+    let flops = rate * 1e6 * cost.flops();
+    println!(
+        "  {:.0} operations an evaluation ({:.0} arithmetic and {:.1} calls at {CALL_FLOPS} each, counted by the CPU reference along the primary rays of one pixel in {COUNTED_EVERY}x{COUNTED_EVERY}): {:.2} GFLOP/s, {:.1}% of the {:.1} GFLOP/s this device reaches on fused multiply-adds",
+        cost.flops(),
+        cost.arithmetic(),
+        cost.calls(),
+        flops / 1e9,
+        100.0 * flops / peak,
+        peak / 1e9,
+    );
+    if args.stages {
+        bench_stages(&mut renderer, job.size, args.frames)?;
+    }
+    Ok(())
+}
+
+/// Times the frame with the march, normals and shading alone, then with
+/// each effect the scene has added in turn: what each stage costs.
+fn bench_stages(renderer: &mut Renderer, size: (u32, u32), frames: u32) -> Outcome {
+    let full = renderer.options().effects;
+    let quality = renderer.options().quality;
+    let mut effects = full;
+    effects.ambient_occlusion = false;
+    effects.shadows = false;
+    effects.glow = None;
+    let mut stages = vec![("march, normals and shading", effects)];
+    // An effect the quality leaves no samples or steps does nothing.
+    if full.ambient_occlusion && quality.ao_samples > 0 {
+        effects.ambient_occlusion = true;
+        stages.push(("+ ambient occlusion", effects));
+    }
+    if full.shadows && quality.shadow_steps > 0 {
+        effects.shadows = true;
+        stages.push(("+ shadows", effects));
+    }
+    if full.glow.is_some() {
+        effects.glow = full.glow;
+        stages.push(("+ glow", effects));
+    }
+    println!("  stage                          ms/frame  added  evaluations/pixel  added");
+    let mut before: Option<Timed> = None;
+    for (name, effects) in stages {
+        renderer.set_effects(effects)?;
+        let timed = time_frames(renderer, size, frames)?;
+        let (ms, evaluations) = (timed.median(), timed.evaluations);
+        let (added_ms, added_evaluations) = before.as_ref().map_or((ms, evaluations), |b| {
+            (ms - b.median(), evaluations - b.evaluations)
+        });
+        println!(
+            "  {name:<30} {ms:>8.1} {added_ms:>6.1} {evaluations:>18.1} {added_evaluations:>6.1}"
+        );
+        before = Some(timed);
+    }
+    renderer.set_effects(full)?;
     Ok(())
 }
 

@@ -29,10 +29,12 @@ use crate::scene::{Camera, Environment, Light, Scene};
 use crate::view::FrameTiming;
 
 mod converge;
+mod cost;
 mod frame;
 mod launch;
 
 pub use converge::{ConvergedFrame, StopRule};
+pub use cost::EvaluationCost;
 
 use launch::*;
 
