@@ -3,7 +3,7 @@
 //! only those the scene calls.
 
 use super::formulas;
-use crate::expr::Unprintable;
+use crate::expr::{Printer, Unprintable};
 use crate::scene::KifsFold;
 
 /// One helper of the library. Code generation records which helpers a
@@ -160,41 +160,41 @@ impl Helper {
         }
     }
 
-    /// The OpenCL C source, printed from the formula.
-    pub(crate) fn source(self) -> Result<String, Unprintable> {
+    /// The helper's source, printed from the formula by `to`.
+    pub(crate) fn source(self, to: &dyn Printer) -> Result<String, Unprintable> {
         match self {
-            Helper::Sphere => formulas::sphere(),
-            Helper::Cuboid => formulas::cuboid(),
-            Helper::RoundBox => formulas::round_box(),
-            Helper::Torus => formulas::torus(),
-            Helper::Cylinder => formulas::cylinder(),
-            Helper::Capsule => formulas::capsule(),
-            Helper::Plane => formulas::plane(),
-            Helper::Octahedron => formulas::octahedron(),
-            Helper::OctahedronBound => formulas::octahedron_bound(),
-            Helper::CappedCone => formulas::capped_cone(),
-            Helper::HexPrism => formulas::hex_prism(),
-            Helper::RoundCone => formulas::round_cone(),
-            Helper::Link => formulas::link(),
-            Helper::CutSphere => formulas::cut_sphere(),
-            Helper::SolidAngle => formulas::solid_angle(),
-            Helper::CappedTorus => formulas::capped_torus(),
-            Helper::Triangle => formulas::triangle(),
-            Helper::Quad => formulas::quad(),
-            Helper::Pyramid => formulas::pyramid(),
-            Helper::Rhombus => formulas::rhombus(),
-            Helper::TriPrism => formulas::tri_prism(),
-            Helper::RoundedCylinder => formulas::rounded_cylinder(),
-            Helper::Cone => formulas::cone(),
-            Helper::InfiniteCylinder => formulas::infinite_cylinder(),
-            Helper::InfiniteCone => formulas::infinite_cone(),
-            Helper::CutHollowSphere => formulas::cut_hollow_sphere(),
-            Helper::DeathStar => formulas::death_star(),
-            Helper::BoxFrame => formulas::box_frame(),
-            Helper::CylinderBetween => formulas::cylinder_between(),
-            Helper::ConeBetween => formulas::cone_between(),
-            Helper::RoundConeBetween => formulas::round_cone_between(),
-            Helper::Ellipsoid => formulas::ellipsoid(),
+            Helper::Sphere => formulas::sphere(to),
+            Helper::Cuboid => formulas::cuboid(to),
+            Helper::RoundBox => formulas::round_box(to),
+            Helper::Torus => formulas::torus(to),
+            Helper::Cylinder => formulas::cylinder(to),
+            Helper::Capsule => formulas::capsule(to),
+            Helper::Plane => formulas::plane(to),
+            Helper::Octahedron => formulas::octahedron(to),
+            Helper::OctahedronBound => formulas::octahedron_bound(to),
+            Helper::CappedCone => formulas::capped_cone(to),
+            Helper::HexPrism => formulas::hex_prism(to),
+            Helper::RoundCone => formulas::round_cone(to),
+            Helper::Link => formulas::link(to),
+            Helper::CutSphere => formulas::cut_sphere(to),
+            Helper::SolidAngle => formulas::solid_angle(to),
+            Helper::CappedTorus => formulas::capped_torus(to),
+            Helper::Triangle => formulas::triangle(to),
+            Helper::Quad => formulas::quad(to),
+            Helper::Pyramid => formulas::pyramid(to),
+            Helper::Rhombus => formulas::rhombus(to),
+            Helper::TriPrism => formulas::tri_prism(to),
+            Helper::RoundedCylinder => formulas::rounded_cylinder(to),
+            Helper::Cone => formulas::cone(to),
+            Helper::InfiniteCylinder => formulas::infinite_cylinder(to),
+            Helper::InfiniteCone => formulas::infinite_cone(to),
+            Helper::CutHollowSphere => formulas::cut_hollow_sphere(to),
+            Helper::DeathStar => formulas::death_star(to),
+            Helper::BoxFrame => formulas::box_frame(to),
+            Helper::CylinderBetween => formulas::cylinder_between(to),
+            Helper::ConeBetween => formulas::cone_between(to),
+            Helper::RoundConeBetween => formulas::round_cone_between(to),
+            Helper::Ellipsoid => formulas::ellipsoid(to),
             Helper::Mandelbulb
             | Helper::Menger
             | Helper::Sierpinski
@@ -202,22 +202,26 @@ impl Helper {
             | Helper::Mandelbox
             | Helper::MandelboxJulia
             | Helper::PseudoKleinian
-            | Helper::Kifs(..) => self.fractal_source(false).expect("a fractal's helper"),
+            | Helper::Kifs(..) => self.fractal_source(to, false).expect("a fractal's helper"),
         }
     }
 
     /// A fractal helper's source, trapped (see
     /// [`formulas::fractal_name`]) or not; `None` for the primitives.
-    pub(crate) fn fractal_source(self, trap: bool) -> Option<Result<String, Unprintable>> {
+    pub(crate) fn fractal_source(
+        self,
+        to: &dyn Printer,
+        trap: bool,
+    ) -> Option<Result<String, Unprintable>> {
         Some(match self {
-            Helper::Mandelbulb => formulas::mandelbulb(trap),
-            Helper::Menger => formulas::menger(trap),
-            Helper::Sierpinski => formulas::sierpinski(trap),
-            Helper::Julia => formulas::julia(trap),
-            Helper::Mandelbox => formulas::mandelbox(false, trap),
-            Helper::MandelboxJulia => formulas::mandelbox(true, trap),
-            Helper::PseudoKleinian => formulas::pseudo_kleinian(trap),
-            Helper::Kifs(fold, turned) => formulas::kifs(fold, turned, self.name(), trap),
+            Helper::Mandelbulb => formulas::mandelbulb(to, trap),
+            Helper::Menger => formulas::menger(to, trap),
+            Helper::Sierpinski => formulas::sierpinski(to, trap),
+            Helper::Julia => formulas::julia(to, trap),
+            Helper::Mandelbox => formulas::mandelbox(to, false, trap),
+            Helper::MandelboxJulia => formulas::mandelbox(to, true, trap),
+            Helper::PseudoKleinian => formulas::pseudo_kleinian(to, trap),
+            Helper::Kifs(fold, turned) => formulas::kifs(to, fold, turned, self.name(), trap),
             _ => return None,
         })
     }
@@ -226,11 +230,12 @@ impl Helper {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::expr::OpenCl;
 
     #[test]
     fn every_helper_prints() {
         for h in Helper::ALL {
-            let source = h.source().unwrap();
+            let source = h.source(&OpenCl).unwrap();
             assert!(
                 source.contains('{') && source.ends_with("}\n"),
                 "{}",
@@ -242,14 +247,103 @@ mod tests {
     #[test]
     fn every_fractal_has_a_trapped_form_that_takes_the_shape() {
         for h in Helper::ALL {
-            let Some(trapped) = h.fractal_source(true) else {
+            let Some(trapped) = h.fractal_source(&OpenCl, true) else {
                 continue;
             };
             let trapped = trapped.unwrap();
             let name = format!("real2 {}(", formulas::fractal_name(h.name(), true));
             assert!(trapped.contains(&name), "{trapped}");
             assert!(trapped.contains("trap_radius"), "{trapped}");
-            assert!(!h.source().unwrap().contains("trap_radius"), "{}", h.name());
+            assert!(
+                !h.source(&OpenCl).unwrap().contains("trap_radius"),
+                "{}",
+                h.name()
+            );
         }
+    }
+}
+
+/// The helpers printed in WGSL: every module parses and validates with
+/// naga, which reads WGSL as a WebGPU implementation does.
+#[cfg(test)]
+mod wgsl {
+    use super::*;
+    use crate::expr::Wgsl;
+    use crate::quality::{Encoding, ToneMap};
+
+    /// Parses and validates `functions` after the printer's prelude.
+    fn validate(functions: &str) {
+        let source = format!("{}\n{functions}", Wgsl::PRELUDE);
+        let module = naga::front::wgsl::parse_str(&source)
+            .unwrap_or_else(|e| panic!("{}", e.emit_to_string(&source)));
+        naga::valid::Validator::new(
+            naga::valid::ValidationFlags::all(),
+            naga::valid::Capabilities::empty(),
+        )
+        .validate(&module)
+        .unwrap_or_else(|e| panic!("{}", e.emit_to_string(&source)));
+    }
+
+    #[test]
+    fn every_helper_is_valid_wgsl() {
+        let mut functions = String::new();
+        for h in Helper::ALL {
+            functions.push_str(&h.source(&Wgsl).unwrap());
+            if let Some(trapped) = h.fractal_source(&Wgsl, true) {
+                functions.push_str(&trapped.unwrap());
+            }
+        }
+        for n in 2..=9 {
+            for trap in [false, true] {
+                functions.push_str(&formulas::mandelbulb_power(&Wgsl, n, trap).unwrap());
+            }
+        }
+        assert!(functions.contains("fn sd_sphere(p: real3, r: real) -> real {"));
+        validate(&functions);
+    }
+
+    #[test]
+    fn every_display_transform_is_valid_wgsl() {
+        for tone_map in ToneMap::ALL {
+            for encoding in [Encoding::Gamma, Encoding::Srgb] {
+                validate(&formulas::display(&Wgsl, tone_map, encoding).unwrap());
+            }
+        }
+    }
+
+    /// The prelude's rounding takes halves away from zero, as OpenCL's
+    /// `round` and the CPU reference do, where WGSL's own takes them to
+    /// even; its finiteness test refuses NaN and both infinities. Checked
+    /// on the prelude's text: the same expressions evaluated here.
+    #[test]
+    fn the_prelude_rounds_halves_away_from_zero() {
+        let round = |x: f32| {
+            let t = x.trunc();
+            if (x - t).abs() >= 0.5 {
+                t + x.signum()
+            } else {
+                t
+            }
+        };
+        for x in [
+            0.5f32,
+            1.5,
+            2.5,
+            -0.5,
+            -2.5,
+            0.499_999_97,
+            -0.499_999_97,
+            3.2,
+            -3.7,
+        ] {
+            assert_eq!(round(x), x.round(), "{x}");
+        }
+        assert!(Wgsl::PRELUDE.contains("let t = trunc(x);"));
+        assert!(Wgsl::PRELUDE.contains("select(t, t + sign(x), abs(x - t) >= 0.5)"));
+        let finite = |x: f32| x.abs() <= 3.402_823_5e38;
+        for x in [f32::NAN, f32::INFINITY, f32::NEG_INFINITY] {
+            assert!(!finite(x));
+        }
+        assert!(finite(f32::MAX) && finite(-f32::MAX));
     }
 }

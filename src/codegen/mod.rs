@@ -40,7 +40,7 @@ use std::sync::atomic::{AtomicU64, Ordering};
 use glam::DVec3;
 
 use crate::error::{Error, Result};
-use crate::expr::Unprintable;
+use crate::expr::{OpenCl, Unprintable};
 use crate::ir::{Bound, CompiledScene, Ir, Scalar, union_chain};
 use crate::math::{DEFAULT_COLOR, DERIVATIVE_CAP, MAGNITUDE_CAP, REAL_TINY};
 use crate::quality::{Effects, Precision, Quality, ScreenNormals};
@@ -423,29 +423,32 @@ pub fn emit_ir(ir: &Ir, options: &Options) -> Result<KernelSource> {
         .into_iter()
         .filter(|h| used.contains(h))
     {
-        section(helper.name(), helper.source())?;
+        section(helper.name(), helper.source(&OpenCl))?;
         if trapped.contains(helper.name())
-            && let Some(source) = helper.fractal_source(true)
+            && let Some(source) = helper.fractal_source(&OpenCl, true)
         {
             section(&formulas::fractal_name(helper.name(), true), source)?;
         }
     }
     for n in powers {
         let name = formulas::power_helper_name(n);
-        section(&name, formulas::mandelbulb_power(n, false))?;
+        section(&name, formulas::mandelbulb_power(&OpenCl, n, false))?;
         if trapped.contains(&name) {
             section(
                 &formulas::fractal_name(&name, true),
-                formulas::mandelbulb_power(n, true),
+                formulas::mandelbulb_power(&OpenCl, n, true),
             )?;
         }
     }
     for (name, shape, integer_powers) in &hybrids {
-        section(name, formulas::hybrid(name, shape, integer_powers, false))?;
+        section(
+            name,
+            formulas::hybrid(&OpenCl, name, shape, integer_powers, false),
+        )?;
         if trapped.contains(name) {
             section(
                 &formulas::fractal_name(name, true),
-                formulas::hybrid(name, shape, integer_powers, true),
+                formulas::hybrid(&OpenCl, name, shape, integer_powers, true),
             )?;
         }
     }
@@ -838,11 +841,12 @@ fn finish(
     }
     if options.target == Target::Render {
         // The display transform the render kernel ends each pixel with.
-        let display = formulas::display(options.effects.tone_map, options.effects.encoding)
-            .map_err(|e| Error::Invalid {
-                what: "formula",
-                reason: e.to_string(),
-            })?;
+        let display =
+            formulas::display(&OpenCl, options.effects.tone_map, options.effects.encoding)
+                .map_err(|e| Error::Invalid {
+                    what: "formula",
+                    reason: e.to_string(),
+                })?;
         w.line("/* ---- display ---- */");
         w.raw(&display);
         w.line("");

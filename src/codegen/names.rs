@@ -10,6 +10,7 @@ use glam::DVec3;
 
 use super::{Options, Target, formulas, header, helpers::Helper, writer::Writer};
 use crate::error::{Error, Result};
+use crate::expr::OpenCl;
 use crate::quality::{Effects, Glow, Precision, Quality};
 use crate::scene::CustomShape;
 use crate::scene::names::strip_comments;
@@ -161,13 +162,13 @@ fn library_texts() -> Vec<String> {
             texts.push(w.finish());
         }
     }
-    texts.extend(Helper::ALL.iter().filter_map(|h| h.source().ok()));
+    texts.extend(Helper::ALL.iter().filter_map(|h| h.source(&OpenCl).ok()));
     texts.extend(
         Helper::ALL
             .iter()
-            .filter_map(|h| h.fractal_source(true).and_then(Result::ok)),
+            .filter_map(|h| h.fractal_source(&OpenCl, true).and_then(Result::ok)),
     );
-    texts.extend(formulas::mandelbulb_power(8, false).ok());
+    texts.extend(formulas::mandelbulb_power(&OpenCl, 8, false).ok());
     texts.push(super::RENDER_KERNEL.into());
     texts.push(include_str!("../../kernels/eval.cl").into());
     texts

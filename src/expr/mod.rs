@@ -7,7 +7,7 @@
 //!   bounds;
 //! - in [`Var`]s, under [`trace`]: a [`Program`] of scalar operations and
 //!   `select`s, which a [`Printer`] writes as a kernel function
-//!   ([`OpenCl`] today; a second backend is a second printer).
+//!   ([`OpenCl`] C, or [`Wgsl`] for WebGPU).
 //!
 //! A program has no loop, no recursion and no side effect, so it always
 //! terminates, and a printer writes only its operations and literals, so
@@ -71,7 +71,7 @@ impl Distance for Formula {
 pub use interval::{Interval, Maybe};
 pub use num::{DERIVATIVE_CAP, Logic, MAGNITUDE_CAP, MAX_LOOP_STEPS, Num, REAL_TINY, Step};
 pub use ops::{Binary, Unary};
-pub use print::{Inline, OpenCl, Printer, Shape, Signature, Unprintable};
+pub use print::{Inline, OpenCl, Printer, Shape, Signature, Unprintable, Wgsl};
 pub use program::{Loop, Op, Program, ValueId};
 pub use text::{
     FUNCTIONS, Formula, FormulaError, MAX_DEPTH, MAX_ITERATIONS, MAX_LENGTH, MAX_NESTING,

@@ -7,7 +7,9 @@ use crate::gpu;
 
 use fractal_sdf::cpu;
 use fractal_sdf::expr::V3;
-use fractal_sdf::expr::{Counted, Distance, Formula, Interval, Num, Program, counting};
+use fractal_sdf::expr::{
+    Counted, Distance, Formula, Interval, Num, Printer, Program, Shape, Signature, Wgsl, counting,
+};
 use fractal_sdf::mesh::{GridOptions, Sampler, extract};
 use fractal_sdf::prelude::*;
 use fractal_sdf::quality::Precision;
@@ -131,6 +133,28 @@ proptest! {
                 shape.opencl_body()
             );
         }
+    }
+
+    /// A random program printed as WGSL parses and validates as a WebGPU
+    /// implementation reads it (naga), beside the prelude it calls into.
+    #[test]
+    fn random_programs_print_as_valid_wgsl(text in formula()) {
+        let f = Formula::parse(&text, &["a"]).unwrap_or_else(|e| panic!("{e}\n{text}"));
+        let signature = Signature::new(
+            "random",
+            &[("p", Shape::Vec3), ("a", Shape::Scalar)],
+            Shape::Scalar,
+        );
+        let function = Wgsl.function(&signature, &f.program()).unwrap();
+        let source = format!("{}\n{function}", Wgsl::PRELUDE);
+        let module = naga::front::wgsl::parse_str(&source)
+            .unwrap_or_else(|e| panic!("{}\n{text}", e.emit_to_string(&source)));
+        let valid = naga::valid::Validator::new(
+            naga::valid::ValidationFlags::all(),
+            naga::valid::Capabilities::empty(),
+        )
+        .validate(&module);
+        prop_assert!(valid.is_ok(), "{}\n{text}", valid.unwrap_err().emit_to_string(&source));
     }
 
     /// The range a random program takes over a box holds its value at

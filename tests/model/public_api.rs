@@ -46,6 +46,9 @@ struct Crate {
     /// Inherent methods and trait impls: (module, type name, line).
     impls: Vec<(String, String, String)>,
     macros: Vec<String>,
+    /// The traits no one outside the crate can name: their impls are not
+    /// part of the API.
+    private_traits: BTreeSet<String>,
 }
 
 fn is_pub(vis: &Visibility) -> bool {
@@ -187,6 +190,9 @@ fn walk_items(items: &[Item], dir: &Path, path: &str, public: bool, c: &mut Crat
                     .map(|v| format!("::{}{}", v.ident, fields_sig(&v.fields)))
                     .collect();
                 def(c, e.ident.to_string(), head, members, Kind::Enum, ne);
+            }
+            Item::Trait(t) if !is_pub(&t.vis) => {
+                c.private_traits.insert(t.ident.to_string());
             }
             Item::Trait(t) if is_pub(&t.vis) && !hidden(&t.attrs) => {
                 let members = t
@@ -511,6 +517,13 @@ fn listing(s: &Surface) -> (String, [usize; 3]) {
             lines.insert(format!("{canonical}{m}"));
         }
         for (module, ty, line) in &s.krate.impls {
+            if let Some(name) = line.strip_prefix("impl ")
+                && s.krate
+                    .private_traits
+                    .contains(name.split('<').next().unwrap_or(name).trim())
+            {
+                continue;
+            }
             // A method belongs to the type of that name in the impl's
             // top-level module, else to the one type of that name.
             if ty == &def.name && owner(s, module, ty).is_some_and(|o| std::ptr::eq(o, def)) {

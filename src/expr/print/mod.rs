@@ -4,13 +4,21 @@
 //! named by the signature, and literals — so nothing a user writes (a
 //! formula in a scene file) can reach the source as text. Values read once
 //! are written inline; values read more often get a name. [`OpenCl`]
-//! writes OpenCL C; a second backend is a second [`Printer`].
+//! writes OpenCL C and [`Wgsl`] the WebGPU shading language: one writer
+//! decides what to name, where loops and early returns go, and each
+//! backend's `Syntax` spells it.
+
+mod opencl;
+mod wgsl;
 
 use std::collections::HashMap;
 
 use super::num::MAX_LOOP_STEPS;
 use super::ops::{Binary, Unary};
 use super::program::{Loop, Op, Program, ValueId};
+
+pub use opencl::OpenCl;
+pub use wgsl::Wgsl;
 
 /// The shape of a parameter or result: how many scalar inputs or outputs
 /// it stands for.
@@ -139,10 +147,64 @@ impl Inline {
     }
 }
 
-/// The OpenCL C printer: `real` is the precision's type, literals are
-/// `R(...)` (the kernel header's literal macro).
-#[derive(Debug, Clone, Copy, Default)]
-pub struct OpenCl;
+/// How a backend's language spells what the writer decides. The types
+/// are named `real`, `real2`, `real3` and `bool` in every backend (the
+/// precision's number, its pairs and 3-vectors, and truth values).
+trait Syntax {
+    /// A literal; an error for NaN or an infinity.
+    fn literal(&self, v: f64) -> Result<String, Unprintable>;
+    /// Whether `text` is a literal as [`Syntax::literal`] writes it.
+    fn is_literal(&self, text: &str) -> bool;
+    /// `u(a)`: `a` as an operand, `inner` as a call's argument.
+    fn unary(&self, u: Unary, a: &str, inner: &str) -> String;
+    /// `x b y` for numbers or (the arithmetic and functions) vectors.
+    fn binary(&self, b: Binary, x: &str, y: &str) -> String;
+    /// Whether a vector operation `b` takes a number as its second
+    /// operand (for every component).
+    fn scalar_operand(&self, b: Binary) -> bool;
+    /// A 3-vector of three components, or of one repeated.
+    fn vector(&self, parts: &[&str]) -> String;
+    /// A pair.
+    fn pair(&self, parts: &[&str]) -> String;
+    /// `a` where `c` holds, else `b`.
+    fn select(&self, c: &str, a: &str, b: &str) -> String;
+    /// An immutable variable `name` of type `ty` (`real`, `real3`, `bool`).
+    fn constant(&self, ty: &str, name: &str, value: &str) -> String;
+    /// A mutable variable.
+    fn variable(&self, ty: &str, name: &str, value: &str) -> String;
+    /// The integer `name`: a loop's step count, `count` clamped to `[0,
+    /// max]` and rounded up.
+    fn steps(&self, name: &str, count: &str, max: u32) -> String;
+    /// The header of a loop whose integer `index` counts from 0 to
+    /// `steps`, opening its block.
+    fn for_header(&self, index: &str, steps: &str) -> String;
+    /// A loop's integer index as a number.
+    fn index_value(&self, index: &str) -> String;
+    /// A parameter's name in the function's body (a backend renames the
+    /// names its language reserves).
+    fn parameter(&self, name: &str) -> String {
+        name.to_string()
+    }
+    /// A whole function: its name, parameters, result type, statements and
+    /// the returned expression.
+    fn function(
+        &self,
+        name: &str,
+        params: &[(String, &str)],
+        result: &str,
+        body: &str,
+        returned: &str,
+    ) -> String;
+}
+
+/// The type of values of shape `shape`.
+fn type_of(shape: Shape) -> &'static str {
+    match shape {
+        Shape::Scalar => "real",
+        Shape::Pair => "real2",
+        Shape::Vec3 => "real3",
+    }
+}
 
 /// Checks a program's inputs and outputs against the counts its caller
 /// gives.
@@ -167,16 +229,16 @@ fn check_arity(program: &Program, inputs: u32, outputs: usize) -> Result<(), Unp
 /// The name of each scalar input (a scalar parameter's name, or a vector
 /// parameter's component, `p.x`), and the vector parameter whose
 /// components start at each input.
-fn input_names(params: &[(&str, Shape)]) -> (Vec<String>, Vec<Option<String>>) {
+fn input_names(params: &[(String, Shape)]) -> (Vec<String>, Vec<Option<String>>) {
     let mut names = Vec::new();
     let mut vectors = Vec::new();
     for (name, shape) in params {
         match shape {
-            Shape::Scalar => names.push((*name).to_string()),
+            Shape::Scalar => names.push(name.clone()),
             Shape::Pair => names.extend(["x", "y"].map(|c| format!("{name}.{c}"))),
             Shape::Vec3 => names.extend(["x", "y", "z"].map(|c| format!("{name}.{c}"))),
         }
-        vectors.push((*shape == Shape::Vec3).then(|| (*name).to_string()));
+        vectors.push((*shape == Shape::Vec3).then(|| name.clone()));
         for _ in 1..shape.width() {
             vectors.push(None);
         }
@@ -184,22 +246,9 @@ fn input_names(params: &[(&str, Shape)]) -> (Vec<String>, Vec<Option<String>>) {
     (names, vectors)
 }
 
-/// An OpenCL C literal of the precision the header chose.
-fn literal(v: f64) -> Result<String, Unprintable> {
-    if !v.is_finite() {
-        return Err(Unprintable::Literal(v));
-    }
-    // Debug formatting is the shortest text that reads back as `v`, with a
-    // `.` or an exponent: a valid C floating constant once suffixed.
-    Ok(if v.is_sign_negative() {
-        format!("(-R({:?}))", -v)
-    } else {
-        format!("R({v:?})")
-    })
-}
-
 /// Writes a program's statements, and the text each value is read as.
-struct OpenClWriter {
+struct Writer<'s> {
+    syn: &'s dyn Syntax,
     /// The statements so far.
     out: String,
     /// The temporaries' prefix: `t` unless a parameter could be one.
@@ -213,6 +262,7 @@ struct OpenClWriter {
 /// One program being written: the text each input and each value so far
 /// is read as, and the enclosing programs' values (innermost last).
 struct Block<'b> {
+    syn: &'b dyn Syntax,
     program: &'b Program,
     inputs: &'b [String],
     /// The vector parameter whose three components start at each input.
@@ -237,12 +287,13 @@ impl Block<'_> {
     /// `outputs`: a vector the program computed whole where it did.
     fn result(&self, shape: Shape, outputs: &[ValueId]) -> String {
         let texts: Vec<&str> = outputs.iter().map(|v| self.atom(*v)).collect();
+        let parts: Vec<&str> = texts.iter().map(|t| unwrap(t)).collect();
         match shape {
             Shape::Scalar => texts[0].to_string(),
-            Shape::Pair => format!("((real2)({}))", args(&texts)),
+            Shape::Pair => self.syn.pair(&parts),
             Shape::Vec3 => match self.whole_vector(outputs[0], outputs[1], outputs[2]) {
                 Some(v) => v.to_string(),
-                None => format!("((real3)({}))", args(&texts)),
+                None => self.syn.vector(&parts),
             },
         }
     }
@@ -301,8 +352,9 @@ impl Block<'_> {
     /// The expression of `op`, parenthesised unless it is a call; `None`
     /// for a loop (written as statements).
     fn expression(&self, op: Op) -> Result<Option<String>, Unprintable> {
+        let syn = self.syn;
         Ok(Some(match op {
-            Op::Const(v) => literal(v)?,
+            Op::Const(v) => syn.literal(v)?,
             Op::Input(i) => self.inputs[i as usize].clone(),
             Op::Capture(up, v) => {
                 let at = self.outer.len() - up as usize;
@@ -310,48 +362,17 @@ impl Block<'_> {
             }
             Op::Loop(_) => return Ok(None),
             Op::Element(l, k) => self.states[&l.index()].elements[k as usize].clone(),
-            Op::Unary(u, a) => {
-                let (a, inner) = (self.atom(a), self.arg(a));
-                match u {
-                    Unary::Neg => format!("(-{a})"),
-                    Unary::Not => format!("(!{a})"),
-                    Unary::Sqrt => format!("sqrt({inner})"),
-                    Unary::Abs => format!("fabs({inner})"),
-                    Unary::Sin => format!("sin({inner})"),
-                    Unary::Cos => format!("cos({inner})"),
-                    Unary::Acos => format!("acos({inner})"),
-                    Unary::Exp => format!("exp({inner})"),
-                    Unary::Ln => format!("log({inner})"),
-                    Unary::Floor => format!("floor({inner})"),
-                    Unary::Round => format!("round({inner})"),
-                    Unary::Finite => format!("isfinite({inner})"),
-                }
-            }
-            Op::Binary(b, x, y) => binary(b, self.atom(x), self.atom(y)),
+            Op::Unary(u, a) => syn.unary(u, self.atom(a), self.arg(a)),
+            Op::Binary(b, x, y) => syn.binary(b, self.atom(x), self.atom(y)),
             Op::Make3(x, y, z) => match self.whole_vector(x, y, z) {
                 Some(v) => v.to_string(),
-                None if x == y && y == z => format!("((real3)({}))", self.arg(x)),
-                None => format!(
-                    "((real3)({}, {}, {}))",
-                    self.arg(x),
-                    self.arg(y),
-                    self.arg(z)
-                ),
+                None if x == y && y == z => syn.vector(&[self.arg(x)]),
+                None => syn.vector(&[self.arg(x), self.arg(y), self.arg(z)]),
             },
             Op::Component(v, i) => format!("{}.{}", self.atom(v), ["x", "y", "z"][i as usize]),
             Op::Unary3(u, a) => return self.expression(Op::Unary(u, a)),
             Op::Binary3(b, x, y) => {
-                // OpenCL C takes a scalar second operand for a vector in
-                // arithmetic, `fmin` and `fmax`.
-                let scalar_ok = matches!(
-                    b,
-                    Binary::Add
-                        | Binary::Sub
-                        | Binary::Mul
-                        | Binary::Div
-                        | Binary::Min
-                        | Binary::Max
-                );
+                let scalar_ok = syn.scalar_operand(b);
                 // One operand stays a vector, so the result is one.
                 let y_splat = scalar_ok && self.splat(y).is_some();
                 let x_splat = !y_splat && matches!(b, Binary::Add | Binary::Mul);
@@ -360,28 +381,23 @@ impl Block<'_> {
                 if b.is_logic() {
                     return Err(Unprintable::Vector);
                 }
-                binary(b, x, y)
+                syn.binary(b, x, y)
             }
-            Op::Select3(c, a, b) => {
-                format!("({} ? {} : {})", self.atom(c), self.atom(a), self.atom(b))
+            Op::Select3(c, a, b) | Op::Select(c, a, b) => {
+                syn.select(self.atom(c), self.atom(a), self.atom(b))
             }
             Op::Length3(x, y, z) => match self.whole_vector(x, y, z) {
                 Some(v) => format!("length({v})"),
                 None => format!(
-                    "length((real3)({}, {}, {}))",
-                    self.arg(x),
-                    self.arg(y),
-                    self.arg(z)
+                    "length({})",
+                    unwrap(&syn.vector(&[self.arg(x), self.arg(y), self.arg(z)]))
                 ),
             },
-            Op::Select(c, a, b) => {
-                format!("({} ? {} : {})", self.atom(c), self.atom(a), self.atom(b))
-            }
         }))
     }
 }
 
-impl OpenClWriter {
+impl Writer<'_> {
     fn line(&mut self, indent: usize, text: &str) {
         for _ in 0..indent {
             self.out.push_str("    ");
@@ -399,11 +415,12 @@ impl OpenClWriter {
     /// Names `text` as a temporary of type `ty`, unless it is already a
     /// plain name or literal.
     fn name(&mut self, indent: usize, ty: &str, text: &str) -> String {
-        if is_simple(text) {
+        if is_simple(self.syn, text) {
             return text.to_string();
         }
         let name = self.temp();
-        self.line(indent, &format!("{ty} {name} = {};", unwrap(text)));
+        let line = self.syn.constant(ty, &name, unwrap(text));
+        self.line(indent, &line);
         name
     }
 
@@ -413,7 +430,7 @@ impl OpenClWriter {
         self.split_block(b, split.map(|v| (v, Exit::Break)))
     }
 
-    /// [`OpenClWriter::block`] with the way out at the split: a loop's
+    /// [`Writer::block`] with the way out at the split: a loop's
     /// `break`, or a function's early `return` of the values where the
     /// split holds (which the first statements compute too).
     fn split_block(
@@ -499,7 +516,7 @@ impl OpenClWriter {
         let trivial = matches!(
             op,
             Op::Const(_) | Op::Input(_) | Op::Capture(..) | Op::Element(..)
-        ) || is_simple(&text);
+        ) || is_simple(self.syn, &text);
         b.text[i] = if name && !trivial {
             let ty = if op.is_logic() {
                 "bool"
@@ -509,7 +526,8 @@ impl OpenClWriter {
                 "real"
             };
             let t = self.temp();
-            self.line(b.indent, &format!("{ty} {t} = {};", unwrap(&text)));
+            let line = self.syn.constant(ty, &t, unwrap(&text));
+            self.line(b.indent, &line);
             t
         } else {
             text
@@ -555,12 +573,16 @@ impl OpenClWriter {
             match group[j] {
                 Some((_, 0)) => {
                     let init = &vectors.iter().find(|(f, _)| *f == j).expect("grouped").1;
-                    self.line(indent, &format!("real3 {state}_{j} = {};", unwrap(init)));
+                    let line = self
+                        .syn
+                        .variable("real3", &format!("{state}_{j}"), unwrap(init));
+                    self.line(indent, &line);
                 }
                 Some(_) => {}
                 None => {
                     let init = unwrap(b.atom(*v)).to_string();
-                    self.line(indent, &format!("real {state}_{j} = {init};"));
+                    let line = self.syn.variable("real", &format!("{state}_{j}"), &init);
+                    self.line(indent, &line);
                 }
             }
         }
@@ -569,18 +591,11 @@ impl OpenClWriter {
         // step, and the count is capped as `Num::iterate` caps it.
         let count = unwrap(b.atom(l.count)).to_string();
         let steps = format!("{}n{id}", self.prefix);
-        self.line(
-            indent,
-            &format!(
-                "int {steps} = (int)clamp(ceil({count}), R(0.0), R({}.0));",
-                MAX_LOOP_STEPS
-            ),
-        );
-        self.line(
-            indent,
-            &format!("for (int {index} = 0; {index} < {steps}; {index}++) {{"),
-        );
-        let mut inputs = vec![format!("(real){index}")];
+        let line = self.syn.steps(&steps, &count, MAX_LOOP_STEPS);
+        self.line(indent, &line);
+        let line = self.syn.for_header(&index, &steps);
+        self.line(indent, &line);
+        let mut inputs = vec![self.syn.index_value(&index)];
         inputs.extend(elements.iter().cloned());
         let mut input_vectors = vec![None; k + 1];
         for (first, _) in &vectors {
@@ -589,6 +604,7 @@ impl OpenClWriter {
         let mut outer: Vec<&[String]> = b.outer.to_vec();
         outer.push(&b.text);
         let mut body = Block {
+            syn: self.syn,
             program: &l.body,
             inputs: &inputs,
             vectors: &input_vectors,
@@ -719,43 +735,11 @@ fn printed_uses(program: &Program) -> Vec<u32> {
     uses
 }
 
-/// `x op y` in OpenCL C, for numbers or (the arithmetic and functions)
-/// vectors.
-fn binary(b: Binary, x: &str, y: &str) -> String {
-    let (ax, ay) = (unwrap(x), unwrap(y));
-    match b {
-        Binary::Add => format!("({x} + {y})"),
-        Binary::Sub => format!("({x} - {y})"),
-        Binary::Mul => format!("({x} * {y})"),
-        Binary::Div => format!("({x} / {y})"),
-        Binary::Lt => format!("({x} < {y})"),
-        Binary::Le => format!("({x} <= {y})"),
-        Binary::And => format!("({x} && {y})"),
-        Binary::Or => format!("({x} || {y})"),
-        Binary::Min => format!("fmin({ax}, {ay})"),
-        Binary::Max => format!("fmax({ax}, {ay})"),
-        Binary::Atan2 => format!("atan2({ax}, {ay})"),
-        Binary::Pow => format!("pow({ax}, {ay})"),
-        // The length of a 2-vector, as the plain types compute it (see
-        // `Num::hypot`).
-        Binary::Hypot => format!("length((real2)({ax}, {ay}))"),
-    }
-}
-
 /// Whether `text` is a name or a literal, cheap to read twice.
-fn is_simple(text: &str) -> bool {
+fn is_simple(syn: &dyn Syntax, text: &str) -> bool {
     text.chars()
         .all(|c| c.is_ascii_alphanumeric() || c == '_' || c == '.')
-        || (text.starts_with("R(") && text.ends_with(')') && !text[2..].contains('('))
-}
-
-/// Values as a call's arguments.
-fn args(values: &[&str]) -> String {
-    values
-        .iter()
-        .map(|v| unwrap(v))
-        .collect::<Vec<_>>()
-        .join(", ")
+        || syn.is_literal(text)
 }
 
 /// `text` without one pair of enclosing parentheses, when they enclose it
@@ -825,122 +809,116 @@ fn early_return(program: &Program) -> Option<(ValueId, Vec<ValueId>, Vec<ValueId
     Some((c, first, late))
 }
 
-impl Printer for OpenCl {
-    fn function(
-        &self,
-        signature: &Signature<'_>,
-        program: &Program,
-    ) -> Result<String, Unprintable> {
-        check_arity(
-            program,
-            signature.inputs(),
-            signature.result.width() as usize,
-        )?;
-        let (inputs, vectors) = input_names(signature.params);
-        // Temporaries are `t0`, `t1`, ..., loops' states `ts0_0` and
-        // indices `ti0`: with more underscores while a parameter's name
-        // starts with the prefix.
-        let mut prefix = String::from("t");
-        while signature
-            .params
-            .iter()
-            .any(|(n, _)| n.starts_with(prefix.as_str()))
-        {
-            prefix.push('_');
-        }
-        let mut w = OpenClWriter {
-            out: String::new(),
-            prefix,
-            temps: 0,
-            loops: 0,
-        };
-        let mut block = Block {
-            program,
-            inputs: &inputs,
-            vectors: &vectors,
-            outer: &[],
-            text: Vec::new(),
-            states: HashMap::new(),
-            indent: 1,
-        };
-        // A result that is one value where a condition holds and another
-        // elsewhere, for every output (a fractal's far field), returns
-        // early: the other values are computed only where they count.
-        let early = early_return(program);
-        let outputs = match &early {
-            Some((_, _, late)) => late.clone(),
-            None => program.outputs.clone(),
-        };
-        w.split_block(
-            &mut block,
-            early.map(|(c, first, _)| (c, Exit::Return(signature.result, first))),
-        )?;
-        let ty = match signature.result {
-            Shape::Scalar => "real",
-            Shape::Pair => "real2",
-            Shape::Vec3 => "real3",
-        };
-        let result = unwrap(&block.result(signature.result, &outputs)).to_string();
-        let params: Vec<String> = signature
-            .params
-            .iter()
-            .map(|(name, shape)| {
-                let ty = match shape {
-                    Shape::Scalar => "real",
-                    Shape::Pair => "real2",
-                    Shape::Vec3 => "real3",
-                };
-                format!("{ty} {name}")
-            })
-            .collect();
-        Ok(format!(
-            "{ty} {}({}) {{\n{}    return {result};\n}}\n",
-            signature.name,
-            params.join(", "),
-            w.out
-        ))
+/// [`Printer::function`] in the language `syn` spells.
+fn print_function(
+    syn: &dyn Syntax,
+    signature: &Signature<'_>,
+    program: &Program,
+) -> Result<String, Unprintable> {
+    check_arity(
+        program,
+        signature.inputs(),
+        signature.result.width() as usize,
+    )?;
+    let params: Vec<(String, Shape)> = signature
+        .params
+        .iter()
+        .map(|(name, shape)| (syn.parameter(name), *shape))
+        .collect();
+    let (inputs, vectors) = input_names(&params);
+    // Temporaries are `t0`, `t1`, ..., loops' states `ts0_0` and
+    // indices `ti0`: with more underscores while a parameter's name
+    // starts with the prefix.
+    let mut prefix = String::from("t");
+    while params.iter().any(|(n, _)| n.starts_with(prefix.as_str())) {
+        prefix.push('_');
     }
+    let mut w = Writer {
+        syn,
+        out: String::new(),
+        prefix,
+        temps: 0,
+        loops: 0,
+    };
+    let mut block = Block {
+        syn,
+        program,
+        inputs: &inputs,
+        vectors: &vectors,
+        outer: &[],
+        text: Vec::new(),
+        states: HashMap::new(),
+        indent: 1,
+    };
+    // A result that is one value where a condition holds and another
+    // elsewhere, for every output (a fractal's far field), returns
+    // early: the other values are computed only where they count.
+    let early = early_return(program);
+    let outputs = match &early {
+        Some((_, _, late)) => late.clone(),
+        None => program.outputs.clone(),
+    };
+    w.split_block(
+        &mut block,
+        early.map(|(c, first, _)| (c, Exit::Return(signature.result, first))),
+    )?;
+    let result = unwrap(&block.result(signature.result, &outputs)).to_string();
+    let params: Vec<(String, &str)> = params
+        .into_iter()
+        .map(|(name, shape)| (name, type_of(shape)))
+        .collect();
+    Ok(syn.function(
+        signature.name,
+        &params,
+        type_of(signature.result),
+        &w.out,
+        &result,
+    ))
+}
 
-    fn inline(
-        &self,
-        inputs: &[(&str, Shape)],
-        results: &[Shape],
-        program: &Program,
-        prefix: &str,
-    ) -> Result<Inline, Unprintable> {
-        let width = |shapes: &mut dyn Iterator<Item = Shape>| shapes.map(Shape::width).sum::<u32>();
-        let outputs = width(&mut results.iter().copied()) as usize;
-        check_arity(program, width(&mut inputs.iter().map(|(_, s)| *s)), outputs)?;
-        let (names, vectors) = input_names(inputs);
-        let mut w = OpenClWriter {
-            out: String::new(),
-            prefix: prefix.to_string(),
-            temps: 0,
-            loops: 0,
-        };
-        let mut block = Block {
-            program,
-            inputs: &names,
-            vectors: &vectors,
-            outer: &[],
-            text: Vec::new(),
-            states: HashMap::new(),
-            indent: 0,
-        };
-        w.block(&mut block, None)?;
-        let mut at = 0;
-        let results = results
-            .iter()
-            .map(|shape| {
-                let width = shape.width() as usize;
-                let text = block.result(*shape, &program.outputs[at..at + width]);
-                at += width;
-                unwrap(&text).to_string()
-            })
-            .collect();
-        Ok(Inline {
-            statements: w.out,
-            results,
+/// [`Printer::inline`] in the language `syn` spells.
+fn print_inline(
+    syn: &dyn Syntax,
+    inputs: &[(&str, Shape)],
+    results: &[Shape],
+    program: &Program,
+    prefix: &str,
+) -> Result<Inline, Unprintable> {
+    let width = |shapes: &mut dyn Iterator<Item = Shape>| shapes.map(Shape::width).sum::<u32>();
+    let outputs = width(&mut results.iter().copied()) as usize;
+    check_arity(program, width(&mut inputs.iter().map(|(_, s)| *s)), outputs)?;
+    let inputs: Vec<(String, Shape)> = inputs.iter().map(|(n, s)| ((*n).to_string(), *s)).collect();
+    let (names, vectors) = input_names(&inputs);
+    let mut w = Writer {
+        syn,
+        out: String::new(),
+        prefix: prefix.to_string(),
+        temps: 0,
+        loops: 0,
+    };
+    let mut block = Block {
+        syn,
+        program,
+        inputs: &names,
+        vectors: &vectors,
+        outer: &[],
+        text: Vec::new(),
+        states: HashMap::new(),
+        indent: 0,
+    };
+    w.block(&mut block, None)?;
+    let mut at = 0;
+    let results = results
+        .iter()
+        .map(|shape| {
+            let width = shape.width() as usize;
+            let text = block.result(*shape, &program.outputs[at..at + width]);
+            at += width;
+            unwrap(&text).to_string()
         })
-    }
+        .collect();
+    Ok(Inline {
+        statements: w.out,
+        results,
+    })
 }
