@@ -14,6 +14,7 @@ REQUIRED_PACKAGES=(
     python3            # scripts/mutate_kernels.py (`make mutants`)
     jq                 # reads `cargo metadata` in scripts/msrv_check.sh
     openimageio-tools  # oiiotool: reads the OpenEXR files the tests write, independently
+    mesa-vulkan-drivers # lavapipe: a CPU Vulkan driver, on which the WGSL tests run through wgpu
     # The one-node Slurm cluster of scripts/slurm.sh and scripts/slurm-test.sh:
     slurm-wlm          # slurmctld, slurmd and the client commands (sbatch, squeue, ...)
     munge              # munged: the authentication Slurm's daemons and clients use

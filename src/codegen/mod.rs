@@ -29,6 +29,8 @@ pub(crate) mod interface;
 pub(crate) mod names;
 mod scene;
 mod tables;
+#[cfg(test)]
+mod wgsl_tests;
 mod writer;
 
 pub use scene::{MIN_HIERARCHY, MIN_INSTANCES};
