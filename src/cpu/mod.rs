@@ -964,6 +964,7 @@ pub fn march(eval: &Evaluator, ray: Ray, settings: &MarchSettings) -> Hit {
 
 /// [`march`], calling `visit` with every point where it evaluates the
 /// distance.
+#[cfg(feature = "opencl")]
 pub(crate) fn march_visiting(
     eval: &Evaluator,
     ray: Ray,
