@@ -58,22 +58,14 @@ fn every_display_transform_is_valid_wgsl() {
     }
 }
 
-/// The prelude's rounding takes halves away from zero, as OpenCL's
-/// `round` and the CPU reference do, where WGSL's own takes them to
-/// even; its finiteness test refuses NaN and both infinities. Checked on
-/// the prelude's text, the same expressions evaluated here against
-/// `f32::round`.
+/// The prelude's rounding takes halves away from zero on the device, as
+/// OpenCL's `round` and the CPU reference do (`f32::round`), where WGSL's
+/// own takes them to even; its finiteness test refuses NaN and both
+/// infinities.
 #[test]
-fn the_prelude_rounds_halves_away_from_zero() {
-    let round = |x: f32| {
-        let t = x.trunc();
-        if (x - t).abs() >= 0.5 {
-            t + x.signum()
-        } else {
-            t
-        }
-    };
-    for x in [
+fn the_prelude_rounds_halves_away_from_zero_on_the_device() {
+    let Some(gpu) = device() else { return };
+    let xs = [
         0.5f32,
         1.5,
         2.5,
@@ -83,16 +75,33 @@ fn the_prelude_rounds_halves_away_from_zero() {
         -0.499_999_97,
         3.2,
         -3.7,
-    ] {
-        assert_eq!(round(x), x.round(), "{x}");
+        8_388_607.5,
+        f32::MAX,
+        f32::NAN,
+        f32::INFINITY,
+        f32::NEG_INFINITY,
+    ];
+    let n = xs.len();
+    let source = format!(
+        "{}\n\
+         @group(0) @binding(0) var<storage, read> inputs: array<f32>;\n\
+         @group(0) @binding(1) var<storage, read_write> outputs: array<f32>;\n\
+         @compute @workgroup_size(64)\n\
+         fn main(@builtin(global_invocation_id) id: vec3<u32>) {{\n\
+         \x20   let i = id.x;\n\
+         \x20   if (i >= {n}u) {{ return; }}\n\
+         \x20   outputs[2u * i] = fsdf_round(inputs[i]);\n\
+         \x20   outputs[2u * i + 1u] = select(0.0, 1.0, fsdf_is_finite(inputs[i]));\n\
+         }}\n",
+        Wgsl::PRELUDE
+    );
+    let got = run(&gpu, &source, &xs, 2 * n, n);
+    for (k, x) in xs.iter().enumerate() {
+        if x.is_finite() {
+            assert_eq!(got[2 * k], x.round(), "round({x})");
+        }
+        assert_eq!(got[2 * k + 1] == 1.0, x.is_finite(), "is_finite({x})");
     }
-    assert!(Wgsl::PRELUDE.contains("let t = trunc(x);"));
-    assert!(Wgsl::PRELUDE.contains("select(t, t + sign(x), abs(x - t) >= 0.5)"));
-    let finite = |x: f32| x.abs() <= 3.402_823_5e38;
-    for x in [f32::NAN, f32::INFINITY, f32::NEG_INFINITY] {
-        assert!(!finite(x));
-    }
-    assert!(finite(f32::MAX) && finite(-f32::MAX));
 }
 
 /// A printed function's name, parameters and result, and the program it
@@ -357,4 +366,19 @@ fn every_helper_runs_on_wgpu_as_its_program_does() {
         recorder.0.borrow().len()
     );
     eprintln!("largest relative difference: {} in {}", worst.0, worst.1);
+}
+
+/// A literal single precision cannot hold is refused, not printed into a
+/// shader that would fail to build.
+#[test]
+fn a_literal_beyond_single_precision_is_unprintable() {
+    use crate::expr::{Num, Var, trace};
+    let program = trace(1, |a| vec![a[0] * Var::of(1e39)]);
+    let signature = Signature::new("big", &[("x", Shape::Scalar)], Shape::Scalar);
+    assert_eq!(
+        Wgsl.function(&signature, &program),
+        Err(Unprintable::Literal(1e39))
+    );
+    let program = trace(1, |a| vec![a[0] * Var::of(3e38)]);
+    validate(&Wgsl.function(&signature, &program).unwrap());
 }

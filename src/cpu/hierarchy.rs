@@ -1,7 +1,8 @@
 //! The CPU reference's walk of a large union: the operands of a tree of
 //! hard unions that have a bound at the current values, indexed by the
-//! same bounding volume hierarchy the kernels walk (`codegen::bvh`), so a
-//! point evaluates only the operands it can be nearest to.
+//! kind of bounding volume hierarchy the kernels walk over a group of
+//! alike operands (`ir::bvh`), so a point evaluates only the operands it
+//! can be nearest to.
 //!
 //! The result is the plain union's: the least distance, and on an exact
 //! tie the later operand's colour, as the chain's order places them. An
@@ -9,12 +10,10 @@
 //! and beyond the nearest distance found so far, so nothing skipped could
 //! have been the minimum or tied with it.
 
+use super::Sample;
 use crate::ir::bvh::{Bvh, Entry, MIN_HIERARCHY, WIDTH};
 use crate::ir::{Bound, NodeId, SHRINK};
 use crate::math::{Real, V3};
-use crate::scene::CsgOp;
-
-use super::{Sample, combine};
 
 /// One union tree's operands, split into those evaluated in turn and
 /// those found through the hierarchy.
@@ -96,8 +95,13 @@ impl<T: Real> Walk<T> {
         self.pending.is_some()
     }
 
-    /// Takes the sample of the operand the last [`Walk::next`] named.
-    pub(super) fn give(&mut self, sample: Sample<T>) {
+    /// Takes the sample of the operand the last [`Walk::next`] named;
+    /// `union` combines two samples, the earlier operand's first.
+    pub(super) fn give(
+        &mut self,
+        sample: Sample<T>,
+        union: impl Fn(Sample<T>, Sample<T>) -> Sample<T>,
+    ) {
         let place = self.pending.take().expect("an operand was asked for");
         self.best = Some(match self.best.take() {
             None => (sample, place),
@@ -113,7 +117,7 @@ impl<T: Real> Walk<T> {
                 } else {
                     later.1
                 };
-                (combine(CsgOp::Union, None, earlier.0, later.0), kept)
+                (union(earlier.0, later.0), kept)
             }
         });
     }
@@ -233,7 +237,9 @@ mod tests {
             while let Some(o) = walk.next(&h) {
                 evaluated += 1;
                 let d = (p - centres[o.index()]).length() - radius;
-                walk.give(Evaluator::leaf(d));
+                walk.give(Evaluator::leaf(d), |a, b| {
+                    super::super::combine(crate::scene::CsgOp::Union, None, a, b)
+                });
             }
             let nearest = centres
                 .iter()

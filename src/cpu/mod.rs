@@ -20,6 +20,7 @@ use sdf::Estimate;
 
 use crate::error::Result;
 use std::collections::HashMap;
+use std::sync::OnceLock;
 
 use crate::ir::{
     Bound, CompiledScene, Ir, IrNode, NodeId, ParamValues, Reach, Scalar, constant, costs,
@@ -84,9 +85,14 @@ pub struct Evaluator {
     swapped: Vec<bool>,
     /// The chains of at least [`MIN_HIERARCHY`](crate::codegen::MIN_HIERARCHY)
     /// operands with bounds at the current values, by root: their bounded
-    /// operands are found through a hierarchy of boxes, as in the kernels.
-    hierarchies: HashMap<usize, Hierarchy>,
+    /// operands are found through a hierarchy of boxes (the kernels walk
+    /// one over a group of alike operands, and loop over others). Built
+    /// at the first evaluation after the values change.
+    hierarchies: OnceLock<HashMap<usize, Hierarchy>>,
     prune: bool,
+    /// Whether samples carry only the distance (as the kernels' `DE`):
+    /// booleans then mix no colours or materials.
+    distance_only: bool,
 }
 
 /// One step of [`Evaluator::eval`]: tasks wait on a stack, samples on
@@ -167,42 +173,44 @@ impl Evaluator {
                 (r.parts.len() > 1 || r.parts[0].1 != 0.0).then_some((o.index(), r))
             })
             .collect();
-        let mut eval = Evaluator {
+        Evaluator {
             ir,
             values,
             bounds,
             chains,
             reaches,
             swapped,
-            hierarchies: HashMap::new(),
+            hierarchies: OnceLock::new(),
             prune: true,
-        };
-        eval.index();
-        eval
+            distance_only: false,
+        }
     }
 
-    /// Builds the hierarchies of the large union trees over their
-    /// operands' bounds at the current values.
-    fn index(&mut self) {
-        self.hierarchies.clear();
-        if self
-            .chains
-            .values()
-            .all(|o| o.len() < crate::ir::bvh::MIN_HIERARCHY)
-        {
-            return;
-        }
-        let bounds: Vec<Option<Bound>> = self
-            .ir
-            .bounds_at(self.values.as_slice())
-            .into_iter()
-            .map(|b| b.filter(|b| b.fits(&F32_LIMITS)))
-            .collect();
-        for (&root, operands) in &self.chains {
-            if let Some(h) = Hierarchy::build(operands, &bounds) {
-                self.hierarchies.insert(root, h);
+    /// The hierarchies of the large union trees over their operands'
+    /// bounds at the current values, built once after the values change.
+    fn hierarchies(&self) -> &HashMap<usize, Hierarchy> {
+        self.hierarchies.get_or_init(|| {
+            let mut out = HashMap::new();
+            if self
+                .chains
+                .values()
+                .all(|o| o.len() < crate::ir::bvh::MIN_HIERARCHY)
+            {
+                return out;
             }
-        }
+            let bounds: Vec<Option<Bound>> = self
+                .ir
+                .bounds_at(self.values.as_slice())
+                .into_iter()
+                .map(|b| b.filter(|b| b.fits(&F32_LIMITS)))
+                .collect();
+            for (&root, operands) in &self.chains {
+                if let Some(h) = Hierarchy::build(operands, &bounds) {
+                    out.insert(root, h);
+                }
+            }
+            out
+        })
     }
 
     /// The same evaluator with the dynamic parameters at `values`.
@@ -210,8 +218,37 @@ impl Evaluator {
     #[must_use]
     pub(crate) fn with_values(mut self, values: ParamValues) -> Self {
         self.values = values;
-        self.index();
+        self.hierarchies = OnceLock::new();
         self
+    }
+
+    /// The same evaluator giving samples that carry only the distance, as
+    /// the kernels' `DE` computes it: booleans mix no colours or
+    /// materials (what an operation count of the distance wants).
+    #[cfg(feature = "opencl")]
+    #[must_use]
+    pub(crate) fn distances_only(mut self) -> Self {
+        self.distance_only = true;
+        self
+    }
+
+    /// A boolean of two samples: [`combine`], or with
+    /// [`Evaluator::distances_only`] the distance and the nearer sample's
+    /// other fields.
+    fn join<T: Real>(&self, op: CsgOp, k: Option<T>, a: Sample<T>, b: Sample<T>) -> Sample<T> {
+        if !self.distance_only {
+            return combine(op, k, a, b);
+        }
+        let c = sdf::csg(op, a.distance, b.distance, k);
+        let near = if op == CsgOp::Cut || c.first_nearer {
+            a
+        } else {
+            b
+        };
+        Sample {
+            distance: c.distance,
+            ..near
+        }
     }
 
     /// Turns the pruning of unions and subtractions off or on (it is on,
@@ -272,7 +309,7 @@ impl Evaluator {
     /// See [`ParamValues::set`].
     pub fn set_param(&mut self, name: &str, value: f64) -> Result<()> {
         self.values.set(name, value)?;
-        self.index();
+        self.hierarchies = OnceLock::new();
         Ok(())
     }
 
@@ -384,7 +421,7 @@ impl Evaluator {
                     let second = out.pop().expect("the second operand's sample");
                     let first = out.pop().expect("the first operand's sample");
                     let k = smoothing.map(|k| self.scalar(k));
-                    out.push(combine(*op, k, first, second));
+                    out.push(self.join(*op, k, first, second));
                 }
                 Task::Chain(root, next, p) => {
                     let operands = &self.chains[&root];
@@ -401,13 +438,14 @@ impl Evaluator {
                 Task::Union => {
                     let b = out.pop().expect("the operand's sample");
                     let a = out.pop().expect("the union's sample so far");
-                    out.push(combine(CsgOp::Union, None, a, b));
+                    out.push(self.join(CsgOp::Union, None, a, b));
                 }
                 Task::Walk(mut walk) => {
                     if walk.waits() {
-                        walk.give(out.pop().expect("the operand's sample"));
+                        let sample = out.pop().expect("the operand's sample");
+                        walk.give(sample, |a, b| self.join(CsgOp::Union, None, a, b));
                     }
-                    match walk.next(&self.hierarchies[&walk.root]) {
+                    match walk.next(&self.hierarchies()[&walk.root]) {
                         Some(o) => {
                             let p = walk.p;
                             tasks.push(Task::Walk(walk));
@@ -431,7 +469,7 @@ impl Evaluator {
         out: &mut Vec<Sample<T>>,
     ) {
         let i = id.index();
-        if self.prune && self.hierarchies.contains_key(&i) {
+        if self.prune && self.hierarchies().contains_key(&i) {
             tasks.push(Task::Walk(Box::new(Walk::new(i, p))));
             return;
         }
@@ -1173,4 +1211,41 @@ fn refine(
         }
     }
     (t1, evaluations)
+}
+
+#[cfg(all(test, feature = "opencl"))]
+mod distance_only {
+    use glam::DVec3;
+
+    use crate::cpu::Evaluator;
+    use crate::expr::{Counted, Num, counting};
+    use crate::math::V3;
+    use crate::scene::{sphere, torus};
+
+    /// Samples that carry only the distance have the distance of full
+    /// samples, and cost fewer operations where booleans would mix
+    /// colours and materials.
+    #[test]
+    fn distance_only_samples_keep_the_distance_and_cost_less() {
+        let node = sphere(1.0)
+            .color(DVec3::X)
+            .smooth_union(torus(1.2, 0.3).color(DVec3::Y), 0.2)
+            .union(sphere(0.5).translate(DVec3::new(2.0, 0.0, 0.0)));
+        let full = Evaluator::new(&node).unwrap();
+        let bare = full.clone().distances_only();
+        for p in [
+            DVec3::new(0.3, 0.2, 1.1),
+            DVec3::new(1.9, 0.1, 0.0),
+            DVec3::new(-3.0, 2.0, 1.0),
+        ] {
+            let q = V3::from_array(p.to_array().map(Counted::of));
+            let (a, full_ops) = counting(|| full.sample::<Counted>(q));
+            let (b, bare_ops) = counting(|| bare.sample::<Counted>(q));
+            assert_eq!(a.distance, b.distance, "at {p}");
+            assert!(bare_ops.flops() < full_ops.flops(), "at {p}");
+        }
+        // Nested, the outer count holds the inner one's.
+        let ((_, inner), outer) = counting(|| counting(|| Counted::of(1.0) + Counted::of(2.0)));
+        assert_eq!((inner.arithmetic, outer.arithmetic), (1, 1));
+    }
 }

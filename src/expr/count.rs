@@ -18,7 +18,7 @@ use std::ops::{Add, Div, Mul, Neg, Sub};
 
 use super::num::{Num, Step, plain_loop};
 
-/// The operations counted on this thread since the last [`counting`].
+/// Operations counted by kind (see [`counting`]).
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
 #[non_exhaustive]
 pub struct Operations {
@@ -76,11 +76,12 @@ fn call() {
 }
 
 /// Runs `f` and gives its result with the operations done on
-/// [`Counted`] numbers on this thread while it ran.
+/// [`Counted`] numbers on this thread while it ran. Nested, the outer
+/// count includes the inner one's.
 pub fn counting<R>(f: impl FnOnce() -> R) -> (R, Operations) {
     let before = COUNT.with(Cell::take);
     let r = f();
-    let ops = COUNT.with(|c| c.replace(before));
+    let ops = COUNT.with(|c| c.replace(before + c.get()));
     (r, ops)
 }
 

@@ -335,9 +335,9 @@ struct BenchArgs {
     #[arg(long, default_value_t = 10, value_parser = clap::value_parser!(u32).range(1..))]
     frames: u32,
     /// Also time the frame stage by stage: the march with normals and
-    /// shading alone, then with each of ambient occlusion, shadows and
-    /// glow that the scene and preset have added one after the other
-    /// (each a program of its own).
+    /// shading alone, then with each of ambient occlusion, shadows, glow
+    /// and lit fog that the scene and preset have added one after the
+    /// other (each a program of its own).
     #[arg(long)]
     stages: bool,
 }
@@ -1055,6 +1055,7 @@ fn bench_stages(renderer: &mut Renderer, size: (u32, u32), frames: u32) -> Outco
     effects.ambient_occlusion = false;
     effects.shadows = false;
     effects.glow = None;
+    effects.volumetric = None;
     let mut stages = vec![("march, normals and shading", effects)];
     // An effect the quality leaves no samples or steps does nothing.
     if full.ambient_occlusion && quality.ao_samples > 0 {
@@ -1068,6 +1069,10 @@ fn bench_stages(renderer: &mut Renderer, size: (u32, u32), frames: u32) -> Outco
     if full.glow.is_some() {
         effects.glow = full.glow;
         stages.push(("+ glow", effects));
+    }
+    if full.volumetric.is_some() && full.fog_density > 0.0 {
+        effects.volumetric = full.volumetric;
+        stages.push(("+ lit fog", effects));
     }
     println!("  stage                          ms/frame  added  evaluations/pixel  added");
     let mut before: Option<Timed> = None;

@@ -80,8 +80,9 @@ impl<'a> Signature<'a> {
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 #[non_exhaustive]
 pub enum Unprintable {
-    /// A literal that is NaN or infinite.
-    #[error("the non-finite literal {0} cannot be written")]
+    /// A literal that is NaN or infinite, or beyond the backend's
+    /// precision.
+    #[error("the literal {0} cannot be written")]
     Literal(f64),
     /// A comparison of 3-vectors (the IR compares numbers only).
     #[error("a comparison of 3-vectors cannot be written")]
@@ -103,7 +104,7 @@ pub trait Printer {
     /// The function `signature` computing `program`.
     ///
     /// # Errors
-    /// [`Unprintable`] for a non-finite literal or a program whose inputs
+    /// [`Unprintable`] for a literal it cannot write or a program whose inputs
     /// or outputs do not match the signature.
     fn function(&self, signature: &Signature<'_>, program: &Program)
     -> Result<String, Unprintable>;
@@ -151,7 +152,8 @@ impl Inline {
 /// are named `real`, `real2`, `real3` and `bool` in every backend (the
 /// precision's number, its pairs and 3-vectors, and truth values).
 trait Syntax {
-    /// A literal; an error for NaN or an infinity.
+    /// A literal; an error for NaN, an infinity or a value beyond the
+    /// backend's precision.
     fn literal(&self, v: f64) -> Result<String, Unprintable>;
     /// Whether `text` is a literal as [`Syntax::literal`] writes it.
     fn is_literal(&self, text: &str) -> bool;

@@ -10,7 +10,16 @@ use super::{
 };
 
 /// The WGSL printer. Every module of printed functions starts with
-/// [`Wgsl::PRELUDE`]. WGSL has single precision only.
+/// [`Wgsl::PRELUDE`]. WGSL has single precision only: a literal beyond
+/// it is [`Unprintable::Literal`].
+///
+/// WGSL lets an implementation assume no value is NaN or infinite, and
+/// leaves `min`, `max` and `clamp` of a NaN, `pow` of a negative base and
+/// the integer of a NaN unspecified, where OpenCL C and the CPU reference
+/// define them; and an operation of literals alone that overflows (such
+/// as `1e30 * 1e30` in a formula's text) is an error when the shader is
+/// created, where OpenCL computes an infinity. Formulas whose values stay
+/// finite (every built-in one) print alike in both.
 ///
 /// ```
 /// use fractal_sdf::expr::{Num, Printer, Shape, Signature, Wgsl, trace};
@@ -30,7 +39,8 @@ alias real = f32;
 alias real2 = vec2<f32>;
 alias real3 = vec3<f32>;
 
-// Whether x is neither infinite nor NaN (NaN fails the comparison).
+// Whether x is neither infinite nor NaN (under IEEE arithmetic, NaN fails
+// the comparison).
 fn fsdf_is_finite(x: real) -> bool {
     return abs(x) <= 3.4028234663852886e38;
 }
@@ -272,7 +282,10 @@ impl Printer for Wgsl {
 
 impl Syntax for Wgsl {
     fn literal(&self, v: f64) -> Result<String, Unprintable> {
-        if !v.is_finite() {
+        // A literal beyond single precision is an error when the shader
+        // is created.
+        #[allow(clippy::cast_possible_truncation)]
+        if !v.is_finite() || (v as f32).is_infinite() {
             return Err(Unprintable::Literal(v));
         }
         // Debug formatting has a `.` or an exponent: an abstract float.

@@ -5,7 +5,7 @@
 use std::time::Instant;
 
 use glam::DVec3;
-use ocl::{Buffer, Kernel, Program};
+use ocl::{Kernel, Program};
 
 use super::Renderer;
 use crate::cpu::{self, Evaluator};
@@ -13,6 +13,7 @@ use crate::error::Result;
 use crate::expr::{Counted, Num, Operations, counting};
 use crate::math::V3;
 use crate::quality::Precision;
+use crate::render::buffer::RealBuffer;
 use crate::render::device::opencl;
 
 /// The operations of a scene's distance evaluations, counted by the CPU
@@ -60,8 +61,19 @@ fn peak_source(precision: Precision) -> String {
         Precision::F32 => "float",
         Precision::F64 => "double",
     };
+    // Every lane starts apart and every lane reaches the output, so no
+    // compiler can merge lanes or drop one as dead.
+    let lanes = (0..PEAK_LANES)
+        .map(|l| format!("({real}){l}"))
+        .collect::<Vec<_>>()
+        .join(", ");
     let chains = (0..PEAK_CHAINS)
-        .map(|c| format!("    {real}16 a{c} = ({real}16)(x + ({real}){c});\n"))
+        .map(|c| {
+            format!(
+                "    {real}16 a{c} = x + ({real}16)({lanes}) * ({real}){};\n",
+                c + 1
+            )
+        })
         .collect::<String>();
     let steps = (0..PEAK_CHAINS)
         .map(|c| format!("        a{c} = fma(a{c}, m, k);\n"))
@@ -84,7 +96,9 @@ fn peak_source(precision: Precision) -> String {
          {steps}\
          \x20   }}\n\
          \x20   {real}16 s = {sum};\n\
-         \x20   out[get_global_id(0)] = s.s0 + s.s5 + s.sa + s.sf;\n\
+         \x20   {real}8 h = s.lo + s.hi;\n\
+         \x20   {real}4 q = h.lo + h.hi;\n\
+         \x20   out[get_global_id(0)] = q.x + q.y + q.z + q.w;\n\
          }}\n"
     )
 }
@@ -94,15 +108,21 @@ impl Renderer {
     /// CPU reference at the current values: at every point where the
     /// primary march of one pixel in `every` × `every` of a `width` ×
     /// `height` image evaluates (as [`cpu::march`] marches it, on the host's
-    /// threads). The kernels compute the same formulas; their compiler may
-    /// share or fuse some operations, so this estimates their work.
+    /// threads), the distance alone, as the kernels' `DE` computes it. The
+    /// kernels compute the same formulas; their compiler may share or fuse
+    /// some operations, a custom shape's own code is not counted, and the
+    /// CPU reference walks a hierarchy over any union of 32 bounded
+    /// operands where the kernels walk one only over alike operands, so
+    /// this estimates their work.
     ///
     /// # Errors
     /// As [`Renderer::viewport`].
     pub fn evaluation_cost(&self, width: u32, height: u32, every: u32) -> Result<EvaluationCost> {
         let viewport = self.viewport(width, height)?;
         let settings = viewport.march_settings(&self.options.quality);
-        let eval = Evaluator::from_compiled(&self.scene).with_values(self.values.clone());
+        let eval = Evaluator::from_compiled(&self.scene)
+            .with_values(self.values.clone())
+            .distances_only();
         let every = every.max(1);
         let rows: Vec<u32> = (0..height).step_by(every as usize).collect();
         let threads = std::thread::available_parallelism().map_or(1, usize::from);
@@ -164,25 +184,22 @@ impl Renderer {
             .build(&self.context)
             .map_err(opencl)?;
         let items = 64 * self.selected.info.compute_units.max(1) as usize * 64;
-        let out = Buffer::<u8>::builder()
-            .queue(self.queue.clone())
-            .len(items * 8)
-            .build()
-            .map_err(opencl)?;
-        let kernel = Kernel::builder()
+        // The buffer's element type is the kernel argument's.
+        let out = RealBuffer::output(&self.queue, precision, items)?;
+        let mut builder = Kernel::builder();
+        builder
             .program(&program)
             .name("peak")
             .queue(self.queue.clone())
-            .global_work_size(items)
-            .arg(&out)
-            .arg(PEAK_STEPS)
-            .build()
-            .map_err(opencl)?;
+            .global_work_size(items);
+        out.push_arg(&mut builder);
+        builder.arg(PEAK_STEPS);
+        let kernel = builder.build().map_err(opencl)?;
         let mut best = f64::INFINITY;
         for _ in 0..3 {
             let start = Instant::now();
             // SAFETY: the kernel writes one value per work item into a
-            // buffer of eight bytes per work item.
+            // buffer of one value per work item.
             unsafe { kernel.enq() }.map_err(opencl)?;
             self.queue.finish().map_err(opencl)?;
             best = best.min(start.elapsed().as_secs_f64());
