@@ -157,10 +157,12 @@ trait Syntax {
     fn literal(&self, v: f64) -> Result<String, Unprintable>;
     /// Whether `text` is a literal as [`Syntax::literal`] writes it.
     fn is_literal(&self, text: &str) -> bool;
-    /// `u(a)`: `a` as an operand, `inner` as a call's argument.
-    fn unary(&self, u: Unary, a: &str, inner: &str) -> String;
-    /// `x b y` for numbers or (the arithmetic and functions) vectors.
-    fn binary(&self, b: Binary, x: &str, y: &str) -> String;
+    /// The function that computes `u` (every [`Unary`] but `Neg` and
+    /// `Not`, which are operators).
+    fn unary_function(&self, u: Unary) -> &'static str;
+    /// The function that computes `b` (`Min`, `Max`, `Atan2` and `Pow`;
+    /// the others are operators, and `Hypot` the length of a pair).
+    fn binary_function(&self, b: Binary) -> &'static str;
     /// Whether a vector operation `b` takes a number as its second
     /// operand (for every component).
     fn scalar_operand(&self, b: Binary) -> bool;
@@ -197,6 +199,38 @@ trait Syntax {
         body: &str,
         returned: &str,
     ) -> String;
+}
+
+/// `u(a)` in `syn`'s language: `a` as an operand, `inner` as a call's
+/// argument.
+fn unary(syn: &dyn Syntax, u: Unary, a: &str, inner: &str) -> String {
+    match u {
+        Unary::Neg => format!("(-{a})"),
+        Unary::Not => format!("(!{a})"),
+        _ => format!("{}({inner})", syn.unary_function(u)),
+    }
+}
+
+/// `x b y` in `syn`'s language, for numbers or (the arithmetic and
+/// functions) vectors.
+fn binary(syn: &dyn Syntax, b: Binary, x: &str, y: &str) -> String {
+    let (ax, ay) = (unwrap(x), unwrap(y));
+    match b {
+        Binary::Add => format!("({x} + {y})"),
+        Binary::Sub => format!("({x} - {y})"),
+        Binary::Mul => format!("({x} * {y})"),
+        Binary::Div => format!("({x} / {y})"),
+        Binary::Lt => format!("({x} < {y})"),
+        Binary::Le => format!("({x} <= {y})"),
+        Binary::And => format!("({x} && {y})"),
+        Binary::Or => format!("({x} || {y})"),
+        // The length of a 2-vector, as the plain types compute it (see
+        // `Num::hypot`).
+        Binary::Hypot => format!("length({})", unwrap(&syn.pair(&[ax, ay]))),
+        Binary::Min | Binary::Max | Binary::Atan2 | Binary::Pow => {
+            format!("{}({ax}, {ay})", syn.binary_function(b))
+        }
+    }
 }
 
 /// The type of values of shape `shape`.
@@ -364,8 +398,8 @@ impl Block<'_> {
             }
             Op::Loop(_) => return Ok(None),
             Op::Element(l, k) => self.states[&l.index()].elements[k as usize].clone(),
-            Op::Unary(u, a) => syn.unary(u, self.atom(a), self.arg(a)),
-            Op::Binary(b, x, y) => syn.binary(b, self.atom(x), self.atom(y)),
+            Op::Unary(u, a) => unary(syn, u, self.atom(a), self.arg(a)),
+            Op::Binary(b, x, y) => binary(syn, b, self.atom(x), self.atom(y)),
             Op::Make3(x, y, z) => match self.whole_vector(x, y, z) {
                 Some(v) => v.to_string(),
                 None if x == y && y == z => syn.vector(&[self.arg(x)]),
@@ -383,7 +417,7 @@ impl Block<'_> {
                 if b.is_logic() {
                     return Err(Unprintable::Vector);
                 }
-                syn.binary(b, x, y)
+                binary(syn, b, x, y)
             }
             Op::Select3(c, a, b) | Op::Select(c, a, b) => {
                 syn.select(self.atom(c), self.atom(a), self.atom(b))

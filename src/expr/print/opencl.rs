@@ -3,7 +3,7 @@
 
 use super::{
     Binary, Inline, Printer, Program, Shape, Signature, Syntax, Unary, Unprintable, print_function,
-    print_inline, unwrap,
+    print_inline,
 };
 
 /// The OpenCL C printer: `real` is the precision's type, literals are
@@ -50,41 +50,29 @@ impl Syntax for OpenCl {
         text.starts_with("R(") && text.ends_with(')') && !text[2..].contains('(')
     }
 
-    fn unary(&self, u: Unary, a: &str, inner: &str) -> String {
+    fn unary_function(&self, u: Unary) -> &'static str {
         match u {
-            Unary::Neg => format!("(-{a})"),
-            Unary::Not => format!("(!{a})"),
-            Unary::Sqrt => format!("sqrt({inner})"),
-            Unary::Abs => format!("fabs({inner})"),
-            Unary::Sin => format!("sin({inner})"),
-            Unary::Cos => format!("cos({inner})"),
-            Unary::Acos => format!("acos({inner})"),
-            Unary::Exp => format!("exp({inner})"),
-            Unary::Ln => format!("log({inner})"),
-            Unary::Floor => format!("floor({inner})"),
-            Unary::Round => format!("round({inner})"),
-            Unary::Finite => format!("isfinite({inner})"),
+            Unary::Sqrt => "sqrt",
+            Unary::Abs => "fabs",
+            Unary::Sin => "sin",
+            Unary::Cos => "cos",
+            Unary::Acos => "acos",
+            Unary::Exp => "exp",
+            Unary::Ln => "log",
+            Unary::Floor => "floor",
+            Unary::Round => "round",
+            Unary::Finite => "isfinite",
+            Unary::Neg | Unary::Not => unreachable!("operators"),
         }
     }
 
-    fn binary(&self, b: Binary, x: &str, y: &str) -> String {
-        let (ax, ay) = (unwrap(x), unwrap(y));
+    fn binary_function(&self, b: Binary) -> &'static str {
         match b {
-            Binary::Add => format!("({x} + {y})"),
-            Binary::Sub => format!("({x} - {y})"),
-            Binary::Mul => format!("({x} * {y})"),
-            Binary::Div => format!("({x} / {y})"),
-            Binary::Lt => format!("({x} < {y})"),
-            Binary::Le => format!("({x} <= {y})"),
-            Binary::And => format!("({x} && {y})"),
-            Binary::Or => format!("({x} || {y})"),
-            Binary::Min => format!("fmin({ax}, {ay})"),
-            Binary::Max => format!("fmax({ax}, {ay})"),
-            Binary::Atan2 => format!("atan2({ax}, {ay})"),
-            Binary::Pow => format!("pow({ax}, {ay})"),
-            // The length of a 2-vector, as the plain types compute it (see
-            // `Num::hypot`).
-            Binary::Hypot => format!("length((real2)({ax}, {ay}))"),
+            Binary::Min => "fmin",
+            Binary::Max => "fmax",
+            Binary::Atan2 => "atan2",
+            Binary::Pow => "pow",
+            _ => unreachable!("operators"),
         }
     }
 

@@ -306,39 +306,29 @@ impl Syntax for Wgsl {
             && !inner.contains(['i', 'I', 'n', 'N'])
     }
 
-    fn unary(&self, u: Unary, a: &str, inner: &str) -> String {
+    fn unary_function(&self, u: Unary) -> &'static str {
         match u {
-            Unary::Neg => format!("(-{a})"),
-            Unary::Not => format!("(!{a})"),
-            Unary::Sqrt => format!("sqrt({inner})"),
-            Unary::Abs => format!("abs({inner})"),
-            Unary::Sin => format!("sin({inner})"),
-            Unary::Cos => format!("cos({inner})"),
-            Unary::Acos => format!("acos({inner})"),
-            Unary::Exp => format!("exp({inner})"),
-            Unary::Ln => format!("log({inner})"),
-            Unary::Floor => format!("floor({inner})"),
-            Unary::Round => format!("fsdf_round({inner})"),
-            Unary::Finite => format!("fsdf_is_finite({inner})"),
+            Unary::Sqrt => "sqrt",
+            Unary::Abs => "abs",
+            Unary::Sin => "sin",
+            Unary::Cos => "cos",
+            Unary::Acos => "acos",
+            Unary::Exp => "exp",
+            Unary::Ln => "log",
+            Unary::Floor => "floor",
+            Unary::Round => "fsdf_round",
+            Unary::Finite => "fsdf_is_finite",
+            Unary::Neg | Unary::Not => unreachable!("operators"),
         }
     }
 
-    fn binary(&self, b: Binary, x: &str, y: &str) -> String {
-        let (ax, ay) = (unwrap(x), unwrap(y));
+    fn binary_function(&self, b: Binary) -> &'static str {
         match b {
-            Binary::Add => format!("({x} + {y})"),
-            Binary::Sub => format!("({x} - {y})"),
-            Binary::Mul => format!("({x} * {y})"),
-            Binary::Div => format!("({x} / {y})"),
-            Binary::Lt => format!("({x} < {y})"),
-            Binary::Le => format!("({x} <= {y})"),
-            Binary::And => format!("({x} && {y})"),
-            Binary::Or => format!("({x} || {y})"),
-            Binary::Min => format!("min({ax}, {ay})"),
-            Binary::Max => format!("max({ax}, {ay})"),
-            Binary::Atan2 => format!("atan2({ax}, {ay})"),
-            Binary::Pow => format!("pow({ax}, {ay})"),
-            Binary::Hypot => format!("length(real2({ax}, {ay}))"),
+            Binary::Min => "min",
+            Binary::Max => "max",
+            Binary::Atan2 => "atan2",
+            Binary::Pow => "pow",
+            _ => unreachable!("operators"),
         }
     }
 
