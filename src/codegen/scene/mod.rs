@@ -16,7 +16,7 @@
 //! entry the host copies in). The code stays the size of one operand
 //! however many there are, and computes what the unrolled code would; a
 //! group of at least [`MIN_HIERARCHY`] is walked through a bounding volume
-//! hierarchy (`codegen::bvh`) that skips the members too far away to
+//! hierarchy (`ir::bvh`) that skips the members too far away to
 //! matter.
 
 use std::cell::RefCell;
