@@ -272,6 +272,17 @@ pub enum Error {
         /// The devices that exist.
         available: String,
     },
+    /// A backend cannot do what was asked (the WGSL backend and double
+    /// precision, say); `instead` says what can.
+    #[error("the {backend} backend cannot {what}: {instead}")]
+    Unsupported {
+        /// The backend: `WGSL`.
+        backend: &'static str,
+        /// What it cannot do.
+        what: String,
+        /// What to do instead.
+        instead: String,
+    },
     /// Double precision was requested on a device without `cl_khr_fp64`.
     #[error(
         "device `{device}` does not support double precision (cl_khr_fp64); use Precision::F32"

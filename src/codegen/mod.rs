@@ -29,12 +29,14 @@ pub(crate) mod interface;
 pub(crate) mod names;
 mod scene;
 mod tables;
+mod wgsl;
 #[cfg(test)]
 mod wgsl_tests;
 mod writer;
 
 pub use scene::{MIN_HIERARCHY, MIN_INSTANCES};
 pub use tables::InstanceTables;
+pub use wgsl::{WGSL_PARAMS, emit_wgsl, emit_wgsl_ir};
 pub use writer::literal;
 
 use std::sync::atomic::{AtomicU64, Ordering};
@@ -169,8 +171,11 @@ impl Effect {
 #[derive(Debug, Clone, PartialEq)]
 #[non_exhaustive]
 pub struct KernelSource {
-    /// The complete OpenCL C source.
+    /// The complete source: an OpenCL C program, or a WGSL module of the
+    /// scene's functions ([`emit_wgsl`]).
     pub source: String,
+    /// The language of [`source`](Self::source).
+    pub language: Language,
     /// The precision the source was generated for; `F64` requires a device
     /// with `cl_khr_fp64`.
     pub precision: Precision,
@@ -215,6 +220,17 @@ pub struct KernelSource {
     /// value, and the hierarchies over instances fitted again when one
     /// changes: [`param_buffer`](Self::param_buffer) applies them.
     pub tables: InstanceTables,
+}
+
+/// The language of a generated program.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[non_exhaustive]
+pub enum Language {
+    /// OpenCL C: the whole program, kernels included ([`emit`]).
+    #[default]
+    OpenCl,
+    /// WGSL: the scene's functions, for a shader to call ([`emit_wgsl`]).
+    Wgsl,
 }
 
 /// Where a custom shape's OpenCL function lies in a generated program: its
@@ -399,61 +415,13 @@ pub fn emit_ir(ir: &Ir, options: &Options) -> Result<KernelSource> {
         node_glow: (glows > 0).then(|| (glows, node_glow(ir))),
         emitters: emitters(ir, options, origin),
     };
-    let used = std::mem::take(&mut emitter.used);
-    let trapped = std::mem::take(&mut emitter.trapped);
     let customs: Vec<_> = emitter.customs.values().cloned().collect();
-    let powers: Vec<u32> = emitter.powers.iter().copied().collect();
-    let mut hybrids: Vec<_> = std::mem::take(&mut emitter.hybrids).into_values().collect();
-    hybrids.sort_by(|a, b| a.0.cmp(&b.0));
     let constants = std::mem::take(&mut emitter.constants);
     let tables = std::mem::take(&mut emitter.tables);
 
     let mut w = writer::Writer::new(precision);
     header(&mut w, options, &features);
-    // Each helper, and after it its trapped form where an orbit trap
-    // colours the fractal.
-    let mut section = |name: &str, source: Result<String, Unprintable>| -> Result<()> {
-        w.line(format!("/* ---- {name} ---- */"));
-        w.raw(&source.map_err(|e| Error::Invalid {
-            what: "formula",
-            reason: e.to_string(),
-        })?);
-        w.line("");
-        Ok(())
-    };
-    for helper in helpers::Helper::ALL
-        .into_iter()
-        .filter(|h| used.contains(h))
-    {
-        section(helper.name(), helper.source(&OpenCl))?;
-        if trapped.contains(helper.name())
-            && let Some(source) = helper.fractal_source(&OpenCl, true)
-        {
-            section(&formulas::fractal_name(helper.name(), true), source)?;
-        }
-    }
-    for n in powers {
-        let name = formulas::power_helper_name(n);
-        section(&name, formulas::mandelbulb_power(&OpenCl, n, false))?;
-        if trapped.contains(&name) {
-            section(
-                &formulas::fractal_name(&name, true),
-                formulas::mandelbulb_power(&OpenCl, n, true),
-            )?;
-        }
-    }
-    for (name, shape, integer_powers) in &hybrids {
-        section(
-            name,
-            formulas::hybrid(&OpenCl, name, shape, integer_powers, false),
-        )?;
-        if trapped.contains(name) {
-            section(
-                &formulas::fractal_name(name, true),
-                formulas::hybrid(&OpenCl, name, shape, integer_powers, true),
-            )?;
-        }
-    }
+    write_helpers(&mut w, &mut emitter)?;
     let mut custom_regions = Vec::with_capacity(customs.len());
     for shape in &customs {
         names::check_custom(shape)?;
@@ -487,6 +455,62 @@ pub fn emit_ir(ir: &Ir, options: &Options) -> Result<KernelSource> {
     kernel.constants = constants;
     kernel.tables = tables;
     Ok(kernel)
+}
+
+/// Writes the helpers the scene functions `emitter` wrote call, in the
+/// writer's language: each helper, and after it its trapped form where an
+/// orbit trap colours the fractal; then the specialised Mandelbulb powers
+/// and the hybrids.
+fn write_helpers(w: &mut writer::Writer, emitter: &mut scene::SceneEmitter<'_>) -> Result<()> {
+    let to = w.printer();
+    let used = std::mem::take(&mut emitter.used);
+    let trapped = std::mem::take(&mut emitter.trapped);
+    let powers: Vec<u32> = emitter.powers.iter().copied().collect();
+    let mut hybrids: Vec<_> = std::mem::take(&mut emitter.hybrids).into_values().collect();
+    hybrids.sort_by(|a, b| a.0.cmp(&b.0));
+    let mut section = |name: &str, source: Result<String, Unprintable>| -> Result<()> {
+        w.line(format!("/* ---- {name} ---- */"));
+        w.raw(&source.map_err(|e| Error::Invalid {
+            what: "formula",
+            reason: e.to_string(),
+        })?);
+        w.line("");
+        Ok(())
+    };
+    for helper in helpers::Helper::ALL
+        .into_iter()
+        .filter(|h| used.contains(h))
+    {
+        section(helper.name(), helper.source(to))?;
+        if trapped.contains(helper.name())
+            && let Some(source) = helper.fractal_source(to, true)
+        {
+            section(&formulas::fractal_name(helper.name(), true), source)?;
+        }
+    }
+    for n in powers {
+        let name = formulas::power_helper_name(n);
+        section(&name, formulas::mandelbulb_power(to, n, false))?;
+        if trapped.contains(&name) {
+            section(
+                &formulas::fractal_name(&name, true),
+                formulas::mandelbulb_power(to, n, true),
+            )?;
+        }
+    }
+    for (name, shape, integer_powers) in &hybrids {
+        section(
+            name,
+            formulas::hybrid(to, name, shape, integer_powers, false),
+        )?;
+        if trapped.contains(name) {
+            section(
+                &formulas::fractal_name(name, true),
+                formulas::hybrid(to, name, shape, integer_powers, true),
+            )?;
+        }
+    }
+    Ok(())
 }
 
 /// A complete program around hand-written scene functions: the header for
@@ -867,6 +891,7 @@ fn finish(
     Ok(KernelSource {
         hash: fnv1a(source.as_bytes()),
         source,
+        language: Language::OpenCl,
         precision: options.quality.precision,
         fast_math: options.quality.fast_math,
         cone_tile: cone_tile(options, features),

@@ -1,19 +1,55 @@
-//! A small source writer: indentation, a fixed statement style and the one
-//! place float literals are formatted.
+//! A small source writer: indentation, a fixed statement style, the one
+//! place float literals are formatted, and the spelling of the few
+//! statements and expressions the scene functions write in OpenCL C or in
+//! WGSL (a declaration, a vector, a choice, a loop).
 
 use std::cell::Cell;
 use std::fmt::Write as _;
 
+use crate::expr::{OpenCl, Printer, Wgsl};
 use crate::ir::Scalar;
 use crate::quality::Precision;
+
+/// The language a [`Writer`] writes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum Lang {
+    OpenCl,
+    Wgsl,
+}
+
+/// The types the scene functions declare: each language's name for them
+/// (`real` and its vectors are aliases of the precision's types in both).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum Ty {
+    Real,
+    Real2,
+    Real3,
+    Real4,
+    Real16,
+    Uint,
+    Int,
+    Bool,
+}
 
 /// Slot numbers from here up name the entries of the current instance's
 /// table row (`q[slot - INSTANCE_SLOT]`) while an instanced union's loop
 /// body is emitted: no scene has a billion dynamic parameters.
 pub(crate) const INSTANCE_SLOT: u32 = 1 << 30;
 
-/// Accumulates OpenCL C source with an indentation level.
+/// A parameter of a scene function.
+#[derive(Debug, Clone, Copy)]
+pub(crate) enum Param<'a> {
+    /// A value.
+    Value(&'a str, Ty),
+    /// A pointer the function writes through.
+    Pointer(&'a str, Ty),
+    /// The parameter buffer.
+    Buffer,
+}
+
+/// Accumulates OpenCL C or WGSL source with an indentation level.
 pub(crate) struct Writer {
+    lang: Lang,
     out: String,
     indent: usize,
     precision: Precision,
@@ -26,7 +62,17 @@ pub(crate) struct Writer {
 
 impl Writer {
     pub(crate) fn new(precision: Precision) -> Self {
+        Self::in_language(Lang::OpenCl, precision)
+    }
+
+    /// A writer of WGSL (single precision only).
+    pub(crate) fn wgsl() -> Self {
+        Self::in_language(Lang::Wgsl, Precision::F32)
+    }
+
+    fn in_language(lang: Lang, precision: Precision) -> Self {
         Writer {
+            lang,
             out: String::new(),
             indent: 0,
             precision,
@@ -123,9 +169,10 @@ impl Writer {
     pub(crate) fn scalar(&self, s: Scalar) -> String {
         match s {
             Scalar::Baked(v) => self.float(v),
-            Scalar::Dynamic(slot) if slot >= INSTANCE_SLOT => {
-                format!("q[{}]", slot - INSTANCE_SLOT)
-            }
+            Scalar::Dynamic(slot) if slot >= INSTANCE_SLOT => match self.lang {
+                Lang::OpenCl => format!("q[{}]", slot - INSTANCE_SLOT),
+                Lang::Wgsl => format!("params[q + {}u]", slot - INSTANCE_SLOT),
+            },
             Scalar::Dynamic(slot) => match self.slot_names.get(slot as usize) {
                 Some(name) => format!("params[{slot}] /* {name} */"),
                 None => format!("params[{slot}]"),
@@ -137,9 +184,189 @@ impl Writer {
     pub(crate) fn vector(&self, v: [Scalar; 3]) -> String {
         let [x, y, z] = v.map(|s| self.scalar(s));
         if x == y && y == z {
-            format!("(real3)({x})")
+            self.construct(Ty::Real3, &[&x])
         } else {
-            format!("(real3)({x}, {y}, {z})")
+            self.construct(Ty::Real3, &[&x, &y, &z])
+        }
+    }
+
+    /// The language written.
+    pub(crate) fn lang(&self) -> Lang {
+        self.lang
+    }
+
+    /// The printer of formulas in the language written.
+    pub(crate) fn printer(&self) -> &'static dyn Printer {
+        match self.lang {
+            Lang::OpenCl => &OpenCl,
+            Lang::Wgsl => &Wgsl,
+        }
+    }
+
+    /// The language's name of a type.
+    pub(crate) fn ty(&self, ty: Ty) -> &'static str {
+        match (self.lang, ty) {
+            (_, Ty::Real) => "real",
+            (_, Ty::Real2) => "real2",
+            (_, Ty::Real3) => "real3",
+            (_, Ty::Real4) => "real4",
+            (_, Ty::Real16) => "real16",
+            (_, Ty::Bool) => "bool",
+            (Lang::OpenCl, Ty::Uint) => "uint",
+            (Lang::OpenCl, Ty::Int) => "int",
+            (Lang::Wgsl, Ty::Uint) => "u32",
+            (Lang::Wgsl, Ty::Int) => "i32",
+        }
+    }
+
+    /// Declares the variable `name` of type `ty`, holding `value`.
+    pub(crate) fn declare(&mut self, ty: Ty, name: &str, value: &str) {
+        let line = match self.lang {
+            Lang::OpenCl => format!("{} {name} = {value};", self.ty(ty)),
+            Lang::Wgsl => format!("var {name}: {} = {value};", self.ty(ty)),
+        };
+        self.line(line);
+    }
+
+    /// Declares the array `name` of `len` values of type `ty`.
+    pub(crate) fn array(&mut self, ty: Ty, name: &str, len: usize) {
+        let line = match self.lang {
+            Lang::OpenCl => format!("{} {name}[{len}];", self.ty(ty)),
+            Lang::Wgsl => format!("var {name}: array<{}, {len}>;", self.ty(ty)),
+        };
+        self.line(line);
+    }
+
+    /// A value of type `ty` made of `parts` (one part fills a vector).
+    pub(crate) fn construct(&self, ty: Ty, parts: &[&str]) -> String {
+        let parts = parts.join(", ");
+        match self.lang {
+            Lang::OpenCl => format!("({})({parts})", self.ty(ty)),
+            Lang::Wgsl => format!("{}({parts})", self.ty(ty)),
+        }
+    }
+
+    /// `a` where `c` holds, else `b` (`c` is a boolean, or in OpenCL a
+    /// number that is nonzero where it holds).
+    pub(crate) fn select(&self, c: &str, a: &str, b: &str) -> String {
+        match self.lang {
+            Lang::OpenCl => format!("{c} ? {a} : {b}"),
+            Lang::Wgsl => format!("select({b}, {a}, {c})"),
+        }
+    }
+
+    /// The number `text` (a decimal) as a value of the precision, in an
+    /// expression that mixes it with vectors and numbers alike.
+    pub(crate) fn real(&self, text: &str) -> String {
+        match self.lang {
+            Lang::OpenCl => format!("R({text})"),
+            Lang::Wgsl => text.to_string(),
+        }
+    }
+
+    /// The smaller and the larger of two values: the function names.
+    pub(crate) fn min_max(&self) -> (&'static str, &'static str) {
+        match self.lang {
+            Lang::OpenCl => ("fmin", "fmax"),
+            Lang::Wgsl => ("min", "max"),
+        }
+    }
+
+    /// A distance beyond every other: OpenCL's infinity; in WGSL, whose
+    /// implementations may assume no value is infinite, the largest
+    /// single-precision number.
+    pub(crate) fn infinity(&self) -> &'static str {
+        match self.lang {
+            Lang::OpenCl => "INFINITY",
+            Lang::Wgsl => "FSDF_INFINITY",
+        }
+    }
+
+    /// `value` converted to type `ty`.
+    pub(crate) fn cast(&self, ty: Ty, value: &str) -> String {
+        match self.lang {
+            Lang::OpenCl => format!("({}){value}", self.ty(ty)),
+            Lang::Wgsl => format!("{}({value})", self.ty(ty)),
+        }
+    }
+
+    /// Opens a loop of `i` (a `uint`) from `start` while below `end`.
+    pub(crate) fn open_for(&mut self, i: &str, start: &str, end: &str) {
+        let head = match self.lang {
+            Lang::OpenCl => format!("for (uint {i} = {start}; {i} < {end}; {i}++)"),
+            Lang::Wgsl => format!("for (var {i}: u32 = {start}; {i} < {end}; {i}++)"),
+        };
+        self.open(head);
+    }
+
+    /// Declares `name`, the index in the parameter buffer at which values
+    /// start `offset` after `base` (in OpenCL a pointer there, in WGSL the
+    /// index: a read of entry `k` from it is [`Writer::at`]).
+    pub(crate) fn declare_offset(&mut self, name: &str, base: usize, offset: &str) {
+        let line = match self.lang {
+            Lang::OpenCl => format!("__global const real* {name} = params + {base}u + {offset};"),
+            Lang::Wgsl => format!("let {name} = {base}u + {offset};"),
+        };
+        self.line(line);
+    }
+
+    /// Entry `k` from an offset [`Writer::declare_offset`] named.
+    pub(crate) fn at(&self, name: &str, k: usize) -> String {
+        match self.lang {
+            Lang::OpenCl => format!("{name}[{k}]"),
+            Lang::Wgsl => format!("params[{name} + {k}u]"),
+        }
+    }
+
+    /// Four entries from an offset as a `real4`: entries `4k` to `4k + 3`.
+    pub(crate) fn load4(&self, name: &str, k: usize) -> String {
+        match self.lang {
+            Lang::OpenCl => format!("vload4({k}, {name})"),
+            Lang::Wgsl => {
+                let e: Vec<String> = (0..4).map(|j| self.at(name, 4 * k + j)).collect();
+                format!("real4({})", e.join(", "))
+            }
+        }
+    }
+
+    /// Lane `j` of a `real4`.
+    pub(crate) fn lane(&self, j: usize) -> String {
+        match self.lang {
+            Lang::OpenCl => format!("s{j}"),
+            Lang::Wgsl => ["x", "y", "z", "w"][j].to_string(),
+        }
+    }
+
+    /// The head of a scene function: its name, result and parameters.
+    /// The parameter buffer is an argument in OpenCL and a binding in
+    /// WGSL.
+    pub(crate) fn function_head(&self, name: &str, result: Ty, params: &[Param<'_>]) -> String {
+        let params: Vec<String> = params
+            .iter()
+            .filter_map(|p| match (self.lang, p) {
+                (Lang::OpenCl, Param::Value(p, ty)) => Some(format!("{} {p}", self.ty(*ty))),
+                (Lang::OpenCl, Param::Pointer(p, ty)) => Some(format!("{}* {p}", self.ty(*ty))),
+                (Lang::OpenCl, Param::Buffer) => Some("__global const real* params".into()),
+                (Lang::Wgsl, Param::Value(p, ty)) => Some(format!("{p}: {}", self.ty(*ty))),
+                (Lang::Wgsl, Param::Pointer(p, ty)) => {
+                    Some(format!("{p}: ptr<function, {}>", self.ty(*ty)))
+                }
+                (Lang::Wgsl, Param::Buffer) => None,
+            })
+            .collect();
+        let params = params.join(", ");
+        match self.lang {
+            Lang::OpenCl => format!("{} {name}({params})", self.ty(result)),
+            Lang::Wgsl => format!("fn {name}({params}) -> {}", self.ty(result)),
+        }
+    }
+
+    /// The arguments of a call of a scene function: `args`, and in OpenCL
+    /// the parameter buffer after them.
+    pub(crate) fn call(&self, name: &str, args: &str) -> String {
+        match self.lang {
+            Lang::OpenCl => format!("{name}({args}, params)"),
+            Lang::Wgsl => format!("{name}({args})"),
         }
     }
 

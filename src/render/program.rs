@@ -299,6 +299,7 @@ mod tests {
         let source: String = (1..=20).map(|i| format!("line {i}\n")).collect();
         KernelSource {
             source,
+            language: crate::codegen::Language::OpenCl,
             precision: Precision::F32,
             hash: 0,
             fast_math: false,

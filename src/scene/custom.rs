@@ -417,20 +417,7 @@ impl CustomShape {
         cpu_type: Option<TypeId>,
     ) -> Result<Self> {
         check_names(name, params)?;
-        let function = format!("custom_{name}");
-        let mut signature_params = vec![("p", Shape::Vec3)];
-        signature_params.extend(params.iter().map(|(n, _)| (*n, Shape::Scalar)));
-        let signature = Signature {
-            name: &function,
-            params: &signature_params,
-            result: Shape::Scalar,
-        };
-        let opencl = OpenCl
-            .function(&signature, &program)
-            .map_err(|e| Error::CustomShape {
-                name: name.into(),
-                reason: e.to_string(),
-            })?;
+        let opencl = print_definition(name, params.iter().map(|(n, _)| *n), &OpenCl, &program)?;
         Ok(CustomShape(Arc::new(Inner {
             name: name.into(),
             params: params.iter().map(|(n, r)| ((*n).to_string(), *r)).collect(),
@@ -440,6 +427,17 @@ impl CustomShape {
             program: Some(Arc::new(program)),
             text: None,
         })))
+    }
+
+    /// The function `custom_NAME(p, params…)` of a shape defined by a
+    /// program, printed by `to` (the OpenCL text is kept at definition).
+    pub(crate) fn definition(&self, to: &dyn Printer, program: &Program) -> Result<String> {
+        print_definition(
+            &self.0.name,
+            self.0.params.iter().map(|(n, _)| n.as_str()),
+            to,
+            program,
+        )
     }
 
     /// Defines an inside shape: see [`InsideShape::new`](super::InsideShape::new).
@@ -785,4 +783,27 @@ fn check_identifier(s: &str) -> std::result::Result<(), String> {
         return Err(format!("`{s}` is longer than 48 characters"));
     }
     Ok(())
+}
+
+/// The function `custom_NAME(p, params…)` computing `program`, printed by
+/// `to`.
+fn print_definition<'n>(
+    name: &str,
+    params: impl Iterator<Item = &'n str>,
+    to: &dyn Printer,
+    program: &Program,
+) -> Result<String> {
+    let function = format!("custom_{name}");
+    let mut signature_params = vec![("p", Shape::Vec3)];
+    signature_params.extend(params.map(|n| (n, Shape::Scalar)));
+    let signature = Signature {
+        name: &function,
+        params: &signature_params,
+        result: Shape::Scalar,
+    };
+    to.function(&signature, program)
+        .map_err(|e| Error::CustomShape {
+            name: name.into(),
+            reason: e.to_string(),
+        })
 }

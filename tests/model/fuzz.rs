@@ -139,3 +139,41 @@ proptest! {
         }
     }
 }
+
+/// Random valid scenes (of every node kind the strategy builds, without
+/// inside shapes) print as WGSL that parses and validates as a WebGPU
+/// implementation reads it (naga), for rendering and for evaluation.
+#[test]
+fn random_scenes_print_as_valid_wgsl() {
+    use fractal_sdf::codegen::{self, Options, Target};
+    let mut runner = TestRunner::new(Config {
+        cases: cases(64),
+        failure_persistence: None,
+        ..Config::default()
+    });
+    runner
+        .run(&scene_node(3), |node| {
+            let scene = Scene::new(node).compile().expect("valid scenes compile");
+            for target in [Target::Render, Target::Evaluate] {
+                let options = Options::default().target(target);
+                let module = match codegen::emit_wgsl(&scene, &options) {
+                    Ok(module) => module,
+                    Err(Error::Unsupported { .. }) if scene.ir().has_inside_shapes() => {
+                        return Ok(());
+                    }
+                    Err(e) => return Err(TestCaseError::fail(e.to_string())),
+                };
+                let source = &module.source;
+                let parsed = naga::front::wgsl::parse_str(source)
+                    .map_err(|e| TestCaseError::fail(e.emit_to_string(source)))?;
+                naga::valid::Validator::new(
+                    naga::valid::ValidationFlags::all(),
+                    naga::valid::Capabilities::empty(),
+                )
+                .validate(&parsed)
+                .map_err(|e| TestCaseError::fail(e.emit_to_string(source)))?;
+            }
+            Ok(())
+        })
+        .unwrap();
+}

@@ -7,15 +7,15 @@ impl<'a> SceneEmitter<'a> {
     pub(super) fn point(&mut self, expr: String) -> String {
         self.points += 1;
         let name = format!("p{}", self.points);
-        self.w.line(format!("real3 {name} = {expr};"));
+        self.w.declare(Ty::Real3, &name, &expr);
         name
     }
 
     /// Writes `formula`, a function of `args` (in order, a point as three
     /// inputs) from [`crate::cpu::sdf`], at this place of the function:
     /// traced into the expression IR with the baked parameters as literals
-    /// (so it keeps only the code they leave) and printed by the OpenCL
-    /// printer. Gives each result's expression.
+    /// (so it keeps only the code they leave) and printed by the
+    /// writer's printer. Gives each result's expression.
     pub(super) fn inline(
         &mut self,
         args: &[Arg<'_>],
@@ -64,7 +64,9 @@ impl<'a> SceneEmitter<'a> {
         });
         let named: Vec<(&str, Shape)> = inputs.iter().map(|(n, s)| (n.as_str(), *s)).collect();
         self.inlined += 1;
-        let out = OpenCl
+        let out = self
+            .w
+            .printer()
             .inline(&named, results, &program, &format!("e{}_", self.inlined))
             .expect("an inline formula reads its arguments and gives its results");
         for line in out.statements.lines() {
@@ -105,7 +107,7 @@ impl<'a> SceneEmitter<'a> {
         all.extend_from_slice(args);
         let [d] = take(self.inline(&all, &[Shape::Scalar], |a| vec![formula(a[0], &a[1..])]));
         let name = format!("d{}", id.index());
-        self.w.line(format!("real {name} = {d};"));
+        self.w.declare(Ty::Real, &name, &d);
         Vars { d: name, ..child }
     }
 
@@ -166,7 +168,7 @@ impl<'a> SceneEmitter<'a> {
             })
             .into_iter();
         let d = out.next().expect("a boolean has a distance");
-        self.w.line(format!("real {} = {d};", v.d));
+        self.w.declare(Ty::Real, &v.d, &d);
         if !self.shade {
             return v;
         }
@@ -188,9 +190,9 @@ impl<'a> SceneEmitter<'a> {
             v.c
         };
         let t = if self.traps() {
-            self.choose("real2", &v.t, &near, (&a.t, &b.t), blend.as_deref())
+            self.choose(Ty::Real2, &v.t, &near, (&a.t, &b.t), blend.as_deref())
         } else {
-            "R(1.0)".into()
+            self.w.real("1.0")
         };
         Vars { d: v.d, c, t }
     }
@@ -201,7 +203,7 @@ impl<'a> SceneEmitter<'a> {
     /// of a value with itself is that value).
     pub(super) fn choose(
         &mut self,
-        ty: &str,
+        ty: Ty,
         var: &str,
         near: &str,
         (a, b): (&str, &str),
@@ -214,8 +216,8 @@ impl<'a> SceneEmitter<'a> {
             Some(m) => (format!("mix({a}, {b}, {m})"), format!("mix({b}, {a}, {m})")),
             None => (a.to_string(), b.to_string()),
         };
-        self.w
-            .line(format!("{ty} {var} = {near} ? {first} : {second};"));
+        let value = self.w.select(near, &first, &second);
+        self.w.declare(ty, var, &value);
         var.to_string()
     }
 }

@@ -111,13 +111,13 @@ impl<'a> SceneEmitter<'a> {
         let r = first.index();
         let (d, c, t) = (format!("dg{r}"), format!("cg{r}"), format!("tg{r}"));
         let colour = self.shade && needs_color;
-        self.w.line(format!("real {d} = INFINITY;"));
+        self.w.declare(Ty::Real, &d, self.w.infinity());
         if colour {
             let (ty, default) = (self.surface_type(), self.default_surface());
-            self.w.line(format!("{ty} {c} = {default};"));
+            self.w.declare(ty, &c, &default);
         }
         if self.traps() {
-            self.w.line(format!("real2 {t} = {};", super::NO_TRAP));
+            self.w.declare(Ty::Real2, &t, &super::no_trap(self.w));
         }
         let (start, row) = match &hierarchy {
             Some(bvh) => self.hierarchy_open(members, bvh, template, stride, r, p),
@@ -131,14 +131,11 @@ impl<'a> SceneEmitter<'a> {
                     members.len(),
                     self.ir.path_tail(first, 2)
                 ));
-                self.w
-                    .open(format!("for (uint i = 0u; i < {}u; i++)", members.len()));
+                self.w.open_for("i", "0u", &format!("{}u", members.len()));
                 (start, stride)
             }
         };
-        self.w.line(format!(
-            "__global const real* q = params + {start}u + i * {row}u;"
-        ));
+        self.w.declare_offset("q", start, &format!("i * {row}u"));
         self.instance = chain.into_iter().collect();
         let v = self.node(first, p, needs_color);
         self.instance.clear();
@@ -147,7 +144,8 @@ impl<'a> SceneEmitter<'a> {
             // a hierarchy's table keeps after the member's values.
             let nearer = match &hierarchy {
                 Some(_) => {
-                    self.w.line(format!("uint k = (uint)q[{stride}];"));
+                    let k = self.w.cast(Ty::Uint, &self.w.at("q", stride));
+                    self.w.declare(Ty::Uint, "k", &k);
                     format!("{} < {d} || ({} == {d} && k >= kg{r})", v.d, v.d)
                 }
                 None => format!("{} <= {d}", v.d),
@@ -165,7 +163,8 @@ impl<'a> SceneEmitter<'a> {
             }
             self.w.close();
         } else {
-            self.w.line(format!("{d} = fmin({d}, {});", v.d));
+            let (min, _) = self.w.min_max();
+            self.w.line(format!("{d} = {min}({d}, {});", v.d));
         }
         self.w.close();
         if hierarchy.is_some() {
@@ -174,7 +173,7 @@ impl<'a> SceneEmitter<'a> {
         Vars {
             d,
             c: if colour { c } else { self.default_surface() },
-            t: if self.traps() { t } else { "R(1.0)".into() },
+            t: if self.traps() { t } else { self.w.real("1.0") },
         }
     }
 
@@ -226,7 +225,7 @@ impl<'a> SceneEmitter<'a> {
         );
         let d = format!("dg{r}");
         if self.shade {
-            self.w.line(format!("uint kg{r} = 0u;"));
+            self.w.declare(Ty::Uint, &format!("kg{r}"), "0u");
         }
         // An entry may hold a member nearer than the minimum so far where
         // its gap (the squared distance from the point to its box, times
@@ -234,85 +233,113 @@ impl<'a> SceneEmitter<'a> {
         // `Bound::distance`) is zero or below the minimum's square.
         let k = bvh.slope * SHRINK;
         let k2 = self.w.float(k * k);
-        let open = |g: &str| format!("({g} <= R(0.0) || ({d} > R(0.0) && {g} < {d} * {d}))");
-        self.w.line(format!("uint {refs}[{STACK}];"));
-        self.w.line(format!("int {counts}[{STACK}];"));
-        self.w.line(format!("real {gaps}[{STACK}];"));
+        let zero = self.w.real("0.0");
+        let open = |g: &str| format!("({g} <= {zero} || ({d} > {zero} && {g} < {d} * {d}))");
+        self.w.array(Ty::Uint, &refs, STACK);
+        self.w.array(Ty::Int, &counts, STACK);
+        self.w.array(Ty::Real, &gaps, STACK);
         self.w.line(format!(
-            "{refs}[0] = 0u; {counts}[0] = 0; {gaps}[0] = R(0.0);"
+            "{refs}[0] = 0u; {counts}[0] = 0; {gaps}[0] = {zero};"
         ));
-        self.w.line(format!("uint {sp} = 1u;"));
+        self.w.declare(Ty::Uint, &sp, "1u");
         self.w.open(format!("while ({sp} > 0u)"));
         self.w.line(format!("{sp}--;"));
-        self.w.line(format!(
-            "if (!{}) continue;",
-            open(&format!("{gaps}[{sp}]"))
-        ));
-        self.w.line(format!(
-            "uint first = {refs}[{sp}]; int count = {counts}[{sp}];"
-        ));
+        let closed = format!("!{}", open(&format!("{gaps}[{sp}]")));
+        match self.w.lang() {
+            Lang::OpenCl => self.w.line(format!("if ({closed}) continue;")),
+            Lang::Wgsl => self.w.line(format!("if ({closed}) {{ continue; }}")),
+        }
+        match self.w.lang() {
+            Lang::OpenCl => self.w.line(format!(
+                "uint first = {refs}[{sp}]; int count = {counts}[{sp}];"
+            )),
+            Lang::Wgsl => {
+                self.w.declare(Ty::Uint, "first", &format!("{refs}[{sp}]"));
+                self.w.declare(Ty::Int, "count", &format!("{counts}[{sp}]"));
+            }
+        }
         self.w.open("if (count == 0)");
-        self.w.line(format!(
-            "__global const real* node = params + {nodes}u + first * {NODE_LEN}u;"
-        ));
+        self.w
+            .declare_offset("node", nodes, &format!("first * {NODE_LEN}u"));
         // One vector lane per entry. Each axis's gap is capped at 1e18
         // (the precisions' largest magnitude), so that its square stays
         // finite at any point a scale makes huge: a smaller gap only opens
         // more entries.
-        let v = format!("real{WIDTH}");
+        const { assert!(WIDTH == 4, "a node's boxes load as one real4 an axis") };
+        let (_, max) = self.w.min_max();
+        // WGSL clamps a vector between vectors.
+        let (low, high) = match self.w.lang() {
+            Lang::OpenCl => (zero.clone(), self.w.real("1e18")),
+            Lang::Wgsl => (
+                self.w.construct(Ty::Real4, &[&zero]),
+                self.w.construct(Ty::Real4, &["1e18"]),
+            ),
+        };
         for (axis, c) in ["x", "y", "z"].iter().enumerate() {
-            self.w.line(format!(
-                "{v} g{c} = clamp(fmax(vload{WIDTH}({axis}, node) - {p}.{c}, \
-                 {p}.{c} - vload{WIDTH}({}, node)), R(0.0), R(1e18));",
-                axis + 3
-            ));
+            let (lo, hi) = (self.w.load4("node", axis), self.w.load4("node", axis + 3));
+            let gap = format!("clamp({max}({lo} - {p}.{c}, {p}.{c} - {hi}), {low}, {high})");
+            self.w.declare(Ty::Real4, &format!("g{c}"), &gap);
         }
-        self.w
-            .line(format!("{v} gap = {k2} * (gx * gx + gy * gy + gz * gz);"));
-        self.w.line(format!(
-            "{v} to = vload{WIDTH}(6, node), n = vload{WIDTH}(7, node);"
-        ));
-        let lanes: Vec<String> = (0..WIDTH).map(|j| format!("s{j}")).collect();
+        self.w.declare(
+            Ty::Real4,
+            "gap",
+            &format!("{k2} * (gx * gx + gy * gy + gz * gz)"),
+        );
+        match self.w.lang() {
+            Lang::OpenCl => self.w.line(format!(
+                "real{WIDTH} to = vload{WIDTH}(6, node), n = vload{WIDTH}(7, node);"
+            )),
+            Lang::Wgsl => {
+                self.w.declare(Ty::Real4, "to", &self.w.load4("node", 6));
+                self.w.declare(Ty::Real4, "n", &self.w.load4("node", 7));
+            }
+        }
+        let lanes: Vec<String> = (0..WIDTH).map(|j| self.w.lane(j)).collect();
         for (j, l) in lanes.iter().enumerate() {
-            self.w.line(format!(
-                "bool o{j} = n.{l} >= R(0.0) && {};",
-                open(&format!("gap.{l}"))
-            ));
+            let o = format!("n.{l} >= {zero} && {}", open(&format!("gap.{l}")));
+            self.w.declare(Ty::Bool, &format!("o{j}"), &o);
         }
         // The open entries go on the stack, the nearest last: it is taken
         // off first.
-        self.w.line(format!("uint m = {WIDTH}u;"));
-        self.w.line("real mg = INFINITY;");
+        self.w.declare(Ty::Uint, "m", &format!("{WIDTH}u"));
+        self.w.declare(Ty::Real, "mg", self.w.infinity());
         for (j, l) in lanes.iter().enumerate() {
             self.w.line(format!(
                 "if (o{j} && gap.{l} < mg) {{ m = {j}u; mg = gap.{l}; }}"
             ));
         }
         for (j, l) in lanes.iter().enumerate() {
+            let (to, n) = (
+                self.w.cast(Ty::Uint, &format!("to.{l}")),
+                self.w.cast(Ty::Int, &format!("n.{l}")),
+            );
             self.w.line(format!(
-                "if (o{j} && m != {j}u) {{ {refs}[{sp}] = (uint)to.{l}; {counts}[{sp}] = (int)n.{l}; \
+                "if (o{j} && m != {j}u) {{ {refs}[{sp}] = {to}; {counts}[{sp}] = {n}; \
                  {gaps}[{sp}] = gap.{l}; {sp}++; }}"
             ));
         }
         self.w.open(format!("if (m < {WIDTH}u)"));
         let pick = |v: &str| {
-            let mut chain = format!("{v}.s{}", WIDTH - 1);
+            let mut chain = format!("{v}.{}", lanes[WIDTH - 1]);
             for j in (0..WIDTH - 1).rev() {
-                chain = format!("m == {j}u ? {v}.s{j} : {chain}");
+                let lane = format!("{v}.{}", lanes[j]);
+                chain = self.w.select(&format!("m == {j}u"), &lane, &chain);
             }
-            chain
+            format!("({chain})")
         };
-        self.w
-            .line(format!("{refs}[{sp}] = (uint)({});", pick("to")));
-        self.w
-            .line(format!("{counts}[{sp}] = (int)({});", pick("n")));
+        let (to, n) = (
+            self.w.cast(Ty::Uint, &pick("to")),
+            self.w.cast(Ty::Int, &pick("n")),
+        );
+        self.w.line(format!("{refs}[{sp}] = {to};"));
+        self.w.line(format!("{counts}[{sp}] = {n};"));
         self.w.line(format!("{gaps}[{sp}] = mg;"));
         self.w.line(format!("{sp}++;"));
         self.w.close();
         self.w.line("continue;");
         self.w.close();
-        self.w
-            .open("for (uint i = first; i < first + (uint)count; i++)");
+        let end = format!("first + {}", self.w.cast(Ty::Uint, "count"));
+        self.w.open_for("i", "first", &end);
         (start, row)
     }
 

@@ -27,9 +27,9 @@ use std::fmt::Write as _;
 use super::formulas::vector;
 use super::helpers::Helper;
 use super::tables::InstanceTables;
-use super::writer::{INSTANCE_SLOT, Writer};
+use super::writer::{INSTANCE_SLOT, Lang, Param, Ty, Writer};
 use crate::cpu::sdf::{self, TrapShape};
-use crate::expr::{Num, OpenCl, Printer, Shape, Var, trace};
+use crate::expr::{Num, Shape, Var, trace};
 use crate::ir::{
     Bound, Ir, IrNode, NodeId, Reach, Scalar, UnionChain, Vector, constant, costs, reach, swaps,
     union_chain,
@@ -52,7 +52,9 @@ use instances::*;
 
 /// The trap of a surface that has none (a `real2`: the trap that tints
 /// its colour, and the trap the shading layers show).
-const NO_TRAP: &str = "(real2)(R(1.0))";
+fn no_trap(w: &Writer) -> String {
+    w.construct(Ty::Real2, &[&w.real("1.0")])
+}
 
 /// One node's result: the variable holding its distance, and expressions
 /// for its colour and orbit trap (a variable only where one is computed,
@@ -264,15 +266,26 @@ impl<'a> SceneEmitter<'a> {
             // Every function lays out the same tables.
             self.constants.clear();
             self.tables = InstanceTables::default();
-            self.w.open(match (shade, material) {
-                (false, _) => "real DE(real3 p0, __global const real* params)",
-                (true, false) => {
-                    "real DE_shade(real3 p0, __global const real* params, real3* color, real2* trap)"
-                }
-                (true, true) => {
-                    "real DE_material(real3 p0, __global const real* params, real16* material)"
-                }
-            });
+            let p0 = Param::Value("p0", Ty::Real3);
+            let head = match (shade, material) {
+                (false, _) => self.w.function_head("DE", Ty::Real, &[p0, Param::Buffer]),
+                (true, false) => self.w.function_head(
+                    "DE_shade",
+                    Ty::Real,
+                    &[
+                        p0,
+                        Param::Buffer,
+                        Param::Pointer("color", Ty::Real3),
+                        Param::Pointer("trap", Ty::Real2),
+                    ],
+                ),
+                (true, true) => self.w.function_head(
+                    "DE_material",
+                    Ty::Real,
+                    &[p0, Param::Buffer, Param::Pointer("material", Ty::Real16)],
+                ),
+            };
+            self.w.open(head);
             let out = self.node(self.ir.root(), "p0", true);
             if material {
                 self.w.line(format!("*material = {};", out.c));
@@ -300,9 +313,12 @@ impl<'a> SceneEmitter<'a> {
         let glows = self.ir.glows();
         for (j, &glow) in glows.iter().enumerate() {
             self.points = 0;
-            self.w.open(format!(
-                "real DE_glow{j}(real3 p0, __global const real* params)"
-            ));
+            let head = self.w.function_head(
+                &format!("DE_glow{j}"),
+                Ty::Real,
+                &[Param::Value("p0", Ty::Real3), Param::Buffer],
+            );
+            self.w.open(head);
             self.w
                 .comment(&format!("the halo of {}", self.ir.path_tail(glow, 3)));
             // The path from the root, outermost first.
@@ -352,20 +368,33 @@ impl<'a> SceneEmitter<'a> {
             return 0;
         }
         // Node j's distance and its halo's colour times its strength.
-        self.w
-            .open("real glow_distance(int j, real3 p, __global const real* params)");
-        self.w.open("switch (j)");
+        let head = self.w.function_head(
+            "glow_distance",
+            Ty::Real,
+            &[
+                Param::Value("j", Ty::Int),
+                Param::Value("p", Ty::Real3),
+                Param::Buffer,
+            ],
+        );
+        self.w.open(head);
+        self.w.open(self.switch("j"));
         for j in 0..glows.len() {
-            self.w
-                .line(format!("case {j}: return DE_glow{j}(p, params);"));
+            let call = self.w.call(&format!("DE_glow{j}"), "p");
+            self.case(j, &format!("return {call};"));
         }
-        self.w.close();
-        self.w.line("return (real)INFINITY;");
+        self.end_switch();
+        let infinity = self.w.cast(Ty::Real, self.w.infinity());
+        self.w.line(format!("return {infinity};"));
         self.w.close();
         self.w.line("");
-        self.w
-            .open("real3 glow_color(int j, __global const real* params)");
-        self.w.open("switch (j)");
+        let head = self.w.function_head(
+            "glow_color",
+            Ty::Real3,
+            &[Param::Value("j", Ty::Int), Param::Buffer],
+        );
+        self.w.open(head);
+        self.w.open(self.switch("j"));
         for (j, &glow) in glows.iter().enumerate() {
             let Kind::Glow {
                 color, strength, ..
@@ -375,14 +404,45 @@ impl<'a> SceneEmitter<'a> {
             };
             let [r, g, b] = color.map(|c| self.w.scalar(c));
             let k = self.w.scalar(*strength);
-            self.w
-                .line(format!("case {j}: return (real3)({r}, {g}, {b}) * {k};"));
+            let rgb = self.w.construct(Ty::Real3, &[&r, &g, &b]);
+            self.case(j, &format!("return {rgb} * {k};"));
         }
-        self.w.close();
-        self.w.line("return (real3)(R(0.0));");
+        self.end_switch();
+        let zero = self.w.construct(Ty::Real3, &[&self.w.real("0.0")]);
+        self.w.line(format!("return {zero};"));
         self.w.close();
         self.w.line("");
         glows.len()
+    }
+
+    /// A vector parameter as a `real3` of its three values.
+    fn three(&self, v: Vector) -> String {
+        let [x, y, z] = v.map(|s| self.w.scalar(s));
+        self.w.construct(Ty::Real3, &[&x, &y, &z])
+    }
+
+    /// The head of a `switch` on the integer `j`.
+    fn switch(&self, j: &str) -> String {
+        match self.w.lang() {
+            Lang::OpenCl => format!("switch ({j})"),
+            Lang::Wgsl => format!("switch {j}"),
+        }
+    }
+
+    /// One case of a `switch`: the statement for `j`.
+    fn case(&mut self, j: usize, statement: &str) {
+        match self.w.lang() {
+            Lang::OpenCl => self.w.line(format!("case {j}: {statement}")),
+            Lang::Wgsl => self.w.line(format!("case {j}: {{ {statement} }}")),
+        }
+    }
+
+    /// Closes a `switch` (WGSL's needs a default case).
+    fn end_switch(&mut self) {
+        if self.w.lang() == Lang::Wgsl {
+            self.w.line("default: {}");
+        }
+        self.w.close();
     }
 
     /// Whether the function being written computes orbit traps.
@@ -401,8 +461,8 @@ impl<'a> SceneEmitter<'a> {
     }
 
     /// The type of the surface values: a colour or a material.
-    fn surface_type(&self) -> &'static str {
-        if self.material { "real16" } else { "real3" }
+    fn surface_type(&self) -> Ty {
+        if self.material { Ty::Real16 } else { Ty::Real3 }
     }
 
     /// A fractal's iteration count under [`Quality::fractal_iterations`]
@@ -433,11 +493,11 @@ impl<'a> SceneEmitter<'a> {
     /// A leaf: its distance expression, default colour, trap 1.
     fn leaf(&mut self, id: NodeId, expr: String) -> Vars {
         let d = format!("d{}", id.index());
-        self.w.line(format!("real {d} = {expr};"));
+        self.w.declare(Ty::Real, &d, &expr);
         Vars {
             d,
             c: self.default_surface(),
-            t: NO_TRAP.into(),
+            t: no_trap(self.w),
         }
     }
 
@@ -480,17 +540,20 @@ impl<'a> SceneEmitter<'a> {
                 self.trapped.insert(function.to_string());
                 let function = super::formulas::fractal_name(function, true);
                 self.w
-                    .line(format!("real2 {pair} = {function}({args}, {trap});"));
+                    .declare(Ty::Real2, &pair, &format!("{function}({args}, {trap})"));
             }
-            None => self.w.line(format!("real2 {pair} = {function}({args});")),
+            None => self
+                .w
+                .declare(Ty::Real2, &pair, &format!("{function}({args})")),
         }
-        self.w.line(format!("real {} = {pair}.x;", v.d));
+        self.w.declare(Ty::Real, &v.d, &format!("{pair}.x"));
         let t = if self.traps() {
             // The trap tints the colour, and is the trap the layers show.
-            self.w.line(format!("real2 {} = (real2)({pair}.y);", v.t));
+            let t = self.w.construct(Ty::Real2, &[&format!("{pair}.y")]);
+            self.w.declare(Ty::Real2, &v.t, &t);
             v.t
         } else {
-            "R(1.0)".into()
+            self.w.real("1.0")
         };
         Vars {
             c: self.default_surface(),
@@ -612,13 +675,13 @@ impl<'a> SceneEmitter<'a> {
             "{}: the second operand only within reach of its bound",
             self.ir.path_tail(id, 2)
         ));
-        self.w.line(format!("real u{i} = {};", a.d));
+        self.w.declare(Ty::Real, &format!("u{i}"), &a.d);
         if self.shade && needs_color {
             let ty = self.surface_type();
-            self.w.line(format!("{ty} uc{i} = {};", a.c));
+            self.w.declare(ty, &format!("uc{i}"), &a.c);
         }
         if self.traps() {
-            self.w.line(format!("real2 ut{i} = {};", a.t));
+            self.w.declare(Ty::Real2, &format!("ut{i}"), &a.t);
         }
         let first = match op {
             CsgOp::Subtract => format!("-u{i}"),
@@ -631,9 +694,10 @@ impl<'a> SceneEmitter<'a> {
         let [g] = take(self.inline(&[Arg::Point(p)], &[Shape::Scalar], |a| {
             vec![reach.distance_at(vector(a, 0))]
         }));
-        self.w.line(format!("real g{i} = {g};"));
+        self.w.declare(Ty::Real, &format!("g{i}"), &g);
+        let zero = self.w.real("0.0");
         self.w
-            .open(format!("if (!(g{i} > {threshold} && g{i} > R(0.0)))"));
+            .open(format!("if (!(g{i} > {threshold} && g{i} > {zero}))"));
         self.gated.insert(id);
     }
 
@@ -652,7 +716,7 @@ impl<'a> SceneEmitter<'a> {
             self.w.line(format!("ut{i} = {};", v.t));
             format!("ut{i}")
         } else {
-            "R(1.0)".into()
+            self.w.real("1.0")
         };
         self.w.close();
         Vars {
@@ -776,17 +840,20 @@ impl<'a> SceneEmitter<'a> {
             }
             Kind::Kifs(f) => {
                 let n = self.iterations(f.iterations, (0, MAX_FOLD_ITERATIONS));
-                let [ox, oy, oz] = f.offset.map(|s| w(self, s));
-                let mut args = format!("{p}, {n}, {}, (real3)({ox}, {oy}, {oz})", w(self, f.scale));
+                let offset = self.three(f.offset);
+                let mut args = format!("{p}, {n}, {}, {offset}", w(self, f.scale));
                 let turned = f.rotate_before.is_some() || f.rotate_after.is_some();
                 if turned {
                     // A turn left out is no turn: zero angles.
                     for turn in [f.rotate_before, f.rotate_after] {
-                        let [x, y, z] = match turn {
-                            Some(a) => a.map(|s| w(self, s)),
-                            None => ["R(0.0)".to_string(), "R(0.0)".into(), "R(0.0)".into()],
+                        let turn = match turn {
+                            Some(a) => self.three(a),
+                            None => {
+                                let zero = self.w.real("0.0");
+                                self.w.construct(Ty::Real3, &[&zero, &zero, &zero])
+                            }
                         };
-                        let _ = write!(args, ", (real3)({x}, {y}, {z})");
+                        let _ = write!(args, ", {turn}");
                     }
                 }
                 Step::Done(self.fractal(id, Helper::Kifs(f.fold, turned), &args))
@@ -808,11 +875,11 @@ impl<'a> SceneEmitter<'a> {
             }
             Kind::PseudoKleinian(f) => {
                 let n = self.iterations(f.iterations, (0, MAX_ESCAPE_ITERATIONS));
-                let [bx, by, bz] = f.fold_size.map(|s| w(self, s));
-                let [cx, cy, cz] = f.offset.map(|s| w(self, s));
                 let args = format!(
-                    "{p}, {n}, (real3)({bx}, {by}, {bz}), {}, (real3)({cx}, {cy}, {cz}), {}",
+                    "{p}, {n}, {}, {}, {}, {}",
+                    self.three(f.fold_size),
                     w(self, f.inversion),
+                    self.three(f.offset),
                     w(self, f.thickness)
                 );
                 Step::Done(self.fractal(id, Helper::PseudoKleinian, &args))
@@ -828,8 +895,7 @@ impl<'a> SceneEmitter<'a> {
                 );
                 let helper = match f.julia {
                     Some(c) => {
-                        let [x, y, z] = c.map(|s| w(self, s));
-                        let _ = write!(args, ", (real3)({x}, {y}, {z})");
+                        let _ = write!(args, ", {}", self.three(c));
                         Helper::MandelboxJulia
                     }
                     None => Helper::Mandelbox,
@@ -975,10 +1041,9 @@ impl<'a> SceneEmitter<'a> {
         };
         // The helper takes the centre and the axis as vectors.
         let [cx, cy, cz, ax, ay, az, across, along, radius, count] = take(values);
-        format!(
-            "(real3)({cx}, {cy}, {cz}), (real3)({ax}, {ay}, {az}), {across}, {along}, {radius}, \
-             {count}"
-        )
+        let centre = self.w.construct(Ty::Real3, &[&cx, &cy, &cz]);
+        let axis = self.w.construct(Ty::Real3, &[&ax, &ay, &az]);
+        format!("{centre}, {axis}, {across}, {along}, {radius}, {count}")
     }
 
     /// Leaving a node after its children: the lines that combine their
@@ -1051,7 +1116,7 @@ impl<'a> SceneEmitter<'a> {
                 self.label(id);
                 let v = vars(id);
                 let rgb = self.w.vector(*color);
-                self.w.line(format!("real3 {} = {rgb};", v.c));
+                self.w.declare(Ty::Real3, &v.c, &rgb);
                 Vars { c: v.c, ..c }
             }
             Kind::OrbitTrap { coloring, .. } => {
@@ -1062,7 +1127,7 @@ impl<'a> SceneEmitter<'a> {
                 // The fractal's own trap tints no colour here; the layers
                 // still show it.
                 let raw = format!("({}).x", c.t);
-                let t = format!("(real2)(R(1.0), {raw})");
+                let t = self.w.construct(Ty::Real2, &[&self.w.real("1.0"), &raw]);
                 if !needs_color {
                     return Vars { t, ..c };
                 }
@@ -1078,7 +1143,7 @@ impl<'a> SceneEmitter<'a> {
                     vec![c.x, c.y, c.z]
                 }));
                 let v = vars(id);
-                self.w.line(format!("real3 {} = {color};", v.c));
+                self.w.declare(Ty::Real3, &v.c, &color);
                 Vars { c: v.c, t, d: c.d }
             }
             Kind::Material { material, .. } => {
@@ -1090,7 +1155,7 @@ impl<'a> SceneEmitter<'a> {
                 let v = vars(id);
                 let values = material.values().map(|s| self.w.scalar(*s));
                 let values = super::material_vector(values, &self.w.float(0.0));
-                self.w.line(format!("real16 {} = {values};", v.c));
+                self.w.declare(Ty::Real16, &v.c, &values);
                 Vars { c: v.c, ..c }
             }
             // Nodes that only move the point pass their child's result on.

@@ -38,6 +38,7 @@ impl Wgsl {
 alias real = f32;
 alias real2 = vec2<f32>;
 alias real3 = vec3<f32>;
+alias real4 = vec4<f32>;
 
 // Whether x is neither infinite nor NaN (under IEEE arithmetic, NaN fails
 // the comparison).

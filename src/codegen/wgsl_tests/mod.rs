@@ -4,7 +4,12 @@
 //! the values of the very program it was printed from, interpreted on the
 //! CPU in single precision.
 
+mod device;
+mod scenes;
+
 use std::cell::RefCell;
+
+use device::{device, run};
 
 use super::formulas;
 use super::helpers::Helper;
@@ -95,7 +100,7 @@ fn the_prelude_rounds_halves_away_from_zero_on_the_device() {
          }}\n",
         Wgsl::PRELUDE
     );
-    let got = run(&gpu, &source, &xs, 2 * n, n);
+    let got = run(&gpu, &source, &[&xs], 2 * n, n);
     for (k, x) in xs.iter().enumerate() {
         if x.is_finite() {
             assert_eq!(got[2 * k], x.round(), "round({x})");
@@ -188,107 +193,6 @@ fn shader(f: &Recorded, wgsl: &str, points: usize) -> String {
     )
 }
 
-/// A Vulkan device through wgpu; `None` where there is none, which under
-/// `make test` or CI is a failure.
-fn device() -> Option<(wgpu::Device, wgpu::Queue)> {
-    let instance =
-        wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle_from_env());
-    let found =
-        pollster::block_on(instance.request_adapter(&wgpu::RequestAdapterOptions::default()))
-            .ok()
-            .and_then(|adapter| {
-                pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor::default())).ok()
-            });
-    let required = std::env::var("FRACTAL_SDF_REQUIRE_DEVICE").is_ok_and(|v| v == "1")
-        || std::env::var("CI").is_ok_and(|v| v == "true" || v == "1");
-    assert!(
-        found.is_some() || !required,
-        "no Vulkan adapter for wgpu: install Mesa's lavapipe (scripts/setup.sh installs \
-         mesa-vulkan-drivers)"
-    );
-    found
-}
-
-/// Runs `source`'s `main` over `points` invocations with `inputs`,
-/// giving `outputs` numbers.
-fn run(
-    (device, queue): &(wgpu::Device, wgpu::Queue),
-    source: &str,
-    inputs: &[f32],
-    outputs: usize,
-    points: usize,
-) -> Vec<f32> {
-    let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
-        label: None,
-        source: wgpu::ShaderSource::Wgsl(source.into()),
-    });
-    let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-        label: None,
-        layout: None,
-        module: &module,
-        entry_point: Some("main"),
-        compilation_options: wgpu::PipelineCompilationOptions::default(),
-        cache: None,
-    });
-    let bytes: Vec<u8> = inputs.iter().flat_map(|v| v.to_le_bytes()).collect();
-    let buffer = |size: usize, usage| {
-        device.create_buffer(&wgpu::BufferDescriptor {
-            label: None,
-            size: size as u64,
-            usage,
-            mapped_at_creation: false,
-        })
-    };
-    let input = buffer(
-        bytes.len(),
-        wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
-    );
-    queue.write_buffer(&input, 0, &bytes);
-    let size = outputs * 4;
-    let output = buffer(
-        size,
-        wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
-    );
-    let staging = buffer(
-        size,
-        wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
-    );
-    let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-        label: None,
-        layout: &pipeline.get_bind_group_layout(0),
-        entries: &[
-            wgpu::BindGroupEntry {
-                binding: 0,
-                resource: input.as_entire_binding(),
-            },
-            wgpu::BindGroupEntry {
-                binding: 1,
-                resource: output.as_entire_binding(),
-            },
-        ],
-    });
-    let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor::default());
-    {
-        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor::default());
-        pass.set_pipeline(&pipeline);
-        pass.set_bind_group(0, &group, &[]);
-        pass.dispatch_workgroups(u32::try_from(points.div_ceil(64)).unwrap(), 1, 1);
-    }
-    encoder.copy_buffer_to_buffer(&output, 0, &staging, 0, size as u64);
-    queue.submit([encoder.finish()]);
-    staging
-        .slice(..)
-        .map_async(wgpu::MapMode::Read, |r| r.unwrap());
-    device.poll(wgpu::PollType::wait_indefinitely()).unwrap();
-    let view = staging
-        .slice(..)
-        .get_mapped_range()
-        .expect("the mapped output");
-    view.chunks_exact(4)
-        .map(|b| f32::from_le_bytes([b[0], b[1], b[2], b[3]]))
-        .collect()
-}
-
 /// Every helper's WGSL, run on the device at 256 random inputs (points
 /// in [-2, 2]³, every other number in [0.1, 2]: positive radii and sizes,
 /// one or two fractal iterations), gives what the CPU computes running
@@ -337,7 +241,7 @@ fn every_helper_runs_on_wgpu_as_its_program_does() {
         let got = run(
             &gpu,
             &shader(f, &wgsl, points),
-            &inputs,
+            &[&inputs],
             points * width,
             points,
         );

@@ -1,0 +1,287 @@
+//! Whole scenes' functions in WGSL: every gallery scene's module (for
+//! rendering and for evaluation) validates with naga, and its `DE` and
+//! `DE_shade` run on the device to the CPU reference's distances and
+//! colours in single precision.
+
+use glam::Vec3;
+
+use super::device::{device, run};
+use crate::codegen::{KernelSource, Language, Options, Target, WGSL_PARAMS, emit_wgsl};
+use crate::cpu::Evaluator;
+use crate::error::Error;
+use crate::gallery;
+use crate::ir::CompiledScene;
+use crate::quality::{Precision, Quality};
+
+/// Parses and validates a module.
+fn validate(name: &str, source: &str) {
+    let module = naga::front::wgsl::parse_str(source)
+        .unwrap_or_else(|e| panic!("{name}: {}", e.emit_to_string(source)));
+    naga::valid::Validator::new(
+        naga::valid::ValidationFlags::all(),
+        naga::valid::Capabilities::empty(),
+    )
+    .validate(&module)
+    .unwrap_or_else(|e| panic!("{name}: {}", e.emit_to_string(source)));
+}
+
+/// The gallery's scenes, compiled, with whether they march inside shapes
+/// (which the WGSL backend refuses).
+fn scenes() -> Vec<(&'static str, CompiledScene, bool)> {
+    gallery::all()
+        .into_iter()
+        .map(|(name, scene)| {
+            let compiled = scene.compile().expect("gallery scenes compile");
+            let inside = compiled.ir().has_inside_shapes();
+            (name, compiled, inside)
+        })
+        .collect()
+}
+
+#[test]
+fn every_gallery_scene_prints_as_valid_wgsl() {
+    let mut printed = 0;
+    for (name, scene, inside) in scenes() {
+        for target in [Target::Render, Target::Evaluate] {
+            let options = Options {
+                target,
+                ..Options::default()
+            };
+            match emit_wgsl(&scene, &options) {
+                Ok(module) => {
+                    assert_eq!(module.language, Language::Wgsl);
+                    assert!(module.source.contains("fn DE(p0: real3) -> real {"));
+                    validate(name, &module.source);
+                    printed += 1;
+                }
+                Err(Error::Unsupported { what, .. }) if inside => {
+                    assert!(what.contains("inside shapes"), "{name}: {what}");
+                }
+                Err(e) => panic!("{name}: {e}"),
+            }
+        }
+    }
+    assert!(printed >= 2 * 20, "only {printed} modules printed");
+}
+
+#[test]
+fn double_precision_is_a_typed_error_that_names_the_way_to_deep_zoom() {
+    let (_, scene, _) = scenes().swap_remove(0);
+    let options = Options {
+        quality: Quality {
+            precision: Precision::F64,
+            ..Quality::default()
+        },
+        ..Options::default()
+    };
+    let error = emit_wgsl(&scene, &options).expect_err("WGSL has no double precision");
+    assert!(matches!(
+        error,
+        Error::Unsupported {
+            backend: "WGSL",
+            ..
+        }
+    ));
+    let message = error.to_string();
+    assert!(
+        message.contains("F64") && message.contains("OpenCL"),
+        "{message}"
+    );
+}
+
+/// Deterministic points in `[-extent, extent]³` (xorshift64).
+fn points(count: usize, extent: f32, seed: u64) -> Vec<Vec3> {
+    let mut s = seed;
+    let mut next = move || {
+        s ^= s << 13;
+        s ^= s >> 7;
+        s ^= s << 17;
+        #[allow(clippy::cast_precision_loss)]
+        let unit = (s >> 40) as f32 / (1u64 << 24) as f32;
+        (2.0 * unit - 1.0) * extent
+    };
+    (0..count)
+        .map(|_| Vec3::new(next(), next(), next()))
+        .collect()
+}
+
+/// A shader that writes, for each point, `DE`, `DE_shade`'s distance and
+/// its colour.
+fn evaluator(module: &KernelSource, count: usize) -> String {
+    let (group, binding) = WGSL_PARAMS;
+    assert_eq!((group, binding), (0, 0), "the harness binds inputs from 0");
+    format!(
+        "{}\n\
+         @group(0) @binding(1) var<storage, read> points: array<f32>;\n\
+         @group(0) @binding(2) var<storage, read_write> outputs: array<f32>;\n\
+         @compute @workgroup_size(64)\n\
+         fn main(@builtin(global_invocation_id) id: vec3<u32>) {{\n\
+         \x20   let i = id.x;\n\
+         \x20   if (i >= {count}u || arrayLength(&params) == 0u) {{ return; }}\n\
+         \x20   let p = real3(points[3u * i], points[3u * i + 1u], points[3u * i + 2u]);\n\
+         \x20   var color = real3(0.0);\n\
+         \x20   var trap = real2(0.0);\n\
+         \x20   outputs[5u * i] = DE(p);\n\
+         \x20   outputs[5u * i + 1u] = DE_shade(p, &color, &trap);\n\
+         \x20   outputs[5u * i + 2u] = color.x;\n\
+         \x20   outputs[5u * i + 3u] = color.y;\n\
+         \x20   outputs[5u * i + 4u] = color.z;\n\
+         }}\n",
+        module.source
+    )
+}
+
+/// Every gallery scene's `DE` and `DE_shade` (for evaluation: no local
+/// frame), run on the device at 512 points in `[-3, 3]³`, give the CPU
+/// reference's single-precision distance and colour within
+/// `1e-3 · max(1, |cpu|)`: the distance of two single-precision
+/// libraries' `sin`, `pow` and `acos`, carried through a fractal's
+/// iterations. The largest difference is printed.
+#[test]
+fn every_gallery_scene_runs_on_wgpu_as_the_cpu_reference_computes_it() {
+    let Some(gpu) = device() else { return };
+    const TOLERANCE: f32 = 1e-3;
+    let count = 512;
+    let options = Options {
+        target: Target::Evaluate,
+        ..Options::default()
+    };
+    let mut worst = (0.0f32, "", "", Vec3::ZERO);
+    let mut checked = 0;
+    for (name, scene, inside) in scenes() {
+        if inside {
+            continue;
+        }
+        let module = emit_wgsl(&scene, &options).expect("the scene prints");
+        let values = scene.default_values();
+        #[allow(clippy::cast_possible_truncation)]
+        let mut params: Vec<f32> = module
+            .param_buffer(values.as_slice())
+            .iter()
+            .map(|&v| v as f32)
+            .collect();
+        // A binding is never empty.
+        params.push(0.0);
+        let at = points(count, 3.0, 0x9e37_79b9_7f4a_7c15);
+        let flat: Vec<f32> = at.iter().flat_map(|p| p.to_array()).collect();
+        let got = run(
+            &gpu,
+            &evaluator(&module, count),
+            &[&params, &flat],
+            5 * count,
+            count,
+        );
+        let cpu = Evaluator::from_compiled(&scene);
+        for (p, g) in at.iter().zip(got.chunks_exact(5)) {
+            let s = cpu.sample::<f32>((*p).into());
+            let color = Vec3::from(s.color);
+            let pairs = [
+                ("DE", g[0], s.distance),
+                ("DE_shade", g[1], s.distance),
+                ("red", g[2], color.x),
+                ("green", g[3], color.y),
+                ("blue", g[4], color.z),
+            ];
+            for (what, device, cpu) in pairs {
+                assert!(cpu.is_finite(), "{name}: the CPU's {what} at {p} is {cpu}");
+                let error = (device - cpu).abs() / cpu.abs().max(1.0);
+                assert!(
+                    error <= TOLERANCE,
+                    "{name}: {what} at {p}: device {device}, CPU {cpu} (relative {error:e})"
+                );
+                if error > worst.0 {
+                    worst = (error, name, what, *p);
+                }
+            }
+        }
+        checked += 1;
+    }
+    println!(
+        "{checked} scenes; largest relative difference {:e} ({} {} at {})",
+        worst.0, worst.1, worst.2, worst.3
+    );
+    assert!(checked >= 20, "only {checked} scenes checked");
+}
+
+/// 400 coloured spheres, every fourth placed by a dynamic position and all
+/// sized by one dynamic radius: one loop over a table, walked through a
+/// bounding volume hierarchy, whose boxes the host fits again when the
+/// values change. After moving them, the device's distances and colours
+/// are the CPU reference's at 512 points.
+#[test]
+fn instances_walked_through_a_hierarchy_run_on_wgpu_as_on_the_cpu() {
+    use crate::prelude::*;
+    use crate::scene::{Param3, param3};
+    let Some(gpu) = device() else { return };
+    let mut scene = Scene::empty();
+    #[allow(clippy::cast_precision_loss)]
+    for i in 0..400 {
+        let t = i as f64 * 0.37;
+        let at = dvec3(
+            t.cos() * 2.0,
+            (t * 0.61).sin() * 2.0,
+            (t * 0.23).cos() * 2.0,
+        );
+        let placed: Param3 = if i % 4 == 0 {
+            param3(&format!("s{i}"), at)
+        } else {
+            at.into()
+        };
+        let tint = dvec3((t * 1.3).sin().abs(), (t * 0.7).cos().abs(), 0.5);
+        scene = scene.add(sphere(param("r", 0.15)).translate(placed).color(tint));
+    }
+    let compiled = scene.compile().expect("the scene compiles");
+    let options = Options {
+        target: Target::Evaluate,
+        ..Options::default()
+    };
+    let module = emit_wgsl(&compiled, &options).expect("the scene prints");
+    assert!(module.source.contains("walked through"), "no hierarchy");
+    // The helper, and one call in each of DE and DE_shade.
+    assert_eq!(module.source.matches("sd_sphere(").count(), 3, "unrolled");
+    let mut eval = Evaluator::from_compiled(&compiled);
+    let mut values = compiled.default_values();
+    for i in (0..400).step_by(8) {
+        for (axis, v) in [("x", 0.3), ("y", -0.2), ("z", 0.1)] {
+            let name = format!("s{i}.{axis}");
+            let moved = values.get(&name).expect("a position") + v;
+            values.set(&name, moved).expect("a position");
+            eval.set_param(&name, moved).expect("a position");
+        }
+    }
+    values.set("r", 0.12).expect("the radius");
+    eval.set_param("r", 0.12).expect("the radius");
+    #[allow(clippy::cast_possible_truncation)]
+    let mut params: Vec<f32> = module
+        .param_buffer(values.as_slice())
+        .iter()
+        .map(|&v| v as f32)
+        .collect();
+    params.push(0.0);
+    let count = 512;
+    let at = points(count, 2.5, 0x2545_f491_4f6c_dd1d);
+    let flat: Vec<f32> = at.iter().flat_map(|p| p.to_array()).collect();
+    let got = run(
+        &gpu,
+        &evaluator(&module, count),
+        &[&params, &flat],
+        5 * count,
+        count,
+    );
+    for (p, g) in at.iter().zip(got.chunks_exact(5)) {
+        let s = eval.sample::<f32>((*p).into());
+        let color = Vec3::from(s.color);
+        for (what, device, cpu) in [
+            ("DE", g[0], s.distance),
+            ("DE_shade", g[1], s.distance),
+            ("red", g[2], color.x),
+            ("green", g[3], color.y),
+            ("blue", g[4], color.z),
+        ] {
+            assert!(
+                (device - cpu).abs() <= 1e-5 * cpu.abs().max(1.0),
+                "{what} at {p}: device {device}, CPU {cpu}"
+            );
+        }
+    }
+}
