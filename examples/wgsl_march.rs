@@ -1,26 +1,28 @@
-//! The gallery's Mandelbulb marched twice at 640×480: by the OpenCL
-//! renderer with ambient occlusion, shadows and glow off (the march,
-//! normals and shading), and by a WGSL compute shader through wgpu whose
-//! distance estimate is the same formula printed by [`expr::Wgsl`] (the
-//! march, a four-tap normal and a plain diffuse light). On a machine
-//! without a GPU these are PoCL and Mesa's lavapipe: two compilers of
-//! the same kind of work for the same CPU cores. Prints each one's frame
-//! time, evaluations per pixel and evaluations a second, and how many
-//! pixels' hit flags differ; writes `out/wgsl_march.png`.
+//! Gallery scenes marched twice at 640×480: by the OpenCL renderer with
+//! ambient occlusion, shadows, glow and fog off (the march, normals and
+//! shading), and by a WGSL compute shader through wgpu that calls the
+//! scene's functions as [`codegen::emit_wgsl`] writes them (the march, a
+//! four-tap normal, the surface's colour under the key light). On a
+//! machine without a GPU these are PoCL and Mesa's lavapipe: two
+//! compilers of the same kind of work for the same CPU cores. Prints each
+//! one's frame time (median of three), evaluations per pixel and
+//! evaluations a second, and the share of pixels whose hit flags differ;
+//! writes `out/wgsl_<scene>.png`.
 //!
-//! It is also how to use a fractal-sdf formula in a wgpu application of
-//! your own: trace it, print it with [`expr::Wgsl`] after
-//! [`Wgsl::PRELUDE`], and call it from your shader.
+//! It is also how to draw a fractal-sdf scene in a wgpu application of
+//! your own: emit its module, bind its parameter buffer at
+//! [`codegen::WGSL_PARAMS`], and call `DE` or `DE_shade` from your shader.
 //!
-//! `cargo run --release --example wgsl_march` (needs a Vulkan adapter:
+//! `cargo run --release --example wgsl_march [SCENE...]` (every gallery
+//! scene the WGSL backend draws by default; needs a Vulkan adapter:
 //! `scripts/setup.sh` installs lavapipe).
 
 use std::error::Error;
 use std::time::Instant;
 
-use fractal_sdf::cpu::sdf;
-use fractal_sdf::expr::{self, Num, Printer, Shape, Signature, Var, Wgsl, trace, v3};
-use fractal_sdf::math::{escape_radius, mandelbulb_radius};
+use fractal_sdf::codegen::{self, KernelSource, Options, Target, WGSL_PARAMS};
+use fractal_sdf::cpu::MarchSettings;
+use fractal_sdf::ir::Bound;
 use fractal_sdf::metrics::mask_mismatch;
 use fractal_sdf::prelude::*;
 use fractal_sdf::render::Renderer;
@@ -29,13 +31,48 @@ const WIDTH: u32 = 640;
 const HEIGHT: u32 = 480;
 
 fn main() -> Result<(), Box<dyn Error>> {
-    let scene = fractal_sdf::gallery::mandelbulb();
+    let asked: Vec<String> = std::env::args().skip(1).collect();
+    let gpu = Gpu::new()?;
+    std::fs::create_dir_all("out")?;
+    println!("640×480 production, the march, normals and shading:");
+    println!(
+        "| scene | OpenCL ({}) | evaluations / pixel | M evaluations / s | WGSL ({}) | \
+         evaluations / pixel | M evaluations / s | hit flags that differ |",
+        Renderer::new(&fractal_sdf::gallery::mandelbulb(), Quality::draft())?
+            .device()
+            .name,
+        gpu.adapter
+    );
+    println!("|---|---:|---:|---:|---:|---:|---:|---:|");
+    for (name, scene) in fractal_sdf::gallery::all() {
+        if !asked.is_empty() && !asked.iter().any(|a| a == name) {
+            continue;
+        }
+        let compiled = scene.compile()?;
+        if compiled.ir().has_inside_shapes() {
+            // Marched by brute force: the OpenCL backend's alone.
+            continue;
+        }
+        let row = compare(name, &scene, &compiled, &gpu)?;
+        println!("{row}");
+    }
+    Ok(())
+}
+
+/// One scene on both backends: its table row.
+fn compare(
+    name: &str,
+    scene: &Scene,
+    compiled: &fractal_sdf::ir::CompiledScene,
+    gpu: &Gpu,
+) -> Result<String, Box<dyn Error>> {
     let quality = Quality::production();
-    let mut renderer = Renderer::new(&scene, quality)?;
+    let mut renderer = Renderer::new(scene, quality)?;
     let mut effects = renderer.options().effects;
     effects.ambient_occlusion = false;
     effects.shadows = false;
     effects.glow = None;
+    effects.fog_density = 0.0;
     renderer.set_effects(effects)?;
     let frame = renderer.render_with_aovs(WIDTH, HEIGHT)?;
     let pixels = f64::from(WIDTH * HEIGHT);
@@ -45,10 +82,12 @@ fn main() -> Result<(), Box<dyn Error>> {
         Ok(())
     })?;
 
-    // The same rays and hit threshold as the OpenCL kernel's.
+    // The same rays and hit threshold as the OpenCL kernel's, in the
+    // module's frame.
+    let module = codegen::emit_wgsl(compiled, &Options::default().target(Target::Render))?;
     let viewport = renderer.viewport(WIDTH, HEIGHT)?;
     let settings = viewport.march_settings(&quality);
-    let origin = viewport.ray(0.5, 0.5).origin;
+    let origin = viewport.ray(0.5, 0.5).origin - module.origin;
     let mut directions = Vec::with_capacity((WIDTH * HEIGHT * 3) as usize);
     for y in 0..HEIGHT {
         for x in 0..WIDTH {
@@ -58,15 +97,25 @@ fn main() -> Result<(), Box<dyn Error>> {
             directions.extend(d.to_array().map(|v| v as f32));
         }
     }
-    let shader = shader(&distance_estimate()?, origin, &settings);
-    let gpu = Gpu::new()?;
-    let march = gpu.prepare(&shader, &directions);
-    march.run(&gpu);
+    let bound = compiled.ir().bounds()[compiled.ir().root().index()].map(|mut b| {
+        b.centre -= module.origin;
+        b
+    });
+    let shader = shader(&module, origin, &settings, bound);
+    let params: Vec<f32> = module
+        .param_buffer(compiled.default_values().as_slice())
+        .iter()
+        .map(|&v| v as f32)
+        // A binding is never empty.
+        .chain([0.0])
+        .collect();
+    let march = gpu.prepare(&shader, &params, &directions);
+    march.run(gpu);
     let wgsl_ms = median_ms(|| {
-        march.run(&gpu);
+        march.run(gpu);
         Ok(())
     })?;
-    let (colours, evaluations) = march.read(&gpu);
+    let (colours, evaluations) = march.read(gpu);
     let wgsl_evaluations = evaluations
         .iter()
         .map(|&e| f64::from(e & 0xffff))
@@ -75,72 +124,54 @@ fn main() -> Result<(), Box<dyn Error>> {
     let image = fractal_sdf::image::RgbaImage::from_fn(WIDTH, HEIGHT, |x, y| {
         fractal_sdf::image::Rgba(colours[(y * WIDTH + x) as usize].to_le_bytes())
     });
-    std::fs::create_dir_all("out")?;
-    fractal_sdf::output::save_png(&image, "out/wgsl_march.png")?;
-
-    println!("Mandelbulb, 640×480, the march, normals and shading:");
-    println!("| backend | frame | evaluations / pixel | million evaluations / s |");
-    println!("|---|---:|---:|---:|");
-    for (name, ms, evaluations) in [
-        (
-            format!("OpenCL ({})", renderer.device().name),
-            opencl_ms,
-            opencl_evaluations,
-        ),
-        (format!("WGSL ({})", gpu.adapter), wgsl_ms, wgsl_evaluations),
-    ] {
-        println!(
-            "| {name} | {ms:.1} ms | {:.1} | {:.1} |",
-            evaluations / pixels,
-            evaluations / ms / 1e3
-        );
-    }
-    println!(
-        "hit flags that differ: {:.3}% of the pixels; out/wgsl_march.png",
+    fractal_sdf::output::save_png(&image, format!("out/wgsl_{name}.png"))?;
+    Ok(format!(
+        "| {name} | {opencl_ms:.1} ms | {:.1} | {:.1} | {wgsl_ms:.1} ms | {:.1} | {:.1} | {:.3}% |",
+        opencl_evaluations / pixels,
+        opencl_evaluations / opencl_ms / 1e3,
+        wgsl_evaluations / pixels,
+        wgsl_evaluations / wgsl_ms / 1e3,
         100.0 * mask_mismatch(&frame.hit, &hits)
-    );
-    Ok(())
+    ))
 }
 
-/// The gallery Mandelbulb's estimate (power 8, 10 iterations, bailout 2,
-/// turned a quarter about x) as a WGSL function `de(p: real3) -> real`.
-fn distance_estimate() -> Result<String, expr::Unprintable> {
-    let power = 8.0;
-    let program = trace(3, |a| {
-        // The child of a rotation by −π/2 about x sees (x, −z, y).
-        let q = v3(a[0], -a[2], a[1]);
-        let e = sdf::mandelbulb_estimate(
-            q,
-            Var::of(power),
-            Var::of(10.0),
-            Var::of(escape_radius(power, 2.0)),
-            Var::of(mandelbulb_radius(power)),
-            Some(8),
-            None,
-        );
-        vec![e.distance]
-    });
-    Wgsl.function(
-        &Signature::new("de", &[("p", Shape::Vec3)], Shape::Scalar),
-        &program,
-    )
-}
-
-/// The compute shader: one invocation a pixel marches its ray as the
-/// OpenCL kernel's plain march does (steps of the distance to the drawn
-/// surface, no shorter than `hit_epsilon` footprints), then shades a hit
-/// with a tetrahedral normal and the scene's key light. Writes the
-/// pixel's colour, and its evaluations (low 16 bits) and hit (bit 16).
-fn shader(de: &str, origin: DVec3, s: &fractal_sdf::cpu::MarchSettings) -> String {
+/// The compute shader: the scene's module, then one invocation a pixel
+/// that marches its ray as the OpenCL kernel's plain march does (steps of
+/// the distance to the drawn surface over its Lipschitz bound, no shorter
+/// than `hit_epsilon` footprints, stopping once past the scene's bounding
+/// sphere), then shades a hit: `DE_shade`'s colour under the key light,
+/// with a tetrahedral normal. Writes the pixel's colour, and its
+/// evaluations (low 16 bits) and hit (bit 16).
+fn shader(module: &KernelSource, origin: DVec3, s: &MarchSettings, bound: Option<Bound>) -> String {
     let f = |v: f64| format!("{:?}", v as f32);
-    let ball = mandelbulb_radius(8.0);
+    // Where the ray may stop: past the sphere around the scene, widened
+    // by the drawn surface's offset (as `march_bound_exit` widens it).
+    let exit = match bound {
+        Some(b) if s.detail * s.footprint_per_unit < b.slope => {
+            let t_max =
+                ((origin - b.centre).length() + b.radius + s.detail * s.footprint_base / b.slope)
+                    / (1.0 - s.detail * s.footprint_per_unit / b.slope);
+            format!(
+                "let oc = ORIGIN - vec3<f32>({}, {}, {});\n    \
+                 let radius = {};\n    \
+                 let b = dot(oc, rd);\n    \
+                 let disc = b * b - (dot(oc, oc) - radius * radius);\n    \
+                 let t_exit = select(-1.0, -b + sqrt(max(disc, 0.0)), disc >= 0.0);",
+                f(b.centre.x),
+                f(b.centre.y),
+                f(b.centre.z),
+                f(b.radius + s.detail * s.footprint(t_max) / b.slope),
+            )
+        }
+        _ => format!("let t_exit = {};", f(s.max_distance)),
+    };
+    let (group, binding) = WGSL_PARAMS;
     format!(
-        "{prelude}
-{de}
+        "{module}
 const ORIGIN = vec3<f32>({ox}, {oy}, {oz});
-@group(0) @binding(0) var<storage, read> directions: array<f32>;
-@group(0) @binding(1) var<storage, read_write> colours: array<u32>;
-@group(0) @binding(2) var<storage, read_write> counts: array<u32>;
+@group({group}) @binding({rays}) var<storage, read> directions: array<f32>;
+@group({group}) @binding({colours_at}) var<storage, read_write> colours: array<u32>;
+@group({group}) @binding({counts_at}) var<storage, read_write> counts: array<u32>;
 
 fn footprint(t: f32) -> f32 {{
     return {base} + {per_unit} * t;
@@ -148,26 +179,26 @@ fn footprint(t: f32) -> f32 {{
 
 @compute @workgroup_size(8, 8)
 fn main(@builtin(global_invocation_id) id: vec3<u32>) {{
-    if (id.x >= {width}u || id.y >= {height}u) {{
+    if (id.x >= {width}u || id.y >= {height}u || arrayLength(&params) == 0u) {{
         return;
     }}
     let i = id.y * {width}u + id.x;
     let rd = vec3<f32>(directions[3u * i], directions[3u * i + 1u], directions[3u * i + 2u]);
+    {exit}
+    let lipschitz = 1.0 + {detail} * {per_unit};
     var t = 0.0;
     var evaluations = 0u;
     var hit = false;
     for (var step = 0; step < {max_steps}; step++) {{
         let p = ORIGIN + rd * t;
-        let d = de(p);
+        let g = DE(p) - {detail} * footprint(t);
         evaluations++;
-        let surface = {detail} * footprint(t);
-        if (d < surface) {{
+        if (g <= 0.0) {{
             hit = true;
             break;
         }}
-        t += max(d - surface, {hit_epsilon} * footprint(t));
-        // Past the ball that holds the set and leaving it: a miss.
-        if (t > {max_distance} || (dot(p, p) > {far} && dot(p, rd) > 0.0)) {{
+        t += max(g / lipschitz, {hit_epsilon} * footprint(t));
+        if (t > {max_distance} || t > t_exit) {{
             break;
         }}
     }}
@@ -177,22 +208,28 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {{
         let p = ORIGIN + rd * t;
         let h = footprint(t);
         let k = vec2<f32>(1.0, -1.0);
-        let n = normalize(k.xyy * de(p + k.xyy * h) + k.yyx * de(p + k.yyx * h)
-            + k.yxy * de(p + k.yxy * h) + k.xxx * de(p + k.xxx * h));
-        evaluations += 4u;
+        let n = normalize(k.xyy * DE(p + k.xyy * h) + k.yyx * DE(p + k.yyx * h)
+            + k.yxy * DE(p + k.yxy * h) + k.xxx * DE(p + k.xxx * h));
+        var surface = vec3<f32>(0.0);
+        var trap = vec2<f32>(0.0);
+        _ = DE_shade(p, &surface, &trap);
+        evaluations += 5u;
         let light = normalize(vec3<f32>(0.5, 0.8, 0.35));
         let lit = 0.15 + 0.85 * max(dot(n, light), 0.0);
-        colour = vec3<f32>(0.9, 0.6, 0.35) * lit;
+        colour = surface * lit;
     }}
     let c = vec3<u32>(clamp(pow(colour, vec3<f32>(1.0 / 2.2)), vec3<f32>(0.0), vec3<f32>(1.0)) * 255.0 + 0.5);
     colours[i] = c.x | (c.y << 8u) | (c.z << 16u) | (255u << 24u);
     counts[i] = min(evaluations, 65535u) | (select(0u, 1u, hit) << 16u);
 }}
 ",
-        prelude = Wgsl::PRELUDE,
+        module = module.source,
         ox = f(origin.x),
         oy = f(origin.y),
         oz = f(origin.z),
+        rays = binding + 1,
+        colours_at = binding + 2,
+        counts_at = binding + 3,
         base = f(s.footprint_base),
         per_unit = f(s.footprint_per_unit),
         width = WIDTH,
@@ -201,7 +238,6 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {{
         detail = f(s.detail),
         hit_epsilon = f(s.hit_epsilon),
         max_distance = f(s.max_distance),
-        far = f(4.0 * ball * ball),
     )
 }
 
@@ -248,8 +284,9 @@ impl Gpu {
         })
     }
 
-    /// The pipeline and buffers of `shader` over the rays' `directions`.
-    fn prepare(&self, shader: &str, directions: &[f32]) -> March {
+    /// The pipeline and buffers of `shader` over the parameter buffer
+    /// `params` and the rays' `directions`.
+    fn prepare(&self, shader: &str, params: &[f32], directions: &[f32]) -> March {
         let module = self
             .device
             .create_shader_module(wgpu::ShaderModuleDescriptor {
@@ -267,26 +304,34 @@ impl Gpu {
                 cache: None,
             });
         use wgpu::BufferUsages as U;
-        let bytes: Vec<u8> = directions.iter().flat_map(|v| v.to_le_bytes()).collect();
-        let rays = self.buffer(bytes.len() as u64, U::STORAGE | U::COPY_DST);
-        self.queue.write_buffer(&rays, 0, &bytes);
+        let upload = |values: &[f32]| {
+            let bytes: Vec<u8> = values.iter().flat_map(|v| v.to_le_bytes()).collect();
+            let buffer = self.buffer(bytes.len() as u64, U::STORAGE | U::COPY_DST);
+            self.queue.write_buffer(&buffer, 0, &bytes);
+            buffer
+        };
+        let (params, rays) = (upload(params), upload(directions));
         let size = u64::from(WIDTH * HEIGHT) * 4;
         let colours = self.buffer(size, U::STORAGE | U::COPY_SRC);
         let counts = self.buffer(size, U::STORAGE | U::COPY_SRC);
         let group = self.device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: None,
-            layout: &pipeline.get_bind_group_layout(0),
+            layout: &pipeline.get_bind_group_layout(WGSL_PARAMS.0),
             entries: &[
                 wgpu::BindGroupEntry {
-                    binding: 0,
+                    binding: WGSL_PARAMS.1,
+                    resource: params.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: WGSL_PARAMS.1 + 1,
                     resource: rays.as_entire_binding(),
                 },
                 wgpu::BindGroupEntry {
-                    binding: 1,
+                    binding: WGSL_PARAMS.1 + 2,
                     resource: colours.as_entire_binding(),
                 },
                 wgpu::BindGroupEntry {
-                    binding: 2,
+                    binding: WGSL_PARAMS.1 + 3,
                     resource: counts.as_entire_binding(),
                 },
             ],
@@ -317,7 +362,7 @@ impl March {
         {
             let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor::default());
             pass.set_pipeline(&self.pipeline);
-            pass.set_bind_group(0, &self.group, &[]);
+            pass.set_bind_group(WGSL_PARAMS.0, &self.group, &[]);
             pass.dispatch_workgroups(WIDTH.div_ceil(8), HEIGHT.div_ceil(8), 1);
         }
         gpu.queue.submit([encoder.finish()]);
