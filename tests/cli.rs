@@ -370,6 +370,45 @@ fn emit_prints_only_what_the_scene_uses() {
 }
 
 #[test]
+fn emit_writes_a_scenes_functions_in_wgsl_and_refuses_double_precision() {
+    let dir = scratch("emit-wgsl");
+    let out = run(&dir, "", &["emit", "mandelbulb", "--language", "wgsl"]);
+    assert!(out.status.success(), "{}", text(&out));
+    let source = String::from_utf8_lossy(&out.stdout);
+    assert!(source.contains("fn DE(p0: real3) -> real {"), "{source}");
+    assert!(!source.contains("__kernel"), "a kernel in the WGSL module");
+    let module = naga::front::wgsl::parse_str(&source)
+        .unwrap_or_else(|e| panic!("{}", e.emit_to_string(&source)));
+    naga::valid::Validator::new(
+        naga::valid::ValidationFlags::all(),
+        naga::valid::Capabilities::empty(),
+    )
+    .validate(&module)
+    .unwrap_or_else(|e| panic!("{}", e.emit_to_string(&source)));
+    // The reference preset computes in double precision, which WGSL
+    // does not have: a typed error, exit code 1, nothing on stdout.
+    let out = run(
+        &dir,
+        "",
+        &[
+            "emit",
+            "mandelbulb",
+            "--language",
+            "wgsl",
+            "--preset",
+            "reference",
+        ],
+    );
+    assert_eq!(out.status.code(), Some(1), "{}", text(&out));
+    assert!(out.stdout.is_empty());
+    let message = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        message.contains("WGSL backend cannot") && message.contains("OpenCL"),
+        "{message}"
+    );
+}
+
+#[test]
 fn devices_and_bench_report_the_device() {
     let Some(device) = gpu::device() else {
         return;

@@ -59,8 +59,9 @@ pub fn emit_wgsl_ir(ir: &Ir, options: &Options) -> Result<KernelSource> {
     options.validate()?;
     if options.quality.precision == Precision::F64 {
         return Err(unsupported(
-            "compute in double precision (F64): WGSL has single precision only",
-            "ask for Precision::F32, or render deep zooms with the OpenCL backend",
+            "compute in double precision (F64), which WGSL does not have",
+            "choose single precision (Precision::F32, a preset other than `reference`), \
+             or render deep zooms with the OpenCL backend",
         ));
     }
     ir.check_limits(Precision::F32.limits())?;
@@ -107,6 +108,11 @@ pub fn emit_wgsl_ir(ir: &Ir, options: &Options) -> Result<KernelSource> {
         w.float(c[1]),
         w.float(c[2])
     ));
+    if origin != DVec3::ZERO {
+        w.line("/* The scene point DE's p0 = 0 stands for (the scene's local frame). */");
+        let [x, y, z] = origin.to_array().map(|v| w.float(v));
+        w.line(format!("const SCENE_ORIGIN: real3 = real3({x}, {y}, {z});"));
+    }
     let (group, binding) = WGSL_PARAMS;
     w.line("/* The dynamic values, then the instance tables. */");
     w.line(format!(

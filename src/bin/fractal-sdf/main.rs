@@ -50,7 +50,7 @@ enum Command {
     Render(RenderArgs),
     /// Render a camera path to numbered frames (PNG, TIFF, JPEG or OpenEXR; resumable), then a video.
     Sequence(SequenceArgs),
-    /// Print the generated OpenCL C of a scene.
+    /// Print the generated OpenCL C of a scene, or its functions in WGSL.
     Emit(EmitArgs),
     /// List the OpenCL platforms and devices.
     Devices,
@@ -325,6 +325,18 @@ struct EmitArgs {
     /// Quality preset, which decides precision and loop bounds.
     #[arg(long)]
     preset: Option<String>,
+    /// The language: the whole OpenCL C program, or the scene's functions
+    /// in WGSL (`DE`, `DE_shade`), to call from a shader of your own
+    /// (single precision only).
+    #[arg(long, value_enum, default_value_t = Language::Opencl)]
+    language: Language,
+}
+
+/// The languages `emit` writes.
+#[derive(Clone, Copy, clap::ValueEnum)]
+enum Language {
+    Opencl,
+    Wgsl,
 }
 
 #[derive(Args)]
@@ -918,7 +930,10 @@ fn emit(args: &EmitArgs, settings: &Settings) -> Outcome {
         .quality(quality(preset, &file, settings))
         .effects(file.effects);
     let compiled = file.scene.compile()?;
-    let kernel = codegen::emit(&compiled, &options)?;
+    let kernel = match args.language {
+        Language::Opencl => codegen::emit(&compiled, &options)?,
+        Language::Wgsl => codegen::emit_wgsl(&compiled, &options)?,
+    };
     write_out(&kernel.source)
 }
 
