@@ -183,7 +183,8 @@ pub struct KernelSource {
     /// hashes, and changing a dynamic value never changes either.
     pub hash: u64,
     /// Whether the program is built with relaxed, fast math
-    /// ([`Quality::fast_math`]).
+    /// ([`Quality::fast_math`]; an OpenCL build option, which a WGSL module
+    /// leaves to the application that builds it).
     pub fast_math: bool,
     /// The side of the coarse pass's tiles, in rendered pixels: the
     /// program has a `cone_starts` kernel when it is not 0
@@ -201,11 +202,13 @@ pub struct KernelSource {
     pub origin: DVec3,
     /// Where the target kernel (the render files `kernels/march.cl` to
     /// `render.cl`, or `kernels/eval.cl`,
-    /// after effect selection) starts in `source`.
+    /// after effect selection) starts in `source`: its end for a WGSL
+    /// module, which holds no kernel.
     pub kernel_start: usize,
     /// Where each custom shape's function lies in `source`, in order, so
     /// that a compiler message about a line of the program can be told as
-    /// a line of the shape's body.
+    /// a line of the shape's body (empty for a WGSL module, whose custom
+    /// shapes are formulas, printed as the built-in ones are).
     pub custom_regions: Vec<CustomRegion>,
     /// Values the program reads from its parameter buffer after the
     /// dynamic parameters (whose values fill the first slots): the values

@@ -18,7 +18,10 @@ pub(crate) enum Lang {
 }
 
 /// The types the scene functions declare: each language's name for them
-/// (`real` and its vectors are aliases of the precision's types in both).
+/// (`real` and its vectors, `uint` and `int` are aliases in WGSL's
+/// prelude, which no local name of the scene functions can hide, as `u{i}`
+/// for node 32 would hide `u32`; WGSL has no `real16`, and the WGSL
+/// functions carry no materials).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub(crate) enum Ty {
     Real,
@@ -212,10 +215,8 @@ impl Writer {
             (_, Ty::Real4) => "real4",
             (_, Ty::Real16) => "real16",
             (_, Ty::Bool) => "bool",
-            (Lang::OpenCl, Ty::Uint) => "uint",
-            (Lang::OpenCl, Ty::Int) => "int",
-            (Lang::Wgsl, Ty::Uint) => "u32",
-            (Lang::Wgsl, Ty::Int) => "i32",
+            (_, Ty::Uint) => "uint",
+            (_, Ty::Int) => "int",
         }
     }
 
@@ -273,8 +274,9 @@ impl Writer {
     }
 
     /// A distance beyond every other: OpenCL's infinity; in WGSL, whose
-    /// implementations may assume no value is infinite, the largest
-    /// single-precision number.
+    /// implementations may assume no value is infinite, 1e19, beyond the
+    /// largest magnitude a value of the scene may have (1e18) and with a
+    /// finite square, which the hierarchy walk takes.
     pub(crate) fn infinity(&self) -> &'static str {
         match self.lang {
             Lang::OpenCl => "INFINITY",
@@ -294,7 +296,7 @@ impl Writer {
     pub(crate) fn open_for(&mut self, i: &str, start: &str, end: &str) {
         let head = match self.lang {
             Lang::OpenCl => format!("for (uint {i} = {start}; {i} < {end}; {i}++)"),
-            Lang::Wgsl => format!("for (var {i}: u32 = {start}; {i} < {end}; {i}++)"),
+            Lang::Wgsl => format!("for (var {i}: uint = {start}; {i} < {end}; {i}++)"),
         };
         self.open(head);
     }
@@ -399,7 +401,8 @@ fn fits(v: f64, precision: Precision) -> bool {
     }
 }
 
-/// Formats `v` as an OpenCL C literal of `precision` that reads back as
+/// Formats `v` as an OpenCL C literal of `precision` (in `F32`, a WGSL
+/// literal too) that reads back as
 /// exactly `v` rounded to that precision: `1.0f`, `(-0.5f)`, `1e-30f` (F64
 /// has no suffix). Negative values are parenthesised.
 ///

@@ -1,7 +1,7 @@
 //! Distances: exact primitives against independent oracles, fractal
 //! estimates, Lipschitz bounds, the smooth minimum, CPU against device
-//! conformance, formulas written once, numerics at the extremes and deep
-//! scenes.
+//! conformance (OpenCL, and WGSL through wgpu), formulas written once,
+//! numerics at the extremes and deep scenes.
 //!
 //! One test binary per concern: each file here is a module.
 
@@ -9,6 +9,10 @@
 mod common;
 #[path = "../gpu/mod.rs"]
 mod gpu;
+/// The Vulkan device and compute-shader runner of the crate's own WGSL
+/// tests.
+#[path = "../../src/codegen/wgsl_tests/device.rs"]
+mod wgpu_device;
 
 #[cfg(feature = "proptest")]
 mod conformance;
@@ -40,3 +44,4 @@ mod orbit_trap;
 #[cfg(feature = "proptest")]
 mod ratio;
 mod smooth_oracle;
+mod wgsl;

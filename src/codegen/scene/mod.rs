@@ -1,7 +1,9 @@
 //! Emits a scene's distance functions from the IR: straight-line code, one
 //! block per node, children before parents, each block headed by a comment
 //! naming the node. The same walk writes `DE` (distance only) and
-//! `DE_shade` (distance, colour and orbit trap).
+//! `DE_shade` (distance, colour and orbit trap), in OpenCL C or in WGSL:
+//! the [`Writer`] spells each statement in its language, and the
+//! formulas go to its language's printer.
 //!
 //! Leaves are table-driven: [`leaf_function`] names each primitive's
 //! library function, and its arguments are the node's parameters in the
@@ -258,6 +260,10 @@ impl<'a> SceneEmitter<'a> {
 
     /// Writes `DE` and `DE_shade`, and `DE_material` with `materials`.
     pub(crate) fn emit(&mut self, materials: bool) {
+        debug_assert!(
+            !materials || self.w.lang() == Lang::OpenCl,
+            "WGSL has no real16 for materials"
+        );
         let functions = [(false, false), (true, false), (true, true)];
         for (shade, material) in functions.into_iter().take(if materials { 3 } else { 2 }) {
             self.shade = shade;

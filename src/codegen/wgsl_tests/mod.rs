@@ -5,7 +5,6 @@
 //! CPU in single precision.
 
 mod device;
-mod scenes;
 
 use std::cell::RefCell;
 

@@ -39,6 +39,8 @@ alias real = f32;
 alias real2 = vec2<f32>;
 alias real3 = vec3<f32>;
 alias real4 = vec4<f32>;
+alias uint = u32;
+alias int = i32;
 
 // Whether x is neither infinite nor NaN (under IEEE arithmetic, NaN fails
 // the comparison).
@@ -259,6 +261,17 @@ const RESERVED: &[&str] = &[
     "trunc",
     "vec2",
     "vec3",
+    // Names the prelude and the scene's modules declare.
+    "real4",
+    "uint",
+    "int",
+    "u32",
+    "fsdf_is_finite",
+    "fsdf_round",
+    "params",
+    "FSDF_INFINITY",
+    "DEFAULT_COLOR",
+    "SCENE_ORIGIN",
 ];
 
 impl Printer for Wgsl {

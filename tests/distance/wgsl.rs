@@ -1,17 +1,18 @@
-//! Whole scenes' functions in WGSL: every gallery scene's module (for
-//! rendering and for evaluation) validates with naga, and its `DE` and
-//! `DE_shade` run on the device to the CPU reference's distances and
-//! colours in single precision.
+//! Whole scenes' functions in WGSL, the third backend of the
+//! conformance: every gallery scene's module (for rendering and for
+//! evaluation) validates with naga, and its `DE` and `DE_shade` run on a
+//! Vulkan device through wgpu (Mesa's lavapipe where there is no GPU) to
+//! the CPU reference's distances and colours in single precision.
 
 use glam::Vec3;
 
-use super::device::{device, run};
-use crate::codegen::{KernelSource, Language, Options, Target, WGSL_PARAMS, emit_wgsl};
-use crate::cpu::Evaluator;
-use crate::error::Error;
-use crate::gallery;
-use crate::ir::CompiledScene;
-use crate::quality::{Precision, Quality};
+use crate::wgpu_device::{device, run};
+use fractal_sdf::Error;
+use fractal_sdf::codegen::{KernelSource, Language, Options, Target, WGSL_PARAMS, emit_wgsl};
+use fractal_sdf::cpu::Evaluator;
+use fractal_sdf::gallery;
+use fractal_sdf::ir::CompiledScene;
+use fractal_sdf::quality::{Precision, Quality};
 
 /// Parses and validates a module.
 fn validate(name: &str, source: &str) {
@@ -43,10 +44,7 @@ fn every_gallery_scene_prints_as_valid_wgsl() {
     let mut printed = 0;
     for (name, scene, inside) in scenes() {
         for target in [Target::Render, Target::Evaluate] {
-            let options = Options {
-                target,
-                ..Options::default()
-            };
+            let options = Options::default().target(target);
             match emit_wgsl(&scene, &options) {
                 Ok(module) => {
                     assert_eq!(module.language, Language::Wgsl);
@@ -67,13 +65,7 @@ fn every_gallery_scene_prints_as_valid_wgsl() {
 #[test]
 fn double_precision_is_a_typed_error_that_names_the_way_to_deep_zoom() {
     let (_, scene, _) = scenes().swap_remove(0);
-    let options = Options {
-        quality: Quality {
-            precision: Precision::F64,
-            ..Quality::default()
-        },
-        ..Options::default()
-    };
+    let options = Options::default().quality(Quality::default().precision(Precision::F64));
     let error = emit_wgsl(&scene, &options).expect_err("WGSL has no double precision");
     assert!(matches!(
         error,
@@ -142,10 +134,7 @@ fn every_gallery_scene_runs_on_wgpu_as_the_cpu_reference_computes_it() {
     let Some(gpu) = device() else { return };
     const TOLERANCE: f32 = 1e-3;
     let count = 512;
-    let options = Options {
-        target: Target::Evaluate,
-        ..Options::default()
-    };
+    let options = Options::default().target(Target::Evaluate);
     let mut worst = (0.0f32, "", "", Vec3::ZERO);
     let mut checked = 0;
     for (name, scene, inside) in scenes() {
@@ -210,8 +199,8 @@ fn every_gallery_scene_runs_on_wgpu_as_the_cpu_reference_computes_it() {
 /// are the CPU reference's at 512 points.
 #[test]
 fn instances_walked_through_a_hierarchy_run_on_wgpu_as_on_the_cpu() {
-    use crate::prelude::*;
-    use crate::scene::{Param3, param3};
+    use fractal_sdf::prelude::*;
+    use fractal_sdf::scene::{Param3, param3};
     let Some(gpu) = device() else { return };
     let mut scene = Scene::empty();
     #[allow(clippy::cast_precision_loss)]
@@ -231,10 +220,7 @@ fn instances_walked_through_a_hierarchy_run_on_wgpu_as_on_the_cpu() {
         scene = scene.add(sphere(param("r", 0.15)).translate(placed).color(tint));
     }
     let compiled = scene.compile().expect("the scene compiles");
-    let options = Options {
-        target: Target::Evaluate,
-        ..Options::default()
-    };
+    let options = Options::default().target(Target::Evaluate);
     let module = emit_wgsl(&compiled, &options).expect("the scene prints");
     assert!(module.source.contains("walked through"), "no hierarchy");
     // The helper, and one call in each of DE and DE_shade.
@@ -285,4 +271,63 @@ fn instances_walked_through_a_hierarchy_run_on_wgpu_as_on_the_cpu() {
         }
     }
     println!("largest relative difference {worst:e}");
+}
+
+/// The scene functions name their values after their nodes (`u32` for the
+/// gate of node 32, `f16` for a fractal's pair): in WGSL a local name
+/// hides a predeclared type of that name, so the loops and casts after
+/// them spell their types through the prelude's aliases (`uint`, `int`),
+/// never by the names a value may take. (naga resolves a type by its
+/// name wherever a type is expected, so it accepts either spelling; an
+/// implementation that follows the specification's scoping would not.) A
+/// scene with a gate named `u32` and a walk over instances after it
+/// validates, and its functions name no type a value may hide.
+#[test]
+fn value_names_never_hide_the_types_the_loops_use() {
+    use fractal_sdf::prelude::*;
+    // Leading shapes (two nodes each with their union, or three when
+    // moved) shift the gates' numbers through every remainder of the six
+    // nodes a pair takes, so that one gate is node 32.
+    let mut hidden = 0;
+    for lead in 0..6 {
+        let mut scene = Scene::empty();
+        for _ in 0..lead % 3 {
+            scene = scene.add(sphere(0.05));
+        }
+        if lead >= 3 {
+            scene = scene.add(sphere(0.05).translate(dvec3(0.0, -2.0, 0.0)));
+        }
+        #[allow(clippy::cast_precision_loss)]
+        for i in 0..12 {
+            let at = dvec3(i as f64 * 0.9, 0.0, 0.0);
+            let pair = sphere(0.3).smooth_union(
+                cuboid(dvec3(0.2, 0.2, 0.2)).translate(dvec3(0.3, 0.0, 0.0)),
+                0.1,
+            );
+            scene = scene.add(pair.translate(at));
+        }
+        #[allow(clippy::cast_precision_loss)]
+        for i in 0..40 {
+            scene = scene.add(sphere(0.1).translate(dvec3(i as f64 * 0.3, 2.0, 0.0)));
+        }
+        let compiled = scene.compile().expect("the scene compiles");
+        for target in [Target::Render, Target::Evaluate] {
+            let module =
+                emit_wgsl(&compiled, &Options::default().target(target)).expect("the scene prints");
+            assert!(module.source.contains("walked through"), "no hierarchy");
+            validate("a gate named u32", &module.source);
+            let functions = module
+                .source
+                .split("/* ---- scene ---- */")
+                .nth(1)
+                .expect("the scene's functions");
+            for typed in [": u32", "u32(", "<u32", ": i32", "i32(", "<i32"] {
+                assert!(!functions.contains(typed), "`{typed}` in the functions");
+            }
+            if module.source.contains("var u32: real") {
+                hidden += 1;
+            }
+        }
+    }
+    assert!(hidden > 0, "no value named u32: the test tests nothing");
 }
