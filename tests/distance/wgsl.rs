@@ -123,6 +123,34 @@ fn evaluator(module: &KernelSource, count: usize) -> String {
     )
 }
 
+/// Runs `module`'s `DE` and `DE_shade` on the device at the points `at`
+/// with the dynamic values `values`: five numbers a point, the two
+/// distances and the colour.
+fn evaluate(
+    gpu: &(wgpu::Device, wgpu::Queue),
+    module: &KernelSource,
+    values: &[f64],
+    at: &[Vec3],
+) -> Vec<f32> {
+    #[allow(clippy::cast_possible_truncation)]
+    let params: Vec<f32> = module
+        .param_buffer(values)
+        .iter()
+        .map(|&v| v as f32)
+        // A binding is never empty.
+        .chain([0.0])
+        .collect();
+    let flat: Vec<f32> = at.iter().flat_map(|p| p.to_array()).collect();
+    let count = at.len();
+    run(
+        gpu,
+        &evaluator(module, count),
+        &[&params, &flat],
+        5 * count,
+        count,
+    )
+}
+
 /// Every gallery scene's `DE` and `DE_shade` (for evaluation: no local
 /// frame), run on the device at 512 points in `[-3, 3]³`, give the CPU
 /// reference's single-precision distance and colour within
@@ -142,24 +170,8 @@ fn every_gallery_scene_runs_on_wgpu_as_the_cpu_reference_computes_it() {
             continue;
         }
         let module = emit_wgsl(&scene, &options).expect("the scene prints");
-        let values = scene.default_values();
-        #[allow(clippy::cast_possible_truncation)]
-        let mut params: Vec<f32> = module
-            .param_buffer(values.as_slice())
-            .iter()
-            .map(|&v| v as f32)
-            .collect();
-        // A binding is never empty.
-        params.push(0.0);
         let at = points(count, 3.0, 0x9e37_79b9_7f4a_7c15);
-        let flat: Vec<f32> = at.iter().flat_map(|p| p.to_array()).collect();
-        let got = run(
-            &gpu,
-            &evaluator(&module, count),
-            &[&params, &flat],
-            5 * count,
-            count,
-        );
+        let got = evaluate(&gpu, &module, scene.default_values().as_slice(), &at);
         let cpu = Evaluator::from_compiled(&scene);
         for (p, g) in at.iter().zip(got.chunks_exact(5)) {
             let s = cpu.sample::<f32>((*p).into());
@@ -237,23 +249,8 @@ fn instances_walked_through_a_hierarchy_run_on_wgpu_as_on_the_cpu() {
     }
     values.set("r", 0.12).expect("the radius");
     eval.set_param("r", 0.12).expect("the radius");
-    #[allow(clippy::cast_possible_truncation)]
-    let mut params: Vec<f32> = module
-        .param_buffer(values.as_slice())
-        .iter()
-        .map(|&v| v as f32)
-        .collect();
-    params.push(0.0);
-    let count = 512;
-    let at = points(count, 2.5, 0x2545_f491_4f6c_dd1d);
-    let flat: Vec<f32> = at.iter().flat_map(|p| p.to_array()).collect();
-    let got = run(
-        &gpu,
-        &evaluator(&module, count),
-        &[&params, &flat],
-        5 * count,
-        count,
-    );
+    let at = points(512, 2.5, 0x2545_f491_4f6c_dd1d);
+    let got = evaluate(&gpu, &module, values.as_slice(), &at);
     let mut worst = 0.0f32;
     for (p, g) in at.iter().zip(got.chunks_exact(5)) {
         let s = eval.sample::<f32>((*p).into());
