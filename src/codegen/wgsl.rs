@@ -2,8 +2,9 @@
 //! program's `DE` and `DE_shade`, spelled by a WGSL writer, after the
 //! helpers they call printed by [`Wgsl`] from the same formulas.
 //!
-//! The module holds the functions and what they read, and no entry point:
-//! a compute or fragment shader appended to it calls them.
+//! The module holds the functions and what they read, and for rendering
+//! the march, but no entry point: a compute or fragment shader appended to
+//! it calls them.
 
 use glam::DVec3;
 
@@ -11,7 +12,7 @@ use super::writer::Writer;
 use super::{KernelSource, Language, Options, Target, fnv1a, scene, unwritable};
 use crate::error::{Error, Result};
 use crate::expr::Wgsl;
-use crate::ir::{CompiledScene, Ir};
+use crate::ir::{Bound, CompiledScene, Ir};
 use crate::math::DEFAULT_COLOR;
 use crate::quality::Precision;
 
@@ -34,9 +35,15 @@ pub fn emit_wgsl(scene: &CompiledScene, options: &Options) -> Result<KernelSourc
 /// `fn DE_shade(p0: real3, color: ptr<function, real3>, trap: ptr<function, real2>) -> real`,
 /// which also writes the surface's colour and orbit trap, as the OpenCL
 /// program's functions of the same names compute them; for
-/// [`Target::Render`], the glow nodes' `glow_distance` and `glow_color`
-/// too, in the scene's local frame (the module's
-/// [`origin`](KernelSource::origin)). They read the parameter buffer at
+/// [`Target::Render`], in the scene's local frame (the module's
+/// [`origin`](KernelSource::origin)), the glow nodes' `glow_distance` and
+/// `glow_color` too, and the OpenCL kernel's march
+/// (`kernels/wgsl/march.wgsl`): `march_ray(ro, rd, start, footprint,
+/// side) -> MarchResult`, with the quality's `MAX_STEPS`,
+/// `MAX_DISTANCE`, `DETAIL`, `HIT_EPSILON`, `OVER_RELAXATION` and the
+/// scene's bounding sphere as constants (`footprint` is a pixel's
+/// footprint at the eye and its growth a unit along the ray, as
+/// [`MarchSettings`](crate::cpu::MarchSettings) has them). They read the parameter buffer at
 /// [`WGSL_PARAMS`]. The module starts with [`Wgsl::PRELUDE`] and holds no
 /// entry point.
 ///
@@ -137,6 +144,9 @@ pub fn emit_wgsl_ir(ir: &Ir, options: &Options) -> Result<KernelSource> {
     w.line("/* ---- scene ---- */");
     unwritable(&body, Precision::F32)?;
     w.raw(&body.finish());
+    if options.target == Target::Render {
+        march(&mut w, options, super::scene_bound(ir, options, origin));
+    }
     unwritable(&w, Precision::F32)?;
     let source = w.finish();
     Ok(KernelSource {
@@ -154,6 +164,45 @@ pub fn emit_wgsl_ir(ir: &Ir, options: &Options) -> Result<KernelSource> {
         tables,
     })
 }
+
+/// The march's settings as constants, then `march_ray` and what it calls
+/// (`kernels/wgsl/march.wgsl`).
+fn march(w: &mut Writer, options: &Options, bound: Option<Bound>) {
+    let q = &options.quality;
+    w.line("/* ---- march ---- */");
+    w.line(format!("const MAX_STEPS: int = {};", q.max_steps));
+    for (name, value) in [
+        ("MAX_DISTANCE", q.max_distance),
+        ("DETAIL", q.detail),
+        ("HIT_EPSILON", q.hit_epsilon),
+        ("OVER_RELAXATION", q.over_relaxation),
+    ] {
+        w.line(format!("const {name}: real = {};", w.float(value)));
+    }
+    w.line("/* The sphere around the scene (src/ir/bounds.rs), where it has one. */");
+    w.line(format!("const SCENE_BOUNDED: bool = {};", bound.is_some()));
+    let b = bound.unwrap_or(Bound {
+        centre: DVec3::ZERO,
+        radius: 0.0,
+        slope: 1.0,
+    });
+    let [x, y, z] = b.centre.to_array().map(|v| w.float(v));
+    w.line(format!(
+        "const SCENE_BOUND_CENTRE: real3 = real3({x}, {y}, {z});"
+    ));
+    w.line(format!(
+        "const SCENE_BOUND_RADIUS: real = {};",
+        w.float(b.radius)
+    ));
+    w.line(format!(
+        "const SCENE_BOUND_SLOPE: real = {};",
+        w.float(b.slope)
+    ));
+    w.raw(MARCH);
+}
+
+/// The march in WGSL.
+const MARCH: &str = include_str!("../../kernels/wgsl/march.wgsl");
 
 /// What the WGSL backend cannot do, and what to do instead.
 fn unsupported(what: &str, instead: &str) -> Error {

@@ -7,6 +7,10 @@
 
 #[path = "../gpu/mod.rs"]
 mod gpu;
+/// The Vulkan device and compute-shader runner of the crate's own WGSL
+/// tests.
+#[path = "../../src/codegen/wgsl_tests/device.rs"]
+mod wgpu_device;
 
 mod agreement;
 mod cancel;
@@ -25,3 +29,4 @@ mod quality;
 mod sizes;
 mod speed_knobs;
 mod updates;
+mod wgsl;
