@@ -1,8 +1,9 @@
 //! Gallery scenes marched twice at 640×480: by the OpenCL renderer with
 //! ambient occlusion, shadows, glow and fog off (the march, normals and
 //! shading), and by a WGSL compute shader through wgpu that calls the
-//! scene's functions as [`codegen::emit_wgsl`] writes them (the march, a
-//! four-tap normal, the surface's colour under the key light). On a
+//! scene's functions as [`codegen::emit_wgsl`] writes them (its
+//! `march_ray`, the OpenCL kernel's march; a four-tap normal; the
+//! surface's colour under the key light). On a
 //! machine without a GPU these are PoCL and Mesa's lavapipe: two
 //! compilers of the same kind of work for the same CPU cores. Prints each
 //! one's frame time (median of three), evaluations per pixel and
@@ -22,7 +23,6 @@ use std::time::Instant;
 
 use fractal_sdf::codegen::{self, KernelSource, Options, Target, WGSL_PARAMS};
 use fractal_sdf::cpu::MarchSettings;
-use fractal_sdf::ir::Bound;
 use fractal_sdf::metrics::mask_mismatch;
 use fractal_sdf::prelude::*;
 use fractal_sdf::render::Renderer;
@@ -97,11 +97,7 @@ fn compare(
             directions.extend(d.to_array().map(|v| v as f32));
         }
     }
-    let bound = compiled.ir().bounds()[compiled.ir().root().index()].map(|mut b| {
-        b.centre -= module.origin;
-        b
-    });
-    let shader = shader(&module, origin, &settings, bound);
+    let shader = shader(&module, origin, &settings);
     let params: Vec<f32> = module
         .param_buffer(compiled.default_values().as_slice())
         .iter()
@@ -136,46 +132,21 @@ fn compare(
 }
 
 /// The compute shader: the scene's module, then one invocation a pixel
-/// that marches its ray as the OpenCL kernel's plain march does (steps of
-/// the distance to the drawn surface over its Lipschitz bound, no shorter
-/// than `hit_epsilon` footprints, stopping once past the scene's bounding
-/// sphere), then shades a hit: `DE_shade`'s colour under the key light,
-/// with a tetrahedral normal. Writes the pixel's colour, and its
-/// evaluations (low 16 bits) and hit (bit 16).
-fn shader(module: &KernelSource, origin: DVec3, s: &MarchSettings, bound: Option<Bound>) -> String {
+/// that marches its ray with the module's `march_ray` (the OpenCL
+/// kernel's march: over-relaxed steps, the hit located, the stop past the
+/// scene's bounding sphere), then shades a hit: `DE_shade`'s colour under
+/// the key light, with a tetrahedral normal. Writes the pixel's colour,
+/// and its evaluations (low 16 bits) and hit (bit 16).
+fn shader(module: &KernelSource, origin: DVec3, s: &MarchSettings) -> String {
     let f = |v: f64| format!("{:?}", v as f32);
-    // Where the ray may stop: past the sphere around the scene, widened
-    // by the drawn surface's offset (as `march_bound_exit` widens it).
-    let exit = match bound {
-        Some(b) if s.detail * s.footprint_per_unit < b.slope => {
-            let t_max =
-                ((origin - b.centre).length() + b.radius + s.detail * s.footprint_base / b.slope)
-                    / (1.0 - s.detail * s.footprint_per_unit / b.slope);
-            format!(
-                "let oc = ORIGIN - vec3<f32>({}, {}, {});\n    \
-                 let radius = {};\n    \
-                 let b = dot(oc, rd);\n    \
-                 let disc = b * b - (dot(oc, oc) - radius * radius);\n    \
-                 let t_exit = select(-1.0, -b + sqrt(max(disc, 0.0)), disc >= 0.0);",
-                f(b.centre.x),
-                f(b.centre.y),
-                f(b.centre.z),
-                f(b.radius + s.detail * s.footprint(t_max) / b.slope),
-            )
-        }
-        _ => format!("let t_exit = {};", f(s.max_distance)),
-    };
     let (group, binding) = WGSL_PARAMS;
     format!(
         "{module}
 const ORIGIN = vec3<f32>({ox}, {oy}, {oz});
+const FOOTPRINT = vec2<f32>({base}, {per_unit});
 @group({group}) @binding({rays}) var<storage, read> directions: array<f32>;
 @group({group}) @binding({colours_at}) var<storage, read_write> colours: array<u32>;
 @group({group}) @binding({counts_at}) var<storage, read_write> counts: array<u32>;
-
-fn footprint(t: f32) -> f32 {{
-    return {base} + {per_unit} * t;
-}}
 
 @compute @workgroup_size(8, 8)
 fn main(@builtin(global_invocation_id) id: vec3<u32>) {{
@@ -184,29 +155,13 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {{
     }}
     let i = id.y * {width}u + id.x;
     let rd = vec3<f32>(directions[3u * i], directions[3u * i + 1u], directions[3u * i + 2u]);
-    {exit}
-    let lipschitz = 1.0 + {detail} * {per_unit};
-    var t = 0.0;
-    var evaluations = 0u;
-    var hit = false;
-    for (var step = 0; step < {max_steps}; step++) {{
-        let p = ORIGIN + rd * t;
-        let g = DE(p) - {detail} * footprint(t);
-        evaluations++;
-        if (g <= 0.0) {{
-            hit = true;
-            break;
-        }}
-        t += max(g / lipschitz, {hit_epsilon} * footprint(t));
-        if (t > {max_distance} || t > t_exit) {{
-            break;
-        }}
-    }}
+    let m = march_ray(ORIGIN, rd, 0.0, FOOTPRINT, 1.0);
+    var evaluations = u32(m.steps);
     let sky = mix(vec3<f32>(0.85, 0.9, 1.0), vec3<f32>(0.35, 0.5, 0.8), f32(id.y) / {height}.0);
     var colour = sky;
-    if (hit) {{
-        let p = ORIGIN + rd * t;
-        let h = footprint(t);
+    if (m.hit) {{
+        let p = ORIGIN + rd * m.t;
+        let h = march_footprint(FOOTPRINT, m.t);
         let k = vec2<f32>(1.0, -1.0);
         let n = normalize(k.xyy * DE(p + k.xyy * h) + k.yyx * DE(p + k.yyx * h)
             + k.yxy * DE(p + k.yxy * h) + k.xxx * DE(p + k.xxx * h));
@@ -220,7 +175,7 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {{
     }}
     let c = vec3<u32>(clamp(pow(colour, vec3<f32>(1.0 / 2.2)), vec3<f32>(0.0), vec3<f32>(1.0)) * 255.0 + 0.5);
     colours[i] = c.x | (c.y << 8u) | (c.z << 16u) | (255u << 24u);
-    counts[i] = min(evaluations, 65535u) | (select(0u, 1u, hit) << 16u);
+    counts[i] = min(evaluations, 65535u) | (select(0u, 1u, m.hit) << 16u);
 }}
 ",
         module = module.source,
@@ -234,10 +189,6 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {{
         per_unit = f(s.footprint_per_unit),
         width = WIDTH,
         height = HEIGHT,
-        max_steps = s.max_steps,
-        detail = f(s.detail),
-        hit_epsilon = f(s.hit_epsilon),
-        max_distance = f(s.max_distance),
     )
 }
 
