@@ -330,6 +330,10 @@ pub enum Error {
     /// Any other OpenCL failure.
     #[error("OpenCL error: {0}")]
     OpenCl(String),
+    /// A wgpu failure: no adapter, a shader the driver rejected, a device
+    /// lost.
+    #[error("wgpu error: {0}")]
+    Wgpu(String),
     /// Reading or writing a file failed.
     #[error("{path}: {action}: {source}")]
     Io {

@@ -2,6 +2,11 @@
 //! its errors and exit codes.
 
 mod gpu;
+/// The Vulkan device of the crate's own WGSL tests: whether wgpu has an
+/// adapter here (a failure where the run requires one).
+#[path = "../src/codegen/wgsl_tests/device.rs"]
+#[allow(dead_code)] // `run`, the distance tests' shader runner
+mod wgpu_device;
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
@@ -408,6 +413,77 @@ fn emit_writes_a_scenes_functions_in_wgsl_and_refuses_double_precision() {
     );
 }
 
+/// `render --backend wgpu` writes the image on the Vulkan adapter (Mesa's
+/// lavapipe where there is no GPU), the picture the OpenCL backend draws;
+/// a double-precision preset, materials and options only the OpenCL
+/// backend has are errors that say so, exit code 1 or 2, and no image.
+#[test]
+fn render_on_the_wgpu_backend_writes_the_opencl_picture() {
+    if gpu::device().is_none() || wgpu_device::device().is_none() {
+        return;
+    }
+    let dir = scratch("render-wgpu");
+    let base = ["render", "mandelbulb", "--size", "48x36"];
+    let with = |extra: &[&str], output: &str| {
+        let output = dir.join(output);
+        let mut args = base.to_vec();
+        args.extend_from_slice(extra);
+        args.extend_from_slice(&["-o", output.to_str().unwrap()]);
+        run(&dir, "", &args)
+    };
+    // The preview preset renders one pixel in 3 × 3 and scales the image
+    // up, on either backend.
+    let out = with(&["--backend", "wgpu", "--preset", "preview"], "wgpu.png");
+    assert!(out.status.success(), "{}", text(&out));
+    assert!(
+        String::from_utf8_lossy(&out.stdout).contains("(wgpu)"),
+        "{}",
+        text(&out)
+    );
+    let out = with(&["--preset", "preview"], "opencl.png");
+    assert!(out.status.success(), "{}", text(&out));
+    let wgpu = image::open(dir.join("wgpu.png")).unwrap().to_rgba8();
+    let opencl = image::open(dir.join("opencl.png")).unwrap().to_rgba8();
+    let db = fractal_sdf::metrics::psnr(&wgpu, &opencl);
+    assert!(db >= 40.0, "{db:.1} dB between the backends");
+
+    for (extra, output, code, says) in [
+        (
+            &["--preset", "reference"][..],
+            "f64.png",
+            1,
+            "double precision",
+        ),
+        (&["--passes", "4"][..], "passes.png", 2, "--passes"),
+    ] {
+        let out = with(&[&["--backend", "wgpu"][..], extra].concat(), output);
+        assert_eq!(out.status.code(), Some(code), "{}", text(&out));
+        let message = String::from_utf8_lossy(&out.stderr);
+        assert!(
+            message.contains(says) && message.contains("OpenCL"),
+            "{message}"
+        );
+        assert!(!dir.join(output).exists());
+    }
+    let materials = dir.join("m.png");
+    let out = run(
+        &dir,
+        "",
+        &[
+            "render",
+            "materials",
+            "--size",
+            "16x12",
+            "--backend",
+            "wgpu",
+            "-o",
+            materials.to_str().unwrap(),
+        ],
+    );
+    assert_eq!(out.status.code(), Some(1), "{}", text(&out));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("materials"));
+}
+
 #[test]
 fn devices_and_bench_report_the_device() {
     let Some(device) = gpu::device() else {
@@ -419,6 +495,10 @@ fn devices_and_bench_report_the_device() {
     let listing = String::from_utf8_lossy(&out.stdout);
     assert!(listing.contains(&device.name), "{listing}");
     assert!(listing.contains("fp64: "), "{listing}");
+    if wgpu_device::device().is_some() {
+        // The wgpu backend's adapters too.
+        assert!(listing.contains("wgpu: "), "{listing}");
+    }
 
     let out = run(
         &dir,

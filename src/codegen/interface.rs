@@ -486,6 +486,22 @@ pub(crate) fn defines(target: super::Target) -> String {
     out
 }
 
+/// The buffer layouts a WGSL render module reads, as constants
+/// (`const CAMERA_ORIGIN: uint = 0u;`): the same tables as the OpenCL
+/// program's `#define`s.
+pub(crate) fn wgsl_constants() -> String {
+    let mut out = String::new();
+    let w = &mut out;
+    for f in camera::FIELDS {
+        let _ = writeln!(w, "const CAMERA_{}: uint = {}u;", f.name, f.offset);
+    }
+    for f in light::FIELDS {
+        let _ = writeln!(w, "const LIGHT_{}: uint = {}u;", f.name, f.offset);
+    }
+    let _ = writeln!(w, "const LIGHT_STRIDE: uint = {}u;", light::STRIDE);
+    out
+}
+
 /// A kernel's declarations as the body of a multi-line `#define`.
 fn args<A>(list: &[(A, &str)]) -> String {
     let decls: Vec<&str> = list.iter().map(|(_, d)| *d).collect();

@@ -9,11 +9,13 @@
 use glam::DVec3;
 
 use super::writer::Writer;
-use super::{KernelSource, Language, Options, Target, fnv1a, scene, unwritable};
+use super::{
+    Effect, KernelSource, Language, Options, Target, fnv1a, formulas, interface, scene, unwritable,
+};
 use crate::error::{Error, Result};
 use crate::expr::Wgsl;
 use crate::ir::{Bound, CompiledScene, Ir};
-use crate::math::DEFAULT_COLOR;
+use crate::math::{DEFAULT_COLOR, REAL_TINY};
 use crate::quality::Precision;
 
 /// The bind group and binding at which a WGSL module of [`emit_wgsl`]
@@ -92,9 +94,11 @@ pub fn emit_wgsl_ir(ir: &Ir, options: &Options) -> Result<KernelSource> {
         options.quality.fractal_iterations,
     );
     emitter.emit(false);
-    if options.target == Target::Render {
-        emitter.emit_glows();
-    }
+    let glows = if options.target == Target::Render {
+        emitter.emit_glows()
+    } else {
+        0
+    };
     let constants = std::mem::take(&mut emitter.constants);
     let tables = std::mem::take(&mut emitter.tables);
     let customs: Vec<_> = emitter.customs.values().cloned().collect();
@@ -145,7 +149,18 @@ pub fn emit_wgsl_ir(ir: &Ir, options: &Options) -> Result<KernelSource> {
     unwritable(&body, Precision::F32)?;
     w.raw(&body.finish());
     if options.target == Target::Render {
-        march(&mut w, options, super::scene_bound(ir, options, origin));
+        let glow = Glow {
+            nodes: glows,
+            brightest: if glows > 0 { super::node_glow(ir) } else { 0.0 },
+            bound: super::glow_bound(ir, options, origin),
+        };
+        march(
+            &mut w,
+            options,
+            super::scene_bound(ir, options, origin),
+            &glow,
+        );
+        render(&mut w, options)?;
     }
     unwritable(&w, Precision::F32)?;
     let source = w.finish();
@@ -165,10 +180,48 @@ pub fn emit_wgsl_ir(ir: &Ir, options: &Options) -> Result<KernelSource> {
     })
 }
 
+/// The glow a render module draws: the scene's (`Effects::glow`) and its
+/// glow nodes' halos.
+struct Glow {
+    /// How many glow nodes the scene has (each with its `DE_glow`).
+    nodes: usize,
+    /// The brightest their halos add up to ([`super::node_glow`]).
+    brightest: f64,
+    /// The sphere around the shapes that glow, for a scene without a bound
+    /// of its own ([`super::glow_bound`]).
+    bound: Option<Bound>,
+}
+
+/// Writes `const NAME_CENTRE`, `NAME_RADIUS` and `NAME_SLOPE`: a bounding
+/// sphere, or a placeholder where there is none (`bound` `None`).
+fn sphere(w: &mut Writer, name: &str, bound: Option<Bound>) {
+    let b = bound.unwrap_or(Bound {
+        centre: DVec3::ZERO,
+        radius: 0.0,
+        slope: 1.0,
+    });
+    let [x, y, z] = b.centre.to_array().map(|v| w.float(v));
+    w.line(format!(
+        "const {name}_CENTRE: real3 = real3({x}, {y}, {z});"
+    ));
+    w.line(format!(
+        "const {name}_RADIUS: real = {};",
+        w.float(b.radius)
+    ));
+    w.line(format!("const {name}_SLOPE: real = {};", w.float(b.slope)));
+}
+
+/// `const NAME: real3 = real3(r, g, b);`
+fn rgb(w: &Writer, name: &str, c: DVec3) -> String {
+    let [r, g, b] = c.to_array().map(|v| w.float(v));
+    format!("const {name}: real3 = real3({r}, {g}, {b});")
+}
+
 /// The march's settings as constants, then `march_ray` and what it calls
 /// (`kernels/wgsl/march.wgsl`).
-fn march(w: &mut Writer, options: &Options, bound: Option<Bound>) {
+fn march(w: &mut Writer, options: &Options, bound: Option<Bound>, glow: &Glow) {
     let q = &options.quality;
+    let on = Effect::enabled(options);
     w.line("/* ---- march ---- */");
     w.line(format!("const MAX_STEPS: int = {};", q.max_steps));
     for (name, value) in [
@@ -181,28 +234,102 @@ fn march(w: &mut Writer, options: &Options, bound: Option<Bound>) {
     }
     w.line("/* The sphere around the scene (src/ir/bounds.rs), where it has one. */");
     w.line(format!("const SCENE_BOUNDED: bool = {};", bound.is_some()));
-    let b = bound.unwrap_or(Bound {
-        centre: DVec3::ZERO,
-        radius: 0.0,
-        slope: 1.0,
-    });
-    let [x, y, z] = b.centre.to_array().map(|v| w.float(v));
+    sphere(w, "SCENE_BOUND", bound);
+    let scene_glow = options.effects.glow.filter(|_| on.contains(&Effect::Glow));
+    w.line("/* The glow: the scene's, and its glow nodes' halos. */");
     w.line(format!(
-        "const SCENE_BOUND_CENTRE: real3 = real3({x}, {y}, {z});"
+        "const ENABLE_GLOW: bool = {};",
+        scene_glow.is_some() || glow.nodes > 0
+    ));
+    let (color, strength) = scene_glow.map_or((DVec3::ZERO, 0.0), |g| (g.color, g.strength));
+    w.line(rgb(w, "GLOW_COLOR", color));
+    w.line(format!(
+        "const GLOW_STRENGTH: real = {};",
+        w.float(strength)
     ));
     w.line(format!(
-        "const SCENE_BOUND_RADIUS: real = {};",
-        w.float(b.radius)
+        "const GLOW_BOUNDED: bool = {};",
+        glow.bound.is_some()
     ));
+    sphere(w, "GLOW_BOUND", glow.bound);
+    w.line(format!("const GLOW_NODES: int = {};", glow.nodes));
+    w.line(format!("const GLOW_SLOTS: int = {};", glow.nodes.max(1)));
     w.line(format!(
-        "const SCENE_BOUND_SLOPE: real = {};",
-        w.float(b.slope)
+        "const NODE_GLOW_BRIGHTEST: real = {};",
+        w.float(glow.brightest)
     ));
+    if glow.nodes == 0 {
+        w.line("/* No glow nodes: no halo to measure. */");
+        w.line("fn glow_distance(j: int, p: real3) -> real {");
+        w.line("    return FSDF_INFINITY;");
+        w.line("}");
+        w.line("fn glow_color(j: int) -> real3 {");
+        w.line("    return real3(0.0);");
+        w.line("}");
+    }
     w.raw(MARCH);
+}
+
+/// The shading's settings as constants, the buffer layouts, the display
+/// transform, then the render kernel (`kernels/wgsl/render.wgsl`).
+fn render(w: &mut Writer, options: &Options) -> Result<()> {
+    let (q, e) = (&options.quality, &options.effects);
+    let on = Effect::enabled(options);
+    w.line("/* ---- shading ---- */");
+    w.line(format!("const REAL_TINY: real = {};", w.float(REAL_TINY)));
+    w.line(format!(
+        "const NORMAL_EPSILON: real = {};",
+        w.float(q.normal_epsilon)
+    ));
+    w.line(format!("const SUPERSAMPLING: int = {};", q.supersampling));
+    w.line(format!("const GAMMA: real = {};", w.float(e.gamma)));
+    w.line(format!(
+        "const EXPOSURE_SCALE: real = {};",
+        w.float(e.exposure_scale())
+    ));
+    w.line(rgb(w, "SKY_TOP", e.sky_top));
+    w.line(rgb(w, "SKY_BOTTOM", e.sky_bottom));
+    let ao = on.contains(&Effect::AmbientOcclusion);
+    w.line(format!("const ENABLE_AO: bool = {ao};"));
+    w.line(format!(
+        "const AO_SAMPLES: int = {};",
+        if ao { q.ao_samples } else { 0 }
+    ));
+    w.line(format!(
+        "const AO_DISTANCE: real = {};",
+        w.float(e.ao_distance)
+    ));
+    let shadows = on.contains(&Effect::Shadows);
+    w.line(format!("const ENABLE_SHADOWS: bool = {shadows};"));
+    w.line(format!(
+        "const SHADOW_STEPS: int = {};",
+        if shadows { q.shadow_steps } else { 0 }
+    ));
+    let fog = on.contains(&Effect::Fog);
+    w.line(format!("const ENABLE_FOG: bool = {fog};"));
+    w.line(format!(
+        "const FOG_DENSITY: real = {};",
+        w.float(if fog { e.fog_density } else { 0.0 })
+    ));
+    w.line("/* The kernel interface (src/codegen/interface.rs). */");
+    w.raw(&interface::wgsl_constants());
+    w.line("/* ---- display ---- */");
+    let display = formulas::display(&Wgsl, e.tone_map, e.encoding).map_err(|e| Error::Invalid {
+        what: "formula",
+        reason: e.to_string(),
+    })?;
+    w.raw(&display);
+    w.line("");
+    w.line("/* ---- render ---- */");
+    w.raw(RENDER);
+    Ok(())
 }
 
 /// The march in WGSL.
 const MARCH: &str = include_str!("../../kernels/wgsl/march.wgsl");
+
+/// The render kernel in WGSL.
+const RENDER: &str = include_str!("../../kernels/wgsl/render.wgsl");
 
 /// What the WGSL backend cannot do, and what to do instead.
 fn unsupported(what: &str, instead: &str) -> Error {

@@ -69,7 +69,13 @@ mod sampling;
 mod stereo;
 mod upscale;
 mod viewport;
+#[cfg(feature = "wgpu")]
+mod wgpu_backend;
 
+/// The wgpu crate the wgpu backend is built on: name its types (devices,
+/// textures) through this path to get the same version.
+#[cfg(feature = "wgpu")]
+pub use ::wgpu;
 pub use adaptive::{AdaptiveFrame, EdgeThresholds, edges};
 pub use aov::{Frame, Layers};
 pub use cancel::CancelToken;
@@ -81,3 +87,5 @@ pub use renderer::{ConvergedFrame, EvaluationCost, RenderOptions, Renderer, Stop
 pub use sampling::{SamplePoint, brute_phase, sample_point};
 pub use stereo::compose;
 pub use viewport::Viewport;
+#[cfg(feature = "wgpu")]
+pub use wgpu_backend::{WGPU_TEXTURE_FORMAT, WgpuFrame, WgpuRenderer, wgpu_adapters};

@@ -1,7 +1,7 @@
-//! Rendering through OpenCL: agreement with the CPU, cancelling, cuts,
+//! Rendering through OpenCL (and wgpu): agreement with the CPU, cancelling, cuts,
 //! effects, errors, lit fog, global illumination, materials, optics, quality,
 //! sizes, frame-to-frame updates, the golden gallery, march bounds, several
-//! devices and the speed knobs.
+//! devices, the speed knobs and the wgpu backend against the OpenCL one.
 //!
 //! One test binary per concern: each file here is a module.
 
@@ -9,7 +9,9 @@
 mod gpu;
 /// The Vulkan device and compute-shader runner of the crate's own WGSL
 /// tests.
+#[cfg(feature = "wgpu")]
 #[path = "../../src/codegen/wgsl_tests/device.rs"]
+#[allow(dead_code)] // `run`, the distance tests' shader runner
 mod wgpu_device;
 
 mod agreement;
@@ -29,4 +31,5 @@ mod quality;
 mod sizes;
 mod speed_knobs;
 mod updates;
-mod wgsl;
+#[cfg(feature = "wgpu")]
+mod wgpu;

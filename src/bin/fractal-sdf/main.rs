@@ -21,7 +21,8 @@ use fractal_sdf::output::{
 use fractal_sdf::prelude::*;
 use fractal_sdf::quality::{Encoding, GlobalIllumination, Preset, ToneMap};
 use fractal_sdf::render::{
-    DeviceKind, DeviceSelector, EdgeThresholds, RenderOptions, Renderer, StopRule, devices,
+    DeviceKind, DeviceSelector, EdgeThresholds, RenderOptions, Renderer, StopRule, WgpuRenderer,
+    devices, wgpu_adapters,
 };
 use fractal_sdf::scene::{CustomShape, Environment, Stereo, StereoLayout};
 use fractal_sdf::sequence::{Encoded, MotionBlur, Sequence, parse_range};
@@ -234,6 +235,19 @@ struct RenderArgs {
     /// pixel footprints (default: the quality's).
     #[arg(long, value_name = "FOOTPRINTS")]
     brute_step: Option<f64>,
+    /// The backend that renders: opencl, or wgpu (WGSL on Vulkan, in
+    /// single precision; one frame of the image alone: no --aov, --passes,
+    /// --noise, --adaptive, --stereo or --gi, nor materials, environment
+    /// lights, lit fog or inside shapes, which need opencl).
+    #[arg(long, value_enum, default_value_t = Backend::Opencl)]
+    backend: Backend,
+}
+
+/// The backends `render` renders with.
+#[derive(Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+enum Backend {
+    Opencl,
+    Wgpu,
 }
 
 impl RenderArgs {
@@ -620,6 +634,9 @@ fn render(args: &RenderArgs, settings: &Settings) -> Outcome {
              grainy: --passes {LENS_PASSES} renders a smooth one in {LENS_PASSES} times the time"
         );
     }
+    if args.backend == Backend::Wgpu {
+        return render_wgpu(args, &job);
+    }
     let (width, height) = job.size;
     let start = Instant::now();
     let bar = spinner(format!("rendering {width}x{height}"));
@@ -703,6 +720,56 @@ fn render(args: &RenderArgs, settings: &Settings) -> Outcome {
         job.preset_name(),
         start.elapsed().as_secs_f64(),
         on_devices(&renderer)
+    );
+    Ok(())
+}
+
+/// `render --backend wgpu`: one frame of the image, on the adapter wgpu
+/// chooses.
+fn render_wgpu(args: &RenderArgs, job: &Job) -> Outcome {
+    let opencl_only = [
+        ("--aov", !args.aov.is_empty()),
+        ("--bits 16", args.bits == "16"),
+        ("--passes", args.passes.is_some_and(|p| p > 1)),
+        ("--noise", args.noise.is_some()),
+        ("--adaptive", args.adaptive.is_some()),
+        ("--stereo", args.stereo.is_some()),
+        ("--gi", args.gi.is_some()),
+        ("--devices", job.devices.is_some()),
+    ];
+    if let Some((option, _)) = opencl_only.iter().find(|(_, asked)| *asked) {
+        return Err(usage(format!(
+            "{option} needs the OpenCL backend: --backend wgpu renders one frame of the image"
+        )));
+    }
+    if image_extension(&args.output).ok().flatten().as_deref() == Some("exr") {
+        return Err(usage(
+            "--backend wgpu writes 8-bit images: write a .png, .jpg or .tif, or render the \
+             .exr with the OpenCL backend",
+        ));
+    }
+    let (width, height) = job.size;
+    let start = Instant::now();
+    let bar = spinner(format!("rendering {width}x{height} on wgpu"));
+    let rendered = (|| {
+        let mut renderer = WgpuRenderer::from_compiled(job.file.scene.compile()?, &job.options)?;
+        for (name, value) in &job.sets {
+            renderer.set_param(name, *value)?;
+        }
+        let image = renderer.render(width, height)?;
+        Ok::<_, fractal_sdf::Error>((image, renderer.adapter().name.clone()))
+    })();
+    bar.finish_and_clear();
+    let (image, adapter) = rendered?;
+    save_image(&image, &args.output)?;
+    if let Some(path) = &args.camera_json {
+        CameraExport::new(&job.file.scene.camera, job.size)?.save(path)?;
+    }
+    println!(
+        "{}: {width}x{height}, {} quality, {:.2} s on {adapter} (wgpu)",
+        args.output.display(),
+        job.preset_name(),
+        start.elapsed().as_secs_f64(),
     );
     Ok(())
 }
@@ -970,6 +1037,17 @@ fn list_devices() -> Outcome {
         "automatic choice: {}",
         DeviceSelector::auto().resolve()?.label()
     );
+    // The wgpu backend's adapters (`render --backend wgpu`).
+    let adapters = wgpu_adapters();
+    if adapters.is_empty() {
+        println!("wgpu: no adapter (on Linux, Mesa's lavapipe is mesa-vulkan-drivers)");
+    }
+    for a in adapters {
+        println!(
+            "wgpu: {} ({:?}, {:?}, driver {} {})",
+            a.name, a.backend, a.device_type, a.driver, a.driver_info
+        );
+    }
     Ok(())
 }
 

@@ -1,0 +1,499 @@
+// The render kernel of kernels/*.cl in WGSL: where each sample looks
+// (optics.cl: the pixel's and the lens's points, the camera ray), the
+// normal, ambient occlusion, soft shadows, the orbit-trap tint, the
+// lights, fog and glow (shade.cl), and the compute entry point `render`
+// that marches, shades and writes each pixel (render.cl's render_tile).
+// The formulas and constants are OpenCL's, line for line; where this file
+// leaves something out, the backend refuses the scene or the option
+// rather than draw something else (src/render/wgpu/).
+//
+// Follows march.wgsl. The module defines before it, besides the march's
+// constants: REAL_TINY, NORMAL_EPSILON, SUPERSAMPLING, GAMMA,
+// EXPOSURE_SCALE, SKY_TOP, SKY_BOTTOM; ENABLE_AO with AO_SAMPLES and
+// AO_DISTANCE, ENABLE_SHADOWS with SHADOW_STEPS, ENABLE_FOG with
+// FOG_DENSITY (a constant that is false leaves its code unreachable);
+// the buffer layouts CAMERA_<field>, LIGHT_<field> and LIGHT_STRIDE
+// (src/codegen/interface.rs, the tables the OpenCL kernel reads too);
+// display_color (the display transform, printed from
+// quality::display_formula); DE_shade, and glow_color where GLOW_NODES is
+// above 0.
+
+// Shading constants that are not quality knobs (march.cl's).
+const MARCH_AMBIENT: real = 0.5;      // strength of the sky's hemisphere light
+const MARCH_SPECULAR: real = 0.25;    // Blinn-Phong specular strength
+const MARCH_SHININESS: real = 32.0;   // Blinn-Phong exponent
+const MARCH_NORMAL_EVALUATIONS: uint = 4u; // DE calls of march_normal
+const AO_FALLOFF: real = 1.5;
+const AO_FLOOR: real = 0.015625; // 2^-6
+const AO_VIEW_FRACTION: real = 0.2;
+const MARCH_PI: real = 3.14159265358979324;
+
+// The camera (the `camera` buffer, laid out as CAMERA_<field>).
+@group(0) @binding(1) var<storage, read> camera: array<real>;
+// The lights, LIGHT_STRIDE reals each.
+@group(0) @binding(2) var<storage, read> lights: array<real>;
+
+// What changes from one frame to the next without rebuilding anything.
+struct Frame {
+    width: uint,       // the rendered image's size in pixels
+    height: uint,
+    light_count: uint,
+    write_aovs: uint,  // 1: write aovs
+}
+@group(0) @binding(3) var<uniform> frame: Frame;
+// The image, in the display's 8-bit steps.
+@group(0) @binding(4) var image: texture_storage_2d<rgba8unorm, write>;
+// Per pixel, for the ray through its centre: the distance to the hit (-1
+// on a miss), 1 where it hit, the distance evaluations of the pixel's
+// colour, and the primary march's.
+@group(0) @binding(5) var<storage, read_write> aovs: array<real4>;
+
+struct MarchCamera {
+    origin: real3,
+    right: real3,
+    up: real3,
+    forward: real3,
+    half_w: real,
+    half_h: real,
+    footprint: real2, // a pixel's footprint at the eye, and its growth per unit along a ray
+    image_w: real,
+    image_h: real,
+    pixel_scale: real,
+    shift: real2,
+    aperture: real,
+    focus: real,
+    orthographic: bool,
+}
+
+fn camera_vector(at: uint) -> real3 {
+    return real3(camera[at], camera[at + 1u], camera[at + 2u]);
+}
+
+fn march_load_camera() -> MarchCamera {
+    var cam: MarchCamera;
+    cam.origin = camera_vector(CAMERA_ORIGIN);
+    cam.orthographic = camera[CAMERA_ORTHOGRAPHIC] > 0.5;
+    cam.right = camera_vector(CAMERA_RIGHT);
+    cam.half_w = camera[CAMERA_HALF_WIDTH];
+    cam.up = camera_vector(CAMERA_UP);
+    cam.half_h = camera[CAMERA_HALF_HEIGHT];
+    cam.forward = camera_vector(CAMERA_FORWARD);
+    cam.footprint = real2(camera[CAMERA_FOOTPRINT_BASE], camera[CAMERA_FOOTPRINT_PER_UNIT]);
+    cam.image_w = camera[CAMERA_IMAGE_WIDTH];
+    cam.image_h = camera[CAMERA_IMAGE_HEIGHT];
+    cam.pixel_scale = camera[CAMERA_PIXEL_SCALE];
+    cam.shift = real2(camera[CAMERA_SHIFT], camera[CAMERA_SHIFT + 1u]);
+    cam.aperture = camera[CAMERA_APERTURE];
+    cam.focus = camera[CAMERA_FOCUS_DISTANCE];
+    return cam;
+}
+
+// A ray: where it starts and its unit direction.
+struct Ray {
+    ro: real3,
+    rd: real3,
+}
+
+// The ray through image position (px, py) in image pixels, (0, 0) being
+// the top left corner of the image, through the centre of the lens.
+fn march_camera_ray(cam: MarchCamera, px: real, py: real) -> Ray {
+    let u = (2.0 * px / cam.image_w - 1.0) * cam.half_w + cam.shift.x * cam.half_h;
+    let v = (1.0 - 2.0 * py / cam.image_h + cam.shift.y) * cam.half_h;
+    if (cam.orthographic) {
+        return Ray(cam.origin + cam.right * u + cam.up * v, cam.forward);
+    }
+    return Ray(cam.origin, normalize(cam.forward + cam.right * u + cam.up * v));
+}
+
+// The ray through image position (px, py) that leaves the lens at `lens`
+// (the unit disc scaled to the aperture) and meets the centre's ray on the
+// plane in focus.
+fn march_lens_ray(cam: MarchCamera, px: real, py: real, lens: real2) -> Ray {
+    var ray = march_camera_ray(cam, px, py);
+    if (cam.aperture > 0.0) {
+        let focus = ray.ro + ray.rd * (cam.focus / dot(ray.rd, cam.forward));
+        ray.ro += (cam.right * lens.x + cam.up * lens.y) * cam.aperture;
+        ray.rd = normalize(focus - ray.ro);
+    }
+    return ray;
+}
+
+// Deterministic per-sample jitter in [0, 1): the same image every run, and
+// the same as the OpenCL kernel's.
+fn march_hash(x_in: uint) -> uint {
+    var x = x_in;
+    x ^= x >> 16u;
+    x *= 0x7feb352du;
+    x ^= x >> 15u;
+    x *= 0x846ca68bu;
+    x ^= x >> 16u;
+    return x;
+}
+
+fn march_jitter(x: uint, y: uint, sample: uint) -> real {
+    let h = march_hash(x ^ march_hash(y ^ march_hash(sample)));
+    return real(h >> 8u) * 5.9604644775390625e-8; // 2^-24
+}
+
+// Point j of the R2 sequence, rotated by a per-pixel offset (optics.cl).
+fn march_pixel_point(pixel: uint, j: uint) -> real2 {
+    let steps = (vec2<uint>(0xc13fa9a9u, 0x91e10da6u) * j) >> vec2<uint>(8u);
+    let q = real2(march_jitter(pixel, 0u, 0u), march_jitter(pixel, 0u, 1u))
+            + real2(real(steps.x), real(steps.y)) * 5.9604644775390625e-8; // 2^-24
+    return q - floor(q);
+}
+
+// The radical inverse of j in base b.
+fn march_radical_inverse(j_in: uint, b: uint) -> real {
+    let step = 1.0 / real(b);
+    var scale = step;
+    var r = 0.0;
+    for (var j = j_in; j > 0u; j /= b) {
+        r += scale * real(j % b);
+        scale *= step;
+    }
+    return r;
+}
+
+// Point j of the Halton sequence in bases 2 and 3, rotated by a per-pixel
+// offset: where sample j leaves the lens, in the unit square.
+fn march_lens_point(pixel: uint, j: uint) -> real2 {
+    let q = real2(march_jitter(pixel, 0u, 2u), march_jitter(pixel, 0u, 3u))
+            + real2(march_radical_inverse(j, 2u), march_radical_inverse(j, 3u));
+    return q - floor(q);
+}
+
+// The unit square onto the unit disc (Shirley and Chiu's concentric map).
+fn march_disc(q: real2) -> real2 {
+    let a = 2.0 * q.x - 1.0;
+    let b = 2.0 * q.y - 1.0;
+    if (a == 0.0 && b == 0.0) {
+        return real2(0.0);
+    }
+    let quarter = 0.78539816339744831;
+    if (abs(a) > abs(b)) {
+        return a * real2(cos(quarter * b / a), sin(quarter * b / a));
+    }
+    return b * real2(sin(quarter * a / b), cos(quarter * a / b));
+}
+
+// Where sample j (the s-th of its pass) lies in its pixel, in [0, 1)^2:
+// jittered in cell s of an N x N grid with supersampling; without, the
+// pixel's centre for sample 0 and the R2 sequence after it.
+fn march_sample_point(pixel: uint, j: uint, s: int) -> real2 {
+    if (SUPERSAMPLING > 1) {
+        return real2((real(s % SUPERSAMPLING) + march_jitter(pixel, j, 0u)) / real(SUPERSAMPLING),
+                     (real(s / SUPERSAMPLING) + march_jitter(pixel, j, 1u)) / real(SUPERSAMPLING));
+    }
+    if (j == 0u) {
+        return real2(0.5);
+    }
+    return march_pixel_point(pixel, j);
+}
+
+// The ray of sample j (the s-th of its pass) of rendered pixel (x, y),
+// whose index is pixel, and its image row.
+struct SampleRay {
+    ray: Ray,
+    py: real,
+}
+
+fn march_sample_ray(cam: MarchCamera, x: int, y: int, pixel: uint, j: uint, s: int) -> SampleRay {
+    let point = march_sample_point(pixel, j, s);
+    var lens = real2(0.0);
+    if (cam.aperture > 0.0) {
+        lens = march_disc(march_lens_point(pixel, j));
+    }
+    let px = (real(x) + point.x) * cam.pixel_scale;
+    let py = (real(y) + point.y) * cam.pixel_scale;
+    return SampleRay(march_lens_ray(cam, px, py, lens), py);
+}
+
+// Unit normal by tetrahedral differences with step h; -rd where the
+// gradient is flat.
+fn march_normal(p: real3, h: real, rd: real3) -> real3 {
+    let k = real2(1.0, -1.0);
+    let g = k.xyy * DE(p + k.xyy * h) + k.yyx * DE(p + k.yyx * h)
+            + k.yxy * DE(p + k.yxy * h) + k.xxx * DE(p + k.xxx * h);
+    let len = length(g);
+    if (len > REAL_TINY) {
+        return g / len;
+    }
+    return -rd;
+}
+
+// The normal of a surface reached from outside, turned to face the ray.
+fn march_facing(n: real3, rd: real3) -> real3 {
+    let away = dot(n, rd);
+    if (away > 0.0) {
+        return normalize(n - 2.0 * away * rd);
+    }
+    return n;
+}
+
+// Ambient occlusion along the normal out to a reach that is AO_DISTANCE or
+// AO_VIEW_FRACTION of the view's height at p, whichever is shorter
+// (shade.cl's march_ambient_occlusion); 1 without it. Adds its
+// evaluations to *evals.
+fn march_occlusion(p: real3, n: real3, view_height: real, offset: real,
+                   evals: ptr<function, uint>) -> real {
+    if (!ENABLE_AO) {
+        return 1.0;
+    }
+    let reach = max(min(AO_DISTANCE, AO_VIEW_FRACTION * view_height), REAL_TINY);
+    var missing = 0.0;
+    var expected = 0.0;
+    for (var i = 0; i < AO_SAMPLES; i++) {
+        let h = reach * (real(i) + offset) / real(AO_SAMPLES);
+        let weight = exp(-AO_FALLOFF * h / reach);
+        let d = DE(p + n * h);
+        missing += weight * clamp(h - d, 0.0, h);
+        expected += weight * h;
+    }
+    *evals += uint(AO_SAMPLES);
+    return clamp(1.0 - missing / expected, AO_FLOOR, 1.0);
+}
+
+// Visibility of a light from ro along rd, from start to max_t: 0 in full
+// shadow, 1 fully lit; Quilez's improved soft shadow for softness above 0,
+// stopping where the rest cannot change the pixel (shade.cl's
+// march_shadow). Adds its evaluations to *evals.
+fn march_shadow(ro: real3, rd: real3, max_t_in: real, eps: real, start: real, softness: real,
+                weight: real, evals: ptr<function, uint>) -> real {
+    var visible = 1.0;
+    var prev_h = 1e20;
+    var t = start;
+    var max_t = max_t_in;
+    let faint = sqrt(0.5 / (255.0 * 3.0 * max(weight, REAL_TINY)));
+    if (SCENE_BOUNDED) {
+        let oc = ro - SCENE_BOUND_CENTRE;
+        let b = dot(oc, rd);
+        let widened = SCENE_BOUND_RADIUS + eps / SCENE_BOUND_SLOPE;
+        let disc = b * b - (dot(oc, oc) - widened * widened);
+        var t_exit = -1.0;
+        if (disc >= 0.0) {
+            t_exit = -b + sqrt(disc);
+        }
+        if (softness <= 0.0) {
+            max_t = min(max_t, t_exit);
+        }
+    }
+    for (var i = 0; i < SHADOW_STEPS && t < max_t; i++) {
+        let h = DE(ro + rd * t);
+        *evals += 1u;
+        if (h < eps) {
+            return 0.0;
+        }
+        if (softness > 0.0) {
+            var y = 0.0;
+            if (h < 2.0 * prev_h) {
+                y = h * h / (2.0 * prev_h);
+            }
+            let side = sqrt(max(h * h - y * y, 0.0));
+            visible = min(visible, side / (softness * max(t - y, REAL_TINY)));
+            prev_h = h;
+            if (visible < faint) {
+                return 0.0;
+            }
+        }
+        t += max(h, eps);
+    }
+    visible = clamp(visible, 0.0, 1.0);
+    return visible * visible * (3.0 - 2.0 * visible);
+}
+
+// Orbit-trap tint: a cosine palette that fades to white as the trap
+// reaches 1.
+fn march_trap_tint(trap: real) -> real3 {
+    let t = clamp(trap, 0.0, 1.0);
+    let phase = real3(0.0, 0.1, 0.2) + t;
+    let palette = 0.5 + 0.5 * cos(2.0 * MARCH_PI * phase);
+    return mix(palette, real3(1.0), t);
+}
+
+// Background at image row py: SKY_BOTTOM at the bottom, SKY_TOP at the top.
+fn march_background(cam: MarchCamera, py: real) -> real3 {
+    let v = clamp(1.0 - py / cam.image_h, 0.0, 1.0);
+    return mix(SKY_BOTTOM, SKY_TOP, v);
+}
+
+// Light i as seen from p: the unit direction towards it, how far it is
+// (MAX_DISTANCE for a directional light) and the radiance that arrives
+// (shade.cl's march_light).
+struct LightSample {
+    to_light: real3,
+    distance: real,
+    radiance: real3,
+}
+
+fn light_vector(at: uint) -> real3 {
+    return real3(lights[at], lights[at + 1u], lights[at + 2u]);
+}
+
+fn march_light(i: uint, p: real3) -> LightSample {
+    let at = LIGHT_STRIDE * i;
+    let v = light_vector(at + LIGHT_POSITION);
+    var l = LightSample(v, MAX_DISTANCE, light_vector(at + LIGHT_RADIANCE));
+    let kind = lights[at + LIGHT_KIND];
+    if (kind > 0.5) {
+        let delta = v - p;
+        let dist2 = max(dot(delta, delta), REAL_TINY);
+        l.distance = sqrt(dist2);
+        l.to_light = delta / l.distance;
+        l.radiance /= dist2;
+        if (kind > 2.5) {
+            // A rectangle lights its own side, dimming with the angle.
+            let face = cross(normalize(light_vector(at + LIGHT_EDGE_U)),
+                             normalize(light_vector(at + LIGHT_EDGE_V)));
+            l.radiance *= max(dot(face, -l.to_light), 0.0);
+        }
+    }
+    return l;
+}
+
+// Lit colour of the surface point p with normal n, seen along rd, with the
+// sky's light scaled by occlusion: Lambert plus a Blinn-Phong highlight
+// per light, through its shadow ray (shade.cl's march_shade without
+// materials). Adds its evaluations to *evals.
+fn march_shade(p: real3, n: real3, rd: real3, eps: real, occlusion: real,
+               evals: ptr<function, uint>) -> real3 {
+    var albedo: real3;
+    var trap: real2;
+    DE_shade(p, &albedo, &trap);
+    *evals += 1u;
+    albedo *= march_trap_tint(trap.x);
+    let sky = mix(SKY_BOTTOM, SKY_TOP, 0.5 + 0.5 * n.y);
+    var color = albedo * sky * (MARCH_AMBIENT * occlusion);
+    // Shadow rays start one hit threshold off the surface and are blocked
+    // within a quarter of it, so a surface does not shadow itself.
+    let lifted = p + n * eps;
+    for (var i = 0u; i < frame.light_count; i++) {
+        let l = march_light(i, p);
+        var radiance = l.radiance;
+        let ndl = dot(n, l.to_light);
+        if (ndl <= 0.0) {
+            continue;
+        }
+        if (ENABLE_SHADOWS) {
+            // The most this light adds to the pixel in any channel.
+            let most = radiance * ((albedo + MARCH_SPECULAR) * ndl);
+            let visible = march_shadow(lifted, l.to_light, l.distance, 0.25 * eps, eps,
+                                       lights[LIGHT_STRIDE * i + LIGHT_SOFTNESS],
+                                       max(most.x, max(most.y, most.z)), evals);
+            if (visible <= 0.0) {
+                continue;
+            }
+            radiance *= visible;
+        }
+        let half_vector = normalize(l.to_light - rd);
+        let specular = MARCH_SPECULAR * pow(max(dot(n, half_vector), 0.0), MARCH_SHININESS);
+        color += radiance * (albedo * ndl + specular * ndl);
+    }
+    return color;
+}
+
+// The fog's optical depth along a ray out to t: uniform fog.
+fn march_fog_depth(t: real) -> real {
+    return FOG_DENSITY * t;
+}
+
+// A pixel's colour and what it cost: the mean of its samples' linear
+// colours, and for the ray through its centre, the march.
+struct Shaded {
+    color: real3,
+    evals: uint,
+    steps: uint,
+    centre: MarchResult,
+}
+
+// Marches and shades the samples of rendered pixel (x, y) (render.cl's
+// render_tile, for a frame of its own).
+fn shade_pixel(cam: MarchCamera, x: int, y: int, pixel: uint) -> Shaded {
+    const per_pass = SUPERSAMPLING * SUPERSAMPLING;
+    var out: Shaded;
+    var sum = real3(0.0);
+    var evals = 0u;
+    var steps = 0u;
+    for (var s = 0; s < per_pass; s++) {
+        let j = uint(s);
+        let sample = march_sample_ray(cam, x, y, pixel, j, s);
+        let ro = sample.ray.ro;
+        let rd = sample.ray.rd;
+        let m = march_ray(ro, rd, 0.0, cam.footprint, 1.0);
+        steps += uint(m.steps);
+        evals += uint(m.steps);
+        let background = march_background(cam, sample.py);
+        var color = background;
+        if (m.hit) {
+            var p = ro + rd * m.t;
+            let footprint = march_footprint(cam.footprint, m.t);
+            var view_height = footprint * cam.image_h;
+            var n = march_normal(p, NORMAL_EPSILON * footprint, rd);
+            evals += MARCH_NORMAL_EVALUATIONS;
+            if (m.t > 0.0) {
+                n = march_facing(n, rd);
+            } else {
+                // The ray starts inside the surface: shade the nearest
+                // point of the surface instead, with no view to scale
+                // occlusion to.
+                p -= n * DE(p);
+                evals += 1u;
+                view_height = FSDF_INFINITY;
+            }
+            let occlusion = march_occlusion(p, n, view_height, 0.5, &evals);
+            color = march_shade(p, n, rd, DETAIL * footprint, occlusion, &evals);
+            if (ENABLE_FOG) {
+                // What the fog takes away, the sky puts back.
+                color = mix(background, color, exp(-march_fog_depth(m.t)));
+            }
+        } else if (ENABLE_GLOW) {
+            color += GLOW_COLOR * (GLOW_STRENGTH * exp(-MARCH_GLOW_FALLOFF * m.closest));
+            for (var k = 0; k < GLOW_NODES; k++) {
+                color += glow_color(k) * exp(-MARCH_GLOW_FALLOFF * m.glow_closest[k]);
+            }
+        }
+        sum += color;
+        if (s == 0) {
+            out.centre = m;
+        }
+    }
+    out.color = sum / real(per_pass);
+    out.evals = evals;
+    out.steps = steps;
+    return out;
+}
+
+// One invocation per rendered pixel: its colour through the display
+// transform into `image`, and with write_aovs its ray's depth, hit and
+// costs into `aovs`.
+@compute @workgroup_size(8, 8)
+fn render(@builtin(global_invocation_id) id: vec3<uint>) {
+    if (id.x >= frame.width || id.y >= frame.height) {
+        return;
+    }
+    let cam = march_load_camera();
+    let x = int(id.x);
+    let y = int(id.y);
+    let pixel = id.y * frame.width + id.x;
+    let shaded = shade_pixel(cam, x, y, pixel);
+    let display = display_color(shaded.color, EXPOSURE_SCALE, 1.0 / GAMMA);
+    // Rounded to the display's 8-bit steps here, to the nearest as the
+    // OpenCL kernel rounds, so the store needs no rounding of its own.
+    let steps = round(clamp(display, real3(0.0), real3(1.0)) * 255.0) / 255.0;
+    textureStore(image, vec2<int>(x, y), real4(steps, 1.0));
+    if (frame.write_aovs != 0u) {
+        var centre = shaded.centre;
+        if (SUPERSAMPLING > 1 || cam.aperture > 0.0) {
+            // The colour samples are jittered: trace the pixel centre.
+            let ray = march_camera_ray(cam, (real(x) + 0.5) * cam.pixel_scale,
+                                       (real(y) + 0.5) * cam.pixel_scale);
+            centre = march_ray(ray.ro, ray.rd, 0.0, cam.footprint, 1.0);
+        }
+        var depth = -1.0;
+        if (centre.hit) {
+            depth = centre.t;
+        }
+        aovs[pixel] = real4(depth, select(0.0, 1.0, centre.hit), real(shaded.evals),
+                            real(shaded.steps));
+    }
+}

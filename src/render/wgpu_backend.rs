@@ -1,0 +1,799 @@
+//! The wgpu backend (feature `wgpu`): the scene's WGSL module
+//! ([`codegen::emit_wgsl`]) run as a compute shader through wgpu, on
+//! Vulkan, Metal, DX12 or a WebGPU device, into an image or into a
+//! texture the application owns.
+//!
+//! [`WgpuRenderer`] draws what [`Renderer`](super::Renderer) draws, from
+//! the same formulas, constants and buffer layouts
+//! (`kernels/wgsl/render.wgsl` is the OpenCL kernel's march and shading,
+//! line for line): the march with glow and glow nodes, tetrahedral
+//! normals, ambient occlusion, hard and soft shadows, every light kind,
+//! uniform fog, supersampling, depth of field and the resolution scale.
+//! What it does not draw yet it refuses with [`Error::Unsupported`]
+//! rather than draw something else: materials, global illumination, an
+//! environment light, lit (volumetric) fog, inside shapes, double
+//! precision and custom shapes written in OpenCL C.
+//!
+//! ```no_run
+//! use fractal_sdf::prelude::*;
+//! use fractal_sdf::render::WgpuRenderer;
+//!
+//! let scene = Scene::new(mandelbulb(8.0))
+//!     .with_camera(Camera::look_at(dvec3(0.0, 0.5, 3.0), DVec3::ZERO));
+//! let mut renderer = WgpuRenderer::new(&scene, Quality::preview())?;
+//! println!("on {}", renderer.adapter().name);
+//! renderer.render(320, 240)?.save("bulb.png")?;
+//! # Ok::<(), Box<dyn std::error::Error>>(())
+//! ```
+
+use std::time::{Duration, Instant};
+
+use image::RgbaImage;
+
+use super::RenderOptions;
+use super::dispatch::MAX_IMAGE_SIDE;
+use super::upscale;
+use super::viewport::{Viewport, check_frame_inputs, pack_lights};
+use crate::codegen::interface::{camera, light};
+use crate::codegen::{self, KernelSource, Target};
+use crate::error::{Error, Result};
+use crate::ir::{CompiledScene, ParamValues};
+use crate::quality::{Precision, Quality};
+use crate::scene::{Camera, Kind, Light, Scene};
+
+/// The side of the render kernel's workgroups (`@workgroup_size(8, 8)`).
+const WORKGROUP: u32 = 8;
+
+/// The bindings of the render kernel's group 0 after the parameters
+/// ([`codegen::WGSL_PARAMS`]): `kernels/wgsl/render.wgsl`.
+const CAMERA: u32 = 1;
+const LIGHTS: u32 = 2;
+const FRAME: u32 = 3;
+const IMAGE: u32 = 4;
+const AOVS: u32 = 5;
+
+/// The format of the texture the render kernel writes: a texture given to
+/// [`WgpuRenderer::render_to_texture`] must have it, and
+/// `TextureUsages::STORAGE_BINDING`.
+pub const WGPU_TEXTURE_FORMAT: ::wgpu::TextureFormat = ::wgpu::TextureFormat::Rgba8Unorm;
+
+/// A frame from [`WgpuRenderer::render_frame`]: the image and, for the ray
+/// through each pixel's centre, whether it hit, how far along it and what
+/// the pixel cost (row-major, at the rendered resolution's pixels scaled
+/// up to the image's).
+#[derive(Debug, Clone, PartialEq)]
+#[non_exhaustive]
+pub struct WgpuFrame {
+    /// The image.
+    pub image: RgbaImage,
+    /// Distance along the centre ray to the surface, `f32::INFINITY` on a
+    /// miss.
+    pub depth: Vec<f32>,
+    /// Whether the centre ray hit the surface.
+    pub hit: Vec<bool>,
+    /// Distance evaluations of the pixel's colour: the primary march's,
+    /// the normal's, the shading's, occlusion's and the shadow rays'.
+    pub evaluations: Vec<u32>,
+    /// Distance evaluations of the primary march alone.
+    pub steps: Vec<u32>,
+}
+
+impl WgpuFrame {
+    /// Mean distance evaluations per pixel.
+    #[must_use]
+    pub fn evaluations_per_pixel(&self) -> f64 {
+        let total: u64 = self.evaluations.iter().map(|&e| u64::from(e)).sum();
+        total as f64 / self.evaluations.len().max(1) as f64
+    }
+}
+
+/// A wgpu device and its queue, and what the adapter says of itself.
+struct Gpu {
+    device: ::wgpu::Device,
+    queue: ::wgpu::Queue,
+    adapter: ::wgpu::AdapterInfo,
+}
+
+/// The image and per-pixel buffers of one size.
+struct Targets {
+    width: u32,
+    height: u32,
+    texture: ::wgpu::Texture,
+    aovs: ::wgpu::Buffer,
+}
+
+/// A renderer on the wgpu backend: [`Renderer`](super::Renderer)'s calls
+/// for a frame (parameters, camera, lights, [`render`](Self::render)),
+/// on a wgpu device. Changing a dynamic parameter, the camera or the
+/// lights writes a buffer: the pipeline is built once.
+pub struct WgpuRenderer {
+    scene: CompiledScene,
+    options: RenderOptions,
+    values: ParamValues,
+    source: KernelSource,
+    gpu: Gpu,
+    pipeline: ::wgpu::ComputePipeline,
+    layout: ::wgpu::BindGroupLayout,
+    pipeline_time: Duration,
+    params: ::wgpu::Buffer,
+    camera: ::wgpu::Buffer,
+    lights: ::wgpu::Buffer,
+    frame: ::wgpu::Buffer,
+    targets: Option<Targets>,
+    timing: Option<Duration>,
+}
+
+impl std::fmt::Debug for WgpuRenderer {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("WgpuRenderer")
+            .field("adapter", &self.gpu.adapter.name)
+            .field("backend", &self.gpu.adapter.backend)
+            .field("options", &self.options)
+            .finish_non_exhaustive()
+    }
+}
+
+/// The adapters wgpu finds on this machine, on every backend it was built
+/// with (the crate builds it with Vulkan).
+#[must_use]
+pub fn wgpu_adapters() -> Vec<::wgpu::AdapterInfo> {
+    let instance = instance();
+    pollster::block_on(instance.enumerate_adapters(::wgpu::Backends::all()))
+        .into_iter()
+        .map(|a| a.get_info())
+        .collect()
+}
+
+fn instance() -> ::wgpu::Instance {
+    ::wgpu::Instance::new(::wgpu::InstanceDescriptor::new_without_display_handle_from_env())
+}
+
+fn wgpu_error(what: &str, detail: impl std::fmt::Display) -> Error {
+    Error::Wgpu(format!("{what}: {detail}"))
+}
+
+/// Runs `f` and turns the validation and out-of-memory errors wgpu reports
+/// while it runs into [`Error::Wgpu`] (rather than wgpu's default, a
+/// panic).
+fn checked<T>(device: &::wgpu::Device, what: &str, f: impl FnOnce() -> T) -> Result<T> {
+    let memory = device.push_error_scope(::wgpu::ErrorFilter::OutOfMemory);
+    let validation = device.push_error_scope(::wgpu::ErrorFilter::Validation);
+    let value = f();
+    let invalid = pollster::block_on(validation.pop());
+    let short = pollster::block_on(memory.pop());
+    match invalid.or(short) {
+        Some(e) => Err(wgpu_error(what, e)),
+        None => Ok(value),
+    }
+}
+
+/// Why the wgpu backend cannot render `scene` with `options` as the OpenCL
+/// backend would, if it cannot.
+fn refuse(scene: &CompiledScene, options: &RenderOptions) -> Result<()> {
+    let unsupported = |what: &str| Error::Unsupported {
+        backend: "wgpu",
+        what: what.into(),
+        instead: "render it with the OpenCL backend".into(),
+    };
+    let materials = scene
+        .ir()
+        .nodes()
+        .iter()
+        .any(|n| matches!(n, Kind::Material { .. }));
+    if materials {
+        return Err(unsupported(
+            "render materials (reflections, transparency, shading models) yet",
+        ));
+    }
+    if options.effects.global_illumination.is_some() {
+        return Err(unsupported("path-trace global illumination yet"));
+    }
+    if scene.environment().is_some() {
+        return Err(unsupported("light a scene with an environment image yet"));
+    }
+    if options.effects.volumetric.is_some() && options.effects.fog_density > 0.0 {
+        return Err(unsupported("light volumetric fog yet"));
+    }
+    Ok(())
+}
+
+impl WgpuRenderer {
+    /// A renderer for `scene` with `quality` and the default effects, on
+    /// the adapter wgpu chooses.
+    ///
+    /// # Errors
+    /// As [`WgpuRenderer::from_compiled`].
+    pub fn new(scene: &Scene, quality: Quality) -> Result<Self> {
+        let options = RenderOptions {
+            quality,
+            ..RenderOptions::default()
+        };
+        Self::from_compiled(scene.compile()?, &options)
+    }
+
+    /// A renderer for a compiled scene on the adapter wgpu chooses (its
+    /// default request: `WGPU_BACKEND` and `WGPU_ADAPTER_NAME` steer it).
+    /// [`RenderOptions::device`], `tile_size`, `deadline` and `cancel`
+    /// are the OpenCL backend's and are not used.
+    ///
+    /// # Errors
+    /// [`Error::Unsupported`] for what the backend does not draw (see the
+    /// [module](self)), double precision among it; [`Error::Wgpu`] where
+    /// wgpu finds no adapter or the driver rejects the shader; quality,
+    /// effects and input errors as [`Renderer::from_compiled`](super::Renderer::from_compiled).
+    pub fn from_compiled(scene: CompiledScene, options: &RenderOptions) -> Result<Self> {
+        let instance = instance();
+        let adapter =
+            pollster::block_on(instance.request_adapter(&::wgpu::RequestAdapterOptions::default()))
+                .map_err(|e| {
+                    wgpu_error(
+                        "no wgpu adapter (on Linux without a GPU, install Mesa's lavapipe: \
+                     `apt-get install mesa-vulkan-drivers`)",
+                        e,
+                    )
+                })?;
+        let (device, queue) =
+            pollster::block_on(adapter.request_device(&::wgpu::DeviceDescriptor::default()))
+                .map_err(|e| wgpu_error("no wgpu device", e))?;
+        Self::with_device(scene, options, device, queue)
+    }
+
+    /// A renderer on the application's own device and queue: for
+    /// [`render_to_texture`](Self::render_to_texture) into the
+    /// application's textures.
+    ///
+    /// # Errors
+    /// As [`WgpuRenderer::from_compiled`].
+    pub fn with_device(
+        scene: CompiledScene,
+        options: &RenderOptions,
+        device: ::wgpu::Device,
+        queue: ::wgpu::Queue,
+    ) -> Result<Self> {
+        refuse(&scene, options)?;
+        let source = codegen::emit_wgsl(
+            &scene,
+            &codegen::Options::default()
+                .quality(options.quality)
+                .effects(options.effects)
+                .target(Target::Render),
+        )?;
+        let values = scene.default_values();
+        let limits = Precision::F32.limits();
+        values.check_within(limits)?;
+        let view = Viewport::in_frame(scene.camera(), 1, 1, Precision::F32, source.origin)?;
+        check_frame_inputs(&view, scene.lights(), source.origin, limits)?;
+        let adapter = device.adapter_info();
+        let started = Instant::now();
+        let (pipeline, layout) = checked(&device, "the render shader", || {
+            let module = device.create_shader_module(::wgpu::ShaderModuleDescriptor {
+                label: Some("fractal-sdf render"),
+                source: ::wgpu::ShaderSource::Wgsl(source.source.as_str().into()),
+            });
+            let layout = bind_group_layout(&device);
+            let pipeline_layout =
+                device.create_pipeline_layout(&::wgpu::PipelineLayoutDescriptor {
+                    label: Some("fractal-sdf render"),
+                    bind_group_layouts: &[Some(&layout)],
+                    immediate_size: 0,
+                });
+            let pipeline = device.create_compute_pipeline(&::wgpu::ComputePipelineDescriptor {
+                label: Some("fractal-sdf render"),
+                layout: Some(&pipeline_layout),
+                module: &module,
+                entry_point: Some("render"),
+                compilation_options: ::wgpu::PipelineCompilationOptions::default(),
+                cache: None,
+            });
+            (pipeline, layout)
+        })?;
+        let pipeline_time = started.elapsed();
+        let storage = ::wgpu::BufferUsages::STORAGE | ::wgpu::BufferUsages::COPY_DST;
+        let params = buffer(
+            &device,
+            "parameters",
+            4 * source.param_buffer(values.as_slice()).len().max(1),
+            storage,
+        );
+        let camera = buffer(&device, "camera", 4 * camera::LEN, storage);
+        let lights = buffer(
+            &device,
+            "lights",
+            4 * light_reals(scene.lights().len()),
+            storage,
+        );
+        let frame = buffer(
+            &device,
+            "frame",
+            16,
+            ::wgpu::BufferUsages::UNIFORM | ::wgpu::BufferUsages::COPY_DST,
+        );
+        let mut renderer = WgpuRenderer {
+            scene,
+            options: options.clone(),
+            values,
+            source,
+            gpu: Gpu {
+                device,
+                queue,
+                adapter,
+            },
+            pipeline,
+            layout,
+            pipeline_time,
+            params,
+            camera,
+            lights,
+            frame,
+            targets: None,
+            timing: None,
+        };
+        renderer.write_params();
+        renderer.write_lights();
+        Ok(renderer)
+    }
+
+    /// The adapter the renderer runs on.
+    #[must_use]
+    pub fn adapter(&self) -> &::wgpu::AdapterInfo {
+        &self.gpu.adapter
+    }
+
+    /// The device the renderer runs on: textures for
+    /// [`render_to_texture`](Self::render_to_texture) come from it.
+    #[must_use]
+    pub fn device(&self) -> &::wgpu::Device {
+        &self.gpu.device
+    }
+
+    /// The queue the renderer submits its frames to.
+    #[must_use]
+    pub fn queue(&self) -> &::wgpu::Queue {
+        &self.gpu.queue
+    }
+
+    /// The WGSL module the renderer runs.
+    #[must_use]
+    pub fn source(&self) -> &KernelSource {
+        &self.source
+    }
+
+    /// How long the driver took to build the render pipeline.
+    #[must_use]
+    pub fn pipeline_time(&self) -> Duration {
+        self.pipeline_time
+    }
+
+    /// How long the last frame took on the device, from submission to the
+    /// end of its work (without reading it back).
+    #[must_use]
+    pub fn last_timing(&self) -> Option<Duration> {
+        self.timing
+    }
+
+    /// The compiled scene.
+    #[must_use]
+    pub fn scene(&self) -> &CompiledScene {
+        &self.scene
+    }
+
+    /// Sets a dynamic parameter: a buffer write, never a new pipeline.
+    ///
+    /// # Errors
+    /// As [`Renderer::set_param`](super::Renderer::set_param), in single
+    /// precision.
+    pub fn set_param(&mut self, name: &str, value: f64) -> Result<()> {
+        self.values
+            .set_within(name, value, Precision::F32.limits())?;
+        self.write_params();
+        Ok(())
+    }
+
+    /// The current value of a dynamic parameter.
+    #[must_use]
+    pub fn param(&self, name: &str) -> Option<f64> {
+        self.values.get(name)
+    }
+
+    /// Sets the camera.
+    ///
+    /// # Errors
+    /// As [`Renderer::set_camera`](super::Renderer::set_camera).
+    pub fn set_camera(&mut self, camera: Camera) -> Result<()> {
+        let view = Viewport::in_frame(&camera, 1, 1, Precision::F32, self.source.origin)?;
+        check_frame_inputs(&view, &[], self.source.origin, Precision::F32.limits())?;
+        self.scene.set_camera(camera)
+    }
+
+    /// The camera.
+    #[must_use]
+    pub fn camera(&self) -> &Camera {
+        self.scene.camera()
+    }
+
+    /// Replaces the lights.
+    ///
+    /// # Errors
+    /// As [`Renderer::set_lights`](super::Renderer::set_lights).
+    pub fn set_lights(&mut self, lights: impl IntoIterator<Item = Light>) -> Result<()> {
+        let lights: Vec<Light> = lights.into_iter().collect();
+        let mut scene = self.scene.clone();
+        scene.set_lights(lights)?;
+        let view = Viewport::in_frame(scene.camera(), 1, 1, Precision::F32, self.source.origin)?;
+        check_frame_inputs(
+            &view,
+            scene.lights(),
+            self.source.origin,
+            Precision::F32.limits(),
+        )?;
+        self.scene = scene;
+        self.write_lights();
+        Ok(())
+    }
+
+    /// Renders a `width` × `height` image.
+    ///
+    /// # Errors
+    /// [`Error::Resolution`] for a zero side or one above
+    /// [`MAX_IMAGE_SIDE`]; [`Error::Precision`] for a camera the single
+    /// precision cannot compute with at this size; [`Error::Wgpu`] if the
+    /// device fails.
+    pub fn render(&mut self, width: u32, height: u32) -> Result<RgbaImage> {
+        Ok(self.render_frame(width, height)?.image)
+    }
+
+    /// Renders a `width` × `height` image with each pixel's depth, hit and
+    /// cost.
+    ///
+    /// # Errors
+    /// As [`WgpuRenderer::render`].
+    pub fn render_frame(&mut self, width: u32, height: u32) -> Result<WgpuFrame> {
+        check_size(width, height)?;
+        let scale = self.options.quality.resolution_scale.max(1);
+        let (w, h) = (width.div_ceil(scale), height.div_ceil(scale));
+        self.write_frame(width, height, scale, true)?;
+        let targets = self.targets(w, h)?;
+        let view = targets
+            .texture
+            .create_view(&::wgpu::TextureViewDescriptor::default());
+        let (texture, aovs) = (targets.texture.clone(), targets.aovs.clone());
+        let image_bytes = padded_row(w) as usize * h as usize;
+        let image_staging = buffer(&self.gpu.device, "image readback", image_bytes, read_back());
+        let aov_bytes = aovs.size() as usize;
+        let aov_staging = buffer(&self.gpu.device, "pixel readback", aov_bytes, read_back());
+        self.dispatch(&view, &aovs, w, h, |encoder| {
+            encoder.copy_texture_to_buffer(
+                texture.as_image_copy(),
+                ::wgpu::TexelCopyBufferInfo {
+                    buffer: &image_staging,
+                    layout: ::wgpu::TexelCopyBufferLayout {
+                        offset: 0,
+                        bytes_per_row: Some(padded_row(w)),
+                        rows_per_image: Some(h),
+                    },
+                },
+                ::wgpu::Extent3d {
+                    width: w,
+                    height: h,
+                    depth_or_array_layers: 1,
+                },
+            );
+            encoder.copy_buffer_to_buffer(&aovs, 0, &aov_staging, 0, aov_bytes as u64);
+        })?;
+        let rows = read(&self.gpu.device, &image_staging)?;
+        let mut rgba = Vec::with_capacity(4 * w as usize * h as usize);
+        for row in rows.chunks_exact(padded_row(w) as usize) {
+            rgba.extend_from_slice(&row[..4 * w as usize]);
+        }
+        let low = RgbaImage::from_raw(w, h, rgba).expect("four bytes per pixel");
+        let pixels: Vec<[f32; 4]> = read(&self.gpu.device, &aov_staging)?
+            .chunks_exact(16)
+            .map(|b| {
+                let f = |i: usize| f32::from_le_bytes([b[i], b[i + 1], b[i + 2], b[i + 3]]);
+                [f(0), f(4), f(8), f(12)]
+            })
+            .collect();
+        let depth: Vec<f32> = pixels
+            .iter()
+            .map(|p| if p[1] > 0.5 { p[0] } else { f32::INFINITY })
+            .collect();
+        let image = if scale > 1 {
+            upscale::image(&low, &depth, width, height, scale)
+        } else {
+            low
+        };
+        // The per-pixel values of the rendered pixel each image pixel
+        // shows.
+        let at = |x: u32, y: u32| ((y / scale) * w + x / scale) as usize;
+        let spread = |f: &dyn Fn(&[f32; 4]) -> f32| -> Vec<f32> {
+            (0..height)
+                .flat_map(|y| (0..width).map(move |x| (x, y)))
+                .map(|(x, y)| f(&pixels[at(x, y)]))
+                .collect()
+        };
+        Ok(WgpuFrame {
+            image,
+            depth: spread(&|p| if p[1] > 0.5 { p[0] } else { f32::INFINITY }),
+            hit: spread(&|p| p[1]).into_iter().map(|v| v > 0.5).collect(),
+            evaluations: spread(&|p| p[2]).into_iter().map(|v| v as u32).collect(),
+            steps: spread(&|p| p[3]).into_iter().map(|v| v as u32).collect(),
+        })
+    }
+
+    /// Renders a frame the size of `view` into it, on the renderer's
+    /// device (see [`WgpuRenderer::with_device`]), without a copy through
+    /// the CPU: the texture must be [`WGPU_TEXTURE_FORMAT`] with
+    /// `TextureUsages::STORAGE_BINDING`. The resolution scale is not
+    /// applied (every pixel of the texture is rendered).
+    ///
+    /// # Errors
+    /// As [`WgpuRenderer::render`]; [`Error::Wgpu`] for a texture of
+    /// another format, usage or device.
+    pub fn render_to_texture(
+        &mut self,
+        view: &::wgpu::TextureView,
+        width: u32,
+        height: u32,
+    ) -> Result<()> {
+        check_size(width, height)?;
+        self.write_frame(width, height, 1, false)?;
+        let aovs = self.targets(1, 1)?.aovs.clone();
+        self.dispatch(view, &aovs, width, height, |_| {})
+    }
+
+    /// Records the render kernel over `width` × `height` pixels into
+    /// `view` and `aovs`, then `after`, submits and waits.
+    fn dispatch(
+        &mut self,
+        view: &::wgpu::TextureView,
+        aovs: &::wgpu::Buffer,
+        width: u32,
+        height: u32,
+        after: impl FnOnce(&mut ::wgpu::CommandEncoder),
+    ) -> Result<()> {
+        let device = &self.gpu.device;
+        let entries = [
+            (codegen::WGSL_PARAMS.1, self.params.as_entire_binding()),
+            (CAMERA, self.camera.as_entire_binding()),
+            (LIGHTS, self.lights.as_entire_binding()),
+            (FRAME, self.frame.as_entire_binding()),
+            (IMAGE, ::wgpu::BindingResource::TextureView(view)),
+            (AOVS, aovs.as_entire_binding()),
+        ];
+        let commands = checked(device, "the render pass", || {
+            let group = device.create_bind_group(&::wgpu::BindGroupDescriptor {
+                label: Some("fractal-sdf render"),
+                layout: &self.layout,
+                entries: &entries
+                    .map(|(binding, resource)| ::wgpu::BindGroupEntry { binding, resource }),
+            });
+            let mut encoder =
+                device.create_command_encoder(&::wgpu::CommandEncoderDescriptor::default());
+            {
+                let mut pass =
+                    encoder.begin_compute_pass(&::wgpu::ComputePassDescriptor::default());
+                pass.set_pipeline(&self.pipeline);
+                pass.set_bind_group(codegen::WGSL_PARAMS.0, &group, &[]);
+                pass.dispatch_workgroups(width.div_ceil(WORKGROUP), height.div_ceil(WORKGROUP), 1);
+            }
+            after(&mut encoder);
+            encoder.finish()
+        })?;
+        let started = Instant::now();
+        self.gpu.queue.submit([commands]);
+        device
+            .poll(::wgpu::PollType::wait_indefinitely())
+            .map_err(|e| wgpu_error("the frame", e))?;
+        self.timing = Some(started.elapsed());
+        Ok(())
+    }
+
+    /// The image and per-pixel buffers for a `width` × `height` rendering,
+    /// made anew where the size changed.
+    fn targets(&mut self, width: u32, height: u32) -> Result<&Targets> {
+        let fits = self
+            .targets
+            .as_ref()
+            .is_some_and(|t| t.width == width && t.height == height);
+        if !fits {
+            let device = &self.gpu.device;
+            let made = checked(device, "the frame's buffers", || Targets {
+                width,
+                height,
+                texture: device.create_texture(&::wgpu::TextureDescriptor {
+                    label: Some("fractal-sdf image"),
+                    size: ::wgpu::Extent3d {
+                        width,
+                        height,
+                        depth_or_array_layers: 1,
+                    },
+                    mip_level_count: 1,
+                    sample_count: 1,
+                    dimension: ::wgpu::TextureDimension::D2,
+                    format: WGPU_TEXTURE_FORMAT,
+                    usage: ::wgpu::TextureUsages::STORAGE_BINDING | ::wgpu::TextureUsages::COPY_SRC,
+                    view_formats: &[],
+                }),
+                aovs: buffer(
+                    device,
+                    "pixels",
+                    16 * width as usize * height as usize,
+                    ::wgpu::BufferUsages::STORAGE | ::wgpu::BufferUsages::COPY_SRC,
+                ),
+            })?;
+            self.targets = Some(made);
+        }
+        Ok(self.targets.as_ref().expect("made above"))
+    }
+
+    /// Writes the camera for a `width` × `height` image rendered at one
+    /// pixel in `scale` × `scale`, and the frame's sizes.
+    fn write_frame(&mut self, width: u32, height: u32, scale: u32, aovs: bool) -> Result<()> {
+        let view = Viewport::in_frame(
+            self.scene.camera(),
+            width,
+            height,
+            Precision::F32,
+            self.source.origin,
+        )?;
+        check_frame_inputs(
+            &view,
+            self.scene.lights(),
+            self.source.origin,
+            Precision::F32.limits(),
+        )?;
+        let camera = view.pack(self.source.origin, scale);
+        self.gpu
+            .queue
+            .write_buffer(&self.camera, 0, &floats(&camera));
+        let lights = u32::try_from(self.scene.lights().len()).expect("a few lights");
+        let frame = [
+            width.div_ceil(scale),
+            height.div_ceil(scale),
+            lights,
+            u32::from(aovs),
+        ];
+        let bytes: Vec<u8> = frame.iter().flat_map(|v| v.to_le_bytes()).collect();
+        self.gpu.queue.write_buffer(&self.frame, 0, &bytes);
+        Ok(())
+    }
+
+    fn write_params(&mut self) {
+        let values = self.source.param_buffer(self.values.as_slice());
+        let mut bytes = floats(&values);
+        bytes.resize(self.params.size() as usize, 0);
+        self.gpu.queue.write_buffer(&self.params, 0, &bytes);
+    }
+
+    fn write_lights(&mut self) {
+        let lights = self.scene.lights();
+        let reals = light_reals(lights.len());
+        if self.lights.size() as usize != 4 * reals {
+            self.lights = buffer(
+                &self.gpu.device,
+                "lights",
+                4 * reals,
+                ::wgpu::BufferUsages::STORAGE | ::wgpu::BufferUsages::COPY_DST,
+            );
+        }
+        let packed = pack_lights(lights, self.source.origin);
+        self.gpu
+            .queue
+            .write_buffer(&self.lights, 0, &floats(&packed));
+    }
+}
+
+/// The render kernel's bindings (every one, including those a scene's
+/// kernel does not read: the parameters of a scene without dynamic ones).
+fn bind_group_layout(device: &::wgpu::Device) -> ::wgpu::BindGroupLayout {
+    let storage = |binding, read_only| ::wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility: ::wgpu::ShaderStages::COMPUTE,
+        ty: ::wgpu::BindingType::Buffer {
+            ty: ::wgpu::BufferBindingType::Storage { read_only },
+            has_dynamic_offset: false,
+            min_binding_size: None,
+        },
+        count: None,
+    };
+    device.create_bind_group_layout(&::wgpu::BindGroupLayoutDescriptor {
+        label: Some("fractal-sdf render"),
+        entries: &[
+            storage(codegen::WGSL_PARAMS.1, true),
+            storage(CAMERA, true),
+            storage(LIGHTS, true),
+            ::wgpu::BindGroupLayoutEntry {
+                binding: FRAME,
+                visibility: ::wgpu::ShaderStages::COMPUTE,
+                ty: ::wgpu::BindingType::Buffer {
+                    ty: ::wgpu::BufferBindingType::Uniform,
+                    has_dynamic_offset: false,
+                    min_binding_size: None,
+                },
+                count: None,
+            },
+            ::wgpu::BindGroupLayoutEntry {
+                binding: IMAGE,
+                visibility: ::wgpu::ShaderStages::COMPUTE,
+                ty: ::wgpu::BindingType::StorageTexture {
+                    access: ::wgpu::StorageTextureAccess::WriteOnly,
+                    format: WGPU_TEXTURE_FORMAT,
+                    view_dimension: ::wgpu::TextureViewDimension::D2,
+                },
+                count: None,
+            },
+            storage(AOVS, false),
+        ],
+    })
+}
+
+/// Reals in the light buffer for `count` lights (at least one light's).
+fn light_reals(count: usize) -> usize {
+    light::STRIDE * count.max(1)
+}
+
+fn check_size(width: u32, height: u32) -> Result<()> {
+    if width == 0 || height == 0 || width > MAX_IMAGE_SIDE || height > MAX_IMAGE_SIDE {
+        return Err(Error::Resolution {
+            width,
+            height,
+            reason: format!("each side must be between 1 and {MAX_IMAGE_SIDE} pixels"),
+        });
+    }
+    Ok(())
+}
+
+/// A row of `width` RGBA8 pixels, padded to wgpu's copy alignment.
+fn padded_row(width: u32) -> u32 {
+    (4 * width).next_multiple_of(::wgpu::COPY_BYTES_PER_ROW_ALIGNMENT)
+}
+
+fn read_back() -> ::wgpu::BufferUsages {
+    ::wgpu::BufferUsages::MAP_READ | ::wgpu::BufferUsages::COPY_DST
+}
+
+fn buffer(
+    device: &::wgpu::Device,
+    label: &str,
+    bytes: usize,
+    usage: ::wgpu::BufferUsages,
+) -> ::wgpu::Buffer {
+    device.create_buffer(&::wgpu::BufferDescriptor {
+        label: Some(label),
+        size: bytes as u64,
+        usage,
+        mapped_at_creation: false,
+    })
+}
+
+/// `values` as the little-endian `f32`s the shader reads.
+fn floats(values: &[f64]) -> Vec<u8> {
+    values
+        .iter()
+        .flat_map(|&v| (v as f32).to_le_bytes())
+        .collect()
+}
+
+/// The contents of a buffer that a finished submission copied into.
+fn read(device: &::wgpu::Device, staging: &::wgpu::Buffer) -> Result<Vec<u8>> {
+    let (send, receive) = std::sync::mpsc::channel();
+    staging
+        .slice(..)
+        .map_async(::wgpu::MapMode::Read, move |r| {
+            let _ = send.send(r);
+        });
+    device
+        .poll(::wgpu::PollType::wait_indefinitely())
+        .map_err(|e| wgpu_error("reading the frame back", e))?;
+    receive
+        .recv()
+        .map_err(|e| wgpu_error("reading the frame back", e))?
+        .map_err(|e| wgpu_error("reading the frame back", e))?;
+    let bytes = staging
+        .slice(..)
+        .get_mapped_range()
+        .map_err(|e| wgpu_error("reading the frame back", e))?
+        .to_vec();
+    staging.unmap();
+    Ok(bytes)
+}

@@ -1,0 +1,240 @@
+//! The wgpu backend (`WgpuRenderer`, feature `wgpu`) against the OpenCL
+//! renderer: every gallery scene it draws, drawn on a Vulkan device (Mesa's
+//! lavapipe where there is no GPU) with each scene file's quality and
+//! effects, is the OpenCL picture; frame-to-frame changes write buffers;
+//! what it does not draw is a typed error.
+
+use crate::gpu;
+use crate::wgpu_device::device;
+
+use fractal_sdf::Error;
+use fractal_sdf::metrics::{mask_mismatch, psnr};
+use fractal_sdf::prelude::*;
+use fractal_sdf::quality::Precision;
+use fractal_sdf::render::{RenderOptions, Renderer, WGPU_TEXTURE_FORMAT, WgpuRenderer};
+
+const WIDTH: u32 = 96;
+const HEIGHT: u32 = 72;
+
+/// Whether both backends are here: OpenCL and a Vulkan adapter (each a
+/// failure where the run requires it).
+fn backends() -> bool {
+    gpu::device().is_some() && device().is_some()
+}
+
+fn options(file: &fractal_sdf::file::SceneFile) -> RenderOptions {
+    let mut options = RenderOptions::default();
+    options.quality = file.quality.unwrap_or_default();
+    options.effects = file.effects;
+    options
+}
+
+/// At 96×72 with each scene file's quality (2×2 supersampling, 4×4 through
+/// a lens) and effects (glow, occlusion, shadows), the two backends draw
+/// the same picture: PSNR at least 40 dB and at most 0.1% of the pixels'
+/// hit flags different (measured at 640×480 by `examples/backends.rs`:
+/// 41.5 to 71.5 dB, at most 0.002% of the hit flags). The scenes it
+/// refuses are those with materials or inside shapes, each with the typed
+/// error.
+#[test]
+fn every_gallery_scene_it_draws_is_the_opencl_picture() {
+    if !backends() {
+        return;
+    }
+    let mut failures = Vec::new();
+    let mut drawn = 0;
+    for name in fractal_sdf::gallery::names() {
+        let file = fractal_sdf::gallery::file(name).expect("a gallery scene");
+        let compiled = file.scene.compile().expect("gallery scenes compile");
+        let options = options(&file);
+        let refusable = compiled.ir().has_inside_shapes() || name == "materials" || name == "gi";
+        let mut wgpu = match WgpuRenderer::from_compiled(compiled.clone(), &options) {
+            Ok(r) => r,
+            Err(Error::Unsupported { what, .. }) if refusable => {
+                println!("{name}: refused ({what})");
+                continue;
+            }
+            Err(e) => panic!("{name}: {e}"),
+        };
+        let drawn_by_wgpu = wgpu.render_frame(WIDTH, HEIGHT).expect("the wgpu frame");
+        let mut opencl = Renderer::from_compiled(compiled, &options).expect("the renderer");
+        let frame = opencl.render_with_aovs(WIDTH, HEIGHT).expect("the frame");
+        let db = psnr(&frame.image, &drawn_by_wgpu.image);
+        let differ = mask_mismatch(&frame.hit, &drawn_by_wgpu.hit);
+        println!(
+            "{name}: {db:.1} dB, {:.3}% hit flags differ",
+            100.0 * differ
+        );
+        assert!(
+            drawn_by_wgpu.hit.iter().any(|&h| h),
+            "{name}: the wgpu frame hits nothing"
+        );
+        if db < 40.0 || differ > 0.001 {
+            failures.push(format!("{name}: {db:.1} dB, {:.3}%", 100.0 * differ));
+        }
+        drawn += 1;
+    }
+    assert!(
+        failures.is_empty(),
+        "pictures differ:\n{}",
+        failures.join("\n")
+    );
+    assert!(drawn >= 19, "only {drawn} scenes drawn");
+}
+
+/// Single precision is all WGSL has: double precision is the typed
+/// error, and it names the OpenCL backend.
+#[test]
+fn double_precision_is_refused_with_the_way_to_deep_zoom() {
+    let mut options = RenderOptions::default();
+    options.quality = Quality::production().precision(Precision::F64);
+    let scene = Scene::new(sphere(1.0)).compile().unwrap();
+    match WgpuRenderer::from_compiled(scene, &options) {
+        Err(e @ Error::Unsupported { .. }) => {
+            let message = e.to_string();
+            assert!(message.contains("double precision"), "{message}");
+            assert!(message.contains("OpenCL"), "{message}");
+        }
+        other => panic!("expected the unsupported error, got {other:?}"),
+    }
+}
+
+/// Materials are the OpenCL backend's alone, for now: a typed error, not
+/// a picture without them.
+#[test]
+fn materials_are_refused_rather_than_drawn_without() {
+    let glass = sphere(1.0).material(Material::glass(1.5));
+    let scene = Scene::new(glass).compile().unwrap();
+    match WgpuRenderer::from_compiled(scene, &RenderOptions::default()) {
+        Err(Error::Unsupported { what, instead, .. }) => {
+            assert!(what.contains("materials"), "{what}");
+            assert!(instead.contains("OpenCL"), "{instead}");
+        }
+        other => panic!("expected the unsupported error, got {other:?}"),
+    }
+}
+
+/// A dynamic parameter, the camera and the lights change with a buffer
+/// write: the picture is the one a renderer built with the new values
+/// draws, on the same pipeline.
+#[test]
+fn parameters_camera_and_lights_change_the_picture_on_the_same_pipeline() {
+    if device().is_none() {
+        return;
+    }
+    let scene = gpu::sphere_box_floor();
+    let (w, h) = (64, 48);
+    let mut r = WgpuRenderer::new(&scene, gpu::quick()).unwrap();
+    let first = r.render(w, h).unwrap();
+    assert_eq!(r.render(w, h).unwrap(), first, "rendering is deterministic");
+    r.set_param("radius", 0.3).unwrap();
+    assert_eq!(r.param("radius"), Some(0.3));
+    let smaller = r.render(w, h).unwrap();
+    assert_ne!(smaller, first);
+    let camera = Camera::look_at(dvec3(3.0, 2.0, 0.5), dvec3(0.0, 0.3, 0.0));
+    r.set_camera(camera).unwrap();
+    let light = Light::directional(dvec3(-1.0, 1.0, 0.2));
+    r.set_lights([light]).unwrap();
+    let moved = r.render(w, h).unwrap();
+
+    let mut fresh = WgpuRenderer::new(&scene, gpu::quick()).unwrap();
+    fresh.set_param("radius", 0.3).unwrap();
+    assert_eq!(fresh.render(w, h).unwrap(), smaller);
+    let built = scene.clone().with_camera(camera).with_lights([light]);
+    let mut fresh = WgpuRenderer::new(&built, gpu::quick()).unwrap();
+    fresh.set_param("radius", 0.3).unwrap();
+    assert_eq!(fresh.render(w, h).unwrap(), moved);
+    assert_ne!(moved, smaller);
+    assert!(matches!(
+        r.set_param("radius", f64::NAN),
+        Err(Error::NonFinite { .. })
+    ));
+}
+
+/// Into the application's texture: the pixels `render` returns, with no
+/// copy through the CPU on the way.
+#[test]
+fn a_frame_rendered_into_a_texture_is_the_image() {
+    if device().is_none() {
+        return;
+    }
+    let (w, h) = (40, 30);
+    let mut r = WgpuRenderer::new(&gpu::sphere_box_floor(), gpu::quick()).unwrap();
+    let image = r.render(w, h).unwrap();
+    let device = r.device().clone();
+    let texture = device.create_texture(&wgpu::TextureDescriptor {
+        label: None,
+        size: wgpu::Extent3d {
+            width: w,
+            height: h,
+            depth_or_array_layers: 1,
+        },
+        mip_level_count: 1,
+        sample_count: 1,
+        dimension: wgpu::TextureDimension::D2,
+        format: WGPU_TEXTURE_FORMAT,
+        usage: wgpu::TextureUsages::STORAGE_BINDING | wgpu::TextureUsages::COPY_SRC,
+        view_formats: &[],
+    });
+    let view = texture.create_view(&wgpu::TextureViewDescriptor::default());
+    r.render_to_texture(&view, w, h).unwrap();
+    let row = (4 * w).next_multiple_of(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT);
+    let staging = device.create_buffer(&wgpu::BufferDescriptor {
+        label: None,
+        size: u64::from(row * h),
+        usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+        mapped_at_creation: false,
+    });
+    let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor::default());
+    encoder.copy_texture_to_buffer(
+        texture.as_image_copy(),
+        wgpu::TexelCopyBufferInfo {
+            buffer: &staging,
+            layout: wgpu::TexelCopyBufferLayout {
+                offset: 0,
+                bytes_per_row: Some(row),
+                rows_per_image: Some(h),
+            },
+        },
+        texture.size(),
+    );
+    r.queue().submit([encoder.finish()]);
+    staging
+        .slice(..)
+        .map_async(wgpu::MapMode::Read, |r| r.unwrap());
+    device.poll(wgpu::PollType::wait_indefinitely()).unwrap();
+    let bytes = staging.slice(..).get_mapped_range().unwrap().to_vec();
+    let pixels: Vec<u8> = bytes
+        .chunks_exact(row as usize)
+        .flat_map(|r| r[..4 * w as usize].to_vec())
+        .collect();
+    assert_eq!(pixels, image.into_raw());
+
+    // A texture of another format is the typed error, not a panic.
+    let wrong = device.create_texture(&wgpu::TextureDescriptor {
+        format: wgpu::TextureFormat::Rgba16Float,
+        ..texture_descriptor(w, h)
+    });
+    let view = wrong.create_view(&wgpu::TextureViewDescriptor::default());
+    assert!(matches!(
+        r.render_to_texture(&view, w, h),
+        Err(Error::Wgpu(_))
+    ));
+}
+
+fn texture_descriptor(w: u32, h: u32) -> wgpu::TextureDescriptor<'static> {
+    wgpu::TextureDescriptor {
+        label: None,
+        size: wgpu::Extent3d {
+            width: w,
+            height: h,
+            depth_or_array_layers: 1,
+        },
+        mip_level_count: 1,
+        sample_count: 1,
+        dimension: wgpu::TextureDimension::D2,
+        format: WGPU_TEXTURE_FORMAT,
+        usage: wgpu::TextureUsages::STORAGE_BINDING,
+        view_formats: &[],
+    }
+}
