@@ -5,6 +5,8 @@
 //! images and the share of pixels whose hit flags differ; writes
 //! `out/backend_<scene>_opencl.png` and `out/backend_<scene>_wgpu.png`.
 //! Scenes the wgpu backend does not draw yet are listed with its reason.
+//! Then the wgpu pipeline's creation, cold and from the cache, and the
+//! frame time of a Mandelbulb whose power changes every frame.
 //!
 //! `cargo run --release --features wgpu --example backends [--size WxH] [SCENE...]`
 //! (640×480 and every gallery scene by default; on a machine without a
@@ -14,6 +16,7 @@ use std::error::Error;
 use std::time::Instant;
 
 use fractal_sdf::metrics::{mask_mismatch, psnr};
+use fractal_sdf::prelude::*;
 use fractal_sdf::render::{RenderOptions, Renderer, WgpuRenderer};
 
 fn main() -> Result<(), Box<dyn Error>> {
@@ -80,6 +83,54 @@ fn main() -> Result<(), Box<dyn Error>> {
         ));
     }
     println!("{}", table.join("\n"));
+    pipelines_and_dynamic_frames(width, height)
+}
+
+/// The wgpu pipeline built cold and found in the cache, and frames whose
+/// dynamic parameter changes each time.
+fn pipelines_and_dynamic_frames(width: u32, height: u32) -> Result<(), Box<dyn Error>> {
+    let power = fractal_sdf::scene::param("power", 8.0);
+    let scene = Scene::new(mandelbulb(power))
+        .with_camera(Camera::look_at(dvec3(0.0, 0.5, 3.0), DVec3::ZERO));
+    let quality = Quality::production();
+    let started = Instant::now();
+    let mut cold = WgpuRenderer::new(&scene, quality)?;
+    let cold_total = started.elapsed().as_secs_f64() * 1e3;
+    let started = Instant::now();
+    let cached = WgpuRenderer::new(&scene, quality)?;
+    let cached_total = started.elapsed().as_secs_f64() * 1e3;
+    println!(
+        "\nwgpu pipeline for a dynamic-power Mandelbulb at production: built in {:.1} ms \
+         ({cold_total:.1} ms the whole renderer), from the cache in {:.3} ms \
+         ({cached_total:.1} ms the whole renderer)",
+        cold.pipeline_time().as_secs_f64() * 1e3,
+        cached.pipeline_time().as_secs_f64() * 1e3,
+    );
+    let mut opencl = Renderer::new(&scene, quality)?;
+    let (mut still, mut moving, mut cl_moving) = (Vec::new(), Vec::new(), Vec::new());
+    for i in 0..5 {
+        let started = Instant::now();
+        cold.render(width, height)?;
+        still.push(started.elapsed().as_secs_f64() * 1e3);
+        let value = 8.0 + 0.25 * f64::from(i + 1);
+        let started = Instant::now();
+        cold.set_param("power", value)?;
+        cold.render(width, height)?;
+        moving.push(started.elapsed().as_secs_f64() * 1e3);
+        let started = Instant::now();
+        opencl.set_param("power", value)?;
+        opencl.render(width, height)?;
+        cl_moving.push(started.elapsed().as_secs_f64() * 1e3);
+    }
+    println!(
+        "{width}×{height} frames, median of 5: wgpu {:.1} ms unchanged, {:.1} ms with the power \
+         changed before each (pipelines built since the first: {}); OpenCL {:.1} ms with it \
+         changed",
+        median(&mut still),
+        median(&mut moving),
+        cold.builds() - 1,
+        median(&mut cl_moving),
+    );
     Ok(())
 }
 

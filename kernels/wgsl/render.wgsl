@@ -4,8 +4,10 @@
 // lights, fog and glow (shade.cl), and the compute entry point `render`
 // that marches, shades and writes each pixel (render.cl's render_tile).
 // The formulas and constants are OpenCL's, line for line; where this file
-// leaves something out, the backend refuses the scene or the option
-// rather than draw something else (src/render/wgpu/).
+// leaves out something that changes the picture, the backend refuses the
+// scene or the option rather than draw something else
+// (src/render/wgpu_backend.rs). The coarse cone pass, which changes only
+// the speed, is left out: rays start at the eye.
 //
 // Follows march.wgsl. The module defines before it, besides the march's
 // constants: REAL_TINY, NORMAL_EPSILON, SUPERSAMPLING, GAMMA,

@@ -386,13 +386,7 @@ pub fn emit_ir(ir: &Ir, options: &Options) -> Result<KernelSource> {
         });
     }
     if options.target == Target::Render && count > MAX_GLOW_NODES {
-        return Err(Error::Invalid {
-            what: "scene",
-            reason: format!(
-                "{count} glow nodes, more than the {MAX_GLOW_NODES} a scene may have (each halo \
-                 is traced on its own): give their union one glow instead"
-            ),
-        });
+        return Err(too_many_glows(count));
     }
     let glows = if options.target == Target::Render {
         emitter.emit_glows()
@@ -634,6 +628,17 @@ fn emitters(ir: &Ir, options: &Options, origin: DVec3) -> Vec<Bound> {
         .filter(|b| b.fits(options.quality.precision.limits()))
         .take(MAX_EMITTERS)
         .collect()
+}
+
+/// A rendered scene with `count` glow nodes, above [`MAX_GLOW_NODES`].
+fn too_many_glows(count: usize) -> Error {
+    Error::Invalid {
+        what: "scene",
+        reason: format!(
+            "{count} glow nodes, more than the {MAX_GLOW_NODES} a scene may have (each halo is \
+             traced on its own): give their union one glow instead"
+        ),
+    }
 }
 
 /// The switch of glow nodes' halos ([`crate::scene::Node::glow`]).

@@ -94,6 +94,10 @@ pub fn emit_wgsl_ir(ir: &Ir, options: &Options) -> Result<KernelSource> {
         options.quality.fractal_iterations,
     );
     emitter.emit(false);
+    let count = ir.glows().len();
+    if options.target == Target::Render && count > super::MAX_GLOW_NODES {
+        return Err(super::too_many_glows(count));
+    }
     let glows = if options.target == Target::Render {
         emitter.emit_glows()
     } else {

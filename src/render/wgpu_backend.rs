@@ -1,7 +1,8 @@
 //! The wgpu backend (feature `wgpu`): the scene's WGSL module
-//! ([`codegen::emit_wgsl`]) run as a compute shader through wgpu, on
-//! Vulkan, Metal, DX12 or a WebGPU device, into an image or into a
-//! texture the application owns.
+//! ([`codegen::emit_wgsl`]) run as a compute shader through wgpu, into an
+//! image or into a texture the application owns. The crate builds wgpu
+//! with its Vulkan backend (Mesa's lavapipe where there is no GPU); the
+//! module itself is plain WGSL, for any WebGPU device.
 //!
 //! [`WgpuRenderer`] draws what [`Renderer`](super::Renderer) draws, from
 //! the same formulas, constants and buffer layouts
@@ -12,7 +13,10 @@
 //! What it does not draw yet it refuses with [`Error::Unsupported`]
 //! rather than draw something else: materials, global illumination, an
 //! environment light, lit (volumetric) fog, inside shapes, double
-//! precision and custom shapes written in OpenCL C.
+//! precision and custom shapes written in OpenCL C. It leaves out what
+//! changes only the speed: the coarse cone pass
+//! ([`Quality::cone_tile`]: rays start at the eye) and relaxed math
+//! ([`Quality::fast_math`]: the driver decides).
 //!
 //! ```no_run
 //! use fractal_sdf::prelude::*;
@@ -26,11 +30,13 @@
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 
+use std::sync::{Mutex, OnceLock, PoisonError};
 use std::time::{Duration, Instant};
 
 use image::RgbaImage;
 
 use super::RenderOptions;
+use super::aov::Frame;
 use super::dispatch::MAX_IMAGE_SIDE;
 use super::upscale;
 use super::viewport::{Viewport, check_frame_inputs, pack_lights};
@@ -38,7 +44,7 @@ use crate::codegen::interface::{camera, light};
 use crate::codegen::{self, KernelSource, Target};
 use crate::error::{Error, Result};
 use crate::ir::{CompiledScene, ParamValues};
-use crate::quality::{Precision, Quality};
+use crate::quality::{Effects, Precision, Quality};
 use crate::scene::{Camera, Kind, Light, Scene};
 
 /// The side of the render kernel's workgroups (`@workgroup_size(8, 8)`).
@@ -94,14 +100,6 @@ struct Gpu {
     adapter: ::wgpu::AdapterInfo,
 }
 
-/// The image and per-pixel buffers of one size.
-struct Targets {
-    width: u32,
-    height: u32,
-    texture: ::wgpu::Texture,
-    aovs: ::wgpu::Buffer,
-}
-
 /// A renderer on the wgpu backend: [`Renderer`](super::Renderer)'s calls
 /// for a frame (parameters, camera, lights, [`render`](Self::render)),
 /// on a wgpu device. Changing a dynamic parameter, the camera or the
@@ -112,14 +110,19 @@ pub struct WgpuRenderer {
     values: ParamValues,
     source: KernelSource,
     gpu: Gpu,
-    pipeline: ::wgpu::ComputePipeline,
-    layout: ::wgpu::BindGroupLayout,
+    pipeline: Pipeline,
     pipeline_time: Duration,
+    builds: u64,
     params: ::wgpu::Buffer,
     camera: ::wgpu::Buffer,
     lights: ::wgpu::Buffer,
     frame: ::wgpu::Buffer,
-    targets: Option<Targets>,
+    /// The image the last frame rendered into.
+    texture: Option<::wgpu::Texture>,
+    /// The per-pixel values of the last frame that asked for them.
+    outputs: Option<::wgpu::Buffer>,
+    /// One pixel's per-pixel values: bound where a frame asks for none.
+    no_outputs: ::wgpu::Buffer,
     timing: Option<Duration>,
 }
 
@@ -152,16 +155,18 @@ fn wgpu_error(what: &str, detail: impl std::fmt::Display) -> Error {
     Error::Wgpu(format!("{what}: {detail}"))
 }
 
-/// Runs `f` and turns the validation and out-of-memory errors wgpu reports
-/// while it runs into [`Error::Wgpu`] (rather than wgpu's default, a
-/// panic).
+/// Runs `f` and turns the validation, out-of-memory and internal errors
+/// wgpu reports while it runs into [`Error::Wgpu`] (rather than wgpu's
+/// default, a panic).
 fn checked<T>(device: &::wgpu::Device, what: &str, f: impl FnOnce() -> T) -> Result<T> {
+    let internal = device.push_error_scope(::wgpu::ErrorFilter::Internal);
     let memory = device.push_error_scope(::wgpu::ErrorFilter::OutOfMemory);
     let validation = device.push_error_scope(::wgpu::ErrorFilter::Validation);
     let value = f();
     let invalid = pollster::block_on(validation.pop());
     let short = pollster::block_on(memory.pop());
-    match invalid.or(short) {
+    let failed = pollster::block_on(internal.pop());
+    match invalid.or(short).or(failed) {
         Some(e) => Err(wgpu_error(what, e)),
         None => Ok(value),
     }
@@ -212,9 +217,14 @@ impl WgpuRenderer {
     }
 
     /// A renderer for a compiled scene on the adapter wgpu chooses (its
-    /// default request: `WGPU_BACKEND` and `WGPU_ADAPTER_NAME` steer it).
+    /// default request: `WGPU_BACKEND` and `WGPU_ADAPTER_NAME` steer it),
+    /// whose device every renderer made this way shares: the first finds
+    /// it, and a scene built before (by any of them, with the same
+    /// quality and effects) takes its pipeline from the cache of the
+    /// last 64.
     /// [`RenderOptions::device`], `tile_size`, `deadline` and `cancel`
-    /// are the OpenCL backend's and are not used.
+    /// are the OpenCL backend's and are not used: a frame is one dispatch,
+    /// which runs to its end.
     ///
     /// # Errors
     /// [`Error::Unsupported`] for what the backend does not draw (see the
@@ -222,19 +232,7 @@ impl WgpuRenderer {
     /// wgpu finds no adapter or the driver rejects the shader; quality,
     /// effects and input errors as [`Renderer::from_compiled`](super::Renderer::from_compiled).
     pub fn from_compiled(scene: CompiledScene, options: &RenderOptions) -> Result<Self> {
-        let instance = instance();
-        let adapter =
-            pollster::block_on(instance.request_adapter(&::wgpu::RequestAdapterOptions::default()))
-                .map_err(|e| {
-                    wgpu_error(
-                        "no wgpu adapter (on Linux without a GPU, install Mesa's lavapipe: \
-                     `apt-get install mesa-vulkan-drivers`)",
-                        e,
-                    )
-                })?;
-        let (device, queue) =
-            pollster::block_on(adapter.request_device(&::wgpu::DeviceDescriptor::default()))
-                .map_err(|e| wgpu_error("no wgpu device", e))?;
+        let (device, queue) = shared_device()?;
         Self::with_device(scene, options, device, queue)
     }
 
@@ -251,13 +249,7 @@ impl WgpuRenderer {
         queue: ::wgpu::Queue,
     ) -> Result<Self> {
         refuse(&scene, options)?;
-        let source = codegen::emit_wgsl(
-            &scene,
-            &codegen::Options::default()
-                .quality(options.quality)
-                .effects(options.effects)
-                .target(Target::Render),
-        )?;
+        let source = module(&scene, options)?;
         let values = scene.default_values();
         let limits = Precision::F32.limits();
         values.check_within(limits)?;
@@ -265,28 +257,7 @@ impl WgpuRenderer {
         check_frame_inputs(&view, scene.lights(), source.origin, limits)?;
         let adapter = device.adapter_info();
         let started = Instant::now();
-        let (pipeline, layout) = checked(&device, "the render shader", || {
-            let module = device.create_shader_module(::wgpu::ShaderModuleDescriptor {
-                label: Some("fractal-sdf render"),
-                source: ::wgpu::ShaderSource::Wgsl(source.source.as_str().into()),
-            });
-            let layout = bind_group_layout(&device);
-            let pipeline_layout =
-                device.create_pipeline_layout(&::wgpu::PipelineLayoutDescriptor {
-                    label: Some("fractal-sdf render"),
-                    bind_group_layouts: &[Some(&layout)],
-                    immediate_size: 0,
-                });
-            let pipeline = device.create_compute_pipeline(&::wgpu::ComputePipelineDescriptor {
-                label: Some("fractal-sdf render"),
-                layout: Some(&pipeline_layout),
-                module: &module,
-                entry_point: Some("render"),
-                compilation_options: ::wgpu::PipelineCompilationOptions::default(),
-                cache: None,
-            });
-            (pipeline, layout)
-        })?;
+        let (pipeline, built) = pipeline(&device, &source)?;
         let pipeline_time = started.elapsed();
         let storage = ::wgpu::BufferUsages::STORAGE | ::wgpu::BufferUsages::COPY_DST;
         let params = buffer(
@@ -302,6 +273,7 @@ impl WgpuRenderer {
             4 * light_reals(scene.lights().len()),
             storage,
         );
+        let no_outputs = buffer(&device, "no pixels", 16, output_usage());
         let frame = buffer(
             &device,
             "frame",
@@ -319,13 +291,15 @@ impl WgpuRenderer {
                 adapter,
             },
             pipeline,
-            layout,
             pipeline_time,
+            builds: u64::from(built),
             params,
             camera,
             lights,
             frame,
-            targets: None,
+            texture: None,
+            outputs: None,
+            no_outputs,
             timing: None,
         };
         renderer.write_params();
@@ -358,14 +332,78 @@ impl WgpuRenderer {
         &self.source
     }
 
-    /// How long the driver took to build the render pipeline.
+    /// How long getting the current render pipeline took: the driver's
+    /// build, or the cache's lookup.
     #[must_use]
     pub fn pipeline_time(&self) -> Duration {
         self.pipeline_time
     }
 
+    /// Pipelines this renderer has had the driver build (those found in
+    /// the cache do not count). Frames, parameter, camera and light
+    /// changes never add to it.
+    #[must_use]
+    pub fn builds(&self) -> u64 {
+        self.builds
+    }
+
+    /// The options the renderer renders with.
+    #[must_use]
+    pub fn options(&self) -> &RenderOptions {
+        &self.options
+    }
+
+    /// Sets the quality: a new module and pipeline (from the cache where
+    /// one was built for it), keeping the parameters, camera and lights.
+    ///
+    /// # Errors
+    /// As [`WgpuRenderer::from_compiled`]; the renderer is unchanged.
+    pub fn set_quality(&mut self, quality: Quality) -> Result<()> {
+        let mut options = self.options.clone();
+        options.quality = quality;
+        self.set_options(options)
+    }
+
+    /// Sets the effects, as [`WgpuRenderer::set_quality`] the quality.
+    ///
+    /// # Errors
+    /// As [`WgpuRenderer::set_quality`].
+    pub fn set_effects(&mut self, effects: Effects) -> Result<()> {
+        let mut options = self.options.clone();
+        options.effects = effects;
+        self.set_options(options)
+    }
+
+    fn set_options(&mut self, options: RenderOptions) -> Result<()> {
+        refuse(&self.scene, &options)?;
+        let source = module(&self.scene, &options)?;
+        let started = Instant::now();
+        let (pipeline, built) = pipeline(&self.gpu.device, &source)?;
+        self.pipeline_time = started.elapsed();
+        self.builds += u64::from(built);
+        self.pipeline = pipeline;
+        self.source = source;
+        self.options = options;
+        let size = 4 * self
+            .source
+            .param_buffer(self.values.as_slice())
+            .len()
+            .max(1);
+        if self.params.size() as usize != size {
+            self.params = buffer(
+                &self.gpu.device,
+                "parameters",
+                size,
+                ::wgpu::BufferUsages::STORAGE | ::wgpu::BufferUsages::COPY_DST,
+            );
+        }
+        self.write_params();
+        Ok(())
+    }
+
     /// How long the last frame took on the device, from submission to the
-    /// end of its work (without reading it back).
+    /// end of its work (with the copies into the buffers it is read back
+    /// from, not the reading).
     #[must_use]
     pub fn last_timing(&self) -> Option<Duration> {
         self.timing
@@ -439,24 +477,34 @@ impl WgpuRenderer {
     /// precision cannot compute with at this size; [`Error::Wgpu`] if the
     /// device fails.
     pub fn render(&mut self, width: u32, height: u32) -> Result<RgbaImage> {
-        Ok(self.render_frame(width, height)?.image)
+        // The depths scale the image up; at full resolution only the image
+        // is needed.
+        let scaled = self.options.quality.resolution_scale > 1;
+        Ok(self.draw(width, height, scaled)?.image)
     }
 
     /// Renders a `width` × `height` image with each pixel's depth, hit and
-    /// cost.
+    /// cost (scaled up as the OpenCL backend scales its per-pixel outputs:
+    /// depth and hit from the nearest rendered pixel, each rendered
+    /// pixel's cost at the first image pixel of its block).
     ///
     /// # Errors
     /// As [`WgpuRenderer::render`].
     pub fn render_frame(&mut self, width: u32, height: u32) -> Result<WgpuFrame> {
+        self.draw(width, height, true)
+    }
+
+    /// Renders and reads back the image, and with `outputs` the per-pixel
+    /// values (empty without).
+    fn draw(&mut self, width: u32, height: u32, outputs: bool) -> Result<WgpuFrame> {
         check_size(width, height)?;
         let scale = self.options.quality.resolution_scale.max(1);
         let (w, h) = (width.div_ceil(scale), height.div_ceil(scale));
-        self.write_frame(width, height, scale, true)?;
-        let targets = self.targets(w, h)?;
-        let view = targets
-            .texture
-            .create_view(&::wgpu::TextureViewDescriptor::default());
-        let (texture, aovs) = (targets.texture.clone(), targets.aovs.clone());
+        self.check_fits(w, h, outputs)?;
+        self.write_frame(width, height, scale, outputs)?;
+        let (pw, ph) = if outputs { (w, h) } else { (1, 1) };
+        let (texture, aovs) = self.targets((w, h), (pw, ph))?;
+        let view = texture.create_view(&::wgpu::TextureViewDescriptor::default());
         let image_bytes = padded_row(w) as usize * h as usize;
         let image_staging = buffer(&self.gpu.device, "image readback", image_bytes, read_back());
         let aov_bytes = aovs.size() as usize;
@@ -472,20 +520,27 @@ impl WgpuRenderer {
                         rows_per_image: Some(h),
                     },
                 },
-                ::wgpu::Extent3d {
-                    width: w,
-                    height: h,
-                    depth_or_array_layers: 1,
-                },
+                texture.size(),
             );
-            encoder.copy_buffer_to_buffer(&aovs, 0, &aov_staging, 0, aov_bytes as u64);
+            if outputs {
+                encoder.copy_buffer_to_buffer(&aovs, 0, &aov_staging, 0, aov_bytes as u64);
+            }
         })?;
         let rows = read(&self.gpu.device, &image_staging)?;
         let mut rgba = Vec::with_capacity(4 * w as usize * h as usize);
         for row in rows.chunks_exact(padded_row(w) as usize) {
             rgba.extend_from_slice(&row[..4 * w as usize]);
         }
-        let low = RgbaImage::from_raw(w, h, rgba).expect("four bytes per pixel");
+        let image = RgbaImage::from_raw(w, h, rgba).expect("four bytes per pixel");
+        if !outputs {
+            return Ok(WgpuFrame {
+                image,
+                depth: Vec::new(),
+                hit: Vec::new(),
+                evaluations: Vec::new(),
+                steps: Vec::new(),
+            });
+        }
         let pixels: Vec<[f32; 4]> = read(&self.gpu.device, &aov_staging)?
             .chunks_exact(16)
             .map(|b| {
@@ -493,31 +548,66 @@ impl WgpuRenderer {
                 [f(0), f(4), f(8), f(12)]
             })
             .collect();
-        let depth: Vec<f32> = pixels
-            .iter()
-            .map(|p| if p[1] > 0.5 { p[0] } else { f32::INFINITY })
-            .collect();
-        let image = if scale > 1 {
-            upscale::image(&low, &depth, width, height, scale)
+        let n = pixels.len();
+        #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss)] // counts below 2^24
+        let low = Frame {
+            image,
+            depth: pixels
+                .iter()
+                .map(|p| if p[1] > 0.5 { p[0] } else { f32::INFINITY })
+                .collect(),
+            hit: pixels.iter().map(|p| p[1] > 0.5).collect(),
+            normal: vec![[0.0; 3]; n],
+            steps: pixels.iter().map(|p| p[3] as u32).collect(),
+            evaluations: pixels.iter().map(|p| p[2] as u32).collect(),
+            start: vec![0.0; n],
+            layers: None,
+        };
+        let frame = if scale > 1 {
+            upscale::frame(&low, width, height, scale)
         } else {
             low
         };
-        // The per-pixel values of the rendered pixel each image pixel
-        // shows.
-        let at = |x: u32, y: u32| ((y / scale) * w + x / scale) as usize;
-        let spread = |f: &dyn Fn(&[f32; 4]) -> f32| -> Vec<f32> {
-            (0..height)
-                .flat_map(|y| (0..width).map(move |x| (x, y)))
-                .map(|(x, y)| f(&pixels[at(x, y)]))
-                .collect()
-        };
         Ok(WgpuFrame {
-            image,
-            depth: spread(&|p| if p[1] > 0.5 { p[0] } else { f32::INFINITY }),
-            hit: spread(&|p| p[1]).into_iter().map(|v| v > 0.5).collect(),
-            evaluations: spread(&|p| p[2]).into_iter().map(|v| v as u32).collect(),
-            steps: spread(&|p| p[3]).into_iter().map(|v| v as u32).collect(),
+            image: frame.image,
+            depth: frame.depth,
+            hit: frame.hit,
+            evaluations: frame.evaluations,
+            steps: frame.steps,
         })
+    }
+
+    /// Whether the device holds a `width` × `height` rendering (with the
+    /// per-pixel values where `outputs`): [`Error::Resolution`] with the
+    /// device's limit where it does not.
+    fn check_fits(&self, width: u32, height: u32, outputs: bool) -> Result<()> {
+        let limits = self.gpu.device.limits();
+        let side = limits.max_texture_dimension_2d;
+        if width > side || height > side {
+            return Err(Error::Resolution {
+                width,
+                height,
+                reason: format!(
+                    "the wgpu device renders images up to {side} pixels a side (render at most \
+                     that, or use the OpenCL backend)"
+                ),
+            });
+        }
+        let bytes = 16 * u64::from(width) * u64::from(height);
+        let most = limits
+            .max_storage_buffer_binding_size
+            .min(limits.max_buffer_size);
+        if outputs && bytes > most {
+            return Err(Error::Resolution {
+                width,
+                height,
+                reason: format!(
+                    "the per-pixel values take {bytes} bytes, more than the {most} the wgpu \
+                     device binds at once (render the image alone, or a smaller one)"
+                ),
+            });
+        }
+        Ok(())
     }
 
     /// Renders a frame the size of `view` into it, on the renderer's
@@ -536,8 +626,9 @@ impl WgpuRenderer {
         height: u32,
     ) -> Result<()> {
         check_size(width, height)?;
+        self.check_fits(width, height, false)?;
         self.write_frame(width, height, 1, false)?;
-        let aovs = self.targets(1, 1)?.aovs.clone();
+        let aovs = self.no_outputs.clone();
         self.dispatch(view, &aovs, width, height, |_| {})
     }
 
@@ -563,7 +654,7 @@ impl WgpuRenderer {
         let commands = checked(device, "the render pass", || {
             let group = device.create_bind_group(&::wgpu::BindGroupDescriptor {
                 label: Some("fractal-sdf render"),
-                layout: &self.layout,
+                layout: &self.pipeline.layout,
                 entries: &entries
                     .map(|(binding, resource)| ::wgpu::BindGroupEntry { binding, resource }),
             });
@@ -572,7 +663,7 @@ impl WgpuRenderer {
             {
                 let mut pass =
                     encoder.begin_compute_pass(&::wgpu::ComputePassDescriptor::default());
-                pass.set_pipeline(&self.pipeline);
+                pass.set_pipeline(&self.pipeline.compute);
                 pass.set_bind_group(codegen::WGSL_PARAMS.0, &group, &[]);
                 pass.dispatch_workgroups(width.div_ceil(WORKGROUP), height.div_ceil(WORKGROUP), 1);
             }
@@ -580,7 +671,7 @@ impl WgpuRenderer {
             encoder.finish()
         })?;
         let started = Instant::now();
-        self.gpu.queue.submit([commands]);
+        checked(device, "the frame", || self.gpu.queue.submit([commands]))?;
         device
             .poll(::wgpu::PollType::wait_indefinitely())
             .map_err(|e| wgpu_error("the frame", e))?;
@@ -588,23 +679,25 @@ impl WgpuRenderer {
         Ok(())
     }
 
-    /// The image and per-pixel buffers for a `width` × `height` rendering,
-    /// made anew where the size changed.
-    fn targets(&mut self, width: u32, height: u32) -> Result<&Targets> {
-        let fits = self
-            .targets
-            .as_ref()
-            .is_some_and(|t| t.width == width && t.height == height);
+    /// The image texture of `image` pixels and the per-pixel buffer of
+    /// `outputs` pixels, made anew where a size changed.
+    fn targets(
+        &mut self,
+        image: (u32, u32),
+        outputs: (u32, u32),
+    ) -> Result<(::wgpu::Texture, ::wgpu::Buffer)> {
+        let device = &self.gpu.device;
+        let fits = self.texture.as_ref().is_some_and(|t| {
+            let size = t.size();
+            (size.width, size.height) == image
+        });
         if !fits {
-            let device = &self.gpu.device;
-            let made = checked(device, "the frame's buffers", || Targets {
-                width,
-                height,
-                texture: device.create_texture(&::wgpu::TextureDescriptor {
+            let texture = checked(device, "the frame's image", || {
+                device.create_texture(&::wgpu::TextureDescriptor {
                     label: Some("fractal-sdf image"),
                     size: ::wgpu::Extent3d {
-                        width,
-                        height,
+                        width: image.0,
+                        height: image.1,
                         depth_or_array_layers: 1,
                     },
                     mip_level_count: 1,
@@ -613,17 +706,26 @@ impl WgpuRenderer {
                     format: WGPU_TEXTURE_FORMAT,
                     usage: ::wgpu::TextureUsages::STORAGE_BINDING | ::wgpu::TextureUsages::COPY_SRC,
                     view_formats: &[],
-                }),
-                aovs: buffer(
-                    device,
-                    "pixels",
-                    16 * width as usize * height as usize,
-                    ::wgpu::BufferUsages::STORAGE | ::wgpu::BufferUsages::COPY_SRC,
-                ),
+                })
             })?;
-            self.targets = Some(made);
+            self.texture = Some(texture);
         }
-        Ok(self.targets.as_ref().expect("made above"))
+        let bytes = 16 * outputs.0 as usize * outputs.1 as usize;
+        let aovs = if bytes == self.no_outputs.size() as usize {
+            self.no_outputs.clone()
+        } else {
+            if self
+                .outputs
+                .as_ref()
+                .is_none_or(|b| b.size() as usize != bytes)
+            {
+                self.outputs = Some(checked(device, "the frame's per-pixel values", || {
+                    buffer(device, "pixels", bytes, output_usage())
+                })?);
+            }
+            self.outputs.clone().expect("made above")
+        };
+        Ok((self.texture.clone().expect("made above"), aovs))
     }
 
     /// Writes the camera for a `width` × `height` image rendered at one
@@ -681,6 +783,108 @@ impl WgpuRenderer {
             .queue
             .write_buffer(&self.lights, 0, &floats(&packed));
     }
+}
+
+/// The scene's WGSL module for rendering with `options`.
+fn module(scene: &CompiledScene, options: &RenderOptions) -> Result<KernelSource> {
+    codegen::emit_wgsl(
+        scene,
+        &codegen::Options::default()
+            .quality(options.quality)
+            .effects(options.effects)
+            .target(Target::Render),
+    )
+}
+
+/// The device and queue [`WgpuRenderer::from_compiled`] renderers share,
+/// or why there is none.
+static SHARED: OnceLock<std::result::Result<(::wgpu::Device, ::wgpu::Queue), String>> =
+    OnceLock::new();
+
+/// The device and queue [`WgpuRenderer::from_compiled`] renderers share,
+/// found on the first call.
+fn shared_device() -> Result<(::wgpu::Device, ::wgpu::Queue)> {
+    let found = SHARED.get_or_init(|| {
+        let adapter = pollster::block_on(
+            instance().request_adapter(&::wgpu::RequestAdapterOptions::default()),
+        )
+        .map_err(|e| {
+            format!(
+                "no wgpu adapter (on Linux without a GPU, install Mesa's lavapipe: \
+                 `apt-get install mesa-vulkan-drivers`): {e}"
+            )
+        })?;
+        // The adapter's own limits: images and per-pixel buffers as large
+        // as it holds, not WebGPU's defaults (8192 pixels a side).
+        let descriptor = ::wgpu::DeviceDescriptor {
+            label: Some("fractal-sdf"),
+            required_limits: adapter.limits(),
+            ..::wgpu::DeviceDescriptor::default()
+        };
+        pollster::block_on(adapter.request_device(&descriptor))
+            .map_err(|e| format!("no wgpu device: {e}"))
+    });
+    found.clone().map_err(Error::Wgpu)
+}
+
+/// A render pipeline and the layout of its bind group.
+#[derive(Clone)]
+struct Pipeline {
+    compute: ::wgpu::ComputePipeline,
+    layout: ::wgpu::BindGroupLayout,
+}
+
+/// How many pipelines the cache keeps, the most recently used.
+const PIPELINE_CACHE_CAPACITY: usize = 64;
+
+/// The pipeline of `source` on `device`: on the shared device, from the
+/// cache of the pipelines built last (by source hash) where it is there;
+/// otherwise built by the driver (an application's own device is not
+/// kept alive by a cache). Returns whether it was built.
+fn pipeline(device: &::wgpu::Device, source: &KernelSource) -> Result<(Pipeline, bool)> {
+    static CACHE: Mutex<Vec<(u64, Pipeline)>> = Mutex::new(Vec::new());
+    let shared = matches!(SHARED.get(), Some(Ok((d, _))) if d == device);
+    let found = shared.then(|| {
+        let mut entries = CACHE.lock().unwrap_or_else(PoisonError::into_inner);
+        let at = entries.iter().position(|(hash, _)| *hash == source.hash)?;
+        // The most recently used last.
+        let entry = entries.remove(at);
+        let pipeline = entry.1.clone();
+        entries.push(entry);
+        Some(pipeline)
+    });
+    if let Some(pipeline) = found.flatten() {
+        return Ok((pipeline, false));
+    }
+    let pipeline = checked(device, "the render shader", || {
+        let module = device.create_shader_module(::wgpu::ShaderModuleDescriptor {
+            label: Some("fractal-sdf render"),
+            source: ::wgpu::ShaderSource::Wgsl(source.source.as_str().into()),
+        });
+        let layout = bind_group_layout(device);
+        let pipeline_layout = device.create_pipeline_layout(&::wgpu::PipelineLayoutDescriptor {
+            label: Some("fractal-sdf render"),
+            bind_group_layouts: &[Some(&layout)],
+            immediate_size: 0,
+        });
+        let compute = device.create_compute_pipeline(&::wgpu::ComputePipelineDescriptor {
+            label: Some("fractal-sdf render"),
+            layout: Some(&pipeline_layout),
+            module: &module,
+            entry_point: Some("render"),
+            compilation_options: ::wgpu::PipelineCompilationOptions::default(),
+            cache: None,
+        });
+        Pipeline { compute, layout }
+    })?;
+    if shared {
+        let mut entries = CACHE.lock().unwrap_or_else(PoisonError::into_inner);
+        if entries.len() >= PIPELINE_CACHE_CAPACITY {
+            entries.remove(0);
+        }
+        entries.push((source.hash, pipeline.clone()));
+    }
+    Ok((pipeline, true))
 }
 
 /// The render kernel's bindings (every one, including those a scene's
@@ -746,6 +950,10 @@ fn check_size(width: u32, height: u32) -> Result<()> {
 /// A row of `width` RGBA8 pixels, padded to wgpu's copy alignment.
 fn padded_row(width: u32) -> u32 {
     (4 * width).next_multiple_of(::wgpu::COPY_BYTES_PER_ROW_ALIGNMENT)
+}
+
+fn output_usage() -> ::wgpu::BufferUsages {
+    ::wgpu::BufferUsages::STORAGE | ::wgpu::BufferUsages::COPY_SRC
 }
 
 fn read_back() -> ::wgpu::BufferUsages {

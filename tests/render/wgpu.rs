@@ -125,6 +125,7 @@ fn parameters_camera_and_lights_change_the_picture_on_the_same_pipeline() {
     let scene = gpu::sphere_box_floor();
     let (w, h) = (64, 48);
     let mut r = WgpuRenderer::new(&scene, gpu::quick()).unwrap();
+    let builds = r.builds();
     let first = r.render(w, h).unwrap();
     assert_eq!(r.render(w, h).unwrap(), first, "rendering is deterministic");
     r.set_param("radius", 0.3).unwrap();
@@ -137,8 +138,22 @@ fn parameters_camera_and_lights_change_the_picture_on_the_same_pipeline() {
     r.set_lights([light]).unwrap();
     let moved = r.render(w, h).unwrap();
 
+    assert_eq!(r.builds(), builds, "frame-to-frame changes build nothing");
+
+    // A second renderer of the scene takes the pipeline from the cache.
     let mut fresh = WgpuRenderer::new(&scene, gpu::quick()).unwrap();
+    assert_eq!(fresh.builds(), 0, "the pipeline comes from the cache");
     fresh.set_param("radius", 0.3).unwrap();
+    assert_eq!(fresh.render(w, h).unwrap(), smaller);
+    // A quality change builds a new pipeline once; changing back finds
+    // the first in the cache.
+    let mut other = gpu::quick();
+    other.ao_samples += 1;
+    fresh.set_quality(other).unwrap();
+    assert_eq!(fresh.builds(), 1);
+    assert_ne!(fresh.render(w, h).unwrap(), smaller);
+    fresh.set_quality(gpu::quick()).unwrap();
+    assert_eq!(fresh.builds(), 1);
     assert_eq!(fresh.render(w, h).unwrap(), smaller);
     let built = scene.clone().with_camera(camera).with_lights([light]);
     let mut fresh = WgpuRenderer::new(&built, gpu::quick()).unwrap();
@@ -209,6 +224,18 @@ fn a_frame_rendered_into_a_texture_is_the_image() {
         .flat_map(|r| r[..4 * w as usize].to_vec())
         .collect();
     assert_eq!(pixels, image.into_raw());
+
+    // An image wider than the device's textures is the typed error
+    // with the limit, before anything is allocated.
+    let side = device.limits().max_texture_dimension_2d + 1;
+    if side <= fractal_sdf::render::MAX_IMAGE_SIDE {
+        match r.render(side, 1) {
+            Err(Error::Resolution { reason, .. }) => {
+                assert!(reason.contains(&(side - 1).to_string()), "{reason}");
+            }
+            other => panic!("expected the resolution error, got {other:?}"),
+        }
+    }
 
     // A texture of another format is the typed error, not a panic.
     let wrong = device.create_texture(&wgpu::TextureDescriptor {

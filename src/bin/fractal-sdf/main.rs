@@ -236,9 +236,10 @@ struct RenderArgs {
     #[arg(long, value_name = "FOOTPRINTS")]
     brute_step: Option<f64>,
     /// The backend that renders: opencl, or wgpu (WGSL on Vulkan, in
-    /// single precision; one frame of the image alone: no --aov, --passes,
-    /// --noise, --adaptive, --stereo or --gi, nor materials, environment
-    /// lights, lit fog or inside shapes, which need opencl).
+    /// single precision; one 8-bit frame of the image: no --aov, --bits
+    /// 16, .exr, --passes, --noise, --adaptive, --stereo, --gi, --device
+    /// or --devices, nor materials, environment lights, lit fog or inside
+    /// shapes, which need opencl).
     #[arg(long, value_enum, default_value_t = Backend::Opencl)]
     backend: Backend,
 }
@@ -622,6 +623,9 @@ fn render(args: &RenderArgs, settings: &Settings) -> Outcome {
             args.output.display()
         )));
     }
+    if args.backend == Backend::Wgpu {
+        return render_wgpu(args, &job);
+    }
     let stop = args
         .noise
         .map(|noise| StopRule::new(noise, args.passes.unwrap_or(NOISE_PASSES)));
@@ -633,9 +637,6 @@ fn render(args: &RenderArgs, settings: &Settings) -> Outcome {
             "note: the camera has a lens (aperture {aperture}), whose blur one pass leaves \
              grainy: --passes {LENS_PASSES} renders a smooth one in {LENS_PASSES} times the time"
         );
-    }
-    if args.backend == Backend::Wgpu {
-        return render_wgpu(args, &job);
     }
     let (width, height) = job.size;
     let start = Instant::now();
@@ -736,6 +737,7 @@ fn render_wgpu(args: &RenderArgs, job: &Job) -> Outcome {
         ("--stereo", args.stereo.is_some()),
         ("--gi", args.gi.is_some()),
         ("--devices", job.devices.is_some()),
+        ("--device", args.scene.device.is_some()),
     ];
     if let Some((option, _)) = opencl_only.iter().find(|(_, asked)| *asked) {
         return Err(usage(format!(
@@ -747,6 +749,13 @@ fn render_wgpu(args: &RenderArgs, job: &Job) -> Outcome {
             "--backend wgpu writes 8-bit images: write a .png, .jpg or .tif, or render the \
              .exr with the OpenCL backend",
         ));
+    }
+    let aperture = job.file.scene.camera.aperture;
+    if aperture > 0.0 {
+        eprintln!(
+            "note: the camera has a lens (aperture {aperture}), whose blur one pass leaves \
+             grainy: the OpenCL backend's --passes {LENS_PASSES} renders a smooth one"
+        );
     }
     let (width, height) = job.size;
     let start = Instant::now();
@@ -1020,7 +1029,26 @@ fn write_out(text: &str) -> Outcome {
 }
 
 fn list_devices() -> Outcome {
-    let all = devices()?;
+    // The wgpu backend's adapters (`render --backend wgpu`), whether or
+    // not OpenCL has a platform here.
+    let adapters = wgpu_adapters();
+    if adapters.is_empty() {
+        println!("wgpu: no adapter (on Linux, Mesa's lavapipe is mesa-vulkan-drivers)");
+    }
+    for a in &adapters {
+        println!(
+            "wgpu: {} ({:?}, {:?}, driver {} {})",
+            a.name, a.backend, a.device_type, a.driver, a.driver_info
+        );
+    }
+    let all = match devices() {
+        Ok(all) => all,
+        Err(e) if !adapters.is_empty() => {
+            println!("OpenCL: {e}");
+            return Ok(());
+        }
+        Err(e) => return Err(e.into()),
+    };
     for (i, d) in all.iter().enumerate() {
         println!(
             "{i}: {} / {} ({:?}, {} compute units, {} MiB, fp64: {}, {})",
@@ -1037,17 +1065,6 @@ fn list_devices() -> Outcome {
         "automatic choice: {}",
         DeviceSelector::auto().resolve()?.label()
     );
-    // The wgpu backend's adapters (`render --backend wgpu`).
-    let adapters = wgpu_adapters();
-    if adapters.is_empty() {
-        println!("wgpu: no adapter (on Linux, Mesa's lavapipe is mesa-vulkan-drivers)");
-    }
-    for a in adapters {
-        println!(
-            "wgpu: {} ({:?}, {:?}, driver {} {})",
-            a.name, a.backend, a.device_type, a.driver, a.driver_info
-        );
-    }
     Ok(())
 }
 
