@@ -415,7 +415,7 @@ fn emit_writes_a_scenes_functions_in_wgsl_and_refuses_double_precision() {
 
 /// `render --backend wgpu` writes the image on the Vulkan adapter (Mesa's
 /// lavapipe where there is no GPU), the picture the OpenCL backend draws;
-/// a double-precision preset, materials and options only the OpenCL
+/// a double-precision preset, a path-traced scene and options only the OpenCL
 /// backend has are errors that say so, exit code 1 or 2, and no image.
 #[test]
 fn render_on_the_wgpu_backend_writes_the_opencl_picture() {
@@ -465,23 +465,23 @@ fn render_on_the_wgpu_backend_writes_the_opencl_picture() {
         );
         assert!(!dir.join(output).exists());
     }
-    let materials = dir.join("m.png");
+    let path_traced = dir.join("gi.png");
     let out = run(
         &dir,
         "",
         &[
             "render",
-            "materials",
+            "gi",
             "--size",
             "16x12",
             "--backend",
             "wgpu",
             "-o",
-            materials.to_str().unwrap(),
+            path_traced.to_str().unwrap(),
         ],
     );
     assert_eq!(out.status.code(), Some(1), "{}", text(&out));
-    assert!(String::from_utf8_lossy(&out.stderr).contains("materials"));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("global illumination"));
 }
 
 #[test]

@@ -13,12 +13,14 @@
 // constants: REAL_TINY, NORMAL_EPSILON, SUPERSAMPLING, GAMMA,
 // EXPOSURE_SCALE, SKY_TOP, SKY_BOTTOM; ENABLE_AO with AO_SAMPLES and
 // AO_DISTANCE, ENABLE_SHADOWS with SHADOW_STEPS, ENABLE_FOG with
-// FOG_DENSITY (a constant that is false leaves its code unreachable);
+// FOG_DENSITY, ENABLE_MATERIALS with BOUNCES, DEFAULT_MATERIAL and each
+// value's lane MATERIAL_<value> (a constant that is false leaves its code
+// unreachable);
 // the buffer layouts CAMERA_<field>, LIGHT_<field> and LIGHT_STRIDE
 // (src/codegen/interface.rs, the tables the OpenCL kernel reads too);
 // display_color (the display transform, printed from
-// quality::display_formula); DE_shade, and glow_color where GLOW_NODES is
-// above 0.
+// quality::display_formula); DE_shade and DE_material, and glow_color
+// where GLOW_NODES is above 0.
 
 // Shading constants that are not quality knobs (march.cl's).
 const MARCH_AMBIENT: real = 0.5;      // strength of the sky's hemisphere light
@@ -233,6 +235,75 @@ fn march_facing(n: real3, rd: real3) -> real3 {
     return n;
 }
 
+// A material: its values in the lanes MATERIAL_<value> of a 4 x 4 matrix
+// (WGSL has no 16-vector), the lanes after them zero.
+alias real16 = mat4x4<f32>;
+
+// Lane i of a material.
+fn material_value(m: real16, i: int) -> real {
+    return m[i / 4][i % 4];
+}
+
+// The material a fraction t of the way from a to b, lane by lane, as
+// OpenCL's mix computes it.
+fn material_mix(a: real16, b: real16, t: real) -> real16 {
+    return a + (b - a) * t;
+}
+
+// t where c holds, else f (WGSL's select takes no matrices).
+fn material_select(f: real16, t: real16, c: bool) -> real16 {
+    if (c) {
+        return t;
+    }
+    return f;
+}
+
+// The sky seen along rd, where a reflected or refracted ray leaves the
+// scene or is cut off: SKY_BOTTOM straight down, SKY_TOP straight up.
+fn march_sky(rd: real3) -> real3 {
+    return mix(SKY_BOTTOM, SKY_TOP, clamp(0.5 + 0.5 * rd.y, 0.0, 1.0));
+}
+
+// Oren-Nayar's diffuse light for microfacet slopes spread by sigma,
+// relative to Lambert's (shade.cl's march_oren_nayar).
+fn march_oren_nayar(sigma: real, n: real3, l: real3, v: real3, ndl: real) -> real {
+    if (sigma <= 0.0) {
+        return 1.0;
+    }
+    let s2 = sigma * sigma;
+    let a = 1.0 - 0.5 * s2 / (s2 + 0.33);
+    let b = 0.45 * s2 / (s2 + 0.09);
+    // The view can sit just behind a normal taken by differences.
+    let ndv = clamp(dot(n, v), 1e-4, 1.0);
+    let lt = l - n * ndl;
+    let vt = v - n * ndv;
+    let norms = length(lt) * length(vt);
+    var cos_phi = 0.0;
+    if (norms > REAL_TINY) {
+        cos_phi = max(dot(lt, vt) / norms, 0.0);
+    }
+    let cos_alpha = min(ndl, ndv);
+    let cos_beta = max(ndl, ndv);
+    let sin_alpha = sqrt(max(1.0 - cos_alpha * cos_alpha, 0.0));
+    let tan_beta = sqrt(max(1.0 - cos_beta * cos_beta, 0.0)) / cos_beta;
+    return a + b * cos_phi * sin_alpha * tan_beta;
+}
+
+const MARCH_SCATTER_SAMPLES: int = 4; // DE calls of march_thinness
+
+// How thin the shape is below p, with outward normal n, down to depth: 0
+// where it is solid that deep, towards 1 where it ends sooner
+// (shade.cl's march_thinness).
+fn march_thinness(p: real3, n: real3, depth: real, evals: ptr<function, uint>) -> real {
+    var solid = 0.0;
+    for (var i = 1; i <= MARCH_SCATTER_SAMPLES; i++) {
+        let h = depth * real(i) / real(MARCH_SCATTER_SAMPLES);
+        solid += clamp(-DE(p - n * h) / h, 0.0, 1.0);
+    }
+    *evals += uint(MARCH_SCATTER_SAMPLES);
+    return 1.0 - solid / real(MARCH_SCATTER_SAMPLES);
+}
+
 // Ambient occlusion along the normal out to a reach that is AO_DISTANCE or
 // AO_VIEW_FRACTION of the view's height at p, whichever is shorter
 // (shade.cl's march_ambient_occlusion); 1 without it. Adds its
@@ -353,17 +424,44 @@ fn march_light(i: uint, p: real3) -> LightSample {
     return l;
 }
 
+// A lit surface: its colour, and the light it gives off (which no share
+// of reflection or transparency dims).
+struct Lit {
+    color: real3,
+    emitted: real3,
+}
+
 // Lit colour of the surface point p with normal n, seen along rd, with the
-// sky's light scaled by occlusion: Lambert plus a Blinn-Phong highlight
-// per light, through its shadow ray (shade.cl's march_shade without
-// materials). Adds its evaluations to *evals.
+// sky's light scaled by occlusion: per light, Lambert's or with a
+// material's roughness Oren-Nayar's diffuse term plus a Blinn-Phong
+// highlight, through its shadow ray; a material's subsurface light from
+// behind, and its emission apart (shade.cl's march_shade). Adds its
+// evaluations to *evals.
 fn march_shade(p: real3, n: real3, rd: real3, eps: real, occlusion: real,
-               evals: ptr<function, uint>) -> real3 {
+               evals: ptr<function, uint>) -> Lit {
+    var out: Lit;
+    out.emitted = real3(0.0);
     var albedo: real3;
     var trap: real2;
     DE_shade(p, &albedo, &trap);
     *evals += 1u;
     albedo *= march_trap_tint(trap.x);
+    var specular_strength = MARCH_SPECULAR;
+    var shininess = MARCH_SHININESS;
+    var material = DEFAULT_MATERIAL;
+    var through = 0.0;
+    if (ENABLE_MATERIALS) {
+        DE_material(p, &material);
+        *evals += 1u;
+        specular_strength = material_value(material, MATERIAL_SPECULAR);
+        shininess = material_value(material, MATERIAL_SHININESS);
+        let subsurface = material_value(material, MATERIAL_SUBSURFACE);
+        let depth = material_value(material, MATERIAL_SCATTER_DEPTH);
+        if (subsurface > 0.0 && depth > 0.0) {
+            through = subsurface * march_thinness(p, n, depth, evals);
+        }
+        out.emitted = albedo * material_value(material, MATERIAL_EMISSION);
+    }
     let sky = mix(SKY_BOTTOM, SKY_TOP, 0.5 + 0.5 * n.y);
     var color = albedo * sky * (MARCH_AMBIENT * occlusion);
     // Shadow rays start one hit threshold off the surface and are blocked
@@ -373,12 +471,20 @@ fn march_shade(p: real3, n: real3, rd: real3, eps: real, occlusion: real,
         let l = march_light(i, p);
         var radiance = l.radiance;
         let ndl = dot(n, l.to_light);
+        if (ENABLE_MATERIALS && ndl < 0.0) {
+            color += radiance * albedo * (through * -ndl);
+        }
         if (ndl <= 0.0) {
             continue;
         }
+        var diffuse = 1.0;
+        if (ENABLE_MATERIALS) {
+            diffuse = march_oren_nayar(material_value(material, MATERIAL_ROUGHNESS), n,
+                                       l.to_light, -rd, ndl);
+        }
         if (ENABLE_SHADOWS) {
             // The most this light adds to the pixel in any channel.
-            let most = radiance * ((albedo + MARCH_SPECULAR) * ndl);
+            let most = radiance * ((albedo * diffuse + specular_strength) * ndl);
             let visible = march_shadow(lifted, l.to_light, l.distance, 0.25 * eps, eps,
                                        lights[LIGHT_STRIDE * i + LIGHT_SOFTNESS],
                                        max(most.x, max(most.y, most.z)), evals);
@@ -388,8 +494,153 @@ fn march_shade(p: real3, n: real3, rd: real3, eps: real, occlusion: real,
             radiance *= visible;
         }
         let half_vector = normalize(l.to_light - rd);
-        let specular = MARCH_SPECULAR * pow(max(dot(n, half_vector), 0.0), MARCH_SHININESS);
-        color += radiance * (albedo * ndl + specular * ndl);
+        let specular = specular_strength * pow(max(dot(n, half_vector), 0.0), shininess);
+        color += radiance * (albedo * (diffuse * ndl) + specular * ndl);
+    }
+    out.color = color;
+    return out;
+}
+
+// A branch carrying less than this share of a pixel cannot change its
+// 8-bit value: it is not traced.
+const MARCH_FAINT: real = 0.001953125; // 2^-9
+
+// A reflected or refracted ray still to trace (optics.cl's MarchBranch).
+struct MarchBranch {
+    ro: real3,
+    rd: real3,
+    weight: real3,   // the share of the pixel's colour it brings
+    travelled: real, // the path's length before ro: sets the footprint
+    depth: int,      // bounces so far, this one included
+    inside: bool,    // whether it travels inside a transparent shape
+}
+
+// The share of light a clear surface reflects (Fresnel's equations for
+// unpolarised light; 1 on total internal reflection).
+fn march_fresnel(cos_i: real, ior: real) -> real {
+    let sin_t2 = (1.0 - cos_i * cos_i) / (ior * ior);
+    if (sin_t2 >= 1.0) {
+        return 1.0;
+    }
+    let cos_t = sqrt(1.0 - sin_t2);
+    let rs = (cos_i - ior * cos_t) / (cos_i + ior * cos_t);
+    let rp = (cos_t - ior * cos_i) / (cos_t + ior * cos_i);
+    return 0.5 * (rs * rs + rp * rp);
+}
+
+// rd refracted through a surface with unit normal n facing it, going from
+// index 1 to index 1 / eta; 0 on total internal reflection.
+fn march_refract(rd: real3, n: real3, eta: real) -> real3 {
+    let cos_i = -dot(n, rd);
+    let k = 1.0 - eta * eta * (1.0 - cos_i * cos_i);
+    if (k < 0.0) {
+        return real3(0.0);
+    }
+    return eta * rd + (eta * cos_i - sqrt(k)) * n;
+}
+
+// The branches of one pixel's path still to trace, depth first.
+struct Branches {
+    stack: array<MarchBranch, BRANCH_SLOTS>,
+    top: int,
+}
+
+// Adds a branch to the stack, or, a bounce too deep, returns the sky's
+// share it brings instead; branches too faint to show are dropped
+// (optics.cl's march_branch).
+fn march_branch(b: MarchBranch, branches: ptr<function, Branches>) -> real3 {
+    if (max(b.weight.x, max(b.weight.y, b.weight.z)) < MARCH_FAINT) {
+        return real3(0.0);
+    }
+    if (b.depth > BOUNCES || (*branches).top >= BOUNCES + 2) {
+        return b.weight * march_sky(b.rd);
+    }
+    (*branches).stack[(*branches).top] = b;
+    (*branches).top += 1;
+    return real3(0.0);
+}
+
+// Shares the path that reaches p (normal n, hit threshold eps) along rd,
+// t from the camera, carrying weight, after depth bounces, among the
+// surface's own colour, a reflected and a refracted ray (optics.cl's
+// march_split). Returns the colour it adds now; the rays go on the stack.
+fn march_split(p: real3, n: real3, rd: real3, eps: real, t: real, weight: real3, depth: int,
+               own: real3, emitted: real3, branches: ptr<function, Branches>,
+               evals: ptr<function, uint>) -> real3 {
+    var material: real16;
+    DE_material(p, &material);
+    *evals += 1u;
+    let r = material_value(material, MATERIAL_REFLECTIVITY);
+    let tau = material_value(material, MATERIAL_TRANSPARENCY);
+    let ior = material_value(material, MATERIAL_IOR);
+    var color = weight * (((1.0 - r) * (1.0 - tau)) * own + emitted);
+    var reflected = r;
+    if (tau > 0.0) {
+        let fresnel = march_fresnel(clamp(-dot(n, rd), 0.0, 1.0), ior);
+        let bent = march_refract(rd, n, 1.0 / ior);
+        let passed = (1.0 - r) * tau * (1.0 - fresnel);
+        if (dot(bent, bent) > 0.0) {
+            let b = MarchBranch(p - n * (2.0 * eps), normalize(bent), weight * passed, t,
+                                depth + 1, true);
+            color += march_branch(b, branches);
+        } else {
+            reflected += passed;
+        }
+        reflected += (1.0 - r) * tau * fresnel;
+    }
+    if (reflected > 0.0) {
+        let b = MarchBranch(p + n * (2.0 * eps), rd - 2.0 * dot(rd, n) * n,
+                            weight * reflected, t, depth + 1, false);
+        color += march_branch(b, branches);
+    }
+    return color;
+}
+
+// The colour of a pixel's path that first meets the surface at p: own
+// weighted by the surface's share, emitted whole, plus what its reflected
+// and refracted rays bring, each marched like a primary ray and lit alike,
+// depth first, at most BOUNCES deep (optics.cl's march_paths).
+fn march_paths(p: real3, n: real3, rd: real3, eps: real, t: real, cam: MarchCamera,
+               own: real3, emitted: real3, evals: ptr<function, uint>) -> real3 {
+    var branches: Branches;
+    branches.top = 0;
+    var color = march_split(p, n, rd, eps, t, real3(1.0), 0, own, emitted, &branches, evals);
+    while (branches.top > 0) {
+        branches.top -= 1;
+        let b = branches.stack[branches.top];
+        // The footprint goes on growing along the path.
+        let along = real2(march_footprint(cam.footprint, b.travelled), cam.footprint.y);
+        let m = march_ray(b.ro, b.rd, 0.0, along, select(1.0, -1.0, b.inside));
+        *evals += uint(m.steps);
+        if (!m.hit) {
+            color += b.weight * march_sky(b.rd);
+            continue;
+        }
+        let q = b.ro + b.rd * m.t;
+        let footprint = march_footprint(along, m.t);
+        let nq = march_normal(q, NORMAL_EPSILON * footprint, b.rd);
+        *evals += MARCH_NORMAL_EVALUATIONS;
+        let eq = DETAIL * footprint;
+        let travelled = b.travelled + m.t;
+        if (b.inside) {
+            var material: real16;
+            DE_material(q, &material);
+            *evals += 1u;
+            let out = march_refract(b.rd, -nq, material_value(material, MATERIAL_IOR));
+            var next = MarchBranch(q + nq * (2.0 * eq), normalize(out), b.weight, travelled,
+                                   b.depth + 1, false);
+            if (dot(out, out) <= 0.0) {
+                next.ro = q - nq * (2.0 * eq);
+                next.rd = b.rd - 2.0 * dot(b.rd, nq) * nq;
+                next.inside = true;
+            }
+            color += march_branch(next, &branches);
+            continue;
+        }
+        let occlusion = march_occlusion(q, nq, footprint * cam.image_h, 0.5, evals);
+        let lit = march_shade(q, nq, b.rd, eq, occlusion, evals);
+        color += march_split(q, nq, b.rd, eq, travelled, b.weight, b.depth, lit.color,
+                             lit.emitted, &branches, evals);
     }
     return color;
 }
@@ -443,7 +694,12 @@ fn shade_pixel(cam: MarchCamera, x: int, y: int, pixel: uint) -> Shaded {
                 view_height = FSDF_INFINITY;
             }
             let occlusion = march_occlusion(p, n, view_height, 0.5, &evals);
-            color = march_shade(p, n, rd, DETAIL * footprint, occlusion, &evals);
+            let lit = march_shade(p, n, rd, DETAIL * footprint, occlusion, &evals);
+            color = lit.color;
+            if (ENABLE_MATERIALS) {
+                color = march_paths(p, n, rd, DETAIL * footprint, m.t, cam, lit.color,
+                                    lit.emitted, &evals);
+            }
             if (ENABLE_FOG) {
                 // What the fog takes away, the sky puts back.
                 color = mix(background, color, exp(-march_fog_depth(m.t)));

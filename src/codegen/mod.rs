@@ -48,9 +48,7 @@ use crate::expr::{OpenCl, Unprintable};
 use crate::ir::{Bound, CompiledScene, Ir, Scalar, union_chain};
 use crate::math::{DEFAULT_COLOR, DERIVATIVE_CAP, MAGNITUDE_CAP, REAL_TINY};
 use crate::quality::{Effects, Precision, Quality, ScreenNormals};
-use crate::scene::{
-    BRUTE_MAX_STEPS, DEFAULT_MATERIAL, INSIDE_HUGE, Kind, MATERIAL_LEN, MATERIAL_SPECS,
-};
+use crate::scene::{BRUTE_MAX_STEPS, DEFAULT_MATERIAL, INSIDE_HUGE, Kind, MATERIAL_SPECS};
 
 /// What the generated program is for.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
@@ -762,16 +760,6 @@ fn kernel_with(options: &Options, bounded: bool, features: &Features) -> String 
     select_blocks(kernel, &on)
 }
 
-/// A material's values as the `real16` the kernels carry, the lanes after
-/// the last value zero.
-pub(crate) fn material_vector(values: [String; MATERIAL_LEN], zero: &str) -> String {
-    const LANES: usize = 16;
-    const _: () = assert!(MATERIAL_LEN <= LANES);
-    let zeros = std::iter::repeat_n(zero.to_string(), LANES - MATERIAL_LEN);
-    let lanes: Vec<String> = values.into_iter().chain(zeros).collect();
-    format!("(real16)({})", lanes.join(", "))
-}
-
 /// The coarse pass's tile side: none for evaluation, nor where inside
 /// shapes (which a cone cannot see) are marched by brute force.
 fn cone_tile(options: &Options, features: &Features) -> u32 {
@@ -1014,10 +1002,7 @@ fn header(w: &mut writer::Writer, options: &Options, features: &Features) {
         defines.push(("SCREEN_NORMALS", method.to_string()));
     }
     if materials {
-        defines.push((
-            "DEFAULT_MATERIAL",
-            material_vector(DEFAULT_MATERIAL.map(f), &f(0.0)),
-        ));
+        defines.push(("DEFAULT_MATERIAL", w.material(DEFAULT_MATERIAL.map(f))));
         defines.push(("BOUNCES", q.bounces.to_string()));
     }
     for (name, value) in defines {

@@ -17,6 +17,7 @@ use crate::expr::Wgsl;
 use crate::ir::{Bound, CompiledScene, Ir};
 use crate::math::{DEFAULT_COLOR, REAL_TINY};
 use crate::quality::Precision;
+use crate::scene::{DEFAULT_MATERIAL, Kind, MATERIAL_SPECS};
 
 /// The bind group and binding at which a WGSL module of [`emit_wgsl`]
 /// reads its parameter buffer, `var<storage, read> params: array<real>`:
@@ -93,7 +94,14 @@ pub fn emit_wgsl_ir(ir: &Ir, options: &Options) -> Result<KernelSource> {
         &mut body,
         options.quality.fractal_iterations,
     );
-    emitter.emit(false);
+    // Materials are shaded only by the renderer, and only scenes that set
+    // one pay for them.
+    let materials = options.target == Target::Render
+        && ir
+            .nodes()
+            .iter()
+            .any(|n| matches!(n, Kind::Material { .. }));
+    emitter.emit(materials);
     let count = ir.glows().len();
     if options.target == Target::Render && count > super::MAX_GLOW_NODES {
         return Err(super::too_many_glows(count));
@@ -164,7 +172,7 @@ pub fn emit_wgsl_ir(ir: &Ir, options: &Options) -> Result<KernelSource> {
             super::scene_bound(ir, options, origin),
             &glow,
         );
-        render(&mut w, options)?;
+        render(&mut w, options, materials)?;
     }
     unwritable(&w, Precision::F32)?;
     let source = w.finish();
@@ -276,7 +284,7 @@ fn march(w: &mut Writer, options: &Options, bound: Option<Bound>, glow: &Glow) {
 
 /// The shading's settings as constants, the buffer layouts, the display
 /// transform, then the render kernel (`kernels/wgsl/render.wgsl`).
-fn render(w: &mut Writer, options: &Options) -> Result<()> {
+fn render(w: &mut Writer, options: &Options, materials: bool) -> Result<()> {
     let (q, e) = (&options.quality, &options.effects);
     let on = Effect::enabled(options);
     w.line("/* ---- shading ---- */");
@@ -315,6 +323,26 @@ fn render(w: &mut Writer, options: &Options) -> Result<()> {
         "const FOG_DENSITY: real = {};",
         w.float(if fog { e.fog_density } else { 0.0 })
     ));
+    w.line(format!("const ENABLE_MATERIALS: bool = {materials};"));
+    w.line(format!("const BOUNCES: int = {};", q.bounces));
+    w.line(format!("const BRANCH_SLOTS: int = {};", q.bounces + 2));
+    w.line(format!(
+        "const DEFAULT_MATERIAL: real16 = {};",
+        w.material(DEFAULT_MATERIAL.map(|v| w.float(v)))
+    ));
+    for (i, spec) in MATERIAL_SPECS.iter().enumerate() {
+        w.line(format!(
+            "const MATERIAL_{}: int = {i};",
+            spec.name.to_uppercase()
+        ));
+    }
+    if !materials {
+        w.line("/* No materials: every surface has the default one. */");
+        w.line("fn DE_material(p0: real3, material: ptr<function, real16>) -> real {");
+        w.line("    *material = DEFAULT_MATERIAL;");
+        w.line("    return DE(p0);");
+        w.line("}");
+    }
     w.line("/* The kernel interface (src/codegen/interface.rs). */");
     w.raw(&interface::wgsl_constants());
     w.line("/* ---- display ---- */");

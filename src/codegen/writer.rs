@@ -9,6 +9,7 @@ use std::fmt::Write as _;
 use crate::expr::{OpenCl, Printer, Wgsl};
 use crate::ir::Scalar;
 use crate::quality::Precision;
+use crate::scene::MATERIAL_LEN;
 
 /// The language a [`Writer`] writes.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -20,8 +21,9 @@ pub(crate) enum Lang {
 /// The types the scene functions declare: each language's name for them
 /// (`real` and its vectors, `uint` and `int` are aliases in WGSL's
 /// prelude, which no local name of the scene functions can hide, as `u{i}`
-/// for node 32 would hide `u32`; WGSL has no `real16`, and the WGSL
-/// functions carry no materials).
+/// for node 32 would hide `u32`; WGSL has no 16-vector, and its
+/// `real16`, a material, is a 4 × 4 matrix, which the render module's
+/// `material_select` and `material_mix` choose and blend).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub(crate) enum Ty {
     Real,
@@ -244,6 +246,36 @@ impl Writer {
         match self.lang {
             Lang::OpenCl => format!("({})({parts})", self.ty(ty)),
             Lang::Wgsl => format!("{}({parts})", self.ty(ty)),
+        }
+    }
+
+    /// A material of `values` (the lanes after them zero).
+    pub(crate) fn material(&self, values: [String; MATERIAL_LEN]) -> String {
+        const LANES: usize = 16;
+        const _: () = assert!(MATERIAL_LEN <= LANES);
+        let zero = self.float(0.0);
+        let lanes: Vec<String> = values
+            .into_iter()
+            .chain(std::iter::repeat_n(zero, LANES - MATERIAL_LEN))
+            .collect();
+        let parts: Vec<&str> = lanes.iter().map(String::as_str).collect();
+        self.construct(Ty::Real16, &parts)
+    }
+
+    /// The value of type `ty` a fraction `m` of the way from `a` to `b`:
+    /// `a + (b - a) m`, lane by lane.
+    pub(crate) fn mix(&self, ty: Ty, a: &str, b: &str, m: &str) -> String {
+        match (self.lang, ty) {
+            (Lang::Wgsl, Ty::Real16) => format!("material_mix({a}, {b}, {m})"),
+            _ => format!("mix({a}, {b}, {m})"),
+        }
+    }
+
+    /// Of type `ty`, `a` where `c` holds, else `b`.
+    pub(crate) fn select_typed(&self, ty: Ty, c: &str, a: &str, b: &str) -> String {
+        match (self.lang, ty) {
+            (Lang::Wgsl, Ty::Real16) => format!("material_select({b}, {a}, {c})"),
+            _ => self.select(c, a, b),
         }
     }
 

@@ -9,9 +9,10 @@
 //! (`kernels/wgsl/render.wgsl` is the OpenCL kernel's march and shading,
 //! line for line): the march with glow and glow nodes, tetrahedral
 //! normals, ambient occlusion, hard and soft shadows, every light kind,
-//! uniform fog, supersampling, depth of field and the resolution scale.
-//! What it does not draw yet it refuses with [`Error::Unsupported`]
-//! rather than draw something else: materials, global illumination, an
+//! uniform fog, materials (shading models, emission, subsurface light,
+//! reflections and transparency), supersampling, depth of field and the
+//! resolution scale. What it does not draw yet it refuses with
+//! [`Error::Unsupported`] rather than draw something else: global illumination, an
 //! environment light, lit (volumetric) fog, inside shapes, double
 //! precision and custom shapes written in OpenCL C. It leaves out what
 //! changes only the speed: the coarse cone pass
@@ -45,7 +46,7 @@ use crate::codegen::{self, KernelSource, Target};
 use crate::error::{Error, Result};
 use crate::ir::{CompiledScene, ParamValues};
 use crate::quality::{Effects, Precision, Quality};
-use crate::scene::{Camera, Kind, Light, Scene};
+use crate::scene::{Camera, Light, Scene};
 
 /// The side of the render kernel's workgroups (`@workgroup_size(8, 8)`).
 const WORKGROUP: u32 = 8;
@@ -180,16 +181,6 @@ fn refuse(scene: &CompiledScene, options: &RenderOptions) -> Result<()> {
         what: what.into(),
         instead: "render it with the OpenCL backend".into(),
     };
-    let materials = scene
-        .ir()
-        .nodes()
-        .iter()
-        .any(|n| matches!(n, Kind::Material { .. }));
-    if materials {
-        return Err(unsupported(
-            "render materials (reflections, transparency, shading models) yet",
-        ));
-    }
     if options.effects.global_illumination.is_some() {
         return Err(unsupported("path-trace global illumination yet"));
     }

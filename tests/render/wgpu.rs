@@ -34,8 +34,8 @@ fn options(file: &fractal_sdf::file::SceneFile) -> RenderOptions {
 /// the same picture: PSNR at least 40 dB and at most 0.1% of the pixels'
 /// hit flags different (measured at 640×480 by `examples/backends.rs`:
 /// 41.5 to 71.5 dB, at most 0.002% of the hit flags). The scenes it
-/// refuses are those with materials or inside shapes, each with the typed
-/// error.
+/// refuses are those path-traced or with inside shapes, each with the
+/// typed error.
 #[test]
 fn every_gallery_scene_it_draws_is_the_opencl_picture() {
     if !backends() {
@@ -47,7 +47,7 @@ fn every_gallery_scene_it_draws_is_the_opencl_picture() {
         let file = fractal_sdf::gallery::file(name).expect("a gallery scene");
         let compiled = file.scene.compile().expect("gallery scenes compile");
         let options = options(&file);
-        let refusable = compiled.ir().has_inside_shapes() || name == "materials" || name == "gi";
+        let refusable = compiled.ir().has_inside_shapes() || name == "gi";
         let mut wgpu = match WgpuRenderer::from_compiled(compiled.clone(), &options) {
             Ok(r) => r,
             Err(Error::Unsupported { what, .. }) if refusable => {
@@ -99,15 +99,19 @@ fn double_precision_is_refused_with_the_way_to_deep_zoom() {
     }
 }
 
-/// Materials are the OpenCL backend's alone, for now: a typed error, not
-/// a picture without them.
+/// Global illumination is the OpenCL backend's alone, for now: a typed
+/// error, not a picture without it.
 #[test]
-fn materials_are_refused_rather_than_drawn_without() {
+fn global_illumination_is_refused_rather_than_drawn_without() {
     let glass = sphere(1.0).material(Material::glass(1.5));
     let scene = Scene::new(glass).compile().unwrap();
-    match WgpuRenderer::from_compiled(scene, &RenderOptions::default()) {
+    let mut options = RenderOptions::default();
+    options.effects = options
+        .effects
+        .global_illumination(fractal_sdf::quality::GlobalIllumination::default());
+    match WgpuRenderer::from_compiled(scene, &options) {
         Err(Error::Unsupported { what, instead, .. }) => {
-            assert!(what.contains("materials"), "{what}");
+            assert!(what.contains("global illumination"), "{what}");
             assert!(instead.contains("OpenCL"), "{instead}");
         }
         other => panic!("expected the unsupported error, got {other:?}"),

@@ -213,10 +213,10 @@ impl<'a> SceneEmitter<'a> {
             return a.to_string();
         }
         let (first, second) = match blend {
-            Some(m) => (format!("mix({a}, {b}, {m})"), format!("mix({b}, {a}, {m})")),
+            Some(m) => (self.w.mix(ty, a, b, m), self.w.mix(ty, b, a, m)),
             None => (a.to_string(), b.to_string()),
         };
-        let value = self.w.select(near, &first, &second);
+        let value = self.w.select_typed(ty, near, &first, &second);
         self.w.declare(ty, var, &value);
         var.to_string()
     }

@@ -260,10 +260,6 @@ impl<'a> SceneEmitter<'a> {
 
     /// Writes `DE` and `DE_shade`, and `DE_material` with `materials`.
     pub(crate) fn emit(&mut self, materials: bool) {
-        debug_assert!(
-            !materials || self.w.lang() == Lang::OpenCl,
-            "WGSL has no real16 for materials"
-        );
         let functions = [(false, false), (true, false), (true, true)];
         for (shade, material) in functions.into_iter().take(if materials { 3 } else { 2 }) {
             self.shade = shade;
@@ -1160,7 +1156,7 @@ impl<'a> SceneEmitter<'a> {
                 self.label(id);
                 let v = vars(id);
                 let values = material.values().map(|s| self.w.scalar(*s));
-                let values = super::material_vector(values, &self.w.float(0.0));
+                let values = self.w.material(values);
                 self.w.declare(Ty::Real16, &v.c, &values);
                 Vars { c: v.c, ..c }
             }
