@@ -34,18 +34,21 @@
 //!     them.
 //! 16. [Performance](performance): the benchmark, render speed, and what
 //!     makes rendering faster at the same image.
-//! 17. [Reliability](reliability): hostile input, the values each
+//! 17. [Backends](backends): OpenCL and wgpu, choosing one, rendering into
+//!     an application's texture, and the two compared.
+//! 18. [Reliability](reliability): hostile input, the values each
 //!     precision holds, and numerical limits.
-//! 18. [How it is tested](how_it_is_tested): oracles, tolerances and
+//! 19. [How it is tested](how_it_is_tested): oracles, tolerances and
 //!     mutation testing.
-//! 19. [Packaging](packaging): the package, its check, docs.rs, the
+//! 20. [Packaging](packaging): the package, its check, docs.rs, the
 //!     minimum Rust and versions.
-//! 20. [Architecture](architecture): where the design is described.
+//! 21. [Architecture](architecture): where the design is described.
 
-// Chapters link to `render` (feature `opencl`) and `testing` (feature
-// `proptest`); without those features the links have no target.
+// Chapters link to `render` (feature `opencl`, and `wgpu` for its wgpu
+// backend) and `testing` (feature `proptest`); without those features the
+// links have no target.
 #![cfg_attr(
-    not(all(feature = "opencl", feature = "proptest")),
+    not(all(feature = "opencl", feature = "proptest", feature = "wgpu")),
     allow(rustdoc::broken_intra_doc_links)
 )]
 
@@ -96,6 +99,9 @@ pub mod custom_shapes {}
 
 #[doc = include_str!("../docs/guide/performance.md")]
 pub mod performance {}
+
+#[doc = include_str!("../docs/guide/backends.md")]
+pub mod backends {}
 
 #[doc = include_str!("../docs/guide/reliability.md")]
 pub mod reliability {}

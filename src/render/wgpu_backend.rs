@@ -102,9 +102,23 @@ struct Gpu {
 }
 
 /// A renderer on the wgpu backend: [`Renderer`](super::Renderer)'s calls
-/// for a frame (parameters, camera, lights, [`render`](Self::render)),
-/// on a wgpu device. Changing a dynamic parameter, the camera or the
-/// lights writes a buffer: the pipeline is built once.
+/// for a frame (parameters, camera, lights, quality, effects,
+/// [`render`](Self::render)), on a wgpu device, drawing the OpenCL
+/// backend's picture from the scene compiled to WGSL. Changing a dynamic
+/// parameter, the camera or the lights writes a buffer: the pipeline is
+/// built once. What it draws and what it refuses, and how it compares:
+/// the [backends chapter](crate::guide::backends).
+///
+/// ```no_run
+/// use fractal_sdf::prelude::*;
+/// use fractal_sdf::render::WgpuRenderer;
+///
+/// let scene = Scene::new(mandelbulb(8.0))
+///     .with_camera(Camera::look_at(dvec3(0.0, 0.5, 3.0), DVec3::ZERO));
+/// let mut renderer = WgpuRenderer::new(&scene, Quality::preview())?;
+/// renderer.render(320, 240)?.save("bulb.png")?;
+/// # Ok::<(), Box<dyn std::error::Error>>(())
+/// ```
 pub struct WgpuRenderer {
     scene: CompiledScene,
     options: RenderOptions,
@@ -219,7 +233,7 @@ impl WgpuRenderer {
     ///
     /// # Errors
     /// [`Error::Unsupported`] for what the backend does not draw (see the
-    /// [module](self)), double precision among it; [`Error::Wgpu`] where
+    /// [backends chapter](crate::guide::backends)), double precision among it; [`Error::Wgpu`] where
     /// wgpu finds no adapter or the driver rejects the shader; quality,
     /// effects and input errors as [`Renderer::from_compiled`](super::Renderer::from_compiled).
     pub fn from_compiled(scene: CompiledScene, options: &RenderOptions) -> Result<Self> {
