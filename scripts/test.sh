@@ -52,9 +52,9 @@ step "$CARGO" clippy --all-targets --all-features -- -D warnings
 # that use them.)
 step "$CARGO" check --all-targets
 step "$CARGO" hack clippy --each-feature -- -D warnings
-# The binary tests/viewer_smoke.rs runs (`cargo test` builds examples only as
+# The binaries tests/viewer_smoke.rs runs (`cargo test` builds examples only as
 # test harnesses); the test profile shares the library build with the tests.
-step "$CARGO" build --profile test --all-features --example viewer
+step "$CARGO" build --profile test --all-features --example viewer --example wgpu_window
 step "$CARGO" test --all-targets --all-features
 step "$CARGO" test --doc --all-features
 # The features docs.rs documents (`[package.metadata.docs.rs]`: all of them).

@@ -5,8 +5,12 @@
 //! one is reported (stderr and the title) while the last good scene stays,
 //! and a settings file's size, preset and key bindings are honoured.
 //!
-//! Needs the example binary, built by `cargo build --profile test
-//! --all-features --example viewer` (as `make test` does first), and
+//! The wgpu window example (`examples/wgpu_window.rs`) likewise shows its
+//! first frame.
+//!
+//! Needs the example binaries, built by `cargo build --profile test
+//! --all-features --example viewer --example wgpu_window` (as `make test`
+//! does first), and
 //! `Xvfb` and `xdotool` (`make setup` installs them). Without them the tests print a note and
 //! pass, except under `CI=true`, where they fail.
 #![cfg(feature = "viewer")]
@@ -88,6 +92,83 @@ fn viewer_binary() -> PathBuf {
         path.display()
     );
     path
+}
+
+/// The wgpu window example next to this test binary, built after the last
+/// change to the library, the kernels or the example.
+#[cfg(feature = "wgpu")]
+fn wgpu_window_binary() -> PathBuf {
+    const BUILD: &str = "cargo build --profile test --all-features --example wgpu_window";
+    let exe = std::env::current_exe().expect("the test binary's path");
+    let profile_dir = exe
+        .parent()
+        .and_then(Path::parent)
+        .expect("tests run from target/PROFILE/deps");
+    let path = profile_dir.join("examples/wgpu_window");
+    let built = std::fs::metadata(&path).and_then(|m| m.modified());
+    let built = built.unwrap_or_else(|_| panic!("{} is missing: run `{BUILD}`", path.display()));
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let sources = ["src", "kernels", "examples/wgpu_window.rs"]
+        .map(|d| newest(&root.join(d)))
+        .into_iter()
+        .max()
+        .unwrap_or(UNIX_EPOCH);
+    assert!(
+        built >= sources,
+        "{} is older than the sources: run `{BUILD}`",
+        path.display()
+    );
+    path
+}
+
+/// The wgpu window example on the virtual X server: its first frame, read
+/// back from the window's surface, is the picture the wgpu renderer draws
+/// of the same scene into an image (the texture drawn onto the surface
+/// texel for texel), and it is not blank.
+#[cfg(feature = "wgpu")]
+#[test]
+fn the_wgpu_window_shows_the_rendered_frame() {
+    if !have("Xvfb") {
+        return;
+    }
+    let x = Xvfb::start();
+    let dir = scratch("wgpu-window");
+    let file = dir.join("first.png");
+    let out = x
+        .command(wgpu_window_binary())
+        .args(["--frames", "3", "--screenshot"])
+        .arg(&file)
+        .output()
+        .expect("the example runs");
+    assert!(
+        out.status.success(),
+        "wgpu_window failed: {}\n{}",
+        String::from_utf8_lossy(&out.stdout),
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let shown = image::open(&file).expect("a screenshot").to_rgba8();
+    gpu::save("wgpu_window_first", &shown);
+    assert_eq!(shown.dimensions(), (320, 240));
+    let c = contrast(&shown);
+    assert!(
+        c > 10.0,
+        "the window looks blank (luminance deviation {c:.1})"
+    );
+
+    // The example's scene, rendered into an image.
+    use fractal_sdf::prelude::*;
+    let mut file = fractal_sdf::gallery::file("mandelbulb").unwrap();
+    file.scene.geometry =
+        Some(mandelbulb(fractal_sdf::scene::param("power", 8.0)).color(dvec3(0.85, 0.65, 0.45)));
+    let mut options = fractal_sdf::render::RenderOptions::default();
+    options.quality = Quality::preview().resolution_scale(1);
+    options.effects = file.effects;
+    let mut renderer =
+        fractal_sdf::render::WgpuRenderer::from_compiled(file.scene.compile().unwrap(), &options)
+            .unwrap();
+    let drawn = renderer.render(320, 240).unwrap();
+    let db = fractal_sdf::metrics::psnr(&shown, &drawn);
+    assert!(db >= 50.0, "the window shows another picture ({db:.1} dB)");
 }
 
 /// Whether `tool` runs; if not, a note (or, in CI, a failure).
