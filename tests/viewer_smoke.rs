@@ -37,8 +37,6 @@ fn in_ci() -> bool {
     std::env::var("CI").is_ok_and(|v| v == "true" || v == "1")
 }
 
-const BUILD: &str = "cargo build --profile test --all-features --example viewer";
-
 /// The newest modification time of the file `path` or of the files under
 /// it.
 fn newest(path: &Path) -> SystemTime {
@@ -67,58 +65,51 @@ fn newest(path: &Path) -> SystemTime {
         .unwrap_or(UNIX_EPOCH)
 }
 
-/// The viewer example next to this test binary (`target/PROFILE/examples`),
-/// built after the last change to what it is built from: the library, the
-/// kernels, the example and the examples' shared code (not the other
-/// examples, whose changes cargo rightly does not rebuild it for).
-fn viewer_binary() -> PathBuf {
+/// The example `name` next to this test binary (`target/PROFILE/examples`),
+/// built after the last change to `sources` (the library, the kernels,
+/// the example and what it shares with others; not the other examples,
+/// whose changes cargo rightly does not rebuild it for).
+fn example_binary(name: &str, sources: &[&str]) -> PathBuf {
+    let build = format!("cargo build --profile test --all-features --example {name}");
     let exe = std::env::current_exe().expect("the test binary's path");
     let profile_dir = exe
         .parent()
         .and_then(Path::parent)
         .expect("tests run from target/PROFILE/deps");
-    let path = profile_dir.join("examples/viewer");
+    let path = profile_dir.join("examples").join(name);
     let built = std::fs::metadata(&path).and_then(|m| m.modified());
-    let built = built.unwrap_or_else(|_| panic!("{} is missing: run `{BUILD}`", path.display()));
+    let built = built.unwrap_or_else(|_| panic!("{} is missing: run `{build}`", path.display()));
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
-    let sources = ["src", "kernels", "examples/viewer", "examples/common"]
+    let sources = sources
+        .iter()
         .map(|d| newest(&root.join(d)))
-        .into_iter()
         .max()
         .unwrap_or(UNIX_EPOCH);
     assert!(
         built >= sources,
-        "{} is older than the sources: run `{BUILD}`",
+        "{} is older than the sources: run `{build}`",
         path.display()
     );
     path
 }
 
-/// The wgpu window example next to this test binary, built after the last
-/// change to the library, the kernels or the example.
+/// The viewer example, built after the last change to what it is built
+/// from.
+fn viewer_binary() -> PathBuf {
+    example_binary(
+        "viewer",
+        &["src", "kernels", "examples/viewer", "examples/common"],
+    )
+}
+
+/// The wgpu window example, built after the last change to the library,
+/// the kernels or the example.
 #[cfg(feature = "wgpu")]
 fn wgpu_window_binary() -> PathBuf {
-    const BUILD: &str = "cargo build --profile test --all-features --example wgpu_window";
-    let exe = std::env::current_exe().expect("the test binary's path");
-    let profile_dir = exe
-        .parent()
-        .and_then(Path::parent)
-        .expect("tests run from target/PROFILE/deps");
-    let path = profile_dir.join("examples/wgpu_window");
-    let built = std::fs::metadata(&path).and_then(|m| m.modified());
-    let built = built.unwrap_or_else(|_| panic!("{} is missing: run `{BUILD}`", path.display()));
-    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
-    let sources = ["src", "kernels", "examples/wgpu_window.rs"]
-        .map(|d| newest(&root.join(d)))
-        .into_iter()
-        .max()
-        .unwrap_or(UNIX_EPOCH);
-    assert!(
-        built >= sources,
-        "{} is older than the sources: run `{BUILD}`",
-        path.display()
-    );
-    path
+    example_binary(
+        "wgpu_window",
+        &["src", "kernels", "examples/wgpu_window.rs"],
+    )
 }
 
 /// The wgpu window example on the virtual X server: its first frame, read

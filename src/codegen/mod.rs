@@ -365,13 +365,7 @@ pub fn emit_ir(ir: &Ir, options: &Options) -> Result<KernelSource> {
         &mut body,
         options.quality.fractal_iterations,
     );
-    // Materials are shaded only by the renderer, and only scenes that set
-    // one pay for them.
-    let materials = options.target == Target::Render
-        && ir
-            .nodes()
-            .iter()
-            .any(|n| matches!(n, Kind::Material { .. }));
+    let materials = shades_materials(ir, options);
     emitter.emit(materials);
     let count = ir.glows().len();
     if options.target == Target::Render && count > 0 && ir.has_inside_shapes() {
@@ -450,6 +444,16 @@ pub fn emit_ir(ir: &Ir, options: &Options) -> Result<KernelSource> {
     kernel.constants = constants;
     kernel.tables = tables;
     Ok(kernel)
+}
+
+/// Whether the program shades materials (`DE_material`): only a renderer
+/// does, and only for a scene that sets one.
+fn shades_materials(ir: &Ir, options: &Options) -> bool {
+    options.target == Target::Render
+        && ir
+            .nodes()
+            .iter()
+            .any(|n| matches!(n, Kind::Material { .. }))
 }
 
 /// Writes the helpers the scene functions `emitter` wrote call, in the

@@ -17,7 +17,7 @@ use crate::expr::Wgsl;
 use crate::ir::{Bound, CompiledScene, Ir};
 use crate::math::{DEFAULT_COLOR, REAL_TINY};
 use crate::quality::Precision;
-use crate::scene::{DEFAULT_MATERIAL, Kind, MATERIAL_SPECS};
+use crate::scene::{DEFAULT_MATERIAL, MATERIAL_SPECS};
 
 /// The bind group and binding at which a WGSL module of [`emit_wgsl`]
 /// reads its parameter buffer, `var<storage, read> params: array<real>`:
@@ -94,13 +94,7 @@ pub fn emit_wgsl_ir(ir: &Ir, options: &Options) -> Result<KernelSource> {
         &mut body,
         options.quality.fractal_iterations,
     );
-    // Materials are shaded only by the renderer, and only scenes that set
-    // one pay for them.
-    let materials = options.target == Target::Render
-        && ir
-            .nodes()
-            .iter()
-            .any(|n| matches!(n, Kind::Material { .. }));
+    let materials = super::shades_materials(ir, options);
     emitter.emit(materials);
     let count = ir.glows().len();
     if options.target == Target::Render && count > super::MAX_GLOW_NODES {

@@ -182,18 +182,8 @@ fn a_frame_rendered_into_a_texture_is_the_image() {
     let image = r.render(w, h).unwrap();
     let device = r.device().clone();
     let texture = device.create_texture(&wgpu::TextureDescriptor {
-        label: None,
-        size: wgpu::Extent3d {
-            width: w,
-            height: h,
-            depth_or_array_layers: 1,
-        },
-        mip_level_count: 1,
-        sample_count: 1,
-        dimension: wgpu::TextureDimension::D2,
-        format: WGPU_TEXTURE_FORMAT,
         usage: wgpu::TextureUsages::STORAGE_BINDING | wgpu::TextureUsages::COPY_SRC,
-        view_formats: &[],
+        ..texture_descriptor(w, h)
     });
     let view = texture.create_view(&wgpu::TextureViewDescriptor::default());
     r.render_to_texture(&view, w, h).unwrap();
