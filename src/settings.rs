@@ -14,6 +14,7 @@
 //! preset = "preview"      # draft, preview, production or reference
 //! size = "800x600"        # images and the viewer's window
 //! device = "pthread"      # a substring of an OpenCL device's name
+//! backend = "opencl"      # or "wgpu": the command's `render --backend`
 //!
 //! [viewer]
 //! mouse_sensitivity = 0.004   # radians per pixel
@@ -29,6 +30,9 @@
 //! assert_eq!(s.preset, Some(fractal_sdf::quality::Preset::Draft));
 //! assert_eq!(s.viewer.mouse_sensitivity, Some(0.01));
 //! assert!(Settings::parse("presett = 1").is_err());
+//! use fractal_sdf::settings::Backend;
+//! assert_eq!(Settings::parse("backend = \"wgpu\"")?.backend, Some(Backend::Wgpu));
+//! assert!(Settings::parse("backend = \"metal\"").is_err());
 //! # Ok::<(), fractal_sdf::Error>(())
 //! ```
 
@@ -59,9 +63,40 @@ pub struct Settings {
     /// A substring of the OpenCL device's name.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub device: Option<String>,
+    /// The backend the command renders with (`"opencl"` or `"wgpu"`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub backend: Option<Backend>,
     /// The viewer's settings.
     #[serde(default)]
     pub viewer: ViewerSettings,
+}
+
+/// A backend that renders: the OpenCL executor
+/// ([`Renderer`](crate::render::Renderer)) or the wgpu one
+/// ([`WgpuRenderer`](crate::render::WgpuRenderer), feature `wgpu`).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+#[non_exhaustive]
+pub enum Backend {
+    /// OpenCL C on an OpenCL device.
+    #[default]
+    OpenCl,
+    /// WGSL through wgpu.
+    Wgpu,
+}
+
+impl Backend {
+    /// Every backend.
+    pub const ALL: [Backend; 2] = [Backend::OpenCl, Backend::Wgpu];
+
+    /// Its name in settings files and on the command line.
+    #[must_use]
+    pub fn name(self) -> &'static str {
+        match self {
+            Backend::OpenCl => "opencl",
+            Backend::Wgpu => "wgpu",
+        }
+    }
 }
 
 /// The interactive viewer's settings.

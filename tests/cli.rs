@@ -442,6 +442,50 @@ fn render_on_the_wgpu_backend_writes_the_opencl_picture() {
     );
     let out = with(&["--preset", "preview"], "opencl.png");
     assert!(out.status.success(), "{}", text(&out));
+    // The settings file chooses the backend where the command line does
+    // not.
+    let chosen = dir.join("chosen.png");
+    let out = run(
+        &dir,
+        "backend = \"wgpu\"\n",
+        &[
+            "render",
+            "csg",
+            "--size",
+            "32x24",
+            "-o",
+            chosen.to_str().unwrap(),
+        ],
+    );
+    assert!(out.status.success(), "{}", text(&out));
+    assert!(
+        String::from_utf8_lossy(&out.stdout).contains("(wgpu)"),
+        "{}",
+        text(&out)
+    );
+    // And `bench` times either.
+    let out = run(
+        &dir,
+        "",
+        &[
+            "bench",
+            "csg",
+            "--size",
+            "32x24",
+            "--preset",
+            "draft",
+            "--frames",
+            "2",
+            "--backend",
+            "wgpu",
+        ],
+    );
+    assert!(out.status.success(), "{}", text(&out));
+    let report = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        report.contains("(wgpu)") && report.contains("ms/frame median of 2"),
+        "{report}"
+    );
     let wgpu = image::open(dir.join("wgpu.png")).unwrap().to_rgba8();
     let opencl = image::open(dir.join("opencl.png")).unwrap().to_rgba8();
     let db = fractal_sdf::metrics::psnr(&wgpu, &opencl);

@@ -26,7 +26,7 @@ use fractal_sdf::render::{
 };
 use fractal_sdf::scene::{CustomShape, Environment, Stereo, StereoLayout};
 use fractal_sdf::sequence::{Encoded, MotionBlur, Sequence, parse_range};
-use fractal_sdf::settings::{CONFIG_ENV, Settings, parse_preset, parse_size};
+use fractal_sdf::settings::{self, CONFIG_ENV, Settings, parse_preset, parse_size};
 use indicatif::{ProgressBar, ProgressStyle};
 
 /// Render signed-distance scenes and 3D fractals with OpenCL.
@@ -238,17 +238,27 @@ struct RenderArgs {
     /// The backend that renders: opencl, or wgpu (WGSL on Vulkan, in
     /// single precision; one 8-bit frame of the image: no --aov, --bits
     /// 16, .exr, --passes, --noise, --adaptive, --stereo, --gi, --device
-    /// or --devices, nor materials, environment lights, lit fog or inside
-    /// shapes, which need opencl).
-    #[arg(long, value_enum, default_value_t = Backend::Opencl)]
-    backend: Backend,
+    /// or --devices, nor environment lights, lit fog or inside shapes,
+    /// which need opencl). Default: the settings file's, else opencl.
+    #[arg(long, value_enum)]
+    backend: Option<Backend>,
 }
 
-/// The backends `render` renders with.
+/// The backends `render` and `bench` render with.
 #[derive(Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
 enum Backend {
     Opencl,
     Wgpu,
+}
+
+impl Backend {
+    /// The backend asked for, else the settings file's, else OpenCL.
+    fn chosen(asked: Option<Backend>, settings: &Settings) -> Backend {
+        asked.unwrap_or(match settings.backend {
+            Some(settings::Backend::Wgpu) => Backend::Wgpu,
+            _ => Backend::Opencl,
+        })
+    }
 }
 
 impl RenderArgs {
@@ -367,6 +377,11 @@ struct BenchArgs {
     /// other (each a program of its own).
     #[arg(long)]
     stages: bool,
+    /// The backend to time: opencl or wgpu (default: the settings file's,
+    /// else opencl). The operation count and the share of the device's
+    /// peak are measured on OpenCL devices alone.
+    #[arg(long, value_enum)]
+    backend: Option<Backend>,
 }
 
 /// A failure and the exit code it gets: 2 for a command line that cannot
@@ -623,7 +638,7 @@ fn render(args: &RenderArgs, settings: &Settings) -> Outcome {
             args.output.display()
         )));
     }
-    if args.backend == Backend::Wgpu {
+    if Backend::chosen(args.backend, settings) == Backend::Wgpu {
         return render_wgpu(args, &job);
     }
     let stop = args
@@ -1086,17 +1101,66 @@ impl Timed {
 }
 
 /// Counts one frame's evaluations, then times `frames` more.
-fn time_frames(renderer: &mut Renderer, size: (u32, u32), frames: u32) -> Result<Timed, Failure> {
+/// A renderer of either backend, as `bench` times it.
+trait Timing {
+    /// Renders a frame and returns each pixel's evaluations: all, and the
+    /// primary march's.
+    fn costs(&mut self, width: u32, height: u32) -> fractal_sdf::Result<(Vec<u32>, Vec<u32>)>;
+    /// Renders a frame.
+    fn frame(&mut self, width: u32, height: u32) -> fractal_sdf::Result<()>;
+    /// The options it renders with.
+    fn options(&self) -> &RenderOptions;
+    /// Sets the effects.
+    fn set_effects(&mut self, effects: Effects) -> fractal_sdf::Result<()>;
+}
+
+impl Timing for Renderer {
+    fn costs(&mut self, width: u32, height: u32) -> fractal_sdf::Result<(Vec<u32>, Vec<u32>)> {
+        let frame = self.render_with_aovs(width, height)?;
+        Ok((frame.evaluations, frame.steps))
+    }
+    fn frame(&mut self, width: u32, height: u32) -> fractal_sdf::Result<()> {
+        self.render(width, height).map(drop)
+    }
+    fn options(&self) -> &RenderOptions {
+        Renderer::options(self)
+    }
+    fn set_effects(&mut self, effects: Effects) -> fractal_sdf::Result<()> {
+        Renderer::set_effects(self, effects)
+    }
+}
+
+impl Timing for WgpuRenderer {
+    fn costs(&mut self, width: u32, height: u32) -> fractal_sdf::Result<(Vec<u32>, Vec<u32>)> {
+        let frame = self.render_frame(width, height)?;
+        Ok((frame.evaluations, frame.steps))
+    }
+    fn frame(&mut self, width: u32, height: u32) -> fractal_sdf::Result<()> {
+        self.render(width, height).map(drop)
+    }
+    fn options(&self) -> &RenderOptions {
+        WgpuRenderer::options(self)
+    }
+    fn set_effects(&mut self, effects: Effects) -> fractal_sdf::Result<()> {
+        WgpuRenderer::set_effects(self, effects)
+    }
+}
+
+fn time_frames(
+    renderer: &mut impl Timing,
+    size: (u32, u32),
+    frames: u32,
+) -> Result<Timed, Failure> {
     let (width, height) = size;
-    let frame = renderer.render_with_aovs(width, height)?;
+    let (evaluations, steps) = renderer.costs(width, height)?;
     let pixels = f64::from(width) * f64::from(height);
-    let evaluations: f64 = frame.evaluations.iter().map(|&e| f64::from(e)).sum();
-    let primary: f64 = frame.steps.iter().map(|&e| f64::from(e)).sum();
+    let evaluations: f64 = evaluations.iter().map(|&e| f64::from(e)).sum();
+    let primary: f64 = steps.iter().map(|&e| f64::from(e)).sum();
     let mut times = Vec::new();
     let bar = ProgressBar::new(u64::from(frames));
     for _ in 0..frames {
         let start = Instant::now();
-        renderer.render(width, height)?;
+        renderer.frame(width, height)?;
         times.push(start.elapsed().as_secs_f64() * 1e3);
         bar.inc(1);
     }
@@ -1113,21 +1177,14 @@ fn time_frames(renderer: &mut Renderer, size: (u32, u32), frames: u32) -> Result
 /// counted for the cost of an evaluation.
 const COUNTED_EVERY: u32 = 8;
 
-fn bench(args: &BenchArgs, settings: &Settings) -> Outcome {
-    let job = Job::new(&args.scene, settings)?;
-    let (width, height) = job.size;
-    let mut renderer = job.renderer()?;
-    let timed = time_frames(&mut renderer, job.size, args.frames)?;
+/// Prints a timed frame's line: its median time and spread, its
+/// evaluations per pixel and a second. Returns the evaluations a second,
+/// in millions.
+fn report(timed: &Timed, (width, height): (u32, u32)) -> f64 {
     let median = timed.median();
     let (low, high) = (
         timed.times.first().copied().unwrap_or(f64::NAN),
         timed.times.last().copied().unwrap_or(f64::NAN),
-    );
-    println!(
-        "{}: {width}x{height}, {} quality on {}",
-        args.scene.scene.label(),
-        job.preset_name(),
-        on_devices(&renderer)
     );
     let pixels = f64::from(width) * f64::from(height);
     let rate = timed.evaluations * pixels / median / 1e3;
@@ -1138,6 +1195,45 @@ fn bench(args: &BenchArgs, settings: &Settings) -> Outcome {
         timed.evaluations,
         timed.primary,
     );
+    rate
+}
+
+fn bench(args: &BenchArgs, settings: &Settings) -> Outcome {
+    let job = Job::new(&args.scene, settings)?;
+    let (width, height) = job.size;
+    if Backend::chosen(args.backend, settings) == Backend::Wgpu {
+        if job.devices.is_some() || args.scene.device.is_some() {
+            return Err(usage(
+                "--device and --devices choose OpenCL devices: --backend wgpu runs on the \
+                 adapter wgpu chooses",
+            ));
+        }
+        let mut renderer = WgpuRenderer::from_compiled(job.file.scene.compile()?, &job.options)?;
+        for (name, value) in &job.sets {
+            renderer.set_param(name, *value)?;
+        }
+        let timed = time_frames(&mut renderer, job.size, args.frames)?;
+        println!(
+            "{}: {width}x{height}, {} quality on {} (wgpu)",
+            args.scene.scene.label(),
+            job.preset_name(),
+            renderer.adapter().name
+        );
+        report(&timed, job.size);
+        if args.stages {
+            bench_stages(&mut renderer, job.size, args.frames)?;
+        }
+        return Ok(());
+    }
+    let mut renderer = job.renderer()?;
+    let timed = time_frames(&mut renderer, job.size, args.frames)?;
+    println!(
+        "{}: {width}x{height}, {} quality on {}",
+        args.scene.scene.label(),
+        job.preset_name(),
+        on_devices(&renderer)
+    );
+    let rate = report(&timed, job.size);
     let cost = renderer.evaluation_cost(width, height, COUNTED_EVERY)?;
     let peak = renderer.peak_flops()?;
     let flops = rate * 1e6 * cost.flops();
@@ -1158,7 +1254,7 @@ fn bench(args: &BenchArgs, settings: &Settings) -> Outcome {
 
 /// Times the frame with the march, normals and shading alone, then with
 /// each effect the scene has added in turn: what each stage costs.
-fn bench_stages(renderer: &mut Renderer, size: (u32, u32), frames: u32) -> Outcome {
+fn bench_stages(renderer: &mut impl Timing, size: (u32, u32), frames: u32) -> Outcome {
     let full = renderer.options().effects;
     let quality = renderer.options().quality;
     let mut effects = full;
