@@ -171,29 +171,10 @@ fn every_gallery_scene_runs_on_wgpu_as_the_cpu_reference_computes_it() {
         }
         let module = emit_wgsl(&scene, &options).expect("the scene prints");
         let at = points(count, 3.0, 0x9e37_79b9_7f4a_7c15);
-        let got = evaluate(&gpu, &module, scene.default_values().as_slice(), &at);
-        let cpu = Evaluator::from_compiled(&scene);
-        for (p, g) in at.iter().zip(got.chunks_exact(5)) {
-            let s = cpu.sample::<f32>((*p).into());
-            let color = Vec3::from(s.color);
-            let pairs = [
-                ("DE", g[0], s.distance),
-                ("DE_shade", g[1], s.distance),
-                ("red", g[2], color.x),
-                ("green", g[3], color.y),
-                ("blue", g[4], color.z),
-            ];
-            for (what, device, cpu) in pairs {
-                assert!(cpu.is_finite(), "{name}: the CPU's {what} at {p} is {cpu}");
-                let error = (device - cpu).abs() / cpu.abs().max(1.0);
-                assert!(
-                    error <= TOLERANCE,
-                    "{name}: {what} at {p}: device {device}, CPU {cpu} (relative {error:e})"
-                );
-                if error > worst.0 {
-                    worst = (error, name, what, *p);
-                }
-            }
+        let (error, what, p) = compare(&gpu, &scene, &module, &at, (TOLERANCE, TOLERANCE))
+            .unwrap_or_else(|failure| panic!("{name}: {failure}"));
+        if error > worst.0 {
+            worst = (error, name, what, p);
         }
         checked += 1;
     }
@@ -202,6 +183,51 @@ fn every_gallery_scene_runs_on_wgpu_as_the_cpu_reference_computes_it() {
         worst.0, worst.1, worst.2, worst.3
     );
     assert!(checked >= 20, "only {checked} scenes checked");
+}
+
+/// Runs `module` (the WGSL of `scene`, for evaluation) at the points `at`
+/// with the scene's default values, and compares its `DE`, `DE_shade`
+/// and colour with the CPU reference's in `f32`: each within `tolerance ·
+/// max(1, |cpu|)` (the distances with `tolerance.0`, the colour's
+/// channels with `tolerance.1`). Returns the largest relative difference,
+/// what it was and where, or the first point beyond the tolerance.
+pub(crate) fn compare(
+    gpu: &(wgpu::Device, wgpu::Queue),
+    scene: &CompiledScene,
+    module: &KernelSource,
+    at: &[Vec3],
+    (distance, colour): (f32, f32),
+) -> Result<(f32, &'static str, Vec3), String> {
+    let got = evaluate(gpu, module, scene.default_values().as_slice(), at);
+    let cpu = Evaluator::from_compiled(scene);
+    let mut worst = (0.0f32, "", Vec3::ZERO);
+    for (p, g) in at.iter().zip(got.chunks_exact(5)) {
+        let s = cpu.sample::<f32>((*p).into());
+        let color = Vec3::from(s.color);
+        let pairs = [
+            ("DE", g[0], s.distance, distance),
+            ("DE_shade", g[1], s.distance, distance),
+            ("red", g[2], color.x, colour),
+            ("green", g[3], color.y, colour),
+            ("blue", g[4], color.z, colour),
+        ];
+        for (what, device, cpu, tolerance) in pairs {
+            if !cpu.is_finite() {
+                return Err(format!("the CPU's {what} at {p} is {cpu}"));
+            }
+            let error = (device - cpu).abs() / cpu.abs().max(1.0);
+            // A NaN from the device fails too.
+            if !(error <= tolerance) {
+                return Err(format!(
+                    "{what} at {p}: device {device}, CPU {cpu} (relative {error:e})"
+                ));
+            }
+            if error > worst.0 {
+                worst = (error, what, *p);
+            }
+        }
+    }
+    Ok(worst)
 }
 
 /// 400 coloured spheres, every fourth placed by a dynamic position and all
