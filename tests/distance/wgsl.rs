@@ -217,7 +217,7 @@ pub(crate) fn compare(
             }
             let error = (device - cpu).abs() / cpu.abs().max(1.0);
             // A NaN from the device fails too.
-            if !(error <= tolerance) {
+            if error.is_nan() || error > tolerance {
                 return Err(format!(
                     "{what} at {p}: device {device}, CPU {cpu} (relative {error:e})"
                 ));
