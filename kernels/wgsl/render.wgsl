@@ -13,7 +13,8 @@
 // constants: REAL_TINY, NORMAL_EPSILON, SUPERSAMPLING, GAMMA,
 // EXPOSURE_SCALE, SKY_TOP, SKY_BOTTOM; ENABLE_AO with AO_SAMPLES and
 // AO_DISTANCE, ENABLE_SHADOWS with SHADOW_STEPS, ENABLE_FOG with
-// FOG_DENSITY, ENABLE_MATERIALS with BOUNCES, DEFAULT_MATERIAL and each
+// FOG_DENSITY, ENABLE_FOG_LIGHT with FOG_FALLOFF, FOG_HEIGHT (in the
+// module's frame), FOG_SAMPLES and FOG_ANISOTROPY, ENABLE_MATERIALS with BOUNCES, DEFAULT_MATERIAL and each
 // value's lane MATERIAL_<value> (a constant that is false leaves its code
 // unreachable);
 // the buffer layouts CAMERA_<field>, LIGHT_<field> and LIGHT_STRIDE
@@ -645,9 +646,92 @@ fn march_paths(p: real3, n: real3, rd: real3, eps: real, t: real, cam: MarchCame
     return color;
 }
 
-// The fog's optical depth along a ray out to t: uniform fog.
-fn march_fog_depth(t: real) -> real {
-    return FOG_DENSITY * t;
+// exp(x) - 1 and log(1 + x), without the cancellation near 0 (WGSL has
+// neither built in).
+fn fsdf_expm1(x: real) -> real {
+    if (abs(x) < 1e-4) {
+        return x * (1.0 + 0.5 * x);
+    }
+    return exp(x) - 1.0;
+}
+
+fn fsdf_log1p(x: real) -> real {
+    if (abs(x) < 1e-4) {
+        return x * (1.0 - 0.5 * x);
+    }
+    return log(1.0 + x);
+}
+
+// The fog's optical depth from ro along the unit rd out to t (which may be
+// FSDF_INFINITY): FOG_DENSITY t for a uniform fog; for lit fog, whose
+// density falls by FOG_FALLOFF with height above FOG_HEIGHT, the fall of
+// the density along the ray over its rate (shade.cl's march_fog_depth).
+fn march_fog_depth(ro: real3, rd: real3, t: real) -> real {
+    if (!ENABLE_FOG_LIGHT) {
+        return FOG_DENSITY * t;
+    }
+    let a0 = -FOG_FALLOFF * (ro.y - FOG_HEIGHT);
+    let k = FOG_FALLOFF * rd.y;
+    let kt = k * t;
+    if (k == 0.0) {
+        // Level (k t would be 0 times infinity on a miss).
+        return FOG_DENSITY * exp(min(a0, 80.0)) * t;
+    }
+    if (abs(kt) < 1e-4) {
+        return FOG_DENSITY * exp(min(a0, 80.0)) * t * (1.0 - 0.5 * kt);
+    }
+    return FOG_DENSITY * (exp(min(a0, 80.0)) - exp(min(a0 - kt, 80.0))) / k;
+}
+
+// The distance from ro along rd at which the fog's optical depth reaches
+// depth (shade.cl's march_fog_reach).
+fn march_fog_reach(ro: real3, rd: real3, depth: real) -> real {
+    let a0 = -FOG_FALLOFF * (ro.y - FOG_HEIGHT);
+    let k = FOG_FALLOFF * rd.y;
+    let q = depth / FOG_DENSITY;
+    let level = q * exp(min(-a0, 80.0));
+    if (abs(k * level) < 1e-4) {
+        return level * (1.0 + 0.5 * k * level);
+    }
+    if (k > 0.0) {
+        return -fsdf_log1p(-min(k * level, 1.0 - 1e-7)) / k;
+    }
+    return (log(exp(min(a0, 80.0)) - k * q) - a0) / -k;
+}
+
+// The light the fog scatters towards the camera along ro + rd s, s from 0
+// to far, once: FOG_SAMPLES points spread evenly in the fog's
+// transmittance, shifted together by jitter, each lit by every light
+// through a shadow ray, with Henyey and Greenstein's phase function
+// (shade.cl's march_fog_light). Adds the shadow rays' evaluations to
+// *evals.
+fn march_fog_light(ro: real3, rd: real3, far: real, jitter: real, cam: MarchCamera,
+                   evals: ptr<function, uint>) -> real3 {
+    let scattered = -fsdf_expm1(-march_fog_depth(ro, rd, far));
+    if (!(scattered > 0.0)) {
+        return real3(0.0);
+    }
+    let share = scattered / real(FOG_SAMPLES);
+    let g = FOG_ANISOTROPY;
+    var sum = real3(0.0);
+    for (var k = 0; k < FOG_SAMPLES; k++) {
+        let u = min(share * (real(k) + jitter), 0.999999);
+        let s = min(march_fog_reach(ro, rd, -fsdf_log1p(-u)), far);
+        let x = ro + rd * s;
+        for (var i = 0u; i < frame.light_count; i++) {
+            let l = march_light(i, x);
+            let bend = 1.0 + g * g - 2.0 * g * dot(l.to_light, rd);
+            var radiance = l.radiance * ((1.0 - g * g) / (4.0 * bend * sqrt(bend)) * share);
+            if (ENABLE_SHADOWS) {
+                let eps = DETAIL * march_footprint(cam.footprint, s);
+                radiance *= march_shadow(x, l.to_light, l.distance, 0.25 * eps, eps,
+                                         lights[LIGHT_STRIDE * i + LIGHT_SOFTNESS],
+                                         max(radiance.x, max(radiance.y, radiance.z)), evals);
+            }
+            sum += radiance;
+        }
+    }
+    return sum;
 }
 
 // A pixel's colour and what it cost: the mean of its samples' linear
@@ -702,13 +786,20 @@ fn shade_pixel(cam: MarchCamera, x: int, y: int, pixel: uint) -> Shaded {
             }
             if (ENABLE_FOG) {
                 // What the fog takes away, the sky puts back.
-                color = mix(background, color, exp(-march_fog_depth(m.t)));
+                color = mix(background, color, exp(-march_fog_depth(ro, rd, m.t)));
             }
         } else if (ENABLE_GLOW) {
             color += GLOW_COLOR * (GLOW_STRENGTH * exp(-MARCH_GLOW_FALLOFF * m.closest));
             for (var k = 0; k < GLOW_NODES; k++) {
                 color += glow_color(k) * exp(-MARCH_GLOW_FALLOFF * m.glow_closest[k]);
             }
+        }
+        if (ENABLE_FOG_LIGHT) {
+            var far = FSDF_INFINITY;
+            if (m.hit) {
+                far = max(m.t, 0.0);
+            }
+            color += march_fog_light(ro, rd, far, march_jitter(pixel, j, 4u), cam, &evals);
         }
         sum += color;
         if (s == 0) {

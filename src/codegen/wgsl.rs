@@ -166,7 +166,7 @@ pub fn emit_wgsl_ir(ir: &Ir, options: &Options) -> Result<KernelSource> {
             super::scene_bound(ir, options, origin),
             &glow,
         );
-        render(&mut w, options, materials)?;
+        render(&mut w, options, materials, origin)?;
     }
     unwritable(&w, Precision::F32)?;
     let source = w.finish();
@@ -278,7 +278,7 @@ fn march(w: &mut Writer, options: &Options, bound: Option<Bound>, glow: &Glow) {
 
 /// The shading's settings as constants, the buffer layouts, the display
 /// transform, then the render kernel (`kernels/wgsl/render.wgsl`).
-fn render(w: &mut Writer, options: &Options, materials: bool) -> Result<()> {
+fn render(w: &mut Writer, options: &Options, materials: bool, origin: DVec3) -> Result<()> {
     let (q, e) = (&options.quality, &options.effects);
     let on = Effect::enabled(options);
     w.line("/* ---- shading ---- */");
@@ -316,6 +316,18 @@ fn render(w: &mut Writer, options: &Options, materials: bool) -> Result<()> {
     w.line(format!(
         "const FOG_DENSITY: real = {};",
         w.float(if fog { e.fog_density } else { 0.0 })
+    ));
+    let lit = e.volumetric.filter(|_| super::fog_light(options));
+    w.line(format!("const ENABLE_FOG_LIGHT: bool = {};", lit.is_some()));
+    let (falloff, height, samples, anisotropy) = lit.map_or((0.0, 0.0, 0, 0.0), |f| {
+        (f.falloff, f.height - origin.y, f.samples, f.anisotropy)
+    });
+    w.line(format!("const FOG_FALLOFF: real = {};", w.float(falloff)));
+    w.line(format!("const FOG_HEIGHT: real = {};", w.float(height)));
+    w.line(format!("const FOG_SAMPLES: int = {samples};"));
+    w.line(format!(
+        "const FOG_ANISOTROPY: real = {};",
+        w.float(anisotropy)
     ));
     w.line(format!("const ENABLE_MATERIALS: bool = {materials};"));
     w.line(format!("const BOUNCES: int = {};", q.bounces));

@@ -9,11 +9,12 @@
 //! (`kernels/wgsl/render.wgsl` is the OpenCL kernel's march and shading,
 //! line for line): the march with glow and glow nodes, tetrahedral
 //! normals, ambient occlusion, hard and soft shadows, every light kind,
-//! uniform fog, materials (shading models, emission, subsurface light,
+//! fog (uniform, or lit with its light shafts), materials (shading
+//! models, emission, subsurface light,
 //! reflections and transparency), supersampling, depth of field and the
 //! resolution scale. What it does not draw yet it refuses with
 //! [`Error::Unsupported`] rather than draw something else: global illumination, an
-//! environment light, lit (volumetric) fog, inside shapes, double
+//! environment light, inside shapes, double
 //! precision and custom shapes written in OpenCL C. It leaves out what
 //! changes only the speed: the coarse cone pass
 //! ([`Quality::cone_tile`]: rays start at the eye) and relaxed math
@@ -200,9 +201,6 @@ fn refuse(scene: &CompiledScene, options: &RenderOptions) -> Result<()> {
     }
     if scene.environment().is_some() {
         return Err(unsupported("light a scene with an environment image yet"));
-    }
-    if options.effects.volumetric.is_some() && options.effects.fog_density > 0.0 {
-        return Err(unsupported("light volumetric fog yet"));
     }
     Ok(())
 }

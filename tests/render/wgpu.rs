@@ -83,6 +83,38 @@ fn every_gallery_scene_it_draws_is_the_opencl_picture() {
     assert!(drawn >= 19, "only {drawn} scenes drawn");
 }
 
+/// The shipped scene files beyond the gallery that the wgpu backend draws
+/// (fog lit by a light, with its shafts through a sponge; a shape given
+/// as a text formula) are the OpenCL picture too; those path-traced
+/// (`lamps`, `furnace`) are the typed error.
+#[test]
+fn the_scene_files_it_draws_are_the_opencl_picture() {
+    if !backends() {
+        return;
+    }
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes");
+    for name in ["fog", "custom_formula", "lamps", "furnace"] {
+        let file = fractal_sdf::file::SceneFile::load(root.join(format!("{name}.ron")))
+            .expect("a shipped scene file");
+        let compiled = file.scene.compile().expect("it compiles");
+        let options = options(&file);
+        let mut wgpu = match WgpuRenderer::from_compiled(compiled.clone(), &options) {
+            Ok(r) => r,
+            Err(Error::Unsupported { what, .. }) if matches!(name, "lamps" | "furnace") => {
+                assert!(what.contains("global illumination"), "{name}: {what}");
+                continue;
+            }
+            Err(e) => panic!("{name}: {e}"),
+        };
+        let drawn = wgpu.render(WIDTH, HEIGHT).expect("the wgpu frame");
+        let mut opencl = Renderer::from_compiled(compiled, &options).expect("the renderer");
+        let image = opencl.render(WIDTH, HEIGHT).expect("the frame");
+        let db = psnr(&image, &drawn);
+        println!("{name}: {db:.1} dB");
+        assert!(db >= 40.0, "{name}: {db:.1} dB between the backends");
+    }
+}
+
 /// Single precision is all WGSL has: double precision is the typed
 /// error, and it names the OpenCL backend.
 #[test]
