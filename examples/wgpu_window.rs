@@ -104,24 +104,40 @@ impl Shown {
         let (device, queue) =
             pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor::default()))?;
         let caps = surface.get_capabilities(&adapter);
-        // The renderer's texture holds display-encoded colours already: a
-        // surface that encodes them again (sRGB) would brighten them.
-        let format = caps
-            .formats
-            .iter()
-            .copied()
-            .find(|f| !f.is_srgb())
-            .ok_or("the surface offers no format without sRGB encoding")?;
+        // The renderer's texture holds display-encoded 8-bit colours
+        // already: the surface takes them as they are (an sRGB surface
+        // would encode them again, through a view without the encoding).
+        let format = [
+            wgpu::TextureFormat::Bgra8Unorm,
+            wgpu::TextureFormat::Rgba8Unorm,
+        ]
+        .into_iter()
+        .find(|f| caps.formats.contains(f))
+        .or_else(|| caps.formats.first().copied())
+        .ok_or("the surface offers no format")?;
+        let view_format = format.remove_srgb_suffix();
+        let mut usage = wgpu::TextureUsages::RENDER_ATTACHMENT;
+        if args.screenshot.is_some() {
+            if !caps.usages.contains(wgpu::TextureUsages::COPY_SRC) {
+                return Err("this surface cannot be read back for --screenshot".into());
+            }
+            usage |= wgpu::TextureUsages::COPY_SRC;
+        }
         let size = window.inner_size();
+        let side = device.limits().max_texture_dimension_2d;
         let config = wgpu::SurfaceConfiguration {
-            usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
+            usage,
             format,
-            width: size.width.max(1),
-            height: size.height.max(1),
+            width: size.width.clamp(1, side),
+            height: size.height.clamp(1, side),
             present_mode: wgpu::PresentMode::AutoVsync,
             desired_maximum_frame_latency: 2,
             alpha_mode: caps.alpha_modes[0],
-            view_formats: Vec::new(),
+            view_formats: if view_format == format {
+                Vec::new()
+            } else {
+                vec![view_format]
+            },
             color_space: wgpu::SurfaceColorSpace::Auto,
         };
         surface.configure(&device, &config);
@@ -161,7 +177,7 @@ impl Shown {
                 module: &module,
                 entry_point: Some("fragment"),
                 compilation_options: wgpu::PipelineCompilationOptions::default(),
-                targets: &[Some(format.into())],
+                targets: &[Some(view_format.into())],
             }),
             primitive: wgpu::PrimitiveState::default(),
             depth_stencil: None,
@@ -182,9 +198,15 @@ impl Shown {
         })
     }
 
+    /// Follows the window's size; a minimised window (no pixels) is left
+    /// as it was, and nothing is drawn until it has some again.
     fn resize(&mut self, size: PhysicalSize<u32>) {
-        self.config.width = size.width.max(1);
-        self.config.height = size.height.max(1);
+        if size.width == 0 || size.height == 0 {
+            return;
+        }
+        let side = self.device.limits().max_texture_dimension_2d;
+        self.config.width = size.width.min(side);
+        self.config.height = size.height.min(side);
         self.surface.configure(&self.device, &self.config);
         self.frame = None;
     }
@@ -231,11 +253,21 @@ impl Shown {
         let output = match self.surface.get_current_texture() {
             wgpu::CurrentSurfaceTexture::Success(t)
             | wgpu::CurrentSurfaceTexture::Suboptimal(t) => t,
+            // Resized or lost under it: configured again, drawn next time.
+            wgpu::CurrentSurfaceTexture::Outdated | wgpu::CurrentSurfaceTexture::Lost => {
+                self.surface.configure(&self.device, &self.config);
+                return Ok(());
+            }
+            // Not shown now: drawn next time.
+            wgpu::CurrentSurfaceTexture::Timeout | wgpu::CurrentSurfaceTexture::Occluded => {
+                return Ok(());
+            }
             other => return Err(format!("no surface texture: {other:?}").into()),
         };
-        let target = output
-            .texture
-            .create_view(&wgpu::TextureViewDescriptor::default());
+        let target = output.texture.create_view(&wgpu::TextureViewDescriptor {
+            format: Some(self.config.format.remove_srgb_suffix()),
+            ..wgpu::TextureViewDescriptor::default()
+        });
         let mut encoder = self
             .device
             .create_command_encoder(&wgpu::CommandEncoderDescriptor::default());
@@ -289,10 +321,13 @@ impl Shown {
             });
             self.device.poll(wgpu::PollType::wait_indefinitely())?;
             let bytes = staging.slice(..).get_mapped_range()?.to_vec();
-            let bgra = matches!(
-                self.config.format,
-                wgpu::TextureFormat::Bgra8Unorm | wgpu::TextureFormat::Bgra8UnormSrgb
-            );
+            let bgra = match self.config.format.remove_srgb_suffix() {
+                wgpu::TextureFormat::Bgra8Unorm => true,
+                wgpu::TextureFormat::Rgba8Unorm => false,
+                other => {
+                    return Err(format!("--screenshot reads 8-bit surfaces, not {other:?}").into());
+                }
+            };
             let mut rgba = Vec::with_capacity(4 * (width * height) as usize);
             for line in bytes.chunks_exact(row as usize) {
                 for p in line[..4 * width as usize].chunks_exact(4) {
@@ -354,6 +389,11 @@ impl ApplicationHandler for App {
             WindowEvent::CloseRequested => event_loop.exit(),
             WindowEvent::Resized(size) => shown.resize(size),
             WindowEvent::RedrawRequested => {
+                let size = shown.window.inner_size();
+                if size.width == 0 || size.height == 0 {
+                    // Minimised: nothing to draw until it has pixels again.
+                    return;
+                }
                 let first = self.frames == 0;
                 let screenshot = self.args.screenshot.as_ref().filter(|_| first);
                 let started = *self.started.get_or_insert_with(Instant::now);

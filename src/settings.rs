@@ -14,7 +14,7 @@
 //! preset = "preview"      # draft, preview, production or reference
 //! size = "800x600"        # images and the viewer's window
 //! device = "pthread"      # a substring of an OpenCL device's name
-//! backend = "opencl"      # or "wgpu": the command's `render --backend`
+//! backend = "opencl"      # or "wgpu": the command's `render` and `bench --backend`
 //!
 //! [viewer]
 //! mouse_sensitivity = 0.004   # radians per pixel
@@ -63,7 +63,8 @@ pub struct Settings {
     /// A substring of the OpenCL device's name.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub device: Option<String>,
-    /// The backend the command renders with (`"opencl"` or `"wgpu"`).
+    /// The backend the command's `render` and `bench` use (`"opencl"` or
+    /// `"wgpu"`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub backend: Option<Backend>,
     /// The viewer's settings.

@@ -495,7 +495,13 @@ fn march_shade(p: real3, n: real3, rd: real3, eps: real, occlusion: real,
             radiance *= visible;
         }
         let half_vector = normalize(l.to_light - rd);
-        let specular = specular_strength * pow(max(dot(n, half_vector), 0.0), shininess);
+        // OpenCL's pow(x, 0) is 1 for every x; Vulkan's, exp2(0 log2 x), is
+        // not defined at x = 0.
+        var highlight = 1.0;
+        if (shininess != 0.0) {
+            highlight = pow(max(dot(n, half_vector), 0.0), shininess);
+        }
+        let specular = specular_strength * highlight;
         color += radiance * (albedo * (diffuse * ndl) + specular * ndl);
     }
     out.color = color;

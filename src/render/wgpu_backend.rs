@@ -808,9 +808,10 @@ static SHARED: OnceLock<std::result::Result<(::wgpu::Device, ::wgpu::Queue), Str
 /// found on the first call.
 fn shared_device() -> Result<(::wgpu::Device, ::wgpu::Queue)> {
     let found = SHARED.get_or_init(|| {
-        let adapter = pollster::block_on(
-            instance().request_adapter(&::wgpu::RequestAdapterOptions::default()),
-        )
+        let adapter = pollster::block_on(::wgpu::util::initialize_adapter_from_env_or_default(
+            &instance(),
+            None,
+        ))
         .map_err(|e| {
             format!(
                 "no wgpu adapter (on Linux without a GPU, install Mesa's lavapipe: \

@@ -753,16 +753,18 @@ fn render_wgpu(args: &RenderArgs, job: &Job) -> Outcome {
         ("--gi", args.gi.is_some()),
         ("--devices", job.devices.is_some()),
         ("--device", args.scene.device.is_some()),
+        ("--deadline", args.scene.deadline.is_some()),
     ];
     if let Some((option, _)) = opencl_only.iter().find(|(_, asked)| *asked) {
         return Err(usage(format!(
-            "{option} needs the OpenCL backend: --backend wgpu renders one frame of the image"
+            "{option} needs the OpenCL backend (--backend opencl): the wgpu backend renders \
+             one frame of the image, in one dispatch"
         )));
     }
     if image_extension(&args.output).ok().flatten().as_deref() == Some("exr") {
         return Err(usage(
-            "--backend wgpu writes 8-bit images: write a .png, .jpg or .tif, or render the \
-             .exr with the OpenCL backend",
+            "the wgpu backend writes 8-bit images: write a .png, .jpg or .tif, or render the \
+             .exr with the OpenCL backend (--backend opencl)",
         ));
     }
     let aperture = job.file.scene.camera.aperture;
@@ -1202,10 +1204,11 @@ fn bench(args: &BenchArgs, settings: &Settings) -> Outcome {
     let job = Job::new(&args.scene, settings)?;
     let (width, height) = job.size;
     if Backend::chosen(args.backend, settings) == Backend::Wgpu {
-        if job.devices.is_some() || args.scene.device.is_some() {
+        if job.devices.is_some() || args.scene.device.is_some() || args.scene.deadline.is_some() {
             return Err(usage(
-                "--device and --devices choose OpenCL devices: --backend wgpu runs on the \
-                 adapter wgpu chooses",
+                "--device, --devices and --deadline are the OpenCL backend's (--backend \
+                 opencl): the wgpu backend runs on the adapter wgpu chooses, a frame in one \
+                 dispatch",
             ));
         }
         let mut renderer = WgpuRenderer::from_compiled(job.file.scene.compile()?, &job.options)?;
