@@ -13,7 +13,8 @@
 // constants: REAL_TINY, NORMAL_EPSILON, SUPERSAMPLING, GAMMA,
 // EXPOSURE_SCALE, SKY_TOP, SKY_BOTTOM; ENABLE_AO with AO_SAMPLES and
 // AO_DISTANCE, ENABLE_SHADOWS with SHADOW_STEPS, ENABLE_FOG with
-// FOG_DENSITY, ENABLE_FOG_LIGHT with FOG_FALLOFF, FOG_HEIGHT (in the
+// FOG_DENSITY, ENABLE_ENVIRONMENT (the `environment` buffer holds an
+// image), ENABLE_FOG_LIGHT with FOG_FALLOFF, FOG_HEIGHT (in the
 // module's frame), FOG_SAMPLES and FOG_ANISOTROPY, ENABLE_MATERIALS with BOUNCES, DEFAULT_MATERIAL and each
 // value's lane MATERIAL_<value> (a constant that is false leaves its code
 // unreachable);
@@ -48,6 +49,10 @@ struct Frame {
 @group(0) @binding(3) var<uniform> frame: Frame;
 // The image, in the display's 8-bit steps.
 @group(0) @binding(4) var image: texture_storage_2d<rgba8unorm, write>;
+// The environment light (codegen::interface::environment's layout): its
+// header, the image's texels and its irradiance map; the header alone,
+// zeros, without one.
+@group(0) @binding(6) var<storage, read> environment: array<f32>;
 // Per pixel, for the ray through its centre: the distance to the hit (-1
 // on a miss), 1 where it hit, the distance evaluations of the pixel's
 // colour, and the primary march's.
@@ -259,9 +264,72 @@ fn material_select(f: real16, t: real16, c: bool) -> real16 {
     return f;
 }
 
+// Texel (x, y) of the w x h image at `at` in the environment's buffer.
+fn march_env_texel(at: int, w: int, x: int, y: int) -> real3 {
+    let i = at + 3 * (y * w + x);
+    return real3(environment[i], environment[i + 1], environment[i + 2]);
+}
+
+// The w x h image at `at` at (u, v), bilinear between texel centres,
+// wrapping across u and clamped in v (shade.cl's march_env_bilinear).
+fn march_env_bilinear(at: int, w: int, h: int, uv: real2) -> real3 {
+    let fx = uv.x * real(w) - 0.5;
+    let fy = clamp(uv.y * real(h) - 0.5, 0.0, real(h - 1));
+    let x0 = floor(fx);
+    let y0 = floor(fy);
+    let tx = fx - x0;
+    let ty = fy - y0;
+    var xa = int(x0) % w;
+    if (xa < 0) {
+        xa += w;
+    }
+    let xb = (xa + 1) % w;
+    let ya = int(y0);
+    let yb = min(ya + 1, h - 1);
+    let a = march_env_texel(at, w, xa, ya);
+    let b = march_env_texel(at, w, xb, ya);
+    let c = march_env_texel(at, w, xa, yb);
+    let e = march_env_texel(at, w, xb, yb);
+    return mix(mix(a, b, tx), mix(c, e, tx), ty);
+}
+
+// The image coordinates of the unit direction d, in the image's frame
+// turned about +Y (shade.cl's march_env_uv).
+fn march_env_uv(d: real3) -> real2 {
+    let c = environment[ENV_ROTATION_COS];
+    let s = environment[ENV_ROTATION_SIN];
+    let turned = real3(c * d.x - s * d.z, d.y, s * d.x + c * d.z);
+    return real2(0.5 + atan2(turned.x, -turned.z) / (2.0 * MARCH_PI),
+                 acos(clamp(turned.y, -1.0, 1.0)) / MARCH_PI);
+}
+
+// The environment's radiance along the unit direction d, bilinear between
+// texel centres: what the camera, mirrors and glass show.
+fn march_environment(d: real3) -> real3 {
+    let w = int(environment[ENV_WIDTH]);
+    let h = int(environment[ENV_HEIGHT]);
+    return march_env_bilinear(int(ENV_TEXELS), w, h, march_env_uv(d))
+           * environment[ENV_INTENSITY];
+}
+
+// The environment's irradiance on a face turned along the unit normal n,
+// over pi (precomputed by the host at a few texels).
+fn march_environment_irradiance(n: real3) -> real3 {
+    let w = int(environment[ENV_WIDTH]);
+    let h = int(environment[ENV_HEIGHT]);
+    let at = int(ENV_TEXELS) + 3 * w * h + (h + 1) + h * (w + 1);
+    return march_env_bilinear(at, int(environment[ENV_IRRADIANCE_WIDTH]),
+                              int(environment[ENV_IRRADIANCE_HEIGHT]), march_env_uv(n))
+           * environment[ENV_INTENSITY];
+}
+
 // The sky seen along rd, where a reflected or refracted ray leaves the
-// scene or is cut off: SKY_BOTTOM straight down, SKY_TOP straight up.
+// scene or is cut off: the environment light, or without one SKY_BOTTOM
+// straight down and SKY_TOP straight up.
 fn march_sky(rd: real3) -> real3 {
+    if (ENABLE_ENVIRONMENT) {
+        return march_environment(rd);
+    }
     return mix(SKY_BOTTOM, SKY_TOP, clamp(0.5 + 0.5 * rd.y, 0.0, 1.0));
 }
 
@@ -463,7 +531,10 @@ fn march_shade(p: real3, n: real3, rd: real3, eps: real, occlusion: real,
         }
         out.emitted = albedo * material_value(material, MATERIAL_EMISSION);
     }
-    let sky = mix(SKY_BOTTOM, SKY_TOP, 0.5 + 0.5 * n.y);
+    var sky = mix(SKY_BOTTOM, SKY_TOP, 0.5 + 0.5 * n.y);
+    if (ENABLE_ENVIRONMENT) {
+        sky = march_environment_irradiance(n);
+    }
     var color = albedo * sky * (MARCH_AMBIENT * occlusion);
     // Shadow rays start one hit threshold off the surface and are blocked
     // within a quarter of it, so a surface does not shadow itself.
@@ -765,7 +836,11 @@ fn shade_pixel(cam: MarchCamera, x: int, y: int, pixel: uint) -> Shaded {
         let m = march_ray(ro, rd, 0.0, cam.footprint, 1.0);
         steps += uint(m.steps);
         evals += uint(m.steps);
-        let background = march_background(cam, sample.py);
+        var background = march_background(cam, sample.py);
+        if (ENABLE_ENVIRONMENT) {
+            // The environment, seen along the ray.
+            background = march_sky(rd);
+        }
         var color = background;
         if (m.hit) {
             var p = ro + rd * m.t;

@@ -499,6 +499,10 @@ pub(crate) fn wgsl_constants() -> String {
         let _ = writeln!(w, "const LIGHT_{}: uint = {}u;", f.name, f.offset);
     }
     let _ = writeln!(w, "const LIGHT_STRIDE: uint = {}u;", light::STRIDE);
+    for f in environment::FIELDS {
+        let _ = writeln!(w, "const ENV_{}: uint = {}u;", f.name, f.offset);
+    }
+    let _ = writeln!(w, "const ENV_TEXELS: uint = {}u;", environment::TEXELS);
     out
 }
 

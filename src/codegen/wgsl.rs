@@ -330,6 +330,10 @@ fn render(w: &mut Writer, options: &Options, materials: bool, origin: DVec3) -> 
         w.float(anisotropy)
     ));
     w.line(format!("const ENABLE_MATERIALS: bool = {materials};"));
+    w.line(format!(
+        "const ENABLE_ENVIRONMENT: bool = {};",
+        options.environment
+    ));
     w.line(format!("const BOUNCES: int = {};", q.bounces));
     w.line(format!("const BRANCH_SLOTS: int = {};", q.bounces + 2));
     w.line(format!(

@@ -10,12 +10,12 @@
 //! line for line): the march with glow and glow nodes, tetrahedral
 //! normals, ambient occlusion, hard and soft shadows, every light kind,
 //! fog (uniform, or lit with its light shafts), materials (shading
-//! models, emission, subsurface light,
-//! reflections and transparency), supersampling, depth of field and the
-//! resolution scale. What it does not draw yet it refuses with
-//! [`Error::Unsupported`] rather than draw something else: global illumination, an
-//! environment light, inside shapes, double
-//! precision and custom shapes written in OpenCL C. It leaves out what
+//! models, emission, subsurface light, reflections and transparency), an
+//! environment image's light and sky, supersampling, depth of field and
+//! the resolution scale. What it does not draw yet it refuses with
+//! [`Error::Unsupported`] rather than draw something else: global
+//! illumination, inside shapes, double precision and custom shapes
+//! written in OpenCL C. It leaves out what
 //! changes only the speed: the coarse cone pass
 //! ([`Quality::cone_tile`]: rays start at the eye) and relaxed math
 //! ([`Quality::fast_math`]: the driver decides).
@@ -59,6 +59,7 @@ const LIGHTS: u32 = 2;
 const FRAME: u32 = 3;
 const IMAGE: u32 = 4;
 const AOVS: u32 = 5;
+const ENVIRONMENT: u32 = 6;
 
 /// The format of the texture the render kernel writes: a texture given to
 /// [`WgpuRenderer::render_to_texture`] must have it, and
@@ -132,6 +133,8 @@ pub struct WgpuRenderer {
     params: ::wgpu::Buffer,
     camera: ::wgpu::Buffer,
     lights: ::wgpu::Buffer,
+    /// The environment light ([`super::environment::pack`]).
+    environment: ::wgpu::Buffer,
     frame: ::wgpu::Buffer,
     /// The image the last frame rendered into.
     texture: Option<::wgpu::Texture>,
@@ -188,9 +191,9 @@ fn checked<T>(device: &::wgpu::Device, what: &str, f: impl FnOnce() -> T) -> Res
     }
 }
 
-/// Why the wgpu backend cannot render `scene` with `options` as the OpenCL
+/// Why the wgpu backend cannot render with `options` as the OpenCL
 /// backend would, if it cannot.
-fn refuse(scene: &CompiledScene, options: &RenderOptions) -> Result<()> {
+fn refuse(options: &RenderOptions) -> Result<()> {
     let unsupported = |what: &str| Error::Unsupported {
         backend: "wgpu",
         what: what.into(),
@@ -198,9 +201,6 @@ fn refuse(scene: &CompiledScene, options: &RenderOptions) -> Result<()> {
     };
     if options.effects.global_illumination.is_some() {
         return Err(unsupported("path-trace global illumination yet"));
-    }
-    if scene.environment().is_some() {
-        return Err(unsupported("light a scene with an environment image yet"));
     }
     Ok(())
 }
@@ -251,7 +251,7 @@ impl WgpuRenderer {
         device: ::wgpu::Device,
         queue: ::wgpu::Queue,
     ) -> Result<Self> {
-        refuse(&scene, options)?;
+        refuse(options)?;
         let source = module(&scene, options)?;
         let values = scene.default_values();
         let limits = Precision::F32.limits();
@@ -277,6 +277,10 @@ impl WgpuRenderer {
             storage,
         );
         let no_outputs = buffer(&device, "no pixels", 16, output_usage());
+        let packed = super::environment::pack(scene.environment());
+        let environment = buffer(&device, "environment", 4 * packed.len(), storage);
+        let bytes: Vec<u8> = packed.iter().flat_map(|v| v.to_le_bytes()).collect();
+        queue.write_buffer(&environment, 0, &bytes);
         let frame = buffer(
             &device,
             "frame",
@@ -299,6 +303,7 @@ impl WgpuRenderer {
             params,
             camera,
             lights,
+            environment,
             frame,
             texture: None,
             outputs: None,
@@ -378,7 +383,7 @@ impl WgpuRenderer {
     }
 
     fn set_options(&mut self, options: RenderOptions) -> Result<()> {
-        refuse(&self.scene, &options)?;
+        refuse(&options)?;
         let source = module(&self.scene, &options)?;
         let started = Instant::now();
         let (pipeline, built) = pipeline(&self.gpu.device, &source)?;
@@ -653,6 +658,7 @@ impl WgpuRenderer {
             (FRAME, self.frame.as_entire_binding()),
             (IMAGE, ::wgpu::BindingResource::TextureView(view)),
             (AOVS, aovs.as_entire_binding()),
+            (ENVIRONMENT, self.environment.as_entire_binding()),
         ];
         let commands = checked(device, "the render pass", || {
             let group = device.create_bind_group(&::wgpu::BindGroupDescriptor {
@@ -795,7 +801,8 @@ fn module(scene: &CompiledScene, options: &RenderOptions) -> Result<KernelSource
         &codegen::Options::default()
             .quality(options.quality)
             .effects(options.effects)
-            .target(Target::Render),
+            .target(Target::Render)
+            .environment(scene.environment().is_some()),
     )
 }
 
@@ -931,6 +938,7 @@ fn bind_group_layout(device: &::wgpu::Device) -> ::wgpu::BindGroupLayout {
                 count: None,
             },
             storage(AOVS, false),
+            storage(ENVIRONMENT, true),
         ],
     })
 }

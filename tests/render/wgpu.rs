@@ -363,3 +363,29 @@ fn materials_in_every_boolean_are_the_opencl_picture() {
     println!("materials in every boolean: {db:.1} dB");
     assert!(db >= 40.0, "{db:.1} dB between the backends");
 }
+
+/// An environment image lights the scene, shows behind it and in its
+/// mirrors and glass on the wgpu backend as on OpenCL.
+#[test]
+fn an_environment_image_is_the_opencl_picture() {
+    if !backends() {
+        return;
+    }
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+    let mut file = fractal_sdf::gallery::file("materials").unwrap();
+    file.scene.environment =
+        Some(fractal_sdf::scene::Environment::load(root.join("scenes/sky.hdr")).unwrap());
+    let compiled = file.scene.compile().unwrap();
+    let options = options(&file);
+    let drawn = WgpuRenderer::from_compiled(compiled.clone(), &options)
+        .unwrap()
+        .render(WIDTH, HEIGHT)
+        .unwrap();
+    let image = Renderer::from_compiled(compiled, &options)
+        .unwrap()
+        .render(WIDTH, HEIGHT)
+        .unwrap();
+    let db = psnr(&image, &drawn);
+    println!("under an environment: {db:.1} dB");
+    assert!(db >= 40.0, "{db:.1} dB between the backends");
+}

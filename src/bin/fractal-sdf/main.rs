@@ -238,7 +238,7 @@ struct RenderArgs {
     /// The backend that renders: opencl, or wgpu (WGSL on Vulkan, in
     /// single precision; one 8-bit frame of the image: no --aov, --bits
     /// 16, .exr, --passes, --noise, --adaptive, --stereo, --gi, --device
-    /// or --devices, nor global illumination, environment lights or inside shapes,
+    /// or --devices, nor global illumination or inside shapes,
     /// which need opencl). Default: the settings file's, else opencl.
     #[arg(long, value_enum)]
     backend: Option<Backend>,
