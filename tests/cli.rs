@@ -498,7 +498,7 @@ fn render_on_the_wgpu_backend_writes_the_opencl_picture() {
             1,
             "double precision",
         ),
-        (&["--passes", "4"][..], "passes.png", 2, "--passes"),
+        (&["--stereo", "anaglyph"][..], "stereo.png", 2, "--stereo"),
     ] {
         let out = with(&[&["--backend", "wgpu"][..], extra].concat(), output);
         assert_eq!(out.status.code(), Some(code), "{}", text(&out));

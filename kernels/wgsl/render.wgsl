@@ -45,6 +45,7 @@ struct Frame {
     height: uint,
     light_count: uint,
     write_aovs: uint,  // 1: write aovs
+    pass_index: int,   // the progressive pass; -1 for a frame of its own
 }
 @group(0) @binding(3) var<uniform> frame: Frame;
 // The image, in the display's 8-bit steps.
@@ -53,6 +54,9 @@ struct Frame {
 // header, the image's texels and its irradiance map; the header alone,
 // zeros, without one.
 @group(0) @binding(6) var<storage, read> environment: array<f32>;
+// Per pixel, the sum of every progressive pass's linear colours so far,
+// and in w the samples that hit.
+@group(0) @binding(7) var<storage, read_write> accumulation: array<real4>;
 // Per pixel, for the ray through its centre: the distance to the hit (-1
 // on a miss), 1 where it hit, the distance evaluations of the pixel's
 // colour, and the primary march's.
@@ -811,25 +815,31 @@ fn march_fog_light(ro: real3, rd: real3, far: real, jitter: real, cam: MarchCame
     return sum;
 }
 
-// A pixel's colour and what it cost: the mean of its samples' linear
-// colours, and for the ray through its centre, the march.
+// A pixel's samples of this pass and what they cost: the sum of their
+// linear colours, how many hit, and for the first sample's ray, the
+// march.
 struct Shaded {
-    color: real3,
+    sum: real3,
+    hits: uint,
     evals: uint,
     steps: uint,
     centre: MarchResult,
 }
 
+const PER_PASS: int = SUPERSAMPLING * SUPERSAMPLING;
+
 // Marches and shades the samples of rendered pixel (x, y) (render.cl's
-// render_tile, for a frame of its own).
+// render_tile): progressive pass k >= 0 takes samples k N^2 to
+// (k + 1) N^2 - 1, a frame of its own the first N^2.
 fn shade_pixel(cam: MarchCamera, x: int, y: int, pixel: uint) -> Shaded {
-    const per_pass = SUPERSAMPLING * SUPERSAMPLING;
     var out: Shaded;
     var sum = real3(0.0);
     var evals = 0u;
     var steps = 0u;
-    for (var s = 0; s < per_pass; s++) {
-        let j = uint(s);
+    var hits = 0u;
+    let first = uint(max(frame.pass_index, 0) * PER_PASS);
+    for (var s = 0; s < PER_PASS; s++) {
+        let j = first + uint(s);
         let sample = march_sample_ray(cam, x, y, pixel, j, s);
         let ro = sample.ray.ro;
         let rd = sample.ray.rd;
@@ -843,6 +853,7 @@ fn shade_pixel(cam: MarchCamera, x: int, y: int, pixel: uint) -> Shaded {
         }
         var color = background;
         if (m.hit) {
+            hits += 1u;
             var p = ro + rd * m.t;
             let footprint = march_footprint(cam.footprint, m.t);
             var view_height = footprint * cam.image_h;
@@ -887,7 +898,8 @@ fn shade_pixel(cam: MarchCamera, x: int, y: int, pixel: uint) -> Shaded {
             out.centre = m;
         }
     }
-    out.color = sum / real(per_pass);
+    out.sum = sum;
+    out.hits = hits;
     out.evals = evals;
     out.steps = steps;
     return out;
@@ -906,12 +918,27 @@ fn render(@builtin(global_invocation_id) id: vec3<uint>) {
     let y = int(id.y);
     let pixel = id.y * frame.width + id.x;
     let shaded = shade_pixel(cam, x, y, pixel);
-    let display = display_color(shaded.color, EXPOSURE_SCALE, 1.0 / GAMMA);
+    var color = shaded.sum / real(PER_PASS);
+    let pass_index = frame.pass_index;
+    if (pass_index >= 0) {
+        // The spare fourth float sums the samples that hit.
+        var total = real4(0.0);
+        if (pass_index > 0) {
+            total = accumulation[pixel];
+        }
+        total += real4(shaded.sum, real(shaded.hits));
+        accumulation[pixel] = total;
+        if (pass_index > 0) {
+            color = total.xyz / (real(pass_index + 1) * real(PER_PASS));
+        }
+    }
+    let display = display_color(color, EXPOSURE_SCALE, 1.0 / GAMMA);
     // Rounded to the display's 8-bit steps here, to the nearest as the
     // OpenCL kernel rounds, so the store needs no rounding of its own.
     let steps = round(clamp(display, real3(0.0), real3(1.0)) * 255.0) / 255.0;
     textureStore(image, vec2<int>(x, y), real4(steps, 1.0));
-    if (frame.write_aovs != 0u) {
+    // Later passes leave the outputs of the first: the same rays.
+    if (frame.write_aovs != 0u && pass_index <= 0) {
         var centre = shaded.centre;
         if (SUPERSAMPLING > 1 || cam.aperture > 0.0) {
             // The colour samples are jittered: trace the pixel centre.

@@ -60,6 +60,7 @@ const FRAME: u32 = 3;
 const IMAGE: u32 = 4;
 const AOVS: u32 = 5;
 const ENVIRONMENT: u32 = 6;
+const ACCUMULATION: u32 = 7;
 
 /// The format of the texture the render kernel writes: a texture given to
 /// [`WgpuRenderer::render_to_texture`] must have it, and
@@ -94,6 +95,13 @@ impl WgpuFrame {
         let total: u64 = self.evaluations.iter().map(|&e| u64::from(e)).sum();
         total as f64 / self.evaluations.len().max(1) as f64
     }
+}
+
+/// A progressive image: its size, the passes it holds and the image.
+struct Progress {
+    size: (u32, u32),
+    passes: u32,
+    image: RgbaImage,
 }
 
 /// A wgpu device and its queue, and what the adapter says of itself.
@@ -142,6 +150,12 @@ pub struct WgpuRenderer {
     outputs: Option<::wgpu::Buffer>,
     /// One pixel's per-pixel values: bound where a frame asks for none.
     no_outputs: ::wgpu::Buffer,
+    /// The progressive passes' sums, per rendered pixel.
+    sums: Option<::wgpu::Buffer>,
+    /// One pixel's sums: bound for a frame of its own.
+    no_accumulation: ::wgpu::Buffer,
+    /// The progressive image so far.
+    progress: Option<Progress>,
     timing: Option<Duration>,
 }
 
@@ -277,6 +291,7 @@ impl WgpuRenderer {
             storage,
         );
         let no_outputs = buffer(&device, "no pixels", 16, output_usage());
+        let no_accumulation = buffer(&device, "no sums", 16, ::wgpu::BufferUsages::STORAGE);
         let packed = super::environment::pack(scene.environment());
         let environment = buffer(&device, "environment", 4 * packed.len(), storage);
         let bytes: Vec<u8> = packed.iter().flat_map(|v| v.to_le_bytes()).collect();
@@ -284,7 +299,7 @@ impl WgpuRenderer {
         let frame = buffer(
             &device,
             "frame",
-            16,
+            32,
             ::wgpu::BufferUsages::UNIFORM | ::wgpu::BufferUsages::COPY_DST,
         );
         let mut renderer = WgpuRenderer {
@@ -308,6 +323,9 @@ impl WgpuRenderer {
             texture: None,
             outputs: None,
             no_outputs,
+            sums: None,
+            no_accumulation,
+            progress: None,
             timing: None,
         };
         renderer.write_params();
@@ -392,6 +410,7 @@ impl WgpuRenderer {
         self.pipeline = pipeline;
         self.source = source;
         self.options = options;
+        self.progress = None;
         let size = 4 * self
             .source
             .param_buffer(self.values.as_slice())
@@ -432,6 +451,7 @@ impl WgpuRenderer {
         self.values
             .set_within(name, value, Precision::F32.limits())?;
         self.write_params();
+        self.progress = None;
         Ok(())
     }
 
@@ -448,6 +468,7 @@ impl WgpuRenderer {
     pub fn set_camera(&mut self, camera: Camera) -> Result<()> {
         let view = Viewport::in_frame(&camera, 1, 1, Precision::F32, self.source.origin)?;
         check_frame_inputs(&view, &[], self.source.origin, Precision::F32.limits())?;
+        self.progress = None;
         self.scene.set_camera(camera)
     }
 
@@ -474,6 +495,7 @@ impl WgpuRenderer {
         )?;
         self.scene = scene;
         self.write_lights();
+        self.progress = None;
         Ok(())
     }
 
@@ -488,7 +510,54 @@ impl WgpuRenderer {
         // The depths scale the image up; at full resolution only the image
         // is needed.
         let scaled = self.options.quality.resolution_scale > 1;
-        Ok(self.draw(width, height, scaled)?.image)
+        self.progress = None;
+        Ok(self.draw(width, height, scaled, None)?.image)
+    }
+
+    /// Renders one more progressive pass of a `width` × `height` image and
+    /// returns the mean of every pass so far, as
+    /// [`Renderer::render_progressive`](super::Renderer::render_progressive)
+    /// does: each pass takes [`Quality::supersampling`]² new samples a
+    /// pixel, at new points in the pixel and on the lens, summed on the
+    /// device. Changing the parameters, camera, lights, quality, effects
+    /// or size, or a frame of its own, starts again from the first pass.
+    /// Past [`Renderer::MAX_PROGRESSIVE_SAMPLES`](super::Renderer::MAX_PROGRESSIVE_SAMPLES)
+    /// samples a pixel the image has converged, and a further call returns
+    /// it again.
+    ///
+    /// # Errors
+    /// As [`WgpuRenderer::render`].
+    pub fn render_progressive(&mut self, width: u32, height: u32) -> Result<RgbaImage> {
+        let per_pass = self.options.quality.supersampling.max(1).pow(2);
+        let pass = match &self.progress {
+            Some(p) if p.size == (width, height) => p.passes,
+            _ => 0,
+        };
+        let limit = super::Renderer::MAX_PROGRESSIVE_SAMPLES;
+        if let Some(p) = self
+            .progress
+            .as_ref()
+            .filter(|_| (pass + 1) * per_pass > limit)
+        {
+            // Converged: no more passes.
+            return Ok(p.image.clone());
+        }
+        let scaled = self.options.quality.resolution_scale > 1;
+        self.progress = None;
+        let image = self.draw(width, height, scaled, Some(pass))?.image;
+        self.progress = Some(Progress {
+            size: (width, height),
+            passes: pass + 1,
+            image: image.clone(),
+        });
+        Ok(image)
+    }
+
+    /// The progressive passes the current image holds (0 before the
+    /// first).
+    #[must_use]
+    pub fn progressive_passes(&self) -> u32 {
+        self.progress.as_ref().map_or(0, |p| p.passes)
     }
 
     /// Renders a `width` × `height` image with each pixel's depth, hit and
@@ -499,25 +568,37 @@ impl WgpuRenderer {
     /// # Errors
     /// As [`WgpuRenderer::render`].
     pub fn render_frame(&mut self, width: u32, height: u32) -> Result<WgpuFrame> {
-        self.draw(width, height, true)
+        self.progress = None;
+        self.draw(width, height, true, None)
     }
 
     /// Renders and reads back the image, and with `outputs` the per-pixel
-    /// values (empty without).
-    fn draw(&mut self, width: u32, height: u32, outputs: bool) -> Result<WgpuFrame> {
+    /// values (empty without); progressive pass `pass`, or a frame of its
+    /// own.
+    fn draw(
+        &mut self,
+        width: u32,
+        height: u32,
+        outputs: bool,
+        pass: Option<u32>,
+    ) -> Result<WgpuFrame> {
         check_size(width, height)?;
         let scale = self.options.quality.resolution_scale.max(1);
         let (w, h) = (width.div_ceil(scale), height.div_ceil(scale));
-        self.check_fits(w, h, outputs)?;
-        self.write_frame(width, height, scale, outputs)?;
+        self.check_fits(w, h, outputs || pass.is_some())?;
+        self.write_frame((width, height), scale, outputs, pass)?;
         let (pw, ph) = if outputs { (w, h) } else { (1, 1) };
         let (texture, aovs) = self.targets((w, h), (pw, ph))?;
+        let accumulation = match pass {
+            Some(_) => self.accumulation(w, h)?,
+            None => self.no_accumulation.clone(),
+        };
         let view = texture.create_view(&::wgpu::TextureViewDescriptor::default());
         let image_bytes = padded_row(w) as usize * h as usize;
         let image_staging = buffer(&self.gpu.device, "image readback", image_bytes, read_back());
         let aov_bytes = aovs.size() as usize;
         let aov_staging = buffer(&self.gpu.device, "pixel readback", aov_bytes, read_back());
-        self.dispatch(&view, &aovs, w, h, |encoder| {
+        self.dispatch(&view, (&aovs, &accumulation), w, h, |encoder| {
             encoder.copy_texture_to_buffer(
                 texture.as_image_copy(),
                 ::wgpu::TexelCopyBufferInfo {
@@ -635,9 +716,9 @@ impl WgpuRenderer {
     ) -> Result<()> {
         check_size(width, height)?;
         self.check_fits(width, height, false)?;
-        self.write_frame(width, height, 1, false)?;
-        let aovs = self.no_outputs.clone();
-        self.dispatch(view, &aovs, width, height, |_| {})
+        self.write_frame((width, height), 1, false, None)?;
+        let (aovs, accumulation) = (self.no_outputs.clone(), self.no_accumulation.clone());
+        self.dispatch(view, (&aovs, &accumulation), width, height, |_| {})
     }
 
     /// Records the render kernel over `width` × `height` pixels into
@@ -645,7 +726,7 @@ impl WgpuRenderer {
     fn dispatch(
         &mut self,
         view: &::wgpu::TextureView,
-        aovs: &::wgpu::Buffer,
+        (aovs, accumulation): (&::wgpu::Buffer, &::wgpu::Buffer),
         width: u32,
         height: u32,
         after: impl FnOnce(&mut ::wgpu::CommandEncoder),
@@ -659,6 +740,7 @@ impl WgpuRenderer {
             (IMAGE, ::wgpu::BindingResource::TextureView(view)),
             (AOVS, aovs.as_entire_binding()),
             (ENVIRONMENT, self.environment.as_entire_binding()),
+            (ACCUMULATION, accumulation.as_entire_binding()),
         ];
         let commands = checked(device, "the render pass", || {
             let group = device.create_bind_group(&::wgpu::BindGroupDescriptor {
@@ -737,9 +819,32 @@ impl WgpuRenderer {
         Ok((self.texture.clone().expect("made above"), aovs))
     }
 
+    /// The progressive sums of a `width` × `height` rendering, made anew
+    /// where the size changed.
+    fn accumulation(&mut self, width: u32, height: u32) -> Result<::wgpu::Buffer> {
+        let bytes = 16 * width as usize * height as usize;
+        if self
+            .sums
+            .as_ref()
+            .is_none_or(|b| b.size() as usize != bytes)
+        {
+            let device = &self.gpu.device;
+            self.sums = Some(checked(device, "the progressive sums", || {
+                buffer(device, "sums", bytes, ::wgpu::BufferUsages::STORAGE)
+            })?);
+        }
+        Ok(self.sums.clone().expect("made above"))
+    }
+
     /// Writes the camera for a `width` × `height` image rendered at one
     /// pixel in `scale` × `scale`, and the frame's sizes.
-    fn write_frame(&mut self, width: u32, height: u32, scale: u32, aovs: bool) -> Result<()> {
+    fn write_frame(
+        &mut self,
+        (width, height): (u32, u32),
+        scale: u32,
+        aovs: bool,
+        pass: Option<u32>,
+    ) -> Result<()> {
         let view = Viewport::in_frame(
             self.scene.camera(),
             width,
@@ -758,13 +863,18 @@ impl WgpuRenderer {
             .queue
             .write_buffer(&self.camera, 0, &floats(&camera));
         let lights = u32::try_from(self.scene.lights().len()).expect("a few lights");
+        // `Frame` in render.wgsl: four unsigned, then the pass (-1 for a
+        // frame of its own), in a 32-byte buffer.
+        let pass = pass.map_or(-1, |p| i32::try_from(p).expect("passes are capped"));
         let frame = [
             width.div_ceil(scale),
             height.div_ceil(scale),
             lights,
             u32::from(aovs),
         ];
-        let bytes: Vec<u8> = frame.iter().flat_map(|v| v.to_le_bytes()).collect();
+        let mut bytes: Vec<u8> = frame.iter().flat_map(|v| v.to_le_bytes()).collect();
+        bytes.extend_from_slice(&pass.to_le_bytes());
+        bytes.resize(32, 0);
         self.gpu.queue.write_buffer(&self.frame, 0, &bytes);
         Ok(())
     }
@@ -939,6 +1049,7 @@ fn bind_group_layout(device: &::wgpu::Device) -> ::wgpu::BindGroupLayout {
             },
             storage(AOVS, false),
             storage(ENVIRONMENT, true),
+            storage(ACCUMULATION, false),
         ],
     })
 }

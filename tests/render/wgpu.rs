@@ -386,3 +386,50 @@ fn an_environment_image_is_the_opencl_picture() {
     let db = between_backends(&compiled, &options, "under_an_environment");
     assert!(db >= 40.0, "{db:.1} dB between the backends");
 }
+
+/// Progressive passes: each pass adds new samples in the pixel and on the
+/// lens, and after four the blur of the lens scene is the OpenCL
+/// backend's after four (measured 51.7 dB); the first pass is the frame of
+/// its own, a change starts again, and the count says how many the image
+/// holds.
+#[test]
+fn progressive_passes_converge_as_on_opencl() {
+    if !backends() {
+        return;
+    }
+    let file = fractal_sdf::gallery::file("depth_of_field").unwrap();
+    let compiled = file.scene.compile().unwrap();
+    let mut options = options(&file);
+    options.quality = options.quality.supersampling(1);
+    let mut wgpu = WgpuRenderer::from_compiled(compiled.clone(), &options).unwrap();
+    let mut opencl = Renderer::from_compiled(compiled, &options).unwrap();
+    let single = wgpu.render(WIDTH, HEIGHT).unwrap();
+    assert_eq!(wgpu.render_progressive(WIDTH, HEIGHT).unwrap(), single);
+    let mut first_db = 0.0;
+    let (mut drawn, mut image) = (single.clone(), single.clone());
+    for pass in 1..=4 {
+        if pass > 1 {
+            drawn = wgpu.render_progressive(WIDTH, HEIGHT).unwrap();
+        }
+        image = opencl.render_progressive(WIDTH, HEIGHT).unwrap();
+        if pass == 1 {
+            first_db = psnr(&image, &drawn);
+        }
+    }
+    assert_eq!(wgpu.progressive_passes(), 4);
+    assert_ne!(drawn, single, "the passes changed nothing");
+    let db = psnr(&image, &drawn);
+    println!("depth of field: one pass {first_db:.1} dB, four passes {db:.1} dB");
+    assert!(
+        db >= 40.0,
+        "{db:.1} dB between the backends after four passes"
+    );
+    // The image moves towards the converged blur: four passes differ from
+    // one pass by more than the backends differ from each other.
+    assert!(psnr(&single, &drawn) < db);
+    // A change (the camera, set again) starts again from the first pass.
+    let camera = *wgpu.camera();
+    wgpu.set_camera(camera).unwrap();
+    assert_eq!(wgpu.progressive_passes(), 0);
+    assert_eq!(wgpu.render_progressive(WIDTH, HEIGHT).unwrap(), single);
+}

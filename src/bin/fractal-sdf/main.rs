@@ -236,8 +236,8 @@ struct RenderArgs {
     #[arg(long, value_name = "FOOTPRINTS")]
     brute_step: Option<f64>,
     /// The backend that renders: opencl, or wgpu (WGSL on Vulkan, in
-    /// single precision; one 8-bit frame of the image: no --aov, --bits
-    /// 16, .exr, --passes, --noise, --adaptive, --stereo, --gi, --device
+    /// single precision; the 8-bit image, with --passes: no --aov, --bits
+    /// 16, .exr, --noise, --adaptive, --stereo, --gi, --device
     /// or --devices, nor global illumination or inside shapes,
     /// which need opencl). Default: the settings file's, else opencl.
     #[arg(long, value_enum)]
@@ -740,13 +740,12 @@ fn render(args: &RenderArgs, settings: &Settings) -> Outcome {
     Ok(())
 }
 
-/// `render --backend wgpu`: one frame of the image, on the adapter wgpu
-/// chooses.
+/// `render --backend wgpu`: the image, in one frame or `--passes`
+/// progressive passes, on the adapter wgpu chooses.
 fn render_wgpu(args: &RenderArgs, job: &Job) -> Outcome {
     let opencl_only = [
         ("--aov", !args.aov.is_empty()),
         ("--bits 16", args.bits == "16"),
-        ("--passes", args.passes.is_some_and(|p| p > 1)),
         ("--noise", args.noise.is_some()),
         ("--adaptive", args.adaptive.is_some()),
         ("--stereo", args.stereo.is_some()),
@@ -758,7 +757,7 @@ fn render_wgpu(args: &RenderArgs, job: &Job) -> Outcome {
     if let Some((option, _)) = opencl_only.iter().find(|(_, asked)| *asked) {
         return Err(usage(format!(
             "{option} needs the OpenCL backend (--backend opencl): the wgpu backend renders \
-             one frame of the image, in one dispatch"
+             the image alone, each pass in one dispatch"
         )));
     }
     if image_extension(&args.output).ok().flatten().as_deref() == Some("exr") {
@@ -767,11 +766,12 @@ fn render_wgpu(args: &RenderArgs, job: &Job) -> Outcome {
              .exr with the OpenCL backend (--backend opencl)",
         ));
     }
+    let passes = args.passes.unwrap_or(1);
     let aperture = job.file.scene.camera.aperture;
-    if aperture > 0.0 {
+    if passes == 1 && aperture > 0.0 {
         eprintln!(
             "note: the camera has a lens (aperture {aperture}), whose blur one pass leaves \
-             grainy: the OpenCL backend's --passes {LENS_PASSES} renders a smooth one"
+             grainy: --passes {LENS_PASSES} renders a smooth one in {LENS_PASSES} times the time"
         );
     }
     let (width, height) = job.size;
@@ -782,7 +782,10 @@ fn render_wgpu(args: &RenderArgs, job: &Job) -> Outcome {
         for (name, value) in &job.sets {
             renderer.set_param(name, *value)?;
         }
-        let image = renderer.render(width, height)?;
+        let mut image = renderer.render_progressive(width, height)?;
+        for _ in 1..passes {
+            image = renderer.render_progressive(width, height)?;
+        }
         Ok::<_, fractal_sdf::Error>((image, renderer.adapter().name.clone()))
     })();
     bar.finish_and_clear();
@@ -791,8 +794,13 @@ fn render_wgpu(args: &RenderArgs, job: &Job) -> Outcome {
     if let Some(path) = &args.camera_json {
         CameraExport::new(&job.file.scene.camera, job.size)?.save(path)?;
     }
+    let passes = if passes > 1 {
+        format!(", {passes} passes")
+    } else {
+        String::new()
+    };
     println!(
-        "{}: {width}x{height}, {} quality, {:.2} s on {adapter} (wgpu)",
+        "{}: {width}x{height}, {} quality{passes}, {:.2} s on {adapter} (wgpu)",
         args.output.display(),
         job.preset_name(),
         start.elapsed().as_secs_f64(),
