@@ -2,7 +2,8 @@
 //! rendered by the OpenCL backend ([`Renderer`]) and by the wgpu backend
 //! ([`WgpuRenderer`]), alternating, three times each. Prints the median
 //! frame time and evaluations per pixel of each, the PSNR between the two
-//! images and the share of pixels whose hit flags differ; writes
+//! images (and of their 4×4 blocks' means for a path-traced scene) and
+//! the share of pixels whose hit flags differ; writes
 //! `out/backend_<scene>_opencl.png` and `out/backend_<scene>_wgpu.png`.
 //! Scenes the wgpu backend does not draw yet are listed with its reason.
 //! Then the wgpu pipeline's creation, cold and from the cache, and the
@@ -15,7 +16,7 @@
 use std::error::Error;
 use std::time::Instant;
 
-use fractal_sdf::metrics::{mask_mismatch, psnr};
+use fractal_sdf::metrics::{block_psnr, mask_mismatch, psnr};
 use fractal_sdf::prelude::*;
 use fractal_sdf::render::{RenderOptions, Renderer, WgpuRenderer};
 
@@ -73,8 +74,18 @@ fn main() -> Result<(), Box<dyn Error>> {
         let pixels = f64::from(width * height);
         let cl_evals = cl.evaluations.iter().map(|&e| f64::from(e)).sum::<f64>() / pixels;
         let differ = mask_mismatch(&cl.hit, &wg.hit);
+        // A path-traced picture's grain differs where a path bounced
+        // elsewhere: its 4×4 blocks' means say whether the pictures agree.
+        let blocks = if options.effects.global_illumination.is_some() {
+            format!(
+                " ({:.1} in 4×4 blocks)",
+                block_psnr(&cl.image, &wg.image, 4)
+            )
+        } else {
+            String::new()
+        };
         table.push(format!(
-            "| {name} | {:.1} | {cl_evals:.1} | {:.1} | {:.1} | {:.1} | {:.3}% |",
+            "| {name} | {:.1} | {cl_evals:.1} | {:.1} | {:.1} | {:.1}{blocks} | {:.3}% |",
             median(&mut cl_ms),
             median(&mut wg_ms),
             wg.evaluations_per_pixel(),

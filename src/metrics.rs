@@ -3,7 +3,9 @@
 //! precision — as numbers a test can bound.
 //!
 //! - [`psnr`] and [`ssim`] compare two colour images (higher is closer;
-//!   identical images give infinity and 1);
+//!   identical images give infinity and 1), and [`block_psnr`] compares
+//!   the means of blocks of pixels: two path-traced pictures of few
+//!   samples, without their grain;
 //! - [`mask_mismatch`] and [`mean_depth_error`] compare the per-pixel hit
 //!   flags and depths of two renders (the renderer's `Frame`, feature
 //!   `opencl`), where the colours alone would hide a missed surface.
@@ -48,6 +50,52 @@ pub fn psnr(a: &RgbaImage, b: &RgbaImage) -> f64 {
     #[allow(clippy::cast_precision_loss)]
     let mse = sum / count as f64;
     10.0 * (255.0 * 255.0 / mse).log10()
+}
+
+/// [`psnr`] between the two images averaged over blocks of `k`×`k`
+/// pixels (a partial block at the right or bottom edge left out): what a
+/// Monte Carlo picture converges to, without the grain of its samples.
+/// Two renders whose samples differ here and there (a path that bounced
+/// elsewhere) agree in their block means where the pictures are the same.
+///
+/// ```
+/// use fractal_sdf::image::{Rgba, RgbaImage};
+/// use fractal_sdf::metrics::{block_psnr, psnr};
+///
+/// // The same grey, drawn as grain: one bright pixel in four.
+/// let flat = RgbaImage::from_pixel(8, 8, Rgba([64, 64, 64, 255]));
+/// let grain = RgbaImage::from_fn(8, 8, |x, y| {
+///     let v = if x % 2 == 0 && y % 2 == 0 { 253 } else { 1 };
+///     Rgba([v, v, v, 255])
+/// });
+/// assert!(psnr(&flat, &grain) < 10.0);
+/// assert!(block_psnr(&flat, &grain, 2).is_infinite());
+/// ```
+///
+/// # Panics
+/// If the images differ in size, or `k` is 0.
+#[must_use]
+pub fn block_psnr(a: &RgbaImage, b: &RgbaImage, k: u32) -> f64 {
+    assert_eq!(a.dimensions(), b.dimensions(), "images differ in size");
+    assert!(k > 0, "blocks of at least one pixel");
+    psnr(&block_means(a, k), &block_means(b, k))
+}
+
+/// The image averaged over blocks of `k`×`k` pixels, rounded to 8 bits.
+fn block_means(image: &RgbaImage, k: u32) -> RgbaImage {
+    let area = k * k;
+    RgbaImage::from_fn(image.width() / k, image.height() / k, |x, y| {
+        let mut sum = [0u32; 4];
+        for dy in 0..k {
+            for dx in 0..k {
+                let p = image.get_pixel(x * k + dx, y * k + dy).0;
+                for (s, v) in sum.iter_mut().zip(p) {
+                    *s += u32::from(v);
+                }
+            }
+        }
+        image::Rgba(sum.map(|s| u8::try_from((s + area / 2) / area).unwrap_or(u8::MAX)))
+    })
 }
 
 /// Luma (Rec. 601) of each pixel, in `[0, 255]`.

@@ -847,8 +847,9 @@ fn shade_pixel(cam: MarchCamera, x: int, y: int, pixel: uint) -> Shaded {
         steps += uint(m.steps);
         evals += uint(m.steps);
         var background = march_background(cam, sample.py);
-        if (ENABLE_ENVIRONMENT) {
-            // The environment, seen along the ray.
+        if (ENABLE_ENVIRONMENT || ENABLE_GI) {
+            // The sky that lights the paths, or the environment, seen
+            // along the ray.
             background = march_sky(rd);
         }
         var color = background;
@@ -869,12 +870,16 @@ fn shade_pixel(cam: MarchCamera, x: int, y: int, pixel: uint) -> Shaded {
                 evals += 1u;
                 view_height = FSDF_INFINITY;
             }
-            let occlusion = march_occlusion(p, n, view_height, 0.5, &evals);
-            let lit = march_shade(p, n, rd, DETAIL * footprint, occlusion, &evals);
-            color = lit.color;
-            if (ENABLE_MATERIALS) {
-                color = march_paths(p, n, rd, DETAIL * footprint, m.t, cam, lit.color,
-                                    lit.emitted, &evals);
+            if (ENABLE_GI) {
+                color = march_path(p, n, rd, max(m.t, 0.0), cam, pixel, j, &evals);
+            } else {
+                let occlusion = march_occlusion(p, n, view_height, 0.5, &evals);
+                let lit = march_shade(p, n, rd, DETAIL * footprint, occlusion, &evals);
+                color = lit.color;
+                if (ENABLE_MATERIALS) {
+                    color = march_paths(p, n, rd, DETAIL * footprint, m.t, cam, lit.color,
+                                        lit.emitted, &evals);
+                }
             }
             if (ENABLE_FOG) {
                 // What the fog takes away, the sky puts back.

@@ -166,7 +166,9 @@ pub fn emit_wgsl_ir(ir: &Ir, options: &Options) -> Result<KernelSource> {
             super::scene_bound(ir, options, origin),
             &glow,
         );
+        let emitters = super::emitters(ir, options, origin);
         render(&mut w, options, materials, origin)?;
+        paths(&mut w, options, &emitters);
     }
     unwritable(&w, Precision::F32)?;
     let source = w.finish();
@@ -331,6 +333,10 @@ fn render(w: &mut Writer, options: &Options, materials: bool, origin: DVec3) -> 
     ));
     w.line(format!("const ENABLE_MATERIALS: bool = {materials};"));
     w.line(format!(
+        "const ENABLE_GI: bool = {};",
+        on.contains(&Effect::GlobalIllumination)
+    ));
+    w.line(format!(
         "const ENABLE_ENVIRONMENT: bool = {};",
         options.environment
     ));
@@ -367,11 +373,48 @@ fn render(w: &mut Writer, options: &Options, materials: bool, origin: DVec3) -> 
     Ok(())
 }
 
+/// Global illumination's settings as constants, the emissive shapes'
+/// bounding spheres, then the path tracer (`kernels/wgsl/paths.wgsl`); or,
+/// without global illumination, a `march_path` the render kernel never
+/// calls.
+fn paths(w: &mut Writer, options: &Options, emitters: &[Bound]) {
+    w.line("/* ---- paths ---- */");
+    let Some(gi) = options.effects.global_illumination else {
+        w.line("/* No global illumination: direct light only. */");
+        w.line(
+            "fn march_path(p: real3, n: real3, rd: real3, t: real, cam: MarchCamera, \
+             pixel: uint, j: uint, evals: ptr<function, uint>) -> real3 {",
+        );
+        w.line("    return real3(0.0);");
+        w.line("}");
+        return;
+    };
+    w.line(format!("const GI_BOUNCES: int = {};", gi.max_bounces));
+    w.line("/* The bounding spheres of the shapes that give off light. */");
+    w.line(format!("const EMITTERS: int = {};", emitters.len()));
+    w.line("fn emitter_bound(e: int) -> real4 {");
+    w.line("    switch e {");
+    for (i, b) in emitters.iter().enumerate() {
+        let [x, y, z] = b.centre.to_array().map(|v| w.float(v));
+        let r = w.float(b.radius);
+        w.line(format!(
+            "        case {i}: {{ return real4({x}, {y}, {z}, {r}); }}"
+        ));
+    }
+    w.line("        default: { return real4(0.0); }");
+    w.line("    }");
+    w.line("}");
+    w.raw(PATHS);
+}
+
 /// The march in WGSL.
 const MARCH: &str = include_str!("../../kernels/wgsl/march.wgsl");
 
 /// The render kernel in WGSL.
 const RENDER: &str = include_str!("../../kernels/wgsl/render.wgsl");
+
+/// The path tracer in WGSL.
+const PATHS: &str = include_str!("../../kernels/wgsl/paths.wgsl");
 
 /// What the WGSL backend cannot do, and what to do instead.
 fn unsupported(what: &str, instead: &str) -> Error {

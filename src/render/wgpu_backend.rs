@@ -11,11 +11,11 @@
 //! normals, ambient occlusion, hard and soft shadows, every light kind,
 //! fog (uniform, or lit with its light shafts), materials (shading
 //! models, emission, subsurface light, reflections and transparency), an
-//! environment image's light and sky, supersampling, depth of field and
-//! the resolution scale. What it does not draw yet it refuses with
-//! [`Error::Unsupported`] rather than draw something else: global
-//! illumination, inside shapes, double precision and custom shapes
-//! written in OpenCL C. It leaves out what
+//! environment image's light and sky, path-traced global illumination
+//! (`kernels/wgsl/paths.wgsl`), supersampling, depth of field and the
+//! resolution scale. What it does not draw yet it refuses with
+//! [`Error::Unsupported`] rather than draw something else: inside shapes,
+//! double precision and custom shapes written in OpenCL C. It leaves out what
 //! changes only the speed: the coarse cone pass
 //! ([`Quality::cone_tile`]: rays start at the eye) and relaxed math
 //! ([`Quality::fast_math`]: the driver decides).
@@ -205,20 +205,6 @@ fn checked<T>(device: &::wgpu::Device, what: &str, f: impl FnOnce() -> T) -> Res
     }
 }
 
-/// Why the wgpu backend cannot render with `options` as the OpenCL
-/// backend would, if it cannot.
-fn refuse(options: &RenderOptions) -> Result<()> {
-    let unsupported = |what: &str| Error::Unsupported {
-        backend: "wgpu",
-        what: what.into(),
-        instead: "render it with the OpenCL backend".into(),
-    };
-    if options.effects.global_illumination.is_some() {
-        return Err(unsupported("path-trace global illumination yet"));
-    }
-    Ok(())
-}
-
 impl WgpuRenderer {
     /// A renderer for `scene` with `quality` and the default effects, on
     /// the adapter wgpu chooses.
@@ -265,7 +251,6 @@ impl WgpuRenderer {
         device: ::wgpu::Device,
         queue: ::wgpu::Queue,
     ) -> Result<Self> {
-        refuse(options)?;
         let source = module(&scene, options)?;
         let values = scene.default_values();
         let limits = Precision::F32.limits();
@@ -401,7 +386,6 @@ impl WgpuRenderer {
     }
 
     fn set_options(&mut self, options: RenderOptions) -> Result<()> {
-        refuse(&options)?;
         let source = module(&self.scene, &options)?;
         let started = Instant::now();
         let (pipeline, built) = pipeline(&self.gpu.device, &source)?;

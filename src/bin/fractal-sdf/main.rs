@@ -749,7 +749,6 @@ fn render_wgpu(args: &RenderArgs, job: &Job) -> Outcome {
         ("--noise", args.noise.is_some()),
         ("--adaptive", args.adaptive.is_some()),
         ("--stereo", args.stereo.is_some()),
-        ("--gi", args.gi.is_some()),
         ("--devices", job.devices.is_some()),
         ("--device", args.scene.device.is_some()),
         ("--deadline", args.scene.deadline.is_some()),
