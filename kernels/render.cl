@@ -72,12 +72,18 @@ int march_stored_point(const MarchCamera* cam, __global const float* depths, int
 #define MARCH_FIT_RADIUS 1
 
 // The hit of sample s at the pixel (dx, dy) away from (x, y), if it lies
-// on the same surface as p (see MARCH_SCREEN_REACH).
+// on the same surface as p (see MARCH_SCREEN_REACH), in *q; leaves *q as
+// it is where it does not.
 int march_neighbour(const MarchCamera* cam, __global const float* depths, int x, int y, int dx,
                     int dy, int s, int width, int height, uint j, real3 p, real reach,
                     real3* q) {
-    return march_stored_point(cam, depths, x + dx, y + dy, s, width, height, j, q) &&
-           length(*q - p) <= reach * (real)max(abs(dx), abs(dy));
+    real3 r;
+    if (march_stored_point(cam, depths, x + dx, y + dy, s, width, height, j, &r) &&
+        length(r - p) <= reach * (real)max(abs(dx), abs(dy))) {
+        *q = r;
+        return 1;
+    }
+    return 0;
 }
 
 // The normal at p, the hit of sample s at pixel (x, y) along rd, from its

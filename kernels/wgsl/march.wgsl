@@ -3,8 +3,8 @@
 // back when their unbounding spheres stop overlapping, the same location
 // of a hit by regula falsi (the Illinois variant), the same glow (the
 // angle of the nearest miss, and each glow node's) and the same stop past
-// the scene's bounding sphere. Inside shapes' brute-force steps are left
-// out (the WGSL backend refuses inside shapes).
+// the scene's bounding sphere, and the same brute-force steps within the
+// region of inside shapes, which have no distance to step by.
 //
 // The module defines before it: MAX_STEPS, MAX_DISTANCE, DETAIL,
 // HIT_EPSILON, OVER_RELAXATION; SCENE_BOUNDED and SCENE_BOUND_CENTRE,
@@ -14,7 +14,9 @@
 // GLOW_BOUND_CENTRE, GLOW_BOUND_RADIUS, GLOW_BOUND_SLOPE (march.cl's
 // ENABLE_GLOW_BOUND), GLOW_NODES (0 without glow nodes), GLOW_SLOTS (at
 // least 1) and NODE_GLOW_BRIGHTEST, with glow_distance where GLOW_NODES is
-// above 0; FSDF_INFINITY; and DE. A constant that is false leaves its code
+// above 0; inside shapes: ENABLE_BRUTE with BRUTE_CENTRE and BRUTE_RADIUS
+// (the sphere they lie in, in the module's frame), BRUTE_STEP,
+// BRUTE_MAX_STEPS and INSIDE_HUGE; FSDF_INFINITY; and DE. A constant that is false leaves its code
 // unreachable, and the shader compiler drops it.
 
 const MARCH_REFINE_LIMIT: int = 24; // most evaluations spent locating a hit
@@ -73,6 +75,47 @@ fn march_footprint(footprint: real2, t: real) -> real {
     return footprint.x + footprint.y * t;
 }
 
+// Where a ray's brute-force steps start, in [0, 1) of a step: set per
+// sample by the brute-force pass (march.cl's MarchCamera.phase).
+var<private> march_phase: real = 0.5;
+
+// Where the ray ro + t rd (rd of unit length) is within the sphere the
+// inside shapes lie in: (enter, exit), enter > exit where it misses it
+// (march.cl's march_brute_span).
+fn march_brute_span(ro: real3, rd: real3) -> real2 {
+    let oc = ro - BRUTE_CENTRE;
+    let b = dot(oc, rd);
+    let disc = b * b - (dot(oc, oc) - BRUTE_RADIUS * BRUTE_RADIUS);
+    if (disc < 0.0) {
+        return real2(1.0, -1.0);
+    }
+    let root = sqrt(disc);
+    return real2(-b - root, -b + root);
+}
+
+// A brute-force step within the span: samples at most h apart on a lattice
+// that starts phase * h past where the ray enters the sphere, or the
+// sphere-tracing step where it is shorter (march.cl's march_brute_step).
+// Keeps the next sample in *next (negative before the first).
+fn march_brute_step(t: real, step: real, span: real2, h: real, phase: real,
+                    next: ptr<function, real>) -> real {
+    if (t + step <= span.x || t >= span.y) {
+        return step;
+    }
+    if (*next < 0.0) {
+        *next = max(t, span.x) + phase * h;
+    }
+    if (*next <= t) {
+        *next = t + h;
+    }
+    let to_next = *next - t;
+    if (to_next > step) {
+        return step;
+    }
+    *next += h;
+    return to_next;
+}
+
 fn march_level(ro: real3, rd: real3, footprint: real2, t: real, side: real) -> real {
     return side * (DE(ro + rd * t) - DETAIL * march_footprint(footprint, t));
 }
@@ -88,7 +131,11 @@ fn march_refine(ro: real3, rd: real3, footprint: real2, t0_in: real, g0_in: real
         if (t1 - t0 <= HIT_EPSILON * march_footprint(footprint, t1)) {
             break;
         }
-        let t = clamp(t0 + (t1 - t0) * (g0 / (g0 - g1)), t0, t1);
+        var t = clamp(t0 + (t1 - t0) * (g0 / (g0 - g1)), t0, t1);
+        // An inside shape's value has a sign and no size: halve the bracket.
+        if (ENABLE_BRUTE && max(abs(g0), abs(g1)) >= 0.5 * INSIDE_HUGE) {
+            t = 0.5 * (t0 + t1);
+        }
         let g = march_level(ro, rd, footprint, t, side);
         *steps += 1;
         if (g > 0.0) {
@@ -158,6 +205,12 @@ fn march_ray(ro: real3, rd: real3, start: real, footprint: real2, side: real) ->
     if (SCENE_BOUNDED) {
         t_exit = march_bound_exit(ro, rd, footprint);
     }
+    var span = real2(1.0, -1.0);
+    if (ENABLE_BRUTE) {
+        span = march_brute_span(ro, rd);
+    }
+    var next_sample = -1.0;
+    var brute_steps = 0;
     for (var i = 0; i < MAX_STEPS; i++) {
         let d = DE(ro + rd * r.t);
         let g = side * (d - DETAIL * march_footprint(footprint, r.t));
@@ -197,7 +250,22 @@ fn march_ray(ro: real3, rd: real3, start: real, footprint: real2, side: real) ->
         let plain = g / lipschitz;
         let shortest = HIT_EPSILON * march_footprint(footprint, r.t);
         relaxed = omega > 1.0 && omega * plain > max(plain, shortest);
-        let step = max(omega * plain, shortest);
+        var step = max(omega * plain, shortest);
+        if (ENABLE_BRUTE) {
+            let h = BRUTE_STEP * march_footprint(footprint, max(r.t, span.x));
+            let brute = march_brute_step(r.t, step, span, h, march_phase, &next_sample);
+            if (brute < step) {
+                // A brute-force step: never relaxed, and not one of the
+                // MAX_STEPS the sphere tracing may take (BRUTE_MAX_STEPS
+                // more).
+                step = brute;
+                relaxed = false;
+                if (brute_steps < BRUTE_MAX_STEPS) {
+                    brute_steps += 1;
+                    i -= 1;
+                }
+            }
+        }
         prev_t = r.t;
         prev_g = g;
         r.t += step;

@@ -61,6 +61,10 @@ struct Frame {
 // on a miss), 1 where it hit, the distance evaluations of the pixel's
 // colour, and the primary march's.
 @group(0) @binding(5) var<storage, read_write> aovs: array<real4>;
+// With inside shapes, what the brute-force pass leaves for each sample s
+// of the pass at (s * height + y) * width + x: its depth (on a miss, -1
+// less the angle of its nearest miss) and its evaluations.
+@group(0) @binding(8) var<storage, read_write> brute_depths: array<real2>;
 
 struct MarchCamera {
     origin: real3,
@@ -424,9 +428,25 @@ fn march_shadow(ro: real3, rd: real3, max_t_in: real, eps: real, start: real, so
             max_t = min(max_t, t_exit);
         }
     }
+    // Inside shapes block the ray where a sample lands in them: samples
+    // BRUTE_STEP times 4 of the shaded pixel's footprints apart (start is
+    // DETAIL footprints), beyond SHADOW_STEPS, from two samples out (the
+    // dust next to a hit would shadow every point of it).
+    let lattice = 4.0 * BRUTE_STEP * start / DETAIL;
+    var span = real2(1.0, -1.0);
+    if (ENABLE_BRUTE) {
+        span = march_brute_span(ro, rd);
+        span.x = max(span.x, 2.0 * lattice);
+    }
+    var next_sample = -1.0;
+    var brute_steps = 0;
     for (var i = 0; i < SHADOW_STEPS && t < max_t; i++) {
-        let h = DE(ro + rd * t);
+        var h = DE(ro + rd * t);
         *evals += 1u;
+        if (ENABLE_BRUTE && h <= -0.5 * INSIDE_HUGE && t < span.x) {
+            // The dust next to the start: no information.
+            h = INSIDE_HUGE;
+        }
         if (h < eps) {
             return 0.0;
         }
@@ -442,7 +462,18 @@ fn march_shadow(ro: real3, rd: real3, max_t_in: real, eps: real, start: real, so
                 return 0.0;
             }
         }
-        t += max(h, eps);
+        var step = max(h, eps);
+        if (ENABLE_BRUTE) {
+            let brute = march_brute_step(t, step, span, lattice, 0.5, &next_sample);
+            if (brute < step) {
+                step = brute;
+                if (brute_steps < BRUTE_MAX_STEPS) {
+                    brute_steps += 1;
+                    i -= 1;
+                }
+            }
+        }
+        t += step;
     }
     visible = clamp(visible, 0.0, 1.0);
     return visible * visible * (3.0 - 2.0 * visible);
@@ -843,7 +874,13 @@ fn shade_pixel(cam: MarchCamera, x: int, y: int, pixel: uint) -> Shaded {
         let sample = march_sample_ray(cam, x, y, pixel, j, s);
         let ro = sample.ray.ro;
         let rd = sample.ray.rd;
-        let m = march_ray(ro, rd, 0.0, cam.footprint, 1.0);
+        var m: MarchResult;
+        if (ENABLE_BRUTE) {
+            // Marched by the brute-force pass.
+            m = march_stored(x, y, s);
+        } else {
+            m = march_ray(ro, rd, 0.0, cam.footprint, 1.0);
+        }
         steps += uint(m.steps);
         evals += uint(m.steps);
         var background = march_background(cam, sample.py);
@@ -858,22 +895,49 @@ fn shade_pixel(cam: MarchCamera, x: int, y: int, pixel: uint) -> Shaded {
             var p = ro + rd * m.t;
             let footprint = march_footprint(cam.footprint, m.t);
             var view_height = footprint * cam.image_h;
-            var n = march_normal(p, NORMAL_EPSILON * footprint, rd);
-            evals += MARCH_NORMAL_EVALUATIONS;
-            if (m.t > 0.0) {
-                n = march_facing(n, rd);
-            } else {
-                // The ray starts inside the surface: shade the nearest
-                // point of the surface instead, with no view to scale
-                // occlusion to.
-                p -= n * DE(p);
+            // Whether p lies in an inside shape, which has no distance to
+            // take a normal or occlusion from.
+            var in_set = false;
+            var n: real3;
+            if (ENABLE_BRUTE) {
+                in_set = DE(p) <= -0.5 * INSIDE_HUGE;
                 evals += 1u;
-                view_height = FSDF_INFINITY;
+                if (in_set) {
+                    n = march_screen_normal(cam, x, y, s, j, p, rd, footprint);
+                }
+            }
+            if (!in_set) {
+                n = march_normal(p, NORMAL_EPSILON * footprint, rd);
+                evals += MARCH_NORMAL_EVALUATIONS;
+                if (m.t > 0.0) {
+                    n = march_facing(n, rd);
+                } else {
+                    // The ray starts inside the surface: shade the nearest
+                    // point of the surface instead, with no view to scale
+                    // occlusion to.
+                    p -= n * DE(p);
+                    evals += 1u;
+                    view_height = FSDF_INFINITY;
+                }
             }
             if (ENABLE_GI) {
                 color = march_path(p, n, rd, max(m.t, 0.0), cam, pixel, j, &evals);
             } else {
-                let occlusion = march_occlusion(p, n, view_height, 0.5, &evals);
+                // Occlusion samples at the midpoints of their intervals;
+                // with inside shapes, which the samples see only where
+                // they land in one, jittered like the march's steps, so
+                // passes average the all-or-nothing samples.
+                var offset = 0.5;
+                if (ENABLE_BRUTE) {
+                    offset = march_brute_phase(pixel, j);
+                }
+                var occlusion = march_occlusion(p, n, view_height, offset, &evals);
+                if (ENABLE_BRUTE) {
+                    // The neighbours' depths add what the screen shows
+                    // around the hit.
+                    occlusion *= march_screen_occlusion(cam, x, y, s, j, p, n, footprint,
+                                                        view_height);
+                }
                 let lit = march_shade(p, n, rd, DETAIL * footprint, occlusion, &evals);
                 color = lit.color;
                 if (ENABLE_MATERIALS) {
@@ -945,8 +1009,10 @@ fn render(@builtin(global_invocation_id) id: vec3<uint>) {
     // Later passes leave the outputs of the first: the same rays.
     if (frame.write_aovs != 0u && pass_index <= 0) {
         var centre = shaded.centre;
-        if (SUPERSAMPLING > 1 || cam.aperture > 0.0) {
+        if (!ENABLE_BRUTE && (SUPERSAMPLING > 1 || cam.aperture > 0.0)) {
             // The colour samples are jittered: trace the pixel centre.
+            // Rays marched by brute force report their first sample's
+            // instead: its normal needs the neighbours' samples.
             let ray = march_camera_ray(cam, (real(x) + 0.5) * cam.pixel_scale,
                                        (real(y) + 0.5) * cam.pixel_scale);
             centre = march_ray(ray.ro, ray.rd, 0.0, cam.footprint, 1.0);

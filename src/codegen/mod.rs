@@ -369,13 +369,7 @@ pub fn emit_ir(ir: &Ir, options: &Options) -> Result<KernelSource> {
     emitter.emit(materials);
     let count = ir.glows().len();
     if options.target == Target::Render && count > 0 && ir.has_inside_shapes() {
-        return Err(Error::Invalid {
-            what: "scene",
-            reason: "glow nodes need the distance to their shapes along each ray, which a \
-                     scene with inside shapes (marched by brute force) does not have: use \
-                     the scene's glow (Effects::glow) instead"
-                .into(),
-        });
+        return Err(glows_with_inside_shapes());
     }
     if options.target == Target::Render && count > MAX_GLOW_NODES {
         return Err(too_many_glows(count));
@@ -630,6 +624,17 @@ fn emitters(ir: &Ir, options: &Options, origin: DVec3) -> Vec<Bound> {
         .filter(|b| b.fits(options.quality.precision.limits()))
         .take(MAX_EMITTERS)
         .collect()
+}
+
+/// A rendered scene with both glow nodes and inside shapes.
+fn glows_with_inside_shapes() -> Error {
+    Error::Invalid {
+        what: "scene",
+        reason: "glow nodes need the distance to their shapes along each ray, which a scene \
+                 with inside shapes (marched by brute force) does not have: use the scene's \
+                 glow (Effects::glow) instead"
+            .into(),
+    }
 }
 
 /// A rendered scene with `count` glow nodes, above [`MAX_GLOW_NODES`].

@@ -16,8 +16,8 @@ use crate::error::{Error, Result};
 use crate::expr::Wgsl;
 use crate::ir::{Bound, CompiledScene, Ir};
 use crate::math::{DEFAULT_COLOR, REAL_TINY};
-use crate::quality::Precision;
-use crate::scene::{DEFAULT_MATERIAL, MATERIAL_SPECS};
+use crate::quality::{Precision, ScreenNormals};
+use crate::scene::{BRUTE_MAX_STEPS, DEFAULT_MATERIAL, INSIDE_HUGE, MATERIAL_SPECS};
 
 /// The bind group and binding at which a WGSL module of [`emit_wgsl`]
 /// reads its parameter buffer, `var<storage, read> params: array<real>`:
@@ -63,8 +63,10 @@ pub fn emit_wgsl(scene: &CompiledScene, options: &Options) -> Result<KernelSourc
 ///
 /// # Errors
 /// [`Error::Unsupported`] for double precision (WGSL has single precision
-/// only), for a custom shape written in OpenCL C rather than as a formula,
-/// and for inside shapes; otherwise as [`emit_ir`](super::emit_ir).
+/// only), and for a custom shape written in OpenCL C rather than as a
+/// formula (an inside shape of the user's among them: the built-in
+/// escape-time sets carry their tests in WGSL); otherwise as
+/// [`emit_ir`](super::emit_ir).
 pub fn emit_wgsl_ir(ir: &Ir, options: &Options) -> Result<KernelSource> {
     options.validate()?;
     if options.quality.precision == Precision::F64 {
@@ -75,12 +77,6 @@ pub fn emit_wgsl_ir(ir: &Ir, options: &Options) -> Result<KernelSource> {
         ));
     }
     ir.check_limits(Precision::F32.limits())?;
-    if ir.has_inside_shapes() {
-        return Err(unsupported(
-            "march inside shapes (marched by brute force)",
-            "render scenes with inside shapes with the OpenCL backend",
-        ));
-    }
     let frame = match options.target {
         Target::Render => ir.local_frame(),
         Target::Evaluate => None,
@@ -97,8 +93,15 @@ pub fn emit_wgsl_ir(ir: &Ir, options: &Options) -> Result<KernelSource> {
     let materials = super::shades_materials(ir, options);
     emitter.emit(materials);
     let count = ir.glows().len();
-    if options.target == Target::Render && count > super::MAX_GLOW_NODES {
+    let rendering = options.target == Target::Render;
+    if rendering && count > 0 && ir.has_inside_shapes() {
+        return Err(super::glows_with_inside_shapes());
+    }
+    if rendering && count > super::MAX_GLOW_NODES {
         return Err(super::too_many_glows(count));
+    }
+    if rendering && options.effects.global_illumination.is_some() {
+        ir.check_paths()?;
     }
     let glows = if options.target == Target::Render {
         emitter.emit_glows()
@@ -118,6 +121,11 @@ pub fn emit_wgsl_ir(ir: &Ir, options: &Options) -> Result<KernelSource> {
          largest magnitude a scene value may have, and with a finite square. */",
     );
     w.line(format!("const FSDF_INFINITY: real = {};", w.float(1e19)));
+    w.line("/* The magnitude of an inside shape's value (scene::INSIDE_HUGE). */");
+    w.line(format!(
+        "const INSIDE_HUGE: real = {};",
+        w.float(INSIDE_HUGE)
+    ));
     let c = DEFAULT_COLOR;
     w.line(format!(
         "const DEFAULT_COLOR: real3 = real3({}, {}, {});",
@@ -138,13 +146,28 @@ pub fn emit_wgsl_ir(ir: &Ir, options: &Options) -> Result<KernelSource> {
     w.line("");
     super::write_helpers(&mut w, &mut emitter)?;
     for shape in &customs {
+        if let Some(definition) = shape.wgsl_inside_definition() {
+            w.line(format!("/* ---- inside shape {} ---- */", shape.name()));
+            w.raw(&definition);
+            w.line("");
+            continue;
+        }
         let Some(program) = shape.program() else {
+            let (what, instead) = if shape.inside_bounds().is_some() {
+                (
+                    "inside shape",
+                    "render it with the OpenCL backend (the built-in escape-time sets, \
+                     InsideShape::mandelbulb and InsideShape::mandelbox, draw on both)",
+                )
+            } else {
+                (
+                    "custom shape",
+                    "define it as a formula (CustomShape::parse) to use it in WGSL",
+                )
+            };
             return Err(unsupported(
-                &format!(
-                    "compile custom shape `{}`, written in OpenCL C",
-                    shape.name()
-                ),
-                "define it as a formula (CustomShape::parse) to use it in WGSL",
+                &format!("compile {what} `{}`, written in OpenCL C", shape.name()),
+                instead,
             ));
         };
         w.line(format!("/* ---- custom shape {} ---- */", shape.name()));
@@ -154,7 +177,12 @@ pub fn emit_wgsl_ir(ir: &Ir, options: &Options) -> Result<KernelSource> {
     w.line("/* ---- scene ---- */");
     unwritable(&body, Precision::F32)?;
     w.raw(&body.finish());
-    if options.target == Target::Render {
+    // Inside shapes are marched by brute force within their region.
+    let brute = ir.brute_region().filter(|_| rendering).map(|b| Bound {
+        centre: b.centre - origin,
+        ..b
+    });
+    if rendering {
         let glow = Glow {
             nodes: glows,
             brightest: if glows > 0 { super::node_glow(ir) } else { 0.0 },
@@ -165,10 +193,12 @@ pub fn emit_wgsl_ir(ir: &Ir, options: &Options) -> Result<KernelSource> {
             options,
             super::scene_bound(ir, options, origin),
             &glow,
+            brute,
         );
         let emitters = super::emitters(ir, options, origin);
         render(&mut w, options, materials, origin)?;
         paths(&mut w, options, &emitters);
+        brute_pass(&mut w, options, brute.is_some());
     }
     unwritable(&w, Precision::F32)?;
     let source = w.finish();
@@ -180,7 +210,7 @@ pub fn emit_wgsl_ir(ir: &Ir, options: &Options) -> Result<KernelSource> {
         precision: Precision::F32,
         fast_math: options.quality.fast_math,
         cone_tile: 0,
-        brute: false,
+        brute: brute.is_some(),
         origin,
         custom_regions: Vec::new(),
         constants,
@@ -227,7 +257,13 @@ fn rgb(w: &Writer, name: &str, c: DVec3) -> String {
 
 /// The march's settings as constants, then `march_ray` and what it calls
 /// (`kernels/wgsl/march.wgsl`).
-fn march(w: &mut Writer, options: &Options, bound: Option<Bound>, glow: &Glow) {
+fn march(
+    w: &mut Writer,
+    options: &Options,
+    bound: Option<Bound>,
+    glow: &Glow,
+    brute: Option<Bound>,
+) {
     let q = &options.quality;
     let on = Effect::enabled(options);
     w.line("/* ---- march ---- */");
@@ -266,6 +302,14 @@ fn march(w: &mut Writer, options: &Options, bound: Option<Bound>, glow: &Glow) {
         "const NODE_GLOW_BRIGHTEST: real = {};",
         w.float(glow.brightest)
     ));
+    w.line("/* Inside shapes: the sphere they lie in, marched by brute force. */");
+    w.line(format!("const ENABLE_BRUTE: bool = {};", brute.is_some()));
+    sphere(w, "BRUTE", brute);
+    w.line(format!(
+        "const BRUTE_STEP: real = {};",
+        w.float(q.brute_step)
+    ));
+    w.line(format!("const BRUTE_MAX_STEPS: int = {BRUTE_MAX_STEPS};"));
     if glow.nodes == 0 {
         w.line("/* No glow nodes: no halo to measure. */");
         w.line("fn glow_distance(j: int, p: real3) -> real {");
@@ -407,11 +451,51 @@ fn paths(w: &mut Writer, options: &Options, emitters: &[Bound]) {
     w.raw(PATHS);
 }
 
+/// With inside shapes, the screen-space normals' method and the
+/// brute-force pass (`kernels/wgsl/brute.wgsl`); without, the functions the
+/// render kernel calls only with them, as stubs.
+fn brute_pass(w: &mut Writer, options: &Options, brute: bool) {
+    w.line("/* ---- inside shapes ---- */");
+    if brute {
+        let method = match options.quality.screen_normals {
+            ScreenNormals::Differences => 0,
+            ScreenNormals::LeastSquares => 1,
+        };
+        w.line(format!("const SCREEN_NORMALS: int = {method};"));
+        w.raw(BRUTE);
+        return;
+    }
+    w.raw(NO_BRUTE);
+}
+
+/// What the render kernel calls only where inside shapes are marched by
+/// brute force: unreachable without them.
+const NO_BRUTE: &str = "/* No inside shapes: every ray marched where it is shaded. */
+fn march_stored(x: int, y: int, s: int) -> MarchResult {
+    var m: MarchResult;
+    return m;
+}
+fn march_brute_phase(pixel: uint, j: uint) -> real {
+    return 0.5;
+}
+fn march_screen_normal(cam: MarchCamera, x: int, y: int, s: int, j: uint, p: real3, rd: real3,
+                       footprint: real) -> real3 {
+    return -rd;
+}
+fn march_screen_occlusion(cam: MarchCamera, x: int, y: int, s: int, j: uint, p: real3,
+                          n: real3, footprint: real, view_height: real) -> real {
+    return 1.0;
+}
+";
+
 /// The march in WGSL.
 const MARCH: &str = include_str!("../../kernels/wgsl/march.wgsl");
 
 /// The render kernel in WGSL.
 const RENDER: &str = include_str!("../../kernels/wgsl/render.wgsl");
+
+/// The brute-force pass of inside shapes in WGSL.
+const BRUTE: &str = include_str!("../../kernels/wgsl/brute.wgsl");
 
 /// The path tracer in WGSL.
 const PATHS: &str = include_str!("../../kernels/wgsl/paths.wgsl");

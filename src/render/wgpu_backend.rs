@@ -14,8 +14,10 @@
 //! environment image's light and sky, path-traced global illumination
 //! (`kernels/wgsl/paths.wgsl`), supersampling, depth of field and the
 //! resolution scale. What it does not draw yet it refuses with
-//! [`Error::Unsupported`] rather than draw something else: inside shapes,
-//! double precision and custom shapes written in OpenCL C. It leaves out what
+//! [`Error::Unsupported`] rather than draw something else: double
+//! precision and custom shapes written in OpenCL C (inside shapes of the
+//! user's among them; the built-in escape-time sets are drawn, by brute
+//! force, `kernels/wgsl/brute.wgsl`). It leaves out what
 //! changes only the speed: the coarse cone pass
 //! ([`Quality::cone_tile`]: rays start at the eye) and relaxed math
 //! ([`Quality::fast_math`]: the driver decides).
@@ -61,6 +63,8 @@ const IMAGE: u32 = 4;
 const AOVS: u32 = 5;
 const ENVIRONMENT: u32 = 6;
 const ACCUMULATION: u32 = 7;
+/// The depths and evaluations of each sample the brute-force pass marched.
+const BRUTE_DEPTHS: u32 = 8;
 
 /// The format of the texture the render kernel writes: a texture given to
 /// [`WgpuRenderer::render_to_texture`] must have it, and
@@ -154,6 +158,9 @@ pub struct WgpuRenderer {
     sums: Option<::wgpu::Buffer>,
     /// One pixel's sums: bound for a frame of its own.
     no_accumulation: ::wgpu::Buffer,
+    /// The brute-force pass's depths, per sample of a pass, where the
+    /// scene has inside shapes; one sample's stand-in otherwise.
+    brute_depths: ::wgpu::Buffer,
     /// The progressive image so far.
     progress: Option<Progress>,
     timing: Option<Duration>,
@@ -277,6 +284,7 @@ impl WgpuRenderer {
         );
         let no_outputs = buffer(&device, "no pixels", 16, output_usage());
         let no_accumulation = buffer(&device, "no sums", 16, ::wgpu::BufferUsages::STORAGE);
+        let brute_depths = buffer(&device, "no depths", 8, ::wgpu::BufferUsages::STORAGE);
         let packed = super::environment::pack(scene.environment());
         let environment = buffer(&device, "environment", 4 * packed.len(), storage);
         let bytes: Vec<u8> = packed.iter().flat_map(|v| v.to_le_bytes()).collect();
@@ -310,6 +318,7 @@ impl WgpuRenderer {
             no_outputs,
             sums: None,
             no_accumulation,
+            brute_depths,
             progress: None,
             timing: None,
         };
@@ -715,6 +724,9 @@ impl WgpuRenderer {
         height: u32,
         after: impl FnOnce(&mut ::wgpu::CommandEncoder),
     ) -> Result<()> {
+        if self.pipeline.brute.is_some() {
+            self.fit_brute_depths(width, height)?;
+        }
         let device = &self.gpu.device;
         let entries = [
             (codegen::WGSL_PARAMS.1, self.params.as_entire_binding()),
@@ -725,6 +737,7 @@ impl WgpuRenderer {
             (AOVS, aovs.as_entire_binding()),
             (ENVIRONMENT, self.environment.as_entire_binding()),
             (ACCUMULATION, accumulation.as_entire_binding()),
+            (BRUTE_DEPTHS, self.brute_depths.as_entire_binding()),
         ];
         let commands = checked(device, "the render pass", || {
             let group = device.create_bind_group(&::wgpu::BindGroupDescriptor {
@@ -738,9 +751,16 @@ impl WgpuRenderer {
             {
                 let mut pass =
                     encoder.begin_compute_pass(&::wgpu::ComputePassDescriptor::default());
-                pass.set_pipeline(&self.pipeline.compute);
+                let groups = (width.div_ceil(WORKGROUP), height.div_ceil(WORKGROUP));
                 pass.set_bind_group(codegen::WGSL_PARAMS.0, &group, &[]);
-                pass.dispatch_workgroups(width.div_ceil(WORKGROUP), height.div_ceil(WORKGROUP), 1);
+                if let Some(brute) = &self.pipeline.brute {
+                    // Inside shapes: every sample marched first, for the
+                    // render kernel to take normals from the neighbours'.
+                    pass.set_pipeline(brute);
+                    pass.dispatch_workgroups(groups.0, groups.1, 1);
+                }
+                pass.set_pipeline(&self.pipeline.compute);
+                pass.dispatch_workgroups(groups.0, groups.1, 1);
             }
             after(&mut encoder);
             encoder.finish()
@@ -751,6 +771,42 @@ impl WgpuRenderer {
             .poll(::wgpu::PollType::wait_indefinitely())
             .map_err(|e| wgpu_error("the frame", e))?;
         self.timing = Some(started.elapsed());
+        Ok(())
+    }
+
+    /// A brute-force depth buffer for every sample of a pass at
+    /// `width` × `height` rendered pixels, made anew where the size
+    /// changed: [`Error::Resolution`] where the device cannot bind it.
+    fn fit_brute_depths(&mut self, width: u32, height: u32) -> Result<()> {
+        let samples = u64::from(self.options.quality.supersampling).pow(2);
+        let bytes = 8 * samples * u64::from(width) * u64::from(height);
+        if self.brute_depths.size() == bytes {
+            return Ok(());
+        }
+        let device = &self.gpu.device;
+        let limits = device.limits();
+        let most = limits
+            .max_storage_buffer_binding_size
+            .min(limits.max_buffer_size);
+        if bytes > most {
+            return Err(Error::Resolution {
+                width,
+                height,
+                reason: format!(
+                    "the brute-force depths of its {samples} samples a pixel take {bytes} \
+                     bytes, more than the {most} the wgpu device binds at once (render a \
+                     smaller image, or with less supersampling)"
+                ),
+            });
+        }
+        let size = usize::try_from(bytes).map_err(|_| Error::Resolution {
+            width,
+            height,
+            reason: "the brute-force depths do not fit in memory".into(),
+        })?;
+        self.brute_depths = checked(device, "the brute-force depths", || {
+            buffer(device, "depths", size, ::wgpu::BufferUsages::STORAGE)
+        })?;
         Ok(())
     }
 
@@ -932,10 +988,12 @@ fn shared_device() -> Result<(::wgpu::Device, ::wgpu::Queue)> {
     found.clone().map_err(Error::Wgpu)
 }
 
-/// A render pipeline and the layout of its bind group.
+/// A render pipeline, the brute-force pass's where the scene has inside
+/// shapes, and the layout of their bind group.
 #[derive(Clone)]
 struct Pipeline {
     compute: ::wgpu::ComputePipeline,
+    brute: Option<::wgpu::ComputePipeline>,
     layout: ::wgpu::BindGroupLayout,
 }
 
@@ -972,15 +1030,21 @@ fn pipeline(device: &::wgpu::Device, source: &KernelSource) -> Result<(Pipeline,
             bind_group_layouts: &[Some(&layout)],
             immediate_size: 0,
         });
-        let compute = device.create_compute_pipeline(&::wgpu::ComputePipelineDescriptor {
-            label: Some("fractal-sdf render"),
-            layout: Some(&pipeline_layout),
-            module: &module,
-            entry_point: Some("render"),
-            compilation_options: ::wgpu::PipelineCompilationOptions::default(),
-            cache: None,
-        });
-        Pipeline { compute, layout }
+        let entry = |name: &str| {
+            device.create_compute_pipeline(&::wgpu::ComputePipelineDescriptor {
+                label: Some(name),
+                layout: Some(&pipeline_layout),
+                module: &module,
+                entry_point: Some(name),
+                compilation_options: ::wgpu::PipelineCompilationOptions::default(),
+                cache: None,
+            })
+        };
+        Pipeline {
+            compute: entry("render"),
+            brute: source.brute.then(|| entry("brute_pass")),
+            layout,
+        }
     })?;
     if shared {
         let mut entries = CACHE.lock().unwrap_or_else(PoisonError::into_inner);
@@ -1034,6 +1098,7 @@ fn bind_group_layout(device: &::wgpu::Device) -> ::wgpu::BindGroupLayout {
             storage(AOVS, false),
             storage(ENVIRONMENT, true),
             storage(ACCUMULATION, false),
+            storage(BRUTE_DEPTHS, false),
         ],
     })
 }

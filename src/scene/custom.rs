@@ -190,6 +190,25 @@ impl InsideBounds {
         }
     }
 
+    /// A WGSL expression, true where `p` lies outside the region.
+    fn wgsl_outside(&self) -> String {
+        let lit = |v: f64| format!("{:?}", v as f32);
+        let vec = |v: DVec3| format!("real3({}, {}, {})", lit(v.x), lit(v.y), lit(v.z));
+        match *self {
+            InsideBounds::Sphere { centre, radius } => {
+                format!("length(p - {}) > {}", vec(centre), lit(radius))
+            }
+            InsideBounds::Cuboid {
+                centre,
+                half_extents,
+            } => format!(
+                "any(abs(p - {}) - {} > real3(0.0))",
+                vec(centre),
+                vec(half_extents)
+            ),
+        }
+    }
+
     /// An OpenCL C expression, true where `p` lies outside the region.
     fn opencl_outside(&self) -> String {
         let lit = |v: f64| format!("R({v:?})");
@@ -294,6 +313,9 @@ struct Inner {
     program: Option<Arc<Program>>,
     /// The text of a shape defined by [`CustomShape::parse`].
     text: Option<String>,
+    /// A built-in inside shape's test in WGSL: the body of
+    /// `fn inside_NAME(p: real3, PARAM: real, ...) -> bool`.
+    wgsl: Option<&'static str>,
 }
 
 impl CustomShape {
@@ -426,6 +448,7 @@ impl CustomShape {
             opencl,
             program: Some(Arc::new(program)),
             text: None,
+            wgsl: None,
         })))
     }
 
@@ -491,6 +514,7 @@ impl CustomShape {
             opencl: opencl_body.into(),
             program: None,
             text: None,
+            wgsl: None,
         })))
     }
 
@@ -621,6 +645,47 @@ impl CustomShape {
         ))
     }
 
+    /// A built-in inside shape with its test in WGSL too (`body`, the body
+    /// of `fn inside_NAME(p: real3, PARAM: real, ...) -> bool`): the WGSL
+    /// backend draws it.
+    pub(super) fn with_wgsl_test(mut self, body: &'static str) -> Self {
+        Arc::get_mut(&mut self.0)
+            .expect("a shape just defined is not shared")
+            .wgsl = Some(body);
+        self
+    }
+
+    /// For an inside shape with a WGSL test, the WGSL definitions of
+    /// `inside_NAME` and of `custom_NAME`, the value scenes compose
+    /// (`INSIDE_HUGE` outside the bounds or the set, `-INSIDE_HUGE` in
+    /// it), as [`opencl_wrapper`](Self::opencl_wrapper) in OpenCL C.
+    /// `None` for other shapes.
+    pub(crate) fn wgsl_inside_definition(&self) -> Option<String> {
+        let bounds = self.inside_bounds()?;
+        let body = self.0.wgsl?;
+        let test = self.test_name()?;
+        let params: String = self
+            .0
+            .params
+            .iter()
+            .map(|(n, _)| format!(", {n}: real"))
+            .collect();
+        let args: String = self
+            .0
+            .params
+            .iter()
+            .map(|(n, _)| format!(", {n}"))
+            .collect();
+        Some(format!(
+            "fn {test}(p: real3{params}) -> bool {{\n{}\n}}\n\
+             fn {}(p: real3{params}) -> real {{\n    if ({}) {{\n        return INSIDE_HUGE;\n    \
+             }}\n    return select(INSIDE_HUGE, -INSIDE_HUGE, {test}(p{args}));\n}}\n",
+            body.trim_end(),
+            self.function_name(),
+            bounds.wgsl_outside(),
+        ))
+    }
+
     fn signature_params(&self) -> String {
         self.0
             .params
@@ -646,6 +711,8 @@ impl CustomShape {
             (x != y).then_some("the formulas differ")
         } else if a.opencl != b.opencl {
             Some("the OpenCL bodies differ")
+        } else if a.wgsl != b.wgsl {
+            Some("the WGSL bodies differ")
         } else if self.inside_bounds() != other.inside_bounds() {
             Some("the bounds (or whether it is an inside test) differ")
         } else if a.cpu_type.is_none() || b.cpu_type.is_none() {

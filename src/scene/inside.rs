@@ -36,7 +36,10 @@ use crate::error::Result;
 /// The OpenCL body is the body of a function
 /// `int inside_NAME(real3 p, real PARAM1, ...)` that returns nonzero where
 /// `p` is in the set. It runs only within the bounds: the set is clipped
-/// to them. Names follow [`CustomShape`]'s rules, and the function
+/// to them. The wgpu backend (feature `wgpu`) draws the built-in sets,
+/// [`mandelbulb`](Self::mandelbulb) and [`mandelbox`](Self::mandelbox),
+/// whose tests are written in WGSL too, and refuses a shape whose test is
+/// OpenCL C alone. Names follow [`CustomShape`]'s rules, and the function
 /// `inside_NAME` may not be a name the generated program already uses.
 ///
 /// # How a scene uses one
@@ -112,7 +115,8 @@ impl InsideShape {
             InsideBounds::sphere(DVec3::ZERO, MANDELBULB_BAILOUT),
             |p, a| mandelbulb_contains(p, a[0], iterations(a[1]), MANDELBULB_BAILOUT),
             MANDELBULB_BODY,
-        );
+        )
+        .map(|shape| shape.with_wgsl_test(MANDELBULB_WGSL));
         InsideShape(shape.expect("the built-in Mandelbulb test is a valid shape"))
     }
 
@@ -138,7 +142,8 @@ impl InsideShape {
             InsideBounds::cuboid(DVec3::ZERO, DVec3::splat(MANDELBOX_HALF_SIDE)),
             |p, a| mandelbox_contains(p, a[0], iterations(a[1])),
             MANDELBOX_BODY,
-        );
+        )
+        .map(|shape| shape.with_wgsl_test(MANDELBOX_WGSL));
         InsideShape(shape.expect("the built-in Mandelbox test is a valid shape"))
     }
 
@@ -238,6 +243,41 @@ for (int i = 0; i < (int)iterations; ++i) {
     }
 }
 return 1;";
+
+/// [`MANDELBULB_BODY`] in WGSL, for the wgpu backend.
+const MANDELBULB_WGSL: &str = "var z = p;
+for (var i = 0; i < i32(iterations); i++) {
+    let r = length(z);
+    if (r > 2.0) {
+        return false;
+    }
+    if (r == 0.0) {
+        z = p;
+        continue;
+    }
+    let polar = acos(clamp(z.z / r, -1.0, 1.0)) * power;
+    let azimuth = atan2(z.y, z.x) * power;
+    z = pow(r, power) * real3(sin(polar) * cos(azimuth), sin(polar) * sin(azimuth), cos(polar)) + p;
+}
+return length(z) <= 2.0;";
+
+/// [`MANDELBOX_BODY`] in WGSL, for the wgpu backend.
+const MANDELBOX_WGSL: &str = "var z = p;
+for (var i = 0; i < i32(iterations); i++) {
+    z = clamp(z, real3(-1.0), real3(1.0)) * 2.0 - z;
+    let r2 = dot(z, z);
+    var k = 1.0;
+    if (r2 < 0.25) {
+        k = 4.0;
+    } else if (r2 < 1.0) {
+        k = 1.0 / r2;
+    }
+    z = z * (scale * k) + p;
+    if (dot(z, z) > 16.0) {
+        return false;
+    }
+}
+return true;";
 
 /// Whether `p` is in the Mandelbulb of `power` at `iterations` iterations:
 /// the orbit `z0 = p`, `z(k+1) = z(k)^power + p` (the triplex power in

@@ -236,10 +236,10 @@ struct RenderArgs {
     #[arg(long, value_name = "FOOTPRINTS")]
     brute_step: Option<f64>,
     /// The backend that renders: opencl, or wgpu (WGSL on Vulkan, in
-    /// single precision; the 8-bit image, with --passes: no --aov, --bits
-    /// 16, .exr, --noise, --adaptive, --stereo, --gi, --device
-    /// or --devices, nor global illumination or inside shapes,
-    /// which need opencl). Default: the settings file's, else opencl.
+    /// single precision; the 8-bit image, with --passes and --gi: no
+    /// --aov, --bits 16, .exr, --noise, --adaptive, --stereo, --device or
+    /// --devices, nor custom shapes written in OpenCL C, which need
+    /// opencl). Default: the settings file's, else opencl.
     #[arg(long, value_enum)]
     backend: Option<Backend>,
 }
