@@ -23,7 +23,11 @@ use crate::error::{Error, Result, fmt_value};
 use crate::output::CameraExport;
 use crate::scene::Camera;
 #[cfg(feature = "opencl")]
-use crate::{animation::Motion, render::Renderer, view::FrameTiming};
+use crate::{
+    animation::Motion,
+    render::{RenderFrames, Renderer},
+    view::FrameTiming,
+};
 
 /// The file name of frame `index`: `frame_00042.png`.
 #[must_use]
@@ -464,6 +468,76 @@ impl Sequence {
         (width, height): (u32, u32),
         mut on_frame: impl FnMut(&RenderedFrame),
     ) -> Result<()> {
+        let (output, layered) = self.prepare(renderer, motions, indices)?;
+        if !layered {
+            return self.images(renderer, path, motions, indices, (width, height), on_frame);
+        }
+        let base = *renderer.camera();
+        for &index in indices {
+            let moments = self.moments(index);
+            let file = self.frame_path(index);
+            let at = |r: &mut Renderer, t: f64| moment(r, path, &base, motions, t);
+            let mut frame = if let [t] = moments[..] {
+                at(renderer, t)?;
+                renderer.render_layers(width, height)?
+            } else {
+                renderer.render_layers_over_time(width, height, &moments, |r, &t| at(r, t))?
+            };
+            if output.needs_ids() {
+                // The layers are the first moment's: so are the ids.
+                at(renderer, moments[0])?;
+                renderer.identify(&mut frame)?;
+            }
+            crate::output::save_frame(&frame, &file, &output)?;
+            on_frame(&RenderedFrame {
+                index,
+                path: file,
+                timing: renderer.last_timing(),
+            });
+        }
+        Ok(())
+    }
+
+    /// [`Sequence::render`] on either backend ([`RenderFrames`]: the wgpu
+    /// backend's [`WgpuRenderer`](crate::render::WgpuRenderer) too), for
+    /// frames that are 8-bit images alone (PNG, TIFF or JPEG, no
+    /// [`Sequence::outputs`] beyond the image).
+    ///
+    /// # Errors
+    /// As [`Sequence::render`]; [`Error::Invalid`] before anything is
+    /// rendered where the frames need the shading layers (OpenEXR, 16 bits
+    /// or other outputs), which [`Sequence::render`] writes with the OpenCL
+    /// backend.
+    pub fn render_images<R: RenderFrames>(
+        &self,
+        renderer: &mut R,
+        path: &CameraPath,
+        motions: &[Motion],
+        indices: &[u32],
+        size: (u32, u32),
+        on_frame: impl FnMut(&RenderedFrame),
+    ) -> Result<()> {
+        let (_, layered) = self.prepare(renderer, motions, indices)?;
+        if layered {
+            return Err(invalid(
+                "frames with the shading layers (OpenEXR, 16 bits or outputs beside the image) \
+                 are written by Sequence::render, on the OpenCL backend: write 8-bit PNG, TIFF \
+                 or JPEG frames here"
+                    .into(),
+            ));
+        }
+        self.images(renderer, path, motions, indices, size, on_frame)
+    }
+
+    /// Checks the frames, motions and motion blur before anything is
+    /// rendered: the outputs to write, and whether they need the shading
+    /// layers.
+    fn prepare<R: RenderFrames>(
+        &self,
+        renderer: &R,
+        motions: &[Motion],
+        indices: &[u32],
+    ) -> Result<(crate::output::FrameOutput, bool)> {
         if let Some(&index) = indices.iter().find(|&&i| i >= self.frames) {
             return Err(invalid(format!(
                 "frame {index} is not in the sequence (frames 0..{})",
@@ -474,29 +548,19 @@ impl Sequence {
             motion.validate()?;
         }
         // Each moment a progressive pass of the quality's samples.
-        let samples = renderer.options().quality.supersampling.max(1).pow(2);
+        let supersampling = renderer.options().quality.supersampling;
+        let samples = supersampling.max(1).pow(2);
         let most = Renderer::MAX_PROGRESSIVE_SAMPLES / samples;
         if self.blur.samples > most {
             return Err(invalid(format!(
-                "{} moments of motion blur take {} samples a pixel at {}x{} supersampling, \
-                 more than the {} progressive rendering holds: use at most {most} moments",
+                "{} moments of motion blur take {} samples a pixel at {supersampling}x\
+                 {supersampling} supersampling, more than the {} progressive rendering holds: \
+                 use at most {most} moments",
                 self.blur.samples,
                 self.blur.samples * samples,
-                renderer.options().quality.supersampling,
-                renderer.options().quality.supersampling,
                 Renderer::MAX_PROGRESSIVE_SAMPLES
             )));
         }
-        let base = *renderer.camera();
-        let at = |renderer: &mut Renderer, t: f64| -> Result<()> {
-            renderer.set_camera(path.camera_at(path.start() + t, &base))?;
-            for motion in motions {
-                for (name, value) in motion.values(t) {
-                    renderer.set_param(&name, value)?;
-                }
-            }
-            Ok(())
-        };
         let mut output = self
             .output
             .clone()
@@ -505,31 +569,31 @@ impl Sequence {
         let probe = self.frame_path(0);
         output.check(&probe)?;
         let layered = output.needs_layers(&probe)? || output.needs_aovs();
+        Ok((output, layered))
+    }
+
+    /// Renders and saves the frames `indices` as 8-bit images.
+    fn images<R: RenderFrames>(
+        &self,
+        renderer: &mut R,
+        path: &CameraPath,
+        motions: &[Motion],
+        indices: &[u32],
+        (width, height): (u32, u32),
+        mut on_frame: impl FnMut(&RenderedFrame),
+    ) -> Result<()> {
+        let base = *renderer.camera();
         for &index in indices {
             let moments = self.moments(index);
             let file = self.frame_path(index);
-            if layered {
-                let mut frame = if let [t] = moments[..] {
-                    at(renderer, t)?;
-                    renderer.render_layers(width, height)?
-                } else {
-                    renderer.render_layers_over_time(width, height, &moments, |r, &t| at(r, t))?
-                };
-                if output.needs_ids() {
-                    // The layers are the first moment's: so are the ids.
-                    at(renderer, moments[0])?;
-                    renderer.identify(&mut frame)?;
-                }
-                crate::output::save_frame(&frame, &file, &output)?;
+            let at = |r: &mut R, t: f64| moment(r, path, &base, motions, t);
+            let image = if let [t] = moments[..] {
+                at(renderer, t)?;
+                renderer.render(width, height)?
             } else {
-                let image = if let [t] = moments[..] {
-                    at(renderer, t)?;
-                    renderer.render(width, height)?
-                } else {
-                    renderer.render_over_time(width, height, &moments, |r, &t| at(r, t))?
-                };
-                crate::output::save_image(&image, &file)?;
-            }
+                renderer.render_over_time(width, height, &moments, |r, &t| at(r, t))?
+            };
+            crate::output::save_image(&image, &file)?;
             on_frame(&RenderedFrame {
                 index,
                 path: file,
@@ -538,6 +602,25 @@ impl Sequence {
         }
         Ok(())
     }
+}
+
+/// Sets `renderer`'s camera to `path`'s at time `t` (with `base`'s
+/// projection) and its parameters to the `motions`' values at `t`.
+#[cfg(feature = "opencl")]
+fn moment<R: RenderFrames>(
+    renderer: &mut R,
+    path: &CameraPath,
+    base: &Camera,
+    motions: &[Motion],
+    t: f64,
+) -> Result<()> {
+    renderer.set_camera(path.camera_at(path.start() + t, base))?;
+    for motion in motions {
+        for (name, value) in motion.values(t) {
+            renderer.set_param(&name, value)?;
+        }
+    }
+    Ok(())
 }
 
 /// Parses a frame range of a sequence of `total` frames: `a..b` (frames a

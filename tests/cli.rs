@@ -499,7 +499,7 @@ fn render_on_the_wgpu_backend_writes_the_opencl_picture() {
             1,
             "double precision",
         ),
-        (&["--stereo", "anaglyph"][..], "stereo.png", 2, "--stereo"),
+        (&["--aov", "depth"][..], "layers.png", 2, "--aov"),
     ] {
         let out = with(&[&["--backend", "wgpu"][..], extra].concat(), output);
         assert_eq!(out.status.code(), Some(code), "{}", text(&out));
@@ -529,6 +529,70 @@ fn render_on_the_wgpu_backend_writes_the_opencl_picture() {
     assert!(out.status.success(), "{}", text(&out));
     let drawn = image::open(&path_traced).unwrap().to_rgba8();
     assert_eq!(drawn.dimensions(), (16, 12));
+    // A stereo pair, side by side: both eyes, as OpenCL lays them out.
+    let out = with(
+        &["--backend", "wgpu", "--stereo", "side-by-side"],
+        "pair_wgpu.png",
+    );
+    assert!(out.status.success(), "{}", text(&out));
+    assert!(String::from_utf8_lossy(&out.stdout).contains("96x36"));
+    let out = with(&["--stereo", "side-by-side"], "pair_opencl.png");
+    assert!(out.status.success(), "{}", text(&out));
+    let pair = |name: &str| image::open(dir.join(name)).unwrap().to_rgba8();
+    let db = fractal_sdf::metrics::psnr(&pair("pair_wgpu.png"), &pair("pair_opencl.png"));
+    assert!(db >= 40.0, "{db:.1} dB between the stereo pairs");
+}
+
+/// `sequence --backend wgpu` renders the frames on the wgpu backend, with
+/// motion blur, as the OpenCL backend renders them; layered frames are a
+/// usage error naming the OpenCL backend.
+#[test]
+fn sequence_on_the_wgpu_backend_is_the_opencl_sequence() {
+    if gpu::device().is_none() || wgpu_device::device().is_none() {
+        return;
+    }
+    let dir = scratch("sequence-wgpu");
+    let frames = |backend: &str, out: &str, extra: &[&str]| {
+        let out_dir = dir.join(out);
+        let mut args = vec![
+            "sequence",
+            "mandelbulb",
+            "--size",
+            "48x36",
+            "--preset",
+            "preview",
+            "--fps",
+            "3",
+            "--seconds",
+            "1",
+            "--motion-blur",
+            "3",
+            "--no-video",
+            "--backend",
+            backend,
+            "--out",
+            out_dir.to_str().unwrap(),
+        ];
+        args.extend_from_slice(extra);
+        run(&dir, "", &args)
+    };
+    let out = frames("wgpu", "wgpu", &[]);
+    assert!(out.status.success(), "{}", text(&out));
+    let out = frames("opencl", "opencl", &[]);
+    assert!(out.status.success(), "{}", text(&out));
+    for i in 0..3 {
+        let frame = |backend: &str| {
+            image::open(dir.join(backend).join(format!("frame_{i:05}.png")))
+                .unwrap()
+                .to_rgba8()
+        };
+        let db = fractal_sdf::metrics::psnr(&frame("wgpu"), &frame("opencl"));
+        assert!(db >= 40.0, "frame {i}: {db:.1} dB between the backends");
+    }
+    let out = frames("wgpu", "exr", &["--format", "exr"]);
+    assert_eq!(out.status.code(), Some(2), "{}", text(&out));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("--backend opencl"));
+    assert!(!dir.join("exr").join("frame_00000.exr").exists());
 }
 
 #[test]

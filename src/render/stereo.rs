@@ -5,6 +5,7 @@
 use image::{Rgba, RgbaImage};
 
 use super::dispatch::MAX_IMAGE_SIDE;
+use super::frames::RenderFrames;
 use super::renderer::Renderer;
 use crate::error::{Error, Result};
 use crate::scene::{Stereo, StereoLayout};
@@ -15,47 +16,62 @@ impl Renderer {
     /// ([`StereoLayout::size`]). The camera is left as it was.
     ///
     /// # Errors
-    /// As [`Stereo::eyes`] and [`Renderer::render`] (each eye's size is
-    /// checked as a frame's); [`Error::Resolution`] where the laid-out
-    /// picture would pass the largest side.
+    /// As [`render_stereo`].
     pub fn render_stereo(&mut self, width: u32, height: u32, stereo: &Stereo) -> Result<RgbaImage> {
-        let (w, h) = (u64::from(width), u64::from(height));
-        let (pw, ph) = match stereo.layout {
-            StereoLayout::Anaglyph => (w, h),
-            StereoLayout::SideBySide => (2 * w, h),
-            StereoLayout::OverUnder => (w, 2 * h),
-        };
-        if pw.max(ph) > u64::from(MAX_IMAGE_SIDE) {
-            return Err(Error::Resolution {
-                width,
-                height,
-                reason: format!(
-                    "the {} picture of two such eyes is {pw}x{ph}, and each side must be at \
-                     most {MAX_IMAGE_SIDE} pixels",
-                    stereo.layout.name()
-                ),
-            });
-        }
-        let centre = *self.camera();
-        let eyes = stereo.eyes(&centre)?;
-        let mut images = Vec::with_capacity(2);
-        for eye in eyes {
-            let image = self
-                .set_camera(eye)
-                .and_then(|()| self.render(width, height));
-            let failed = image.is_err();
-            images.push(image);
-            if failed {
-                break;
-            }
-        }
-        // The centre camera was valid, so it is taken back.
-        self.set_camera(centre)?;
-        let mut images = images.into_iter();
-        let left = images.next().expect("one eye at least")?;
-        let right = images.next().expect("two eyes when the first rendered")?;
-        Ok(compose(&left, &right, stereo.layout))
+        render_stereo(self, width, height, stereo)
     }
+}
+
+/// Renders both eyes of `stereo` around `renderer`'s current camera, each
+/// `width` × `height`, on either backend, and lays them out in one
+/// picture ([`StereoLayout::size`]). The camera is left as it was.
+///
+/// # Errors
+/// As [`Stereo::eyes`] and the renderer's `render` (each eye's size is
+/// checked as a frame's); [`Error::Resolution`] where the laid-out
+/// picture would pass the largest side.
+pub fn render_stereo<R: RenderFrames>(
+    renderer: &mut R,
+    width: u32,
+    height: u32,
+    stereo: &Stereo,
+) -> Result<RgbaImage> {
+    let (w, h) = (u64::from(width), u64::from(height));
+    let (pw, ph) = match stereo.layout {
+        StereoLayout::Anaglyph => (w, h),
+        StereoLayout::SideBySide => (2 * w, h),
+        StereoLayout::OverUnder => (w, 2 * h),
+    };
+    if pw.max(ph) > u64::from(MAX_IMAGE_SIDE) {
+        return Err(Error::Resolution {
+            width,
+            height,
+            reason: format!(
+                "the {} picture of two such eyes is {pw}x{ph}, and each side must be at most \
+                 {MAX_IMAGE_SIDE} pixels",
+                stereo.layout.name()
+            ),
+        });
+    }
+    let centre = *renderer.camera();
+    let eyes = stereo.eyes(&centre)?;
+    let mut images = Vec::with_capacity(2);
+    for eye in eyes {
+        let image = renderer
+            .set_camera(eye)
+            .and_then(|()| renderer.render(width, height));
+        let failed = image.is_err();
+        images.push(image);
+        if failed {
+            break;
+        }
+    }
+    // The centre camera was valid, so it is taken back.
+    renderer.set_camera(centre)?;
+    let mut images = images.into_iter();
+    let left = images.next().expect("one eye at least")?;
+    let right = images.next().expect("two eyes when the first rendered")?;
+    Ok(compose(&left, &right, stereo.layout))
 }
 
 /// Lays out two eyes' images of the same size.

@@ -546,6 +546,45 @@ impl WgpuRenderer {
         Ok(image)
     }
 
+    /// One progressive pass at each of `moments`, `set` before each (the
+    /// camera, parameters or lights at that moment): the mean of them all,
+    /// motion blur as [`Renderer::render_over_time`](super::Renderer::render_over_time)
+    /// draws it. The progressive image starts again afterwards.
+    ///
+    /// # Errors
+    /// [`Error::Quality`] for no moments or more than progressive
+    /// rendering holds at the quality's supersampling; the first error of
+    /// `set` or of a pass; otherwise as [`WgpuRenderer::render`].
+    pub fn render_over_time<T>(
+        &mut self,
+        width: u32,
+        height: u32,
+        moments: &[T],
+        mut set: impl FnMut(&mut Self, &T) -> Result<()>,
+    ) -> Result<RgbaImage> {
+        let per_pass = self.options.quality.supersampling.max(1).pow(2);
+        let most = (super::Renderer::MAX_PROGRESSIVE_SAMPLES / per_pass).max(1);
+        let count = u32::try_from(moments.len()).unwrap_or(u32::MAX);
+        if count == 0 || count > most {
+            return Err(Error::Quality {
+                setting: "moments",
+                value: f64::from(count),
+                expected: format!("1 to {most} for the quality's samples"),
+            });
+        }
+        let scaled = self.options.quality.resolution_scale > 1;
+        let mut last = None;
+        for (pass, moment) in (0u32..).zip(moments) {
+            let drawn =
+                set(self, moment).and_then(|()| self.draw(width, height, scaled, Some(pass)));
+            // Each pass goes on from the sums of the last, whatever `set`
+            // changed; no progressive image continues from them.
+            self.progress = None;
+            last = Some(drawn?.image);
+        }
+        Ok(last.expect("at least one moment"))
+    }
+
     /// The progressive passes the current image holds (0 before the
     /// first).
     #[must_use]

@@ -23,6 +23,21 @@ pub struct FrameTiming {
     pub profiled: bool,
 }
 
+impl FrameTiming {
+    /// A frame timed by the host alone, from submitting the work until the
+    /// device finished it (the wgpu backend's): the kernel's time and the
+    /// frame's, no profiling events.
+    #[cfg(feature = "wgpu")]
+    pub(crate) fn wall(elapsed: Duration) -> Self {
+        FrameTiming {
+            kernel: elapsed,
+            readback: Duration::ZERO,
+            total: elapsed,
+            profiled: false,
+        }
+    }
+}
+
 /// Running statistics over frame times: count, total, minimum, maximum,
 /// mean, and the frame rates they imply.
 ///

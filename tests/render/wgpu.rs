@@ -307,6 +307,104 @@ fn inside_shapes_are_the_opencl_picture() {
     }
 }
 
+/// A frame sequence with motion blur (a ball crossing the view while the
+/// shutter is open) renders on the wgpu backend through
+/// `Sequence::render_images` as `Sequence::render` renders it on OpenCL,
+/// and a stereo pair through `render_stereo` as on OpenCL: the same code
+/// drives either renderer (`RenderFrames`). Frames with the shading
+/// layers are refused before anything is rendered.
+#[test]
+fn sequences_and_stereo_pairs_are_the_opencl_frames() {
+    use fractal_sdf::animation::{CameraPath, Interpolation, Key, Keyframe, Motion};
+    use fractal_sdf::render::{RenderFrames, render_stereo};
+    use fractal_sdf::scene::{Stereo, StereoLayout};
+    use fractal_sdf::sequence::{MotionBlur, Sequence};
+    if !backends() {
+        return;
+    }
+    let scene = Scene::new(
+        sphere(0.3)
+            .translate(fractal_sdf::scene::param3("at", DVec3::ZERO))
+            .union(plane(dvec3(0.0, 1.0, 0.0), 0.5)),
+    )
+    .with_camera(Camera::look_at(dvec3(0.0, 0.4, 4.0), DVec3::ZERO));
+    let motions = [Motion::Keys {
+        name: "at.x".into(),
+        keys: vec![
+            Key::new(0.0, -1.5).interpolation(Interpolation::Linear),
+            Key::new(1.0, 1.5),
+        ],
+    }];
+    let (at, target) = (scene.camera.position, scene.camera.target);
+    let path = CameraPath::new(vec![
+        Keyframe::new(0.0, at, target),
+        Keyframe::new(1.0, at, target),
+    ])
+    .unwrap();
+    let compiled = scene.compile().unwrap();
+    let mut options = RenderOptions::default();
+    options.quality = Quality::preview().resolution_scale(1);
+    let mut wgpu = WgpuRenderer::from_compiled(compiled.clone(), &options).unwrap();
+    let mut opencl = Renderer::from_compiled(compiled, &options).unwrap();
+    let dir = std::env::temp_dir().join(format!("fractal-sdf-wgpu-seq-{}", std::process::id()));
+    let sequence = |name: &str| {
+        Sequence::new(dir.join(name), 2.0, 2)
+            .unwrap()
+            .motion_blur(MotionBlur::new(8, 1.0))
+            .unwrap()
+    };
+    let (on_wgpu, on_opencl) = (sequence("wgpu"), sequence("opencl"));
+    let mut timed = 0;
+    on_wgpu
+        .render_images(&mut wgpu, &path, &motions, &[0, 1], (WIDTH, HEIGHT), |f| {
+            timed += usize::from(f.timing.is_some());
+        })
+        .unwrap();
+    assert_eq!(timed, 2, "every frame reports its time");
+    on_opencl
+        .render(
+            &mut opencl,
+            &path,
+            &motions,
+            &[0, 1],
+            (WIDTH, HEIGHT),
+            |_| {},
+        )
+        .unwrap();
+    let frame = |seq: &Sequence, i| image::open(seq.frame_path(i)).unwrap().to_rgba8();
+    for i in 0..2 {
+        let db = psnr(&frame(&on_opencl, i), &frame(&on_wgpu, i));
+        println!("motion-blurred frame {i}: {db:.1} dB");
+        assert!(db >= 40.0, "frame {i}: {db:.1} dB between the backends");
+    }
+    // The blur is there: the first frame differs from the ball at rest at
+    // its first moment.
+    wgpu.set_param("at.x", -1.5).unwrap();
+    let still = RenderFrames::render(&mut wgpu, WIDTH, HEIGHT).unwrap();
+    assert!(psnr(&still, &frame(&on_wgpu, 0)) < 35.0, "no blur");
+
+    let stereo = Stereo::new(StereoLayout::SideBySide);
+    let drawn = render_stereo(&mut wgpu, WIDTH, HEIGHT, &stereo).unwrap();
+    opencl.set_param("at.x", -1.5).unwrap();
+    let image = opencl.render_stereo(WIDTH, HEIGHT, &stereo).unwrap();
+    assert_eq!(drawn.dimensions(), (2 * WIDTH, HEIGHT));
+    let db = psnr(&image, &drawn);
+    println!("stereo pair: {db:.1} dB");
+    assert!(db >= 40.0, "{db:.1} dB between the stereo pairs");
+
+    let layered = Sequence::new(dir.join("exr"), 2.0, 2)
+        .unwrap()
+        .format("exr")
+        .unwrap();
+    let refused = layered.render_images(&mut wgpu, &path, &motions, &[0], (WIDTH, HEIGHT), |_| {});
+    assert!(
+        matches!(&refused, Err(Error::Invalid { reason, .. }) if reason.contains("OpenCL")),
+        "{refused:?}"
+    );
+    assert!(!layered.frame_path(0).exists());
+    std::fs::remove_dir_all(&dir).ok();
+}
+
 /// A dynamic parameter, the camera and the lights change with a buffer
 /// write: the picture is the one a renderer built with the new values
 /// draws, on the same pipeline.

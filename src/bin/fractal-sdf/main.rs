@@ -22,10 +22,10 @@ use fractal_sdf::prelude::*;
 use fractal_sdf::quality::{Encoding, GlobalIllumination, Preset, ToneMap};
 use fractal_sdf::render::{
     DeviceKind, DeviceSelector, EdgeThresholds, RenderOptions, Renderer, StopRule, WgpuRenderer,
-    devices, wgpu_adapters,
+    devices, render_stereo, wgpu_adapters,
 };
 use fractal_sdf::scene::{CustomShape, Environment, Stereo, StereoLayout};
-use fractal_sdf::sequence::{Encoded, MotionBlur, Sequence, parse_range};
+use fractal_sdf::sequence::{Encoded, MotionBlur, RenderedFrame, Sequence, parse_range};
 use fractal_sdf::settings::{self, CONFIG_ENV, Settings, parse_preset, parse_size};
 use indicatif::{ProgressBar, ProgressStyle};
 
@@ -244,7 +244,7 @@ struct RenderArgs {
     backend: Option<Backend>,
 }
 
-/// The backends `render` and `bench` render with.
+/// The backends `render`, `sequence` and `bench` render with.
 #[derive(Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
 enum Backend {
     Opencl,
@@ -341,6 +341,10 @@ struct SequenceArgs {
         requires = "motion_blur"
     )]
     shutter: f64,
+    /// The backend that renders: opencl, or wgpu (8-bit frames: no --aov
+    /// or exr). Default: the settings file's, else opencl.
+    #[arg(long, value_enum)]
+    backend: Option<Backend>,
 }
 
 #[derive(Args)]
@@ -547,6 +551,23 @@ impl Job {
         Ok(renderer)
     }
 
+    /// The wgpu backend's renderer of the job's scene, with its `--set`
+    /// values: `--device`, `--devices` and `--deadline` are usage errors.
+    fn wgpu_renderer(&self, scene: &SceneArgs) -> Outcome<WgpuRenderer> {
+        if self.devices.is_some() || scene.device.is_some() || scene.deadline.is_some() {
+            return Err(usage(
+                "--device, --devices and --deadline are the OpenCL backend's (--backend \
+                 opencl): the wgpu backend runs on the adapter wgpu chooses, a frame in one \
+                 dispatch",
+            ));
+        }
+        let mut renderer = WgpuRenderer::from_compiled(self.file.scene.compile()?, &self.options)?;
+        for (name, value) in &self.sets {
+            renderer.set_param(name, *value)?;
+        }
+        Ok(renderer)
+    }
+
     fn preset_name(&self) -> String {
         Preset::ALL
             .into_iter()
@@ -639,7 +660,7 @@ fn render(args: &RenderArgs, settings: &Settings) -> Outcome {
         )));
     }
     if Backend::chosen(args.backend, settings) == Backend::Wgpu {
-        return render_wgpu(args, &job);
+        return render_wgpu(args, &job, stereo.as_ref());
     }
     let stop = args
         .noise
@@ -741,14 +762,13 @@ fn render(args: &RenderArgs, settings: &Settings) -> Outcome {
 }
 
 /// `render --backend wgpu`: the image, in one frame or `--passes`
-/// progressive passes, on the adapter wgpu chooses.
-fn render_wgpu(args: &RenderArgs, job: &Job) -> Outcome {
+/// progressive passes, or a stereo pair, on the adapter wgpu chooses.
+fn render_wgpu(args: &RenderArgs, job: &Job, stereo: Option<&Stereo>) -> Outcome {
     let opencl_only = [
         ("--aov", !args.aov.is_empty()),
         ("--bits 16", args.bits == "16"),
         ("--noise", args.noise.is_some()),
         ("--adaptive", args.adaptive.is_some()),
-        ("--stereo", args.stereo.is_some()),
         ("--devices", job.devices.is_some()),
         ("--device", args.scene.device.is_some()),
         ("--deadline", args.scene.deadline.is_some()),
@@ -767,7 +787,7 @@ fn render_wgpu(args: &RenderArgs, job: &Job) -> Outcome {
     }
     let passes = args.passes.unwrap_or(1);
     let aperture = job.file.scene.camera.aperture;
-    if passes == 1 && aperture > 0.0 {
+    if stereo.is_none() && passes == 1 && aperture > 0.0 {
         eprintln!(
             "note: the camera has a lens (aperture {aperture}), whose blur one pass leaves \
              grainy: --passes {LENS_PASSES} renders a smooth one in {LENS_PASSES} times the time"
@@ -776,28 +796,30 @@ fn render_wgpu(args: &RenderArgs, job: &Job) -> Outcome {
     let (width, height) = job.size;
     let start = Instant::now();
     let bar = spinner(format!("rendering {width}x{height} on wgpu"));
+    let mut renderer = job.wgpu_renderer(&args.scene)?;
     let rendered = (|| {
-        let mut renderer = WgpuRenderer::from_compiled(job.file.scene.compile()?, &job.options)?;
-        for (name, value) in &job.sets {
-            renderer.set_param(name, *value)?;
+        if let Some(stereo) = stereo {
+            return render_stereo(&mut renderer, width, height, stereo);
         }
         let mut image = renderer.render_progressive(width, height)?;
         for _ in 1..passes {
             image = renderer.render_progressive(width, height)?;
         }
-        Ok::<_, fractal_sdf::Error>((image, renderer.adapter().name.clone()))
+        Ok(image)
     })();
     bar.finish_and_clear();
-    let (image, adapter) = rendered?;
+    let image = rendered?;
+    let adapter = &renderer.adapter().name;
     save_image(&image, &args.output)?;
     if let Some(path) = &args.camera_json {
         CameraExport::new(&job.file.scene.camera, job.size)?.save(path)?;
     }
-    let passes = if passes > 1 {
+    let passes = if passes > 1 && stereo.is_none() {
         format!(", {passes} passes")
     } else {
         String::new()
     };
+    let (width, height) = image.dimensions();
     println!(
         "{}: {width}x{height}, {} quality{passes}, {:.2} s on {adapter} (wgpu)",
         args.output.display(),
@@ -904,6 +926,13 @@ fn sequence(args: &SequenceArgs, settings: &Settings) -> Outcome {
         }
     }
     let aovs = parse_aovs(&args.aov)?;
+    let wgpu = Backend::chosen(args.backend, settings) == Backend::Wgpu;
+    if wgpu && (!aovs.is_empty() || args.format.eq_ignore_ascii_case("exr")) {
+        return Err(usage(
+            "--aov and exr frames need the OpenCL backend (--backend opencl): the wgpu backend \
+             writes 8-bit png, tif or jpg frames",
+        ));
+    }
     let seq = Sequence::for_duration(&args.out, args.fps, path.duration())?
         .motion_blur(MotionBlur::new(args.motion_blur, args.shutter))?
         .format(&args.format)
@@ -975,7 +1004,6 @@ fn sequence(args: &SequenceArgs, settings: &Settings) -> Outcome {
         share,
     );
     if !todo.is_empty() {
-        let mut renderer = job.renderer()?;
         let bar = ProgressBar::new(todo.len() as u64);
         bar.set_style(
             ProgressStyle::with_template(
@@ -983,19 +1011,20 @@ fn sequence(args: &SequenceArgs, settings: &Settings) -> Outcome {
             )
             .expect("a valid template"),
         );
-        seq.render(
-            &mut renderer,
-            &path,
-            &job.file.motions,
-            &todo,
-            job.size,
-            |frame| {
-                if let Some(t) = frame.timing {
-                    bar.set_message(format!("{:.0} ms/frame", t.total.as_secs_f64() * 1e3));
-                }
-                bar.inc(1);
-            },
-        )?;
+        let on_frame = |frame: &RenderedFrame| {
+            if let Some(t) = frame.timing {
+                bar.set_message(format!("{:.0} ms/frame", t.total.as_secs_f64() * 1e3));
+            }
+            bar.inc(1);
+        };
+        let (motions, size) = (&job.file.motions, job.size);
+        if wgpu {
+            let mut renderer = job.wgpu_renderer(&args.scene)?;
+            seq.render_images(&mut renderer, &path, motions, &todo, size, on_frame)?;
+        } else {
+            let mut renderer = job.renderer()?;
+            seq.render(&mut renderer, &path, motions, &todo, size, on_frame)?;
+        }
         bar.finish();
     }
     if seq.extension() == "exr" {
@@ -1211,17 +1240,7 @@ fn bench(args: &BenchArgs, settings: &Settings) -> Outcome {
     let job = Job::new(&args.scene, settings)?;
     let (width, height) = job.size;
     if Backend::chosen(args.backend, settings) == Backend::Wgpu {
-        if job.devices.is_some() || args.scene.device.is_some() || args.scene.deadline.is_some() {
-            return Err(usage(
-                "--device, --devices and --deadline are the OpenCL backend's (--backend \
-                 opencl): the wgpu backend runs on the adapter wgpu chooses, a frame in one \
-                 dispatch",
-            ));
-        }
-        let mut renderer = WgpuRenderer::from_compiled(job.file.scene.compile()?, &job.options)?;
-        for (name, value) in &job.sets {
-            renderer.set_param(name, *value)?;
-        }
+        let mut renderer = job.wgpu_renderer(&args.scene)?;
         let timed = time_frames(&mut renderer, job.size, args.frames)?;
         println!(
             "{}: {width}x{height}, {} quality on {} (wgpu)",
