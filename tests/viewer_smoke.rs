@@ -524,6 +524,57 @@ fn scripted_keys_change_the_headless_screenshot() {
     std::fs::remove_dir_all(dir).unwrap();
 }
 
+/// `--backend wgpu`: the viewer draws with the wgpu backend the picture it
+/// draws with OpenCL, and its keys work there too (`v` twice: a
+/// side-by-side stereo pair).
+#[test]
+fn the_viewer_draws_on_the_wgpu_backend() {
+    if gpu::device().is_none() || wgpu_device::device().is_none() || !have("Xvfb") {
+        return;
+    }
+    let x = Xvfb::start();
+    let dir = scratch("viewer-wgpu");
+    let shot = |name: &str, extra: &[&str]| {
+        let file = dir.join(name);
+        let out = x
+            .command(viewer_binary())
+            .args(SCENE)
+            .args(["--frames", "3", "--screenshot"])
+            .arg(&file)
+            .args(extra)
+            .output()
+            .expect("the viewer runs");
+        assert!(
+            out.status.success(),
+            "viewer failed: {}\n{}",
+            String::from_utf8_lossy(&out.stdout),
+            String::from_utf8_lossy(&out.stderr)
+        );
+        (
+            image::open(&file).expect("a screenshot").to_rgba8(),
+            String::from_utf8_lossy(&out.stdout).into_owned(),
+        )
+    };
+    let (opencl, _) = shot("opencl.png", &["--backend", "opencl"]);
+    let (drawn, said) = shot("wgpu.png", &["--backend", "wgpu"]);
+    assert!(said.contains("(wgpu)"), "{said}");
+    gpu::save("viewer_wgpu", &drawn);
+    assert_shows_the_scene(&drawn, "the wgpu screenshot");
+    let db = fractal_sdf::metrics::psnr(&opencl, &drawn);
+    assert!(db >= 40.0, "{db:.1} dB between the backends' screenshots");
+    let script = KeyScript::new([(1, Key::V), (1, Key::V)])
+        .unwrap()
+        .to_string();
+    let (pair, _) = shot("pair.png", &["--backend", "wgpu", "--keys", &script]);
+    let half = |x| image::imageops::crop_imm(&pair, x, 0, 48, 72).to_image();
+    let apart = differing_pixels(&half(0), &half(48));
+    assert!(
+        apart > 48 * 72 / 50 && contrast(&half(0)) > 10.0,
+        "two eyes on wgpu: {apart} pixels differ"
+    );
+    std::fs::remove_dir_all(dir).unwrap();
+}
+
 #[test]
 fn real_key_presses_reach_the_window() {
     if gpu::device().is_none() || !have("Xvfb") || !have("xdotool") {

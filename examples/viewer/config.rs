@@ -16,7 +16,7 @@ stays. A bad version is reported on stderr and in the title (ERROR) while
 the last good scene stays on screen.
 
 SETTINGS: $FRACTAL_SDF_CONFIG or fractal-sdf/config.toml in the user's
-configuration directory: `preset`, `size`, `device`, and under [viewer]
+configuration directory: `preset`, `size`, `device`, `backend`, and under [viewer]
 `mouse_sensitivity` and [viewer.keys] (action name = key name, e.g.
 `toggle_glow = \"l\"`; names below). Options given here override them; a
 scene file's own quality overrides `preset`.
@@ -28,6 +28,7 @@ OPTIONS:
   --no-shadows         start with shadows off
   --glow               start with glow on
   --device NAME        the first OpenCL device whose name contains NAME
+  --backend NAME       opencl (default) or wgpu (built with --features wgpu)
   --sensitivity F      mouse sensitivity in radians per pixel (default 0.004)
   --speed F            movement speed in units per second (default: a third of
                        the distance to the scene camera's target)
@@ -62,6 +63,7 @@ pub(super) struct Args {
     pub(super) no_shadows: bool,
     pub(super) glow: bool,
     pub(super) device: Option<String>,
+    pub(super) backend: Option<BackendKind>,
     pub(super) sensitivity: Option<f64>,
     pub(super) speed: Option<f64>,
     pub(super) target: Duration,
@@ -107,6 +109,10 @@ pub(super) fn parse_args() -> Result<Option<Args>> {
         no_shadows: a.contains("--no-shadows"),
         glow: a.contains("--glow"),
         device: a.opt_value_from_str("--device").map_err(u)?,
+        backend: match a.opt_value_from_str::<_, String>("--backend").map_err(u)? {
+            Some(name) => Some(BackendKind::from_name(&name)?),
+            None => None,
+        },
         sensitivity: a.opt_value_from_str("--sensitivity").map_err(u)?,
         speed: a.opt_value_from_str("--speed").map_err(u)?,
         target: Duration::from_secs_f64(
@@ -156,6 +162,7 @@ pub(super) struct Config {
     /// without a quality.
     pub(super) settings_preset: Option<Preset>,
     pub(super) device: DeviceSelector,
+    pub(super) backend: BackendKind,
     pub(super) sensitivity: f64,
     pub(super) bindings: KeyBindings,
     pub(super) script: KeyScript,
@@ -197,7 +204,18 @@ impl Config {
             Some(name) => DeviceSelector::device(name.clone()),
             None => DeviceSelector::auto(),
         };
+        let backend = args.backend.unwrap_or(match settings.backend {
+            Some(fractal_sdf::settings::Backend::Wgpu) => BackendKind::Wgpu,
+            _ => BackendKind::OpenCl,
+        });
+        if backend == BackendKind::Wgpu && args.device.is_some() {
+            return Err(common::usage(
+                "--device chooses an OpenCL device: the wgpu backend runs on the adapter wgpu \
+                 chooses (WGPU_ADAPTER_NAME steers it)",
+            ));
+        }
         Ok(Config {
+            backend,
             settings_preset: settings.preset,
             size: args.size.or(settings.size).unwrap_or((640, 480)),
             args,

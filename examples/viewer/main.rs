@@ -16,10 +16,12 @@
 //! (`fractal_sdf::view`); this file only connects them to a `winit` window
 //! and a `softbuffer` surface. Run with `--help` for every option.
 
+mod backend;
 #[path = "../common/mod.rs"]
 mod common;
 mod config;
 
+use backend::*;
 use config::*;
 
 use std::num::NonZeroU32;
@@ -81,7 +83,7 @@ struct Viewer {
     motions: Vec<Motion>,
     /// The scene file, when the scene comes from one.
     watched: Option<Watched>,
-    renderer: Renderer,
+    renderer: Backend,
     fly: FlyCamera,
     keys: Movement,
     settings: ViewSettings,
@@ -117,6 +119,7 @@ impl Viewer {
             size,
             settings_preset,
             device,
+            backend,
             sensitivity,
             bindings,
             script,
@@ -166,8 +169,9 @@ impl Viewer {
         settings.ambient_occlusion &= !args.no_ao;
         settings.shadows &= !args.no_shadows;
         settings.glow |= args.glow;
-        let renderer = Renderer::with_options(
-            &scene,
+        let renderer = Backend::new(
+            backend,
+            scene.compile()?,
             &RenderOptions::default()
                 .quality(settings.quality())
                 .effects(settings.effects())
@@ -176,8 +180,8 @@ impl Viewer {
         println!(
             "{name}: {} on {} (build {:.0} ms)",
             settings.summary(),
-            renderer.device().label(),
-            renderer.build_info().build_time.as_secs_f64() * 1e3
+            renderer.label(),
+            renderer.build_time().as_secs_f64() * 1e3
         );
         let mut fly = FlyCamera::from_camera(&scene.camera);
         fly.sensitivity = sensitivity;
@@ -252,16 +256,11 @@ impl Viewer {
                 if self.settings.apply(action) {
                     let t = Instant::now();
                     let (quality, effects) = (self.settings.quality(), self.settings.effects());
-                    if self.renderer.options().quality != quality {
-                        self.renderer.set_quality(quality)?;
-                    }
-                    if self.renderer.options().effects != effects {
-                        self.renderer.set_effects(effects)?;
-                    }
+                    let cached = self.renderer.set_options(quality, effects)?;
                     println!(
                         "{} ({} in {:.0} ms)",
                         self.settings.summary(),
-                        if self.renderer.build_info().cached {
+                        if cached {
                             "cached program"
                         } else {
                             "new program"
@@ -339,15 +338,7 @@ impl Viewer {
         };
         let compiled = file.scene.compile()?;
         let (quality, effects) = (settings.quality(), settings.effects());
-        let source = codegen::emit(
-            &compiled,
-            &codegen::Options::default()
-                .quality(quality)
-                .effects(effects)
-                .target(codegen::Target::Render),
-        )?;
-        let same_program = source == *self.renderer.source()
-            && same_slots(self.renderer.scene().params(), compiled.params());
+        let same_program = self.renderer.runs(&compiled, quality, effects)?;
         let mut fresh = None;
         let how = if same_program && update_in_place(&mut self.renderer, &compiled).is_ok() {
             "same program"
@@ -358,8 +349,8 @@ impl Viewer {
                 .clone()
                 .quality(quality)
                 .effects(effects);
-            let r = fresh.insert(Renderer::from_compiled(compiled, &options)?);
-            if r.build_info().cached {
+            let r = fresh.insert(self.renderer.another(compiled, &options)?);
+            if r.cached() {
                 "cached program"
             } else {
                 "new program"
@@ -367,12 +358,7 @@ impl Viewer {
         };
         let renderer = fresh.as_mut().unwrap_or(&mut self.renderer);
         // Options that leave the program as it is take it from the cache.
-        if renderer.options().quality != quality {
-            renderer.set_quality(quality)?;
-        }
-        if renderer.options().effects != effects {
-            renderer.set_effects(effects)?;
-        }
+        renderer.set_options(quality, effects)?;
         renderer.set_camera(fly.camera(&file.scene.camera))?;
         for motion in &file.motions {
             for (name, value) in motion.values(self.anim_time) {
@@ -456,10 +442,7 @@ impl Viewer {
         if let Some(d) = divisor {
             let (w, h) = reduced_size(width, height, d);
             let image = self.draw(w, h, d == 1)?;
-            let took = self
-                .renderer
-                .last_timing()
-                .map_or(Duration::ZERO, |t| t.total);
+            let took = self.renderer.last_frame_time();
             self.scaler.record(d, took);
             self.smoothed_ms = if self.frame == 0 {
                 took.as_secs_f64() * 1e3
@@ -606,7 +589,7 @@ impl Viewer {
 
 /// Gives `renderer` the parameter defaults and lights of `compiled`, whose
 /// program is the renderer's; on an error the parameters are put back.
-fn update_in_place(renderer: &mut Renderer, compiled: &CompiledScene) -> Result<()> {
+fn update_in_place(renderer: &mut Backend, compiled: &CompiledScene) -> Result<()> {
     let slots = compiled.params().slots();
     let before: Vec<(&str, f64)> = slots
         .iter()
@@ -615,7 +598,7 @@ fn update_in_place(renderer: &mut Renderer, compiled: &CompiledScene) -> Result<
     let result = slots
         .iter()
         .try_for_each(|s| renderer.set_param(&s.name, s.default))
-        .and_then(|()| renderer.set_lights(compiled.lights().iter().copied()));
+        .and_then(|()| renderer.set_lights(compiled.lights()));
     if result.is_err() {
         for (name, value) in before {
             let _ = renderer.set_param(name, value);
