@@ -73,11 +73,15 @@ pub fn psnr(a: &RgbaImage, b: &RgbaImage) -> f64 {
 /// ```
 ///
 /// # Panics
-/// If the images differ in size, or `k` is 0.
+/// If the images differ in size, or `k` is 0 or larger than either side
+/// (no whole block to compare).
 #[must_use]
 pub fn block_psnr(a: &RgbaImage, b: &RgbaImage, k: u32) -> f64 {
     assert_eq!(a.dimensions(), b.dimensions(), "images differ in size");
-    assert!(k > 0, "blocks of at least one pixel");
+    assert!(
+        k > 0 && k <= a.width() && k <= a.height(),
+        "blocks of 1 pixel to the image's shorter side"
+    );
     psnr(&block_means(a, k), &block_means(b, k))
 }
 

@@ -3,8 +3,9 @@
 // line. An inside shape has a membership test and no distance, so a ray
 // within its region samples points at most BRUTE_STEP footprints apart
 // (march.wgsl), and a hit on it takes its normal and occlusion from the
-// neighbouring pixels' hits: the compute entry point `brute_depths` marches
-// every sample of the pass first, and `render` shades them.
+// neighbouring pixels' hits: the compute entry point `brute_pass` marches
+// every sample of the pass first into `brute_depths`, and `render` shades
+// them.
 //
 // Follows render.wgsl, and is part of the module only where the scene
 // has inside shapes. The module defines before it SCREEN_NORMALS (0:

@@ -1,9 +1,9 @@
 // Path-traced global illumination in WGSL: kernels/paths.cl, line for
 // line. Each sample's first hit starts a path that bounces through the
 // scene, sampling the lights, the environment and the emissive shapes at
-// every surface it meets (next-event estimation, weighted against the
-// surface's own sampling by the power heuristic) and bringing the sky's
-// light where it leaves. The units are paths.cl's: a light's radiance is
+// every surface it meets (next-event estimation; the environment's and
+// the emissive shapes' weighted against the surface's own sampling by the
+// power heuristic) and bringing the sky's light where it leaves. The units are paths.cl's: a light's radiance is
 // the light a white Lambertian surface facing it sends back, so a surface
 // lit by one light has the same colour with and without paths.
 //

@@ -15,10 +15,13 @@
 // AO_DISTANCE, ENABLE_SHADOWS with SHADOW_STEPS, ENABLE_FOG with
 // FOG_DENSITY, ENABLE_ENVIRONMENT (the `environment` buffer holds an
 // image), ENABLE_FOG_LIGHT with FOG_FALLOFF, FOG_HEIGHT (in the
-// module's frame), FOG_SAMPLES and FOG_ANISOTROPY, ENABLE_MATERIALS with BOUNCES, DEFAULT_MATERIAL and each
-// value's lane MATERIAL_<value> (a constant that is false leaves its code
-// unreachable);
-// the buffer layouts CAMERA_<field>, LIGHT_<field> and LIGHT_STRIDE
+// module's frame), FOG_SAMPLES and FOG_ANISOTROPY, ENABLE_MATERIALS with
+// BOUNCES, DEFAULT_MATERIAL and each value's lane MATERIAL_<value>,
+// ENABLE_GI with march_path (paths.wgsl, or a stub without global
+// illumination), ENABLE_BRUTE with march_stored, march_brute_phase,
+// march_screen_normal and march_screen_occlusion (brute.wgsl, or stubs
+// without inside shapes) (a constant that is false leaves its code
+// unreachable); the buffer layouts CAMERA_<field>, LIGHT_<field> and LIGHT_STRIDE
 // (src/codegen/interface.rs, the tables the OpenCL kernel reads too);
 // display_color (the display transform, printed from
 // quality::display_formula); DE_shade and DE_material, and glow_color

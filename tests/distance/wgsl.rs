@@ -26,45 +26,33 @@ fn validate(name: &str, source: &str) {
     .unwrap_or_else(|e| panic!("{name}: {}", e.emit_to_string(source)));
 }
 
-/// The gallery's scenes, compiled, with whether they march inside shapes
-/// (which the WGSL backend refuses).
-fn scenes() -> Vec<(&'static str, CompiledScene, bool)> {
+/// The gallery's scenes, compiled.
+fn scenes() -> Vec<(&'static str, CompiledScene)> {
     gallery::all()
         .into_iter()
-        .map(|(name, scene)| {
-            let compiled = scene.compile().expect("gallery scenes compile");
-            let inside = compiled.ir().has_inside_shapes();
-            (name, compiled, inside)
-        })
+        .map(|(name, scene)| (name, scene.compile().expect("gallery scenes compile")))
         .collect()
 }
 
 #[test]
 fn every_gallery_scene_prints_as_valid_wgsl() {
     let mut printed = 0;
-    for (name, scene, inside) in scenes() {
+    for (name, scene) in scenes() {
         for target in [Target::Render, Target::Evaluate] {
             let options = Options::default().target(target);
-            match emit_wgsl(&scene, &options) {
-                Ok(module) => {
-                    assert_eq!(module.language, Language::Wgsl);
-                    assert!(module.source.contains("fn DE(p0: real3) -> real {"));
-                    validate(name, &module.source);
-                    printed += 1;
-                }
-                Err(Error::Unsupported { what, .. }) if inside => {
-                    assert!(what.contains("inside shapes"), "{name}: {what}");
-                }
-                Err(e) => panic!("{name}: {e}"),
-            }
+            let module = emit_wgsl(&scene, &options).unwrap_or_else(|e| panic!("{name}: {e}"));
+            assert_eq!(module.language, Language::Wgsl);
+            assert!(module.source.contains("fn DE(p0: real3) -> real {"));
+            validate(name, &module.source);
+            printed += 1;
         }
     }
-    assert!(printed >= 2 * 20, "only {printed} modules printed");
+    assert_eq!(printed, 2 * gallery::names().len());
 }
 
 #[test]
 fn double_precision_is_a_typed_error_that_names_the_way_to_deep_zoom() {
-    let (_, scene, _) = scenes().swap_remove(0);
+    let (_, scene) = scenes().swap_remove(0);
     let options = Options::default().quality(Quality::default().precision(Precision::F64));
     let error = emit_wgsl(&scene, &options).expect_err("WGSL has no double precision");
     assert!(matches!(
@@ -165,10 +153,7 @@ fn every_gallery_scene_runs_on_wgpu_as_the_cpu_reference_computes_it() {
     let options = Options::default().target(Target::Evaluate);
     let mut worst = (0.0f32, "", "", Vec3::ZERO);
     let mut checked = 0;
-    for (name, scene, inside) in scenes() {
-        if inside {
-            continue;
-        }
+    for (name, scene) in scenes() {
         let module = emit_wgsl(&scene, &options).expect("the scene prints");
         let at = points(count, 3.0, 0x9e37_79b9_7f4a_7c15);
         let (error, what, p) = compare(&gpu, &scene, &module, &at, (TOLERANCE, TOLERANCE))
@@ -182,7 +167,7 @@ fn every_gallery_scene_runs_on_wgpu_as_the_cpu_reference_computes_it() {
         "{checked} scenes; largest relative difference {:e} ({} {} at {})",
         worst.0, worst.1, worst.2, worst.3
     );
-    assert!(checked >= 20, "only {checked} scenes checked");
+    assert_eq!(checked, gallery::names().len());
 }
 
 /// Runs `module` (the WGSL of `scene`, for evaluation) at the points `at`

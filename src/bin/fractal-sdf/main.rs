@@ -236,9 +236,9 @@ struct RenderArgs {
     #[arg(long, value_name = "FOOTPRINTS")]
     brute_step: Option<f64>,
     /// The backend that renders: opencl, or wgpu (WGSL on Vulkan, in
-    /// single precision; the 8-bit image, with --passes and --gi: no
-    /// --aov, --bits 16, .exr, --noise, --adaptive, --stereo, --device or
-    /// --devices, nor custom shapes written in OpenCL C, which need
+    /// single precision; the 8-bit image, with --passes, --gi and
+    /// --stereo: no --aov, --bits 16, .exr, --noise, --adaptive, --device
+    /// or --devices, nor custom shapes written in OpenCL C, which need
     /// opencl). Default: the settings file's, else opencl.
     #[arg(long, value_enum)]
     backend: Option<Backend>,
@@ -795,8 +795,8 @@ fn render_wgpu(args: &RenderArgs, job: &Job, stereo: Option<&Stereo>) -> Outcome
     }
     let (width, height) = job.size;
     let start = Instant::now();
-    let bar = spinner(format!("rendering {width}x{height} on wgpu"));
     let mut renderer = job.wgpu_renderer(&args.scene)?;
+    let bar = spinner(format!("rendering {width}x{height} on wgpu"));
     let rendered = (|| {
         if let Some(stereo) = stereo {
             return render_stereo(&mut renderer, width, height, stereo);
@@ -927,12 +927,7 @@ fn sequence(args: &SequenceArgs, settings: &Settings) -> Outcome {
     }
     let aovs = parse_aovs(&args.aov)?;
     let wgpu = Backend::chosen(args.backend, settings) == Backend::Wgpu;
-    if wgpu && (!aovs.is_empty() || args.format.eq_ignore_ascii_case("exr")) {
-        return Err(usage(
-            "--aov and exr frames need the OpenCL backend (--backend opencl): the wgpu backend \
-             writes 8-bit png, tif or jpg frames",
-        ));
-    }
+    let layered = !aovs.is_empty() || args.format.eq_ignore_ascii_case("exr");
     let seq = Sequence::for_duration(&args.out, args.fps, path.duration())?
         .motion_blur(MotionBlur::new(args.motion_blur, args.shutter))?
         .format(&args.format)
@@ -982,6 +977,12 @@ fn sequence(args: &SequenceArgs, settings: &Settings) -> Outcome {
         });
     }
 
+    if wgpu && layered {
+        return Err(usage(
+            "--aov and exr frames need the OpenCL backend (--backend opencl): the wgpu backend \
+             writes 8-bit png, tif or jpg frames",
+        ));
+    }
     let todo: Vec<u32> = seq
         .remaining(range.clone(), job.size)
         .into_iter()
