@@ -6,8 +6,7 @@
 // The formulas and constants are OpenCL's, line for line; where this file
 // leaves out something that changes the picture, the backend refuses the
 // scene or the option rather than draw something else
-// (src/render/wgpu_backend.rs). The coarse cone pass, which changes only
-// the speed, is left out: rays start at the eye.
+// (src/render/wgpu_backend.rs).
 //
 // Follows march.wgsl. The module defines before it, besides the march's
 // constants: REAL_TINY, NORMAL_EPSILON, SUPERSAMPLING, GAMMA,
@@ -20,7 +19,8 @@
 // ENABLE_GI with march_path (paths.wgsl, or a stub without global
 // illumination), ENABLE_BRUTE with march_stored, march_brute_phase,
 // march_screen_normal and march_screen_occlusion (brute.wgsl, or stubs
-// without inside shapes) (a constant that is false leaves its code
+// without inside shapes), ENABLE_CONE with cone_start (cone.wgsl, or a
+// stub without the coarse pass) (a constant that is false leaves its code
 // unreachable); the buffer layouts CAMERA_<field>, LIGHT_<field> and LIGHT_STRIDE
 // (src/codegen/interface.rs, the tables the OpenCL kernel reads too);
 // display_color (the display transform, printed from
@@ -68,6 +68,8 @@ struct Frame {
 // of the pass at (s * height + y) * width + x: its depth (on a miss, -1
 // less the angle of its nearest miss) and its evaluations.
 @group(0) @binding(8) var<storage, read_write> brute_depths: array<real2>;
+// With the coarse pass, where each tile's rays start (cone.wgsl).
+@group(0) @binding(9) var<storage, read_write> cone_starts: array<real>;
 
 struct MarchCamera {
     origin: real3,
@@ -872,6 +874,12 @@ fn shade_pixel(cam: MarchCamera, x: int, y: int, pixel: uint) -> Shaded {
     var steps = 0u;
     var hits = 0u;
     let first = uint(max(frame.pass_index, 0) * PER_PASS);
+    // Where the pixel's rays start: past the empty space the coarse pass
+    // found in front of its tile.
+    var start = 0.0;
+    if (ENABLE_CONE) {
+        start = cone_start(x, y);
+    }
     for (var s = 0; s < PER_PASS; s++) {
         let j = first + uint(s);
         let sample = march_sample_ray(cam, x, y, pixel, j, s);
@@ -882,7 +890,7 @@ fn shade_pixel(cam: MarchCamera, x: int, y: int, pixel: uint) -> Shaded {
             // Marched by the brute-force pass.
             m = march_stored(x, y, s);
         } else {
-            m = march_ray(ro, rd, 0.0, cam.footprint, 1.0);
+            m = march_ray(ro, rd, start, cam.footprint, 1.0);
         }
         steps += uint(m.steps);
         evals += uint(m.steps);
@@ -1018,7 +1026,11 @@ fn render(@builtin(global_invocation_id) id: vec3<uint>) {
             // instead: its normal needs the neighbours' samples.
             let ray = march_camera_ray(cam, (real(x) + 0.5) * cam.pixel_scale,
                                        (real(y) + 0.5) * cam.pixel_scale);
-            centre = march_ray(ray.ro, ray.rd, 0.0, cam.footprint, 1.0);
+            var start = 0.0;
+            if (ENABLE_CONE) {
+                start = cone_start(x, y);
+            }
+            centre = march_ray(ray.ro, ray.rd, start, cam.footprint, 1.0);
         }
         var depth = -1.0;
         if (centre.hit) {

@@ -182,6 +182,13 @@ pub fn emit_wgsl_ir(ir: &Ir, options: &Options) -> Result<KernelSource> {
         centre: b.centre - origin,
         ..b
     });
+    // The coarse pass, where a cone can see the scene: not where inside
+    // shapes are marched by brute force.
+    let cone_tile = if rendering && brute.is_none() {
+        options.quality.cone_tile
+    } else {
+        0
+    };
     if rendering {
         let glow = Glow {
             nodes: glows,
@@ -199,6 +206,7 @@ pub fn emit_wgsl_ir(ir: &Ir, options: &Options) -> Result<KernelSource> {
         render(&mut w, options, materials, origin)?;
         paths(&mut w, options, &emitters);
         brute_pass(&mut w, options, brute.is_some());
+        cone_pass(&mut w, cone_tile);
     }
     unwritable(&w, Precision::F32)?;
     let source = w.finish();
@@ -209,7 +217,7 @@ pub fn emit_wgsl_ir(ir: &Ir, options: &Options) -> Result<KernelSource> {
         language: Language::Wgsl,
         precision: Precision::F32,
         fast_math: options.quality.fast_math,
-        cone_tile: 0,
+        cone_tile,
         brute: brute.is_some(),
         origin,
         custom_regions: Vec::new(),
@@ -468,6 +476,22 @@ fn brute_pass(w: &mut Writer, options: &Options, brute: bool) {
     w.raw(NO_BRUTE);
 }
 
+/// With the coarse pass (tiles of `tile` rendered pixels a side), its
+/// tile side and the pass (`kernels/wgsl/cone.wgsl`); without, a
+/// `cone_start` the render kernel never calls.
+fn cone_pass(w: &mut Writer, tile: u32) {
+    w.line("/* ---- the coarse pass ---- */");
+    w.line(format!("const ENABLE_CONE: bool = {};", tile > 0));
+    if tile > 0 {
+        w.line(format!("const CONE_TILE: uint = {tile}u;"));
+        w.raw(CONE);
+        return;
+    }
+    w.line("fn cone_start(x: int, y: int) -> real {");
+    w.line("    return 0.0;");
+    w.line("}");
+}
+
 /// What the render kernel calls only where inside shapes are marched by
 /// brute force: unreachable without them.
 const NO_BRUTE: &str = "/* No inside shapes: every ray marched where it is shaded. */
@@ -493,6 +517,9 @@ const MARCH: &str = include_str!("../../kernels/wgsl/march.wgsl");
 
 /// The render kernel in WGSL.
 const RENDER: &str = include_str!("../../kernels/wgsl/render.wgsl");
+
+/// The coarse pass in WGSL.
+const CONE: &str = include_str!("../../kernels/wgsl/cone.wgsl");
 
 /// The brute-force pass of inside shapes in WGSL.
 const BRUTE: &str = include_str!("../../kernels/wgsl/brute.wgsl");

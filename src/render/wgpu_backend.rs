@@ -17,10 +17,10 @@
 //! [`Error::Unsupported`] rather than draw something else: double
 //! precision and custom shapes written in OpenCL C (inside shapes of the
 //! user's among them; the built-in escape-time sets are drawn, by brute
-//! force, `kernels/wgsl/brute.wgsl`). It leaves out what
-//! changes only the speed: the coarse cone pass
-//! ([`Quality::cone_tile`]: rays start at the eye) and relaxed math
-//! ([`Quality::fast_math`]: the driver decides).
+//! force, `kernels/wgsl/brute.wgsl`). The coarse pass
+//! ([`Quality::cone_tile`], `kernels/wgsl/cone.wgsl`) starts each tile's
+//! rays where its cone stopped, as on OpenCL; relaxed math
+//! ([`Quality::fast_math`]) is left to the driver.
 //!
 //! ```no_run
 //! use fractal_sdf::prelude::*;
@@ -65,6 +65,8 @@ const ENVIRONMENT: u32 = 6;
 const ACCUMULATION: u32 = 7;
 /// The depths and evaluations of each sample the brute-force pass marched.
 const BRUTE_DEPTHS: u32 = 8;
+/// The distance each tile's rays start at, from the coarse pass.
+const CONE_STARTS: u32 = 9;
 
 /// The format of the texture the render kernel writes: a texture given to
 /// [`WgpuRenderer::render_to_texture`] must have it, and
@@ -161,6 +163,9 @@ pub struct WgpuRenderer {
     /// The brute-force pass's depths, per sample of a pass, where the
     /// scene has inside shapes; one sample's stand-in otherwise.
     brute_depths: ::wgpu::Buffer,
+    /// The coarse pass's starting distances, per tile, where the program
+    /// has the pass; one tile's stand-in otherwise.
+    cone_starts: ::wgpu::Buffer,
     /// The progressive image so far.
     progress: Option<Progress>,
     timing: Option<Duration>,
@@ -285,6 +290,7 @@ impl WgpuRenderer {
         let no_outputs = buffer(&device, "no pixels", 16, output_usage());
         let no_accumulation = buffer(&device, "no sums", 16, ::wgpu::BufferUsages::STORAGE);
         let brute_depths = buffer(&device, "no depths", 8, ::wgpu::BufferUsages::STORAGE);
+        let cone_starts = buffer(&device, "no starts", 4, ::wgpu::BufferUsages::STORAGE);
         let packed = super::environment::pack(scene.environment());
         let environment = buffer(&device, "environment", 4 * packed.len(), storage);
         let bytes: Vec<u8> = packed.iter().flat_map(|v| v.to_le_bytes()).collect();
@@ -319,6 +325,7 @@ impl WgpuRenderer {
             sums: None,
             no_accumulation,
             brute_depths,
+            cone_starts,
             progress: None,
             timing: None,
         };
@@ -766,6 +773,11 @@ impl WgpuRenderer {
         if self.pipeline.brute.is_some() {
             self.fit_brute_depths(width, height)?;
         }
+        let tile = self.source.cone_tile;
+        let tiles = (width.div_ceil(tile.max(1)), height.div_ceil(tile.max(1)));
+        if self.pipeline.cone.is_some() {
+            self.fit_cone_starts(tiles)?;
+        }
         let device = &self.gpu.device;
         let entries = [
             (codegen::WGSL_PARAMS.1, self.params.as_entire_binding()),
@@ -777,6 +789,7 @@ impl WgpuRenderer {
             (ENVIRONMENT, self.environment.as_entire_binding()),
             (ACCUMULATION, accumulation.as_entire_binding()),
             (BRUTE_DEPTHS, self.brute_depths.as_entire_binding()),
+            (CONE_STARTS, self.cone_starts.as_entire_binding()),
         ];
         let commands = checked(device, "the render pass", || {
             let group = device.create_bind_group(&::wgpu::BindGroupDescriptor {
@@ -792,6 +805,15 @@ impl WgpuRenderer {
                     encoder.begin_compute_pass(&::wgpu::ComputePassDescriptor::default());
                 let groups = (width.div_ceil(WORKGROUP), height.div_ceil(WORKGROUP));
                 pass.set_bind_group(codegen::WGSL_PARAMS.0, &group, &[]);
+                if let Some(cone) = &self.pipeline.cone {
+                    // The coarse pass: where each tile's rays start.
+                    pass.set_pipeline(cone);
+                    pass.dispatch_workgroups(
+                        tiles.0.div_ceil(WORKGROUP),
+                        tiles.1.div_ceil(WORKGROUP),
+                        1,
+                    );
+                }
                 if let Some(brute) = &self.pipeline.brute {
                     // Inside shapes: every sample marched first, for the
                     // render kernel to take normals from the neighbours'.
@@ -810,6 +832,21 @@ impl WgpuRenderer {
             .poll(::wgpu::PollType::wait_indefinitely())
             .map_err(|e| wgpu_error("the frame", e))?;
         self.timing = Some(started.elapsed());
+        Ok(())
+    }
+
+    /// A buffer of a starting distance for each of `tiles` (columns, rows)
+    /// of the coarse pass, made anew where the count changed.
+    fn fit_cone_starts(&mut self, (columns, rows): (u32, u32)) -> Result<()> {
+        let bytes = 4 * u64::from(columns) * u64::from(rows);
+        if self.cone_starts.size() == bytes {
+            return Ok(());
+        }
+        let device = &self.gpu.device;
+        let size = usize::try_from(bytes).map_err(|_| Error::Wgpu("too many tiles".into()))?;
+        self.cone_starts = checked(device, "the coarse pass's starts", || {
+            buffer(device, "starts", size, ::wgpu::BufferUsages::STORAGE)
+        })?;
         Ok(())
     }
 
@@ -1028,11 +1065,13 @@ fn shared_device() -> Result<(::wgpu::Device, ::wgpu::Queue)> {
 }
 
 /// A render pipeline, the brute-force pass's where the scene has inside
-/// shapes, and the layout of their bind group.
+/// shapes, the coarse pass's where the program has one, and the layout of
+/// their bind group.
 #[derive(Clone)]
 struct Pipeline {
     compute: ::wgpu::ComputePipeline,
     brute: Option<::wgpu::ComputePipeline>,
+    cone: Option<::wgpu::ComputePipeline>,
     layout: ::wgpu::BindGroupLayout,
 }
 
@@ -1082,6 +1121,7 @@ fn pipeline(device: &::wgpu::Device, source: &KernelSource) -> Result<(Pipeline,
         Pipeline {
             compute: entry("render"),
             brute: source.brute.then(|| entry("brute_pass")),
+            cone: (source.cone_tile > 0).then(|| entry("cone_pass")),
             layout,
         }
     })?;
@@ -1138,6 +1178,7 @@ fn bind_group_layout(device: &::wgpu::Device) -> ::wgpu::BindGroupLayout {
             storage(ENVIRONMENT, true),
             storage(ACCUMULATION, false),
             storage(BRUTE_DEPTHS, false),
+            storage(CONE_STARTS, false),
         ],
     })
 }
