@@ -561,7 +561,7 @@ fn the_viewer_draws_on_the_wgpu_backend() {
     gpu::save("viewer_wgpu", &drawn);
     assert_shows_the_scene(&drawn, "the wgpu screenshot");
     let db = fractal_sdf::metrics::psnr(&opencl, &drawn);
-    assert!(db >= 40.0, "{db:.1} dB between the backends' screenshots");
+    assert!(db >= 60.0, "{db:.1} dB between the backends' screenshots");
     let script = KeyScript::new([(1, Key::V), (1, Key::V)])
         .unwrap()
         .to_string();

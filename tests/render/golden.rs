@@ -69,13 +69,12 @@ fn gallery_renders_match_the_golden_images() {
 }
 
 /// The wgpu backend against the same references (made on OpenCL): every
-/// gallery scene at 96×64 preview reaches 30 dB and shows a lit subject.
-/// Measured on lavapipe: 33.4 (`bulb_variants`) to 50.4 dB.
-/// The bar is below the 40 dB of `tests/render/wgpu.rs`, which compares
-/// the backends at each scene file's quality: preview renders one pixel
-/// in 3 × 3, at 32 × 22, so each rendered pixel whose fractal dust
-/// rounds the other way on the other compiler covers nine pixels of the
-/// image (the differences are isolated pixels in the dust, nothing else).
+/// gallery scene at 96×64 preview shows a lit subject and reaches 45 dB;
+/// the path-traced `gi` 40 dB and the brute-forced `mandelbulb_escape`
+/// 30 dB, whose samples may go another way where the compilers round
+/// differently (preview renders one pixel in 3 × 3, so each such rendered
+/// pixel covers nine of the image). Measured on lavapipe: 50.1 dB
+/// (`keyframes`) to identical, `gi` 41.4 dB, `mandelbulb_escape` 33.3 dB.
 #[cfg(feature = "wgpu")]
 #[test]
 fn gallery_renders_on_wgpu_match_the_golden_images() {
@@ -98,9 +97,14 @@ fn gallery_renders_on_wgpu_match_the_golden_images() {
             .to_rgba8();
         let db = psnr(&image, &golden);
         report.push(format!("{name}: {db:.1} dB"));
-        if db < 30.0 {
+        let bar = match name {
+            "mandelbulb_escape" => 30.0,
+            "gi" => 40.0,
+            _ => 45.0,
+        };
+        if db < bar {
             gpu::save(&format!("golden_{name}_wgpu"), &image);
-            failures.push(format!("{name}: PSNR {db:.1} dB < 30 dB on wgpu"));
+            failures.push(format!("{name}: PSNR {db:.1} dB < {bar} dB on wgpu"));
         }
         drawn += 1;
     }

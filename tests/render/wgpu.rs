@@ -86,10 +86,11 @@ fn options(file: &fractal_sdf::file::SceneFile) -> RenderOptions {
 
 /// At 96×72 with each scene file's quality (2×2 supersampling, 4×4 through
 /// a lens) and effects (glow, occlusion, shadows), the two backends draw
-/// the same picture of every gallery scene: PSNR at least 40 dB and at
-/// most 0.1% of the pixels' hit flags different (measured here: 41.8 dB
-/// for `bulb_variants` to 65.6, at most 0.014% of the hit flags; at
-/// 640×480 by `examples/backends.rs`: 41.5 to 71.5 dB, at most 0.002%).
+/// the same picture of every gallery scene: PSNR at least 60 dB and at
+/// most 0.1% of the pixels' hit flags different (measured here: 67.5 dB
+/// for `keyframes` to identical, no hit flag different: the backends take
+/// the same steps from the same coarse pass, and differ only in the
+/// roundings of the functions they call).
 /// The path-traced `gi` and the brute-force `mandelbulb_escape` are held
 /// as sampled pictures ([`sampled_pictures_agree`], and at most 0.5% of
 /// the hit flags: 0.145% measured for `mandelbulb_escape`).
@@ -123,7 +124,7 @@ fn every_gallery_scene_is_the_opencl_picture() {
         );
         if sampled {
             sampled_pictures_agree(&drawn_by_wgpu.image, &frame.image, name);
-        } else if db < 40.0 {
+        } else if db < 60.0 {
             failures.push(format!("{name}: {db:.1} dB"));
         }
         // The brute-force march's filaments: a little more.
@@ -144,7 +145,7 @@ fn every_gallery_scene_is_the_opencl_picture() {
 /// The shipped scene files beyond the gallery (fog lit by a light, with
 /// its shafts through a sponge; a shape given as a text formula; lamps
 /// that light a path-traced scene; the white furnace) are the OpenCL
-/// picture too.
+/// picture too (measured: 91.3, 91.3, 88.3 dB and identical).
 #[test]
 fn the_scene_files_are_the_opencl_picture() {
     if !backends() {
@@ -162,7 +163,7 @@ fn the_scene_files_are_the_opencl_picture() {
         } else {
             let db = psnr(&image, &drawn);
             println!("{name}: {db:.1} dB");
-            assert!(db >= 40.0, "{name}: {db:.1} dB between the backends");
+            assert!(db >= 60.0, "{name}: {db:.1} dB between the backends");
         }
     }
 }
@@ -375,7 +376,7 @@ fn sequences_and_stereo_pairs_are_the_opencl_frames() {
     for i in 0..2 {
         let db = psnr(&frame(&on_opencl, i), &frame(&on_wgpu, i));
         println!("motion-blurred frame {i}: {db:.1} dB");
-        assert!(db >= 40.0, "frame {i}: {db:.1} dB between the backends");
+        assert!(db >= 60.0, "frame {i}: {db:.1} dB between the backends");
     }
     // The blur is there: the first frame differs from the ball at rest at
     // its first moment.
@@ -390,7 +391,7 @@ fn sequences_and_stereo_pairs_are_the_opencl_frames() {
     assert_eq!(drawn.dimensions(), (2 * WIDTH, HEIGHT));
     let db = psnr(&image, &drawn);
     println!("stereo pair: {db:.1} dB");
-    assert!(db >= 40.0, "{db:.1} dB between the stereo pairs");
+    assert!(db >= 60.0, "{db:.1} dB between the stereo pairs");
 
     let layered = Sequence::new(dir.join("exr"), 2.0, 2)
         .unwrap()
@@ -605,7 +606,7 @@ fn materials_in_every_boolean_are_the_opencl_picture() {
         return;
     }
     let db = between_backends(&compiled, &options, "materials_in_every_boolean");
-    assert!(db >= 40.0, "{db:.1} dB between the backends");
+    assert!(db >= 60.0, "{db:.1} dB between the backends");
 }
 
 /// An environment image lights the scene, shows behind it and in its
@@ -627,7 +628,7 @@ fn an_environment_image_is_the_opencl_picture() {
 
 /// Progressive passes: each pass adds new samples in the pixel and on the
 /// lens, and after four the blur of the lens scene is the OpenCL
-/// backend's after four (measured 51.7 dB); the first pass is the frame of
+/// backend's after four (measured: identical); the first pass is the frame of
 /// its own, a change starts again, and the count says how many the image
 /// holds.
 #[test]
