@@ -630,12 +630,7 @@ impl CustomShape {
     pub fn opencl_wrapper(&self) -> Option<String> {
         let bounds = self.inside_bounds()?;
         let test = self.test_name()?;
-        let args: String = self
-            .0
-            .params
-            .iter()
-            .map(|(n, _)| format!(", {n}"))
-            .collect();
+        let args = self.params_as(|n| format!(", {n}"));
         Some(format!(
             "real {}(real3 p{}) {{\n    if ({}) {{\n        return INSIDE_HUGE;\n    }}\n    \
              return {test}(p{args}) ? -INSIDE_HUGE : INSIDE_HUGE;\n}}\n",
@@ -664,18 +659,8 @@ impl CustomShape {
         let bounds = self.inside_bounds()?;
         let body = self.0.wgsl?;
         let test = self.test_name()?;
-        let params: String = self
-            .0
-            .params
-            .iter()
-            .map(|(n, _)| format!(", {n}: real"))
-            .collect();
-        let args: String = self
-            .0
-            .params
-            .iter()
-            .map(|(n, _)| format!(", {n}"))
-            .collect();
+        let params = self.params_as(|n| format!(", {n}: real"));
+        let args = self.params_as(|n| format!(", {n}"));
         Some(format!(
             "fn {test}(p: real3{params}) -> bool {{\n{}\n}}\n\
              fn {}(p: real3{params}) -> real {{\n    if ({}) {{\n        return INSIDE_HUGE;\n    \
@@ -687,11 +672,12 @@ impl CustomShape {
     }
 
     fn signature_params(&self) -> String {
-        self.0
-            .params
-            .iter()
-            .map(|(n, _)| format!(", real {n}"))
-            .collect()
+        self.params_as(|n| format!(", real {n}"))
+    }
+
+    /// Each parameter's name written by `item`, one after another.
+    fn params_as(&self, item: impl Fn(&str) -> String) -> String {
+        self.0.params.iter().map(|(n, _)| item(n)).collect()
     }
 
     /// What tells `other` apart from this shape, or `None` if the two are
