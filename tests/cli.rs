@@ -808,6 +808,48 @@ fn bad_input_is_a_clear_error_and_a_nonzero_exit() {
     }
 }
 
+/// `mesh --backend wgpu` samples the scene's WGSL `DE` through wgpu: a
+/// closed mesh with the triangles the OpenCL device's has, within the
+/// roundings of single precision; `--f64` with it is a usage error.
+#[test]
+fn mesh_on_the_wgpu_backend_is_the_opencl_mesh() {
+    if gpu::device().is_none() || wgpu_device::device().is_none() {
+        return;
+    }
+    let dir = scratch("mesh-wgpu");
+    let mesh = |name: &str, extra: &[&str]| {
+        let file = dir.join(name);
+        let mut args = vec![
+            "mesh",
+            "julia",
+            "--resolution",
+            "32",
+            "-o",
+            file.to_str().unwrap(),
+        ];
+        args.extend_from_slice(extra);
+        (run(&dir, "", &args), file)
+    };
+    let (out, wgpu) = mesh("wgpu.stl", &["--backend", "wgpu"]);
+    assert!(out.status.success(), "{}", text(&out));
+    let said = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        said.contains("closed 2-manifold") && said.contains("wgpu"),
+        "{said}"
+    );
+    let (out, opencl) = mesh("opencl.stl", &[]);
+    assert!(out.status.success(), "{}", text(&out));
+    let faces = |path: &Path| {
+        let mut file = std::fs::File::open(path).unwrap();
+        stl_io::read_stl(&mut file).unwrap().faces.len()
+    };
+    let (a, b) = (faces(&wgpu), faces(&opencl));
+    assert!(a.abs_diff(b) * 200 <= b, "{a} against {b} triangles");
+    let (out, _) = mesh("f64.stl", &["--backend", "wgpu", "--f64"]);
+    assert_eq!(out.status.code(), Some(2), "{}", text(&out));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("single precision"));
+}
+
 #[test]
 fn mesh_and_volume_write_files_and_refuse_bad_grids() {
     if gpu::device().is_none() {

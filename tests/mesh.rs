@@ -3,6 +3,12 @@
 //! grids whose signs are the CPU reference's; clear errors for bad grids.
 
 mod gpu;
+/// The Vulkan device of the crate's own WGSL tests: whether wgpu has an
+/// adapter (a failure where the run requires one).
+#[cfg(feature = "wgpu")]
+#[path = "../src/codegen/wgsl_tests/device.rs"]
+#[allow(dead_code)] // `run`, the distance tests' shader runner
+mod wgpu_device;
 
 use std::f64::consts::PI;
 use std::path::PathBuf;
@@ -115,6 +121,70 @@ fn a_box_keeps_its_edges_and_corners() {
             assert!(off > 0.2 && nearest_corner > 0.3, "{off} {nearest_corner}");
         }
     }
+}
+
+/// `Sampler::Wgpu`: the scene's WGSL `DE` through wgpu samples the mesh
+/// the CPU reference samples (in single precision both), its vertex
+/// colours from the WGSL `DE_shade`, and refuses double precision.
+#[cfg(feature = "wgpu")]
+#[test]
+fn the_wgpu_backend_and_the_cpu_give_the_same_mesh() {
+    if wgpu_device::device().is_none() {
+        return;
+    }
+    let node = sphere(0.6)
+        .color(dvec3(0.9, 0.2, 0.1))
+        .smooth_union(
+            cuboid(dvec3(0.4, 0.3, 0.5))
+                .color(dvec3(0.1, 0.3, 0.9))
+                .translate(dvec3(0.5, 0.0, 0.0)),
+            0.1,
+        )
+        .union(mandelbulb(8.0).scale(0.4).translate(dvec3(-0.7, 0.2, 0.0)));
+    let scene = compiled(node);
+    let options = GridOptions::default().resolution(64);
+    let on_wgpu = mesh::extract(&scene, &options.clone().sampler(Sampler::Wgpu)).unwrap();
+    let on_cpu = mesh::extract(&scene, &options.clone().sampler(Sampler::Cpu)).unwrap();
+    let near = |a: f64, b: f64, tolerance: f64| (a - b).abs() <= tolerance * b.abs();
+    #[allow(clippy::cast_precision_loss)]
+    let count = |m: &Mesh| m.triangles.len() as f64;
+    assert!(
+        near(count(&on_wgpu), count(&on_cpu), 5e-3),
+        "{} vs {}",
+        count(&on_wgpu),
+        count(&on_cpu)
+    );
+    assert!(near(on_wgpu.volume(), on_cpu.volume(), 1e-3));
+    assert!(near(on_wgpu.area(), on_cpu.area(), 2e-3));
+    assert!(on_wgpu.topology().is_closed_manifold());
+    // The colours: red at the ball's top, blue on the box's far face.
+    let colour_at = |m: &Mesh, at: DVec3| {
+        let i = m
+            .positions
+            .iter()
+            .enumerate()
+            .min_by(|a, b| {
+                let d = |p: &glam::Vec3| (p.as_dvec3() - at).length();
+                d(a.1).total_cmp(&d(b.1))
+            })
+            .unwrap()
+            .0;
+        m.colors[i]
+    };
+    for mesh in [&on_wgpu, &on_cpu] {
+        let red = colour_at(mesh, dvec3(0.0, 0.7, 0.0));
+        let blue = colour_at(mesh, dvec3(1.0, 0.0, 0.0));
+        assert!(u16::from(red[0]) > u16::from(red[2]) + 100, "{red:?}");
+        assert!(u16::from(blue[2]) > u16::from(blue[0]) + 100, "{blue:?}");
+    }
+    let refused = mesh::extract(
+        &scene,
+        &options.sampler(Sampler::Wgpu).precision(Precision::F64),
+    );
+    assert!(
+        matches!(&refused, Err(fractal_sdf::Error::Unsupported { what, .. }) if what.contains("double")),
+        "{refused:?}"
+    );
 }
 
 #[test]

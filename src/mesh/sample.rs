@@ -21,6 +21,11 @@ pub enum Sampler {
     /// The CPU reference evaluator, on every core (the default without
     /// `opencl`).
     Cpu,
+    /// The scene's WGSL `DE` through wgpu, in single precision
+    /// ([`WgpuPointEvaluator`](crate::render::WgpuPointEvaluator), feature
+    /// `wgpu`).
+    #[cfg(feature = "wgpu")]
+    Wgpu,
 }
 
 impl Default for Sampler {
@@ -40,6 +45,8 @@ pub(crate) enum Sampling {
     },
     #[cfg(feature = "opencl")]
     Device(Box<PointEvaluator>),
+    #[cfg(feature = "wgpu")]
+    Wgpu(Box<crate::render::WgpuPointEvaluator>),
 }
 
 impl Sampling {
@@ -53,6 +60,20 @@ impl Sampling {
             Sampler::Device(selector) => Sampling::Device(Box::new(PointEvaluator::from_compiled(
                 scene, precision, selector,
             )?)),
+            #[cfg(feature = "wgpu")]
+            Sampler::Wgpu => {
+                if precision == Precision::F64 {
+                    return Err(Error::Unsupported {
+                        backend: "wgpu",
+                        what: "sample in double precision (F64), which WGSL does not have".into(),
+                        instead: "sample in single precision, or on an OpenCL device or the CPU"
+                            .into(),
+                    });
+                }
+                Sampling::Wgpu(Box::new(crate::render::WgpuPointEvaluator::from_compiled(
+                    scene,
+                )?))
+            }
         })
     }
 
@@ -65,6 +86,8 @@ impl Sampling {
             }
             #[cfg(feature = "opencl")]
             Sampling::Device(device) => device.set_param(name, value),
+            #[cfg(feature = "wgpu")]
+            Sampling::Wgpu(points) => points.set_param(name, value),
         }
     }
 
@@ -76,6 +99,8 @@ impl Sampling {
             }),
             #[cfg(feature = "opencl")]
             Sampling::Device(device) => device.distances(points),
+            #[cfg(feature = "wgpu")]
+            Sampling::Wgpu(device) => device.distances(points),
         }
     }
 
@@ -89,6 +114,8 @@ impl Sampling {
             Sampling::Device(device) => {
                 Ok(device.eval(points)?.into_iter().map(|s| s.color).collect())
             }
+            #[cfg(feature = "wgpu")]
+            Sampling::Wgpu(device) => device.colors(points),
         }
     }
 
@@ -103,22 +130,35 @@ impl Sampling {
         blocks: &[[i32; 3]],
     ) -> Result<Vec<f32>> {
         let per = (side as usize).pow(3);
+        let at = |i: usize| {
+            let b = blocks[i / per];
+            let s = u32::try_from(i % per).expect("a block is small");
+            let at = [s % side, (s / side) % side, s / (side * side)];
+            origin
+                + spacing
+                    * DVec3::new(
+                        f64::from(b[0]) + f64::from(at[0]),
+                        f64::from(b[1]) + f64::from(at[1]),
+                        f64::from(b[2]) + f64::from(at[2]),
+                    )
+        };
         match self {
             Sampling::Cpu { eval, precision } => on_cores(eval, per * blocks.len(), |i| {
-                let b = blocks[i / per];
-                let s = u32::try_from(i % per).expect("a block is small");
-                let at = [s % side, (s / side) % side, s / (side * side)];
-                let p = origin
-                    + spacing
-                        * DVec3::new(
-                            f64::from(b[0]) + f64::from(at[0]),
-                            f64::from(b[1]) + f64::from(at[1]),
-                            f64::from(b[2]) + f64::from(at[2]),
-                        );
                 #[allow(clippy::cast_possible_truncation)] // Grids hold f32.
-                let d = distance(eval, *precision, p) as f32;
+                let d = distance(eval, *precision, at(i)) as f32;
                 d
             }),
+            #[cfg(feature = "wgpu")]
+            Sampling::Wgpu(device) => {
+                let points: Vec<DVec3> = (0..per * blocks.len()).map(at).collect();
+                #[allow(clippy::cast_possible_truncation)] // Grids hold f32.
+                let out = device
+                    .distances(&points)?
+                    .into_iter()
+                    .map(|d| d as f32)
+                    .collect();
+                Ok(out)
+            }
             #[cfg(feature = "opencl")]
             Sampling::Device(device) => {
                 #[allow(clippy::cast_possible_truncation)] // Grids hold f32.

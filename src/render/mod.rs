@@ -72,6 +72,8 @@ mod upscale;
 mod viewport;
 #[cfg(feature = "wgpu")]
 mod wgpu_backend;
+#[cfg(feature = "wgpu")]
+mod wgpu_points;
 
 /// The wgpu crate the wgpu backend is built on: name its types (devices,
 /// textures) through this path to get the same version.
@@ -91,3 +93,5 @@ pub use stereo::{compose, render_stereo};
 pub use viewport::Viewport;
 #[cfg(feature = "wgpu")]
 pub use wgpu_backend::{WGPU_TEXTURE_FORMAT, WgpuFrame, WgpuRenderer, wgpu_adapters};
+#[cfg(feature = "wgpu")]
+pub use wgpu_points::WgpuPointEvaluator;

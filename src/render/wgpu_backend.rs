@@ -196,14 +196,14 @@ fn instance() -> ::wgpu::Instance {
     ::wgpu::Instance::new(::wgpu::InstanceDescriptor::new_without_display_handle_from_env())
 }
 
-fn wgpu_error(what: &str, detail: impl std::fmt::Display) -> Error {
+pub(super) fn wgpu_error(what: &str, detail: impl std::fmt::Display) -> Error {
     Error::Wgpu(format!("{what}: {detail}"))
 }
 
 /// Runs `f` and turns the validation, out-of-memory and internal errors
 /// wgpu reports while it runs into [`Error::Wgpu`] (rather than wgpu's
 /// default, a panic).
-fn checked<T>(device: &::wgpu::Device, what: &str, f: impl FnOnce() -> T) -> Result<T> {
+pub(super) fn checked<T>(device: &::wgpu::Device, what: &str, f: impl FnOnce() -> T) -> Result<T> {
     let internal = device.push_error_scope(::wgpu::ErrorFilter::Internal);
     let memory = device.push_error_scope(::wgpu::ErrorFilter::OutOfMemory);
     let validation = device.push_error_scope(::wgpu::ErrorFilter::Validation);
@@ -1039,7 +1039,7 @@ static SHARED: OnceLock<std::result::Result<(::wgpu::Device, ::wgpu::Queue), Str
 
 /// The device and queue [`WgpuRenderer::from_compiled`] renderers share,
 /// found on the first call.
-fn shared_device() -> Result<(::wgpu::Device, ::wgpu::Queue)> {
+pub(super) fn shared_device() -> Result<(::wgpu::Device, ::wgpu::Queue)> {
     let found = SHARED.get_or_init(|| {
         let adapter = pollster::block_on(::wgpu::util::initialize_adapter_from_env_or_default(
             &instance(),
@@ -1208,11 +1208,11 @@ fn output_usage() -> ::wgpu::BufferUsages {
     ::wgpu::BufferUsages::STORAGE | ::wgpu::BufferUsages::COPY_SRC
 }
 
-fn read_back() -> ::wgpu::BufferUsages {
+pub(super) fn read_back() -> ::wgpu::BufferUsages {
     ::wgpu::BufferUsages::MAP_READ | ::wgpu::BufferUsages::COPY_DST
 }
 
-fn buffer(
+pub(super) fn buffer(
     device: &::wgpu::Device,
     label: &str,
     bytes: usize,
@@ -1235,7 +1235,7 @@ fn floats(values: &[f64]) -> Vec<u8> {
 }
 
 /// The contents of a buffer that a finished submission copied into.
-fn read(device: &::wgpu::Device, staging: &::wgpu::Buffer) -> Result<Vec<u8>> {
+pub(super) fn read(device: &::wgpu::Device, staging: &::wgpu::Buffer) -> Result<Vec<u8>> {
     let (send, receive) = std::sync::mpsc::channel();
     staging
         .slice(..)

@@ -244,7 +244,8 @@ struct RenderArgs {
     backend: Option<Backend>,
 }
 
-/// The backends `render`, `sequence` and `bench` render with.
+/// The backends `render`, `sequence` and `bench` render with, and `mesh` and
+/// `volume` sample with.
 #[derive(Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
 enum Backend {
     Opencl,

@@ -28,8 +28,12 @@ pub struct GridArgs {
     #[arg(long, value_name = "BOX", allow_hyphen_values = true)]
     bounds: Option<String>,
     /// Compute distances on the CPU reference instead of an OpenCL device.
-    #[arg(long, conflicts_with = "device")]
+    #[arg(long, conflicts_with_all = ["device", "backend"])]
     cpu: bool,
+    /// The device backend that computes distances: opencl (default), or
+    /// wgpu (the scene's WGSL through wgpu, in single precision).
+    #[arg(long, value_enum, conflicts_with = "device")]
+    backend: Option<super::Backend>,
     /// A substring of the OpenCL device's name (default: automatic).
     #[arg(long)]
     device: Option<String>,
@@ -91,6 +95,13 @@ impl GridArgs {
         let scene = file.scene.compile()?;
         let sampler = if self.cpu {
             Sampler::Cpu
+        } else if self.backend == Some(super::Backend::Wgpu) {
+            if self.f64 {
+                return Err(usage(
+                    "--f64 needs the OpenCL backend or --cpu: WGSL has single precision only",
+                ));
+            }
+            Sampler::Wgpu
         } else {
             Sampler::Device(
                 self.device
@@ -101,6 +112,7 @@ impl GridArgs {
         let on = match &sampler {
             Sampler::Cpu => "the CPU".to_string(),
             Sampler::Device(selector) => selector.resolve()?.label(),
+            Sampler::Wgpu => "the wgpu adapter".to_string(),
             other => format!("{other:?}"),
         };
         let mut options = GridOptions::default()
