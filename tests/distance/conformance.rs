@@ -458,9 +458,10 @@ fn opencl_f64_matches_the_cpu_reference() {
 /// colour 6.9e-3 (`orbit_trap_dynamic_power`: an orbit trap's colour comes
 /// from the iteration whose orbit passes nearest, and where two pass
 /// almost as near, `pow`'s error can pick the other). The tolerances are
-/// 5e-3 and 2e-2 (PoCL's OpenCL keeps 2e-5 for both). The nodes WGSL does
-/// not print (an inside shape, marched by brute force; a custom shape
-/// written in OpenCL C) are the typed error, and are counted.
+/// 5e-3 and 2e-2 (PoCL's OpenCL keeps 2e-5 for both). The inside shape
+/// (the escape-time Mandelbulb) prints, with its test in WGSL, and
+/// agrees in sign at every point; the node WGSL does not print (a custom
+/// shape written in OpenCL C) is the typed error, and is counted.
 #[test]
 fn wgpu_f32_matches_the_cpu_reference() {
     use fractal_sdf::Error;
