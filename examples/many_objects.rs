@@ -18,6 +18,11 @@
 //! `cargo run --release --example many_objects` (1,000, 10,000 and 100,000
 //! spheres, baked and dynamic), or `-- N baked|dynamic` for one row; the
 //! 100,000 baked spheres' frame is written to `out/many_objects.png`.
+//! With `--features wgpu` and `--backend wgpu` (before the row's
+//! arguments, if any) the same table is measured on the wgpu backend,
+//! less the object ids, which belong to the OpenCL renderer; compiling is
+//! then the WGSL module and its pipeline, and the 100,000 baked spheres'
+//! frame is `out/many_objects_wgpu.png`.
 
 mod common;
 
@@ -28,22 +33,39 @@ use fractal_sdf::prelude::*;
 use fractal_sdf::render::{RenderOptions, Renderer};
 use fractal_sdf::scene::{Param3, param3};
 
-const HEADER: &str = "| spheres | positions | compile | peak memory | 640×480 production frame | evaluations / pixel | set every position | fill the tables and refit | object ids (CPU) |\n|---:|---|---:|---:|---:|---:|---:|---:|---:|";
+const HEADER: &str = "| spheres | positions | compile | peak memory | 640×480 production frame | evaluations / pixel | set every position | fill the tables and refit |";
 
 fn main() -> fractal_sdf::Result<()> {
-    let args: Vec<String> = std::env::args().skip(1).collect();
+    let mut args: Vec<String> = std::env::args().skip(1).collect();
+    let wgpu = match args.iter().position(|a| a == "--backend") {
+        Some(i) if args.get(i + 1).map(String::as_str) == Some("wgpu") => {
+            args.drain(i..=i + 1);
+            true
+        }
+        Some(i) if args.get(i + 1).map(String::as_str) == Some("opencl") => {
+            args.drain(i..=i + 1);
+            false
+        }
+        Some(_) => return Err(common::usage("--backend takes opencl or wgpu")),
+        None => false,
+    };
     if let [n, mode] = args.as_slice() {
         let n: usize = n.parse().expect("a sphere count");
-        println!("{}", row(n, mode == "dynamic")?);
+        println!("{}", row(n, mode == "dynamic", wgpu)?);
         return Ok(());
     }
-    println!("{HEADER}");
+    if wgpu {
+        println!("{HEADER}\n|---:|---|---:|---:|---:|---:|---:|---:|");
+    } else {
+        println!("{HEADER} object ids (CPU) |\n|---:|---|---:|---:|---:|---:|---:|---:|---:|");
+    }
     let me = std::env::current_exe().expect("the example's path");
+    let backend = if wgpu { "wgpu" } else { "opencl" };
     for n in [1_000, 10_000, 100_000] {
         for mode in ["baked", "dynamic"] {
             // Each program compiled afresh, not taken from PoCL's cache.
             let out = Command::new(&me)
-                .args([n.to_string(), mode.to_string()])
+                .args(["--backend", backend, &n.to_string(), mode])
                 .env("POCL_KERNEL_CACHE", "0")
                 .output()
                 .expect("the example runs");
@@ -92,8 +114,30 @@ fn scene(n: usize, dynamic: bool) -> Scene {
         .with_camera(Camera::look_at(dvec3(2.4, 1.6, 3.2), dvec3(0.0, -0.1, 0.0)))
 }
 
-fn row(n: usize, dynamic: bool) -> fractal_sdf::Result<String> {
-    let ms = |t: Instant| t.elapsed().as_secs_f64() * 1e3;
+fn ms(t: Instant) -> f64 {
+    t.elapsed().as_secs_f64() * 1e3
+}
+
+/// Moves every sphere of `n` a little: the positions of a dynamic row.
+#[allow(clippy::cast_precision_loss)]
+fn move_all(
+    n: usize,
+    mut set: impl FnMut(&str, f64) -> fractal_sdf::Result<()>,
+) -> fractal_sdf::Result<()> {
+    for i in 0..n {
+        let (centre, ..) = placed(i, n);
+        let moved = centre + dvec3(0.0, 0.1 * (i as f64 * 0.37).sin(), 0.0);
+        for (axis, v) in ["x", "y", "z"].iter().zip(moved.to_array()) {
+            set(&format!("s{i}.{axis}"), v)?;
+        }
+    }
+    Ok(())
+}
+
+fn row(n: usize, dynamic: bool, wgpu: bool) -> fractal_sdf::Result<String> {
+    if wgpu {
+        return wgpu_row(n, dynamic);
+    }
     let scene = scene(n, dynamic);
     let t = Instant::now();
     // The tree of nodes is not needed once compiled: dropped here, it
@@ -120,13 +164,7 @@ fn row(n: usize, dynamic: bool) -> fractal_sdf::Result<String> {
     times.sort_by(f64::total_cmp);
     let (set, refit) = if dynamic {
         let t = Instant::now();
-        for i in 0..n {
-            let (centre, ..) = placed(i, n);
-            let moved = centre + dvec3(0.0, 0.1 * (i as f64 * 0.37).sin(), 0.0);
-            for (axis, v) in ["x", "y", "z"].iter().zip(moved.to_array()) {
-                renderer.set_param(&format!("s{i}.{axis}"), v)?;
-            }
-        }
+        move_all(n, |name, v| renderer.set_param(name, v))?;
         let set = ms(t);
         let t = Instant::now();
         let buffer = renderer.source().param_buffer(renderer.values().as_slice());
@@ -147,5 +185,56 @@ fn row(n: usize, dynamic: bool) -> fractal_sdf::Result<String> {
         if dynamic { "dynamic" } else { "baked" },
         peak,
         times[1],
+    ))
+}
+
+/// A row on the wgpu backend: the same scene, frames and moves.
+#[cfg(feature = "wgpu")]
+fn wgpu_row(n: usize, dynamic: bool) -> fractal_sdf::Result<String> {
+    use fractal_sdf::render::WgpuRenderer;
+    let scene = scene(n, dynamic);
+    let t = Instant::now();
+    let compiled = scene.compile()?;
+    drop(scene);
+    let options = RenderOptions::default().quality(Quality::production());
+    let mut renderer = WgpuRenderer::from_compiled(compiled, &options)?;
+    let compile = ms(t);
+    let (w, h) = (640, 480);
+    let evaluations = renderer.render_frame(w, h)?.evaluations_per_pixel();
+    let mut times = Vec::new();
+    for _ in 0..3 {
+        let t = Instant::now();
+        let image = renderer.render(w, h)?;
+        times.push(ms(t));
+        if n == 100_000 && !dynamic {
+            std::fs::create_dir_all("out").ok();
+            fractal_sdf::output::save_png(&image, "out/many_objects_wgpu.png")?;
+        }
+    }
+    times.sort_by(f64::total_cmp);
+    let (set, refit) = if dynamic {
+        let t = Instant::now();
+        move_all(n, |name, v| renderer.set_param(name, v))?;
+        let set = ms(t);
+        let t = Instant::now();
+        let buffer = renderer.source().param_buffer(renderer.values().as_slice());
+        let refit = ms(t);
+        assert!(!buffer.is_empty());
+        (format!("{set:.0} ms"), format!("{refit:.1} ms"))
+    } else {
+        ("(a new program)".into(), String::new())
+    };
+    Ok(format!(
+        "| {n} | {} | {compile:.0} ms | {} | {:.0} ms | {evaluations:.1} | {set} | {refit} |",
+        if dynamic { "dynamic" } else { "baked" },
+        common::peak_memory(),
+        times[1],
+    ))
+}
+
+#[cfg(not(feature = "wgpu"))]
+fn wgpu_row(_: usize, _: bool) -> fractal_sdf::Result<String> {
+    Err(common::usage(
+        "--backend wgpu needs the wgpu feature: cargo run --release --features wgpu --example many_objects -- --backend wgpu",
     ))
 }

@@ -145,6 +145,9 @@ pub struct WgpuRenderer {
     pipeline_time: Duration,
     builds: u64,
     params: ::wgpu::Buffer,
+    /// The dynamic values the parameter buffer holds; `None` where it
+    /// must be written whole before the next frame.
+    written: Option<Vec<f64>>,
     camera: ::wgpu::Buffer,
     lights: ::wgpu::Buffer,
     /// The environment light ([`super::environment::pack`]).
@@ -305,6 +308,7 @@ impl WgpuRenderer {
             scene,
             options: options.clone(),
             values,
+            written: None,
             source,
             gpu: Gpu {
                 device,
@@ -329,7 +333,6 @@ impl WgpuRenderer {
             progress: None,
             timing: None,
         };
-        renderer.write_params();
         renderer.write_lights();
         Ok(renderer)
     }
@@ -424,7 +427,7 @@ impl WgpuRenderer {
                 ::wgpu::BufferUsages::STORAGE | ::wgpu::BufferUsages::COPY_DST,
             );
         }
-        self.write_params();
+        self.written = None;
         Ok(())
     }
 
@@ -450,7 +453,6 @@ impl WgpuRenderer {
     pub fn set_param(&mut self, name: &str, value: f64) -> Result<()> {
         self.values
             .set_within(name, value, Precision::F32.limits())?;
-        self.write_params();
         self.progress = None;
         Ok(())
     }
@@ -459,6 +461,12 @@ impl WgpuRenderer {
     #[must_use]
     pub fn param(&self, name: &str) -> Option<f64> {
         self.values.get(name)
+    }
+
+    /// Every dynamic parameter's current value.
+    #[must_use]
+    pub fn values(&self) -> &ParamValues {
+        &self.values
     }
 
     /// Sets the camera.
@@ -961,6 +969,7 @@ impl WgpuRenderer {
         aovs: bool,
         pass: Option<u32>,
     ) -> Result<()> {
+        self.write_params();
         let view = Viewport::in_frame(
             self.scene.camera(),
             width,
@@ -995,11 +1004,26 @@ impl WgpuRenderer {
         Ok(())
     }
 
+    /// Writes the dynamic values that changed since the last frame, as
+    /// the OpenCL renderer does: the values alone, unless the instance
+    /// tables copy one that changed (then the tables are filled and their
+    /// hierarchies fitted again, once for every value set since).
     fn write_params(&mut self) {
-        let values = self.source.param_buffer(self.values.as_slice());
-        let mut bytes = floats(&values);
-        bytes.resize(self.params.size() as usize, 0);
-        self.gpu.queue.write_buffer(&self.params, 0, &bytes);
+        let values = self.values.as_slice();
+        match &self.written {
+            Some(written) if same_bits(written, values) => return,
+            Some(written) if !self.source.tables.differ(written, values) => {
+                self.gpu
+                    .queue
+                    .write_buffer(&self.params, 0, &floats(values));
+            }
+            _ => {
+                let mut bytes = floats(&self.source.param_buffer(values));
+                bytes.resize(self.params.size() as usize, 0);
+                self.gpu.queue.write_buffer(&self.params, 0, &bytes);
+            }
+        }
+        self.written = Some(values.to_vec());
     }
 
     fn write_lights(&mut self) {
@@ -1224,6 +1248,11 @@ pub(super) fn buffer(
         usage,
         mapped_at_creation: false,
     })
+}
+
+/// Whether `a` and `b` hold the same values, bit for bit.
+fn same_bits(a: &[f64], b: &[f64]) -> bool {
+    a.len() == b.len() && a.iter().zip(b).all(|(x, y)| x.to_bits() == y.to_bits())
 }
 
 /// `values` as the little-endian `f32`s the shader reads.

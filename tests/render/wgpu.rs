@@ -458,6 +458,94 @@ fn parameters_camera_and_lights_change_the_picture_on_the_same_pipeline() {
     ));
 }
 
+/// Forty spheres placed by dynamic positions (a walked instance table)
+/// and a box with a dynamic size outside the table.
+#[allow(clippy::cast_precision_loss)]
+fn moving_spheres(positions: &[DVec3], size: f64) -> Scene {
+    let spheres = positions
+        .iter()
+        .enumerate()
+        .map(|(i, &at)| {
+            sphere(0.12)
+                .translate(fractal_sdf::scene::param3(&format!("s{i}"), at))
+                .color(dvec3(0.2 + 0.015 * i as f64, 0.5, 0.8))
+        })
+        .reduce(Node::union)
+        .unwrap();
+    let size = fractal_sdf::scene::param("size", size);
+    Scene::new(
+        spheres
+            .union(
+                cuboid(dvec3(0.2, 0.2, 0.2))
+                    .round(size)
+                    .translate(dvec3(0.0, 0.9, 0.0)),
+            )
+            .union(plane(DVec3::Y, 1.0)),
+    )
+    .with_camera(Camera::look_at(dvec3(0.0, 1.5, 3.5), DVec3::ZERO))
+}
+
+/// Moving every instance of a walked table is written once, at the next
+/// frame: the picture is a renderer's built with the new positions, and
+/// the OpenCL renderer's after the same moves; a value outside the tables
+/// changed after them changes the picture too.
+#[test]
+#[allow(clippy::cast_precision_loss)]
+fn moving_every_instance_is_the_picture_of_the_new_positions() {
+    if !backends() {
+        return;
+    }
+    let (w, h) = (64, 48);
+    let ring = |turn: f64| -> Vec<DVec3> {
+        (0..40)
+            .map(|i| {
+                let a = i as f64 * std::f64::consts::TAU / 40.0 + turn;
+                dvec3(a.cos(), 0.3 * (3.0 * a).sin() + 0.2 * turn, a.sin())
+            })
+            .collect()
+    };
+    let (before, after) = (ring(0.0), ring(0.4));
+    let scene = moving_spheres(&before, 0.05);
+    let mut wgpu = WgpuRenderer::new(&scene, gpu::quick()).unwrap();
+    let mut opencl = Renderer::new(&scene, gpu::quick()).unwrap();
+    let first = wgpu.render(w, h).unwrap();
+    for (i, at) in after.iter().enumerate() {
+        for (axis, v) in ["x", "y", "z"].iter().zip(at.to_array()) {
+            let name = format!("s{i}.{axis}");
+            wgpu.set_param(&name, v).unwrap();
+            opencl.set_param(&name, v).unwrap();
+        }
+    }
+    let moved = wgpu.render(w, h).unwrap();
+    assert_ne!(moved, first, "the spheres moved");
+    let built = WgpuRenderer::new(&moving_spheres(&after, 0.05), gpu::quick())
+        .unwrap()
+        .render(w, h)
+        .unwrap();
+    let db = psnr(&built, &moved);
+    println!("moved against built there: {db:.1} dB");
+    assert!(db >= 60.0, "moved against built there: {db:.1} dB");
+    let db = psnr(&opencl.render(w, h).unwrap(), &moved);
+    println!("moved on wgpu against OpenCL: {db:.1} dB");
+    assert!(db >= 60.0, "moved on wgpu against OpenCL: {db:.1} dB");
+
+    // A value the tables do not copy: the values alone are written.
+    wgpu.set_param("size", 0.15).unwrap();
+    let rounder = wgpu.render(w, h).unwrap();
+    assert_ne!(rounder, moved);
+    let built = WgpuRenderer::new(&moving_spheres(&after, 0.15), gpu::quick())
+        .unwrap()
+        .render(w, h)
+        .unwrap();
+    let db = psnr(&built, &rounder);
+    assert!(db >= 60.0, "a value outside the tables: {db:.1} dB");
+    assert_eq!(
+        wgpu.render(w, h).unwrap(),
+        rounder,
+        "nothing changed, nothing written"
+    );
+}
+
 /// Into the application's texture: the pixels `render` returns, with no
 /// copy through the CPU on the way.
 #[test]
