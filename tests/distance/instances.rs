@@ -78,18 +78,31 @@ proptest! {
 
     /// The walk skips a box only where the bounds say nothing in it can be
     /// nearer than what was found: the union's value and colour are the
-    /// plain union's at every point, in both precisions.
+    /// plain union's at every point, in both precisions. With a floor
+    /// through the set and a shape of another kind in the union, the walk
+    /// starts from their distance (negative below the floor).
     #[test]
     fn a_walked_union_is_the_plain_union(
         (kind, set) in instances(),
         seed in 0u64..1000,
+        floor in prop::option::of(-1.2..1.2f64),
     ) {
-        let node = set
+        let mut node = set
             .iter()
             .map(|&placed| shape(kind, placed))
             .reduce(Node::union)
             .expect("instances");
-        let points = points_near(&set, seed);
+        let mut points = points_near(&set, seed);
+        if let Some(h) = floor {
+            node = node
+                .union(plane(DVec3::Y, -h).color(dvec3(0.9, 0.9, 0.9)))
+                .union(capsule(dvec3(-0.6, h, -0.2), dvec3(0.6, h, 0.1), 0.05));
+            points.extend((0..200).map(|i| {
+                let x = f64::from(i % 20) * 0.12 - 1.2;
+                let z = f64::from(i / 20) * 0.25 - 1.2;
+                dvec3(x, h + 0.02 * f64::from(i % 7) - 0.06, z)
+            }));
+        }
         let walked = cpu::Evaluator::new(&node).unwrap();
         let tested = walks_like_plain(&walked, &points);
         prop_assert!(tested.is_ok(), "{}", tested.unwrap_err());

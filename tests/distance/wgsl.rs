@@ -218,8 +218,9 @@ pub(crate) fn compare(
 /// 400 coloured spheres, every fourth placed by a dynamic position and all
 /// sized by one dynamic radius: one loop over a table, walked through a
 /// bounding volume hierarchy, whose boxes the host fits again when the
-/// values change. After moving them, the device's distances and colours
-/// are the CPU reference's at 512 points.
+/// values change; a floor through them, which `DE`'s walk starts from.
+/// After moving them, the device's distances and colours are the CPU
+/// reference's at 512 points.
 #[test]
 fn instances_walked_through_a_hierarchy_run_on_wgpu_as_on_the_cpu() {
     use fractal_sdf::prelude::*;
@@ -242,6 +243,7 @@ fn instances_walked_through_a_hierarchy_run_on_wgpu_as_on_the_cpu() {
         let tint = dvec3((t * 1.3).sin().abs(), (t * 0.7).cos().abs(), 0.5);
         scene = scene.add(sphere(param("r", 0.15)).translate(placed).color(tint));
     }
+    let scene = scene.add(plane(DVec3::Y, 0.5).color(dvec3(0.8, 0.8, 0.8)));
     let compiled = scene.compile().expect("the scene compiles");
     let options = Options::default().target(Target::Evaluate);
     let module = emit_wgsl(&compiled, &options).expect("the scene prints");

@@ -121,7 +121,21 @@ impl<'a> SceneEmitter<'a> {
         needs_color: bool,
     ) -> Vars {
         self.label(id);
-        let mut results = children.into_iter().chain(cluster.groups);
+        let mut groups = cluster.groups;
+        // Only the distance: each group's loop starts from the minimum of
+        // the operands before it (a floor, other groups), and its walk
+        // skips every box beyond that from the start.
+        let (min, _) = self.w.min_max();
+        let mut bound = children
+            .iter()
+            .map(|c| c.d.clone())
+            .reduce(|a, b| format!("{min}({a}, {b})"));
+        for members in cluster.pending {
+            let v = self.instance_loop(&members, &cluster.p, needs_color, bound.as_deref());
+            bound = Some(v.d.clone());
+            groups.push(v);
+        }
+        let mut results = children.into_iter().chain(groups);
         let mut acc = results.next().expect("a union tree has an operand");
         for (union, next) in cluster.unions.into_iter().zip(results) {
             acc = self.csg(union, CsgOp::Union, None, &acc, &next, needs_color);

@@ -66,17 +66,23 @@ impl<'a> SceneEmitter<'a> {
             return None;
         }
         let mut looped = BTreeSet::new();
-        let mut results = Vec::new();
+        let (mut results, mut pending) = (Vec::new(), Vec::new());
         for shape in &order {
-            let members = &groups[shape];
+            let members = groups.remove(shape).expect("each shape has its group");
             looped.extend(members.iter().map(|m| m.id));
-            results.push(self.instance_loop(members, p, needs_color));
+            if self.shade {
+                results.push(self.instance_loop(&members, p, needs_color, None));
+            } else {
+                pending.push(members);
+            }
         }
         self.clusters.insert(
             id,
             Cluster {
                 unions,
                 groups: results,
+                pending,
+                p: p.to_string(),
             },
         );
         let rest = operands.into_iter().filter(|o| !looped.contains(o));
@@ -92,7 +98,17 @@ impl<'a> SceneEmitter<'a> {
     /// all have bounds is walked through a bounding volume hierarchy
     /// instead ([`bvh`](super::bvh)), which skips the members too far away
     /// to change the minimum.
-    pub(super) fn instance_loop(&mut self, members: &[Member], p: &str, needs_color: bool) -> Vars {
+    ///
+    /// `bound`, where given, is a distance the union already has (its other
+    /// operands' minimum): the loop starts from it, so that a walk skips
+    /// every box beyond it from the start. The minimum is the same.
+    pub(super) fn instance_loop(
+        &mut self,
+        members: &[Member],
+        p: &str,
+        needs_color: bool,
+        bound: Option<&str>,
+    ) -> Vars {
         let first = members[0].id;
         let chain = instance(self.ir, first, &self.defaults)
             .expect("members are instances")
@@ -111,7 +127,8 @@ impl<'a> SceneEmitter<'a> {
         let r = first.index();
         let (d, c, t) = (format!("dg{r}"), format!("cg{r}"), format!("tg{r}"));
         let colour = self.shade && needs_color;
-        self.w.declare(Ty::Real, &d, self.w.infinity());
+        self.w
+            .declare(Ty::Real, &d, bound.unwrap_or(self.w.infinity()));
         if colour {
             let (ty, default) = (self.surface_type(), self.default_surface());
             self.w.declare(ty, &c, &default);
@@ -535,4 +552,9 @@ impl Mapper<Scalar, Vector, NodeId> for Renumber {
 pub(super) struct Cluster {
     pub(super) unions: Vec<NodeId>,
     pub(super) groups: Vec<Vars>,
+    /// Where only the distance is wanted (`DE`): the groups whose loops are
+    /// emitted after the union's other operands, from their minimum.
+    pub(super) pending: Vec<Vec<Member>>,
+    /// The point the union is evaluated at.
+    pub(super) p: String,
 }
