@@ -230,6 +230,71 @@ fn moved_instances_are_found_where_they_moved() {
     }
 }
 
+/// A walked union with another walked union among its operands (boxes,
+/// moved and rounded as one) and a floor: `DE` writes each walk after the
+/// union's other operands, from their distance, while every function lays
+/// out the two groups' tables in the same order (the debug build checks
+/// it). The device's distances and colours are the CPU reference's.
+#[test]
+#[allow(clippy::cast_precision_loss)]
+fn a_walked_union_within_a_walked_union_reads_its_own_table() {
+    let boxes = (0..40)
+        .map(|i| {
+            let a = i as f64 * 0.31;
+            cuboid(dvec3(0.08, 0.05, 0.06))
+                .translate(dvec3(a.cos(), 0.4 * (2.0 * a).sin(), a.sin()))
+                .color(dvec3(0.9, 0.3, 0.1))
+        })
+        .reduce(Node::union)
+        .expect("boxes")
+        .round(0.02)
+        .translate(dvec3(0.3, 0.5, 0.0));
+    let node = (0..48)
+        .map(|i| {
+            let a = i as f64 * 0.47;
+            sphere(0.1 + 0.002 * i as f64)
+                .translate(dvec3(1.2 * a.sin(), 0.3 * a.cos(), 1.2 * (0.7 * a).cos()))
+                .color(dvec3(0.1, 0.4, 0.9))
+        })
+        .reduce(Node::union)
+        .expect("spheres")
+        .union(boxes)
+        .union(plane(DVec3::Y, 0.45));
+    let source = codegen::emit(
+        &Scene::new(node.clone()).compile().unwrap(),
+        &Options::default(),
+    )
+    .unwrap();
+    assert_eq!(
+        source.source.matches("walked through").count(),
+        4,
+        "two walks in each function"
+    );
+    let mut points = random_points(400, 1.8, 7);
+    points.extend((0..200).map(|i| {
+        dvec3(
+            f64::from(i % 20) * 0.1 - 1.0,
+            -0.45,
+            f64::from(i / 20) * 0.2 - 1.0,
+        )
+    }));
+    let Some(device) = gpu::device() else { return };
+    for precision in [Precision::F32, Precision::F64] {
+        if precision == Precision::F64 && !gpu::fp64(&device) {
+            continue;
+        }
+        let tolerance = tolerance(precision, device.kind);
+        let tested = check_device_matches_cpu(
+            &node,
+            &DeviceSelector::auto(),
+            precision,
+            &points,
+            tolerance,
+        );
+        assert!(tested.is_ok(), "{precision:?}: {}", tested.unwrap_err());
+    }
+}
+
 /// A fixed direction per index, spread over the sphere.
 fn unit_vector_at(i: usize) -> DVec3 {
     let t = i as f64;

@@ -130,8 +130,8 @@ impl<'a> SceneEmitter<'a> {
             .iter()
             .map(|c| c.d.clone())
             .reduce(|a, b| format!("{min}({a}, {b})"));
-        for members in cluster.pending {
-            let v = self.instance_loop(&members, &cluster.p, needs_color, bound.as_deref());
+        for group in cluster.pending {
+            let v = self.instance_loop(group, &cluster.p, needs_color, bound.as_deref());
             bound = Some(v.d.clone());
             groups.push(v);
         }

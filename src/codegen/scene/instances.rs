@@ -70,10 +70,14 @@ impl<'a> SceneEmitter<'a> {
         for shape in &order {
             let members = groups.remove(shape).expect("each shape has its group");
             looped.extend(members.iter().map(|m| m.id));
+            // Laid out now, in the order every function meets the groups
+            // (they all read one parameter buffer); `DE` writes the loop
+            // later.
+            let group = self.lay_out(members);
             if self.shade {
-                results.push(self.instance_loop(&members, p, needs_color, None));
+                results.push(self.instance_loop(group, p, needs_color, None));
             } else {
-                pending.push(members);
+                pending.push(group);
             }
         }
         self.clusters.insert(
@@ -104,31 +108,32 @@ impl<'a> SceneEmitter<'a> {
     /// every box beyond it from the start. The minimum is the same.
     pub(super) fn instance_loop(
         &mut self,
-        members: &[Member],
+        group: Group,
         p: &str,
         needs_color: bool,
         bound: Option<&str>,
     ) -> Vars {
+        let Group {
+            members,
+            chain,
+            hierarchy,
+            start,
+            row,
+            nodes,
+        } = group;
         let first = members[0].id;
-        let chain = instance(self.ir, first, &self.defaults)
-            .expect("members are instances")
-            .chain;
-        let template = template(&chain);
         let stride = members[0].values.len();
-        let hierarchy = if members.len() >= MIN_HIERARCHY {
-            let bounds: Option<Vec<Bound>> = members
-                .iter()
-                .map(|m| chain_bound(&template, &m.values))
-                .collect();
-            bounds.and_then(|b| Bvh::build(&b))
-        } else {
-            None
-        };
         let r = first.index();
         let (d, c, t) = (format!("dg{r}"), format!("cg{r}"), format!("tg{r}"));
         let colour = self.shade && needs_color;
-        self.w
-            .declare(Ty::Real, &d, bound.unwrap_or(self.w.infinity()));
+        // Folded with infinity as the unions fold their operands, so that a
+        // bound that is not a number starts the walk as none would.
+        let (min, _) = self.w.min_max();
+        let start_at = bound.map_or_else(
+            || self.w.infinity().to_string(),
+            |b| format!("{min}({b}, {})", self.w.cast(Ty::Real, self.w.infinity())),
+        );
+        self.w.declare(Ty::Real, &d, &start_at);
         if colour {
             let (ty, default) = (self.surface_type(), self.default_surface());
             self.w.declare(ty, &c, &default);
@@ -136,22 +141,17 @@ impl<'a> SceneEmitter<'a> {
         if self.traps() {
             self.w.declare(Ty::Real2, &t, &super::no_trap(self.w));
         }
-        let (start, row) = match &hierarchy {
-            Some(bvh) => self.hierarchy_open(members, bvh, template, stride, r, p),
+        match &hierarchy {
+            Some(bvh) => self.hierarchy_open(&members, bvh, (start, row, nodes), r, p),
             None => {
-                let start = self.slots + self.constants.len();
-                for m in members {
-                    self.table_row(m);
-                }
                 self.w.comment(&format!(
                     "{} instances of {}: {stride} values each from params[{start}]",
                     members.len(),
                     self.ir.path_tail(first, 2)
                 ));
                 self.w.open_for("i", "0u", &format!("{}u", members.len()));
-                (start, stride)
             }
-        };
+        }
         self.w.declare_offset("q", start, &format!("i * {row}u"));
         self.instance = chain.into_iter().collect();
         let v = self.node(first, p, needs_color);
@@ -194,21 +194,40 @@ impl<'a> SceneEmitter<'a> {
         }
     }
 
-    /// Lays out a hierarchy's table (each member's values, then its place
-    /// in the union, in the order of the leaves) and its nodes, and opens
-    /// the walk down to the loop over a leaf's members. Returns where the
-    /// table starts and its row length.
-    fn hierarchy_open(
-        &mut self,
-        members: &[Member],
-        bvh: &Bvh,
-        template: Vec<IrNode>,
-        stride: usize,
-        r: usize,
-        p: &str,
-    ) -> (usize, usize) {
+    /// Lays out a group's table in the parameter buffer: each member's
+    /// values in turn, or, for a group walked through a hierarchy, each
+    /// member's values and its place in the union in the order of the
+    /// leaves, then the hierarchy's nodes.
+    pub(super) fn lay_out(&mut self, members: Vec<Member>) -> Group {
+        let chain = instance(self.ir, members[0].id, &self.defaults)
+            .expect("members are instances")
+            .chain;
+        let template = template(&chain);
+        let stride = members[0].values.len();
+        let hierarchy = if members.len() >= MIN_HIERARCHY {
+            let bounds: Option<Vec<Bound>> = members
+                .iter()
+                .map(|m| chain_bound(&template, &m.values))
+                .collect();
+            bounds.and_then(|b| Bvh::build(&b))
+        } else {
+            None
+        };
         let table = self.constants.len();
         let start = self.slots + table;
+        let Some(bvh) = &hierarchy else {
+            for m in &members {
+                self.table_row(m);
+            }
+            return Group {
+                members,
+                chain,
+                hierarchy,
+                start,
+                row: stride,
+                nodes: 0,
+            };
+        };
         for &i in &bvh.order {
             self.table_row(&members[i]);
             self.constants.push(i as f64);
@@ -227,6 +246,27 @@ impl<'a> SceneEmitter<'a> {
             });
         }
         self.constants.extend_from_slice(&bvh.nodes);
+        Group {
+            members,
+            chain,
+            hierarchy,
+            start,
+            row,
+            nodes,
+        }
+    }
+
+    /// Opens the walk of a group laid out at `(start, row, nodes)` (its
+    /// table, row length and nodes) down to the loop over a leaf's members.
+    fn hierarchy_open(
+        &mut self,
+        members: &[Member],
+        bvh: &Bvh,
+        (start, row, nodes): (usize, usize, usize),
+        r: usize,
+        p: &str,
+    ) {
+        let stride = row - 1;
         self.w.comment(&format!(
             "{} instances of {}: {stride} values and a place each from params[{start}] - \
              walked through {} nodes of {WIDTH} boxes from params[{nodes}]",
@@ -357,7 +397,6 @@ impl<'a> SceneEmitter<'a> {
         self.w.close();
         let end = format!("first + {}", self.w.cast(Ty::Uint, "count"));
         self.w.open_for("i", "first", &end);
-        (start, row)
     }
 
     /// Appends a member's row of values to the tables, noting the entries
@@ -462,6 +501,23 @@ pub(super) struct Instance {
     pub(super) copies: Vec<(usize, u32)>,
 }
 
+/// A group of instances laid out in the parameter buffer
+/// ([`SceneEmitter::lay_out`]), its loop not yet written.
+pub(super) struct Group {
+    members: Vec<Member>,
+    /// The first member's chain, rewritten to read its values from a row.
+    chain: Vec<(NodeId, IrNode)>,
+    /// The hierarchy it is walked through, if any.
+    hierarchy: Option<Bvh>,
+    /// Where its table starts in the parameter buffer.
+    start: usize,
+    /// Its row length: a member's values, and its place where walked.
+    row: usize,
+    /// Where the hierarchy's nodes start in the parameter buffer (walked
+    /// groups only).
+    nodes: usize,
+}
+
 /// One operand of an instanced group: its node, its row of values, and
 /// the entries of the row that copy a dynamic parameter.
 pub(super) struct Member {
@@ -552,9 +608,10 @@ impl Mapper<Scalar, Vector, NodeId> for Renumber {
 pub(super) struct Cluster {
     pub(super) unions: Vec<NodeId>,
     pub(super) groups: Vec<Vars>,
-    /// Where only the distance is wanted (`DE`): the groups whose loops are
-    /// emitted after the union's other operands, from their minimum.
-    pub(super) pending: Vec<Vec<Member>>,
+    /// Where only the distance is wanted (`DE`): the groups, laid out,
+    /// whose loops are emitted after the union's other operands, from
+    /// their minimum.
+    pub(super) pending: Vec<Group>,
     /// The point the union is evaluated at.
     pub(super) p: String,
 }

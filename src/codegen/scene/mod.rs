@@ -261,6 +261,8 @@ impl<'a> SceneEmitter<'a> {
     /// Writes `DE` and `DE_shade`, and `DE_material` with `materials`.
     pub(crate) fn emit(&mut self, materials: bool) {
         let functions = [(false, false), (true, false), (true, true)];
+        #[cfg(debug_assertions)]
+        let mut first_layout: Option<Vec<f64>> = None;
         for (shade, material) in functions.into_iter().take(if materials { 3 } else { 2 }) {
             self.shade = shade;
             self.material = material;
@@ -298,6 +300,14 @@ impl<'a> SceneEmitter<'a> {
             self.w.line(format!("return {};", out.d));
             self.w.close();
             self.w.line("");
+            #[cfg(debug_assertions)]
+            match &first_layout {
+                Some(first) => debug_assert!(
+                    *first == self.constants,
+                    "every function lays out the same tables"
+                ),
+                None => first_layout = Some(self.constants.clone()),
+            }
         }
     }
 
