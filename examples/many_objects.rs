@@ -30,7 +30,7 @@ use std::process::Command;
 use std::time::Instant;
 
 use fractal_sdf::prelude::*;
-use fractal_sdf::render::{RenderOptions, Renderer};
+use fractal_sdf::render::{RenderFrames, RenderOptions, Renderer};
 use fractal_sdf::scene::{Param3, param3};
 
 const HEADER: &str = "| spheres | positions | compile | peak memory | 640×480 production frame | evaluations / pixel | set every position | fill the tables and refit |";
@@ -134,6 +134,43 @@ fn move_all(
     Ok(())
 }
 
+/// The median of three 640×480 frames (the 100,000 baked spheres' saved
+/// to `png`), and for dynamic positions the time to set every position and
+/// the time `refit` takes to fill the tables and fit the boxes again.
+fn frames_and_moves<R: RenderFrames>(
+    renderer: &mut R,
+    n: usize,
+    dynamic: bool,
+    png: &str,
+    refit: impl Fn(&R) -> usize,
+) -> fractal_sdf::Result<(f64, String, String)> {
+    let mut times = Vec::new();
+    for _ in 0..3 {
+        let t = Instant::now();
+        let image = renderer.render(640, 480)?;
+        times.push(ms(t));
+        if n == 100_000 && !dynamic {
+            std::fs::create_dir_all("out").ok();
+            fractal_sdf::output::save_png(&image, png)?;
+        }
+    }
+    times.sort_by(f64::total_cmp);
+    if !dynamic {
+        return Ok((times[1], "(a new program)".into(), String::new()));
+    }
+    let t = Instant::now();
+    move_all(n, |name, v| renderer.set_param(name, v))?;
+    let set = ms(t);
+    let t = Instant::now();
+    assert!(refit(renderer) > 0);
+    let refitted = ms(t);
+    Ok((
+        times[1],
+        format!("{set:.0} ms"),
+        format!("{refitted:.1} ms"),
+    ))
+}
+
 fn row(n: usize, dynamic: bool, wgpu: bool) -> fractal_sdf::Result<String> {
     if wgpu {
         return wgpu_row(n, dynamic);
@@ -151,29 +188,10 @@ fn row(n: usize, dynamic: bool, wgpu: bool) -> fractal_sdf::Result<String> {
     let frame = renderer.render_with_aovs(w, h)?;
     let evaluations: f64 =
         frame.evaluations.iter().map(|&e| f64::from(e)).sum::<f64>() / f64::from(w * h);
-    let mut times = Vec::new();
-    for _ in 0..3 {
-        let t = Instant::now();
-        let image = renderer.render(w, h)?;
-        times.push(ms(t));
-        if n == 100_000 && !dynamic {
-            std::fs::create_dir_all("out").ok();
-            fractal_sdf::output::save_png(&image, "out/many_objects.png")?;
-        }
-    }
-    times.sort_by(f64::total_cmp);
-    let (set, refit) = if dynamic {
-        let t = Instant::now();
-        move_all(n, |name, v| renderer.set_param(name, v))?;
-        let set = ms(t);
-        let t = Instant::now();
-        let buffer = renderer.source().param_buffer(renderer.values().as_slice());
-        let refit = ms(t);
-        assert!(!buffer.is_empty());
-        (format!("{set:.0} ms"), format!("{refit:.1} ms"))
-    } else {
-        ("(a new program)".into(), String::new())
-    };
+    let (frame, set, refit) =
+        frames_and_moves(&mut renderer, n, dynamic, "out/many_objects.png", |r| {
+            r.source().param_buffer(r.values().as_slice()).len()
+        })?;
     // Read before the layered frame's buffers add to it.
     let peak = common::peak_memory();
     let mut layered = renderer.render_layers(w, h)?;
@@ -184,7 +202,7 @@ fn row(n: usize, dynamic: bool, wgpu: bool) -> fractal_sdf::Result<String> {
         "| {n} | {} | {compile:.0} ms | {} | {:.0} ms | {evaluations:.1} | {set} | {refit} | {ids:.0} ms |",
         if dynamic { "dynamic" } else { "baked" },
         peak,
-        times[1],
+        frame,
     ))
 }
 
@@ -201,34 +219,18 @@ fn wgpu_row(n: usize, dynamic: bool) -> fractal_sdf::Result<String> {
     let compile = ms(t);
     let (w, h) = (640, 480);
     let evaluations = renderer.render_frame(w, h)?.evaluations_per_pixel();
-    let mut times = Vec::new();
-    for _ in 0..3 {
-        let t = Instant::now();
-        let image = renderer.render(w, h)?;
-        times.push(ms(t));
-        if n == 100_000 && !dynamic {
-            std::fs::create_dir_all("out").ok();
-            fractal_sdf::output::save_png(&image, "out/many_objects_wgpu.png")?;
-        }
-    }
-    times.sort_by(f64::total_cmp);
-    let (set, refit) = if dynamic {
-        let t = Instant::now();
-        move_all(n, |name, v| renderer.set_param(name, v))?;
-        let set = ms(t);
-        let t = Instant::now();
-        let buffer = renderer.source().param_buffer(renderer.values().as_slice());
-        let refit = ms(t);
-        assert!(!buffer.is_empty());
-        (format!("{set:.0} ms"), format!("{refit:.1} ms"))
-    } else {
-        ("(a new program)".into(), String::new())
-    };
+    let (frame, set, refit) = frames_and_moves(
+        &mut renderer,
+        n,
+        dynamic,
+        "out/many_objects_wgpu.png",
+        |r| r.source().param_buffer(r.values().as_slice()).len(),
+    )?;
     Ok(format!(
         "| {n} | {} | {compile:.0} ms | {} | {:.0} ms | {evaluations:.1} | {set} | {refit} |",
         if dynamic { "dynamic" } else { "baked" },
         common::peak_memory(),
-        times[1],
+        frame,
     ))
 }
 
