@@ -162,7 +162,10 @@ pub struct HybridStage<S = Param> {
 /// [`HYBRID_SAFETY`](crate::cpu::sdf::HYBRID_SAFETY) without a power
 /// and [`HYBRID_POWER_SAFETY`](crate::cpu::sdf::HYBRID_POWER_SAFETY) with
 /// one, each covering the classic hybrids and 400 random ones (see the
-/// [guide](crate::guide::fractals#hybrids)). A real
+/// [guide](crate::guide::fractals#hybrids)). With a power, the estimate
+/// is also at most what each power step's
+/// [reach](crate::cpu::sdf::HYBRID_POWER_REACH) allows, where an orbit
+/// passes close to the origin. A real
 /// (not integer) power's map is discontinuous across the half-plane
 /// `y = 0, x < 0`, where no estimate from a derivative holds. The trap is
 /// the orbit's smallest radius (at most 1).

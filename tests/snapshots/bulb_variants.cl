@@ -134,6 +134,7 @@ real2 hybrid_0(real3 p, real iterations, real bailout) {
     real ts0_3 = R(1.0);
     real ts0_4 = t8;
     real ts0_5 = t5;
+    real ts0_6 = R(1e18);
     int tn0 = (int)clamp(ceil(t7), R(0.0), R(1048576.0));
     for (int ti0 = 0; ti0 < tn0; ti0++) {
         real t9 = length(ts0_0);
@@ -159,17 +160,19 @@ real2 hybrid_0(real3 p, real iterations, real bailout) {
         real t29 = t25 ? fmin(t23 + R(1.0), R(1e30)) : t23;
         real t30 = fmin(ts0_4, t27);
         real t31 = (t28 || (t0 < t27)) ? R(1.0) : ts0_5;
+        real t32 = fmin(ts0_6, (t9 * R(4.0)) / fmax(ts0_3, R(1e-30)));
         ts0_0 = t26;
         ts0_3 = t29;
         ts0_4 = t30;
         ts0_5 = t31;
+        ts0_6 = t32;
         if (t28) {
             break;
         }
     }
-    real t32 = length(ts0_0);
-    real t33 = fmin(fmax(((R(0.5) * t32) * log(fmax(t32, R(1e-30)) / bailout)) / fmax(ts0_3, R(1e-30)), -R(1e18)), R(1e18));
-    return (real2)(t6 ? t2 : fmax(R(0.4) * ((R(0.5) < ts0_5) ? fmax(t33, R(1e-30)) : t33), t2), fmin(sqrt(ts0_4), R(1.0)));
+    real t33 = length(ts0_0);
+    real t34 = fmin(fmin(fmax(((R(0.5) * t33) * log(fmax(t33, R(1e-30)) / bailout)) / fmax(ts0_3, R(1e-30)), -R(1e18)), R(1e18)), ts0_6);
+    return (real2)(t6 ? t2 : fmax(R(0.4) * ((R(0.5) < ts0_5) ? fmax(t34, R(1e-30)) : t34), t2), fmin(sqrt(ts0_4), R(1.0)));
 }
 
 /* ---- hybrid_1 ---- */
@@ -187,6 +190,7 @@ real2 hybrid_1(real3 p, real iterations, real bailout) {
     real ts0_3 = R(1.0);
     real ts0_4 = t8;
     real ts0_5 = t5;
+    real ts0_6 = R(1e18);
     int tn0 = (int)clamp(ceil(t7), R(0.0), R(1048576.0));
     for (int ti0 = 0; ti0 < tn0; ti0++) {
         real t9 = R(2.0) * ts0_0.x;
@@ -205,17 +209,19 @@ real2 hybrid_1(real3 p, real iterations, real bailout) {
         real t22 = t18 ? fmin(t16 + R(1.0), R(1e30)) : t16;
         real t23 = fmin(ts0_4, t20);
         real t24 = (t21 || (t0 < t20)) ? R(1.0) : ts0_5;
+        real t25 = fmin(ts0_6, (length(ts0_0) * R(4.0)) / fmax(ts0_3, R(1e-30)));
         ts0_0 = t19;
         ts0_3 = t22;
         ts0_4 = t23;
         ts0_5 = t24;
+        ts0_6 = t25;
         if (t21) {
             break;
         }
     }
-    real t25 = length(ts0_0);
-    real t26 = fmin(fmax(((R(0.5) * t25) * log(fmax(t25, R(1e-30)) / bailout)) / fmax(ts0_3, R(1e-30)), -R(1e18)), R(1e18));
-    return (real2)(t6 ? t2 : fmax(R(0.4) * ((R(0.5) < ts0_5) ? fmax(t26, R(1e-30)) : t26), t2), fmin(sqrt(ts0_4), R(1.0)));
+    real t26 = length(ts0_0);
+    real t27 = fmin(fmin(fmax(((R(0.5) * t26) * log(fmax(t26, R(1e-30)) / bailout)) / fmax(ts0_3, R(1e-30)), -R(1e18)), R(1e18)), ts0_6);
+    return (real2)(t6 ? t2 : fmax(R(0.4) * ((R(0.5) < ts0_5) ? fmax(t27, R(1e-30)) : t27), t2), fmin(sqrt(ts0_4), R(1.0)));
 }
 
 /* ---- scene ---- */

@@ -40,7 +40,8 @@ pub(crate) use trap::TrapSlot;
 
 pub(crate) use hybrid::hybrid_integer_powers;
 pub use hybrid::{
-    HYBRID_FAR_FIELD, HYBRID_FOLLOW, HYBRID_POWER_SAFETY, HYBRID_SAFETY, hybrid, hybrid_estimate,
+    HYBRID_FAR_FIELD, HYBRID_FOLLOW, HYBRID_POWER_REACH, HYBRID_POWER_SAFETY, HYBRID_SAFETY,
+    hybrid, hybrid_estimate,
 };
 
 /// Exact distance to a sphere of radius `r` at the origin.
