@@ -674,21 +674,24 @@ fn every_shipped_scene_file_loads() {
     assert!(count > gallery::names().len(), "{count} scene files");
 }
 
-/// The one-formula scenes of the guide's cost table (`benches/formulas`)
-/// load and compile.
+/// The guide's benchmark scenes load and compile: the one-formula scenes
+/// of its cost table (`benches/formulas`) and the Mandelbox drawn from its
+/// estimate and by brute force (`benches/brute`).
 #[test]
-fn the_formula_benchmark_scenes_load() {
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("benches/formulas");
-    let mut count = 0;
-    for entry in std::fs::read_dir(&dir).unwrap() {
-        let path = entry.unwrap().path();
-        let file = SceneFile::load(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
-        file.scene
-            .compile()
-            .unwrap_or_else(|e| panic!("{}: {e}", path.display()));
-        count += 1;
+fn the_benchmark_scenes_load() {
+    for (folder, least) in [("benches/formulas", 13), ("benches/brute", 3)] {
+        let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join(folder);
+        let mut count = 0;
+        for entry in std::fs::read_dir(&dir).unwrap() {
+            let path = entry.unwrap().path();
+            let file = SceneFile::load(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+            file.scene
+                .compile()
+                .unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+            count += 1;
+        }
+        assert!(count >= least, "{count} scenes in {}", dir.display());
     }
-    assert!(count >= 13, "{count} scenes in {}", dir.display());
 }
 
 /// Keyframed tracks in a file: a parameter's keys and a path's optional
