@@ -37,18 +37,23 @@ pub const HYBRID_POWER_SAFETY: f64 = 0.4;
 /// `HYBRID_POWER_REACH · r / (n · dr)` over the orbit's power steps, with
 /// `r` the radius entering a step of power `n` and `dr` the running
 /// derivative there: a move of `p` by `d` moves the point entering the step
-/// by about `d · dr`, and `z^n` stretches a move `e` by up to `((r + e)^n −
-/// r^n) / e`, which is `((1 + x)^n − 1) / (n x)` times its derivative
-/// `n r^(n − 1)` with `x = e / r`: less than `e − 1` while `e ≤ r / n`,
-/// but growing like `exp(n x)` beyond. Where an orbit passes close to the origin
-/// before a power, the derivative taken there sees nothing of how fast the
-/// map bends around it, and the estimate could claim a ball that reaches
-/// the set (by 4 and 1.6 times in two of the first 100 hybrids of
-/// `examples/hybrid_survey`). The multiplier is measured: at 16 those two
-/// overestimate again, at 12 none of the first 100 does, and at 8 none of
-/// 300; the power-8 Mandelbulb written as a hybrid then takes 4.5% more
-/// evaluations a pixel (at 4, 32% more; at 1, where the stretch is
-/// provably within `e − 1` of the derivative, three times as many).
+/// by about `d · dr` (to first order). Along the radius, `z^n` stretches a
+/// move `δ` by `((r + δ)^n − r^n) / δ`, which is `((1 + x)^n − 1) / (n x)`
+/// times its derivative `n r^(n − 1)` with `x = δ / r`: at most `e − 1`
+/// times while `δ ≤ r / n`, but growing like `exp(n x)` beyond. Where an
+/// orbit passes close to the origin before a power, the derivative taken
+/// there sees nothing of how fast the map bends around it, and the
+/// estimate could claim a ball that reaches the set (by 4.0, 1.6, 2.67
+/// and 8.0 times in four of the first 300 hybrids of
+/// `examples/hybrid_survey`). The multiplier is measured: at 16 the first
+/// two of those overestimate again, at 12 none of the first 100 hybrids
+/// does, and at 8 none of 300; the power-8 Mandelbulb written as a hybrid
+/// then takes 4.5% more evaluations a pixel (at 4, 32% more; at 1, three
+/// times as many). An escaping orbit that meets the origin exactly has a
+/// reach of 0, so around such a point (isolated, where it exists) the
+/// estimate falls to 0 although the set is not there: a ray passing
+/// within the hit threshold of it stops on nothing, a speck of at most a
+/// pixel.
 pub const HYBRID_POWER_REACH: f64 = 8.0;
 
 /// Beyond this many times the bailout the estimate is the distance to the
@@ -237,6 +242,7 @@ fn azimuthal_stretch<T: Num>(z: V3<T>, r: T, direction: V3<T>, cap: T) -> T {
 /// of that iteration leaves it there, and the loop ends). With `r` the
 /// orbit's last radius and `dr` its running derivative, the estimate is
 /// `0.5 · r · ln(r / bailout) / dr` where an iteration raises to a power
+/// (and at most the power steps' reach, [`HYBRID_POWER_REACH`])
 /// and `(r − bailout) / dr` otherwise, times the hybrid's
 /// [`safety`](Hybrid::safety) ([`HYBRID_POWER_SAFETY`] or
 /// [`HYBRID_SAFETY`] where it has none), and at least the distance to the
