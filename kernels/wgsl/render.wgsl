@@ -417,6 +417,7 @@ fn march_shadow(ro: real3, rd: real3, max_t_in: real, eps: real, start: real, so
                 weight: real, evals: ptr<function, uint>) -> real {
     var visible = 1.0;
     var prev_h = 1e20;
+    var prev_step = 0.0; // from the previous sample to this one
     var t = start;
     var max_t = max_t_in;
     let faint = sqrt(0.5 / (255.0 * 3.0 * max(weight, REAL_TINY)));
@@ -456,9 +457,14 @@ fn march_shadow(ro: real3, rd: real3, max_t_in: real, eps: real, start: real, so
             return 0.0;
         }
         if (softness > 0.0) {
+            // Where the two distance spheres cross, if between the two
+            // samples (shade.cl's march_shadow says why).
             var y = 0.0;
             if (h < 2.0 * prev_h) {
                 y = h * h / (2.0 * prev_h);
+            }
+            if (y >= prev_step) {
+                y = 0.0;
             }
             let side = sqrt(max(h * h - y * y, 0.0));
             visible = min(visible, side / (softness * max(t - y, REAL_TINY)));
@@ -479,6 +485,7 @@ fn march_shadow(ro: real3, rd: real3, max_t_in: real, eps: real, start: real, so
             }
         }
         t += step;
+        prev_step = step;
     }
     visible = clamp(visible, 0.0, 1.0);
     return visible * visible * (3.0 - 2.0 * visible);

@@ -642,3 +642,63 @@ fn too_many_glow_nodes_are_refused() {
         "{err}"
     );
 }
+
+/// Regression: the improved soft-shadow estimate takes the point where the
+/// distance spheres of two shadow samples cross as the ray's nearest
+/// approach. Where a distance nearly doubles from one sample to the next
+/// (the ray heading almost straight away from the nearest surface) that
+/// point lies behind the earlier sample, off the stretch between them,
+/// and its tiny side distance darkened single floor pixels in rings around
+/// a shape. A soft shadow is smooth: no floor pixel's light is below all
+/// eight of its neighbours' by a tenth.
+#[test]
+fn a_soft_shadow_has_no_isolated_dark_pixels() {
+    let Some(_) = gpu::device() else { return };
+    let (w, h) = (320, 240);
+    let scene = fractal_sdf::gallery::hybrid();
+    let effects = Effects::default().ambient_occlusion(false);
+    let mut renderer =
+        Renderer::with_options(&scene, &gpu::options(gpu::quick(), effects)).unwrap();
+    let frame = renderer.render_layers(w, h).unwrap();
+    let shadow = &frame.layers.as_ref().expect("layers").shadow;
+    let floor = |i: usize| frame.hit[i] && frame.normal[i][1] > 0.999;
+    let (mut floor_pixels, mut isolated) = (0, Vec::new());
+    for y in 1..h as usize - 1 {
+        for x in 1..w as usize - 1 {
+            let i = y * w as usize + x;
+            let around: Vec<usize> = [
+                (-1, -1),
+                (0, -1),
+                (1, -1),
+                (-1, 0),
+                (1, 0),
+                (-1, 1),
+                (0, 1),
+                (1, 1),
+            ]
+            .iter()
+            .map(|&(dx, dy)| ((y as i64 + dy) as usize) * w as usize + (x as i64 + dx) as usize)
+            .collect();
+            if !floor(i) || !around.iter().all(|&j| floor(j)) {
+                continue;
+            }
+            floor_pixels += 1;
+            let least = around
+                .iter()
+                .map(|&j| shadow[j])
+                .fold(f32::INFINITY, f32::min);
+            if shadow[i] < least - 0.1 {
+                isolated.push((x, y, shadow[i], least));
+            }
+        }
+    }
+    eprintln!(
+        "{} isolated dark pixels of {floor_pixels} floor pixels",
+        isolated.len()
+    );
+    assert!(floor_pixels > 10_000, "{floor_pixels} floor pixels");
+    assert!(
+        isolated.is_empty(),
+        "isolated dark pixels (x, y, light, least around): {isolated:?}"
+    );
+}

@@ -404,6 +404,7 @@ real march_shadow(real3 ro, real3 rd, real max_t, real eps, real start, real sof
                   real weight, __global const real* params, uint* evals) {
     real visible = R(1.0);
     real prev_h = R(1e20);
+    real prev_step = R(0.0); // from the previous sample to this one
     real t = start;
     real faint = sqrt(R(0.5) / (R(255.0) * R(3.0) * fmax(weight, REAL_TINY)));
     real3 oc = ro - SCENE_BOUND_CENTRE;
@@ -425,11 +426,18 @@ real march_shadow(real3 ro, real3 rd, real max_t, real eps, real start, real sof
 
         if (softness > R(0.0)) {
             // The closest point to the surface between this sample and the
-            // previous one, estimated from the two distance spheres. They
-            // cross only if h < 2 prev_h, always true of an exact distance
-            // but not of every estimator (or after a minimum-length step);
-            // otherwise use this sample's own distance.
+            // previous one, estimated from the two distance spheres: where
+            // they cross, y back along the ray. They cross only if h < 2
+            // prev_h, always true of an exact distance but not of every
+            // estimator (or after a minimum-length step), and the crossing
+            // is between the two samples only if y < prev_step; a distance
+            // that nearly doubles (the ray heading almost straight away
+            // from the nearest surface) puts it behind the previous sample,
+            // whose own distance already counted there, with a side
+            // distance near 0 that would darken the pixel. Otherwise use
+            // this sample's own distance.
             real y = h < R(2.0) * prev_h ? h * h / (R(2.0) * prev_h) : R(0.0);
+            y = y < prev_step ? y : R(0.0);
             real side = sqrt(fmax(h * h - y * y, R(0.0)));
             visible = fmin(visible, side / (softness * fmax(t - y, REAL_TINY)));
             prev_h = h;
@@ -439,6 +447,7 @@ real march_shadow(real3 ro, real3 rd, real max_t, real eps, real start, real sof
         }
         real step = fmax(h, eps);
         t += step;
+        prev_step = step;
     }
     visible = clamp(visible, R(0.0), R(1.0));
     return visible * visible * (R(3.0) - R(2.0) * visible);
